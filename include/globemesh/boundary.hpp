@@ -1,0 +1,32 @@
+// globemesh/boundary.hpp: the closed boundary rings of the ocean on the sphere.
+//
+// Invariants of a Boundary handed to the mesher: every ring is closed (the last node connects
+// back to the first, which is not repeated), has at least 3 nodes, no two consecutive nodes are
+// equal or antipodal, rings are simple and do not cross each other on the sphere, and the ocean
+// lies on the LEFT of every ring when walked in node order, seen from outside the sphere.
+// Segment i joins nodes[i] to nodes[(i+1) % n] along the shorter great-circle arc and is tagged
+// coast (land on its right) or open (the edge of a user region, sea on both sides).
+// Standard library only.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "globemesh/sphere.hpp"
+
+namespace globemesh {
+
+enum class SegmentKind : std::uint8_t { coast = 1, open = 2 };
+
+struct Ring {
+    std::vector<Vec3> nodes;        ///< unit vectors, ocean on the left
+    std::vector<SegmentKind> kinds; ///< kinds[i] tags the segment nodes[i] -> nodes[i+1]
+};
+
+struct Boundary {
+    std::vector<Ring> rings;
+    /// True when no ring exists and the whole sphere is ocean (an aqua-planet).
+    bool empty() const { return rings.empty(); }
+};
+
+} // namespace globemesh

@@ -1,0 +1,158 @@
+// globemesh/delaunay.hpp: the (constrained) Delaunay triangulation of points on the sphere.
+//
+// What it is. The Delaunay triangulation of points on the unit sphere is the 3-D convex hull of
+// the points (CGAL manual, "2D Triangulations on the Sphere"). SphericalDelaunay keeps that hull
+// as a closed triangle surface: arrays of vertex and neighbour indices per triangle, no
+// allocation per triangle. Insertion is Bowyer-Watson: the triangles whose circumcircle holds the
+// new point (in hull terms: whose plane it lies beyond) are replaced by a fan around it.
+//
+// Solid and ghost triangles. A triangle abc is "solid" when det[a,b,c] > 0 (the origin is below
+// its plane, so it is a proper spherical triangle). When every point lies in one closed
+// hemisphere, the hull does not contain the origin and the triangles that close it on the far
+// side have det <= 0: these are "ghost" triangles (CGAL's ghost faces). Solid triangles cover the
+// spherical convex hull of the points; ghost triangles close the surface. Callers that want a
+// mesh of the sphere keep only solid triangles (triangulate) or label ghosts as outside (mesher).
+//
+// Invariants (validate() checks them all): every live triangle lists three distinct vertices,
+// counter-clockwise seen from outside the hull; neighbour links are symmetric; V - E + F = 2;
+// every unconstrained edge is locally Delaunay under predicates::in_circle; a constrained edge is
+// never flipped. The perturbed predicates make the triangulation unique for a point set without
+// constraints, whatever the insertion order.
+//
+// Precision contract. Predicates are exact on the stored doubles. Points closer than the merge
+// tolerance (default 1e-12 rad, 6 micrometres on the Earth) are merged and reported. Rounded unit
+// vectors lie up to ~1e-16 off the sphere, so a point within ~1e-8 rad of existing ones can fall
+// inside the hull of its neighbours; such a point is merged into its nearest vertex too (reported
+// the same way) rather than breaking the structure.
+//
+// Edge convention: edge i of triangle t joins vertex(t, i+1) to vertex(t, i+2) (indices mod 3),
+// opposite vertex(t, i). A half-edge is encoded as 3*t + i. Standard library only.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "globemesh/sphere.hpp"
+
+namespace globemesh {
+
+using VertexId = std::uint32_t;
+using TriangleId = std::uint32_t;
+using HalfEdge = std::uint32_t;
+inline constexpr VertexId no_vertex = 0xffffffffu;
+inline constexpr TriangleId no_triangle = 0xffffffffu;
+inline constexpr HalfEdge no_half_edge = 0xffffffffu;
+
+inline constexpr TriangleId triangle_of(HalfEdge h) { return h / 3; }
+inline constexpr int edge_of(HalfEdge h) { return static_cast<int>(h % 3); }
+inline constexpr HalfEdge half_edge(TriangleId t, int i) { return 3 * t + static_cast<HalfEdge>(i); }
+
+class SphericalDelaunay {
+public:
+    struct Options {
+        double merge_tolerance_rad = 1e-12; ///< points closer than this are merged
+        std::uint64_t seed = 1;             ///< seed of the BRIO rounds (insertion order only)
+    };
+
+    SphericalDelaunay() = default;
+    explicit SphericalDelaunay(Options options) : options_(options) {}
+
+    /// Inserts points in a cache-friendly order (BRIO rounds, each sorted along a Hilbert curve
+    /// on the cube faces). Returns, for each input point, the vertex it became or was merged into.
+    /// On an empty triangulation, needs four points not on one plane: throws DataError
+    /// ("fewer than 3 distinct points", "all points on one circle") otherwise.
+    std::vector<VertexId> insert_points(std::span<const Vec3> points);
+
+    /// Inserts one point, starting the walk at `hint` (any live triangle, or no_triangle).
+    /// Returns its vertex, or the vertex it was merged into (then merged_count() grows).
+    /// The cavity never crosses a constrained edge. Triangles created inherit the cavity's label.
+    VertexId insert(const Vec3& p, TriangleId hint = no_triangle);
+
+    /// Inserts p into the edge h (constrained or not) and keeps both halves constrained when h
+    /// was. p should lie on or very near the edge's arc (e.g. its midpoint). Returns the vertex.
+    VertexId split_edge(HalfEdge h, const Vec3& p);
+
+    /// Makes a-b an edge of the triangulation and constrains it, by flipping the edges that cross
+    /// the arc a-b (never inserting points). When a vertex lies exactly on the arc, the
+    /// constraint is split there. Returns false (and changes nothing) when an existing constrained
+    /// edge crosses the arc.
+    bool insert_constraint(VertexId a, VertexId b);
+
+    /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
+    /// Returns false and leaves v where it was when the move would fold a triangle of its star.
+    bool move_vertex(VertexId v, const Vec3& p);
+
+    /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
+    void flip(HalfEdge h);
+
+    /// Flips unconstrained non-Delaunay edges until none remains (Lawson). Returns the flips made.
+    std::size_t make_delaunay();
+
+    /// A live triangle whose spherical cone contains p, or that p is beyond (for points outside
+    /// the solid region). Walks from `hint`.
+    TriangleId locate(const Vec3& p, TriangleId hint = no_triangle) const;
+
+    // --- access ---
+    std::size_t vertex_count() const { return points_.size(); }
+    std::size_t triangle_slots() const { return tri_vertices_.size() / 3; }
+    std::size_t triangle_count() const { return triangle_slots() - free_.size(); }
+    std::size_t merged_count() const { return merged_; }
+    bool is_live(TriangleId t) const { return tri_vertices_[3 * t] != no_vertex; }
+    const Vec3& point(VertexId v) const { return points_[v]; }
+    const std::vector<Vec3>& points() const { return points_; }
+    VertexId vertex(TriangleId t, int i) const { return tri_vertices_[3 * t + i]; }
+    /// The half-edge on the other side of h.
+    HalfEdge twin(HalfEdge h) const { return links_[h] & link_mask; }
+    TriangleId neighbour(TriangleId t, int i) const { return triangle_of(twin(half_edge(t, i))); }
+    bool is_constrained(HalfEdge h) const { return (links_[h] & constrained_bit) != 0; }
+    void set_constrained(HalfEdge h, bool on);
+    /// det[a,b,c] > 0 for the triangle's vertices (see "Solid and ghost triangles").
+    bool is_solid(TriangleId t) const;
+    /// A free byte per triangle for the caller (the mesher stores ocean/land in it).
+    std::uint8_t label(TriangleId t) const { return labels_[t]; }
+    void set_label(TriangleId t, std::uint8_t l) { labels_[t] = l; }
+    /// The last triangle created (a good walk hint).
+    TriangleId last_triangle() const { return last_; }
+    /// Origin and destination of half-edge h.
+    VertexId origin(HalfEdge h) const { return vertex(triangle_of(h), (edge_of(h) + 1) % 3); }
+    VertexId destination(HalfEdge h) const { return vertex(triangle_of(h), (edge_of(h) + 2) % 3); }
+    /// A half-edge leaving v (origin(h) == v) for every vertex; no_half_edge for merged-away ones.
+    std::vector<HalfEdge> vertex_half_edges() const;
+    /// The half-edge from a to b, searching the star of a from `from` (a half-edge leaving a);
+    /// no_half_edge when a-b is not an edge.
+    HalfEdge find_edge(HalfEdge from, VertexId b) const;
+
+    /// Every broken invariant, in words; empty when the triangulation is valid.
+    std::vector<std::string> validate() const;
+
+private:
+    static constexpr std::uint32_t constrained_bit = 0x80000000u;
+    static constexpr std::uint32_t link_mask = 0x7fffffffu;
+
+    void link(HalfEdge a, HalfEdge b);
+    TriangleId new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label);
+    void free_triangle(TriangleId t);
+    void initial_tetrahedron(std::span<const Vec3> points, std::span<const std::uint32_t> order,
+                             std::vector<VertexId>& vertex_of);
+    bool visible(TriangleId t, const Vec3& p) const;
+    VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
+    bool legalize_from(std::vector<HalfEdge>& stack);
+
+    Options options_;
+    std::vector<Vec3> points_;
+    std::vector<VertexId> tri_vertices_; // 3 per triangle slot; no_vertex marks a free slot
+    std::vector<std::uint32_t> links_;   // 3 per slot: twin half-edge | constrained_bit
+    std::vector<std::uint8_t> labels_;
+    std::vector<TriangleId> free_;
+    std::size_t merged_ = 0;
+    TriangleId last_ = no_triangle;
+    // scratch buffers reused across insertions (no allocation per insertion)
+    std::vector<TriangleId> cavity_;
+    std::vector<HalfEdge> cavity_boundary_;
+    mutable std::vector<TriangleId> search_;
+    mutable std::vector<std::uint8_t> mark_;
+};
+
+} // namespace globemesh

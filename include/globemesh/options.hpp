@@ -1,0 +1,57 @@
+// globemesh/options.hpp: every user choice of a meshing run, with its default.
+//
+// MeshOptions is a plain aggregate (GDAL's GDALTranslateOptions, JIGSAW's jigsaw_jig_t): the CLI
+// binds its flags straight to these fields and config files use the same names, so this struct
+// is the single source of defaults. Lengths are in km, areas in km2, angles in degrees.
+// validate() checks the values alone (no file is opened) and throws UsageError naming the option.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace globemesh {
+
+struct MeshOptions {
+    // --- coastline (coast/) ---
+    std::string coast;       ///< --coast: any OGR vector source of land polygons or coast lines
+    std::string coast_layer; ///< --coast-layer: layer name; default the only polygon/line layer
+    std::string coast_where; ///< --coast-where: OGR SQL attribute filter; default none
+    std::string coast_srs;   ///< --coast-srs: CRS of a layer that declares none (e.g. EPSG:4326)
+    /// --region W,S,E,N in degrees; W > E crosses +-180. Default: the whole globe.
+    std::optional<std::array<double, 4>> region;
+    std::string region_file; ///< --region-file: polygons (any OGR source, any CRS) bounding the ocean
+    double min_island_area_km2 = 0; ///< --min-island-area: drop islands and lakes smaller (km2)
+    /// Islands whose area is below this many equilateral triangles of the local size are dropped.
+    double min_island_triangles = 4;
+    bool keep_inland_seas = false; ///< --keep-inland-seas: keep water bodies not connected to the ocean
+
+    // --- bathymetry (bathymetry/) ---
+    std::string bathy;             ///< --bathy: any GDAL raster of elevation (or depth)
+    int bathy_band = 1;            ///< --bathy-band: 1-based band number
+    bool depth_positive = false;   ///< --depth-positive: the raster stores depth positive down
+    std::optional<double> bathy_fill_m; ///< --bathy-fill: depth (m) where the raster has no data
+
+    // --- size field (sizefield/), km ---
+    double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh
+    double hmin_km = 0.0;       ///< --hmin: smallest edge length (km); 0 means hmax/20... set by validate
+    double coast_size_km = 0.0; ///< --coast-size: edge length at the coast (km); 0 = off
+    double coast_rate = 0.1;    ///< --coast-rate: growth of h with distance from the coast (km/km)
+    double wavelength = 0.0;    ///< --wavelength: points per wavelength of the tide; 0 = off
+    double wave_period_h = 12.42; ///< --wave-period: period of that wave (hours; M2 by default)
+    double slope = 0.0;         ///< --slope: points per topographic length scale; 0 = off
+    std::string size_regions;   ///< --size-regions: polygons with a "size_km" attribute
+    double grade = 0.15;        ///< --grade: largest |grad h| (km/km)
+
+    // --- mesher (mesher/) ---
+    std::uint64_t max_nodes = 20'000'000; ///< --max-nodes: refuse runs estimated larger
+    int smooth_iterations = 4;            ///< --smooth: smoothing/relaxation sweeps
+    std::uint64_t seed = 1;               ///< --seed: seed of every pseudo-random choice
+};
+
+/// Checks option values alone (ranges, hmin <= hmax, region bounds); throws UsageError naming
+/// the option. Opens no file.
+void validate(const MeshOptions& options);
+
+} // namespace globemesh

@@ -1,0 +1,30 @@
+// globemesh/progress.hpp: progress reporting and cancellation, as GDAL's GDALProgressFunc.
+//
+// A Progress is called with a fraction in [0, 1] and a short stage name; returning false asks the
+// library to stop, which it does by throwing globemesh::Cancelled at the next check. An empty
+// Progress reports nothing.
+#pragma once
+
+#include <functional>
+#include <string_view>
+
+#include "globemesh/error.hpp"
+
+namespace globemesh {
+
+using Progress = std::function<bool(double fraction, std::string_view stage)>;
+
+/// A Progress that maps [0, 1] of a sub-stage onto [lo, hi] of the parent (GDAL's scaled progress).
+inline Progress sub_progress(const Progress& parent, double lo, double hi) {
+    if (!parent) return {};
+    return [parent, lo, hi](double f, std::string_view stage) {
+        return parent(lo + (hi - lo) * f, stage);
+    };
+}
+
+/// Reports f to p (when set) and throws Cancelled when the callback asks to stop.
+inline void report(const Progress& p, double f, std::string_view stage) {
+    if (p && !p(f, stage)) throw Cancelled();
+}
+
+} // namespace globemesh

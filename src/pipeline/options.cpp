@@ -1,0 +1,49 @@
+#include <cmath>
+#include <string>
+
+#include "globemesh/error.hpp"
+#include "globemesh/options.hpp"
+
+namespace globemesh {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+    if (!ok) throw UsageError(message);
+}
+
+bool positive(double v) { return std::isfinite(v) && v > 0; }
+
+} // namespace
+
+void validate(const MeshOptions& o) {
+    require(positive(o.hmax_km), "--hmax must be a positive length, e.g. 100km");
+    require(std::isfinite(o.hmin_km) && o.hmin_km >= 0, "--hmin must be a positive length, e.g. 10km");
+    require(o.hmin_km <= o.hmax_km, "--hmin (" + std::to_string(o.hmin_km) +
+                                        " km) must not be larger than --hmax (" +
+                                        std::to_string(o.hmax_km) + " km)");
+    require(std::isfinite(o.coast_size_km) && o.coast_size_km >= 0,
+            "--coast-size must be a positive length, e.g. 20km");
+    require(std::isfinite(o.coast_rate) && o.coast_rate >= 0, "--coast-rate must be >= 0");
+    require(std::isfinite(o.wavelength) && o.wavelength >= 0, "--wavelength must be >= 0 (points per wavelength)");
+    require(positive(o.wave_period_h), "--wave-period must be a positive number of hours");
+    require(std::isfinite(o.slope) && o.slope >= 0, "--slope must be >= 0 (points per length scale)");
+    require(positive(o.grade) && o.grade < 10, "--grade must be in (0, 10)");
+    require(std::isfinite(o.min_island_area_km2) && o.min_island_area_km2 >= 0,
+            "--min-island-area must be a positive area, e.g. 100km2");
+    require(o.bathy_band >= 1, "--bathy-band must be 1 or more");
+    require(o.max_nodes >= 3, "--max-nodes must be at least 3");
+    require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000, "--smooth must be in 0..1000");
+    if (o.region) {
+        const auto& r = *o.region;
+        for (double v : r) require(std::isfinite(v), "--region values must be numbers: W,S,E,N in degrees");
+        require(r[0] >= -180 && r[0] <= 180 && r[2] >= -180 && r[2] <= 180,
+                "--region longitudes must be in [-180, 180]");
+        require(r[1] >= -90 && r[3] <= 90 && r[1] < r[3],
+                "--region needs -90 <= S < N <= 90 (W,S,E,N in degrees)");
+        require(r[0] != r[2], "--region W and E must differ (W > E crosses +-180)");
+    }
+    require(!(o.region && !o.region_file.empty()), "--region and --region-file cannot be used together");
+}
+
+} // namespace globemesh

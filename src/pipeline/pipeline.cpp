@@ -1,0 +1,1 @@
+#include "globemesh/pipeline.hpp"
