@@ -1,0 +1,35 @@
+// globemesh/gpkg.hpp: GeoPackage output (OGR) and the PNG preview (GDAL rasterization).
+//
+// write_gpkg writes layers a QGIS user opens and styles at once: faces (cut at +-180, pole
+// corners split), nodes, boundary (tagged lines), mesh_info, and a default style for faces in
+// layer_styles. One feature per face. Written to a temporary name and renamed at the end.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "globemesh/mesh.hpp"
+
+namespace globemesh {
+
+struct GpkgOptions {
+    bool overwrite = false; ///< replace an existing file; otherwise an existing output is an IoError
+};
+
+/// Writes the mesh as a GeoPackage. Throws IoError and leaves no partial or temporary file.
+void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options = {});
+
+struct PreviewOptions {
+    std::string land;                 ///< optional OGR land polygons drawn under the mesh
+    std::string colour_by = "quality"; ///< "quality" or "depth"
+    int width_px = 1600;
+    std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N; default the mesh extent or globe
+    bool overwrite = false;
+};
+
+/// Draws faces coloured by quality or depth over the land, with GDAL's rasterizer and PNG driver.
+void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, const PreviewOptions& options = {});
+
+} // namespace globemesh
