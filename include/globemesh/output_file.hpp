@@ -1,0 +1,47 @@
+// globemesh/output_file.hpp: safe writing of one output file (temporary name, rename at the end).
+//
+// An OutputFile reserves a hidden temporary name beside the target (same folder, so the final
+// rename is atomic on POSIX file systems). The writer writes to temp_path() and calls commit(),
+// which moves the file to the target. If commit() is never reached (an exception, a cancelled
+// run), the destructor removes the temporary file and any sidecar files named after it
+// (temp + ".aux.xml", "-journal", "-wal", "-shm"), so a failure leaves neither a partial output nor
+// a temporary file. An existing target is refused (IoError) unless overwrite is set; without
+// overwrite the final step is link()+unlink(), which never replaces a file that appeared meanwhile.
+// A process killed by SIGKILL cannot clean up: then only the hidden temporary file remains, never
+// a partial target.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace globemesh {
+
+class OutputFile {
+public:
+    /// Checks that the target can be written (folder exists, target absent unless overwrite) and
+    /// picks a temporary name. `what` names the output in messages (e.g. "UGRID output").
+    /// Throws IoError naming the path and what to do.
+    OutputFile(std::filesystem::path target, bool overwrite, std::string what = "output");
+    ~OutputFile();
+    OutputFile(const OutputFile&) = delete;
+    OutputFile& operator=(const OutputFile&) = delete;
+
+    /// Where the writer writes; the file does not exist yet when the OutputFile is made.
+    const std::filesystem::path& temp_path() const { return temp_; }
+    const std::filesystem::path& target() const { return target_; }
+
+    /// Moves the finished temporary file to the target. Throws IoError (target appeared without
+    /// overwrite, rename failed); the temporary file is then still removed by the destructor.
+    void commit();
+
+    /// Writes `text` to the target safely in one go (for small reports such as JSON).
+    static void write_text(const std::filesystem::path& target, const std::string& text, bool overwrite);
+
+private:
+    std::filesystem::path target_, temp_;
+    bool overwrite_;
+    std::string what_;
+    bool committed_ = false;
+};
+
+} // namespace globemesh

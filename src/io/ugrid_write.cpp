@@ -1,0 +1,341 @@
+// UGRID 1.0 NetCDF writer: see globemesh/ugrid.hpp.
+//
+// Layout (names are fixed so tools and tests can rely on them): dimensions nMesh_node,
+// nMesh_face, nMesh_edge, nMesh_boundary (only when the mesh has a boundary), Two, Three; the
+// topology variable "mesh"; coordinates mesh_{node,face,edge}_{lon,lat}; connectivities
+// mesh_face_nodes, mesh_edge_nodes, mesh_face_edges, mesh_face_links, mesh_edge_face_links,
+// mesh_boundary_nodes, all 0-based with start_index written; "crs" for CF and MDAL. Nothing in
+// the file depends on the clock: the only date is the caller's history string.
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/PolygonArea.hpp>
+
+#include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/ugrid.hpp"
+#include "mesh_topology.hpp"
+#include "netcdf_handle.hpp"
+
+#ifndef GLOBEMESH_VERSION
+#define GLOBEMESH_VERSION "unknown"
+#endif
+
+namespace globemesh {
+
+namespace {
+
+constexpr const char* wgs84_wkt =
+    "GEOGCRS[\"WGS 84\",DATUM[\"World Geodetic System 1984\",ELLIPSOID[\"WGS 84\",6378137,298.257223563,"
+    "LENGTHUNIT[\"metre\",1]]],PRIMEM[\"Greenwich\",0,ANGLEUNIT[\"degree\",0.0174532925199433]],"
+    "CS[ellipsoidal,2],AXIS[\"geodetic latitude (Lat)\",north,ORDER[1],ANGLEUNIT[\"degree\",0.0174532925199433]],"
+    "AXIS[\"geodetic longitude (Lon)\",east,ORDER[2],ANGLEUNIT[\"degree\",0.0174532925199433]],"
+    "ID[\"EPSG\",4326]]";
+
+/// Writes the variables of one file; every call checks its status.
+class UgridWriter {
+public:
+    UgridWriter(int id, const std::filesystem::path& file, bool compress)
+        : id_(id), file_(file), compress_(compress) {}
+
+    int dim(const char* name, std::size_t len) {
+        int d;
+        io::nc_check(nc_def_dim(id_, name, len, &d), file_, std::string("defining dimension ") + name);
+        return d;
+    }
+    int var(const char* name, nc_type type, std::vector<int> dims) {
+        int v;
+        io::nc_check(nc_def_var(id_, name, type, int(dims.size()), dims.data(), &v), file_,
+                     std::string("defining variable ") + name);
+        if (compress_ && !dims.empty())
+            io::nc_check(nc_def_var_deflate(id_, v, 1, 1, 4), file_, std::string("compressing ") + name);
+        return v;
+    }
+    void text(int v, const char* name, const std::string& value) {
+        io::nc_check(nc_put_att_text(id_, v, name, value.size(), value.c_str()), file_,
+                     std::string("writing attribute ") + name);
+    }
+    void ints(int v, const char* name, std::vector<int> values) {
+        io::nc_check(nc_put_att_int(id_, v, name, NC_INT, values.size(), values.data()), file_,
+                     std::string("writing attribute ") + name);
+    }
+    void dbl(int v, const char* name, double value) {
+        io::nc_check(nc_put_att_double(id_, v, name, NC_DOUBLE, 1, &value), file_,
+                     std::string("writing attribute ") + name);
+    }
+    bool has_att(int v, const char* name) const { return nc_inq_attid(id_, v, name, nullptr) == NC_NOERR; }
+    void put(int v, const std::vector<double>& data, const char* name) {
+        io::nc_check(nc_put_var_double(id_, v, data.data()), file_, std::string("writing ") + name);
+    }
+    template <std::size_t N>
+    void put(int v, const std::vector<std::array<std::int32_t, N>>& data, const char* name) {
+        static_assert(sizeof(std::array<std::int32_t, N>) == N * sizeof(std::int32_t));
+        io::nc_check(nc_put_var_int(id_, v, data.empty() ? nullptr : data.front().data()), file_,
+                     std::string("writing ") + name);
+    }
+    void put(int v, const std::vector<int>& data, const char* name) {
+        io::nc_check(nc_put_var_int(id_, v, data.data()), file_, std::string("writing ") + name);
+    }
+
+private:
+    int id_;
+    const std::filesystem::path& file_;
+    bool compress_;
+};
+
+/// A netCDF attribute name from a free-form key (letters, digits, underscore).
+std::string attribute_name(const std::string& key) {
+    std::string s;
+    for (char c : key) s += (std::isalnum(static_cast<unsigned char>(c)) || c == '_') ? c : '_';
+    if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) s.insert(0, "a_");
+    return s;
+}
+
+void lonlat_of(const std::vector<Vec3>& points, std::vector<double>& lon, std::vector<double>& lat) {
+    lon.resize(points.size());
+    lat.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        LonLat p = vec_to_lonlat(points[i]);
+        lon[i] = p.lon, lat[i] = p.lat;
+    }
+}
+
+/// Geodesic area of each face on the WGS84 ellipsoid, m2 (GeographicLib PolygonArea).
+std::vector<double> geodesic_areas(const Mesh& mesh, const std::vector<double>& lon, const std::vector<double>& lat) {
+    std::vector<double> area(mesh.faces.size());
+    GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        poly.Clear();
+        for (auto v : mesh.faces[f]) poly.AddPoint(lat[v], lon[v]);
+        double perimeter = 0, a = 0;
+        poly.Compute(false, true, perimeter, a);
+        area[f] = std::fabs(a);
+    }
+    return area;
+}
+
+void field_attributes(UgridWriter& w, int v, const Field& f, const char* location, const char* coords) {
+    w.text(v, "mesh", "mesh");
+    w.text(v, "location", location);
+    w.text(v, "coordinates", coords);
+    w.text(v, "grid_mapping", "crs");
+    std::string standard = f.standard_name;
+    std::string units = f.units;
+    if (f.name == "depth") {
+        if (standard.empty()) standard = "sea_floor_depth_below_geoid";
+        if (units.empty()) units = std::string(1, 'm');
+        w.text(v, "positive", "down");
+    }
+    if (f.name == "target_size" && units.empty()) units = "km";
+    w.text(v, "long_name", f.long_name.empty() ? f.name : f.long_name);
+    if (!standard.empty()) w.text(v, "standard_name", standard);
+    if (!units.empty()) w.text(v, "units", units);
+}
+
+} // namespace
+
+void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const UgridOptions& options) {
+    for (const auto& f : mesh.node_fields)
+        if (f.values.size() != mesh.nodes.size())
+            throw DataError("mesh: node field " + f.name + " has " + std::to_string(f.values.size()) +
+                            " values for " + std::to_string(mesh.nodes.size()) + " nodes");
+    for (const auto& f : mesh.face_fields)
+        if (f.values.size() != mesh.faces.size())
+            throw DataError("mesh: face field " + f.name + " has " + std::to_string(f.values.size()) +
+                            " values for " + std::to_string(mesh.faces.size()) + " faces");
+    if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
+
+    OutputFile out(path, options.overwrite, "UGRID output");
+    const io::MeshTopology topo = io::build_topology(mesh);
+    const MeshStats stats = io::compute_stats(mesh, topo);
+    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_nodes.size(),
+                      nb = topo.boundary_edges.size();
+
+    // Values computed before the file is opened, so a failure here leaves nothing to clean up.
+    std::vector<double> node_lon, node_lat, face_lon, face_lat, edge_lon, edge_lat;
+    lonlat_of(mesh.nodes, node_lon, node_lat);
+    std::vector<Vec3> centres(nf), midpoints(ne);
+    std::vector<double> quality(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+        const Vec3 &a = mesh.nodes[mesh.faces[f][0]], &b = mesh.nodes[mesh.faces[f][1]], &c = mesh.nodes[mesh.faces[f][2]];
+        centres[f] = normalized(a + b + c);
+        quality[f] = triangle_quality(a, b, c);
+    }
+    for (std::size_t e = 0; e < ne; ++e)
+        midpoints[e] = arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
+    lonlat_of(centres, face_lon, face_lat);
+    lonlat_of(midpoints, edge_lon, edge_lat);
+    std::vector<double> area = geodesic_areas(mesh, node_lon, node_lat);
+    std::vector<std::array<std::int32_t, 2>> boundary_nodes(nb);
+    for (std::size_t i = 0; i < nb; ++i) boundary_nodes[i] = topo.edge_nodes[topo.boundary_edges[i]];
+
+    io::NcHandle nc;
+    const int mode = options.classic ? (NC_NOCLOBBER | NC_64BIT_OFFSET) : (NC_NOCLOBBER | NC_NETCDF4);
+    io::nc_check(nc_create(out.temp_path().c_str(), mode, nc.out()), path, "creating the file", "UGRID output");
+    int old_fill;
+    nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
+    UgridWriter w(nc.id(), path, !options.classic);
+
+    const int d_node = w.dim("nMesh_node", nn), d_face = w.dim("nMesh_face", nf), d_edge = w.dim("nMesh_edge", ne);
+    const int d_two = w.dim("Two", 2), d_three = w.dim("Three", 3);
+    const int d_bnd = nb ? w.dim("nMesh_boundary", nb) : -1;
+
+    // CRS, read by CF tools (grid_mapping_name, crs_wkt) and by MDAL (EPSG_code, epsg).
+    int crs = w.var("crs", NC_INT, {});
+    w.text(crs, "grid_mapping_name", "latitude_longitude");
+    w.dbl(crs, "longitude_of_prime_meridian", 0.0);
+    w.dbl(crs, "semi_major_axis", 6378137.0);
+    w.dbl(crs, "inverse_flattening", 298.257223563);
+    w.text(crs, "crs_wkt", wgs84_wkt);
+    w.text(crs, "wkt", wgs84_wkt);
+    w.ints(crs, "epsg", {4326});
+    w.text(crs, "EPSG_code", "EPSG:4326");
+
+    int topo_var = w.var("mesh", NC_INT, {});
+    w.text(topo_var, "cf_role", "mesh_topology");
+    w.text(topo_var, "long_name", "Topology of the 2-D unstructured ocean mesh");
+    w.ints(topo_var, "topology_dimension", {2});
+    w.text(topo_var, "node_coordinates", "mesh_node_lon mesh_node_lat");
+    w.text(topo_var, "face_coordinates", "mesh_face_lon mesh_face_lat");
+    w.text(topo_var, "edge_coordinates", "mesh_edge_lon mesh_edge_lat");
+    w.text(topo_var, "face_node_connectivity", "mesh_face_nodes");
+    w.text(topo_var, "edge_node_connectivity", "mesh_edge_nodes");
+    w.text(topo_var, "face_edge_connectivity", "mesh_face_edges");
+    w.text(topo_var, "face_face_connectivity", "mesh_face_links");
+    w.text(topo_var, "edge_face_connectivity", "mesh_edge_face_links");
+    if (nb) w.text(topo_var, "boundary_node_connectivity", "mesh_boundary_nodes");
+    w.text(topo_var, "face_dimension", "nMesh_face");
+    w.text(topo_var, "edge_dimension", "nMesh_edge");
+
+    struct Coord { const char* name; int dim; bool lon; const char* what; };
+    const Coord coords[] = {{"mesh_node_lon", d_node, true, "node"}, {"mesh_node_lat", d_node, false, "node"},
+                            {"mesh_face_lon", d_face, true, "face centre"}, {"mesh_face_lat", d_face, false, "face centre"},
+                            {"mesh_edge_lon", d_edge, true, "edge midpoint"}, {"mesh_edge_lat", d_edge, false, "edge midpoint"}};
+    int coord_vars[6];
+    for (int i = 0; i < 6; ++i) {
+        const Coord& c = coords[i];
+        int v = coord_vars[i] = w.var(c.name, NC_DOUBLE, {c.dim});
+        w.text(v, "standard_name", c.lon ? "longitude" : "latitude");
+        w.text(v, "long_name", std::string(c.lon ? "longitude of " : "latitude of ") + c.what);
+        w.text(v, "units", c.lon ? "degrees_east" : "degrees_north");
+        w.text(v, "grid_mapping", "crs");
+    }
+
+    auto connectivity = [&](const char* name, const char* role, int d_elem, int d_cols, const char* long_name, bool fill) {
+        int v = w.var(name, NC_INT, {d_elem, d_cols});
+        w.text(v, "cf_role", role);
+        w.text(v, "long_name", long_name);
+        w.ints(v, "start_index", {0});
+        if (fill) w.ints(v, "_FillValue", {-1});
+        return v;
+    };
+    int v_face_nodes = connectivity("mesh_face_nodes", "face_node_connectivity", d_face, d_three,
+                                    "nodes of each face, counter-clockwise", false);
+    int v_edge_nodes = connectivity("mesh_edge_nodes", "edge_node_connectivity", d_edge, d_two,
+                                    "nodes of each edge", false);
+    int v_face_edges = connectivity("mesh_face_edges", "face_edge_connectivity", d_face, d_three,
+                                    "edges of each face (edge k joins nodes k and k+1)", false);
+    int v_face_links = connectivity("mesh_face_links", "face_face_connectivity", d_face, d_three,
+                                    "neighbour faces of each face", true);
+    int v_edge_faces = connectivity("mesh_edge_face_links", "edge_face_connectivity", d_edge, d_two,
+                                    "faces on each side of each edge", true);
+    int v_bnd = nb ? connectivity("mesh_boundary_nodes", "boundary_node_connectivity", d_bnd, d_two,
+                                  "nodes of each boundary edge, mesh on the left", false)
+                   : -1;
+
+    const char* node_coords = "mesh_node_lon mesh_node_lat";
+    const char* face_coords = "mesh_face_lon mesh_face_lat";
+    std::vector<int> node_vars, face_vars;
+    // Variable names in use; a field whose name is taken gets a "_node"/"_face" suffix.
+    std::set<std::string> used = {"crs", "mesh", "quality", "area", "boundary_tag", "mesh_node_lon",
+                                  "mesh_node_lat", "mesh_face_lon", "mesh_face_lat", "mesh_edge_lon",
+                                  "mesh_edge_lat", "mesh_face_nodes", "mesh_edge_nodes", "mesh_face_edges",
+                                  "mesh_face_links", "mesh_edge_face_links", "mesh_boundary_nodes"};
+    auto var_name = [&used](const std::string& name, const char* suffix) {
+        std::string n = attribute_name(name);
+        while (used.count(n)) n += suffix;
+        used.insert(n);
+        return n;
+    };
+    for (const auto& f : mesh.node_fields) {
+        node_vars.push_back(w.var(var_name(f.name, "_node").c_str(), NC_DOUBLE, {d_node}));
+        field_attributes(w, node_vars.back(), f, "node", node_coords);
+    }
+    Field q_field{"quality", "quality (2*sqrt(3)*inradius/longest edge)", "1", "", {}};
+    Field a_field{"area", "face area (geodesic, WGS84)", "m2", "cell_area", {}};
+    int v_quality = w.var("quality", NC_DOUBLE, {d_face});
+    field_attributes(w, v_quality, q_field, "face", face_coords);
+    w.text(v_quality, "comment", "shape quality of the chordal triangle: 1 equilateral, 0 degenerate");
+    int v_area = w.var("area", NC_DOUBLE, {d_face});
+    field_attributes(w, v_area, a_field, "face", face_coords);
+    std::vector<const Field*> extra_face_fields;
+    for (const auto& f : mesh.face_fields) {
+        if (f.name == "quality" || f.name == "area") continue; // recomputed above
+        extra_face_fields.push_back(&f);
+        face_vars.push_back(w.var(var_name(f.name, "_face").c_str(), NC_DOUBLE, {d_face}));
+        field_attributes(w, face_vars.back(), f, "face", face_coords);
+    }
+    int v_tag = w.var("boundary_tag", NC_INT, {d_edge});
+    w.text(v_tag, "mesh", "mesh");
+    w.text(v_tag, "location", "edge");
+    w.text(v_tag, "coordinates", "mesh_edge_lon mesh_edge_lat");
+    w.text(v_tag, "long_name", "boundary tag of each edge");
+    w.ints(v_tag, "flag_values", {0, 1, 2});
+    w.text(v_tag, "flag_meanings", "interior coast open");
+
+    // Global attributes: conventions, provenance, the mesh's run metadata, summary statistics.
+    w.text(NC_GLOBAL, "Conventions", "CF-1.8 UGRID-1.0");
+    w.text(NC_GLOBAL, "title", options.title);
+    w.text(NC_GLOBAL, "source", std::string("globemesh ") + GLOBEMESH_VERSION);
+    if (!options.history.empty()) w.text(NC_GLOBAL, "history", options.history);
+    for (const auto& [key, value] : mesh.attributes) {
+        std::string name = attribute_name(key);
+        if (!w.has_att(NC_GLOBAL, name.c_str())) w.text(NC_GLOBAL, name.c_str(), value);
+    }
+    w.ints(NC_GLOBAL, "node_count", {int(nn)});
+    w.ints(NC_GLOBAL, "face_count", {int(nf)});
+    w.ints(NC_GLOBAL, "edge_count", {int(ne)});
+    w.ints(NC_GLOBAL, "boundary_edge_count", {int(nb)});
+    w.ints(NC_GLOBAL, "boundary_loop_count", {int(stats.boundary_loops)});
+    w.dbl(NC_GLOBAL, "quality_min", stats.quality_min);
+    w.dbl(NC_GLOBAL, "quality_mean", stats.quality_mean);
+    w.dbl(NC_GLOBAL, "quality_fraction_above_0_8", stats.quality_above_0_8);
+    w.dbl(NC_GLOBAL, "edge_length_km_min", stats.edge_km_min);
+    w.dbl(NC_GLOBAL, "edge_length_km_mean", stats.edge_km_mean);
+    w.dbl(NC_GLOBAL, "edge_length_km_max", stats.edge_km_max);
+    w.dbl(NC_GLOBAL, "area_km2", stats.area_km2);
+
+    io::nc_check(nc_enddef(nc.id()), path, "leaving define mode", "UGRID output");
+
+    w.put(coord_vars[0], node_lon, "node longitudes");
+    w.put(coord_vars[1], node_lat, "node latitudes");
+    {
+        std::vector<std::array<std::int32_t, 3>> faces(nf);
+        for (std::size_t f = 0; f < nf; ++f)
+            for (int k = 0; k < 3; ++k) faces[f][k] = std::int32_t(mesh.faces[f][k]);
+        w.put(v_face_nodes, faces, "face nodes");
+    }
+    if (options.after_partial_write) options.after_partial_write();
+    w.put(coord_vars[2], face_lon, "face longitudes");
+    w.put(coord_vars[3], face_lat, "face latitudes");
+    w.put(coord_vars[4], edge_lon, "edge longitudes");
+    w.put(coord_vars[5], edge_lat, "edge latitudes");
+    w.put(v_edge_nodes, topo.edge_nodes, "edge nodes");
+    w.put(v_face_edges, topo.face_edges, "face edges");
+    w.put(v_face_links, topo.face_faces, "face neighbours");
+    w.put(v_edge_faces, topo.edge_faces, "edge faces");
+    if (nb) w.put(v_bnd, boundary_nodes, "boundary nodes");
+    for (std::size_t i = 0; i < node_vars.size(); ++i) w.put(node_vars[i], mesh.node_fields[i].values, mesh.node_fields[i].name.c_str());
+    w.put(v_quality, quality, "quality");
+    w.put(v_area, area, "area");
+    for (std::size_t i = 0; i < face_vars.size(); ++i) w.put(face_vars[i], extra_face_fields[i]->values, extra_face_fields[i]->name.c_str());
+    w.put(v_tag, topo.edge_tags, "boundary tags");
+    nc.close(path, "UGRID output");
+    out.commit();
+}
+
+} // namespace globemesh

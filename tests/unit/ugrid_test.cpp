@@ -1,0 +1,400 @@
+// UGRID writer, reader and statistics. Oracles: Euler's formula, 4*pi*R^2, GeographicLib's
+// ellipsoid area, the netCDF-C API reading the file back, and ../shared/tools/mesh-verify.
+#include <gtest/gtest.h>
+
+#include <netcdf.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <GeographicLib/Geodesic.hpp>
+
+#include <fstream>
+#include <iterator>
+
+#include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/ugrid.hpp"
+#include "io_test_meshes.hpp"
+#include "support.hpp"
+
+using namespace globemesh;
+using namespace globemesh::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> folder_listing(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string file_bytes(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), {}};
+}
+
+std::string text_att(int nc, int var, const char* name) {
+    std::size_t len = 0;
+    if (nc_inq_attlen(nc, var, name, &len) != NC_NOERR) return "<missing>";
+    std::string s(len, '\0');
+    nc_get_att_text(nc, var, name, s.data());
+    return s;
+}
+
+void expect_same_stats(const MeshStats& a, const MeshStats& b) {
+    EXPECT_EQ(a.nodes, b.nodes);
+    EXPECT_EQ(a.faces, b.faces);
+    EXPECT_EQ(a.edges, b.edges);
+    EXPECT_EQ(a.boundary_edges, b.boundary_edges);
+    EXPECT_EQ(a.boundary_loops, b.boundary_loops);
+    EXPECT_NEAR(a.quality_min, b.quality_min, 1e-12);
+    EXPECT_NEAR(a.quality_mean, b.quality_mean, 1e-12);
+    EXPECT_EQ(a.quality_histogram, b.quality_histogram);
+    EXPECT_NEAR(a.edge_km_min, b.edge_km_min, 1e-6);
+    EXPECT_NEAR(a.edge_km_max, b.edge_km_max, 1e-6);
+    EXPECT_NEAR(a.area_km2, b.area_km2, 1e-6 * a.area_km2);
+    EXPECT_NEAR(a.lon_min, b.lon_min, 1e-9);
+    EXPECT_NEAR(a.lat_max, b.lat_max, 1e-9);
+    EXPECT_EQ(a.has_size, b.has_size);
+    EXPECT_NEAR(a.size_ratio_median, b.size_ratio_median, 1e-9);
+    EXPECT_NEAR(a.size_ratio_in_range, b.size_ratio_in_range, 1e-12);
+}
+
+/// Writes a small UGRID file the way another tool might, with the netCDF-C API directly.
+void write_foreign(const fs::path& path, const Mesh& m, bool transposed, int start, bool four_columns) {
+    int nc, d_node, d_face, d_col, vx, vy, vf, topo;
+    ASSERT_EQ(nc_create(path.c_str(), NC_CLOBBER, &nc), NC_NOERR);
+    nc_def_dim(nc, "nodes", m.nodes.size(), &d_node);
+    nc_def_dim(nc, "cells", m.faces.size(), &d_face);
+    const int cols = four_columns ? 4 : 3;
+    nc_def_dim(nc, "corners", cols, &d_col);
+    nc_def_var(nc, "Mesh2", NC_INT, 0, nullptr, &topo);
+    auto text = [&](int v, const char* n, const std::string& s) { nc_put_att_text(nc, v, n, s.size(), s.c_str()); };
+    text(topo, "cf_role", "mesh_topology");
+    int two = 2;
+    nc_put_att_int(nc, topo, "topology_dimension", NC_INT, 1, &two);
+    text(topo, "node_coordinates", "Mesh2_node_x Mesh2_node_y");
+    text(topo, "face_node_connectivity", "Mesh2_face_nodes");
+    text(topo, "face_dimension", "cells");
+    nc_def_var(nc, "Mesh2_node_x", NC_DOUBLE, 1, &d_node, &vx);
+    nc_def_var(nc, "Mesh2_node_y", NC_DOUBLE, 1, &d_node, &vy);
+    text(vx, "standard_name", "longitude"), text(vx, "units", "degrees_east");
+    text(vy, "standard_name", "latitude"), text(vy, "units", "degrees_north");
+    int dims[2] = {d_face, d_col};
+    if (transposed) std::swap(dims[0], dims[1]);
+    nc_def_var(nc, "Mesh2_face_nodes", NC_INT, 2, dims, &vf);
+    text(vf, "cf_role", "face_node_connectivity");
+    nc_put_att_int(nc, vf, "start_index", NC_INT, 1, &start);
+    int fill = -999;
+    if (four_columns) nc_put_att_int(nc, vf, "_FillValue", NC_INT, 1, &fill);
+    int vd;
+    nc_def_var(nc, "bathymetry", NC_FLOAT, 1, &d_node, &vd);
+    text(vd, "mesh", "Mesh2"), text(vd, "location", "node"), text(vd, "units", "m");
+    nc_enddef(nc);
+    std::vector<double> x, y;
+    std::vector<float> depth;
+    for (const auto& v : m.nodes) {
+        LonLat p = vec_to_lonlat(v);
+        x.push_back(p.lon + 360.0 * (p.lon < 0)); // another tool may use [0, 360)
+        y.push_back(p.lat);
+        depth.push_back(float(100.0 * (1.0 + v.z)));
+    }
+    nc_put_var_double(nc, vx, x.data());
+    nc_put_var_double(nc, vy, y.data());
+    nc_put_var_float(nc, vd, depth.data());
+    std::vector<int> conn(m.faces.size() * cols);
+    for (std::size_t f = 0; f < m.faces.size(); ++f)
+        for (int k = 0; k < cols; ++k) {
+            int value = k < 3 ? int(m.faces[f][k]) + start : fill;
+            if (transposed) conn[k * m.faces.size() + f] = value;
+            else conn[f * cols + k] = value;
+        }
+    nc_put_var_int(nc, vf, conn.data());
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+}
+
+} // namespace
+
+TEST(Ugrid, closed_icosphere_passes_mesh_verify_and_round_trips_its_statistics) {
+    TempDir dir;
+    Mesh m = icosphere(3);
+    add_fields(m);
+    write_ugrid(m, dir / "ico.nc");
+    expect_mesh_verify(dir / "ico.nc", "--size-var target_size");
+
+    MeshStats s = compute_stats(m);
+    EXPECT_EQ(s.faces, 1280u);
+    EXPECT_EQ(s.nodes, 642u);
+    EXPECT_EQ(s.edges, 1920u);
+    EXPECT_EQ(long(s.nodes) - long(s.edges) + long(s.faces), 2); // Euler, closed sphere
+    EXPECT_EQ(s.boundary_edges, 0u);
+    EXPECT_EQ(s.boundary_loops, 0u);
+    EXPECT_NEAR(s.area_km2, 4 * pi * earth_radius_km * earth_radius_km, 1e-9 * s.area_km2);
+    EXPECT_TRUE(s.has_size);
+
+    Mesh back = read_ugrid(dir / "ico.nc");
+    ASSERT_EQ(back.nodes.size(), m.nodes.size());
+    for (std::size_t i = 0; i < m.nodes.size(); ++i) EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-14);
+    EXPECT_EQ(back.faces, m.faces);
+    ASSERT_NE(back.node_field("depth"), nullptr);
+    EXPECT_EQ(back.node_field("depth")->values, m.node_field("depth")->values);
+    EXPECT_EQ(back.node_field("depth")->standard_name, "sea_floor_depth_below_geoid");
+    ASSERT_NE(back.face_field("quality"), nullptr);
+    expect_same_stats(compute_stats(back), s);
+}
+
+TEST(Ugrid, mesh_with_holes_keeps_tagged_boundary_loops_and_passes_mesh_verify) {
+    TempDir dir;
+    Mesh m = icosphere_with_holes(3);
+    ASSERT_FALSE(m.boundary.empty());
+    write_ugrid(m, dir / "holes.nc");
+    expect_mesh_verify(dir / "holes.nc");
+    MeshStats s = compute_stats(m);
+    EXPECT_EQ(s.boundary_loops, 3u);
+    EXPECT_EQ(s.boundary_edges, m.boundary.size());
+    EXPECT_EQ(long(s.nodes) - long(s.edges) + long(s.faces), 2 - 3); // sphere with three holes
+
+    Mesh back = read_ugrid(dir / "holes.nc");
+    expect_same_stats(compute_stats(back), s);
+    auto sorted = [](std::vector<BoundaryEdge> b) {
+        std::vector<std::tuple<NodeIndex, NodeIndex, int>> t;
+        for (auto e : b) t.emplace_back(e.a, e.b, int(e.tag));
+        std::sort(t.begin(), t.end());
+        return t;
+    };
+    EXPECT_EQ(sorted(back.boundary), sorted(m.boundary)); // same edges, orientation and tags
+    int open = 0;
+    for (auto e : back.boundary) open += e.tag == EdgeTag::open;
+    EXPECT_GT(open, 0);
+    EXPECT_LT(open, int(back.boundary.size()));
+}
+
+TEST(Ugrid, antimeridian_cap_passes_mesh_verify_with_longitudes_in_range) {
+    TempDir dir;
+    Mesh m = icosphere_cap(4, 180, 0, 30);
+    write_ugrid(m, dir / "pacific.nc");
+    expect_mesh_verify(dir / "pacific.nc", "--size-var target_size");
+    int nc, v;
+    ASSERT_EQ(nc_open((dir / "pacific.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    for (const char* name : {"mesh_node_lon", "mesh_face_lon", "mesh_edge_lon"}) {
+        ASSERT_EQ(nc_inq_varid(nc, name, &v), NC_NOERR);
+        std::size_t n;
+        int dim;
+        nc_inq_vardimid(nc, v, &dim);
+        nc_inq_dimlen(nc, dim, &n);
+        std::vector<double> lon(n);
+        nc_get_var_double(nc, v, lon.data());
+        for (double x : lon) {
+            EXPECT_GE(x, -180.0) << name;
+            EXPECT_LT(x, 180.0) << name;
+        }
+        EXPECT_LT(*std::min_element(lon.begin(), lon.end()), -150.0);
+        EXPECT_GT(*std::max_element(lon.begin(), lon.end()), 150.0);
+    }
+    nc_close(nc);
+}
+
+TEST(Ugrid, file_carries_every_connectivity_start_index_crs_and_only_int_float_double_data) {
+    TempDir dir;
+    Mesh m = icosphere_with_holes(2);
+    m.attributes = {{"coast_file", "land.gpkg"}, {"min size km", "10"}};
+    UgridOptions o;
+    o.history = "globemesh mesh --coast land.gpkg -o x.nc (2024-01-01)";
+    write_ugrid(m, dir / "m.nc", o);
+    int nc, topo, crs, lon;
+    ASSERT_EQ(nc_open((dir / "m.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    int format;
+    nc_inq_format(nc, &format);
+    EXPECT_EQ(format, NC_FORMAT_NETCDF4);
+    ASSERT_EQ(nc_inq_varid(nc, "mesh", &topo), NC_NOERR);
+    EXPECT_EQ(text_att(nc, topo, "cf_role"), "mesh_topology");
+    EXPECT_EQ(text_att(nc, topo, "node_coordinates"), "mesh_node_lon mesh_node_lat");
+    for (const char* role : {"face_node_connectivity", "edge_node_connectivity", "face_edge_connectivity",
+                             "face_face_connectivity", "edge_face_connectivity", "boundary_node_connectivity"}) {
+        std::string name = text_att(nc, topo, role);
+        int v;
+        ASSERT_EQ(nc_inq_varid(nc, name.c_str(), &v), NC_NOERR) << role;
+        EXPECT_EQ(text_att(nc, v, "cf_role"), role);
+        int start = -7;
+        EXPECT_EQ(nc_get_att_int(nc, v, "start_index", &start), NC_NOERR) << role;
+        EXPECT_EQ(start, 0);
+    }
+    ASSERT_EQ(nc_inq_varid(nc, "mesh_node_lon", &lon), NC_NOERR);
+    EXPECT_EQ(text_att(nc, lon, "grid_mapping"), "crs");
+    ASSERT_EQ(nc_inq_varid(nc, "crs", &crs), NC_NOERR);
+    EXPECT_EQ(text_att(nc, crs, "EPSG_code"), "EPSG:4326");
+    EXPECT_EQ(text_att(nc, crs, "grid_mapping_name"), "latitude_longitude");
+    int epsg = 0;
+    nc_get_att_int(nc, crs, "epsg", &epsg);
+    EXPECT_EQ(epsg, 4326);
+    EXPECT_EQ(text_att(nc, NC_GLOBAL, "Conventions"), "CF-1.8 UGRID-1.0");
+    EXPECT_EQ(text_att(nc, NC_GLOBAL, "history"), o.history);
+    EXPECT_EQ(text_att(nc, NC_GLOBAL, "coast_file"), "land.gpkg");
+    EXPECT_EQ(text_att(nc, NC_GLOBAL, "min_size_km"), "10");
+    EXPECT_NE(text_att(nc, NC_GLOBAL, "source").find("globemesh"), std::string::npos);
+    int faces = 0;
+    nc_get_att_int(nc, NC_GLOBAL, "face_count", &faces);
+    EXPECT_EQ(std::size_t(faces), m.faces.size());
+    int nvars;
+    nc_inq_nvars(nc, &nvars);
+    int data_vars = 0;
+    for (int v = 0; v < nvars; ++v) {
+        nc_type t;
+        nc_inq_vartype(nc, v, &t);
+        EXPECT_TRUE(t == NC_INT || t == NC_FLOAT || t == NC_DOUBLE) << "variable " << v << " type " << t;
+        if (text_att(nc, v, "mesh") == "mesh") ++data_vars;
+    }
+    EXPECT_EQ(data_vars, 5); // depth, target_size, quality, area, boundary_tag
+    int tag;
+    ASSERT_EQ(nc_inq_varid(nc, "boundary_tag", &tag), NC_NOERR);
+    EXPECT_EQ(text_att(nc, tag, "flag_meanings"), "interior coast open");
+    EXPECT_EQ(text_att(nc, tag, "location"), "edge");
+    nc_close(nc);
+}
+
+TEST(Ugrid, face_areas_are_geodesic_and_tile_the_wgs84_ellipsoid) {
+    TempDir dir;
+    write_ugrid(icosphere(3), dir / "ico.nc");
+    int nc, v, dim;
+    ASSERT_EQ(nc_open((dir / "ico.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "area", &v), NC_NOERR);
+    EXPECT_EQ(text_att(nc, v, "units"), "m2");
+    nc_inq_vardimid(nc, v, &dim);
+    std::size_t n;
+    nc_inq_dimlen(nc, dim, &n);
+    std::vector<double> area(n);
+    nc_get_var_double(nc, v, area.data());
+    nc_close(nc);
+    double total = 0;
+    for (double a : area) total += a;
+    EXPECT_NEAR(total, GeographicLib::Geodesic::WGS84().EllipsoidArea(), 1e-8 * total);
+}
+
+TEST(Ugrid, same_mesh_gives_identical_bytes) {
+    TempDir dir;
+    Mesh m = icosphere_with_holes(2);
+    write_ugrid(m, dir / "a.nc");
+    write_ugrid(m, dir / "b.nc");
+    EXPECT_EQ(file_bytes(dir / "a.nc"), file_bytes(dir / "b.nc"));
+    UgridOptions classic;
+    classic.classic = true;
+    write_ugrid(m, dir / "c.nc", classic);
+    write_ugrid(m, dir / "d.nc", classic);
+    EXPECT_EQ(file_bytes(dir / "c.nc"), file_bytes(dir / "d.nc"));
+}
+
+TEST(Ugrid, classic_format_is_netcdf3_and_reads_back_the_same) {
+    TempDir dir;
+    Mesh m = icosphere_with_holes(2);
+    UgridOptions o;
+    o.classic = true;
+    write_ugrid(m, dir / "c.nc", o);
+    int nc, format;
+    ASSERT_EQ(nc_open((dir / "c.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    nc_inq_format(nc, &format);
+    nc_close(nc);
+    EXPECT_TRUE(format == NC_FORMAT_CLASSIC || format == NC_FORMAT_64BIT_OFFSET);
+    expect_mesh_verify(dir / "c.nc");
+    expect_same_stats(compute_stats(read_ugrid(dir / "c.nc")), compute_stats(m));
+}
+
+TEST(Ugrid, reads_one_based_four_column_file_with_fill_value_from_another_tool) {
+    TempDir dir;
+    Mesh m = icosphere(2);
+    write_foreign(dir / "other.nc", m, false, 1, true);
+    expect_mesh_verify(dir / "other.nc");
+    Mesh back = read_ugrid(dir / "other.nc");
+    EXPECT_EQ(back.faces, m.faces);
+    ASSERT_EQ(back.nodes.size(), m.nodes.size());
+    for (std::size_t i = 0; i < m.nodes.size(); ++i) EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-13);
+    ASSERT_NE(back.node_field("bathymetry"), nullptr);
+    expect_same_stats(compute_stats(back), compute_stats(m));
+}
+
+TEST(Ugrid, reads_transposed_connectivity_named_by_face_dimension) {
+    TempDir dir;
+    Mesh m = icosphere(2);
+    write_foreign(dir / "t.nc", m, true, 0, false);
+    expect_mesh_verify(dir / "t.nc");
+    EXPECT_EQ(read_ugrid(dir / "t.nc").faces, m.faces);
+}
+
+TEST(Ugrid, out_of_range_index_and_non_ugrid_files_are_errors_not_read) {
+    TempDir dir;
+    Mesh m = icosphere(1);
+    m.nodes.pop_back(); // the faces now reference a node that is not in the file
+    write_foreign(dir / "bad.nc", m, false, 1, false);
+    try {
+        read_ugrid(dir / "bad.nc");
+        FAIL() << "no DataError";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("outside [1, 41]"), std::string::npos) << e.what();
+    }
+    std::ofstream(dir / "text.nc") << "not netcdf";
+    EXPECT_THROW(read_ugrid(dir / "text.nc"), IoError);
+    EXPECT_THROW(read_ugrid(dir / "missing.nc"), IoError);
+}
+
+TEST(Ugrid, existing_output_is_refused_without_overwrite_and_replaced_with_it) {
+    TempDir dir;
+    std::ofstream(dir / "out.nc") << "keep me";
+    EXPECT_THROW(write_ugrid(icosphere(1), dir / "out.nc"), IoError);
+    EXPECT_EQ(file_bytes(dir / "out.nc"), "keep me");
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"out.nc"});
+    UgridOptions o;
+    o.overwrite = true;
+    write_ugrid(icosphere(1), dir / "out.nc", o);
+    EXPECT_EQ(read_ugrid(dir / "out.nc").faces.size(), 80u);
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"out.nc"});
+}
+
+TEST(Ugrid, unwritable_or_missing_folder_is_an_io_error_and_leaves_nothing) {
+    TempDir dir;
+    EXPECT_THROW(write_ugrid(icosphere(1), dir / "no/such/folder/out.nc"), IoError);
+    fs::create_directory(dir / "ro");
+    fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    if (::geteuid() != 0) {
+        EXPECT_THROW(write_ugrid(icosphere(1), dir / "ro/out.nc"), IoError);
+        EXPECT_TRUE(folder_listing(dir / "ro").empty());
+    } else {
+        // root ignores permission bits: /proc refuses new files whatever the user.
+        EXPECT_THROW(write_ugrid(icosphere(1), "/proc/globemesh-io-test.nc"), IoError);
+        EXPECT_FALSE(fs::exists("/proc/globemesh-io-test.nc"));
+    }
+    fs::permissions(dir / "ro", fs::perms::owner_all);
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"ro"});
+}
+
+TEST(Ugrid, run_cancelled_during_writing_leaves_no_partial_or_temporary_file) {
+    TempDir dir;
+    UgridOptions o;
+    bool hook_ran = false;
+    o.after_partial_write = [&] {
+        hook_ran = true;
+        EXPECT_EQ(folder_listing(dir.path()).size(), 1u); // the temporary file, being written
+        EXPECT_FALSE(fs::exists(dir / "out.nc"));
+        throw Cancelled();
+    };
+    EXPECT_THROW(write_ugrid(icosphere(2), dir / "out.nc", o), Cancelled);
+    EXPECT_TRUE(hook_ran);
+    EXPECT_TRUE(folder_listing(dir.path()).empty());
+    o.classic = true;
+    EXPECT_THROW(write_ugrid(icosphere(2), dir / "out.nc", o), Cancelled);
+    EXPECT_TRUE(folder_listing(dir.path()).empty());
+}
+
+TEST(OutputFile, write_text_is_atomic_and_refuses_existing_files) {
+    TempDir dir;
+    OutputFile::write_text(dir / "r.json", "{}\n", false);
+    EXPECT_EQ(file_bytes(dir / "r.json"), "{}\n");
+    EXPECT_THROW(OutputFile::write_text(dir / "r.json", "x", false), IoError);
+    OutputFile::write_text(dir / "r.json", "[]\n", true);
+    EXPECT_EQ(file_bytes(dir / "r.json"), "[]\n");
+    {
+        OutputFile abandoned(dir / "never.txt", false);
+        std::ofstream(abandoned.temp_path()) << "partial";
+    }
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"r.json"});
+}
