@@ -7,6 +7,7 @@
 
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -16,6 +17,8 @@ namespace globemesh {
 
 struct GpkgOptions {
     bool overwrite = false; ///< replace an existing file; otherwise an existing output is an IoError
+    /// Test hook: called once after the faces are written, before the rename.
+    std::function<void()> after_partial_write;
 };
 
 /// Writes the mesh as a GeoPackage. Throws IoError and leaves no partial or temporary file.
@@ -27,6 +30,8 @@ struct PreviewOptions {
     int width_px = 1600;
     std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N; default the mesh extent or globe
     bool overwrite = false;
+    /// Test hook: called once after the picture is drawn, before it is written and renamed.
+    std::function<void()> after_partial_write;
 };
 
 /// Draws faces coloured by quality or depth over the land, with GDAL's rasterizer and PNG driver.

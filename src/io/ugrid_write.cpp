@@ -12,12 +12,10 @@
 #include <string>
 #include <vector>
 
-#include <GeographicLib/Geodesic.hpp>
-#include <GeographicLib/PolygonArea.hpp>
-
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "face_geometry.hpp"
 #include "mesh_topology.hpp"
 #include "netcdf_handle.hpp"
 
@@ -104,20 +102,6 @@ void lonlat_of(const std::vector<Vec3>& points, std::vector<double>& lon, std::v
     }
 }
 
-/// Geodesic area of each face on the WGS84 ellipsoid, m2 (GeographicLib PolygonArea).
-std::vector<double> geodesic_areas(const Mesh& mesh, const std::vector<double>& lon, const std::vector<double>& lat) {
-    std::vector<double> area(mesh.faces.size());
-    GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-        poly.Clear();
-        for (auto v : mesh.faces[f]) poly.AddPoint(lat[v], lon[v]);
-        double perimeter = 0, a = 0;
-        poly.Compute(false, true, perimeter, a);
-        area[f] = std::fabs(a);
-    }
-    return area;
-}
-
 void field_attributes(UgridWriter& w, int v, const Field& f, const char* location, const char* coords) {
     w.text(v, "mesh", "mesh");
     w.text(v, "location", location);
@@ -169,7 +153,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         midpoints[e] = arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
     lonlat_of(centres, face_lon, face_lat);
     lonlat_of(midpoints, edge_lon, edge_lat);
-    std::vector<double> area = geodesic_areas(mesh, node_lon, node_lat);
+    std::vector<double> area = io::geodesic_face_areas_m2(mesh);
     std::vector<std::array<std::int32_t, 2>> boundary_nodes(nb);
     for (std::size_t i = 0; i < nb; ++i) boundary_nodes[i] = topo.edge_nodes[topo.boundary_edges[i]];
 

@@ -1,0 +1,323 @@
+// GeoPackage writer (OGR GPKG driver): see globemesh/gpkg.hpp.
+//
+// Layers: faces (MultiPolygon, one feature per face, FID = face index + 1, cut at +-180 and with
+// pole corners split, see face_geometry.hpp), nodes (Point, every node field), boundary (runs of
+// equally tagged boundary edges as MultiLineString), mesh_info (key/value attributes), and
+// layer_styles (QGIS's own table) holding a graduated-by-quality default style for faces.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include <ogrsf_frmts.h>
+
+#include "face_geometry.hpp"
+#include "gdal_util.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/gpkg.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/ugrid.hpp"
+#include "mesh_topology.hpp"
+
+#ifndef GLOBEMESH_VERSION
+#define GLOBEMESH_VERSION "unknown"
+#endif
+
+namespace globemesh {
+
+namespace {
+
+struct QualityClass {
+    double lower, upper;
+    const char* colour; ///< "r,g,b,a" as QGIS writes colours
+    const char* label;
+};
+constexpr QualityClass quality_classes[] = {
+    {0.0, 0.3, "215,25,28,255", "poor (< 0.3)"},        {0.3, 0.5, "253,174,97,255", "0.3 - 0.5"},
+    {0.5, 0.7, "255,255,191,255", "0.5 - 0.7"},          {0.7, 0.9, "166,217,106,255", "0.7 - 0.9"},
+    {0.9, 1.000001, "26,150,65,255", "good (>= 0.9)"}};
+
+/// A QGIS 3 graduated renderer on "quality" (the style QGIS itself writes, trimmed to symbology).
+std::string faces_style_qml() {
+    std::ostringstream q;
+    q << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+      << "<qgis version=\"3.22.16-Białowieża\" styleCategories=\"Symbology\">\n"
+      << " <renderer-v2 type=\"graduatedSymbol\" attr=\"quality\" graduatedMethod=\"GraduatedColor\" "
+         "symbollevels=\"0\" enableorderby=\"0\" forceraster=\"0\">\n  <ranges>\n";
+    int i = 0;
+    for (const auto& c : quality_classes)
+        q << "   <range render=\"true\" symbol=\"" << i++ << "\" lower=\"" << c.lower << "\" upper=\"" << c.upper
+          << "\" label=\"" << c.label << "\"/>\n";
+    q << "  </ranges>\n  <symbols>\n";
+    i = 0;
+    for (const auto& c : quality_classes)
+        q << "   <symbol type=\"fill\" name=\"" << i++ << "\" alpha=\"1\" clip_to_extent=\"1\" force_rhr=\"0\">\n"
+          << "    <layer class=\"SimpleFill\" enabled=\"1\" pass=\"0\" locked=\"0\">\n"
+          << "     <Option type=\"Map\">\n"
+          << "      <Option type=\"QString\" name=\"color\" value=\"" << c.colour << "\"/>\n"
+          << "      <Option type=\"QString\" name=\"joinstyle\" value=\"bevel\"/>\n"
+          << "      <Option type=\"QString\" name=\"outline_color\" value=\"60,60,60,255\"/>\n"
+          << "      <Option type=\"QString\" name=\"outline_style\" value=\"solid\"/>\n"
+          << "      <Option type=\"QString\" name=\"outline_width\" value=\"0.06\"/>\n"
+          << "      <Option type=\"QString\" name=\"outline_width_unit\" value=\"MM\"/>\n"
+          << "      <Option type=\"QString\" name=\"style\" value=\"solid\"/>\n"
+          << "     </Option>\n    </layer>\n   </symbol>\n";
+    q << "  </symbols>\n  <classificationMethod id=\"Pretty\">\n   <symmetricMode enabled=\"0\" "
+         "symmetrypoint=\"0\" astride=\"0\"/>\n   <labelFormat format=\"%1 - %2\" trimtrailingzeroes=\"1\" "
+         "labelprecision=\"2\"/>\n  </classificationMethod>\n  <rotation/>\n  <sizescale/>\n"
+      << " </renderer-v2>\n <blendMode>0</blendMode>\n <featureBlendMode>0</featureBlendMode>\n"
+      << " <layerGeometryType>2</layerGeometryType>\n</qgis>\n";
+    return q.str();
+}
+
+class GpkgWriter {
+public:
+    GpkgWriter(GDALDataset* ds, const std::filesystem::path& path) : ds_(ds), path_(path) {
+        srs_.importFromEPSG(4326);
+        srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    }
+    [[noreturn]] void fail(const std::string& step) const {
+        throw IoError("GeoPackage output " + path_.string() + ": " + step + ": " + io::last_gdal_error());
+    }
+    OGRLayer* layer(const char* name, OGRwkbGeometryType type, const char* description, const char* fid = "FID=fid") {
+        const char* options[] = {fid, nullptr, nullptr};
+        std::string desc = std::string("DESCRIPTION=") + description;
+        options[1] = desc.c_str();
+        OGRLayer* l = ds_->CreateLayer(name, type == wkbNone ? nullptr : &srs_, type, const_cast<char**>(options));
+        if (!l) fail(std::string("creating layer ") + name);
+        return l;
+    }
+    void field(OGRLayer* l, const char* name, OGRFieldType type, const char* default_value = nullptr) {
+        OGRFieldDefn f(name, type);
+        if (default_value) f.SetDefault(default_value);
+        if (l->CreateField(&f) != OGRERR_NONE) fail(std::string("creating field ") + name);
+    }
+    void add(OGRLayer* l, OGRFeature& f) {
+        if (l->CreateFeature(&f) != OGRERR_NONE) fail(std::string("writing a feature of ") + l->GetName());
+    }
+    void begin() {
+        if (ds_->StartTransaction() != OGRERR_NONE) fail("starting a transaction");
+    }
+    void commit() {
+        if (ds_->CommitTransaction() != OGRERR_NONE) fail("committing (disk full?)");
+    }
+
+private:
+    GDALDataset* ds_;
+    const std::filesystem::path& path_;
+    OGRSpatialReference srs_;
+};
+
+OGRPolygon* polygon_of(const io::LonLatPart& ring) {
+    auto* r = new OGRLinearRing();
+    r->setNumPoints(int(ring.size() + 1), FALSE);
+    for (std::size_t i = 0; i <= ring.size(); ++i) r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
+    auto* p = new OGRPolygon();
+    p->addRingDirectly(r);
+    return p;
+}
+
+/// Boundary edges chained into loops, each loop split into runs of one tag.
+struct BoundaryRun {
+    std::vector<NodeIndex> nodes;
+    int tag = 1;
+    int loop = 0;
+};
+
+std::vector<BoundaryRun> boundary_runs(const io::MeshTopology& topo) {
+    std::map<std::int32_t, std::vector<std::int32_t>> outgoing; // node -> boundary edges leaving it
+    for (auto e : topo.boundary_edges) outgoing[topo.edge_nodes[e][0]].push_back(e);
+    std::map<std::int32_t, bool> used;
+    std::vector<BoundaryRun> runs;
+    int loop = 0;
+    for (auto start : topo.boundary_edges) {
+        if (used[start]) continue;
+        std::vector<std::int32_t> edges;
+        for (std::int32_t e = start; e >= 0 && !used[e];) {
+            used[e] = true;
+            edges.push_back(e);
+            std::int32_t next = -1;
+            for (auto cand : outgoing[topo.edge_nodes[e][1]])
+                if (!used[cand]) { next = cand; break; }
+            e = next;
+        }
+        // Start at a change of tag, so a run never wraps round the start of the loop.
+        std::size_t first = 0;
+        for (std::size_t i = 0; i < edges.size(); ++i)
+            if (topo.edge_tags[edges[i]] != topo.edge_tags[edges[(i + edges.size() - 1) % edges.size()]]) { first = i; break; }
+        std::rotate(edges.begin(), edges.begin() + std::ptrdiff_t(first), edges.end());
+        for (std::size_t i = 0; i < edges.size(); ++i) {
+            int tag = topo.edge_tags[edges[i]];
+            if (i == 0 || tag != runs.back().tag || runs.back().loop != loop) {
+                runs.push_back({{NodeIndex(topo.edge_nodes[edges[i]][0])}, tag, loop});
+            }
+            runs.back().nodes.push_back(NodeIndex(topo.edge_nodes[edges[i]][1]));
+        }
+        ++loop;
+    }
+    return runs;
+}
+
+} // namespace
+
+void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options) {
+    if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
+    OutputFile out(path, options.overwrite, "GeoPackage output");
+    const io::MeshTopology topo = io::build_topology(mesh);
+    const MeshStats stats = io::compute_stats(mesh, topo);
+    const std::vector<double> area = io::geodesic_face_areas_m2(mesh);
+
+    GDALAllRegister();
+    io::QuietGdalErrors quiet;
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!driver) throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
+    io::GdalDatasetPtr ds(driver->Create(out.temp_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!ds) throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")");
+    GpkgWriter w(ds.get(), path);
+
+    // faces
+    OGRLayer* faces = w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
+    w.field(faces, "face", OFTInteger);
+    w.field(faces, "quality", OFTReal);
+    w.field(faces, "area_km2", OFTReal);
+    const Field* depth = mesh.node_field("depth");
+    const Field* size = mesh.node_field("target_size");
+    if (depth) w.field(faces, "depth", OFTReal);
+    if (size) w.field(faces, "target_size", OFTReal);
+    std::vector<const Field*> face_fields;
+    for (const auto& f : mesh.face_fields)
+        if (f.name != "quality" && f.name != "area" && f.name != "area_km2" && f.name != "face" &&
+            !(depth && f.name == "depth") && !(size && f.name == "target_size") && f.values.size() == mesh.faces.size()) {
+            w.field(faces, f.name.c_str(), OFTReal);
+            face_fields.push_back(&f);
+        }
+    w.begin();
+    for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
+        const auto& t = mesh.faces[i];
+        OGRFeature feature(faces->GetLayerDefn());
+        feature.SetFID(GIntBig(i) + 1);
+        feature.SetField("face", int(i));
+        feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
+        feature.SetField("area_km2", area[i] * 1e-6);
+        auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
+        if (depth) feature.SetField("depth", mean(depth));
+        if (size) feature.SetField("target_size", mean(size));
+        for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
+        auto* multi = new OGRMultiPolygon();
+        for (const auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
+            multi->addGeometryDirectly(polygon_of(ring));
+        feature.SetGeometryDirectly(multi);
+        w.add(faces, feature);
+    }
+    w.commit();
+    if (options.after_partial_write) options.after_partial_write();
+
+    // nodes
+    OGRLayer* nodes = w.layer("nodes", wkbPoint, "mesh nodes with their fields");
+    w.field(nodes, "node", OFTInteger);
+    for (const auto& f : mesh.node_fields)
+        if (f.name != "node") w.field(nodes, f.name.c_str(), OFTReal);
+    w.begin();
+    for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+        OGRFeature feature(nodes->GetLayerDefn());
+        feature.SetFID(GIntBig(i) + 1);
+        feature.SetField("node", int(i));
+        for (const auto& f : mesh.node_fields)
+            if (f.name != "node" && f.values.size() == mesh.nodes.size()) feature.SetField(f.name.c_str(), f.values[i]);
+        LonLat p = vec_to_lonlat(mesh.nodes[i]);
+        feature.SetGeometryDirectly(new OGRPoint(p.lon, p.lat));
+        w.add(nodes, feature);
+    }
+    w.commit();
+
+    // boundary
+    OGRLayer* boundary = w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
+    w.field(boundary, "tag", OFTString);
+    w.field(boundary, "tag_code", OFTInteger);
+    w.field(boundary, "loop", OFTInteger);
+    w.field(boundary, "edges", OFTInteger);
+    w.field(boundary, "length_km", OFTReal);
+    w.begin();
+    for (const auto& run : boundary_runs(topo)) {
+        OGRFeature feature(boundary->GetLayerDefn());
+        feature.SetField("tag", run.tag == int(EdgeTag::open) ? "open" : "coast");
+        feature.SetField("tag_code", run.tag);
+        feature.SetField("loop", run.loop);
+        feature.SetField("edges", int(run.nodes.size() - 1));
+        double km = 0;
+        std::vector<Vec3> points;
+        for (std::size_t i = 0; i < run.nodes.size(); ++i) {
+            points.push_back(mesh.nodes[run.nodes[i]]);
+            if (i) km += arc_km(points[i - 1], points[i]);
+        }
+        feature.SetField("length_km", km);
+        auto* multi = new OGRMultiLineString();
+        for (const auto& part : io::polyline_parts(points)) {
+            auto* line = new OGRLineString();
+            for (const auto& p : part) line->addPoint(p[0], p[1]);
+            multi->addGeometryDirectly(line);
+        }
+        feature.SetGeometryDirectly(multi);
+        w.add(boundary, feature);
+    }
+    w.commit();
+
+    // mesh_info
+    OGRLayer* info = w.layer("mesh_info", wkbNone, "run metadata and summary statistics");
+    w.field(info, "key", OFTString);
+    w.field(info, "value", OFTString);
+    std::vector<std::pair<std::string, std::string>> rows = {
+        {"source", std::string("globemesh ") + GLOBEMESH_VERSION},
+        {"node_count", std::to_string(stats.nodes)},
+        {"face_count", std::to_string(stats.faces)},
+        {"edge_count", std::to_string(stats.edges)},
+        {"boundary_edge_count", std::to_string(stats.boundary_edges)},
+        {"boundary_loop_count", std::to_string(stats.boundary_loops)},
+        {"quality_min", std::to_string(stats.quality_min)},
+        {"quality_mean", std::to_string(stats.quality_mean)},
+        {"quality_fraction_above_0_8", std::to_string(stats.quality_above_0_8)},
+        {"edge_length_km_min", std::to_string(stats.edge_km_min)},
+        {"edge_length_km_mean", std::to_string(stats.edge_km_mean)},
+        {"edge_length_km_max", std::to_string(stats.edge_km_max)}};
+    rows.insert(rows.end(), mesh.attributes.begin(), mesh.attributes.end());
+    w.begin();
+    for (const auto& [key, value] : rows) {
+        OGRFeature feature(info->GetLayerDefn());
+        feature.SetField("key", key.c_str());
+        feature.SetField("value", value.c_str());
+        w.add(info, feature);
+    }
+    w.commit();
+
+    // layer_styles, in the schema QGIS creates and reads (QgsOgrProviderUtils / saveStyle).
+    OGRLayer* styles = w.layer("layer_styles", wkbNone, "QGIS layer styles", "FID=id");
+    for (const char* name : {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
+                             "styleQML", "styleSLD"})
+        w.field(styles, name, OFTString);
+    {
+        OGRFieldDefn f("useAsDefault", OFTInteger);
+        f.SetSubType(OFSTBoolean);
+        if (styles->CreateField(&f) != OGRERR_NONE) w.fail("creating field useAsDefault");
+    }
+    for (const char* name : {"description", "owner", "ui"}) w.field(styles, name, OFTString);
+    w.field(styles, "update_time", OFTDateTime, "CURRENT_TIMESTAMP");
+    OGRFeature style(styles->GetLayerDefn());
+    style.SetField("f_table_catalog", "");
+    style.SetField("f_table_schema", "");
+    style.SetField("f_table_name", "faces");
+    style.SetField("f_geometry_column", "geom");
+    style.SetField("styleName", "faces by quality");
+    style.SetField("styleQML", faces_style_qml().c_str());
+    style.SetField("styleSLD", "");
+    style.SetField("useAsDefault", 1);
+    style.SetField("description", "globemesh default: faces coloured by quality (2*sqrt(3)*inradius/longest edge)");
+    style.SetField("owner", "");
+    style.SetField("ui", "");
+    w.add(styles, style);
+
+    if (!io::close_dataset(ds))
+        throw IoError("GeoPackage output " + path.string() + ": closing failed (disk full?): " + io::last_gdal_error());
+    out.commit();
+}
+
+} // namespace globemesh

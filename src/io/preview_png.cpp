@@ -1,0 +1,202 @@
+// PNG preview of a mesh: see globemesh/gpkg.hpp.
+//
+// Plate carree (lon/lat) picture drawn with GDAL's rasterizer into a MEM RGBA raster and written
+// by the PNG driver: background, optional land polygons, faces coloured by quality or depth
+// (cut at +-180, so nothing smears), and the face outlines when faces are at least 6 px wide.
+// An extent that crosses the antimeridian (W > E, or E > 180) is drawn continuously.
+#include <algorithm>
+#include <cmath>
+
+#include <gdal_alg.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
+
+#include "face_geometry.hpp"
+#include "gdal_util.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/gpkg.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/ugrid.hpp"
+
+namespace globemesh {
+
+namespace {
+
+using Rgba = std::array<double, 4>;
+
+/// Interpolates a colour ramp of (position, colour) stops at t in [0, 1].
+Rgba ramp(const std::vector<std::pair<double, Rgba>>& stops, double t) {
+    t = std::clamp(t, 0.0, 1.0);
+    for (std::size_t i = 1; i < stops.size(); ++i)
+        if (t <= stops[i].first) {
+            double u = (t - stops[i - 1].first) / (stops[i].first - stops[i - 1].first);
+            Rgba c;
+            for (int k = 0; k < 4; ++k) c[k] = std::round(stops[i - 1].second[k] + u * (stops[i].second[k] - stops[i - 1].second[k]));
+            return c;
+        }
+    return stops.back().second;
+}
+
+/// Geometries to burn, each with its RGBA; owns them.
+class BurnList {
+public:
+    ~BurnList() {
+        for (auto g : geoms_) OGRGeometryFactory::destroyGeometry(OGRGeometry::FromHandle(g));
+    }
+    void add(OGRGeometry* g, const Rgba& c) {
+        geoms_.push_back(OGRGeometry::ToHandle(g));
+        values_.insert(values_.end(), c.begin(), c.end());
+    }
+    void burn(GDALDataset* ds, const char* all_touched, const std::filesystem::path& path) {
+        if (geoms_.empty()) return;
+        int bands[4] = {1, 2, 3, 4};
+        char* opts[] = {const_cast<char*>(all_touched), nullptr};
+        if (GDALRasterizeGeometries(GDALDataset::ToHandle(ds), 4, bands, int(geoms_.size()), geoms_.data(), nullptr,
+                                    nullptr, values_.data(), opts, nullptr, nullptr) != CE_None)
+            throw IoError("preview " + path.string() + ": rasterizing failed: " + io::last_gdal_error());
+    }
+
+private:
+    std::vector<OGRGeometryH> geoms_;
+    std::vector<double> values_;
+};
+
+/// The copies of a part shifted by -360/0/+360 that meet the extent's longitudes [w, e].
+std::vector<double> shifts_for(double lon_min, double lon_max, double w, double e) {
+    std::vector<double> s;
+    for (double shift : {-360.0, 0.0, 360.0})
+        if (lon_max + shift >= w && lon_min + shift <= e) s.push_back(shift);
+    return s;
+}
+
+std::array<double, 4> default_extent(const Mesh& mesh) {
+    std::vector<double> lons;
+    double south = 90, north = -90;
+    for (const auto& v : mesh.nodes) {
+        LonLat p = vec_to_lonlat(v);
+        if (!(v.x == 0 && v.y == 0)) lons.push_back(p.lon);
+        south = std::min(south, p.lat), north = std::max(north, p.lat);
+    }
+    if (lons.empty()) return {-180, -90, 180, 90};
+    std::sort(lons.begin(), lons.end());
+    // The widest gap between node longitudes (circularly) is where the picture is cut.
+    double gap = lons.front() + 360 - lons.back(), west = lons.front(), east = lons.back();
+    for (std::size_t i = 1; i < lons.size(); ++i)
+        if (lons[i] - lons[i - 1] > gap) gap = lons[i] - lons[i - 1], west = lons[i], east = lons[i - 1] + 360;
+    if (gap < 30 || north - south > 150) return {-180, -90, 180, 90};
+    double pad_x = 0.03 * (east - west), pad_y = 0.03 * (north - south);
+    return {west - pad_x, std::max(-90.0, south - pad_y), east + pad_x, std::min(90.0, north + pad_y)};
+}
+
+} // namespace
+
+void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, const PreviewOptions& options) {
+    if (options.colour_by != "quality" && options.colour_by != "depth")
+        throw UsageError("preview colour \"" + options.colour_by + "\": use quality or depth");
+    if (options.width_px < 16 || options.width_px > 20000)
+        throw UsageError("preview width " + std::to_string(options.width_px) + ": use 16 to 20000 pixels");
+    const Field* depth = mesh.node_field("depth");
+    if (options.colour_by == "depth" && !depth)
+        throw DataError("preview " + path.string() + ": the mesh has no depth field to colour by");
+    auto [w, s, e, n] = options.extent_deg ? *options.extent_deg : default_extent(mesh);
+    if (e <= w) e += 360;
+    if (!(n > s) || s < -90 || n > 90 || e - w > 360)
+        throw UsageError("preview extent: give W,S,E,N in degrees with S < N, both within [-90, 90]");
+    OutputFile out(path, options.overwrite, "preview");
+
+    GDALAllRegister();
+    io::QuietGdalErrors quiet;
+    const int width = options.width_px;
+    const int height = std::max(16, int(std::lround(width * (n - s) / (e - w))));
+    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+    GDALDriver* png = GetGDALDriverManager()->GetDriverByName("PNG");
+    if (!mem || !png) throw IoError("preview " + path.string() + ": GDAL lacks the MEM or PNG driver");
+    io::GdalDatasetPtr canvas(mem->Create("", width, height, 4, GDT_Byte, nullptr));
+    if (!canvas) throw IoError("preview " + path.string() + ": cannot allocate the picture: " + io::last_gdal_error());
+    double gt[6] = {w, (e - w) / width, 0, n, 0, -(n - s) / height};
+    canvas->SetGeoTransform(gt);
+    const Rgba background = {236, 242, 248, 255};
+    for (int b = 1; b <= 4; ++b) canvas->GetRasterBand(b)->Fill(background[b - 1]);
+
+    if (!options.land.empty()) {
+        io::GdalDatasetPtr land(GDALDataset::Open(options.land.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+        if (!land) throw IoError("preview land " + options.land + ": cannot open (" + io::last_gdal_error() + ")");
+        OGRSpatialReference wgs84;
+        wgs84.importFromEPSG(4326);
+        wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+        const Rgba land_colour = {205, 195, 170, 255};
+        std::vector<std::unique_ptr<OGRGeometry>> land_geoms;
+        for (OGRLayer* layer : land->GetLayers()) {
+            std::unique_ptr<OGRCoordinateTransformation> ct;
+            if (const OGRSpatialReference* srs = layer->GetSpatialRef(); srs && !srs->IsSame(&wgs84)) {
+                ct.reset(OGRCreateCoordinateTransformation(srs, &wgs84));
+                if (!ct) throw DataError("preview land " + options.land + ": cannot transform layer " + layer->GetName() + " to EPSG:4326");
+            }
+            for (auto& feature : *layer) {
+                const OGRGeometry* g = feature->GetGeometryRef();
+                if (!g || wkbFlatten(g->getGeometryType()) == wkbPoint) continue;
+                std::unique_ptr<OGRGeometry> copy(g->clone());
+                if (ct && copy->transform(ct.get()) != OGRERR_NONE) continue;
+                land_geoms.push_back(std::move(copy));
+            }
+        }
+        // Land copies one turn east or west are drawn by moving the picture's origin instead.
+        for (double shift : shifts_for(-180, 180, w, e)) {
+            BurnList burn;
+            for (const auto& g : land_geoms) burn.add(g->clone(), land_colour);
+            double shifted[6] = {w - shift, gt[1], 0, n, 0, gt[5]};
+            canvas->SetGeoTransform(shifted);
+            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+        }
+        canvas->SetGeoTransform(gt);
+    }
+
+    // Faces, coloured by quality (red poor .. green good) or depth (light to dark blue).
+    double depth_max = 1;
+    if (depth)
+        for (double d : depth->values)
+            if (std::isfinite(d)) depth_max = std::max(depth_max, d);
+    const std::vector<std::pair<double, Rgba>> quality_ramp = {
+        {0.0, {165, 0, 38, 255}}, {0.4, {244, 109, 67, 255}}, {0.6, {254, 224, 139, 255}},
+        {0.8, {166, 217, 106, 255}}, {1.0, {0, 104, 55, 255}}};
+    const std::vector<std::pair<double, Rgba>> depth_ramp = {
+        {0.0, {222, 235, 247, 255}}, {0.5, {66, 146, 198, 255}}, {1.0, {8, 48, 107, 255}}};
+    BurnList faces, outlines;
+    double mean_edge_deg = compute_stats(mesh).edge_km_mean / earth_radius_km * rad_to_deg;
+    const bool draw_outlines = mean_edge_deg / gt[1] >= 6.0;
+    const Rgba outline = {40, 40, 40, 255};
+    for (const auto& t : mesh.faces) {
+        const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+        Rgba colour = options.colour_by == "depth"
+                          ? ramp(depth_ramp, (depth->values[t[0]] + depth->values[t[1]] + depth->values[t[2]]) / 3.0 / depth_max)
+                          : ramp(quality_ramp, triangle_quality(a, b, c));
+        for (const auto& ring : io::face_polygons(a, b, c)) {
+            double lo = 1e9, hi = -1e9;
+            for (const auto& p : ring) lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+            for (double shift : shifts_for(lo, hi, w, e)) {
+                auto* r = new OGRLinearRing();
+                for (const auto& p : ring) r->addPoint(p[0] + shift, p[1]);
+                r->closeRings();
+                if (draw_outlines) outlines.add(r->clone(), outline);
+                auto* poly = new OGRPolygon();
+                poly->addRingDirectly(r);
+                faces.add(poly, colour);
+            }
+        }
+    }
+    faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+    outlines.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+    if (options.after_partial_write) options.after_partial_write();
+
+    // Written without georeferencing sidecars (no .aux.xml, no world file): a picture only.
+    double identity[6] = {0, 1, 0, 0, 0, 1};
+    canvas->SetGeoTransform(identity);
+    io::ScopedGdalConfig no_pam("GDAL_PAM_ENABLED", "NO");
+    io::GdalDatasetPtr written(png->CreateCopy(out.temp_path().c_str(), canvas.get(), FALSE, nullptr, nullptr, nullptr));
+    if (!written) throw IoError("preview " + path.string() + ": writing the PNG failed: " + io::last_gdal_error());
+    if (!io::close_dataset(written))
+        throw IoError("preview " + path.string() + ": closing the PNG failed (disk full?): " + io::last_gdal_error());
+    out.commit();
+}
+
+} // namespace globemesh
