@@ -1,0 +1,122 @@
+// globemesh/bathymetry.hpp: bathymetry from any GDAL raster, as a plain lon/lat grid in memory.
+//
+// read_bathymetry() opens the raster named by --bathy with GDAL, takes band --bathy-band, applies
+// GDAL's scale/offset, turns the nodata value and NaN into "no data", flips depth-positive grids
+// (--depth-positive) to elevation positive up, and hands back a Raster: values on a regular
+// lon/lat grid of cell centres, in metres, elevation positive up (land > 0, sea floor < 0). No GDAL
+// type appears in this interface.
+//
+// Georeferencing: a raster in a geographic CRS with a north-up (or south-up) geotransform is read
+// as is, longitudes in 0..360 or -180..180 alike. Any other raster (projected, rotated) is read
+// through an in-memory warped VRT to EPSG:4326 (GDALWarp, bilinear, exact transformer -et 0,
+// NaN outside the source footprint). A grid whose columns span 360 degrees is global and wraps
+// across +-180; a node-registered global grid (first and last column on the same meridian) drops
+// its duplicate last column.
+//
+// Sampling (Raster::sample, elevation_m): bilinear in lon/lat between the four surrounding cell
+// centres, exact at the cell centres (error below 1e-9 m there, the values being stored as float)
+// and exactly bilinear inside a cell. Where some of the four corners have no data the valid ones
+// are averaged with renormalised bilinear weights, unless the nearest corner has no data: then
+// the point has no data. Between the outermost cell centres and the raster's edge (half a cell)
+// the edge value is held; a global grid whose edge row lies within one cell of a pole holds
+// that row up to the pole.
+// Outside the raster, or where there is no data, elevation_m gives the fill (-bathy_fill_m) when
+// set, NaN otherwise.
+//
+// Memory: values are stored once, as float (4 bytes a cell; exact for Int16/Int32 below 2^24
+// and Float32 rasters, relative rounding 6e-8 otherwise), read straight from GDAL's blocks into
+// that array. Rasters with more than max_cells cells (default 2^28, 1 GiB: a 1-arc-minute global
+// grid fits) are read decimated with GDAL's average resampling to at most max_cells.
+//
+// Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
+// exist; DataError for a raster without georeferencing, with no valid cell, or that does not
+// cover the region (unless --bathy-fill gives a value for the uncovered part).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "globemesh/options.hpp"
+#include "globemesh/progress.hpp"
+#include "globemesh/sphere.hpp"
+
+namespace globemesh {
+
+/// West, south, east, north edges of a grid in degrees (east > west; east may exceed 180).
+struct LonLatBounds {
+    double west = -180, south = -90, east = 180, north = 90;
+};
+
+/// Values (NaN = no data) on a regular lon/lat grid of cell centres.
+/// Node (i, j) sits at lon0 + i*dlon, lat0 + j*dlat; value index j*nlon + i.
+class Raster {
+public:
+    Raster() = default;
+    /// lon0_deg/lat0_deg: centre of cell (0, 0); dlon_deg > 0; dlat_deg non-zero (negative for
+    /// north-up rows). values.size() must be nlon*nlat. The grid is global when nlon*dlon is 360
+    /// (to 1e-6 of a cell). Throws DataError on inconsistent sizes.
+    Raster(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_deg, std::size_t nlon,
+           std::size_t nlat, std::vector<float> values);
+
+    std::size_t nlon() const { return nlon_; }
+    std::size_t nlat() const { return nlat_; }
+    double lon0_deg() const { return lon0_; }
+    double lat0_deg() const { return lat0_; }
+    double dlon_deg() const { return dlon_; }
+    double dlat_deg() const { return dlat_; }
+    /// Longitude of column i, degrees (lon0 + i*dlon, not reduced to [-180, 180)).
+    double lon_deg(std::size_t i) const { return lon0_ + static_cast<double>(i) * dlon_; }
+    /// Latitude of row j, degrees.
+    double lat_deg(std::size_t j) const { return lat0_ + static_cast<double>(j) * dlat_; }
+    /// Stored value of node (i, j) (NaN = no data).
+    float value(std::size_t i, std::size_t j) const { return values_[j * nlon_ + i]; }
+    const std::vector<float>& values() const { return values_; }
+    /// True when the columns span 360 degrees: column nlon-1 neighbours column 0.
+    bool global() const { return global_; }
+    /// Edges of the cells (half a cell beyond the outermost centres), degrees.
+    LonLatBounds bounds() const;
+    /// True when (lon, lat) lies inside bounds() (longitude taken modulo 360).
+    bool contains(double lon_deg, double lat_deg) const;
+
+    /// Bilinear value at (lon, lat) in degrees, any longitude; NaN outside or without data.
+    double sample(double lon_deg, double lat_deg) const;
+
+    /// Elevation at a point, metres positive up: sample(), or the fill where that is NaN.
+    double elevation_m(double lon_deg, double lat_deg) const;
+    double elevation_m(const Vec3& p) const;
+    /// Depth at a point, metres positive down (-elevation_m).
+    double depth_m(const Vec3& p) const { return -elevation_m(p); }
+
+    /// Elevation (m, positive up) returned where the raster has no value; nullopt gives NaN.
+    void set_fill_elevation_m(std::optional<double> fill) { fill_ = fill; }
+    std::optional<double> fill_elevation_m() const { return fill_; }
+
+    /// Number of nodes holding data (not NaN).
+    std::size_t valid_count() const;
+
+private:
+    double lon0_ = 0, lat0_ = 0, dlon_ = 1, dlat_ = 1;
+    std::size_t nlon_ = 0, nlat_ = 0;
+    bool global_ = false;
+    double v_lo_ = 0, v_hi_ = 0; ///< valid row positions (cell units from row 0)
+    std::vector<float> values_;
+    std::optional<double> fill_;
+};
+
+/// Reads one band of any GDAL raster as elevation in metres (positive up); see the file comment.
+/// path: the raster; band: 1-based; depth_positive: the raster stores depth positive down;
+/// max_cells: decimate (GDAL average) rasters larger than this. Throws IoError, UsageError
+/// (band out of range, naming --bathy-band) or DataError (no georeferencing, all nodata).
+Raster read_raster(const std::string& path, int band = 1, bool depth_positive = false,
+                   const Progress& progress = {}, std::size_t max_cells = std::size_t{1} << 28);
+
+/// Reads options.bathy (band options.bathy_band, options.depth_positive), sets the fill to
+/// -options.bathy_fill_m when given, and checks that the raster covers options.region (the whole
+/// globe without --region; --region-file is not checked here). Throws as read_raster, and
+/// DataError when the raster covers only part of the region and no --bathy-fill is set.
+Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {});
+
+} // namespace globemesh

@@ -1,0 +1,318 @@
+// read_raster / read_bathymetry: GDAL in, Raster out. The only file of bathymetry/ that sees GDAL.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <cpl_error.h>
+#include <cpl_string.h>
+#include <gdal.h>
+#include <gdal_utils.h>
+#include <ogr_srs_api.h>
+
+#include "globemesh/bathymetry.hpp"
+#include "globemesh/error.hpp"
+
+namespace globemesh {
+
+namespace {
+
+/// Routes GDAL's error messages to a quiet handler for its lifetime (the library never prints);
+/// the last message stays readable through CPLGetLastErrorMsg.
+class QuietGdalErrors {
+public:
+    QuietGdalErrors() {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        CPLErrorReset();
+    }
+    ~QuietGdalErrors() { CPLPopErrorHandler(); }
+    QuietGdalErrors(const QuietGdalErrors&) = delete;
+    QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
+};
+
+struct DatasetCloser {
+    void operator()(void* ds) const {
+        if (ds) GDALClose(static_cast<GDALDatasetH>(ds));
+    }
+};
+using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
+
+std::string gdal_message() {
+    std::string m = CPLGetLastErrorMsg();
+    return m.empty() ? std::string("unknown GDAL error") : m;
+}
+
+/// An argv list for the GDAL utilities, freed on scope exit.
+class StringList {
+public:
+    explicit StringList(std::initializer_list<const char*> items) {
+        for (const char* s : items) list_ = CSLAddString(list_, s);
+    }
+    ~StringList() { CSLDestroy(list_); }
+    StringList(const StringList&) = delete;
+    StringList& operator=(const StringList&) = delete;
+    char** get() const { return list_; }
+    void add(const char* s) { list_ = CSLAddString(list_, s); }
+
+private:
+    char** list_ = nullptr;
+};
+
+/// True when the dataset's CRS is geographic in degrees and its geotransform is not rotated.
+bool is_plain_lonlat(GDALDatasetH ds, const double gt[6]) {
+    OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
+    if (!srs || !OSRIsGeographic(srs)) return false;
+    double unit = OSRGetAngularUnits(srs, nullptr);
+    if (std::abs(unit - deg_to_rad) > 1e-12) return false;
+    return gt[2] == 0 && gt[4] == 0 && gt[1] > 0 && gt[5] != 0;
+}
+
+/// A VRT holding band `band` of ds alone (the warper takes every band otherwise).
+DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string& path) {
+    std::string b = std::to_string(band);
+    StringList argv{"-of", "VRT", "-b", b.c_str()};
+    GDALTranslateOptions* opts = GDALTranslateOptionsNew(argv.get(), nullptr);
+    int usage_error = 0;
+    DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
+    GDALTranslateOptionsFree(opts);
+    if (!out) throw IoError("--bathy " + path + ": cannot select band " + b + ": " + gdal_message());
+    return out;
+}
+
+/// The smallest lon/lat size (degrees) of a source pixel step over a 21 x 21 sample of the
+/// raster, or 0 when it cannot be computed. Warping at this resolution only upsamples, so GDAL's
+/// bilinear kernel stays the plain 2 x 2 one (exact on planes); downsampling widens it.
+double finest_lonlat_step(GDALDatasetH ds) {
+    double gt[6];
+    OGRSpatialReferenceH src = GDALGetSpatialRef(ds);
+    if (!src || GDALGetGeoTransform(ds, gt) != CE_None) return 0;
+    struct SrsDel { void operator()(void* p) const { OSRRelease(static_cast<OGRSpatialReferenceH>(p)); } };
+    struct OctDel { void operator()(void* p) const { OCTDestroyCoordinateTransformation(static_cast<OGRCoordinateTransformationH>(p)); } };
+    std::unique_ptr<void, SrsDel> dst(OSRNewSpatialReference(nullptr));
+    OSRImportFromEPSG(static_cast<OGRSpatialReferenceH>(dst.get()), 4326);
+    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(dst.get()), OAMS_TRADITIONAL_GIS_ORDER);
+    std::unique_ptr<void, SrsDel> src_copy(OSRClone(src));
+    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(src_copy.get()), OAMS_TRADITIONAL_GIS_ORDER);
+    std::unique_ptr<void, OctDel> ct(OCTNewCoordinateTransformation(
+        static_cast<OGRSpatialReferenceH>(src_copy.get()), static_cast<OGRSpatialReferenceH>(dst.get())));
+    if (!ct) return 0;
+    const double nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
+    double best = 0;
+    for (int a = 0; a <= 20; ++a)
+        for (int b = 0; b <= 20; ++b) {
+            double px = std::min(nx - 1, nx * a / 20.0), py = std::min(ny - 1, ny * b / 20.0);
+            double x[3], y[3], z[3] = {0, 0, 0};
+            int ok[3];
+            for (int k = 0; k < 3; ++k) {
+                double qx = px + (k == 1), qy = py + (k == 2);
+                x[k] = gt[0] + qx * gt[1] + qy * gt[2];
+                y[k] = gt[3] + qx * gt[4] + qy * gt[5];
+            }
+            if (!OCTTransformEx(static_cast<OGRCoordinateTransformationH>(ct.get()), 3, x, y, z, ok) ||
+                !ok[0] || !ok[1] || !ok[2])
+                continue;
+            for (int k = 1; k < 3; ++k) {
+                double step = std::hypot(x[k] - x[0], y[k] - y[0]);
+                if (step > 0 && std::isfinite(step) && (best == 0 || step < best)) best = step;
+            }
+        }
+    return best;
+}
+
+/// ds warped to EPSG:4326 as a lazy in-memory VRT: bilinear, exact transformer, Float32 with NaN
+/// where the source has no data or no coverage, at the source's finest pixel size.
+DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string& path) {
+    const std::string res = std::to_string(finest_lonlat_step(ds));
+    StringList argv{"-of", "VRT", "-t_srs", "EPSG:4326", "-r", "bilinear", "-et", "0",
+                    "-ot", "Float32", "-dstnodata", "nan"};
+    if (res != "0.000000") {
+        argv.add("-tr");
+        argv.add(res.c_str());
+        argv.add(res.c_str());
+    }
+    GDALWarpAppOptions* opts = GDALWarpAppOptionsNew(argv.get(), nullptr);
+    int usage_error = 0;
+    GDALDatasetH src = ds;
+    DatasetPtr out(GDALWarp("", nullptr, 1, &src, opts, &usage_error));
+    GDALWarpAppOptionsFree(opts);
+    if (!out)
+        throw DataError("--bathy " + path + ": cannot reproject to lon/lat (EPSG:4326): " +
+                        gdal_message());
+    return out;
+}
+
+struct ProgressBridge {
+    const Progress* progress;
+    double lo, hi;
+    bool cancelled = false;
+};
+
+int CPL_STDCALL gdal_progress(double f, const char*, void* data) {
+    auto* b = static_cast<ProgressBridge*>(data);
+    if (*b->progress && !(*b->progress)(b->lo + (b->hi - b->lo) * f, "read bathymetry")) {
+        b->cancelled = true;
+        return FALSE;
+    }
+    return TRUE;
+}
+
+std::string fmt_deg(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+} // namespace
+
+Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
+                   std::size_t max_cells) {
+    GDALAllRegister();
+    QuietGdalErrors quiet;
+    report(progress, 0.0, "read bathymetry");
+
+    DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    if (!ds) throw IoError("--bathy " + path + ": cannot open as a raster: " + gdal_message());
+    GDALDatasetH h = ds.get();
+    const int nbands = GDALGetRasterCount(h);
+    if (band < 1 || band > nbands)
+        throw UsageError("--bathy-band " + std::to_string(band) + ": " + path + " has " +
+                         std::to_string(nbands) + " band" + (nbands == 1 ? "" : "s"));
+    GDALRasterBandH src_band = GDALGetRasterBand(h, band);
+
+    // Scale, offset and nodata belong to the original band; the warper keeps raw values.
+    int has = 0;
+    double scale = GDALGetRasterScale(src_band, &has);
+    if (!has || !std::isfinite(scale) || scale == 0) scale = 1.0;
+    double offset = GDALGetRasterOffset(src_band, &has);
+    if (!has || !std::isfinite(offset)) offset = 0.0;
+    int has_nodata = 0;
+    double nodata = GDALGetRasterNoDataValue(src_band, &has_nodata);
+
+    double gt[6];
+    if (GDALGetGeoTransform(h, gt) != CE_None || !GDALGetSpatialRef(h))
+        throw DataError("--bathy " + path +
+                        ": has no georeferencing (geotransform and CRS); assign them, e.g. "
+                        "gdal_translate -a_srs EPSG:4326 -a_ullr W N E S");
+
+    // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
+    DatasetPtr band_vrt, warped;
+    GDALRasterBandH read_band = src_band;
+    bool warp = !is_plain_lonlat(h, gt);
+    if (warp) {
+        band_vrt = single_band_vrt(h, band, path);
+        warped = warped_to_lonlat(band_vrt.get(), path);
+        read_band = GDALGetRasterBand(warped.get(), 1);
+        if (GDALGetGeoTransform(warped.get(), gt) != CE_None)
+            throw DataError("--bathy " + path + ": the warped raster has no geotransform");
+        has_nodata = 0; // the warper writes NaN where there is no data
+    }
+    GDALDatasetH read_ds = warped ? warped.get() : h;
+    std::size_t nx = static_cast<std::size_t>(GDALGetRasterXSize(read_ds));
+    std::size_t ny = static_cast<std::size_t>(GDALGetRasterYSize(read_ds));
+
+    // A node-registered global grid repeats its first meridian as the last column: drop it.
+    if (nx > 1 && std::abs(static_cast<double>(nx - 1) * gt[1] - 360.0) <= 1e-6 * gt[1]) --nx;
+
+    // Decimate (GDAL average) rasters larger than max_cells.
+    std::size_t bx = nx, by = ny;
+    if (max_cells > 0 && nx * ny > max_cells) {
+        double f = std::sqrt(static_cast<double>(nx) * static_cast<double>(ny) / static_cast<double>(max_cells));
+        bx = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(nx) / f)));
+        by = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(ny) / f)));
+    }
+    const double sx = static_cast<double>(nx) / static_cast<double>(bx);
+    const double sy = static_cast<double>(ny) / static_cast<double>(by);
+    const double dlon = gt[1] * sx, dlat = gt[5] * sy;
+
+    std::vector<float> values(bx * by);
+    // Strips of rows, so that progress and cancellation are reported while GDAL reads its blocks.
+    int block_x = 0, block_y = 0;
+    GDALGetBlockSize(read_band, &block_x, &block_y);
+    std::size_t strip = std::max<std::size_t>(1, std::min<std::size_t>(by, std::max(block_y, 64)));
+    for (std::size_t r0 = 0; r0 < by; r0 += strip) {
+        std::size_t r1 = std::min(by, r0 + strip);
+        GDALRasterIOExtraArg extra;
+        INIT_RASTERIO_EXTRA_ARG(extra);
+        ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(r0) / static_cast<double>(by),
+                              0.05 + 0.9 * static_cast<double>(r1) / static_cast<double>(by)};
+        if (progress) {
+            extra.pfnProgress = gdal_progress;
+            extra.pProgressData = &bridge;
+        }
+        double y0 = static_cast<double>(r0) * sy, y1 = static_cast<double>(r1) * sy;
+        int iy0 = static_cast<int>(std::floor(y0));
+        int iy1 = std::min(static_cast<int>(ny), static_cast<int>(std::ceil(y1 - 1e-9)));
+        if (bx != nx || by != ny) {
+            extra.eResampleAlg = GRIORA_Average;
+            extra.bFloatingPointWindowValidity = TRUE;
+            extra.dfXOff = 0;
+            extra.dfXSize = static_cast<double>(nx);
+            extra.dfYOff = y0;
+            extra.dfYSize = y1 - y0;
+        }
+        CPLErr err = GDALRasterIOEx(read_band, GF_Read, 0, iy0, static_cast<int>(nx), iy1 - iy0,
+                                    values.data() + r0 * bx, static_cast<int>(bx),
+                                    static_cast<int>(r1 - r0), GDT_Float32, 0, 0, &extra);
+        if (bridge.cancelled) throw Cancelled();
+        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal_message());
+    }
+
+    // Raw values -> metres, elevation positive up; nodata and NaN -> NaN.
+    const float nodata_f = static_cast<float>(nodata);
+    const bool nodata_nan = has_nodata && std::isnan(nodata);
+    for (float& v : values) {
+        if (!std::isfinite(v) || (has_nodata && !nodata_nan && v == nodata_f)) {
+            v = std::numeric_limits<float>::quiet_NaN();
+            continue;
+        }
+        double z = static_cast<double>(v) * scale + offset;
+        v = static_cast<float>(depth_positive ? -z : z);
+    }
+
+    Raster raster(gt[0] + 0.5 * dlon, gt[3] + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
+    if (raster.valid_count() == 0)
+        throw DataError("--bathy " + path + ": band " + std::to_string(band) +
+                        " holds no valid value (all nodata)");
+    report(progress, 1.0, "read bathymetry");
+    return raster;
+}
+
+Raster read_bathymetry(const MeshOptions& o, const Progress& progress) {
+    if (o.bathy.empty()) throw UsageError("--bathy: no raster given");
+    if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
+        throw UsageError("--bathy-fill must be a depth in metres");
+    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress);
+    if (o.bathy_fill_m) {
+        r.set_fill_elevation_m(-*o.bathy_fill_m);
+        return r;
+    }
+    // Coverage of the region (the whole globe without --region), on a dense set of points.
+    double w = -180, s = -90, e = 180, n = 90;
+    if (o.region) {
+        w = (*o.region)[0];
+        s = (*o.region)[1];
+        e = (*o.region)[2];
+        n = (*o.region)[3];
+        if (e <= w) e += 360;
+    }
+    const int steps = 720;
+    bool covered = true;
+    for (int k = 0; k <= steps && covered; ++k) {
+        double lon = w + (e - w) * k / steps;
+        double lat = s + (n - s) * k / steps;
+        covered = r.contains(lon, 0.5 * (s + n)) && r.contains(0.5 * (w + e), lat) &&
+                  r.contains(lon, s) && r.contains(lon, n);
+    }
+    if (!covered) {
+        LonLatBounds b = r.bounds();
+        throw DataError("--bathy " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." +
+                        fmt_deg(b.east) + ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north) +
+                        (o.region ? " but not all of --region" : " but the region is the whole globe") +
+                        "; pass --bathy-fill DEPTH for the rest or a --region inside the raster");
+    }
+    return r;
+}
+
+} // namespace globemesh

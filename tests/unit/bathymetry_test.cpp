@@ -1,0 +1,370 @@
+// Tests of bathymetry/: synthetic rasters written here with GDAL whose values are known exactly,
+// and the real ETOPO5 fixtures checked against an independent read (netCDF-C coordinates and
+// values, GDALRasterIO of single pixels).
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gdal.h>
+#include <netcdf.h>
+#include <ogr_srs_api.h>
+
+#include "globemesh/bathymetry.hpp"
+#include "globemesh/error.hpp"
+#include "support.hpp"
+
+using namespace globemesh;
+using globemesh::test::fixture;
+using globemesh::test::TempDir;
+
+namespace {
+
+struct GridSpec {
+    double west, north, dx, dy; // geotransform origin and pixel size (dy > 0 means north-up)
+    int nx, ny;
+    int epsg = 4326;
+    bool georeferenced = true;
+    GDALDataType type = GDT_Float32;
+    std::optional<double> nodata;
+    std::optional<std::pair<double, double>> scale_offset;
+    int bands = 1;
+    GridSpec(double w, double n, double x, double y, int nx_, int ny_, int epsg_ = 4326)
+        : west(w), north(n), dx(x), dy(y), nx(nx_), ny(ny_), epsg(epsg_) {}
+};
+
+/// Writes a GeoTIFF whose pixel (i, j) holds value(x_centre, y_centre) (CRS units).
+void write_tiff(const std::string& path, const GridSpec& s, const std::function<double(double, double)>& value) {
+    GDALAllRegister();
+    GDALDriverH drv = GDALGetDriverByName("GTiff");
+    GDALDatasetH ds = GDALCreate(drv, path.c_str(), s.nx, s.ny, s.bands, s.type, nullptr);
+    ASSERT_NE(ds, nullptr);
+    if (s.georeferenced) {
+        double gt[6] = {s.west, s.dx, 0, s.north, 0, -s.dy};
+        GDALSetGeoTransform(ds, gt);
+        OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
+        OSRImportFromEPSG(srs, s.epsg);
+        GDALSetSpatialRef(ds, srs);
+        OSRRelease(srs);
+    }
+    std::vector<double> row(static_cast<std::size_t>(s.nx));
+    for (int b = 1; b <= s.bands; ++b) {
+        GDALRasterBandH band = GDALGetRasterBand(ds, b);
+        if (s.nodata) GDALSetRasterNoDataValue(band, *s.nodata);
+        if (s.scale_offset) {
+            GDALSetRasterScale(band, s.scale_offset->first);
+            GDALSetRasterOffset(band, s.scale_offset->second);
+        }
+        for (int j = 0; j < s.ny; ++j) {
+            for (int i = 0; i < s.nx; ++i)
+                row[static_cast<std::size_t>(i)] = value(s.west + (i + 0.5) * s.dx, s.north - (j + 0.5) * s.dy);
+            ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, j, s.nx, 1, row.data(), s.nx, 1, GDT_Float64, 0, 0), CE_None);
+        }
+    }
+    GDALClose(ds);
+}
+
+/// The value a Float32 raster stores for v.
+double f32(double v) { return static_cast<double>(static_cast<float>(v)); }
+
+MeshOptions options_for(const std::string& path) {
+    MeshOptions o;
+    o.bathy = path;
+    return o;
+}
+
+/// One pixel of a raster read with GDALRasterIO as Float64, for independent checks.
+double gdal_pixel(const std::string& path, int i, int j) {
+    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
+    double v = std::nan("");
+    if (ds) {
+        if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, i, j, 1, 1, &v, 1, 1, GDT_Float64, 0, 0) != CE_None)
+            v = std::nan("");
+        GDALClose(ds);
+    }
+    return v;
+}
+
+} // namespace
+
+TEST(Bathymetry, linear_slope_is_exact_at_nodes_and_inside_cells) {
+    TempDir dir;
+    const std::string path = (dir / "slope.tif").string();
+    // Centres at multiples of 0.25 degrees: the plane has values exact in float.
+    auto plane = [](double lon, double lat) { return -4000.0 + 20.0 * lon + 10.0 * lat; };
+    write_tiff(path, {10, 50, 0.5, 0.5, 21, 15}, plane);
+    Raster r = read_raster(path);
+    ASSERT_EQ(r.nlon(), 21u);
+    ASSERT_EQ(r.nlat(), 15u);
+    EXPECT_FALSE(r.global());
+    for (std::size_t j = 0; j < r.nlat(); ++j)
+        for (std::size_t i = 0; i < r.nlon(); ++i) {
+            double lon = 10.25 + 0.5 * static_cast<double>(i), lat = 49.75 - 0.5 * static_cast<double>(j);
+            EXPECT_NEAR(r.elevation_m(lon, lat), plane(lon, lat), 1e-9);
+            EXPECT_NEAR(r.elevation_m(lonlat_to_vec(lon, lat)), plane(lon, lat), 1e-9);
+            EXPECT_NEAR(r.depth_m(lonlat_to_vec(lon, lat)), -plane(lon, lat), 1e-9);
+        }
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> ulon(10.25, 20.25), ulat(42.75, 49.75);
+    for (int k = 0; k < 1000; ++k) {
+        double lon = ulon(rng), lat = ulat(rng);
+        EXPECT_NEAR(r.elevation_m(lon, lat), plane(lon, lat), 1e-9) << lon << " " << lat;
+    }
+    // Half a cell beyond the outermost centres holds the edge; farther is outside.
+    EXPECT_NEAR(r.elevation_m(10.1, 45.25), plane(10.25, 45.25), 1e-9);
+    EXPECT_TRUE(std::isnan(r.elevation_m(9.9, 45.0)));
+    EXPECT_TRUE(std::isnan(r.elevation_m(15.0, 50.1)));
+    EXPECT_TRUE(std::isnan(r.elevation_m(-165.0, 45.0)));
+}
+
+TEST(Bathymetry, bilinear_function_is_reproduced_exactly_inside_cells) {
+    TempDir dir;
+    const std::string path = (dir / "bilinear.tif").string();
+    auto f = [](double lon, double lat) { return 3.0 * (lon - 10.0) * (lat - 40.0) - 2.0 * lon + lat - 500.0; };
+    write_tiff(path, {10, 50, 0.5, 0.5, 21, 15}, f);
+    Raster r = read_raster(path);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> ulon(10.25, 20.25), ulat(42.75, 49.75);
+    for (int k = 0; k < 1000; ++k) {
+        double lon = ulon(rng), lat = ulat(rng);
+        // Bilinear interpolation reproduces a*lon*lat + b*lon + c*lat + d exactly within a cell.
+        EXPECT_NEAR(r.elevation_m(lon, lat), f(lon, lat), 1e-9) << lon << " " << lat;
+    }
+}
+
+TEST(Bathymetry, gaussian_seamount_matches_its_formula) {
+    TempDir dir;
+    const std::string path = (dir / "seamount.tif").string();
+    auto z = [](double lon, double lat) {
+        double r2 = (lon + 30) * (lon + 30) + (lat - 20) * (lat - 20);
+        return -5000.0 + 4000.0 * std::exp(-r2 / (2 * 0.5 * 0.5));
+    };
+    write_tiff(path, {-32, 22, 0.02, 0.02, 200, 200}, z);
+    Raster r = read_raster(path);
+    double max_node_err = 0, max_err = 0;
+    for (std::size_t j = 0; j < r.nlat(); j += 7)
+        for (std::size_t i = 0; i < r.nlon(); i += 7) {
+            double lon = -32 + 0.01 + 0.02 * static_cast<double>(i), lat = 22 - 0.01 - 0.02 * static_cast<double>(j);
+            max_node_err = std::max(max_node_err, std::abs(r.elevation_m(lon, lat) - f32(z(lon, lat))));
+            // Between nodes: bilinear error bounded by |second derivative| * h^2 / 8.
+            max_err = std::max(max_err, std::abs(r.elevation_m(lon + 0.007, lat - 0.013) - z(lon + 0.007, lat - 0.013)));
+        }
+    EXPECT_LT(max_node_err, 1e-9);
+    // |z''| <= 4000 / 0.25 per degree^2 = 16000; h = 0.02 deg: 16000 * 4e-4 / 8 * 2 axes = 1.6 m.
+    EXPECT_LT(max_err, 1.6);
+    EXPECT_NEAR(r.elevation_m(-30.01, 20.01), f32(z(-30.01, 20.01)), 1e-9);
+}
+
+TEST(Bathymetry, global_grid_in_0_360_wraps_across_the_antimeridian) {
+    TempDir dir;
+    const std::string path = (dir / "global360.tif").string();
+    // 1-degree cells, lon 0..360; integer values so that float storage is exact.
+    auto z = [](double lon, double lat) { return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000; };
+    write_tiff(path, {0, 90, 1, 1, 360, 180}, z);
+    MeshOptions o = options_for(path);
+    Raster r = read_bathymetry(o); // covers the globe: no DataError
+    ASSERT_TRUE(r.global());
+    // Nodes, asked for in -180..180 longitudes.
+    for (double lat : {-89.5, -30.5, 0.5, 60.5, 89.5})
+        for (double lon = 0.5; lon < 360; lon += 17)
+            EXPECT_NEAR(r.elevation_m(lon > 180 ? lon - 360 : lon, lat), z(lon, lat), 1e-9);
+    // Across the seam between column 359 (359.5) and column 0 (0.5 == 360.5).
+    for (double lon : {-0.3, 359.7, 0.2, -359.8}) {
+        double u = (std::fmod(lon + 360.0, 360.0) - 359.5 + (lon > 0 && lon < 0.5 ? 360 : 0));
+        if (u < 0) u += 360;
+        double expect = (1 - u) * z(359.5, 10.5) + u * z(0.5, 10.5);
+        EXPECT_NEAR(r.elevation_m(lon, 10.5), expect, 1e-9) << lon;
+    }
+    // Near the poles the first and last rows are held.
+    EXPECT_NEAR(r.elevation_m(lonlat_to_vec(0, 90)), z(0.5, 89.5) * 0.5 + z(359.5, 89.5) * 0.5, 1e-9);
+    EXPECT_NEAR(r.elevation_m(45.5, -89.9), z(45.5, -89.5), 1e-9);
+}
+
+TEST(Bathymetry, node_registered_global_grid_drops_its_repeated_meridian) {
+    TempDir dir;
+    const std::string path = (dir / "nodes.tif").string();
+    // 361 x 181 nodes from -180 to 180: pixel centres on whole degrees.
+    auto z = [](double lon, double lat) { return std::round(lat * 10) + std::round(std::sin(lon * deg_to_rad) * 100); };
+    write_tiff(path, {-180.5, 90.5, 1, 1, 361, 181}, z);
+    Raster r = read_raster(path);
+    EXPECT_EQ(r.nlon(), 360u);
+    EXPECT_TRUE(r.global());
+    EXPECT_NEAR(r.elevation_m(180, 10), z(-180, 10), 1e-9);
+    EXPECT_NEAR(r.elevation_m(179.5, 10), 0.5 * (z(179, 10) + z(-180, 10)), 1e-9);
+    EXPECT_NEAR(r.elevation_m(0, 90), z(0, 90), 1e-9);
+}
+
+TEST(Bathymetry, projected_raster_is_read_through_a_warp_to_lonlat) {
+    TempDir dir;
+    const std::string path = (dir / "mercator.tif").string();
+    // EPSG:3857: x is linear in longitude, so a plane in x and y is known at every lon/lat.
+    const double a = 6378137.0;
+    auto plane = [](double x, double y) { return -3000.0 + 1e-3 * x + 5e-4 * (y - 5e6); };
+    write_tiff(path, {0, 6.0e6, 5000, 5000, 200, 200, 3857}, plane);
+    Raster r = read_raster(path);
+    EXPECT_NEAR(r.bounds().west, 0.0, 0.1);
+    for (double lon = 1; lon <= 8; lon += 0.7)
+        for (double lat = 41; lat <= 46; lat += 0.6) {
+            double x = a * lon * deg_to_rad, y = a * std::log(std::tan(pi / 4 + lat * deg_to_rad / 2));
+            // Warp (upsampling, bilinear): exact on a plane but for float storage (1.2e-4 m);
+            // our lon/lat bilinear errs by 5e-4 * y'' * dlat^2 / 8 < 1e-3 m.
+            EXPECT_NEAR(r.elevation_m(lon, lat), plane(x, y), 2e-3) << lon << " " << lat;
+        }
+    // Beyond the source footprint there is no data.
+    EXPECT_TRUE(std::isnan(r.elevation_m(-5.0, 43.0)));
+}
+
+TEST(Bathymetry, nodata_holes_give_nan_or_the_fill) {
+    TempDir dir;
+    const std::string path = (dir / "holes.tif").string();
+    auto z = [](double lon, double lat) {
+        if (lon > 2 && lon < 4 && lat > 2 && lat < 4) return -9999.0;
+        if (lon > 6 && lat < 1) return std::nan("");
+        return -100.0 * std::round(lon) - std::round(lat);
+    };
+    GridSpec s{0, 10, 0.5, 0.5, 20, 20};
+    s.nodata = -9999.0;
+    write_tiff(path, s, z);
+    Raster r = read_raster(path);
+    EXPECT_TRUE(std::isnan(r.elevation_m(3.0, 3.0)));
+    EXPECT_TRUE(std::isnan(r.elevation_m(8.0, 0.5)));
+    EXPECT_NEAR(r.elevation_m(7.25, 7.25), z(7.25, 7.25), 1e-9);
+    // Nearest corner valid, one corner in the hole: renormalised weights of the three others.
+    // Cell (1.75..2.25) x (1.75..2.25): the hole corner is (2.25, 2.25).
+    double lon = 1.85, lat = 1.95, fu = (lon - 1.75) / 0.5, fv = (lat - 1.75) / 0.5;
+    double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv;
+    double expect = (w00 * z(1.75, 1.75) + w10 * z(2.25, 1.75) + w01 * z(1.75, 2.25)) / (w00 + w10 + w01);
+    EXPECT_NEAR(r.elevation_m(lon, lat), expect, 1e-9);
+    // Nearest corner in the hole: no data.
+    EXPECT_TRUE(std::isnan(r.elevation_m(2.2, 2.2)));
+    r.set_fill_elevation_m(-42.0);
+    EXPECT_EQ(r.elevation_m(3.0, 3.0), -42.0);
+    EXPECT_EQ(r.depth_m(lonlat_to_vec(3.0, 3.0)), 42.0);
+    EXPECT_EQ(r.elevation_m(50.0, 3.0), -42.0); // outside the raster
+}
+
+TEST(Bathymetry, scale_offset_and_depth_positive_are_honoured) {
+    TempDir dir;
+    const std::string path = (dir / "scaled.tif").string();
+    GridSpec s{0, 10, 1, 1, 10, 10};
+    s.type = GDT_Int16;
+    s.scale_offset = std::make_pair(0.5, -1000.0);
+    write_tiff(path, s, [](double lon, double lat) { return std::round(lon * 10 + lat); });
+    Raster r = read_raster(path);
+    EXPECT_NEAR(r.elevation_m(3.5, 4.5), std::round(39.5) * 0.5 - 1000.0, 1e-9); // raw = round(3.5*10 + 4.5)
+    Raster d = read_raster(path, 1, true);
+    EXPECT_NEAR(d.elevation_m(3.5, 4.5), -r.elevation_m(3.5, 4.5), 1e-9);
+    EXPECT_NEAR(d.depth_m(lonlat_to_vec(3.5, 4.5)), r.elevation_m(3.5, 4.5), 1e-9);
+}
+
+TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
+    TempDir dir;
+    auto one_line = [](const std::string& m) { return m.find('\n') == std::string::npos; };
+    const std::string bare = (dir / "bare.tif").string();
+    GridSpec s{0, 10, 1, 1, 4, 4};
+    s.georeferenced = false;
+    write_tiff(bare, s, [](double, double) { return -1.0; });
+    try {
+        read_raster(bare);
+        FAIL() << "no georeferencing accepted";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find(bare), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("georeferencing"), std::string::npos) << e.what();
+        EXPECT_TRUE(one_line(e.what()));
+    }
+    const std::string ok = (dir / "ok.tif").string();
+    write_tiff(ok, {0, 10, 1, 1, 4, 4}, [](double, double) { return -1.0; });
+    try {
+        read_raster(ok, 2);
+        FAIL() << "band 2 of 1 accepted";
+    } catch (const UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("--bathy-band 2"), std::string::npos) << e.what();
+    }
+    const std::string empty = (dir / "nodata.tif").string();
+    GridSpec n{0, 10, 1, 1, 4, 4};
+    n.nodata = -1.0;
+    write_tiff(empty, n, [](double, double) { return -1.0; });
+    EXPECT_THROW(read_raster(empty), DataError);
+    EXPECT_THROW(read_raster((dir / "missing.tif").string()), IoError);
+    // A regional raster does not cover the globe, nor a region beyond it, unless filled.
+    MeshOptions o = options_for(ok);
+    try {
+        read_bathymetry(o);
+        FAIL() << "partial coverage accepted";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("--bathy-fill"), std::string::npos) << e.what();
+        EXPECT_TRUE(one_line(e.what()));
+    }
+    o.region = std::array<double, 4>{1, 7, 3, 9};
+    EXPECT_NO_THROW(read_bathymetry(o));
+    o.region = std::array<double, 4>{1, 7, 5, 9};
+    EXPECT_THROW(read_bathymetry(o), DataError);
+    o.bathy_fill_m = 30.0;
+    Raster filled = read_bathymetry(o);
+    EXPECT_EQ(filled.elevation_m(4.8, 8.0), -30.0);
+}
+
+TEST(Bathymetry, decimates_rasters_larger_than_the_cell_cap) {
+    TempDir dir;
+    const std::string path = (dir / "big.tif").string();
+    auto plane = [](double lon, double lat) { return -4000.0 + 20.0 * lon + 10.0 * lat; };
+    write_tiff(path, {0, 40, 0.25, 0.25, 80, 40}, plane);
+    Raster r = read_raster(path, 1, false, {}, 800); // 3200 cells -> 40 x 20 averaged
+    EXPECT_EQ(r.nlon(), 40u);
+    EXPECT_EQ(r.nlat(), 20u);
+    // The average of a plane over a 2x2 block is the plane at the block centre.
+    for (double lon = 1; lon < 19; lon += 1.7)
+        EXPECT_NEAR(r.elevation_m(lon, 35.3), plane(lon, 35.3), 1e-3);
+}
+
+TEST(Bathymetry, etopo5_global_netcdf_matches_its_own_coordinates_and_values) {
+    const std::string path = fixture("bathy/etopo5_global_10min.nc").string();
+    Raster r = read_bathymetry(options_for(path));
+    EXPECT_TRUE(r.global());
+    EXPECT_EQ(r.nlon(), 2160u);
+    EXPECT_EQ(r.nlat(), 1080u);
+    // Independent read with netCDF-C: the file's own lon/lat variables and elevation.
+    int nc = -1, lon_id, lat_id, z_id;
+    ASSERT_EQ(nc_open(path.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lon", &lon_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lat", &lat_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "elevation", &z_id), NC_NOERR);
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<std::size_t> ui(0, 2159), uj(0, 1079);
+    int land = 0, sea = 0;
+    for (int k = 0; k < 300; ++k) {
+        std::size_t idx[2] = {uj(rng), ui(rng)};
+        double lon, lat, z;
+        ASSERT_EQ(nc_get_var1_double(nc, lon_id, &idx[1], &lon), NC_NOERR);
+        ASSERT_EQ(nc_get_var1_double(nc, lat_id, &idx[0], &lat), NC_NOERR);
+        ASSERT_EQ(nc_get_var1_double(nc, z_id, idx, &z), NC_NOERR);
+        EXPECT_NEAR(r.elevation_m(lonlat_to_vec(lon, lat)), z, 1e-6) << lon << " " << lat;
+        (z > 0 ? land : sea)++;
+    }
+    nc_close(nc);
+    EXPECT_GT(sea, land); // most of the Earth is ocean
+    EXPECT_LT(r.elevation_m(-155, 0), -3000);  // central Pacific
+    EXPECT_GT(r.elevation_m(86.9, 28.0), 3000); // Himalaya
+}
+
+TEST(Bathymetry, etopo5_nwshelf_geotiff_nodes_sit_on_whole_5_minutes) {
+    const std::string path = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    MeshOptions o = options_for(path);
+    o.region = std::array<double, 4>{-10, 48, 10, 60};
+    Raster r = read_bathymetry(o);
+    EXPECT_EQ(r.nlon(), 301u);
+    EXPECT_EQ(r.nlat(), 193u);
+    EXPECT_NEAR(r.lon_deg(0), -12.0, 1e-9); // PixelIsPoint: node 0 at 12 W, 62 N
+    EXPECT_NEAR(r.lat_deg(0), 62.0, 1e-9);
+    for (int j = 0; j < 193; j += 19)
+        for (int i = 0; i < 301; i += 23) {
+            double lon = -12.0 + i / 12.0, lat = 62.0 - j / 12.0;
+            EXPECT_NEAR(r.elevation_m(lon, lat), gdal_pixel(path, i, j), 1e-9) << lon << " " << lat;
+        }
+    EXPECT_LT(r.elevation_m(3.0, 56.0), 0);   // North Sea
+    EXPECT_GT(r.elevation_m(-4.0, 57.0), 100); // Scottish Highlands
+    // The whole globe is not covered.
+    EXPECT_THROW(read_bathymetry(options_for(path)), DataError);
+}
