@@ -1,0 +1,109 @@
+// globemesh/coast.hpp: coastlines from any OGR source, turned into Boundary rings on the sphere.
+//
+// Two stages, because the size field needs the cleaned full-resolution coast before the
+// simplification that depends on it:
+//
+//   1. load_coast(): read any OGR vector layer (land polygons, or closed coastline lines that are
+//      polygonized), reproject to lon/lat (GIS axis order) through OGR/PROJ, make valid (GEOS
+//      MakeValid, STRUCTURE method), dissolve (union), keep holes, clip to --region or
+//      --region-file, drop islands and lakes below --min-island-area (geodesic area), then build
+//      the ocean's rings on the sphere: edges along the +-180 meridian cancel where the ocean
+//      lies on both sides (stitching), edges along lat +-90 vanish (pole closures), so
+//      Antarctica becomes one ring around the South Pole with no node on the artificial cut.
+//      GIS operations run in planar lon/lat with GEOS (where they are planar by nature); the
+//      rings then become great-circle polylines (planar edges longer than 0.5 degree are first
+//      densified in lon/lat) and are verified on the sphere.
+//   2. shape_boundary(): drop islands (and closed water bodies) smaller than
+//      options.min_island_triangles equilateral triangles of the local size, simplify each ring
+//      to the local size (Douglas-Peucker on the sphere with tolerance h/2, then nodes closer
+//      than h/2 are thinned), re-insert original nodes wherever a simplified arc would touch or
+//      cross another arc (topology preserved: rings never cross, islands never merge), and split
+//      every remaining arc so that consecutive nodes are about h(x) apart along great circles.
+//
+// Invariants of every Boundary returned (boundary.hpp): rings closed, >= 3 nodes, no two
+// consecutive nodes equal or antipodal, rings simple and mutually non-crossing as great-circle
+// arcs (checked by check_boundary(); a violation that cannot be repaired is a DataError), ocean
+// on the left. Segments on a region edge are SegmentKind::open, every other one coast.
+//
+// Repairs stated in numbers: longitudes within 1e-9 degree of +-180 are put on it (and 180.0000..14
+// is clamped); latitudes within 0.002 degree (220 m) of a pole are put on the pole, because
+// datasets close Antarctica there; where two rings (or one ring) meet at a single point (valid
+// in GEOS, not for a mesher) each copy of that node is moved 1e-7 rad (0.64 m) into the land.
+// Lon/lat sources in the 0..360 convention are not supported (longitudes must be in -180..180).
+//
+// Units: areas km2 (GeographicLib on WGS84), lengths km (mean radius, sphere.hpp).
+// Deterministic: every container is ordered; the same input gives the same rings.
+// References: GEOS C API (MakeValid, UnaryUnion, Polygonize); GeographicLib PolygonArea
+// (Karney 2013, "Algorithms for geodesics"); Douglas & Peucker (1973).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "globemesh/boundary.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/progress.hpp"
+#include "globemesh/sphere.hpp"
+
+namespace globemesh {
+
+/// The cleaned ocean domain at full resolution (stage 1).
+struct CoastData {
+    Boundary rings;            ///< ocean on the left, segments tagged coast/open, no resampling
+    double ocean_area_km2 = 0; ///< geodesic (WGS84) area of the ocean domain the rings enclose
+    std::size_t islands_removed = 0; ///< land polygons dropped by --min-island-area
+    std::size_t lakes_removed = 0;   ///< holes and inland water bodies dropped (area or inland seas)
+    double area_gained_km2 = 0;      ///< ocean added by dropping islands
+    double area_lost_km2 = 0;        ///< ocean lost by dropping lakes and inland seas
+    std::string layer;               ///< name of the layer that was read
+};
+
+/// Reads, reprojects, cleans and clips the coast of options.coast (and options.region /
+/// options.region_file) into full-resolution rings. Uses options.coast, coast_layer,
+/// coast_where, coast_srs, region, region_file, min_island_area_km2, keep_inland_seas.
+/// Throws UsageError (no --coast, bad --coast-where or --coast-srs), IoError (file missing or
+/// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
+/// region; rings that cannot be repaired), Cancelled.
+CoastData load_coast(const MeshOptions& options, const Progress& progress = {});
+
+/// Target edge length in km at a point of the unit sphere (must be > 0).
+using SizeFn = std::function<double(const Vec3&)>;
+
+struct CoastReport {
+    std::size_t rings = 0;            ///< rings in the shaped boundary
+    std::size_t nodes = 0;            ///< nodes in the shaped boundary
+    std::size_t islands_removed = 0;  ///< by --min-island-area (stage 1) and by size (stage 2)
+    std::size_t lakes_removed = 0;    ///< holes and closed water bodies removed (both stages)
+    std::size_t conflicts_repaired = 0; ///< simplified arcs refined because they touched another
+    double area_lost_km2 = 0;         ///< ocean removed: dropped lakes + net loss of simplification
+    double area_gained_km2 = 0;       ///< ocean added: dropped islands + net gain of simplification
+    double ocean_area_km2 = 0;        ///< geodesic area enclosed by the shaped boundary
+};
+
+/// Stage 2: drops rings smaller than options.min_island_triangles triangles of the local size,
+/// simplifies to the local size with topology preserved and resamples every ring so consecutive
+/// nodes are about size_km(x) apart along great-circle arcs. Throws DataError when the shaped
+/// rings cannot be made to satisfy boundary.hpp, Cancelled.
+Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
+                        CoastReport* report = nullptr, const Progress& progress = {});
+
+/// One violated invariant of a Boundary: a message and where (ring, segment), -1 when none.
+struct BoundaryIssue {
+    std::string what;
+    long ring = -1, segment = -1, other_ring = -1, other_segment = -1;
+};
+
+/// Checks every invariant of boundary.hpp except the side of the ocean: ring sizes, unit
+/// vectors, consecutive nodes distinct and not antipodal, no two arcs (of one ring or two)
+/// touching or crossing except consecutive arcs at their shared node, no arc folding back on
+/// the previous one. Double precision: points closer than 1e-14 rad to an arc count as touching
+/// it. Returns the issues found (empty when the boundary is valid), at most max_issues.
+std::vector<BoundaryIssue> check_boundary(const Boundary& boundary, std::size_t max_issues = 100);
+
+/// Geodesic area (WGS84, GeographicLib) of the region to the left of all rings, km2; the whole
+/// Earth for an empty boundary. Exact for rings whose arcs are geodesics.
+double boundary_area_km2(const Boundary& boundary);
+
+} // namespace globemesh

@@ -1,0 +1,217 @@
+// Invariant checks of a Boundary on the sphere (double precision) and its geodesic area.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/PolygonArea.hpp>
+
+#include "coast_internal.hpp"
+#include "globemesh/coast.hpp"
+
+namespace globemesh {
+namespace coast_detail {
+
+namespace {
+
+constexpr double touch_eps = 1e-14;
+
+int side(double d) { return d > touch_eps ? 1 : (d < -touch_eps ? -1 : 0); }
+
+/// True when p (on the great circle of arc a-b, normal n) lies within the arc.
+bool within_arc(const Vec3& a, const Vec3& b, const Vec3& n, const Vec3& p) {
+    return dot(cross(a, p), n) >= -touch_eps && dot(cross(p, b), n) >= -touch_eps;
+}
+
+} // namespace
+
+/// a x b computed as (a + b) x (b - a) / 2, accurate also for nearby points (S2's robust cross
+/// product): its direction error stays near one ulp however short the arc.
+Vec3 robust_cross(const Vec3& a, const Vec3& b) { return 0.5 * cross(a + b, b - a); }
+
+bool arcs_conflict(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+    if (dot(a + b, c + d) <= 0) return false; // far apart (arcs are shorter than pi/2 here)
+    Vec3 n1 = robust_cross(a, b), n2 = robust_cross(c, d);
+    double l1 = norm(n1), l2 = norm(n2);
+    if (l1 == 0 || l2 == 0) return true; // degenerate arc: treat as a conflict
+    n1 = (1.0 / l1) * n1;
+    n2 = (1.0 / l2) * n2;
+    int sa = side(dot(n2, a)), sb = side(dot(n2, b));
+    int sc = side(dot(n1, c)), sd = side(dot(n1, d));
+    if (sa * sb > 0 || sc * sd > 0) return false;
+    Vec3 x = cross(n1, n2);
+    double lx = norm(x);
+    if ((sa == 0 && sb == 0) || (sc == 0 && sd == 0) || lx < 1e-12) { // one great circle: overlap?
+        return within_arc(a, b, n1, c) || within_arc(a, b, n1, d) || within_arc(c, d, n2, a) ||
+               within_arc(c, d, n2, b);
+    }
+    // Each arc's ends straddle (or touch) the other's great circle: they meet iff the meeting
+    // point lies on the same side for both arcs.
+    x = (1.0 / lx) * x;
+    double s1 = dot(x, a + b), s2 = dot(x, c + d);
+    if (std::abs(s1) < touch_eps || std::abs(s2) < touch_eps) return true;
+    return (s1 > 0) == (s2 > 0);
+}
+
+std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>& rings,
+                                    std::size_t max_pairs) {
+    struct Seg {
+        std::uint32_t ring, index;
+    };
+    std::vector<Seg> segs;
+    double total = 0;
+    std::size_t count = 0;
+    for (std::uint32_t r = 0; r < rings.size(); ++r) {
+        const auto& nodes = *rings[r];
+        for (std::uint32_t i = 0; i < nodes.size(); ++i) {
+            segs.push_back({r, i});
+            total += norm(nodes[i] - nodes[(i + 1) % nodes.size()]);
+            ++count;
+        }
+    }
+    std::vector<ArcPair> out;
+    if (count == 0) return out;
+    // Cell size: a few mean chords, bounded so the grid stays small.
+    double cell = std::clamp(4.0 * total / static_cast<double>(count), 2e-5, 0.05);
+    auto key = [cell](double x, double y, double z) {
+        auto q = [cell](double v) { return static_cast<std::uint64_t>(std::floor((v + 1.5) / cell)); };
+        return (q(x) << 42) | (q(y) << 21) | q(z);
+    };
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
+    entries.reserve(count * 4);
+    for (std::uint32_t s = 0; s < segs.size(); ++s) {
+        const auto& nodes = *rings[segs[s].ring];
+        const Vec3& a = nodes[segs[s].index];
+        const Vec3& b = nodes[(segs[s].index + 1) % nodes.size()];
+        double ang = arc_angle(a, b);
+        int pieces = std::max(1, static_cast<int>(std::ceil(ang / (0.5 * cell))));
+        Vec3 prev = a;
+        for (int k = 1; k <= pieces; ++k) {
+            Vec3 next = k == pieces ? b : arc_interpolate(a, b, double(k) / pieces);
+            double pad = 1e-9 + 0.125 * arc_angle(prev, next) * arc_angle(prev, next);
+            double lo[3] = {std::min(prev.x, next.x) - pad, std::min(prev.y, next.y) - pad,
+                            std::min(prev.z, next.z) - pad};
+            double hi[3] = {std::max(prev.x, next.x) + pad, std::max(prev.y, next.y) + pad,
+                            std::max(prev.z, next.z) + pad};
+            for (double x = lo[0];; x += cell) {
+                double cx = std::min(x, hi[0]);
+                for (double y = lo[1];; y += cell) {
+                    double cy = std::min(y, hi[1]);
+                    for (double z = lo[2];; z += cell) {
+                        double cz = std::min(z, hi[2]);
+                        entries.push_back({key(cx, cy, cz), s});
+                        if (cz >= hi[2]) break;
+                    }
+                    if (cy >= hi[1]) break;
+                }
+                if (cx >= hi[0]) break;
+            }
+            prev = next;
+        }
+    }
+    std::sort(entries.begin(), entries.end());
+    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t i = 0; i < entries.size();) {
+        std::size_t j = i;
+        while (j < entries.size() && entries[j].first == entries[i].first) ++j;
+        for (std::size_t p = i; p < j; ++p)
+            for (std::size_t q = p + 1; q < j; ++q) pairs.push_back({entries[p].second, entries[q].second});
+        i = j;
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    for (auto [s, t] : pairs) {
+        const Seg& u = segs[s];
+        const Seg& v = segs[t];
+        const auto& ru = *rings[u.ring];
+        const auto& rv = *rings[v.ring];
+        const Vec3& a = ru[u.index];
+        const Vec3& b = ru[(u.index + 1) % ru.size()];
+        const Vec3& c = rv[v.index];
+        const Vec3& d = rv[(v.index + 1) % rv.size()];
+        bool conflict;
+        if (u.ring == v.ring && ru.size() > 2 &&
+            ((u.index + 1) % ru.size() == v.index || (v.index + 1) % ru.size() == u.index)) {
+            // Consecutive arcs share one node: they conflict only when one folds back on the
+            // other (a zero-width spike).
+            bool u_first = (u.index + 1) % ru.size() == v.index;
+            const Vec3& p = u_first ? a : c;
+            const Vec3& m = u_first ? b : d;
+            const Vec3& q = u_first ? d : b;
+            Vec3 n = robust_cross(p, m);
+            double ln = norm(n);
+            conflict = ln == 0 || (std::abs(dot((1.0 / ln) * n, q)) < touch_eps && dot(m - p, q - m) < 0);
+        } else {
+            conflict = arcs_conflict(a, b, c, d);
+        }
+        if (conflict) {
+            out.push_back({u.ring, u.index, v.ring, v.index});
+            if (out.size() >= max_pairs) break;
+        }
+    }
+    return out;
+}
+
+double rings_area_km2(const std::vector<std::vector<LonLat>>& rings) {
+    const auto& wgs = GeographicLib::Geodesic::WGS84();
+    double earth = wgs.EllipsoidArea() * 1e-6;
+    if (rings.empty()) return earth;
+    double sum = 0;
+    for (const auto& ring : rings) {
+        GeographicLib::PolygonArea poly(wgs, false);
+        for (const auto& p : ring) poly.AddPoint(p.lat, p.lon);
+        double perimeter, area;
+        poly.Compute(false, true, perimeter, area);
+        sum += area * 1e-6;
+    }
+    double r = std::fmod(sum, earth);
+    if (r < 0) r += earth;
+    // A region that is almost the whole Earth and one that is almost empty differ by a full
+    // Earth; the rounding of the sum can only matter within a few m2 of those ends.
+    if (r < 1e-6 * earth && sum > 0.5 * earth) r = earth;
+    return r;
+}
+
+} // namespace coast_detail
+
+std::vector<BoundaryIssue> check_boundary(const Boundary& boundary, std::size_t max_issues) {
+    std::vector<BoundaryIssue> issues;
+    auto add = [&](std::string what, long ring, long seg, long oring = -1, long oseg = -1) {
+        if (issues.size() < max_issues) issues.push_back({std::move(what), ring, seg, oring, oseg});
+    };
+    std::vector<const std::vector<Vec3>*> rings;
+    for (long r = 0; r < static_cast<long>(boundary.rings.size()); ++r) {
+        const Ring& ring = boundary.rings[r];
+        rings.push_back(&ring.nodes);
+        if (ring.nodes.size() < 3) add("ring has fewer than 3 nodes", r, -1);
+        if (ring.kinds.size() != ring.nodes.size()) add("ring has kinds.size() != nodes.size()", r, -1);
+        for (long i = 0; i < static_cast<long>(ring.nodes.size()); ++i) {
+            const Vec3& a = ring.nodes[i];
+            const Vec3& b = ring.nodes[(i + 1) % ring.nodes.size()];
+            if (std::abs(norm(a) - 1.0) > 1e-12) add("node is not a unit vector", r, i);
+            if (a == b) add("consecutive nodes are equal", r, i);
+            else if (norm(a + b) < 1e-12) add("consecutive nodes are antipodal", r, i);
+        }
+    }
+    if (!issues.empty()) return issues;
+    for (const auto& c : coast_detail::find_conflicts(rings, max_issues))
+        add("arcs touch or cross", c.ring_a, c.seg_a, c.ring_b, c.seg_b);
+    return issues;
+}
+
+double boundary_area_km2(const Boundary& boundary) {
+    std::vector<std::vector<LonLat>> rings;
+    for (const auto& ring : boundary.rings) {
+        std::vector<LonLat> ll;
+        ll.reserve(ring.nodes.size());
+        for (const auto& v : ring.nodes) ll.push_back(vec_to_lonlat(v));
+        rings.push_back(std::move(ll));
+    }
+    return coast_detail::rings_area_km2(rings);
+}
+
+} // namespace globemesh
