@@ -25,7 +25,7 @@ struct GpkgOptions {
 void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options = {});
 
 struct PreviewOptions {
-    std::string land;                 ///< optional OGR land polygons drawn under the mesh
+    std::string land;                 ///< optional OGR land polygons drawn under the mesh (layer "land", else the first)
     std::string colour_by = "quality"; ///< "quality" or "depth"
     int width_px = 1600;
     std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N; default the mesh extent or globe

@@ -126,7 +126,11 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
         wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
         const Rgba land_colour = {205, 195, 170, 255};
         std::vector<std::unique_ptr<OGRGeometry>> land_geoms;
-        for (OGRLayer* layer : land->GetLayers()) {
+        // The layer named "land" when there is one, else the first (a file may also hold "ocean").
+        OGRLayer* layer = land->GetLayerByName("land");
+        if (!layer) layer = land->GetLayer(0);
+        if (!layer) throw DataError("preview land " + options.land + ": the file has no layer");
+        {
             std::unique_ptr<OGRCoordinateTransformation> ct;
             if (const OGRSpatialReference* srs = layer->GetSpatialRef(); srs && !srs->IsSame(&wgs84)) {
                 ct.reset(OGRCreateCoordinateTransformation(srs, &wgs84));

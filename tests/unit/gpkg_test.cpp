@@ -1,0 +1,257 @@
+// GeoPackage writer and PNG preview, read back with OGR/GDAL. Oracles: counts from the mesh, the
+// plate carree rectangle (360 x 180 square degrees) that a closed mesh's faces must tile exactly,
+// part widths, and pixel colours at places known to be face, land or background.
+#include <gtest/gtest.h>
+
+#include <gdal_priv.h>
+#include <ogrsf_frmts.h>
+
+#include <fstream>
+
+#include "globemesh/error.hpp"
+#include "globemesh/gpkg.hpp"
+#include "io_test_meshes.hpp"
+#include "support.hpp"
+
+using namespace globemesh;
+using namespace globemesh::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Dataset {
+    explicit Dataset(const fs::path& p, unsigned flags = GDAL_OF_VECTOR) {
+        GDALAllRegister();
+        ds.reset(GDALDataset::Open(p.c_str(), flags | GDAL_OF_READONLY));
+    }
+    struct Close {
+        void operator()(GDALDataset* d) const { GDALClose(d); }
+    };
+    std::unique_ptr<GDALDataset, Close> ds;
+};
+
+std::vector<std::string> folder_listing(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// Sum of planar lon/lat areas of all features, and the widest polygon part, degrees.
+std::pair<double, double> faces_area_and_widest_part(OGRLayer* layer) {
+    double area = 0, widest = 0;
+    layer->ResetReading();
+    for (auto& f : *layer) {
+        const auto* multi = f->GetGeometryRef()->toMultiPolygon();
+        for (const auto* part : multi) {
+            OGREnvelope env;
+            part->getEnvelope(&env);
+            widest = std::max(widest, env.MaxX - env.MinX);
+            EXPECT_GE(env.MinX, -180.0);
+            EXPECT_LE(env.MaxX, 180.0);
+            area += part->get_Area();
+        }
+    }
+    return {area, widest};
+}
+
+std::array<int, 4> pixel(GDALDataset* ds, double lon, double lat, const std::array<double, 4>& extent) {
+    int x = int((lon - extent[0]) / (extent[2] - extent[0]) * ds->GetRasterXSize());
+    int y = int((extent[3] - lat) / (extent[3] - extent[1]) * ds->GetRasterYSize());
+    std::array<int, 4> c{};
+    for (int b = 0; b < std::min(4, ds->GetRasterCount()); ++b) {
+        GByte v = 0;
+        EXPECT_EQ(ds->GetRasterBand(b + 1)->RasterIO(GF_Read, x, y, 1, 1, &v, 1, 1, GDT_Byte, 0, 0), CE_None);
+        c[b] = v;
+    }
+    return c;
+}
+
+} // namespace
+
+TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
+    TempDir dir;
+    Mesh m = icosphere_with_holes(3);
+    m.attributes = {{"coast", "land.gpkg"}};
+    write_gpkg(m, dir / "m.gpkg");
+    Dataset d(dir / "m.gpkg");
+    ASSERT_TRUE(d.ds);
+    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    OGRLayer* nodes = d.ds->GetLayerByName("nodes");
+    OGRLayer* boundary = d.ds->GetLayerByName("boundary");
+    OGRLayer* info = d.ds->GetLayerByName("mesh_info");
+    ASSERT_TRUE(faces && nodes && boundary && info);
+    EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
+    EXPECT_EQ(nodes->GetFeatureCount(), GIntBig(m.nodes.size()));
+    EXPECT_EQ(wkbFlatten(faces->GetGeomType()), wkbMultiPolygon);
+    EXPECT_TRUE(faces->GetSpatialRef() && faces->GetSpatialRef()->GetEPSGGeogCS() == 4326);
+    for (const char* field : {"quality", "area_km2", "depth", "target_size"})
+        EXPECT_GE(faces->GetLayerDefn()->GetFieldIndex(field), 0) << field;
+    for (const char* field : {"depth", "target_size"}) EXPECT_GE(nodes->GetLayerDefn()->GetFieldIndex(field), 0) << field;
+
+    // Face 7: mean depth of its nodes, quality as the sphere module computes it.
+    std::unique_ptr<OGRFeature> f7(faces->GetFeature(8));
+    ASSERT_TRUE(f7);
+    const auto& t = m.faces[7];
+    const auto& depth = m.node_field("depth")->values;
+    EXPECT_NEAR(f7->GetFieldAsDouble("depth"), (depth[t[0]] + depth[t[1]] + depth[t[2]]) / 3, 1e-9);
+    EXPECT_NEAR(f7->GetFieldAsDouble("quality"), triangle_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]]), 1e-12);
+
+    // Boundary runs: every boundary edge once, tags coast and open both present.
+    int edges = 0, coast = 0, open = 0;
+    for (auto& f : *boundary) {
+        edges += f->GetFieldAsInteger("edges");
+        std::string tag = f->GetFieldAsString("tag");
+        coast += tag == "coast", open += tag == "open";
+    }
+    EXPECT_EQ(std::size_t(edges), m.boundary.size());
+    EXPECT_GT(coast, 0);
+    EXPECT_GT(open, 0);
+    bool found = false;
+    for (auto& f : *info) found |= std::string(f->GetFieldAsString("key")) == "coast";
+    EXPECT_TRUE(found);
+}
+
+TEST(Gpkg, closed_mesh_faces_tile_the_lonlat_rectangle_with_no_part_wider_than_180) {
+    TempDir dir;
+    write_gpkg(icosphere(3), dir / "ico.gpkg");
+    Dataset d(dir / "ico.gpkg");
+    ASSERT_TRUE(d.ds);
+    auto [area, widest] = faces_area_and_widest_part(d.ds->GetLayerByName("faces"));
+    EXPECT_NEAR(area, 360.0 * 180.0, 1e-6); // no gap and no overlap, poles and seam included
+    EXPECT_LT(widest, 180.0);
+}
+
+TEST(Gpkg, pole_corner_is_written_as_two_points_at_the_neighbouring_longitudes) {
+    TempDir dir;
+    Mesh m = icosphere(0); // node 0 is the north pole; face 0 is (pole, u, un)
+    write_gpkg(m, dir / "ico.gpkg");
+    Dataset d(dir / "ico.gpkg");
+    std::unique_ptr<OGRFeature> f(d.ds->GetLayerByName("faces")->GetFeature(1));
+    const auto* ring = f->GetGeometryRef()->toMultiPolygon()->getGeometryRef(0)->getExteriorRing();
+    std::vector<double> pole_lons;
+    for (int i = 0; i + 1 < ring->getNumPoints(); ++i)
+        if (ring->getY(i) == 90.0) pole_lons.push_back(ring->getX(i));
+    ASSERT_EQ(pole_lons.size(), 2u);
+    std::sort(pole_lons.begin(), pole_lons.end());
+    EXPECT_NEAR(pole_lons[0], -180.0, 1e-9); // the corners of face 0 are at lon -180 and -108
+    EXPECT_NEAR(pole_lons[1], -108.0, 1e-9);
+}
+
+TEST(Gpkg, faces_crossing_the_antimeridian_are_cut_into_two_parts) {
+    TempDir dir;
+    Mesh m = icosphere_cap(4, 180, 0, 30);
+    write_gpkg(m, dir / "pacific.gpkg");
+    Dataset d(dir / "pacific.gpkg");
+    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
+    auto [area, widest] = faces_area_and_widest_part(faces);
+    EXPECT_LT(widest, 30.0);
+    int cut = 0;
+    faces->ResetReading();
+    for (auto& f : *faces) cut += f->GetGeometryRef()->toMultiPolygon()->getNumGeometries() == 2;
+    EXPECT_GT(cut, 5);
+    // Boundary lines are cut too: no segment jumps across the map.
+    for (auto& f : *d.ds->GetLayerByName("boundary")) {
+        OGREnvelope env;
+        for (const auto* line : f->GetGeometryRef()->toMultiLineString()) {
+            line->getEnvelope(&env);
+            EXPECT_LT(env.MaxX - env.MinX, 90.0);
+        }
+    }
+}
+
+TEST(Gpkg, default_qgis_style_colours_faces_by_quality) {
+    TempDir dir;
+    write_gpkg(icosphere(1), dir / "s.gpkg");
+    Dataset d(dir / "s.gpkg");
+    OGRLayer* styles = d.ds->GetLayerByName("layer_styles");
+    ASSERT_TRUE(styles);
+    for (const char* field : {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
+                              "styleQML", "styleSLD", "useAsDefault", "description", "owner", "ui", "update_time"})
+        EXPECT_GE(styles->GetLayerDefn()->GetFieldIndex(field), 0) << field;
+    ASSERT_EQ(styles->GetFeatureCount(), 1);
+    std::unique_ptr<OGRFeature> s(styles->GetNextFeature());
+    EXPECT_STREQ(s->GetFieldAsString("f_table_name"), "faces");
+    EXPECT_STREQ(s->GetFieldAsString("f_geometry_column"), d.ds->GetLayerByName("faces")->GetGeometryColumn());
+    EXPECT_EQ(s->GetFieldAsInteger("useAsDefault"), 1);
+    std::string qml = s->GetFieldAsString("styleQML");
+    EXPECT_NE(qml.find("type=\"graduatedSymbol\" attr=\"quality\""), std::string::npos);
+}
+
+TEST(Gpkg, existing_output_refused_and_failures_leave_no_file) {
+    TempDir dir;
+    std::ofstream(dir / "o.gpkg") << "keep";
+    EXPECT_THROW(write_gpkg(icosphere(1), dir / "o.gpkg"), IoError);
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"o.gpkg"});
+    fs::remove(dir / "o.gpkg");
+    EXPECT_THROW(write_gpkg(icosphere(1), dir / "missing/o.gpkg"), IoError);
+    GpkgOptions o;
+    o.after_partial_write = [&] { throw Cancelled(); };
+    EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg", o), Cancelled);
+    EXPECT_TRUE(folder_listing(dir.path()).empty());
+    o.after_partial_write = [&] { throw std::runtime_error("simulated failure"); };
+    EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg", o), std::runtime_error);
+    EXPECT_TRUE(folder_listing(dir.path()).empty());
+}
+
+TEST(Preview, draws_faces_over_land_without_smearing_across_the_map) {
+    TempDir dir;
+    Mesh m = icosphere_cap(4, 180, 0, 30);
+    PreviewOptions o;
+    o.land = fixture("coast/ne_110m_land.gpkg").string();
+    o.width_px = 720;
+    o.extent_deg = std::array<double, 4>{-180, -90, 180, 90};
+    write_preview_png(m, dir / "globe.png", o);
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"globe.png"}); // no .aux.xml
+    Dataset d(dir / "globe.png", GDAL_OF_RASTER);
+    ASSERT_TRUE(d.ds);
+    EXPECT_STREQ(d.ds->GetDriver()->GetDescription(), "PNG");
+    EXPECT_EQ(d.ds->GetRasterXSize(), 720);
+    EXPECT_EQ(d.ds->GetRasterYSize(), 360);
+    const auto extent = *o.extent_deg;
+    const std::array<int, 4> background = {236, 242, 248, 255}, land = {205, 195, 170, 255};
+    EXPECT_EQ(pixel(d.ds.get(), 20, 5, extent), land);           // central Africa
+    EXPECT_EQ(pixel(d.ds.get(), -30, -40, extent), background);  // South Atlantic, no mesh
+    EXPECT_EQ(pixel(d.ds.get(), 0, 1, extent), background);      // a smeared face would cover this
+    // Face centres (not edges, where outlines are drawn) east and west of the antimeridian.
+    LonLat east{0, 0}, west{0, 0};
+    for (const auto& t : m.faces) {
+        LonLat c = vec_to_lonlat(normalized(m.nodes[t[0]] + m.nodes[t[1]] + m.nodes[t[2]]));
+        if (c.lon > 170 && std::fabs(c.lat) < 10) east = c;
+        if (c.lon < -170 && std::fabs(c.lat) < 10) west = c;
+    }
+    auto at_cap_east = pixel(d.ds.get(), east.lon, east.lat, extent), at_cap_west = pixel(d.ds.get(), west.lon, west.lat, extent);
+    EXPECT_NE(at_cap_east, background);
+    EXPECT_NE(at_cap_west, background);
+    EXPECT_GT(at_cap_east[1], at_cap_east[0]); // quality ~0.9: green over red
+}
+
+TEST(Preview, default_extent_of_a_pacific_mesh_is_continuous_across_180_and_colours_by_depth) {
+    TempDir dir;
+    Mesh m = icosphere_cap(4, 180, 0, 30);
+    PreviewOptions o;
+    o.colour_by = "depth";
+    o.width_px = 400;
+    write_preview_png(m, dir / "pac.png", o);
+    Dataset d(dir / "pac.png", GDAL_OF_RASTER);
+    ASSERT_TRUE(d.ds);
+    // The picture spans about 60 degrees round lon 180 (not the whole globe): centre is mesh.
+    EXPECT_GT(d.ds->GetRasterYSize(), 300);
+    EXPECT_LT(d.ds->GetRasterYSize(), 500);
+    // Most of the picture is faces in blue depth colours: the cap is drawn in one piece.
+    const int w = d.ds->GetRasterXSize(), h = d.ds->GetRasterYSize();
+    std::vector<GByte> r(std::size_t(w) * h), b(std::size_t(w) * h);
+    ASSERT_EQ(d.ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, r.data(), w, h, GDT_Byte, 0, 0), CE_None);
+    ASSERT_EQ(d.ds->GetRasterBand(3)->RasterIO(GF_Read, 0, 0, w, h, b.data(), w, h, GDT_Byte, 0, 0), CE_None);
+    std::size_t blue = 0;
+    for (std::size_t i = 0; i < r.size(); ++i) blue += b[i] > r[i] + 50;
+    EXPECT_GT(double(blue) / double(r.size()), 0.45);
+    EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), IoError); // exists, no overwrite
+    o.overwrite = true;
+    o.after_partial_write = [] { throw Cancelled(); };
+    EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), Cancelled);
+    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"pac.png"});
+    o.colour_by = "salinity";
+    EXPECT_THROW(write_preview_png(m, dir / "x.png", o), UsageError);
+}
