@@ -2,15 +2,91 @@
 //
 // run_cli parses the arguments (CLI11, config files), validates them, calls the library, shows
 // GDAL-style progress on `err`, and maps errors to one line on `err` prefixed "globemesh:" and an
-// exit status: 0 success, 1 data/IO error, 2 usage error. It never calls exit().
+// exit status: 0 success, 1 data/IO error (and cancellation), 2 usage error. It never calls
+// exit(). Nothing but results (help, version, the run summary, --print-config, info) goes to
+// `out`.
+//
+// Units at the command line: lengths take km or m ("20km", "5000m"; a bare number is km),
+// areas km2 or m2 ("1000km2", "1e6m2"; bare: km2), durations h, min or s ("12.42h"; bare: h).
+// They are converted here, once, into the km / km2 / hour fields of MeshOptions.
 #pragma once
 
+#include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <ostream>
 #include <span>
 #include <string>
+#include <string_view>
+#include <vector>
+
+#include "globemesh/gpkg.hpp"
+#include "globemesh/mesh.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/pipeline.hpp"
+#include "globemesh/ugrid.hpp"
 
 namespace globemesh {
 
+/// Runs `globemesh ARGS...` (args exclude the program name). Returns the exit status.
 int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err);
+
+/// The library calls run_cli makes. run_cli(args, out, err) uses library_calls(), the real
+/// functions; tests pass their own to show that a bad command stops before any call is made,
+/// or to interrupt a run at a chosen point (a seam like GDAL's test hooks). Each member must be
+/// set.
+struct CliLibrary {
+    std::function<Mesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
+    std::function<Mesh(const TriangulateOptions&, const Progress&, StageTimings*)> triangulate_file;
+    std::function<void(const Mesh&, const std::filesystem::path&, const UgridOptions&)> write_ugrid;
+    std::function<void(const Mesh&, const std::filesystem::path&, const GpkgOptions&)> write_gpkg;
+    std::function<void(const Mesh&, const std::filesystem::path&, const PreviewOptions&)> write_preview_png;
+    std::function<Mesh(const std::filesystem::path&)> read_ugrid;
+    std::function<MeshStats(const Mesh&)> compute_stats;
+};
+
+/// The real library functions (pipeline.hpp, ugrid.hpp, gpkg.hpp).
+CliLibrary library_calls();
+
+/// run_cli with the given library calls.
+int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err,
+            const CliLibrary& library);
+
+/// Program-only choices of `globemesh mesh`, kept apart from the library's MeshOptions (GDAL's
+/// "OptionsForBinary" split). CLI11 binds the flags straight to these fields.
+struct CliOptions {
+    MeshOptions mesh;
+    std::string output;             ///< -o/--output: UGRID NetCDF file to write (required)
+    std::string gpkg;               ///< --gpkg: also write a GeoPackage
+    std::string preview;            ///< --preview: also draw a PNG picture of the mesh
+    std::string format = "netcdf4"; ///< --format: netcdf4 (deflate) or classic (netCDF-3)
+    std::string timings;            ///< --timings: JSON file of seconds per stage
+    std::string report;             ///< --report: JSON file of the run summary and histogram
+    bool overwrite = false;         ///< --overwrite: replace existing outputs
+    bool quiet = false;             ///< --quiet: no progress on stderr
+    bool verbose = false;           ///< --verbose: stage names with the progress
+    bool check = false;             ///< --check: verify the mesh invariants before writing
+    bool print_config = false;      ///< --print-config: print the effective configuration, stop
+};
+
+/// Parses the arguments of `globemesh mesh` (after the word "mesh"), including any --config
+/// file, into CliOptions. Validates nothing beyond the syntax and units. Throws UsageError
+/// naming the option (also for --help, which has nothing to return here).
+CliOptions parse_mesh_args(std::span<const std::string> args);
+
+/// "20km", "5000m", "20" (km) -> km. Throws UsageError for a non-number or an unknown unit.
+double parse_length_km(std::string_view text);
+/// "1000km2", "1e6m2", "1000" (km2) -> km2. Throws UsageError like parse_length_km.
+double parse_area_km2(std::string_view text);
+/// "12.42h", "745min", "44712s", "12.42" (h) -> hours. Throws UsageError like parse_length_km.
+double parse_duration_h(std::string_view text);
+/// "50m", "0.05km", "50" (m) -> metres (depths). Throws UsageError like parse_length_km.
+double parse_depth_m(std::string_view text);
+
+/// The invariants of mesh.hpp that fail (empty when the mesh is sound): indices in range,
+/// three distinct corners, counter-clockwise faces (sign of det[a,b,c] in floating point), unit nodes (|1-|v|| < 1e-12),
+/// every edge shared by at most two faces with opposite directions, boundary list equal to the
+/// edges used by one face, field sizes. At most `limit` messages.
+std::vector<std::string> check_mesh(const Mesh& mesh, std::size_t limit = 20);
 
 } // namespace globemesh

@@ -1,10 +1,631 @@
+// run_cli(): parsing (CLI11 and config files), validation, progress, outputs, summaries and the
+// mapping of errors to exit statuses. One CLI11 App per subcommand, so that `--config` reads a
+// flat file whose keys are the long option names (CLI11 reads config files for its top App only).
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <cpl_error.h>
+#include <gdal.h>
+
+#include "cli_support.hpp"
 #include "globemesh/cli.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/gpkg.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/pipeline.hpp"
+#include "globemesh/ugrid.hpp"
 
 namespace globemesh {
 
-int run_cli(std::span<const std::string>, std::ostream&, std::ostream& err) {
-    err << "globemesh: not yet implemented\n";
-    return 1;
+namespace {
+
+namespace fs = std::filesystem;
+using namespace globemesh::cli;
+
+int report_error(std::ostream& err);
+
+std::string version_text() {
+    return std::string("globemesh ") + GLOBEMESH_VERSION + " (GDAL " + GDALVersionInfo("RELEASE_NAME") + ")";
 }
+
+/// Shortest text that reads back as the same double.
+std::string exact_text(double v) {
+    char buffer[32];
+    auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
+    return std::string(buffer, end);
+}
+
+/// A CLI11 transform that turns "20km" into "20" (the field's unit), so the bound field, the
+/// --help default and --print-config all speak the field's unit.
+CLI::Validator unit_transform(double (*parse)(std::string_view), const std::string& name) {
+    return CLI::Validator(
+        [parse](std::string& value) -> std::string {
+            try {
+                value = exact_text(parse(value));
+                return {};
+            } catch (const UsageError& e) {
+                return e.what();
+            }
+        },
+        name);
+}
+
+/// CLI11 wants the arguments in reverse order.
+std::vector<std::string> reversed(std::span<const std::string> args) {
+    return std::vector<std::string>(args.rbegin(), args.rend());
+}
+
+/// One line: newlines of multi-line messages (CLI11's) become "; ".
+std::string one_line(std::string message) {
+    while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+    std::string r;
+    for (char c : message) {
+        if (c == '\n')
+            r += "; ";
+        else
+            r += c;
+    }
+    return r;
+}
+
+/// The command line for the `history` attribute, with the date (UTC).
+std::string history_text(const std::string& sub, std::span<const std::string> args) {
+    std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char date[32];
+    std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    std::string command = "globemesh " + sub;
+    for (const auto& a : args) {
+        const bool plain = !a.empty() && a.find_first_of(" \t'\"\\$`") == std::string::npos;
+        command += " " + (plain ? a : "'" + a + "'");
+    }
+    return std::string(date) + ": " + command;
+}
+
+/// GDAL messages go through our stream: warnings only with --verbose (errors become exceptions
+/// at the library's call sites, which read CPLGetLastErrorMsg).
+class GdalMessages {
+public:
+    GdalMessages(std::ostream& err, bool verbose) : err_(err), verbose_(verbose) {
+        CPLPushErrorHandlerEx(&GdalMessages::handler, this);
+    }
+    ~GdalMessages() { CPLPopErrorHandler(); }
+    GdalMessages(const GdalMessages&) = delete;
+    GdalMessages& operator=(const GdalMessages&) = delete;
+
+private:
+    static void CPL_STDCALL handler(CPLErr level, CPLErrorNum, const char* message) {
+        auto* self = static_cast<GdalMessages*>(CPLGetErrorHandlerUserData());
+        if (self && self->verbose_ && level == CE_Warning)
+            self->err_ << "\nwarning (GDAL): " << message << "\n";
+    }
+    std::ostream& err_;
+    bool verbose_;
+};
+
+// --------------------------------------------------------------------------------------------
+// globemesh mesh
+
+/// The `mesh` subcommand: its CLI11 App bound to a CliOptions, plus the fields that need a
+/// conversion after parsing (optional values).
+struct MeshCommand {
+    CliOptions o;
+    std::vector<double> region;
+    double bathy_fill_m = 0;
+    CLI::App app{"Mesh the ocean between the coastlines, graded by the size options.", "globemesh mesh"};
+    CLI::Option* region_opt = nullptr;
+    CLI::Option* bathy_fill_opt = nullptr;
+
+    MeshCommand() {
+        app.option_defaults()->always_capture_default();
+        app.set_version_flag("--version", version_text(), "Print the version and exit");
+        app.get_formatter()->column_width(36);
+        MeshOptions& m = o.mesh;
+        const std::string coast = "Coastline", bathy = "Bathymetry", size = "Size field",
+                          mesher = "Mesher", output = "Output", run = "Run";
+
+        app.add_option("--coast", m.coast, "Land polygons or coast lines: any OGR vector source (required)")
+            ->group(coast)->type_name("SOURCE");
+        app.add_option("--coast-layer", m.coast_layer, "Layer of --coast; default the only polygon or line layer")
+            ->group(coast)->type_name("NAME");
+        app.add_option("--coast-where", m.coast_where, "OGR SQL attribute filter on --coast; default none")
+            ->group(coast)->type_name("SQL");
+        app.add_option("--coast-srs", m.coast_srs, "CRS of a --coast layer that declares none, e.g. EPSG:4326")
+            ->group(coast)->type_name("SRS");
+        region_opt = app.add_option("--region", region,
+                                    "Region W,S,E,N in degrees (W > E crosses 180); default the whole globe")
+                         ->group(coast)->type_name("W,S,E,N")->delimiter(',')->expected(4);
+        region_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // no region: the globe
+        app.add_option("--region-file", m.region_file, "Polygons (any OGR source, any CRS) bounding the ocean")
+            ->group(coast)->type_name("SOURCE");
+        app.add_option("--min-island-area", m.min_island_area_km2,
+                       "Drop islands and lakes smaller than AREA (km2 or m2; bare number: km2)")
+            ->group(coast)->type_name("AREA")->transform(unit_transform(parse_area_km2, ""));
+        app.add_flag("--keep-inland-seas", m.keep_inland_seas, "Keep water bodies not connected to the ocean")
+            ->group(coast);
+
+        app.add_option("--bathy", m.bathy, "Elevation (or depth) raster: any GDAL raster; default none")
+            ->group(bathy)->type_name("RASTER");
+        app.add_option("--bathy-band", m.bathy_band, "1-based band of --bathy")->group(bathy)->type_name("N");
+        app.add_flag("--depth-positive", m.depth_positive, "The raster stores depth, positive down")
+            ->group(bathy);
+        bathy_fill_opt = app.add_option("--bathy-fill", bathy_fill_m,
+                                        "Depth where the raster has no data (m or km; bare number: m); default none")
+                             ->group(bathy)->type_name("DEPTH")->transform(unit_transform(parse_depth_m, ""));
+        bathy_fill_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // unset: no fill
+
+        app.add_option("--hmax", m.hmax_km, "Largest edge length (km or m; bare number: km); alone gives a uniform mesh")
+            ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
+        app.add_option("--hmin", m.hmin_km, "Smallest edge length (km or m); 0: hmax/20")
+            ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
+        app.add_option("--coast-size", m.coast_size_km, "Edge length at the coast (km or m); 0: off")
+            ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
+        app.add_option("--coast-rate", m.coast_rate, "Growth of the edge length with distance from the coast (km/km)")
+            ->group(size)->type_name("RATE");
+        app.add_option("--wavelength", m.wavelength, "Points per wavelength of the tide; 0: off")
+            ->group(size)->type_name("N");
+        app.add_option("--wave-period", m.wave_period_h, "Period of that wave (h, min or s; bare number: h; M2)")
+            ->group(size)->type_name("DURATION")->transform(unit_transform(parse_duration_h, ""));
+        app.add_option("--slope", m.slope, "Points per topographic length scale; 0: off")
+            ->group(size)->type_name("N");
+        app.add_option("--size-regions", m.size_regions, "Polygons with a size_km attribute: edge length inside")
+            ->group(size)->type_name("SOURCE");
+        app.add_option("--grade", m.grade, "Largest |grad h|, the gradation of edge lengths (km/km)")
+            ->group(size)->type_name("G");
+
+        app.add_option("--max-nodes", m.max_nodes, "Refuse runs estimated to give more nodes")
+            ->group(mesher)->type_name("N");
+        app.add_option("--smooth", m.smooth_iterations, "Smoothing/relaxation sweeps")->group(mesher)->type_name("N");
+        app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")->group(mesher)->type_name("N");
+
+        app.add_option("-o,--output", o.output, "UGRID NetCDF file to write (required)")
+            ->group(output)->type_name("OUT.nc");
+        app.add_option("--gpkg", o.gpkg, "Also write a GeoPackage (faces, nodes, boundary, mesh_info)")
+            ->group(output)->type_name("OUT.gpkg");
+        app.add_option("--preview", o.preview, "Also draw the mesh over the land as a PNG")
+            ->group(output)->type_name("OUT.png");
+        app.add_option("--format", o.format, "NetCDF flavour: netcdf4 (deflate) or classic")
+            ->group(output)->type_name("FORMAT")->check(CLI::IsMember({"netcdf4", "classic"}));
+        app.add_option("--timings", o.timings, "Write the seconds per stage as JSON")
+            ->group(output)->type_name("FILE.json");
+        app.add_option("--report", o.report, "Write the run summary and quality histogram as JSON")
+            ->group(output)->type_name("FILE.json");
+        app.add_flag("--overwrite", o.overwrite, "Replace existing output files")->group(output);
+
+        app.set_config("--config", "", "Read options from a TOML or INI file (keys: the long option names)")
+            ->group(run)->type_name("FILE");
+        app.add_flag("--print-config", o.print_config, "Print the effective configuration (for --config) and stop")
+            ->group(run)->configurable(false);
+        // Not CLI11's excludes(): --print-config writes both as false, and must read back.
+        app.add_flag("-q,--quiet", o.quiet, "No progress on stderr (not with --verbose)")->group(run);
+        app.add_flag("-v,--verbose", o.verbose, "Show stage names with the progress, and GDAL warnings")
+            ->group(run);
+        app.add_flag("--check", o.check, "Check the mesh invariants before writing (exit 1 if one fails)")
+            ->group(run);
+    }
+    MeshCommand(const MeshCommand&) = delete;
+    MeshCommand& operator=(const MeshCommand&) = delete;
+
+    /// Parses; CLI11 errors (including help and version) propagate.
+    void parse(std::span<const std::string> args) {
+        app.parse(reversed(args));
+        if (region_opt->count() > 0 && region.size() == 4)
+            o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
+        if (bathy_fill_opt->count() > 0) o.mesh.bathy_fill_m = bathy_fill_m;
+        if (o.quiet && o.verbose) throw UsageError("--quiet and --verbose exclude each other");
+    }
+};
+
+/// The checks run_cli makes before anything is opened: library validation, then the paths.
+void check_mesh_run(const CliOptions& o) {
+    validate(o.mesh);
+    if (o.mesh.coast.empty())
+        throw UsageError("--coast is required: land polygons or coast lines, e.g. --coast land.gpkg");
+    if (o.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o ocean.nc");
+    const std::vector<std::pair<std::string, std::string>> outputs = {
+        {"--output", o.output}, {"--gpkg", o.gpkg}, {"--preview", o.preview},
+        {"--timings", o.timings}, {"--report", o.report}};
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        for (std::size_t j = i + 1; j < outputs.size(); ++j) {
+            if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
+                fs::absolute(outputs[i].second).lexically_normal() ==
+                    fs::absolute(outputs[j].second).lexically_normal())
+                throw UsageError(outputs[i].first + " and " + outputs[j].first + " name the same file " +
+                                 outputs[i].second);
+        }
+    }
+    check_input_path(o.mesh.coast, "--coast");
+    check_input_path(o.mesh.bathy, "--bathy");
+    check_input_path(o.mesh.region_file, "--region-file");
+    check_input_path(o.mesh.size_regions, "--size-regions");
+    for (const auto& [name, path] : outputs)
+        if (!path.empty()) check_output_path(path, name, o.overwrite);
+}
+
+/// Removes the files of this run if it fails part-way, so no run leaves some outputs only.
+class OutputsGuard {
+public:
+    void add(const std::string& path) { paths_.push_back(path); }
+    void commit() { paths_.clear(); }
+    ~OutputsGuard() {
+        for (const auto& p : paths_) {
+            std::error_code ec;
+            fs::remove(p, ec);
+        }
+    }
+
+private:
+    std::vector<std::string> paths_;
+};
+
+void throw_if_interrupted() {
+    if (InterruptGuard::interrupted()) throw Cancelled();
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Adds the `mesh` key of issue 4 (everything from rings and size field to the final mesh,
+/// I/O excluded) when the pipeline did not report it: the sum of the stages not named read*.
+void add_mesh_total(StageTimings& timings) {
+    for (const auto& [name, s] : timings.stages)
+        if (name == "mesh") return;
+    double total = 0;
+    for (const auto& [name, s] : timings.stages)
+        if (name.rfind("read", 0) != 0) total += s;
+    timings.add("mesh", total);
+}
+
+int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream& err,
+             TerminalProgress& terminal, const CliLibrary& lib) {
+    auto command = std::make_unique<MeshCommand>();
+    try {
+        command->parse(args);
+    } catch (const CLI::CallForHelp&) {
+        out << command->app.help();
+        return 0;
+    } catch (const CLI::CallForAllHelp&) {
+        out << command->app.help();
+        return 0;
+    } catch (const CLI::CallForVersion&) {
+        out << version_text() << "\n";
+        return 0;
+    }
+    const CliOptions& o = command->o;
+    if (o.print_config) {
+        validate(o.mesh);
+        out << command->app.config_to_str(true, true);
+        return 0;
+    }
+    check_mesh_run(o);
+
+    InterruptGuard interrupt;
+    GdalMessages gdal_messages(err, o.verbose);
+    const auto t0 = std::chrono::steady_clock::now();
+    StageTimings timings;
+    terminal.configure(o.quiet, o.verbose);
+    Mesh mesh = lib.mesh_ocean(o.mesh, terminal.callback(), &timings);
+    throw_if_interrupted();
+    terminal.update(1.0, "mesh"); // close the progress line if the pipeline stopped short of 1
+    add_mesh_total(timings);
+
+    if (o.check) {
+        auto problems = check_mesh(mesh);
+        if (!problems.empty())
+            throw DataError("--check: the mesh breaks " + std::to_string(problems.size()) +
+                            (problems.size() >= 20 ? "+" : "") + " invariants, first: " + problems.front() +
+                            "; please report this with the command line");
+    }
+
+    OutputsGuard written;
+    const auto tw = std::chrono::steady_clock::now();
+    UgridOptions ugrid;
+    ugrid.classic = o.format == "classic";
+    ugrid.overwrite = o.overwrite;
+    ugrid.history = history_text("mesh", args);
+    lib.write_ugrid(mesh, o.output, ugrid);
+    written.add(o.output);
+    throw_if_interrupted();
+    if (!o.gpkg.empty()) {
+        GpkgOptions gpkg;
+        gpkg.overwrite = o.overwrite;
+        lib.write_gpkg(mesh, o.gpkg, gpkg);
+        written.add(o.gpkg);
+        throw_if_interrupted();
+    }
+    if (!o.preview.empty()) {
+        PreviewOptions preview;
+        preview.land = o.mesh.coast;
+        preview.colour_by = mesh.node_field("depth") ? "depth" : "quality";
+        preview.extent_deg = o.mesh.region;
+        preview.overwrite = o.overwrite;
+        lib.write_preview_png(mesh, o.preview, preview);
+        written.add(o.preview);
+        throw_if_interrupted();
+    }
+    timings.add("write", seconds_since(tw));
+
+    const MeshStats stats = lib.compute_stats(mesh);
+    const double total_s = seconds_since(t0);
+    const long long peak = peak_memory_bytes();
+    if (!o.timings.empty()) {
+        write_file_safely(o.timings, timings_json(timings));
+        written.add(o.timings);
+    }
+    if (!o.report.empty()) {
+        std::ostringstream r;
+        r << "{\n  \"globemesh\": " << json_string(GLOBEMESH_VERSION) << ",\n"
+          << "  \"command\": " << json_string(ugrid.history) << ",\n"
+          << "  \"outputs\": {\"netcdf\": " << json_string(o.output);
+        if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
+        if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
+        r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n"
+          << "  " << timings_json(timings).substr(1, timings_json(timings).size() - 3) << ",\n"
+          << "  \"total_seconds\": " << json_number(total_s) << ",\n"
+          << "  \"peak_memory_bytes\": " << peak << "\n}\n";
+        write_file_safely(o.report, r.str());
+        written.add(o.report);
+    }
+    written.commit();
+
+    print_stats(out, stats, false);
+    print_timings(out, timings);
+    out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
+        << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"
+        << "wrote             " << o.output;
+    for (const auto* p : {&o.gpkg, &o.preview, &o.timings, &o.report})
+        if (!p->empty()) out << ", " << *p;
+    out << "\n";
+    return 0;
+}
+
+// --------------------------------------------------------------------------------------------
+// globemesh triangulate
+
+struct TriangulateCommand {
+    TriangulateOptions t;
+    std::string output, gpkg, timings;
+    bool overwrite = false, quiet = false, verbose = false;
+    CLI::App app{"Spherical Delaunay triangulation of scattered points (any OGR point source).",
+                 "globemesh triangulate"};
+
+    TriangulateCommand() {
+        app.option_defaults()->always_capture_default();
+        app.set_version_flag("--version", version_text(), "Print the version and exit");
+        app.get_formatter()->column_width(36);
+        app.add_option("POINTS", t.points, "Points: CSV with lon/lat columns, GeoPackage, shapefile, ...")
+            ->required()->type_name("SOURCE");
+        app.add_option("-o,--output", output, "UGRID NetCDF file to write (required)")->type_name("OUT.nc");
+        app.add_option("--gpkg", gpkg, "Also write a GeoPackage")->type_name("OUT.gpkg");
+        app.add_option("--layer", t.layer, "Layer of POINTS; default the first layer")->type_name("NAME");
+        app.add_option("--timings", timings, "Write the seconds per stage as JSON")->type_name("FILE.json");
+        app.add_flag("--overwrite", overwrite, "Replace existing output files");
+        app.add_flag("-q,--quiet", quiet, "No progress on stderr (not with --verbose)");
+        app.add_flag("-v,--verbose", verbose, "Show stage names with the progress");
+    }
+};
+
+int run_triangulate(std::span<const std::string> args, std::ostream& out, std::ostream& err,
+                    TerminalProgress& terminal, const CliLibrary& lib) {
+    auto command = std::make_unique<TriangulateCommand>();
+    try {
+        command->app.parse(reversed(args));
+    } catch (const CLI::CallForHelp&) {
+        out << command->app.help();
+        return 0;
+    } catch (const CLI::CallForVersion&) {
+        out << version_text() << "\n";
+        return 0;
+    }
+    const auto& c = *command;
+    if (c.quiet && c.verbose) throw UsageError("--quiet and --verbose exclude each other");
+    if (c.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o out.nc");
+    check_input_path(c.t.points, "POINTS");
+    check_output_path(c.output, "--output", c.overwrite);
+    if (!c.gpkg.empty()) check_output_path(c.gpkg, "--gpkg", c.overwrite);
+    if (!c.timings.empty()) check_output_path(c.timings, "--timings", c.overwrite);
+
+    InterruptGuard interrupt;
+    GdalMessages gdal_messages(err, c.verbose);
+    StageTimings timings;
+    terminal.configure(c.quiet, c.verbose);
+    Mesh mesh = lib.triangulate_file(c.t, terminal.callback(), &timings);
+    throw_if_interrupted();
+    terminal.update(1.0, "triangulate");
+    OutputsGuard written;
+    const auto tw = std::chrono::steady_clock::now();
+    UgridOptions ugrid;
+    ugrid.overwrite = c.overwrite;
+    ugrid.title = "globemesh spherical Delaunay triangulation";
+    ugrid.history = history_text("triangulate", args);
+    lib.write_ugrid(mesh, c.output, ugrid);
+    written.add(c.output);
+    if (!c.gpkg.empty()) {
+        GpkgOptions gpkg;
+        gpkg.overwrite = c.overwrite;
+        lib.write_gpkg(mesh, c.gpkg, gpkg);
+        written.add(c.gpkg);
+    }
+    throw_if_interrupted();
+    timings.add("write", seconds_since(tw));
+    if (!c.timings.empty()) {
+        write_file_safely(c.timings, timings_json(timings));
+        written.add(c.timings);
+    }
+    written.commit();
+    out << "nodes             " << mesh.nodes.size() << "\n"
+        << "faces             " << mesh.faces.size() << "\n";
+    print_timings(out, timings);
+    return 0;
+}
+
+// --------------------------------------------------------------------------------------------
+// globemesh info
+
+struct InfoCommand {
+    std::string path;
+    bool json = false;
+    CLI::App app{"Counts, extent, edge lengths and quality of a UGRID mesh file.", "globemesh info"};
+    InfoCommand() {
+        app.set_version_flag("--version", version_text(), "Print the version and exit");
+        app.get_formatter()->column_width(36);
+        app.add_option("MESH", path, "UGRID NetCDF file (ours or another tool's)")->required()->type_name("MESH.nc");
+        app.add_flag("--json", json, "Print JSON for machines");
+    }
+};
+
+int run_info(std::span<const std::string> args, std::ostream& out, const CliLibrary& lib) {
+    InfoCommand command;
+    try {
+        command.app.parse(reversed(args));
+    } catch (const CLI::CallForHelp&) {
+        out << command.app.help();
+        return 0;
+    } catch (const CLI::CallForVersion&) {
+        out << version_text() << "\n";
+        return 0;
+    }
+    check_input_path(command.path, "MESH");
+    const MeshStats stats = lib.compute_stats(lib.read_ugrid(command.path));
+    if (command.json)
+        out << stats_json(stats, "") << "\n";
+    else
+        print_stats(out, stats, true);
+    return 0;
+}
+
+// --------------------------------------------------------------------------------------------
+// globemesh (top level), help
+
+std::unique_ptr<CLI::App> make_top_app() {
+    auto app = std::make_unique<CLI::App>(
+        "Ocean meshes on the sphere from GIS data: coastlines from any OGR source, bathymetry from "
+        "any GDAL raster, UGRID NetCDF and GeoPackage out. See globemesh(1).",
+        "globemesh");
+    app->set_version_flag("--version", version_text(), "Print the version and exit");
+    app->add_subcommand("mesh", "Mesh the ocean: globemesh mesh --coast LAND -o OCEAN.nc [options]");
+    app->add_subcommand("triangulate", "Delaunay triangulation of points: globemesh triangulate POINTS -o OUT.nc");
+    app->add_subcommand("info", "Statistics of a UGRID mesh file: globemesh info MESH.nc [--json]");
+    app->add_subcommand("help", "Help on globemesh or one subcommand: globemesh help [SUBCOMMAND]");
+    app->require_subcommand(1);
+    return app;
+}
+
+int run_help(std::span<const std::string> args, std::ostream& out) {
+    if (args.empty()) {
+        out << make_top_app()->help();
+        return 0;
+    }
+    if (args.size() > 1) throw UsageError("help takes one subcommand name, e.g. globemesh help mesh");
+    if (args[0] == "mesh") {
+        MeshCommand c;
+        out << c.app.help();
+    } else if (args[0] == "triangulate") {
+        TriangulateCommand c;
+        out << c.app.help();
+    } else if (args[0] == "info") {
+        InfoCommand c;
+        out << c.app.help();
+    } else if (args[0] == "help") {
+        out << make_top_app()->help();
+    } else {
+        throw UsageError("help: unknown subcommand '" + args[0] + "' (the subcommands are mesh, triangulate, info, help)");
+    }
+    return 0;
+}
+
+int dispatch(std::span<const std::string> args, std::ostream& out, std::ostream& err,
+             TerminalProgress& terminal, const CliLibrary& lib) {
+    if (args.empty())
+        throw UsageError("no subcommand given: run 'globemesh help' (e.g. globemesh mesh --coast land.gpkg -o ocean.nc)");
+    const std::string& name = args[0];
+    const auto rest = args.subspan(1);
+    if (name == "mesh") return run_mesh(rest, out, err, terminal, lib);
+    if (name == "triangulate") return run_triangulate(rest, out, err, terminal, lib);
+    if (name == "info") return run_info(rest, out, lib);
+    if (name == "help") return run_help(rest, out);
+    if (!name.empty() && name[0] != '-')
+        throw UsageError("unknown subcommand '" + name + "' (the subcommands are mesh, triangulate, info, help)");
+    auto top = make_top_app();
+    try {
+        top->parse(reversed(args));
+    } catch (const CLI::CallForHelp&) {
+        out << top->help();
+        return 0;
+    } catch (const CLI::CallForAllHelp&) {
+        out << top->help();
+        return 0;
+    } catch (const CLI::CallForVersion&) {
+        out << version_text() << "\n";
+        return 0;
+    } catch (const CLI::ParseError&) {
+        throw UsageError("unknown option '" + name +
+                         "' (globemesh takes --help, --version or a subcommand: mesh, triangulate, info, help)");
+    }
+    return 0; // unreachable: a subcommand name would have been dispatched above
+}
+
+} // namespace
+
+CliOptions parse_mesh_args(std::span<const std::string> args) {
+    auto command = std::make_unique<MeshCommand>();
+    try {
+        command->parse(args);
+    } catch (const CLI::ParseError& e) {
+        throw UsageError(one_line(e.what()));
+    }
+    return command->o;
+}
+
+int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err,
+            const CliLibrary& library) {
+    TerminalProgress terminal(err);
+    try {
+        return dispatch(args, out, err, terminal, library);
+    } catch (...) {
+        terminal.end_line();
+        return report_error(err);
+    }
+}
+
+namespace {
+
+/// Maps the exception in flight to one line on err and the exit status.
+int report_error(std::ostream& err) {
+    try {
+        throw;
+    } catch (const CLI::ParseError& e) {
+        err << "globemesh: " << one_line(e.what()) << "\n";
+        return 2;
+    } catch (const UsageError& e) {
+        err << "globemesh: " << one_line(e.what()) << "\n";
+        return 2;
+    } catch (const Cancelled& e) {
+        err << "globemesh: cancelled, no output written\n";
+        return 1;
+    } catch (const Error& e) {
+        err << "globemesh: " << one_line(e.what()) << "\n";
+        return 1;
+    } catch (const std::exception& e) {
+        err << "globemesh: internal error: " << one_line(e.what()) << "\n";
+        return 1;
+    } catch (...) {
+        err << "globemesh: internal error: unknown exception\n";
+        return 1;
+    }
+}
+
+} // namespace
 
 } // namespace globemesh

@@ -1,0 +1,264 @@
+#include "cli_support.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include "globemesh/error.hpp"
+
+namespace globemesh::cli {
+
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_sigint(int) { g_interrupted = 1; }
+
+} // namespace
+
+InterruptGuard::InterruptGuard() {
+    g_interrupted = 0;
+    struct sigaction action {};
+    action.sa_handler = on_sigint;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = 0;
+    installed_ = sigaction(SIGINT, &action, &previous_) == 0;
+}
+
+InterruptGuard::~InterruptGuard() {
+    if (installed_) sigaction(SIGINT, &previous_, nullptr);
+}
+
+bool InterruptGuard::interrupted() { return g_interrupted != 0; }
+
+bool TerminalProgress::update(double fraction, std::string_view stage) {
+    if (InterruptGuard::interrupted()) return false;
+    if (quiet_) return true;
+    if (verbose_ && stage != stage_) {
+        if (mid_line_) err_ << '\n';
+        err_ << '[' << stage << "] ";
+        stage_ = std::string(stage);
+        mid_line_ = true;
+    }
+    // GDALTermProgress's arithmetic: 40 ticks, a number every fourth, " - done." at 100.
+    const int tick = std::clamp(static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 40.0), 0, 40);
+    if (tick < last_tick_ && last_tick_ >= 39) last_tick_ = -1; // a new run of 0..100
+    if (tick <= last_tick_) return true;
+    while (tick > last_tick_) {
+        ++last_tick_;
+        if (last_tick_ % 4 == 0)
+            err_ << (last_tick_ / 4) * 10;
+        else
+            err_ << '.';
+    }
+    mid_line_ = true;
+    if (tick == 40) {
+        err_ << " - done.\n";
+        mid_line_ = false;
+    }
+    err_.flush();
+    return true;
+}
+
+void TerminalProgress::end_line() {
+    if (mid_line_) err_ << '\n';
+    mid_line_ = false;
+}
+
+void write_file_safely(const std::filesystem::path& path, const std::string& text) {
+    namespace fs = std::filesystem;
+    fs::path tmp = path;
+    tmp += ".tmp-" + std::to_string(::getpid());
+    {
+        std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
+        if (!file) throw IoError("cannot write " + path.string() + ": check the folder exists and is writable");
+        file << text;
+        file.flush();
+        if (!file) {
+            file.close();
+            std::error_code ec;
+            fs::remove(tmp, ec);
+            throw IoError("cannot write " + path.string() + " (disk full?)");
+        }
+    }
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw IoError("cannot write " + path.string() + ": " + ec.message());
+    }
+}
+
+std::string json_number(double v) {
+    if (!std::isfinite(v)) return "null";
+    char buffer[32];
+    auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);
+    return std::string(buffer, end);
+}
+
+std::string json_string(const std::string& s) {
+    std::string r = "\"";
+    for (unsigned char c : s) {
+        switch (c) {
+        case '"': r += "\\\""; break;
+        case '\\': r += "\\\\"; break;
+        case '\n': r += "\\n"; break;
+        case '\t': r += "\\t"; break;
+        case '\r': r += "\\r"; break;
+        default:
+            if (c < 0x20) {
+                char esc[8];
+                std::snprintf(esc, sizeof esc, "\\u%04x", c);
+                r += esc;
+            } else {
+                r += static_cast<char>(c);
+            }
+        }
+    }
+    return r + "\"";
+}
+
+std::string timings_json(const StageTimings& timings) {
+    std::string s = "{\"stages\": {";
+    for (std::size_t i = 0; i < timings.stages.size(); ++i) {
+        s += (i ? ", " : "") + json_string(timings.stages[i].first) + ": " +
+             json_number(timings.stages[i].second);
+    }
+    return s + "}}\n";
+}
+
+std::string stats_json(const MeshStats& st, const std::string& in) {
+    std::ostringstream o;
+    const std::string in2 = in + "  ";
+    o << "{\n"
+      << in2 << "\"nodes\": " << st.nodes << ",\n"
+      << in2 << "\"faces\": " << st.faces << ",\n"
+      << in2 << "\"edges\": " << st.edges << ",\n"
+      << in2 << "\"boundary_edges\": " << st.boundary_edges << ",\n"
+      << in2 << "\"boundary_loops\": " << st.boundary_loops << ",\n"
+      << in2 << "\"extent_deg\": {\"lon_min\": " << json_number(st.lon_min)
+      << ", \"lon_max\": " << json_number(st.lon_max) << ", \"lat_min\": " << json_number(st.lat_min)
+      << ", \"lat_max\": " << json_number(st.lat_max) << "},\n"
+      << in2 << "\"area_km2\": " << json_number(st.area_km2) << ",\n"
+      << in2 << "\"edge_km\": {\"min\": " << json_number(st.edge_km_min)
+      << ", \"mean\": " << json_number(st.edge_km_mean) << ", \"max\": " << json_number(st.edge_km_max)
+      << "},\n"
+      << in2 << "\"quality\": {\"min\": " << json_number(st.quality_min)
+      << ", \"mean\": " << json_number(st.quality_mean)
+      << ", \"above_0_8\": " << json_number(st.quality_above_0_8) << ",\n"
+      << in2 << "  \"histogram_edges\": [0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1],\n"
+      << in2 << "  \"histogram\": [";
+    for (std::size_t i = 0; i < st.quality_histogram.size(); ++i)
+        o << (i ? ", " : "") << st.quality_histogram[i];
+    o << "]}";
+    if (st.has_size) {
+        o << ",\n"
+          << in2 << "\"size_ratio\": {\"median\": " << json_number(st.size_ratio_median)
+          << ", \"in_0_7_1_4\": " << json_number(st.size_ratio_in_range) << "}";
+    }
+    o << "\n" << in << "}";
+    return o.str();
+}
+
+void print_stats(std::ostream& out, const MeshStats& st, bool histogram) {
+    auto old_flags = out.flags();
+    auto old_precision = out.precision();
+    out << std::fixed;
+    out << "nodes             " << st.nodes << "\n"
+        << "faces             " << st.faces << "\n"
+        << "edges             " << st.edges << "\n"
+        << "boundary          " << st.boundary_edges << " edges in " << st.boundary_loops << " loops\n"
+        << std::setprecision(4) << "extent            lon " << st.lon_min << " .. " << st.lon_max
+        << ", lat " << st.lat_min << " .. " << st.lat_max << " (degrees)\n"
+        << std::setprecision(1) << "area              " << st.area_km2 << " km2\n"
+        << std::setprecision(3) << "edge length       min " << st.edge_km_min << "  mean "
+        << st.edge_km_mean << "  max " << st.edge_km_max << " (km)\n"
+        << "quality           min " << st.quality_min << "  mean " << st.quality_mean << "  above 0.8 "
+        << std::setprecision(1) << 100 * st.quality_above_0_8 << "%\n";
+    if (st.has_size) {
+        out << std::setprecision(3) << "edge / target     median " << st.size_ratio_median
+            << "  in [0.7, 1.4] " << std::setprecision(1) << 100 * st.size_ratio_in_range << "%\n";
+    }
+    if (histogram) {
+        out << "quality histogram\n";
+        std::size_t total = 0, largest = 0;
+        for (auto c : st.quality_histogram) total += c, largest = std::max(largest, c);
+        for (std::size_t i = 0; i < st.quality_histogram.size(); ++i) {
+            const std::size_t c = st.quality_histogram[i];
+            const int bar = largest ? static_cast<int>(std::lround(40.0 * c / largest)) : 0;
+            out << "  " << std::setprecision(1) << 0.1 * i << (i == 9 ? "-1.0]" : "-") ;
+            if (i != 9) out << 0.1 * (i + 1) << ')';
+            out << ' ' << std::setw(10) << c << ' ' << std::setw(5) << std::setprecision(1)
+                << (total ? 100.0 * c / total : 0.0) << "% " << std::string(bar, '#') << "\n";
+        }
+    }
+    out.flags(old_flags);
+    out.precision(old_precision);
+}
+
+void print_timings(std::ostream& out, const StageTimings& timings) {
+    auto old_flags = out.flags();
+    auto old_precision = out.precision();
+    out << "time (s)";
+    bool first = true;
+    for (const auto& [name, seconds] : timings.stages) {
+        out << (first ? "          " : "                  ") << name << ' ' << std::fixed
+            << std::setprecision(3) << seconds << "\n";
+        first = false;
+    }
+    if (first) out << "\n";
+    out.flags(old_flags);
+    out.precision(old_precision);
+}
+
+long long peak_memory_bytes() {
+    struct rusage usage {};
+    if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+    return static_cast<long long>(usage.ru_maxrss) * 1024; // Linux reports kilobytes
+}
+
+namespace {
+
+/// True for names GDAL resolves itself: /vsi... paths and "SCHEME:..." connection strings.
+bool is_gdal_special(const std::string& path) {
+    if (path.rfind("/vsi", 0) == 0) return true;
+    const auto colon = path.find(':');
+    if (colon == std::string::npos || colon < 2) return false; // "C:" style or none
+    for (std::size_t i = 0; i < colon; ++i)
+        if (!std::isalpha(static_cast<unsigned char>(path[i]))) return false;
+    return true;
+}
+
+} // namespace
+
+void check_output_path(const std::string& path, const std::string& what, bool overwrite) {
+    namespace fs = std::filesystem;
+    fs::path p(path);
+    fs::path folder = p.parent_path();
+    if (folder.empty()) folder = ".";
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec))
+        throw IoError(what + ": the folder " + folder.string() + " of " + path +
+                      " does not exist; create it first");
+    if (fs::exists(p, ec) && !overwrite)
+        throw IoError(what + ": " + path + " exists; use --overwrite to replace it");
+    if (fs::is_directory(p, ec))
+        throw IoError(what + ": " + path + " is a folder; give a file name");
+}
+
+void check_input_path(const std::string& path, const std::string& what) {
+    if (path.empty() || is_gdal_special(path)) return;
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw IoError(what + ": " + path + " does not exist");
+}
+
+} // namespace globemesh::cli

@@ -1,0 +1,88 @@
+// Private to src/cli: terminal progress, the Ctrl-C guard, JSON output written safely, and the
+// run summary shared by `mesh`, `triangulate` and `info`.
+#pragma once
+
+#include <csignal>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "globemesh/pipeline.hpp"
+#include "globemesh/progress.hpp"
+#include "globemesh/ugrid.hpp"
+
+namespace globemesh::cli {
+
+/// Installs a SIGINT handler for its lifetime (restoring the previous one after) that only
+/// sets a flag; interrupted() reads it. One guard at a time (run_cli is not re-entrant).
+class InterruptGuard {
+public:
+    InterruptGuard();
+    ~InterruptGuard();
+    InterruptGuard(const InterruptGuard&) = delete;
+    InterruptGuard& operator=(const InterruptGuard&) = delete;
+    static bool interrupted();
+
+private:
+    struct sigaction previous_ {};
+    bool installed_ = false;
+};
+
+/// GDAL's terminal progress ("0...10...20...30...40...50...60...70...80...90...100 - done."),
+/// drawn on `err` rather than stdout (where GDALTermProgress writes) so that stdout carries
+/// results only. With `verbose`, each new stage starts a line "[stage] ". The callback returns
+/// false once SIGINT arrived, which cancels the run. run_cli owns one, so that an error line
+/// never lands in the middle of a progress line.
+class TerminalProgress {
+public:
+    explicit TerminalProgress(std::ostream& err) : err_(err) {}
+    void configure(bool quiet, bool verbose) { quiet_ = quiet, verbose_ = verbose; }
+    bool update(double fraction, std::string_view stage);
+    Progress callback() {
+        return [this](double f, std::string_view stage) { return update(f, stage); };
+    }
+    /// Ends a progress line left open (before an error message).
+    void end_line();
+
+private:
+    std::ostream& err_;
+    bool quiet_ = false, verbose_ = false, mid_line_ = false;
+    int last_tick_ = -1;
+    std::string stage_;
+};
+
+/// Writes `text` to `path` through a temporary file in the same folder renamed at the end, so
+/// that a reader never sees half a file. Throws IoError naming the path.
+void write_file_safely(const std::filesystem::path& path, const std::string& text);
+
+/// A JSON number (shortest round-trip form) or null when not finite.
+std::string json_number(double v);
+/// A JSON string literal with escapes.
+std::string json_string(const std::string& s);
+
+/// {"stages": {name: seconds, ...}} in run order.
+std::string timings_json(const StageTimings& timings);
+
+/// The statistics of compute_stats as a JSON object (no trailing newline), indented by `indent`.
+std::string stats_json(const MeshStats& stats, const std::string& indent);
+
+/// Human-readable statistics (counts, extent, quality, edge lengths, size ratio, histogram).
+void print_stats(std::ostream& out, const MeshStats& stats, bool histogram);
+
+/// Seconds per stage on one line per stage.
+void print_timings(std::ostream& out, const StageTimings& timings);
+
+/// Peak resident memory of this process in bytes (getrusage ru_maxrss).
+long long peak_memory_bytes();
+
+/// Throws IoError when `path`'s folder does not exist, or when `path` exists and !overwrite.
+/// `what` names the option, e.g. "--gpkg".
+void check_output_path(const std::string& path, const std::string& what, bool overwrite);
+
+/// Throws IoError when a local input file is missing; GDAL virtual paths (/vsi...) and
+/// connection strings (PG:..., https://...) are left to GDAL.
+void check_input_path(const std::string& path, const std::string& what);
+
+} // namespace globemesh::cli

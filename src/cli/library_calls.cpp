@@ -1,0 +1,28 @@
+// The real library calls of run_cli, in their own file: a program linking run_cli(args, out,
+// err) links the whole library, while tests that pass their own CliLibrary need only the parts
+// they use.
+#include "globemesh/cli.hpp"
+
+namespace globemesh {
+
+CliLibrary library_calls() {
+    CliLibrary lib;
+    lib.mesh_ocean = [](const MeshOptions& o, const Progress& p, StageTimings* t) { return mesh_ocean(o, p, t); };
+    lib.triangulate_file = [](const TriangulateOptions& o, const Progress& p, StageTimings* t) {
+        return triangulate_file(o, p, t);
+    };
+    lib.write_ugrid = [](const Mesh& m, const std::filesystem::path& p, const UgridOptions& o) { write_ugrid(m, p, o); };
+    lib.write_gpkg = [](const Mesh& m, const std::filesystem::path& p, const GpkgOptions& o) { write_gpkg(m, p, o); };
+    lib.write_preview_png = [](const Mesh& m, const std::filesystem::path& p, const PreviewOptions& o) {
+        write_preview_png(m, p, o);
+    };
+    lib.read_ugrid = [](const std::filesystem::path& p) { return read_ugrid(p); };
+    lib.compute_stats = [](const Mesh& m) { return compute_stats(m); };
+    return lib;
+}
+
+int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
+    return run_cli(args, out, err, library_calls());
+}
+
+} // namespace globemesh

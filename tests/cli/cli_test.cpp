@@ -1,0 +1,542 @@
+// The command line in-process through run_cli (PROJ's test_projinfo_lib style). These tests pass
+// their own CliLibrary: a bad command must stop before any library call, so the library here
+// fails the test if it is reached. The runs through the real library are in tests/e2e.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "globemesh/cli.hpp"
+#include "globemesh/error.hpp"
+#include "support.hpp"
+
+namespace fs = std::filesystem;
+using globemesh::test::fixture;
+using globemesh::test::TempDir;
+
+namespace {
+
+struct Result {
+    int status = -1;
+    std::string out, err;
+};
+
+/// A library whose every call is counted and refused: reaching it is a test failure.
+struct RefusingLibrary {
+    int calls = 0;
+    globemesh::CliLibrary lib() {
+        globemesh::CliLibrary l;
+        auto refuse = [this] {
+            ++calls;
+            throw std::logic_error("the library was reached");
+        };
+        l.mesh_ocean = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
+        l.triangulate_file = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
+        l.write_ugrid = [refuse](auto&&...) { refuse(); };
+        l.write_gpkg = [refuse](auto&&...) { refuse(); };
+        l.write_preview_png = [refuse](auto&&...) { refuse(); };
+        l.read_ugrid = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
+        l.compute_stats = [refuse](auto&&...) -> globemesh::MeshStats { refuse(); return {}; };
+        return l;
+    }
+};
+
+Result run(const std::vector<std::string>& args, const globemesh::CliLibrary& lib) {
+    std::ostringstream out, err;
+    Result r;
+    r.status = globemesh::run_cli(args, out, err, lib);
+    r.out = out.str();
+    r.err = err.str();
+    return r;
+}
+
+/// Runs with a refusing library and checks the library was not reached.
+Result run_refused(const std::vector<std::string>& args) {
+    RefusingLibrary refusing;
+    Result r = run(args, refusing.lib());
+    EXPECT_EQ(refusing.calls, 0) << "the library was called for a command that should stop first";
+    return r;
+}
+
+int count_lines(const std::string& s) {
+    int n = 0;
+    for (char c : s) n += c == '\n';
+    return n;
+}
+
+const std::string coast = fixture("coast/ne_110m_land.gpkg").string();
+
+std::string read_text(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+    std::ofstream f(p);
+    f << text;
+}
+
+/// Field by field comparison of two MeshOptions.
+void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshOptions& b) {
+    EXPECT_EQ(a.coast, b.coast);
+    EXPECT_EQ(a.coast_layer, b.coast_layer);
+    EXPECT_EQ(a.coast_where, b.coast_where);
+    EXPECT_EQ(a.coast_srs, b.coast_srs);
+    EXPECT_EQ(a.region, b.region);
+    EXPECT_EQ(a.region_file, b.region_file);
+    EXPECT_EQ(a.min_island_area_km2, b.min_island_area_km2);
+    EXPECT_EQ(a.min_island_triangles, b.min_island_triangles);
+    EXPECT_EQ(a.keep_inland_seas, b.keep_inland_seas);
+    EXPECT_EQ(a.bathy, b.bathy);
+    EXPECT_EQ(a.bathy_band, b.bathy_band);
+    EXPECT_EQ(a.depth_positive, b.depth_positive);
+    EXPECT_EQ(a.bathy_fill_m, b.bathy_fill_m);
+    EXPECT_EQ(a.hmax_km, b.hmax_km);
+    EXPECT_EQ(a.hmin_km, b.hmin_km);
+    EXPECT_EQ(a.coast_size_km, b.coast_size_km);
+    EXPECT_EQ(a.coast_rate, b.coast_rate);
+    EXPECT_EQ(a.wavelength, b.wavelength);
+    EXPECT_EQ(a.wave_period_h, b.wave_period_h);
+    EXPECT_EQ(a.slope, b.slope);
+    EXPECT_EQ(a.size_regions, b.size_regions);
+    EXPECT_EQ(a.grade, b.grade);
+    EXPECT_EQ(a.max_nodes, b.max_nodes);
+    EXPECT_EQ(a.smooth_iterations, b.smooth_iterations);
+    EXPECT_EQ(a.seed, b.seed);
+}
+
+void expect_same_cli(const globemesh::CliOptions& a, const globemesh::CliOptions& b) {
+    expect_same_options(a.mesh, b.mesh);
+    EXPECT_EQ(a.output, b.output);
+    EXPECT_EQ(a.gpkg, b.gpkg);
+    EXPECT_EQ(a.preview, b.preview);
+    EXPECT_EQ(a.format, b.format);
+    EXPECT_EQ(a.timings, b.timings);
+    EXPECT_EQ(a.report, b.report);
+    EXPECT_EQ(a.overwrite, b.overwrite);
+    EXPECT_EQ(a.quiet, b.quiet);
+    EXPECT_EQ(a.verbose, b.verbose);
+    EXPECT_EQ(a.check, b.check);
+}
+
+/// Every option except the program-only ones, each away from its default, in all unit styles.
+std::vector<std::string> every_option(const std::string& out_dir) {
+    return {"--coast", coast, "--coast-layer", "ne_110m_land", "--coast-where", "featurecla = 'Land'",
+            "--coast-srs", "EPSG:4326", "--region", "-20.5,40,10.25,65", "--min-island-area", "2.5e7m2",
+            "--keep-inland-seas", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+            "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--hmax", "45000m",
+            "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
+            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
+            "--max-nodes", "123456", "--smooth", "7", "--seed", "42",
+            "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
+            "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
+            "--overwrite", "--verbose", "--check"};
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Units
+
+TEST(Cli, lengths_convert_from_metres_and_kilometres) {
+    EXPECT_DOUBLE_EQ(globemesh::parse_length_km("5000m"), 5.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_length_km("20km"), 20.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_length_km("20"), 20.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_length_km(" 2.5e3 m "), 2.5);
+    EXPECT_DOUBLE_EQ(globemesh::parse_length_km("+7 km"), 7.0);
+}
+
+TEST(Cli, areas_convert_from_square_metres_and_square_kilometres) {
+    EXPECT_DOUBLE_EQ(globemesh::parse_area_km2("1e6m2"), 1.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_area_km2("1000km2"), 1000.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_area_km2("1000"), 1000.0);
+}
+
+TEST(Cli, durations_and_depths_convert) {
+    EXPECT_DOUBLE_EQ(globemesh::parse_duration_h("90min"), 1.5);
+    EXPECT_DOUBLE_EQ(globemesh::parse_duration_h("3600s"), 1.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_duration_h("12.42"), 12.42);
+    EXPECT_DOUBLE_EQ(globemesh::parse_depth_m("0.05km"), 50.0);
+    EXPECT_DOUBLE_EQ(globemesh::parse_depth_m("50"), 50.0);
+}
+
+TEST(Cli, unknown_units_and_non_numbers_are_usage_errors) {
+    EXPECT_THROW(globemesh::parse_length_km("20parsecs"), globemesh::UsageError);
+    EXPECT_THROW(globemesh::parse_length_km("km"), globemesh::UsageError);
+    EXPECT_THROW(globemesh::parse_length_km(""), globemesh::UsageError);
+    EXPECT_THROW(globemesh::parse_length_km("inf"), globemesh::UsageError);
+    EXPECT_THROW(globemesh::parse_area_km2("10km"), globemesh::UsageError);
+    EXPECT_THROW(globemesh::parse_length_km("10km2"), globemesh::UsageError);
+}
+
+TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
+    const auto a = globemesh::parse_mesh_args(std::vector<std::string>{
+        "--hmax", "5000m", "--hmin", "0.5", "--min-island-area", "1e6m2", "--coast-size", "2km",
+        "--wave-period", "30min", "--bathy-fill", "1km"});
+    EXPECT_DOUBLE_EQ(a.mesh.hmax_km, 5.0);
+    EXPECT_DOUBLE_EQ(a.mesh.hmin_km, 0.5);
+    EXPECT_DOUBLE_EQ(a.mesh.min_island_area_km2, 1.0);
+    EXPECT_DOUBLE_EQ(a.mesh.coast_size_km, 2.0);
+    EXPECT_DOUBLE_EQ(a.mesh.wave_period_h, 0.5);
+    ASSERT_TRUE(a.mesh.bathy_fill_m.has_value());
+    EXPECT_DOUBLE_EQ(*a.mesh.bathy_fill_m, 1000.0);
+    const auto b = globemesh::parse_mesh_args(std::vector<std::string>{"--hmax", "5"});
+    EXPECT_EQ(a.mesh.hmax_km, b.mesh.hmax_km);
+}
+
+TEST(Cli, defaults_are_those_of_mesh_options) {
+    const auto a = globemesh::parse_mesh_args(std::vector<std::string>{});
+    expect_same_options(a.mesh, globemesh::MeshOptions{});
+    EXPECT_FALSE(a.mesh.region.has_value());
+    EXPECT_FALSE(a.mesh.bathy_fill_m.has_value());
+    EXPECT_EQ(a.format, "netcdf4");
+}
+
+TEST(Cli, region_takes_four_comma_separated_degrees) {
+    const auto a = globemesh::parse_mesh_args(std::vector<std::string>{"--region", "-20,40,10,65"});
+    ASSERT_TRUE(a.mesh.region.has_value());
+    EXPECT_EQ(*a.mesh.region, (std::array<double, 4>{-20, 40, 10, 65}));
+    EXPECT_THROW(globemesh::parse_mesh_args(std::vector<std::string>{"--region", "1,2,3"}),
+                 globemesh::UsageError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Config files and --print-config
+
+TEST(Cli, config_file_equals_the_same_options_given_as_flags) {
+    TempDir dir;
+    const fs::path toml = dir / "run.toml";
+    write_text(toml, "# a run\ncoast = \"" + coast + "\"\nhmax = \"45km\"\nhmin = \"2000m\"\n"
+                     "region = [-20, 40, 10, 65]\nkeep-inland-seas = true\nmin-island-area = \"1e8m2\"\n"
+                     "seed = 9\nformat = \"classic\"\noutput = \"x.nc\"\n");
+    const fs::path ini = dir / "run.ini";
+    write_text(ini, "; a run\ncoast=" + coast + "\nhmax=45km\nhmin=2000m\nregion=-20,40,10,65\n"
+                    "keep-inland-seas=true\nmin-island-area=1e8m2\nseed=9\nformat=classic\noutput=x.nc\n");
+    const auto flags = globemesh::parse_mesh_args(std::vector<std::string>{
+        "--coast", coast, "--hmax", "45", "--hmin", "2", "--region", "-20,40,10,65", "--keep-inland-seas",
+        "--min-island-area", "100", "--seed", "9", "--format", "classic", "-o", "x.nc"});
+    const auto from_toml = globemesh::parse_mesh_args(std::vector<std::string>{"--config", toml.string()});
+    const auto from_ini = globemesh::parse_mesh_args(std::vector<std::string>{"--config", ini.string()});
+    expect_same_cli(from_toml, flags);
+    expect_same_cli(from_ini, flags);
+    EXPECT_DOUBLE_EQ(flags.mesh.hmax_km, 45.0); // and not the default
+}
+
+TEST(Cli, flags_override_the_config_file) {
+    TempDir dir;
+    write_text(dir / "run.toml", "hmax = \"45km\"\nseed = 9\n");
+    const auto a = globemesh::parse_mesh_args(
+        std::vector<std::string>{"--config", (dir / "run.toml").string(), "--hmax", "30km"});
+    EXPECT_DOUBLE_EQ(a.mesh.hmax_km, 30.0);
+    EXPECT_EQ(a.mesh.seed, 9u);
+}
+
+TEST(Cli, print_config_round_trips_every_option) {
+    TempDir dir;
+    const auto args = every_option(dir.path().string());
+    const auto original = globemesh::parse_mesh_args(args);
+    auto print_args = args;
+    print_args.insert(print_args.begin(), "mesh");
+    print_args.push_back("--print-config");
+    const Result printed = run_refused(print_args);
+    ASSERT_EQ(printed.status, 0) << printed.err;
+    EXPECT_EQ(printed.err, "");
+    write_text(dir / "printed.toml", printed.out);
+    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "printed.toml").string()});
+    expect_same_cli(again, original);
+    // Not vacuous: the values differ from the defaults.
+    EXPECT_DOUBLE_EQ(original.mesh.hmax_km, 45.0);
+    EXPECT_DOUBLE_EQ(original.mesh.wave_period_h, 12.42);
+    EXPECT_DOUBLE_EQ(original.mesh.min_island_area_km2, 25.0);
+    EXPECT_EQ(original.mesh.coast_rate, 0.123456789012345);
+    EXPECT_NE(original.mesh.seed, globemesh::MeshOptions{}.seed);
+    // And printing the re-read configuration gives the same text.
+    const Result printed_again =
+        run_refused({"mesh", "--config", (dir / "printed.toml").string(), "--print-config"});
+    EXPECT_EQ(printed_again.out, printed.out);
+}
+
+TEST(Cli, print_config_of_defaults_reads_back_as_the_defaults) {
+    TempDir dir;
+    const Result printed = run_refused({"mesh", "--print-config"});
+    ASSERT_EQ(printed.status, 0) << printed.err;
+    write_text(dir / "d.toml", printed.out);
+    SCOPED_TRACE(printed.out);
+    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "d.toml").string()});
+    expect_same_cli(again, globemesh::CliOptions{});
+}
+
+TEST(Cli, a_missing_config_file_is_an_error_naming_it) {
+    const Result r = run_refused({"mesh", "--config", "/nonexistent/run.toml"});
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("/nonexistent/run.toml"), std::string::npos) << r.err;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors: status, one line naming the option or file, no output, no library call
+
+struct ErrorCase {
+    std::string name;
+    std::vector<std::string> args; // "{dir}" is replaced by a fresh temporary folder
+    int status;
+    std::string named; // text the one line must contain
+};
+
+class CliErrors : public ::testing::TestWithParam<ErrorCase> {};
+
+TEST_P(CliErrors, one_line_naming_the_culprit_and_no_output) {
+    const ErrorCase& c = GetParam();
+    TempDir dir;
+    std::vector<std::string> args;
+    for (auto a : c.args) {
+        for (auto p = a.find("{dir}"); p != std::string::npos; p = a.find("{dir}"))
+            a.replace(p, 5, dir.path().string());
+        args.push_back(a);
+    }
+    write_text(dir / "existing.nc", "keep me");
+    const Result r = run_refused(args);
+    EXPECT_EQ(r.status, c.status) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("globemesh: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.named), std::string::npos) << "expected '" << c.named << "' in: " << r.err;
+    EXPECT_EQ(r.out, "");
+    // Nothing but the file the test made is in the folder, and it is untouched.
+    std::vector<std::string> files;
+    for (const auto& e : fs::directory_iterator(dir.path())) files.push_back(e.path().filename().string());
+    EXPECT_EQ(files, std::vector<std::string>{"existing.nc"});
+    EXPECT_EQ(read_text(dir / "existing.nc"), "keep me");
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cli, CliErrors,
+    ::testing::Values(
+        ErrorCase{"unknown_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "20parsecs"}, 2, "--hmax"},
+        ErrorCase{"not_a_number", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmin", "small"}, 2, "--hmin"},
+        ErrorCase{"negative_size", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "-5km"}, 2, "--hmax"},
+        ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20km"}, 2, "--hmin"},
+        ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
+        ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
+        ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
+        ErrorCase{"unknown_option", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmaxx", "3"}, 2, "--hmaxx"},
+        ErrorCase{"quiet_and_verbose", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "-q", "-v"}, 2, "--quiet"},
+        ErrorCase{"no_coast", {"mesh", "-o", "{dir}/o.nc"}, 2, "--coast"},
+        ErrorCase{"no_output", {"mesh", "--coast", coast}, 2, "--output"},
+        ErrorCase{"same_output_twice", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/o.nc"}, 2, "--gpkg"},
+        ErrorCase{"unknown_subcommand", {"meshh", "--coast", coast}, 2, "meshh"},
+        ErrorCase{"no_subcommand", {}, 2, "subcommand"},
+        ErrorCase{"unknown_top_level_option", {"--hmax", "3"}, 2, "--hmax"},
+        ErrorCase{"help_on_unknown_subcommand", {"help", "bogus"}, 2, "bogus"},
+        ErrorCase{"missing_coast_file", {"mesh", "--coast", "{dir}/nowhere.gpkg", "-o", "{dir}/o.nc"}, 1, "nowhere.gpkg"},
+        ErrorCase{"missing_bathy_file", {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"}, 1, "nodem.tif"},
+        ErrorCase{"output_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"}, 1, "--output"},
+        ErrorCase{"existing_output", {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"}, 1, "--overwrite"},
+        ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.nc"}, 1, "existing.nc"},
+        ErrorCase{"report_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/x/r.json"}, 1, "--report"},
+        ErrorCase{"triangulate_missing_points", {"triangulate", "{dir}/none.csv", "-o", "{dir}/t.nc"}, 1, "none.csv"},
+        ErrorCase{"triangulate_without_output", {"triangulate", fixture("points/stations.csv").string()}, 2, "--output"},
+        ErrorCase{"triangulate_existing_output", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/existing.nc"}, 1, "existing.nc"},
+        ErrorCase{"info_missing_file", {"info", "{dir}/none.nc"}, 1, "none.nc"},
+        ErrorCase{"info_without_file", {"info"}, 2, "MESH"}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(Cli, the_folder_named_in_a_missing_folder_error_is_the_real_one) {
+    TempDir dir;
+    const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "no/such/o.nc").string()});
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find((dir / "no/such").string()), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "no"));
+}
+
+TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
+    TempDir dir;
+    const std::vector<std::string> args = {"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "-q"};
+    auto with_error = [&](std::function<void()> thrower) {
+        RefusingLibrary refusing;
+        auto lib = refusing.lib();
+        lib.mesh_ocean = [thrower](auto&&...) -> globemesh::Mesh { thrower(); return {}; };
+        return run(args, lib);
+    };
+    const Result usage = with_error([] { throw globemesh::UsageError("--coast-layer: no layer 'x'"); });
+    EXPECT_EQ(usage.status, 2);
+    EXPECT_EQ(usage.err, "globemesh: --coast-layer: no layer 'x'\n");
+    const Result data = with_error([] { throw globemesh::DataError("--region: no ocean in the region"); });
+    EXPECT_EQ(data.status, 1);
+    EXPECT_EQ(data.err, "globemesh: --region: no ocean in the region\n");
+    const Result io = with_error([] { throw globemesh::IoError("cannot read x.gpkg"); });
+    EXPECT_EQ(io.status, 1);
+    const Result internal = with_error([] { throw std::out_of_range("vector::at\nsecond line"); });
+    EXPECT_EQ(internal.status, 1);
+    EXPECT_EQ(internal.err, "globemesh: internal error: vector::at; second line\n");
+    for (const auto* r : {&usage, &data, &io, &internal}) EXPECT_EQ(r->out, "");
+    EXPECT_FALSE(fs::exists(dir / "o.nc"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ctrl-C
+
+TEST(Cli, sigint_cancels_the_run_leaves_no_output_and_restores_the_handler) {
+    TempDir dir;
+    struct sigaction before {};
+    sigaction(SIGINT, nullptr, &before);
+    RefusingLibrary refusing;
+    auto lib = refusing.lib();
+    bool handled_inside = false;
+    lib.mesh_ocean = [&](const globemesh::MeshOptions&, const globemesh::Progress& progress,
+                         globemesh::StageTimings*) -> globemesh::Mesh {
+        globemesh::report(progress, 0.1, "refine");
+        std::raise(SIGINT); // our handler only sets a flag, so the test process survives
+        handled_inside = true;
+        globemesh::report(progress, 0.2, "refine"); // throws Cancelled
+        ADD_FAILURE() << "the progress callback did not cancel the run";
+        return {};
+    };
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib);
+    EXPECT_TRUE(handled_inside);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("globemesh: cancelled"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+    struct sigaction after {};
+    sigaction(SIGINT, nullptr, &after);
+    EXPECT_EQ(after.sa_handler, before.sa_handler);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Progress
+
+TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
+    TempDir dir;
+    auto lib_with_progress = [](RefusingLibrary& refusing) {
+        auto lib = refusing.lib();
+        lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
+                            globemesh::StageTimings*) -> globemesh::Mesh {
+            for (int i = 0; i <= 10; ++i) globemesh::report(progress, i / 10.0, i < 5 ? "size_field" : "refine");
+            throw globemesh::DataError("stop here");
+        };
+        return lib;
+    };
+    RefusingLibrary r1, r2, r3;
+    const Result normal = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib_with_progress(r1));
+    EXPECT_EQ(normal.err, "0...10...20...30...40...50...60...70...80...90...100 - done.\nglobemesh: stop here\n");
+    EXPECT_EQ(normal.out, "");
+    const Result quiet = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--quiet"}, lib_with_progress(r2));
+    EXPECT_EQ(quiet.err, "globemesh: stop here\n");
+    const Result verbose = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--verbose"}, lib_with_progress(r3));
+    EXPECT_NE(verbose.err.find("[size_field] 0"), std::string::npos) << verbose.err;
+    EXPECT_NE(verbose.err.find("\n[refine] "), std::string::npos) << verbose.err;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Help and version
+
+TEST(Cli, version_prints_the_project_version) {
+    // The version in the top CMakeLists.txt, read independently of the build's definition.
+    const std::string cmake = read_text(fs::path(GLOBEMESH_FIXTURES_DIR) / ".." / "CMakeLists.txt");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(cmake, m, std::regex(R"(project\(globemesh VERSION ([0-9.]+))")));
+    for (const auto& args : {std::vector<std::string>{"--version"}, std::vector<std::string>{"mesh", "--version"}}) {
+        const Result r = run_refused(args);
+        EXPECT_EQ(r.status, 0);
+        EXPECT_EQ(r.out.rfind("globemesh " + m[1].str() + " ", 0), 0u) << r.out;
+        EXPECT_EQ(count_lines(r.out), 1);
+        EXPECT_EQ(r.err, "");
+    }
+}
+
+TEST(Cli, help_lists_the_subcommands) {
+    for (const auto& args : {std::vector<std::string>{"help"}, std::vector<std::string>{"--help"}}) {
+        const Result r = run_refused(args);
+        EXPECT_EQ(r.status, 0);
+        EXPECT_EQ(r.err, "");
+        for (const char* sub : {"mesh", "triangulate", "info", "help"})
+            EXPECT_TRUE(std::regex_search(r.out, std::regex(std::string("\\n\\s+") + sub + "\\s"))) << sub << " in\n" << r.out;
+    }
+}
+
+TEST(Cli, help_of_a_subcommand_shows_its_options_and_defaults) {
+    const Result a = run_refused({"help", "mesh"});
+    const Result b = run_refused({"mesh", "--help"});
+    EXPECT_EQ(a.status, 0);
+    EXPECT_EQ(b.status, 0);
+    EXPECT_EQ(a.out, b.out);
+    EXPECT_TRUE(std::regex_search(a.out, std::regex(R"(--hmax LENGTH=100\s)"))) << a.out;
+    EXPECT_TRUE(std::regex_search(a.out, std::regex(R"(--grade G=0\.15\s)"))) << a.out;
+    const Result t = run_refused({"triangulate", "--help"});
+    EXPECT_NE(t.out.find("POINTS"), std::string::npos);
+    const Result i = run_refused({"info", "--help"});
+    EXPECT_NE(i.out.find("--json"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The man page documents exactly the options --help lists
+
+namespace {
+
+const fs::path man_page = fs::path(GLOBEMESH_FIXTURES_DIR) / ".." / "man" / "globemesh.1";
+
+std::set<std::string> long_options(const std::string& text) {
+    std::set<std::string> names;
+    const std::regex option(R"((^|[^A-Za-z0-9-])(--[a-z][a-z0-9-]*))");
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), option); it != std::sregex_iterator(); ++it)
+        names.insert((*it)[2].str());
+    return names;
+}
+
+std::string man_text_plain() {
+    // man(7) writes a minus as "\-": turn it back into "-" before looking for options.
+    return std::regex_replace(read_text(man_page), std::regex(R"(\\-)"), "-");
+}
+
+} // namespace
+
+TEST(Cli, every_option_in_help_is_in_the_man_page) {
+    ASSERT_TRUE(fs::exists(man_page)) << man_page;
+    const auto documented = long_options(man_text_plain());
+    for (const char* sub : {"mesh", "triangulate", "info"}) {
+        const Result r = run_refused({sub, "--help"});
+        const auto listed = long_options(r.out);
+        EXPECT_GT(listed.size(), 2u) << sub;
+        for (const auto& o : listed) EXPECT_TRUE(documented.count(o)) << o << " of " << sub << " is not in " << man_page;
+    }
+}
+
+TEST(Cli, every_option_in_the_man_page_is_in_help) {
+    std::set<std::string> listed = long_options(run_refused({"--help"}).out);
+    for (const char* sub : {"mesh", "triangulate", "info"})
+        for (const auto& o : long_options(run_refused({sub, "--help"}).out)) listed.insert(o);
+    const auto documented = long_options(man_text_plain());
+    EXPECT_GT(documented.size(), 30u);
+    for (const auto& o : documented) EXPECT_TRUE(listed.count(o)) << o << " is in the man page but in no --help";
+}
+
+// ---------------------------------------------------------------------------------------------
+// check_mesh
+
+TEST(Cli, check_mesh_accepts_the_octahedron_and_names_broken_faces) {
+    globemesh::Mesh m;
+    m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+    EXPECT_TRUE(globemesh::check_mesh(m).empty());
+    auto flipped = m;
+    std::swap(flipped.faces[2][0], flipped.faces[2][1]);
+    const auto problems = globemesh::check_mesh(flipped);
+    ASSERT_FALSE(problems.empty());
+    EXPECT_NE(problems.front().find("face 2"), std::string::npos) << problems.front();
+    auto open = m; // drop the south half: 4 boundary edges, which must be listed
+    open.faces.resize(4);
+    EXPECT_FALSE(globemesh::check_mesh(open).empty());
+    for (int k = 0; k < 4; ++k)
+        open.boundary.push_back({globemesh::NodeIndex((k + 1) % 4), globemesh::NodeIndex(k), globemesh::EdgeTag::open});
+    // Faces (k, k+1, 4) leave the edge k -> k+1 open; the list above has them reversed.
+    EXPECT_FALSE(globemesh::check_mesh(open).empty());
+    for (auto& e : open.boundary) std::swap(e.a, e.b);
+    EXPECT_TRUE(globemesh::check_mesh(open).empty());
+}
