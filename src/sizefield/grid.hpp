@@ -1,0 +1,61 @@
+// Internal to sizefield/: the background grid's geometry and the two grid solvers.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "globemesh/boundary.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/progress.hpp"
+#include "globemesh/sphere.hpp"
+
+namespace globemesh::detail {
+
+/// A lon/lat grid of cell centres: node (i, j) at lon0 + i*dlon, lat0 + j*dlat (dlat > 0, rows
+/// south to north). A global grid has an even nlon, wraps across +-180 and links row 0 (and the
+/// last row) to the node 180 degrees away on the same row, across the pole.
+struct BackgroundGrid {
+    double lon0 = 0, lat0 = 0, dlon = 1, dlat = 1; // degrees
+    std::size_t nlon = 0, nlat = 0;
+    bool global = false;
+    std::vector<double> sin_lon, cos_lon, sin_lat, cos_lat;
+    std::vector<double> dx_km; ///< great-circle distance between neighbours on row j
+    double dy_km = 0;          ///< great-circle distance between neighbours along a column
+
+    BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_deg,
+                   std::size_t nlon_, std::size_t nlat_, bool global_);
+
+    std::size_t size() const { return nlon * nlat; }
+    double lon(std::size_t i) const { return lon0 + static_cast<double>(i) * dlon; }
+    double lat(std::size_t j) const { return lat0 + static_cast<double>(j) * dlat; }
+    Vec3 node(std::size_t i, std::size_t j) const {
+        return {cos_lat[j] * cos_lon[i], cos_lat[j] * sin_lon[i], sin_lat[j]};
+    }
+    Vec3 node(std::size_t n) const { return node(n % nlon, n / nlon); }
+
+    /// The two neighbours of node n along its row (west, east); npos where there is none.
+    void row_neighbours(std::size_t n, std::size_t out[2]) const;
+    /// The two neighbours of node n along its meridian (south, north); npos where there is none.
+    void column_neighbours(std::size_t n, std::size_t out[2]) const;
+
+    static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+};
+
+/// The grid build_size_field uses for these options: see sizefield.hpp.
+BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std::size_t max_nodes);
+
+/// Great-circle distance (km) from every node to the nearest point of the boundary rings, up to
+/// max_km (nodes farther get +infinity).
+std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b, double max_km,
+                                     const Progress& progress);
+
+/// Lowers h so that the upwind |grad h| <= grade at every node (fast marching).
+void limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade,
+                    const Progress& progress);
+
+/// min(h, size_km) over the nodes inside each polygon of an OGR source with a size_km field.
+void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h);
+
+} // namespace globemesh::detail

@@ -1,0 +1,158 @@
+// --size-regions: polygons with a size_km attribute, burnt onto the background grid with GDAL's
+// rasteriser (the grid's node is the centre of a raster cell, so "cell centre inside" is exactly
+// GDAL's default burn rule).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <cpl_error.h>
+#include <gdal.h>
+#include <gdal_alg.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#include "globemesh/error.hpp"
+#include "grid.hpp"
+
+namespace globemesh::detail {
+
+namespace {
+
+class QuietGdalErrors {
+public:
+    QuietGdalErrors() {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        CPLErrorReset();
+    }
+    ~QuietGdalErrors() { CPLPopErrorHandler(); }
+    QuietGdalErrors(const QuietGdalErrors&) = delete;
+    QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
+};
+
+struct DatasetCloser {
+    void operator()(void* p) const {
+        if (p) GDALClose(static_cast<GDALDatasetH>(p));
+    }
+};
+struct GeometryDestroyer {
+    void operator()(void* p) const {
+        if (p) OGR_G_DestroyGeometry(static_cast<OGRGeometryH>(p));
+    }
+};
+struct FeatureDestroyer {
+    void operator()(void* p) const {
+        if (p) OGR_F_Destroy(static_cast<OGRFeatureH>(p));
+    }
+};
+struct SrsReleaser {
+    void operator()(void* p) const {
+        if (p) OSRRelease(static_cast<OGRSpatialReferenceH>(p));
+    }
+};
+struct TransformDestroyer {
+    void operator()(void* p) const {
+        if (p) OCTDestroyCoordinateTransformation(static_cast<OGRCoordinateTransformationH>(p));
+    }
+};
+using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
+using GeometryPtr = std::unique_ptr<void, GeometryDestroyer>;
+using FeaturePtr = std::unique_ptr<void, FeatureDestroyer>;
+using SrsPtr = std::unique_ptr<void, SrsReleaser>;
+using TransformPtr = std::unique_ptr<void, TransformDestroyer>;
+
+std::string last_message() {
+    std::string m = CPLGetLastErrorMsg();
+    return m.empty() ? std::string("unknown error") : m;
+}
+
+} // namespace
+
+void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h) {
+    GDALAllRegister();
+    QuietGdalErrors quiet;
+    DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    if (!ds) throw IoError("--size-regions " + path + ": cannot open as vector data: " + last_message());
+
+    SrsPtr wgs84(OSRNewSpatialReference(nullptr));
+    OSRImportFromEPSG(static_cast<OGRSpatialReferenceH>(wgs84.get()), 4326);
+    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(wgs84.get()), OAMS_TRADITIONAL_GIS_ORDER);
+
+    // Polygons in lon/lat with their sizes.
+    std::vector<std::pair<double, GeometryPtr>> regions;
+    bool any_field = false;
+    for (int l = 0; l < GDALDatasetGetLayerCount(ds.get()); ++l) {
+        OGRLayerH layer = GDALDatasetGetLayer(ds.get(), l);
+        OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
+        int field = OGR_FD_GetFieldIndex(defn, "size_km");
+        if (field < 0) continue;
+        any_field = true;
+        OGRSpatialReferenceH srs = OGR_L_GetSpatialRef(layer);
+        if (!srs)
+            throw DataError("--size-regions " + path + ": layer " + OGR_L_GetName(layer) +
+                            " has no CRS; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
+        TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, static_cast<OGRSpatialReferenceH>(wgs84.get())));
+        if (!to_lonlat)
+            throw DataError("--size-regions " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");
+        OGR_L_ResetReading(layer);
+        while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
+            OGRFeatureH fh = static_cast<OGRFeatureH>(f.get());
+            OGRGeometryH geom = OGR_F_GetGeometryRef(fh);
+            if (!geom || !OGR_F_IsFieldSetAndNotNull(fh, field)) continue;
+            OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geom));
+            if (type != wkbPolygon && type != wkbMultiPolygon) continue;
+            double size = OGR_F_GetFieldAsDouble(fh, field);
+            if (!(std::isfinite(size) && size > 0))
+                throw DataError("--size-regions " + path + ": feature " + std::to_string(OGR_F_GetFID(fh)) +
+                                " has size_km " + OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
+            GeometryPtr copy(OGR_G_Clone(geom));
+            if (OGR_G_Transform(static_cast<OGRGeometryH>(copy.get()), static_cast<OGRCoordinateTransformationH>(to_lonlat.get())) != OGRERR_NONE)
+                throw DataError("--size-regions " + path + ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) + " to lon/lat");
+            regions.emplace_back(size, std::move(copy));
+        }
+    }
+    if (!any_field)
+        throw DataError("--size-regions " + path + ": no layer has a size_km field (edge length in km)");
+    if (regions.empty()) return;
+    // Largest first: with the REPLACE rule the smallest size burnt last wins (a minimum).
+    std::stable_sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<OGRGeometryH> geoms;
+    std::vector<double> burn;
+    for (auto& r : regions) {
+        geoms.push_back(static_cast<OGRGeometryH>(r.second.get()));
+        burn.push_back(r.first);
+    }
+
+    GDALDriverH mem = GDALGetDriverByName("MEM");
+    const int nx = static_cast<int>(g.nlon), ny = static_cast<int>(g.nlat);
+    const double west = g.lon0 - 0.5 * g.dlon, north = g.lat0 + (static_cast<double>(g.nlat) - 0.5) * g.dlat;
+    std::vector<float> row(g.nlon);
+    // Grids reaching beyond [-180, 180] also burn the polygons shifted by 360 degrees.
+    for (double shift : {0.0, -360.0, 360.0}) {
+        const double east = west + static_cast<double>(g.nlon) * g.dlon;
+        if (shift < 0 && east <= 180.0) continue;
+        if (shift > 0 && west >= -180.0) continue;
+        DatasetPtr target(GDALCreate(mem, "", nx, ny, 1, GDT_Float32, nullptr));
+        if (!target) throw IoError("--size-regions: cannot create an in-memory grid: " + last_message());
+        // North-up: raster row r is grid row nlat-1-r. Shift moves the polygons' lon by -shift.
+        double gt[6] = {west + shift, g.dlon, 0, north, 0, -g.dlat};
+        GDALSetGeoTransform(target.get(), gt);
+        GDALRasterBandH band = GDALGetRasterBand(target.get(), 1);
+        GDALFillRaster(band, std::numeric_limits<double>::infinity(), 0);
+        int one = 1;
+        if (GDALRasterizeGeometries(target.get(), 1, &one, static_cast<int>(geoms.size()), geoms.data(),
+                                    nullptr, nullptr, burn.data(), nullptr, nullptr, nullptr) != CE_None)
+            throw IoError("--size-regions " + path + ": rasterising failed: " + last_message());
+        for (int r = 0; r < ny; ++r) {
+            if (GDALRasterIO(band, GF_Read, 0, r, nx, 1, row.data(), nx, 1, GDT_Float32, 0, 0) != CE_None)
+                throw IoError("--size-regions: reading the in-memory grid failed: " + last_message());
+            std::size_t j = g.nlat - 1 - static_cast<std::size_t>(r);
+            for (std::size_t i = 0; i < g.nlon; ++i) h[j * g.nlon + i] = std::min(h[j * g.nlon + i], row[i]);
+        }
+    }
+}
+
+} // namespace globemesh::detail

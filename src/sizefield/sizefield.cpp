@@ -1,0 +1,182 @@
+// SizeField, build_size_field and the analytic size functions.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "globemesh/error.hpp"
+#include "globemesh/sizefield.hpp"
+#include "grid.hpp"
+
+namespace globemesh {
+
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+std::string km(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g km", v);
+    return buf;
+}
+
+} // namespace
+
+double wavelength_size_km(double depth_m, double period_h, double n) {
+    const double d = std::max(depth_m, min_depth_m);
+    return period_h * 3600.0 * std::sqrt(standard_gravity * d) / n / 1000.0;
+}
+
+double slope_size_km(double depth_m, double grad_m_per_km, double n) {
+    const double d = std::max(depth_m, min_depth_m);
+    if (!(grad_m_per_km > 0)) return inf;
+    return 2.0 * pi * d / (n * grad_m_per_km);
+}
+
+SizeField::SizeField(Raster grid) {
+    if (grid.values().empty()) throw DataError("size field: empty background grid");
+    min_ = inf;
+    max_ = 0;
+    for (float v : grid.values()) {
+        if (!(std::isfinite(v) && v > 0)) throw DataError("size field: a background node is not a positive size");
+        min_ = std::min(min_, static_cast<double>(v));
+        max_ = std::max(max_, static_cast<double>(v));
+    }
+    grid_ = std::make_shared<const Raster>(std::move(grid));
+}
+
+double SizeField::size_km(double lon, double lat) const {
+    const Raster& g = *grid_;
+    if (!g.global()) {
+        // Hold the edge values outside a regional grid: clamp to the nearest edge.
+        const LonLatBounds b = g.bounds();
+        double l = lon;
+        if (l < b.west || l > b.east) {
+            double east_gap = std::remainder(l - b.east, 360.0), west_gap = std::remainder(b.west - l, 360.0);
+            if (east_gap >= 0 && west_gap >= 0) l = east_gap < west_gap ? b.east : b.west;
+            else l = b.west + std::remainder(l - b.west, 360.0);
+            l = std::clamp(l, b.west, b.east);
+        }
+        lat = std::clamp(lat, b.south, b.north);
+        lon = l;
+    }
+    double h = g.sample(lon, lat);
+    return std::isnan(h) ? max_ : h;
+}
+
+double SizeField::size_km(const Vec3& p) const {
+    const LonLat ll = vec_to_lonlat(p);
+    return size_km(ll.lon, ll.lat);
+}
+
+SizeFn SizeField::function() const {
+    SizeField copy = *this;
+    return [copy](const Vec3& p) { return copy.size_km(p); };
+}
+
+SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boundary* coast,
+                           const Progress& progress, std::size_t max_nodes) {
+    validate(o);
+    if (!(o.hmax_km > 0)) throw UsageError("--hmax must be a positive length, e.g. 100km");
+    if ((o.wavelength > 0 || o.slope > 0) && !bathy)
+        throw UsageError(std::string(o.wavelength > 0 ? "--wavelength" : "--slope") +
+                         " needs a bathymetry raster: give --bathy");
+    if (o.coast_size_km > 0 && !coast)
+        throw UsageError("--coast-size needs the coastline: give --coast");
+    const double hmax = o.hmax_km;
+    const double hfloor = o.hmin_km > 0 ? o.hmin_km : std::max(hmax / 1000.0, 0.01);
+    if (o.coast_size_km > 0 && o.coast_size_km > hmax)
+        throw UsageError("--coast-size (" + km(o.coast_size_km) + ") must not be larger than --hmax (" + km(hmax) + ")");
+
+    report(progress, 0.0, "size field");
+    detail::BackgroundGrid g = detail::make_background_grid(o, hfloor, max_nodes);
+    std::vector<float> h(g.size(), static_cast<float>(hmax));
+    auto lower = [&](std::size_t n, double v) {
+        if (v < h[n]) h[n] = static_cast<float>(v);
+    };
+
+    // Distance to the coast.
+    if (o.coast_size_km > 0 && coast && !coast->empty()) {
+        const double reach = o.coast_rate > 0 ? (hmax - o.coast_size_km) / o.coast_rate : inf;
+        std::vector<float> d = detail::coast_distance_km(g, *coast, std::min(reach * 1.01 + 2 * g.dy_km, pi * earth_radius_km),
+                                                         sub_progress(progress, 0.05, 0.35));
+        for (std::size_t n = 0; n < g.size(); ++n)
+            if (std::isfinite(d[n])) lower(n, o.coast_size_km + o.coast_rate * d[n]);
+    }
+    report(progress, 0.35, "size field");
+
+    // Wavelength and slope, from the depth on the grid.
+    if (bathy && (o.wavelength > 0 || o.slope > 0)) {
+        std::vector<float> depth(g.size());
+        for (std::size_t j = 0; j < g.nlat; ++j) {
+            for (std::size_t i = 0; i < g.nlon; ++i)
+                depth[j * g.nlon + i] = static_cast<float>(-bathy->elevation_m(g.lon(i), g.lat(j)));
+            if (j % 256 == 0) report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat), "size field");
+        }
+        for (std::size_t n = 0; n < g.size(); ++n) {
+            const double dn = depth[n];
+            if (std::isnan(dn)) continue;
+            if (o.wavelength > 0) lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
+            if (o.slope > 0) {
+                // Central differences of the floored depth (one-sided at edges and no-data).
+                auto floored = [&](std::size_t m) {
+                    return std::isnan(depth[m]) ? std::numeric_limits<double>::quiet_NaN()
+                                                : std::max(static_cast<double>(depth[m]), min_depth_m);
+                };
+                auto derivative = [&](const std::size_t nb[2], double step) {
+                    double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
+                    double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
+                    double here = std::max(dn, min_depth_m);
+                    if (!std::isnan(lo) && !std::isnan(hi)) return (hi - lo) / (2 * step);
+                    if (!std::isnan(hi)) return (hi - here) / step;
+                    if (!std::isnan(lo)) return (here - lo) / step;
+                    return 0.0;
+                };
+                std::size_t r[2], c[2];
+                g.row_neighbours(n, r);
+                g.column_neighbours(n, c);
+                const double gx = derivative(r, g.dx_km[n / g.nlon]);
+                const double gy = derivative(c, g.dy_km);
+                lower(n, slope_size_km(dn, std::hypot(gx, gy), o.slope));
+            }
+        }
+    }
+    report(progress, 0.55, "size field");
+
+    if (!o.size_regions.empty()) detail::apply_size_regions(g, o.size_regions, h);
+    report(progress, 0.6, "size field");
+
+    for (float& v : h) v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
+    detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
+    report(progress, 1.0, "size field");
+    return SizeField(Raster(g.lon0, g.lat0, g.dlon, g.dlat, g.nlon, g.nlat, std::move(h)));
+}
+
+SizeFn uniform_size(double h_km) {
+    if (!(std::isfinite(h_km) && h_km > 0)) throw UsageError("uniform size: h must be a positive length in km");
+    return [h_km](const Vec3&) { return h_km; };
+}
+
+SizeFn gulf_stream_size(Vec3 centre, double h_near_km, double h_far_km, double radius_km, double ramp_km) {
+    if (!(h_near_km > 0 && h_far_km > 0 && std::isfinite(h_near_km) && std::isfinite(h_far_km)))
+        throw UsageError("gulf_stream_size: sizes must be positive lengths in km");
+    if (!(radius_km >= 0 && ramp_km >= 0)) throw UsageError("gulf_stream_size: radius and ramp must be >= 0 km");
+    const Vec3 c = normalized(centre);
+    return [=](const Vec3& p) {
+        const double d = arc_km(c, p);
+        if (d <= radius_km) return h_near_km;
+        if (d >= radius_km + ramp_km) return h_far_km;
+        return h_near_km + (h_far_km - h_near_km) * (d - radius_km) / ramp_km;
+    };
+}
+
+SizeFn latitude_size(double h_equator_km, double h_pole_km) {
+    if (!(h_equator_km > 0 && h_pole_km > 0 && std::isfinite(h_equator_km) && std::isfinite(h_pole_km)))
+        throw UsageError("latitude_size: sizes must be positive lengths in km");
+    return [=](const Vec3& p) {
+        const double s = std::min(1.0, std::abs(p.z) / norm(p));
+        return h_equator_km + (h_pole_km - h_equator_km) * s;
+    };
+}
+
+} // namespace globemesh

@@ -1,0 +1,382 @@
+// Tests of sizefield/: each component against its formula with independent inputs (analytic
+// depth, brute-force great-circle distances), gradation on every background-grid edge, the real
+// ETOPO5 field, the analytic size functions and the bad inputs.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gdal.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#include "globemesh/error.hpp"
+#include "globemesh/sizefield.hpp"
+#include "support.hpp"
+
+using namespace globemesh;
+using globemesh::test::fixture;
+using globemesh::test::TempDir;
+
+namespace {
+
+/// A Float32 lon/lat raster held in memory (no file needed for the size field).
+Raster lonlat_raster(double west, double south, double d, std::size_t nx, std::size_t ny,
+                     const std::function<double(double, double)>& elevation) {
+    std::vector<float> v(nx * ny);
+    for (std::size_t j = 0; j < ny; ++j)
+        for (std::size_t i = 0; i < nx; ++i)
+            v[j * nx + i] = static_cast<float>(elevation(west + (i + 0.5) * d, south + (j + 0.5) * d));
+    return Raster(west + 0.5 * d, south + 0.5 * d, d, d, nx, ny, std::move(v));
+}
+
+MeshOptions regional(double w, double s, double e, double n, double hmin, double hmax) {
+    MeshOptions o;
+    o.region = std::array<double, 4>{w, s, e, n};
+    o.hmin_km = hmin;
+    o.hmax_km = hmax;
+    o.grade = 9.9; // hardly limits: the components show through
+    return o;
+}
+
+/// Great-circle distance (km) from p to the arc a-b, by its own formula (not the library's).
+double distance_to_arc_km(const Vec3& p, const Vec3& a, const Vec3& b) {
+    Vec3 n = normalized(cross(a, b));
+    Vec3 q = p - dot(p, n) * n; // projection on the great circle
+    if (norm(q) > 0) {
+        q = normalized(q);
+        if (dot(cross(a, q), n) >= 0 && dot(cross(q, b), n) >= 0)
+            return std::asin(std::min(1.0, std::abs(dot(p, n)))) * earth_radius_km;
+    }
+    return std::min(std::acos(std::clamp(dot(p, a), -1.0, 1.0)), std::acos(std::clamp(dot(p, b), -1.0, 1.0))) * earth_radius_km;
+}
+
+double distance_to_boundary_km(const Vec3& p, const Boundary& b) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Ring& r : b.rings)
+        for (std::size_t k = 0; k < r.nodes.size(); ++k)
+            best = std::min(best, distance_to_arc_km(p, r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]));
+    return best;
+}
+
+Boundary ring_of(std::initializer_list<LonLat> corners) {
+    Ring r;
+    for (const LonLat& c : corners) {
+        r.nodes.push_back(lonlat_to_vec(c));
+        r.kinds.push_back(SegmentKind::coast);
+    }
+    Boundary b;
+    b.rings.push_back(r);
+    return b;
+}
+
+/// Largest ratio |h(a) - h(b)| / (grade * |ab|) over every row and column edge of the grid,
+/// including the +-180 seam and the pairs across the poles.
+double worst_edge_gradient_ratio(const SizeField& f, double grade) {
+    const Raster& g = f.grid();
+    const std::size_t nx = g.nlon(), ny = g.nlat();
+    double worst = 0;
+    auto check = [&](std::size_t i0, std::size_t j0, std::size_t i1, std::size_t j1) {
+        double d = arc_km(lonlat_to_vec(g.lon_deg(i0), g.lat_deg(j0)), lonlat_to_vec(g.lon_deg(i1), g.lat_deg(j1)));
+        double dh = std::abs(static_cast<double>(g.value(i0, j0)) - g.value(i1, j1));
+        worst = std::max(worst, dh / (grade * d));
+    };
+    for (std::size_t j = 0; j < ny; ++j)
+        for (std::size_t i = 0; i < nx; ++i) {
+            if (i + 1 < nx) check(i, j, i + 1, j);
+            else if (g.global()) check(i, j, 0, j);
+            if (j + 1 < ny) check(i, j, i, j + 1);
+        }
+    if (g.global())
+        for (std::size_t i = 0; i < nx / 2; ++i) {
+            check(i, 0, i + nx / 2, 0);
+            check(i, ny - 1, i + nx / 2, ny - 1);
+        }
+    return worst;
+}
+
+} // namespace
+
+TEST(SizeField, hmax_alone_gives_a_uniform_field) {
+    MeshOptions o;
+    o.hmax_km = 80;
+    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 16);
+    EXPECT_TRUE(f.grid().global());
+    EXPECT_EQ(f.min_km(), 80);
+    EXPECT_EQ(f.max_km(), 80);
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n;
+    for (int k = 0; k < 100; ++k) EXPECT_NEAR(f.size_km(normalized({n(rng), n(rng), n(rng)})), 80, 1e-12);
+    EXPECT_NEAR(f.size_km(lonlat_to_vec(0, 90)), 80, 1e-12);
+}
+
+TEST(SizeField, wavelength_component_matches_its_formula_and_depth_floor) {
+    // Depth 10..4000 m rising eastwards; land (elevation > 0) in the westmost degree.
+    auto elevation = [](double lon, double) { return lon < 1 ? 50.0 : -std::round(400.0 * (lon - 1.0)); };
+    Raster bathy = lonlat_raster(0, 0, 0.05, 240, 120, elevation);
+    MeshOptions o = regional(0.5, 1, 11.5, 5, 2, 500);
+    o.wavelength = 40;
+    SizeField f = build_size_field(o, &bathy, nullptr, {}, 1 << 18);
+    const Raster& g = f.grid();
+    int checked = 0;
+    for (std::size_t j = 0; j < g.nlat(); j += 5)
+        for (std::size_t i = 0; i < g.nlon(); i += 3) {
+            double lon = g.lon_deg(i), lat = g.lat_deg(j);
+            double depth = -bathy.elevation_m(lon, lat);
+            if (std::isnan(depth)) continue;
+            // T sqrt(g D) / n with D floored at 5 m (land and very shallow water).
+            double expect = 12.42 * 3600 * std::sqrt(9.80665 * std::max(depth, 5.0)) / 40 / 1000;
+            expect = std::clamp(expect, 2.0, 500.0);
+            EXPECT_NEAR(g.value(i, j), expect, 1e-5 * expect) << lon << " " << lat;
+            ++checked;
+        }
+    EXPECT_GT(checked, 100);
+    EXPECT_NEAR(f.size_km(0.7, 3), 12.42 * 3600 * std::sqrt(9.80665 * 5.0) / 40 / 1000, 1e-4);
+}
+
+TEST(SizeField, slope_component_matches_its_formula_over_a_seamount) {
+    // Gaussian seamount: depth D = 4000 - 3000 exp(-r^2 / (2 s^2)), r in degrees, s = 1 degree.
+    auto depth = [](double lon, double lat) {
+        return 4000.0 - 3000.0 * std::exp(-((lon - 5) * (lon - 5) + (lat - 5) * (lat - 5)) / 2.0);
+    };
+    Raster bathy = lonlat_raster(0, 0, 0.02, 500, 500, [&](double lon, double lat) { return -depth(lon, lat); });
+    MeshOptions o = regional(2, 2, 8, 8, 4, 5000);
+    o.slope = 20;
+    SizeField f = build_size_field(o, &bathy, nullptr, {}, 1 << 18);
+    const Raster& g = f.grid();
+    double worst = 0;
+    int checked = 0;
+    for (std::size_t j = 2; j + 2 < g.nlat(); j += 4)
+        for (std::size_t i = 2; i + 2 < g.nlon(); i += 4) {
+            double lon = g.lon_deg(i), lat = g.lat_deg(j);
+            double r2 = (lon - 5) * (lon - 5) + (lat - 5) * (lat - 5);
+            if (r2 < 0.1 || r2 > 6) continue; // away from the flat top and the flat far field
+            // Analytic gradient, m/km: dD/dlon / (R cos(lat) rad/deg), dD/dlat / (R rad/deg).
+            double e = 3000.0 * std::exp(-r2 / 2.0);
+            double ddlon = e * (lon - 5), ddlat = e * (lat - 5);
+            double gx = ddlon / (earth_radius_km * std::cos(lat * deg_to_rad) * deg_to_rad);
+            double gy = ddlat / (earth_radius_km * deg_to_rad);
+            double expect = 2 * pi * depth(lon, lat) / (20 * std::hypot(gx, gy));
+            if (expect > 4900) continue;
+            worst = std::max(worst, std::abs(g.value(i, j) - expect) / expect);
+            ++checked;
+        }
+    EXPECT_GT(checked, 50);
+    // Central differences on a 2 km grid over a 1-degree Gaussian: relative error well below 1%.
+    EXPECT_LT(worst, 0.01);
+}
+
+TEST(SizeField, coast_component_matches_great_circle_distance_to_the_rings) {
+    Boundary island = ring_of({{-2, -1}, {2, -1.5}, {2.5, 2}, {-1, 1.5}});
+    MeshOptions o = regional(-10, -10, 10, 10, 10, 150);
+    o.coast_size_km = 10;
+    o.coast_rate = 0.1;
+    SizeField f = build_size_field(o, nullptr, &island, {}, 1 << 18);
+    const Raster& g = f.grid();
+    const double spacing = g.dlat_deg() * deg_to_rad * earth_radius_km;
+    double worst = 0;
+    for (std::size_t j = 0; j < g.nlat(); j += 3)
+        for (std::size_t i = 0; i < g.nlon(); i += 3) {
+            double d = distance_to_boundary_km(lonlat_to_vec(g.lon_deg(i), g.lat_deg(j)), island);
+            double expect = std::min(150.0, 10 + 0.1 * d);
+            worst = std::max(worst, std::abs(g.value(i, j) - expect));
+        }
+    // Distance error below a quarter of the grid spacing, times the rate.
+    EXPECT_LT(worst, 0.1 * 0.25 * spacing) << "grid spacing " << spacing << " km";
+}
+
+TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles) {
+    // A steep coast component (rate 2) around an island on the antimeridian and one near the
+    // north pole: gradation to 0.15 must bring it down to about 5 + 0.15 d.
+    Boundary b = ring_of({{178, -2}, {-178, -2}, {-178, 2}, {178, 2}});
+    Boundary polar = ring_of({{0, 86}, {120, 86}, {-120, 86}});
+    b.rings.push_back(polar.rings[0]);
+    MeshOptions o;
+    o.hmin_km = 5;
+    o.hmax_km = 400;
+    o.coast_size_km = 5;
+    o.coast_rate = 2;
+    o.grade = 0.15;
+    SizeField f = build_size_field(o, nullptr, &b, {}, 1 << 18);
+    ASSERT_TRUE(f.grid().global());
+    EXPECT_LE(worst_edge_gradient_ratio(f, 0.15), 1.0 + 1e-5);
+    // Oracle: the exact gradient-limited field of the node values h0 = min(400, 5 + 2 d), d by
+    // brute force: h*(x) = min over nodes m of h0(m) + 0.15 |xm|. Fast marching is first order
+    // and overestimates |xm|; the coast distance the library seeds with differs from d by at
+    // most rate * step^2 / (8 d) (about 2 km here).
+    const Raster& g = f.grid();
+    std::vector<std::pair<Vec3, double>> seeds;
+    for (std::size_t j = 0; j < g.nlat(); ++j)
+        for (std::size_t i = 0; i < g.nlon(); ++i) {
+            Vec3 p = lonlat_to_vec(g.lon_deg(i), g.lat_deg(j));
+            double h0 = 5 + 2 * distance_to_boundary_km(p, b);
+            if (h0 < 400) seeds.emplace_back(p, h0);
+        }
+    const double dy = g.dlat_deg() * deg_to_rad * earth_radius_km;
+    double worst_over = 0, worst_under = 0;
+    for (std::size_t j = 0; j < g.nlat(); j += 13)
+        for (std::size_t i = 0; i < g.nlon(); i += 13) {
+            Vec3 p = lonlat_to_vec(g.lon_deg(i), g.lat_deg(j));
+            double exact = 400;
+            for (const auto& [q, h0] : seeds) exact = std::min(exact, h0 + 0.15 * arc_km(p, q));
+            // First-order error: 5% plus 1.5 cells of distance (curved fronts near the ring
+            // corners, and the fast-varying metric of the rows near the pole).
+            worst_over = std::max(worst_over, (g.value(i, j) - exact) / (0.05 * exact + 0.15 * 1.5 * dy));
+            worst_under = std::max(worst_under, (exact - g.value(i, j)) / exact);
+        }
+    EXPECT_LT(worst_over, 1.0);
+    EXPECT_LT(worst_under, 0.05);
+    // Continuous across +-180 and over the pole.
+    EXPECT_NEAR(f.size_km(179.999, 30), f.size_km(-179.999, 30), 1e-3);
+    EXPECT_NEAR(f.size_km(0, 89.99), f.size_km(180, 89.99), 0.2);
+}
+
+TEST(SizeField, size_regions_from_a_projected_polygon_file) {
+    TempDir dir;
+    const std::string path = (dir / "regions.gpkg").string();
+    {
+        GDALAllRegister();
+        GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+        ASSERT_NE(ds, nullptr);
+        OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
+        OSRImportFromEPSG(srs, 3857);
+        OGRLayerH layer = GDALDatasetCreateLayer(ds, "regions", srs, wkbPolygon, nullptr);
+        OSRRelease(srs);
+        OGRFieldDefnH fd = OGR_Fld_Create("size_km", OFTReal);
+        OGR_L_CreateField(layer, fd, TRUE);
+        OGR_Fld_Destroy(fd);
+        // A Mercator square from 0 to 2 degrees east, 0 to ~2 degrees north: 7 km inside.
+        OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+        OGR_F_SetFieldDouble(f, 0, 7.0);
+        OGRGeometryH g = nullptr;
+        char wkt[] = "POLYGON ((0 0, 222639 0, 222639 222684, 0 222684, 0 0))";
+        char* p = wkt;
+        OGR_G_CreateFromWkt(&p, nullptr, &g);
+        OGR_F_SetGeometryDirectly(f, g);
+        ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
+        OGR_F_Destroy(f);
+        GDALClose(ds);
+    }
+    MeshOptions o = regional(-5, -5, 5, 5, 2, 100);
+    o.size_regions = path;
+    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    EXPECT_NEAR(f.size_km(1, 1), 7, 1e-5);
+    EXPECT_NEAR(f.size_km(0.2, 1.8), 7, 1e-5);
+    EXPECT_NEAR(f.size_km(-4.5, -4.5), 100, 1e-5);
+    // Graded around the square: 7 + 9.9 * distance, so 100 km is reached within about 10 km.
+    EXPECT_GT(f.size_km(2.5, 1), 50);
+    // A file without a size_km field is refused.
+    const std::string bare = (dir / "bare.gpkg").string();
+    GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GPKG"), bare.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    GDALDatasetCreateLayer(ds, "nothing", nullptr, wkbPolygon, nullptr);
+    GDALClose(ds);
+    o.size_regions = bare;
+    EXPECT_THROW(build_size_field(o, nullptr, nullptr, {}, 1 << 16), DataError);
+}
+
+TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmin_km = 10;
+    o.hmax_km = 150;
+    o.wavelength = 40;
+    o.slope = 20;
+    o.grade = 0.15;
+    SizeField f = build_size_field(o, &bathy, nullptr, {}, 1 << 20);
+    EXPECT_GE(f.min_km(), 10 - 1e-5);
+    EXPECT_LE(f.max_km(), 150 + 1e-5);
+    EXPECT_LE(worst_edge_gradient_ratio(f, 0.15), 1.0 + 1e-5);
+    // North Sea (50-100 m): wavelength 44712 s * sqrt(9.8 * 60) / 40 ~ 27 km.
+    EXPECT_LT(f.size_km(3, 56), 40);
+    // Abyssal Pacific north of Hawaii's chain (4900 m, smooth at 10'): hmax.
+    EXPECT_GT(f.size_km(-140, 10), 140);
+    // Shelves (0..200 m deep) are resolved much finer than the abyss (> 4000 m) on the whole.
+    std::vector<double> shelf, abyss;
+    const Raster& g = f.grid();
+    for (std::size_t j = 0; j < g.nlat(); j += 3)
+        for (std::size_t i = 0; i < g.nlon(); i += 3) {
+            double z = bathy.elevation_m(g.lon_deg(i), g.lat_deg(j));
+            if (z < 0 && z > -200) shelf.push_back(g.value(i, j));
+            if (z < -4000) abyss.push_back(g.value(i, j));
+        }
+    auto median = [](std::vector<double> v) {
+        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+        return v[v.size() / 2];
+    };
+    ASSERT_GT(shelf.size(), 100u);
+    EXPECT_LT(median(shelf), 0.5 * median(abyss));
+    // The Mid-Atlantic Ridge is finer than the abyssal plains beside it.
+    EXPECT_LT(f.size_km(-29, 30), f.size_km(-50, 28));
+}
+
+TEST(SizeField, evaluation_is_bilinear_on_the_background_grid) {
+    MeshOptions o;
+    o.hmin_km = 20;
+    o.hmax_km = 200;
+    o.coast_size_km = 20;
+    o.coast_rate = 0.1;
+    Boundary b = ring_of({{-5, -5}, {5, -5}, {5, 5}, {-5, 5}});
+    SizeField f = build_size_field(o, nullptr, &b, {}, 1 << 16);
+    const Raster& g = f.grid();
+    for (std::size_t j = 0; j < g.nlat(); j += 13)
+        for (std::size_t i = 0; i < g.nlon(); i += 11) {
+            EXPECT_NEAR(f.size_km(lonlat_to_vec(g.lon_deg(i), g.lat_deg(j))), g.value(i, j), 1e-9);
+            double mid = 0.25 * (static_cast<double>(g.value(i, j)) + g.value((i + 1) % g.nlon(), j) +
+                                 g.value(i, std::min(j + 1, g.nlat() - 1)) + g.value((i + 1) % g.nlon(), std::min(j + 1, g.nlat() - 1)));
+            if (j + 1 < g.nlat()) {
+                EXPECT_NEAR(f.size_km(g.lon_deg(i) + 0.5 * g.dlon_deg(), g.lat_deg(j) + 0.5 * g.dlat_deg()), mid, 1e-9);
+            }
+        }
+    SizeFn fn = f.function();
+    EXPECT_EQ(fn(lonlat_to_vec(1, 2)), f.size_km(lonlat_to_vec(1, 2)));
+}
+
+TEST(SizeField, analytic_fields_match_their_definitions) {
+    SizeFn u = uniform_size(30);
+    EXPECT_EQ(u(lonlat_to_vec(10, 10)), 30);
+    Vec3 c = lonlat_to_vec(-70, 38);
+    SizeFn gs = gulf_stream_size(c);
+    EXPECT_EQ(gs(c), 20);
+    EXPECT_EQ(gs(lonlat_to_vec(110, -38)), 160);
+    // 2000 km from the centre: halfway along the 1000 km ramp -> 90 km.
+    Vec3 p = arc_interpolate(c, lonlat_to_vec(0, 0), 2000.0 / arc_km(c, lonlat_to_vec(0, 0)));
+    EXPECT_NEAR(gs(p), 90, 1e-6);
+    SizeFn lat = latitude_size(15, 150);
+    EXPECT_NEAR(lat(lonlat_to_vec(40, 0)), 15, 1e-12);
+    EXPECT_NEAR(lat(lonlat_to_vec(40, 30)), 15 + 135 * 0.5, 1e-9);
+    EXPECT_NEAR(lat(lonlat_to_vec(40, -90)), 150, 1e-12);
+    EXPECT_THROW(uniform_size(0), UsageError);
+    EXPECT_THROW(latitude_size(-1, 10), UsageError);
+}
+
+TEST(SizeField, bad_options_give_one_line_errors_naming_the_option) {
+    auto message = [](const MeshOptions& o, const Raster* bathy) -> std::string {
+        try {
+            build_size_field(o, bathy, nullptr, {}, 1 << 12);
+        } catch (const UsageError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    MeshOptions o;
+    o.hmin_km = 200;
+    o.hmax_km = 100;
+    EXPECT_NE(message(o, nullptr).find("--hmin"), std::string::npos);
+    o = MeshOptions{};
+    o.hmax_km = 0;
+    EXPECT_NE(message(o, nullptr).find("--hmax"), std::string::npos);
+    o = MeshOptions{};
+    o.hmax_km = -3;
+    EXPECT_NE(message(o, nullptr).find("--hmax"), std::string::npos);
+    o = MeshOptions{};
+    o.wavelength = 40;
+    EXPECT_NE(message(o, nullptr).find("--wavelength"), std::string::npos);
+    o = MeshOptions{};
+    o.coast_size_km = 5;
+    EXPECT_NE(message(o, nullptr).find("--coast"), std::string::npos);
+    o = MeshOptions{};
+    o.coast_size_km = -5;
+    EXPECT_NE(message(o, nullptr).find("--coast-size"), std::string::npos);
+}
