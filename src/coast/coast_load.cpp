@@ -137,15 +137,18 @@ void snap_coordinates(PointList& pts, bool transformed) {
     }
     if (!transformed) {
         for (auto& p : pts) {
-            if (p.lon > 180.0 - seam_snap_deg) p.lon = 180.0;
-            if (p.lon < -180.0 + seam_snap_deg) p.lon = -180.0;
+            if (std::abs(p.lon - 180.0) < seam_snap_deg) p.lon = 180.0;
+            if (std::abs(p.lon + 180.0) < seam_snap_deg) p.lon = -180.0;
         }
         return;
     }
-    // A projection's inverse may return either +180 or -180 on the seam: take the side of the
-    // nearest preceding vertex off the seam.
+    // A projection's inverse may return either +180 or -180 on the seam: a run of vertices on
+    // the seam takes the side of the vertex before it, up to a pole vertex (where a closure
+    // such as Antarctica's crosses to the other side), and the side of the vertex after it
+    // from there on.
     auto on_seam = [](const LonLat& p) { return std::abs(p.lon) > 180.0 - seam_snap_deg; };
     std::size_t n = pts.size();
+    if (n && pts.front().lon == pts.back().lon && pts.front().lat == pts.back().lat) --n; // closed ring
     std::size_t anchor = n;
     for (std::size_t i = 0; i < n; ++i)
         if (!on_seam(pts[i])) anchor = i;
@@ -153,12 +156,23 @@ void snap_coordinates(PointList& pts, bool transformed) {
         for (auto& p : pts) p.lon = p.lon > 0 ? 180.0 : -180.0;
         return;
     }
-    double side = pts[anchor].lon >= 0 ? 180.0 : -180.0;
+    auto side_of = [](const LonLat& p) { return p.lon >= 0 ? 180.0 : -180.0; };
     for (std::size_t k = 1; k <= n; ++k) {
-        auto& p = pts[(anchor + k) % n];
-        if (on_seam(p)) p.lon = side;
-        else side = p.lon >= 0 ? 180.0 : -180.0;
+        std::size_t i = (anchor + k) % n;
+        if (!on_seam(pts[i])) continue;
+        std::size_t end = k; // the run is k .. end-1 (offsets from anchor)
+        while (end <= n && on_seam(pts[(anchor + end) % n])) ++end;
+        double before = side_of(pts[(anchor + k - 1) % n]);
+        double after = side_of(pts[(anchor + end) % n]);
+        bool past_pole = false;
+        for (std::size_t m = k; m < end; ++m) {
+            auto& p = pts[(anchor + m) % n];
+            p.lon = past_pole ? after : before;
+            if (std::abs(p.lat) == 90.0) past_pole = true;
+        }
+        k = end;
     }
+    if (n < pts.size()) pts.back() = pts.front();
 }
 
 PointList read_points(OGRGeometryH g, bool transformed) {
@@ -294,6 +308,7 @@ Source read_source(const std::string& path, const std::string& layer_name, const
     }
 
     OGR_L_ResetReading(layer);
+    CPLErrorReset();
     for (;;) {
         FeaturePtr f(OGR_L_GetNextFeature(layer));
         if (!f) break;
@@ -310,6 +325,8 @@ Source read_source(const std::string& path, const std::string& layer_name, const
             collect_geometry(g, false, src);
         }
     }
+    if (src.features == 0 && !where.empty() && CPLGetLastErrorType() >= CE_Failure)
+        throw UsageError("--coast-where '" + where + "' failed on " + where_msg + ": " + CPLGetLastErrorMsg());
     if (src.features == 0)
         throw DataError(where_msg + " has no features" + (where.empty() ? "" : " matching --coast-where") +
                         "; give a layer of land polygons or coastlines");
@@ -530,6 +547,31 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
         for (const auto* p : ps) out.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
     }
     return out;
+}
+
+
+/// Adds a valid polygonal geometry to `parts`, cutting what lies beyond +-180 (a ring drawn
+/// across the antimeridian with longitudes such as 190) and wrapping it back by 360 degrees.
+void add_wrapped(Geos& geos, GeomPtr g, std::vector<GeomPtr>& parts) {
+    double x0, y0, x1, y1;
+    if (GEOSisEmpty_r(geos.get(), g.get()) || GEOSGeom_getExtent_r(geos.get(), g.get(), &x0, &y0, &x1, &y1) == 0 ||
+        (x0 >= -180.0 && x1 <= 180.0)) {
+        parts.push_back(std::move(g));
+        return;
+    }
+    for (int k = static_cast<int>(std::floor((x0 + 180.0) / 360.0)); k * 360.0 - 180.0 < x1; ++k) {
+        double shift = -360.0 * k;
+        GeomPtr piece = own(geos, GEOSClipByRect_r(geos.get(), g.get(), -180.0 - shift, -90.0, 180.0 - shift, 90.0),
+                            "cut at the antimeridian");
+        if (GEOSisEmpty_r(geos.get(), piece.get())) continue;
+        auto move = [](double* x, double*, void* user) {
+            *x += *static_cast<double*>(user);
+            return 1;
+        };
+        GeomPtr moved = own(geos, GEOSGeom_transformXY_r(geos.get(), piece.get(), move, &shift), "wrap longitudes");
+        if (GEOSisValid_r(geos.get(), moved.get()) != 1) moved = make_valid(geos, moved.get());
+        parts.push_back(std::move(moved));
+    }
 }
 
 double geodesic_area_km2(const PointList& ring) {
@@ -821,6 +863,13 @@ std::size_t separate_pinches(Boundary& b) {
 }
 
 
+/// Geodesic area to the left of densified chains (closed rings), km2.
+double chains_area_km2(const std::vector<Chain>& chains) {
+    std::vector<std::vector<LonLat>> ll;
+    for (const auto& c : chains) ll.push_back(c.pts);
+    return coast_detail::rings_area_km2(ll);
+}
+
 /// Orients a closed lon/lat ring: counter-clockwise in the plane when ccw, else clockwise.
 void orient(PointList& pts, bool ccw) {
     if ((signed_planar_area(pts) > 0) != ccw) std::reverse(pts.begin(), pts.end());
@@ -900,15 +949,19 @@ std::vector<Chain> world_rings(Geos& geos, const std::vector<GeomPtr>& land, boo
     }
     std::vector<Chain> rings = main.finish();
     std::vector<double> lake_area;
-    for (const auto& lake : lakes) lake_area.push_back(coast_detail::rings_area_km2(lake.rings));
+    std::vector<std::vector<Chain>> lake_chains;
+    for (const auto& lake : lakes) {
+        RingBuilder single(geos, clip);
+        for (const auto& r : lake.rings) single.add_ring(r);
+        lake_chains.push_back(single.finish());
+        lake_area.push_back(chains_area_km2(lake_chains.back()));
+    }
     std::size_t largest = lakes.size();
     if (rings.empty() && !lakes.empty())
         largest = static_cast<std::size_t>(std::max_element(lake_area.begin(), lake_area.end()) - lake_area.begin());
     for (std::size_t i = 0; i < lakes.size(); ++i) {
         if (i == largest) {
-            RingBuilder single(geos, clip);
-            for (const auto& r : lakes[i].rings) single.add_ring(r);
-            for (auto& c : single.finish()) rings.push_back(std::move(c));
+            for (auto& c : lake_chains[i]) rings.push_back(std::move(c));
             continue;
         }
         ++out.lakes_removed;
@@ -1012,13 +1065,14 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         for (std::size_t k = 0; k < inland.size(); ++k)
             if (largest == inland.size() || planar_area[inland[k].first] > planar_area[inland[largest].first]) largest = k;
     for (std::size_t k = 0; k < inland.size(); ++k) {
+        RingBuilder single(geos, clip);
+        for (auto& r : inland[k].second) single.add_ring(r);
+        std::vector<Chain> chains = single.finish();
         if (k == largest) {
-            RingBuilder single(geos, clip);
-            for (auto& r : inland[k].second) single.add_ring(r);
-            for (auto& c : single.finish()) rings.push_back(std::move(c));
+            for (auto& c : chains) rings.push_back(std::move(c));
         } else {
             ++out.lakes_removed;
-            out.area_lost_km2 += coast_detail::rings_area_km2(inland[k].second);
+            out.area_lost_km2 += chains_area_km2(chains);
         }
     }
     return rings;
@@ -1041,10 +1095,10 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
     std::vector<GeomPtr> parts;
     for (const auto& poly : src.polygons) {
         GeomPtr g = make_polygon(geos, poly);
-        if (GEOSisValid_r(geos.get(), g.get()) == 1) parts.push_back(std::move(g));
-        else parts.push_back(make_valid(geos, g.get()));
+        if (GEOSisValid_r(geos.get(), g.get()) != 1) g = make_valid(geos, g.get());
+        add_wrapped(geos, std::move(g), parts);
     }
-    if (!src.lines.empty()) parts.push_back(make_valid(geos, polygonize_lines(geos, src.lines, where).get()));
+    if (!src.lines.empty()) add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
     std::vector<GeomPtr> land = dissolve(geos, parts);
     parts.clear();
     report(progress, 0.5, "cleaning coast");

@@ -1,0 +1,306 @@
+// Hostile coast inputs, written as small GeoJSON/CSV files into a temporary directory: each is
+// repaired into valid rings (checked by an independent brute force and by area oracles) or
+// refused with a one-line UsageError / DataError / IoError, never a crash.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "globemesh/coast.hpp"
+#include "globemesh/error.hpp"
+#include "support.hpp"
+#include "unit/coast_support.hpp"
+
+using namespace globemesh;
+using globemesh::test::count_violations;
+using globemesh::test::TempDir;
+
+namespace {
+
+std::string write(const TempDir& dir, const std::string& name, const std::string& text) {
+    auto path = dir / name;
+    std::ofstream(path) << text;
+    return path.string();
+}
+
+/// A GeoJSON FeatureCollection (lon/lat WGS84) with one feature per geometry.
+std::string geojson(std::initializer_list<std::string> geometries) {
+    std::string s = "{\"type\":\"FeatureCollection\",\"features\":[";
+    bool first = true;
+    for (const auto& g : geometries) {
+        if (!first) s += ",";
+        first = false;
+        s += "{\"type\":\"Feature\",\"properties\":{\"name\":\"f\"},\"geometry\":" + g + "}";
+    }
+    return s + "]}";
+}
+
+std::string polygon(const std::string& rings) { return "{\"type\":\"Polygon\",\"coordinates\":[" + rings + "]}"; }
+
+MeshOptions options_for(const std::string& path) {
+    MeshOptions o;
+    o.coast = path;
+    return o;
+}
+
+double earth_km2() { return GeographicLib::Geodesic::WGS84().EllipsoidArea() * 1e-6; }
+
+/// Geodesic area (km2) of a lon/lat polygon given by its corners, edges densified to 0.01 degree
+/// in lon/lat (the planar GIS meaning of an edge).
+double planar_polygon_area_km2(const std::vector<LonLat>& corners) {
+    GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+        LonLat a = corners[i], b = corners[(i + 1) % corners.size()];
+        int n = std::max(1, static_cast<int>(std::hypot(b.lon - a.lon, b.lat - a.lat) / 0.01));
+        for (int k = 0; k < n; ++k)
+            poly.AddPoint(a.lat + (b.lat - a.lat) * k / n, a.lon + (b.lon - a.lon) * k / n);
+    }
+    double perimeter, area;
+    poly.Compute(false, false, perimeter, area);
+    return std::min(area, GeographicLib::Geodesic::WGS84().EllipsoidArea() - area) * 1e-6;
+}
+
+void expect_valid_both_stages(const CoastData& d, double h_km = 50) {
+    EXPECT_TRUE(check_boundary(d.rings).empty());
+    EXPECT_EQ(count_violations(d.rings), 0u);
+    MeshOptions o;
+    o.min_island_triangles = 0;
+    Boundary b = shape_boundary(d, [h_km](const Vec3&) { return h_km; }, o);
+    EXPECT_TRUE(check_boundary(b).empty());
+    EXPECT_EQ(count_violations(b), 0u);
+}
+
+template <class E>
+std::string message_of(const MeshOptions& o) {
+    try {
+        load_coast(o);
+    } catch (const E& e) {
+        std::string m = e.what();
+        EXPECT_EQ(m.find('\n'), std::string::npos) << "not one line: " << m;
+        return m;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "wrong exception type: " << e.what();
+        return {};
+    }
+    ADD_FAILURE() << "no exception";
+    return {};
+}
+
+} // namespace
+
+TEST(CoastHostile, bow_tie_becomes_two_triangles_touching_apart) {
+    TempDir dir;
+    auto path = write(dir, "bowtie.geojson", geojson({polygon("[[0,0],[10,10],[10,0],[0,10],[0,0]]")}));
+    CoastData d = load_coast(options_for(path));
+    EXPECT_EQ(d.rings.rings.size(), 2u);
+    expect_valid_both_stages(d);
+    double land = planar_polygon_area_km2({{5, 5}, {10, 0}, {10, 10}}) + planar_polygon_area_km2({{5, 5}, {0, 10}, {0, 0}});
+    EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
+}
+
+TEST(CoastHostile, spike_is_removed) {
+    TempDir dir;
+    auto path = write(dir, "spike.geojson", geojson({polygon("[[0,0],[10,0],[10,10],[10,15],[10,10],[0,10],[0,0]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    for (const auto& v : d.rings.rings[0].nodes) EXPECT_LE(vec_to_lonlat(v).lat, 10.0 + 1e-9);
+    expect_valid_both_stages(d);
+    double land = planar_polygon_area_km2({{0, 0}, {10, 0}, {10, 10}, {0, 10}});
+    EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
+}
+
+TEST(CoastHostile, duplicate_consecutive_vertices_are_merged) {
+    TempDir dir;
+    auto path = write(dir, "dups.geojson",
+                      geojson({polygon("[[0,0],[0,0],[0,0],[10,0],[10,0],[10,10],[10,10],[10,10],[0,10],[0,0],[0,0]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    expect_valid_both_stages(d);
+}
+
+TEST(CoastHostile, island_split_at_the_antimeridian_is_stitched_into_one_ring) {
+    TempDir dir;
+    // As datasets store it: two halves sharing the seam.
+    auto halves = write(dir, "halves.geojson",
+                        geojson({"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10],[180,10],[170,10],[170,-10]]],"
+                                 "[[[-180,-10],[-170,-10],[-170,10],[-180,10],[-180,-10]]]]}"}));
+    // Drawn across it with longitudes beyond 180.
+    auto across = write(dir, "across.geojson", geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
+    double land = planar_polygon_area_km2({{170, -10}, {190, -10}, {190, 10}, {170, 10}});
+    for (const auto& path : {halves, across}) {
+        CoastData d = load_coast(options_for(path));
+        ASSERT_EQ(d.rings.rings.size(), 1u) << path;
+        expect_valid_both_stages(d);
+        EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land) << path;
+        // No node on the cut except where the coast itself (lat +-10) crosses it.
+        for (const auto& v : d.rings.rings[0].nodes) {
+            LonLat p = vec_to_lonlat(v);
+            if (std::abs(std::abs(p.lon) - 180) < 1e-9) {
+                EXPECT_NEAR(std::abs(p.lat), 10.0, 1e-9);
+            }
+        }
+    }
+}
+
+TEST(CoastHostile, polygon_covering_the_north_pole_becomes_a_ring_around_it) {
+    TempDir dir;
+    auto path = write(dir, "cap.geojson", geojson({polygon("[[-180,80],[180,80],[180,90],[-180,90],[-180,80]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    expect_valid_both_stages(d);
+    double winding = 0;
+    const auto& nodes = d.rings.rings[0].nodes;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        LonLat p = vec_to_lonlat(nodes[i]);
+        EXPECT_NEAR(p.lat, 80.0, 1e-9);
+        winding += std::remainder(vec_to_lonlat(nodes[(i + 1) % nodes.size()]).lon - p.lon, 360.0);
+    }
+    EXPECT_NEAR(winding, -360.0, 1e-6); // westward: the ocean (south) on the left
+    GeographicLib::PolygonArea cap(GeographicLib::Geodesic::WGS84());
+    for (int k = 0; k < 36000; ++k) cap.AddPoint(80, -180 + 0.01 * k);
+    double perimeter, area;
+    cap.Compute(false, false, perimeter, area);
+    double cap_km2 = std::min(area, GeographicLib::Geodesic::WGS84().EllipsoidArea() - area) * 1e-6;
+    EXPECT_NEAR(earth_km2() - d.ocean_area_km2, cap_km2, 0.001 * cap_km2);
+}
+
+TEST(CoastHostile, zero_area_sliver_is_dropped) {
+    TempDir dir;
+    auto path = write(dir, "sliver.geojson",
+                      geojson({polygon("[[0,0],[10,0],[20,0],[0,0]]"), polygon("[[30,30],[31,30],[31,31],[30,31],[30,30]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    for (const auto& v : d.rings.rings[0].nodes) EXPECT_GE(vec_to_lonlat(v).lat, 30.0 - 1e-9);
+    expect_valid_both_stages(d, 20);
+}
+
+TEST(CoastHostile, only_a_sliver_leaves_an_aqua_planet) {
+    TempDir dir;
+    auto path = write(dir, "sliver.geojson", geojson({polygon("[[0,0],[10,0],[20,0],[0,0]]")}));
+    CoastData d = load_coast(options_for(path));
+    EXPECT_TRUE(d.rings.empty());
+    EXPECT_NEAR(d.ocean_area_km2, earth_km2(), 1e-6 * earth_km2());
+}
+
+TEST(CoastHostile, polygons_touching_at_one_point_are_moved_apart) {
+    TempDir dir;
+    auto path = write(dir, "touch.geojson",
+                      geojson({polygon("[[0,0],[5,0],[5,5],[0,5],[0,0]]"), polygon("[[5,5],[10,5],[10,10],[5,10],[5,5]]")}));
+    CoastData d = load_coast(options_for(path));
+    expect_valid_both_stages(d);
+}
+
+TEST(CoastHostile, overlapping_polygons_are_dissolved) {
+    TempDir dir;
+    auto path = write(dir, "overlap.geojson",
+                      geojson({polygon("[[0,0],[10,0],[10,10],[0,10],[0,0]]"), polygon("[[5,5],[15,5],[15,15],[5,15],[5,5]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    expect_valid_both_stages(d);
+    double land = planar_polygon_area_km2({{0, 0}, {10, 0}, {10, 5}, {15, 5}, {15, 15}, {5, 15}, {5, 10}, {0, 10}});
+    EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
+}
+
+TEST(CoastHostile, island_in_a_lake_goes_with_the_lake_unless_inland_seas_are_kept) {
+    TempDir dir;
+    auto path = write(dir, "lake.geojson",
+                      geojson({polygon("[[0,0],[20,0],[20,20],[0,20],[0,0]],[[5,5],[5,15],[15,15],[15,5],[5,5]]"),
+                               polygon("[[9,9],[11,9],[11,11],[9,11],[9,9]]")}));
+    CoastData d = load_coast(options_for(path));
+    EXPECT_EQ(d.rings.rings.size(), 1u);
+    EXPECT_EQ(d.lakes_removed, 1u);
+    expect_valid_both_stages(d);
+    MeshOptions o = options_for(path);
+    o.keep_inland_seas = true;
+    CoastData all = load_coast(o);
+    EXPECT_EQ(all.rings.rings.size(), 3u);
+    expect_valid_both_stages(all);
+    double lake = planar_polygon_area_km2({{5, 5}, {15, 5}, {15, 15}, {5, 15}}) - planar_polygon_area_km2({{9, 9}, {11, 9}, {11, 11}, {9, 11}});
+    EXPECT_NEAR(all.ocean_area_km2 - d.ocean_area_km2, lake, 0.002 * lake);
+    EXPECT_NEAR(d.area_lost_km2, lake, 0.002 * lake);
+}
+
+TEST(CoastHostile, empty_layer_is_refused) {
+    TempDir dir;
+    auto path = write(dir, "empty.geojson", "{\"type\":\"FeatureCollection\",\"features\":[]}");
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("no features"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, point_layer_is_refused) {
+    TempDir dir;
+    auto path = write(dir, "points.geojson", geojson({"{\"type\":\"Point\",\"coordinates\":[1,2]}"}));
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("Point"), std::string::npos) << m;
+    MeshOptions named = options_for(path);
+    named.coast_layer = "points";
+    m = message_of<DataError>(named);
+    EXPECT_NE(m.find("only points"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, region_without_ocean_is_refused) {
+    TempDir dir;
+    auto path = write(dir, "big.geojson", geojson({polygon("[[0,0],[40,0],[40,40],[0,40],[0,0]]")}));
+    MeshOptions o = options_for(path);
+    o.region = std::array<double, 4>{10, 10, 20, 20};
+    auto m = message_of<DataError>(o);
+    EXPECT_NE(m.find("no ocean"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, missing_file_is_an_io_error) {
+    auto m = message_of<IoError>(options_for("/nonexistent/coast.gpkg"));
+    EXPECT_NE(m.find("/nonexistent/coast.gpkg"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, wrong_layer_name_lists_the_layers) {
+    MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
+    o.coast_layer = "lnad";
+    auto m = message_of<DataError>(o);
+    EXPECT_NE(m.find("lnad"), std::string::npos) << m;
+    EXPECT_NE(m.find("land"), std::string::npos) << m;
+    EXPECT_NE(m.find("ocean"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, layer_without_crs_needs_coast_srs) {
+    TempDir dir;
+    auto path = write(dir, "nocrs.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+    MeshOptions o = options_for(path);
+    o.coast_srs = "EPSG:4326";
+    CoastData d = load_coast(o);
+    EXPECT_EQ(d.rings.rings.size(), 1u);
+    o.coast_srs = "not a crs";
+    m = message_of<UsageError>(o);
+    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, bad_attribute_filter_is_a_usage_error) {
+    MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
+    o.coast_layer = "land";
+    o.coast_where = "no_such_column = 3";
+    auto m = message_of<UsageError>(o);
+    EXPECT_NE(m.find("--coast-where"), std::string::npos) << m;
+    o.coast_where = "scalerank = 99";
+    m = message_of<DataError>(o);
+    EXPECT_NE(m.find("no features"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, open_coastline_far_from_the_seam_is_refused) {
+    TempDir dir;
+    auto path = write(dir, "open.geojson", geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,0],[10,10],[0,10]]}"}));
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("not closed"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, closed_coastline_lines_are_polygonized) {
+    TempDir dir;
+    // A figure-eight line (self-crossing) and a plain closed line.
+    auto path = write(dir, "lines.geojson",
+                      geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,10],[10,0],[0,10],[0,0]]}",
+                               "{\"type\":\"LineString\",\"coordinates\":[[30,30],[31,30],[31,31],[30,31],[30,30]]}"}));
+    CoastData d = load_coast(options_for(path));
+    EXPECT_EQ(d.rings.rings.size(), 3u);
+    expect_valid_both_stages(d, 20);
+}

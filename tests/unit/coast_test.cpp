@@ -1,0 +1,340 @@
+// Coast module on real Natural Earth fixtures: ring invariants (checked by an independent brute
+// force), ocean area against GeographicLib on the source's own ocean layer, Antarctica around
+// the South Pole, shapefile = GeoPackage, projected copy within 1 m, shaping at 100 and 10 km,
+// regions across +-180 and at a pole.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "globemesh/coast.hpp"
+#include "globemesh/error.hpp"
+#include "support.hpp"
+#include "unit/coast_support.hpp"
+
+using namespace globemesh;
+using globemesh::test::count_violations;
+using globemesh::test::fixture;
+using globemesh::test::layer_area_km2;
+
+namespace {
+
+MeshOptions coast_options(const std::string& rel, const std::string& layer = "land") {
+    MeshOptions o;
+    o.coast = fixture(rel).string();
+    o.coast_layer = layer;
+    return o;
+}
+
+const CoastData& ne110() {
+    static const CoastData data = load_coast(coast_options("coast/ne_110m_land.gpkg"));
+    return data;
+}
+const CoastData& ne50() {
+    static const CoastData data = load_coast(coast_options("coast/ne_50m_land.gpkg"));
+    return data;
+}
+
+std::size_t node_count(const Boundary& b) {
+    std::size_t n = 0;
+    for (const auto& r : b.rings) n += r.nodes.size();
+    return n;
+}
+
+/// Sum of longitude steps along a ring, degrees: +-360 for a ring around a pole, 0 otherwise.
+double winding_deg(const Ring& r) {
+    double sum = 0;
+    for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+        double a = vec_to_lonlat(r.nodes[i]).lon, b = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]).lon;
+        sum += std::remainder(b - a, 360.0);
+    }
+    return sum;
+}
+
+SizeFn uniform(double h) {
+    return [h](const Vec3&) { return h; };
+}
+
+void expect_valid(const Boundary& b) {
+    auto issues = check_boundary(b);
+    EXPECT_TRUE(issues.empty()) << issues.front().what << " ring " << issues.front().ring << " seg "
+                                << issues.front().segment;
+}
+
+} // namespace
+
+TEST(Coast, natural_earth_110m_gives_simple_non_crossing_rings) {
+    const auto& d = ne110();
+    ASSERT_GT(d.rings.rings.size(), 100u);
+    EXPECT_EQ(count_violations(d.rings), 0u);
+    expect_valid(d.rings);
+    for (const auto& r : d.rings.rings) {
+        ASSERT_EQ(r.kinds.size(), r.nodes.size());
+        for (auto k : r.kinds) EXPECT_EQ(k, SegmentKind::coast);
+    }
+}
+
+TEST(Coast, ocean_area_110m_matches_the_source_ocean_layer) {
+    // Default: the Caspian (an inland sea, the smaller polygon of the ocean layer) is dropped.
+    double oracle = layer_area_km2(fixture("coast/ne_110m_land.gpkg").string(), "ocean", true);
+    EXPECT_NEAR(ne110().ocean_area_km2, oracle, 0.005 * oracle);
+    EXPECT_EQ(ne110().lakes_removed, 1u);
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.keep_inland_seas = true;
+    CoastData with_caspian = load_coast(o);
+    double all = layer_area_km2(fixture("coast/ne_110m_land.gpkg").string(), "ocean");
+    EXPECT_NEAR(with_caspian.ocean_area_km2, all, 0.005 * all);
+    EXPECT_NEAR(with_caspian.ocean_area_km2 - ne110().ocean_area_km2, all - oracle, 0.01 * (all - oracle));
+}
+
+TEST(Coast, antarctica_is_one_ring_around_the_south_pole_without_cut_nodes) {
+    for (const CoastData* d : {&ne110(), &ne50()}) {
+        int around_south = 0;
+        for (const auto& r : d->rings.rings) {
+            double w = winding_deg(r);
+            if (std::abs(std::abs(w) - 360.0) > 1e-6) {
+                EXPECT_NEAR(w, 0.0, 1e-6);
+                continue;
+            }
+            ++around_south;
+            for (const auto& v : r.nodes) {
+                LonLat p = vec_to_lonlat(v);
+                EXPECT_LT(p.lat, -60.0);
+                EXPECT_GT(p.lat, -86.0) << "node on the artificial closure near the pole";
+                // The data's cut runs down lon +-180 below the coast at about -84.4 (50m) / -84.7.
+                if (std::abs(std::abs(p.lon) - 180.0) < 1e-9) {
+                    EXPECT_GT(p.lat, -84.8);
+                }
+            }
+            // Ocean on the left: walking east along the coast (positive winding) keeps the sea north.
+            EXPECT_GT(w, 0.0);
+        }
+        EXPECT_EQ(around_south, 1);
+    }
+}
+
+TEST(Coast, shapefile_and_geopackage_give_the_same_rings) {
+    CoastData shp = load_coast(coast_options("coast/ne_110m_land_shp/ne_110m_land.shp", ""));
+    ASSERT_EQ(shp.rings.rings.size(), ne110().rings.rings.size());
+    for (std::size_t r = 0; r < shp.rings.rings.size(); ++r)
+        EXPECT_EQ(shp.rings.rings[r].nodes, ne110().rings.rings[r].nodes) << "ring " << r;
+}
+
+TEST(Coast, projected_copy_gives_the_same_rings_within_one_metre) {
+    CoastData proj = load_coast(coast_options("coast/ne_110m_land_equal_earth.gpkg"));
+    const auto& ref = ne110().rings.rings;
+    ASSERT_EQ(proj.rings.rings.size(), ref.size());
+    double worst_km = 0;
+    for (std::size_t r = 0; r < ref.size(); ++r) {
+        ASSERT_EQ(proj.rings.rings[r].nodes.size(), ref[r].nodes.size()) << "ring " << r;
+        for (std::size_t i = 0; i < ref[r].nodes.size(); ++i)
+            worst_km = std::max(worst_km, arc_km(proj.rings.rings[r].nodes[i], ref[r].nodes[i]));
+    }
+    EXPECT_LT(worst_km, 1e-3);
+    EXPECT_NEAR(proj.ocean_area_km2, ne110().ocean_area_km2, 1.0);
+}
+
+TEST(Coast, natural_earth_50m_rings_are_valid_and_enclose_the_ocean_area) {
+    const auto& d = ne50();
+    expect_valid(d.rings);
+    double oracle = layer_area_km2(fixture("coast/ne_50m_land.gpkg").string(), "ocean", true);
+    EXPECT_NEAR(d.ocean_area_km2, oracle, 0.005 * oracle);
+}
+
+TEST(Coast, coastline_lines_are_polygonized_like_the_land_polygons) {
+    CoastData lines = load_coast(coast_options("coast/ne_50m_coastline.gpkg", ""));
+    EXPECT_EQ(lines.layer, "coastline");
+    expect_valid(lines.rings);
+    EXPECT_NEAR(lines.ocean_area_km2, ne50().ocean_area_km2, 0.005 * ne50().ocean_area_km2);
+    EXPECT_NEAR(static_cast<double>(lines.rings.rings.size()), static_cast<double>(ne50().rings.rings.size()), 10.0);
+}
+
+TEST(Coast, shaping_at_100_and_10_km_keeps_every_invariant) {
+    for (const CoastData* d : {&ne110(), &ne50()}) {
+        for (double h : {100.0, 10.0}) {
+            CoastReport rep;
+            MeshOptions o;
+            Boundary b = shape_boundary(*d, uniform(h), o, &rep);
+            expect_valid(b);
+            if (d == &ne110()) {
+                EXPECT_EQ(count_violations(b), 0u) << "h " << h;
+            }
+            EXPECT_EQ(rep.rings, b.rings.size());
+            EXPECT_EQ(rep.nodes, node_count(b));
+            // Consecutive nodes are at most about h apart (arcs are split to round(L/h) pieces).
+            double longest = 0;
+            for (const auto& r : b.rings)
+                for (std::size_t i = 0; i < r.nodes.size(); ++i)
+                    longest = std::max(longest, arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]));
+            EXPECT_LT(longest, 1.5 * h) << "h " << h;
+            // Small islands go, the ocean area hardly changes.
+            EXPECT_NEAR(rep.ocean_area_km2, d->ocean_area_km2, 0.01 * d->ocean_area_km2) << "h " << h;
+            EXPECT_NEAR(boundary_area_km2(b), rep.ocean_area_km2, 1.0);
+            // Islands (land area < a quarter of the Earth) survive iff their full-resolution
+            // area reaches 4 equilateral triangles of side h (1 % margin: spherical vs WGS84).
+            double earth = GeographicLib::Geodesic::WGS84().EllipsoidArea() * 1e-6;
+            double min_island = 4 * std::sqrt(3.0) / 4 * h * h;
+            std::size_t surely_kept = 0, maybe_kept = 0;
+            for (const auto& r : d->rings.rings) {
+                Boundary one;
+                one.rings.push_back(r);
+                double land = earth - boundary_area_km2(one);
+                bool island = land < 0.25 * earth;
+                if (!island || land > 1.01 * min_island) ++surely_kept;
+                if (!island || land > 0.99 * min_island) ++maybe_kept;
+            }
+            EXPECT_GE(b.rings.size(), surely_kept) << "h " << h;
+            EXPECT_LE(b.rings.size(), maybe_kept) << "h " << h;
+        }
+    }
+}
+
+TEST(Coast, shaping_follows_a_varying_size) {
+    // h = 20 km north of the equator, 200 km south of it.
+    auto size = [](const Vec3& v) { return v.z > 0 ? 20.0 : 200.0; };
+    MeshOptions o;
+    Boundary b = shape_boundary(ne110(), size, o);
+    expect_valid(b);
+    double north = 0, south = 0;
+    std::size_t nn = 0, ns = 0;
+    for (const auto& r : b.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            double d = arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]);
+            if (r.nodes[i].z > 0.1) north += d, ++nn;
+            if (r.nodes[i].z < -0.1) south += d, ++ns;
+        }
+    ASSERT_GT(nn, 0u);
+    ASSERT_GT(ns, 0u);
+    EXPECT_LT(north / nn, 25.0);
+    EXPECT_GT(south / ns, 60.0);
+}
+
+TEST(Coast, region_across_the_antimeridian_gets_open_edges_on_the_box) {
+    MeshOptions o = coast_options("coast/ne_50m_land.gpkg");
+    o.region = std::array<double, 4>{170, -25, -170, -10}; // around Fiji
+    CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    EXPECT_EQ(count_violations(d.rings), 0u);
+    std::size_t open = 0, coast = 0;
+    for (const auto& r : d.rings.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            LonLat p = vec_to_lonlat(r.nodes[i]);
+            EXPECT_TRUE(p.lon >= 170 - 1e-9 || p.lon <= -170 + 1e-9) << p.lon;
+            EXPECT_GE(p.lat, -25 - 1e-9);
+            EXPECT_LE(p.lat, -10 + 1e-9);
+            if (r.kinds[i] == SegmentKind::open) {
+                ++open;
+                LonLat q = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]);
+                bool on_box = (std::abs(p.lat - q.lat) < 1e-9 && (std::abs(p.lat + 25) < 1e-9 || std::abs(p.lat + 10) < 1e-9)) ||
+                              (std::abs(p.lon - q.lon) < 1e-9 && (std::abs(p.lon - 170) < 1e-9 || std::abs(p.lon + 170) < 1e-9));
+                EXPECT_TRUE(on_box) << p.lon << " " << p.lat << " -> " << q.lon << " " << q.lat;
+                // No open edge along the glued +-180 seam.
+                EXPECT_FALSE(std::abs(std::abs(p.lon) - 180) < 1e-9 && std::abs(std::abs(q.lon) - 180) < 1e-9);
+            } else {
+                ++coast;
+            }
+        }
+    EXPECT_GT(open, 0u);
+    EXPECT_GT(coast, 0u);
+    // Ocean area: the box (20 x 15 degrees) less a little land; the box's geodesic area bounds it.
+    GeographicLib::PolygonArea box(GeographicLib::Geodesic::WGS84());
+    for (double lon = 170; lon < 190; lon += 0.5) box.AddPoint(-25, lon);
+    for (double lat = -25; lat < -10; lat += 0.5) box.AddPoint(lat, 190);
+    for (double lon = 190; lon > 170; lon -= 0.5) box.AddPoint(-10, lon);
+    for (double lat = -10; lat > -25; lat -= 0.5) box.AddPoint(lat, 170);
+    double perimeter, area;
+    box.Compute(false, true, perimeter, area);
+    area *= 1e-6;
+    EXPECT_LT(d.ocean_area_km2, area);
+    EXPECT_GT(d.ocean_area_km2, 0.97 * area);
+    Boundary b = shape_boundary(d, uniform(20), o);
+    expect_valid(b);
+}
+
+TEST(Coast, region_reaching_the_north_pole_has_no_pole_node) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.region = std::array<double, 4>{-180, 65, 180, 90}; // the Arctic cap
+    CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    EXPECT_EQ(count_violations(d.rings), 0u);
+    std::size_t open = 0;
+    for (const auto& r : d.rings.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            LonLat p = vec_to_lonlat(r.nodes[i]);
+            EXPECT_LT(p.lat, 89.0);
+            EXPECT_GE(p.lat, 65 - 1e-9);
+            if (r.kinds[i] == SegmentKind::open) {
+                ++open;
+                EXPECT_NEAR(p.lat, 65.0, 1e-9);
+            }
+        }
+    EXPECT_GT(open, 0u);
+    // Less than the cap north of 65 N, more than half of it (the Arctic Ocean dominates).
+    double cap = 2 * pi * earth_radius_km * earth_radius_km * (1 - std::sin(65 * deg_to_rad));
+    EXPECT_LT(d.ocean_area_km2, cap);
+    EXPECT_GT(d.ocean_area_km2, 0.5 * cap);
+    expect_valid(shape_boundary(d, uniform(50), o));
+}
+
+TEST(Coast, open_region_box_in_the_open_sea_is_all_open_boundary) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.region = std::array<double, 4>{-150, -30, -130, -10};
+    CoastData d = load_coast(o);
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    for (auto k : d.rings.rings[0].kinds) EXPECT_EQ(k, SegmentKind::open);
+    // Oracle: the box's geodesic area with edges densified as the rings are (0.5 degree).
+    GeographicLib::PolygonArea box(GeographicLib::Geodesic::WGS84());
+    for (double lon = -150; lon < -130; lon += 0.5) box.AddPoint(-30, lon);
+    for (double lat = -30; lat < -10; lat += 0.5) box.AddPoint(lat, -130);
+    for (double lon = -130; lon > -150; lon -= 0.5) box.AddPoint(-10, lon);
+    for (double lat = -10; lat > -30; lat -= 0.5) box.AddPoint(lat, -150);
+    double perimeter, area;
+    box.Compute(false, true, perimeter, area);
+    EXPECT_NEAR(d.ocean_area_km2, area * 1e-6, 1e-6 * area * 1e-6);
+}
+
+TEST(Coast, min_island_area_drops_small_islands_by_geodesic_area) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.min_island_area_km2 = 50000;
+    CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    EXPECT_GT(d.islands_removed, 10u);
+    EXPECT_LT(d.rings.rings.size(), ne110().rings.rings.size());
+    EXPECT_NEAR(d.ocean_area_km2 - ne110().ocean_area_km2, d.area_gained_km2 - d.area_lost_km2 + ne110().area_lost_km2,
+                1e-6 * ne110().ocean_area_km2);
+}
+
+TEST(Coast, missing_coast_option_is_a_usage_error) {
+    MeshOptions o;
+    try {
+        load_coast(o);
+        FAIL() << "no exception";
+    } catch (const UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("--coast"), std::string::npos);
+    }
+}
+
+TEST(Coast, two_polygon_layers_without_a_layer_name_list_the_layers) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg", "");
+    try {
+        load_coast(o);
+        FAIL() << "no exception";
+    } catch (const DataError& e) {
+        std::string m = e.what();
+        EXPECT_NE(m.find("land"), std::string::npos);
+        EXPECT_NE(m.find("ocean"), std::string::npos);
+    }
+}
+
+TEST(Coast, progress_reaches_one_and_cancel_stops) {
+    double last = -1;
+    Progress p = [&](double f, std::string_view) {
+        EXPECT_GE(f, last);
+        last = f;
+        return true;
+    };
+    load_coast(coast_options("coast/ne_110m_land.gpkg"), p);
+    EXPECT_EQ(last, 1.0);
+    Progress stop = [](double, std::string_view) { return false; };
+    EXPECT_THROW(load_coast(coast_options("coast/ne_110m_land.gpkg"), stop), Cancelled);
+}
