@@ -317,7 +317,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     terminal.configure(o.quiet, o.verbose);
     Mesh mesh = lib.mesh_ocean(o.mesh, terminal.callback(), &timings);
     throw_if_interrupted();
-    terminal.update(1.0, "mesh"); // close the progress line if the pipeline stopped short of 1
+    terminal.finish(); // close the progress line if the pipeline stopped short of 1
     add_mesh_total(timings);
 
     if (o.check) {
@@ -366,7 +366,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     if (!o.report.empty()) {
         std::ostringstream r;
         r << "{\n  \"globemesh\": " << json_string(GLOBEMESH_VERSION) << ",\n"
-          << "  \"command\": " << json_string(ugrid.history) << ",\n"
+          << "  \"history\": " << json_string(ugrid.history) << ",\n"
           << "  \"outputs\": {\"netcdf\": " << json_string(o.output);
         if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
         if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
@@ -442,7 +442,7 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     terminal.configure(c.quiet, c.verbose);
     Mesh mesh = lib.triangulate_file(c.t, terminal.callback(), &timings);
     throw_if_interrupted();
-    terminal.update(1.0, "triangulate");
+    terminal.finish();
     OutputsGuard written;
     const auto tw = std::chrono::steady_clock::now();
     UgridOptions ugrid;

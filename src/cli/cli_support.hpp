@@ -45,6 +45,8 @@ public:
     }
     /// Ends a progress line left open (before an error message).
     void end_line();
+    /// Draws the ticks up to 100 when the library stopped reporting short of 1.
+    void finish() { update(1.0, stage_); }
 
 private:
     std::ostream& err_;
