@@ -33,9 +33,9 @@ struct QualityClass {
     const char* label;
 };
 constexpr QualityClass quality_classes[] = {
-    {0.0, 0.3, "215,25,28,255", "poor (< 0.3)"},        {0.3, 0.5, "253,174,97,255", "0.3 - 0.5"},
+    {0.0, 0.3, "215,25,28,255", "poor (below 0.3)"},        {0.3, 0.5, "253,174,97,255", "0.3 - 0.5"},
     {0.5, 0.7, "255,255,191,255", "0.5 - 0.7"},          {0.7, 0.9, "166,217,106,255", "0.7 - 0.9"},
-    {0.9, 1.000001, "26,150,65,255", "good (>= 0.9)"}};
+    {0.9, 1.000001, "26,150,65,255", "good (0.9 and above)"}};
 
 /// A QGIS 3 graduated renderer on "quality" (the style QGIS itself writes, trimmed to symbology).
 std::string faces_style_qml() {
@@ -230,7 +230,8 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     }
     w.commit();
 
-    // boundary
+    // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
+    if (!topo.boundary_edges.empty()) {
     OGRLayer* boundary = w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
     w.field(boundary, "tag", OFTString);
     w.field(boundary, "tag_code", OFTInteger);
@@ -261,6 +262,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         w.add(boundary, feature);
     }
     w.commit();
+    }
 
     // mesh_info
     OGRLayer* info = w.layer("mesh_info", wkbNone, "run metadata and summary statistics");
