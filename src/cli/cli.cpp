@@ -130,6 +130,8 @@ struct MeshCommand {
         app.option_defaults()->always_capture_default();
         app.set_version_flag("--version", version_text(), "Print the version and exit");
         app.get_formatter()->column_width(36);
+        app.footer("Lengths: 20km, 5000m or 20 (km). Areas: 1000km2, 1e6m2 or 1000 (km2). Durations: 12.42h,\n"
+                   "745min, 44712s or 12.42 (h). Depths: 50m, 0.05km or 50 (m). See globemesh(1).\n");
         MeshOptions& m = o.mesh;
         const std::string coast = "Coastline", bathy = "Bathymetry", size = "Size field",
                           mesher = "Mesher", output = "Output", run = "Run";
@@ -371,7 +373,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
         if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
         r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n"
-          << "  " << timings_json(timings).substr(1, timings_json(timings).size() - 3) << ",\n"
+          << "  \"stages\": " << stages_json(timings) << ",\n"
           << "  \"total_seconds\": " << json_number(total_s) << ",\n"
           << "  \"peak_memory_bytes\": " << peak << "\n}\n";
         write_file_safely(o.report, r.str());

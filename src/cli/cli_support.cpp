@@ -126,13 +126,13 @@ std::string json_string(const std::string& s) {
     return r + "\"";
 }
 
-std::string timings_json(const StageTimings& timings) {
-    std::string s = "{\"stages\": {";
+std::string stages_json(const StageTimings& timings) {
+    std::string s = "{";
     for (std::size_t i = 0; i < timings.stages.size(); ++i) {
         s += (i ? ", " : "") + json_string(timings.stages[i].first) + ": " +
              json_number(timings.stages[i].second);
     }
-    return s + "}}\n";
+    return s + "}";
 }
 
 std::string stats_json(const MeshStats& st, const std::string& in) {

@@ -64,8 +64,12 @@ std::string json_number(double v);
 /// A JSON string literal with escapes.
 std::string json_string(const std::string& s);
 
-/// {"stages": {name: seconds, ...}} in run order.
-std::string timings_json(const StageTimings& timings);
+/// {name: seconds, ...} in run order.
+std::string stages_json(const StageTimings& timings);
+/// {"stages": {name: seconds, ...}} and a newline: the --timings file.
+inline std::string timings_json(const StageTimings& timings) {
+    return "{\"stages\": " + stages_json(timings) + "}\n";
+}
 
 /// The statistics of compute_stats as a JSON object (no trailing newline), indented by `indent`.
 std::string stats_json(const MeshStats& stats, const std::string& indent);

@@ -540,3 +540,92 @@ TEST(Cli, check_mesh_accepts_the_octahedron_and_names_broken_faces) {
     for (auto& e : open.boundary) std::swap(e.a, e.b);
     EXPECT_TRUE(globemesh::check_mesh(open).empty());
 }
+
+// ---------------------------------------------------------------------------------------------
+// What run_cli does with a finished mesh: outputs, timings, report, and clean-up on failure.
+// The library is replaced by fakes that write small files, so these test the CLI's own logic.
+
+namespace {
+
+struct FakeRun {
+    std::vector<std::string> written; // paths the fake writers were asked for, in order
+    bool fail_gpkg = false;
+    globemesh::CliLibrary lib() {
+        globemesh::CliLibrary l;
+        l.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& p,
+                          globemesh::StageTimings* t) {
+            globemesh::report(p, 0.5, "refine");
+            t->add("read_coast", 0.5);
+            t->add("refine", 1.25);
+            t->add("improve", 0.25);
+            globemesh::Mesh m;
+            m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+            return m;
+        };
+        l.triangulate_file = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
+        l.write_ugrid = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::UgridOptions& o) {
+            EXPECT_NE(o.history.find("globemesh mesh --coast"), std::string::npos) << o.history;
+            write_text(p, "nc");
+            written.push_back(p.string());
+        };
+        l.write_gpkg = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::GpkgOptions&) {
+            if (fail_gpkg) throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
+            write_text(p, "gpkg");
+            written.push_back(p.string());
+        };
+        l.write_preview_png = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::PreviewOptions&) {
+            write_text(p, "png");
+            written.push_back(p.string());
+        };
+        l.read_ugrid = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
+        l.compute_stats = [](const globemesh::Mesh& m) {
+            globemesh::MeshStats s;
+            s.nodes = m.nodes.size();
+            s.faces = m.faces.size();
+            s.quality_histogram[9] = m.faces.size();
+            return s;
+        };
+        return l;
+    }
+};
+
+} // namespace
+
+TEST(Cli, timings_and_report_hold_the_stages_and_the_mesh_total) {
+    TempDir dir;
+    FakeRun fake;
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--timings",
+                          (dir / "t.json").string(), "--report", (dir / "r.json").string(), "-q", "--check"},
+                         fake.lib());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    const std::string t = read_text(dir / "t.json");
+    // Issue 4's "mesh" key: every stage but the reading, 1.25 + 0.25 s here.
+    EXPECT_TRUE(std::regex_search(
+        t, std::regex(R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write": [0-9.e-]+\}\}\n$)")))
+        << t;
+    const std::string report = read_text(dir / "r.json");
+    EXPECT_NE(report.find("\"nodes\": 6"), std::string::npos) << report;
+    EXPECT_NE(report.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos) << report;
+    EXPECT_TRUE(std::regex_search(report, std::regex(R"("peak_memory_bytes": [1-9][0-9]{5,})"))) << report;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(nodes\s+6\n)"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(faces\s+8\n)"))) << r.out;
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir.path())) names.insert(e.path().filename().string());
+    EXPECT_EQ(names, (std::set<std::string>{"o.nc", "t.json", "r.json"})); // no temporary files
+}
+
+TEST(Cli, a_failing_writer_leaves_none_of_the_run_outputs) {
+    TempDir dir;
+    FakeRun fake;
+    fake.fail_gpkg = true;
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg",
+                          (dir / "o.gpkg").string(), "--report", (dir / "r.json").string(), "-q"},
+                         fake.lib());
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "globemesh: cannot write " + (dir / "o.gpkg").string() + " (disk full)\n");
+    EXPECT_EQ(fake.written, std::vector<std::string>{(dir / "o.nc").string()}); // it was written...
+    EXPECT_TRUE(fs::is_empty(dir.path()));                                       // ...and removed
+    EXPECT_EQ(r.out, "");
+}
