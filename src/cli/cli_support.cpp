@@ -20,7 +20,15 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 
-extern "C" void on_sigint(int) { g_interrupted = 1; }
+/// The first Ctrl-C asks the run to stop at its next progress report; a second one, for a run
+/// that does not report, ends the process the default way.
+extern "C" void on_sigint(int) {
+    if (g_interrupted) {
+        std::signal(SIGINT, SIG_DFL);
+        std::raise(SIGINT);
+    }
+    g_interrupted = 1;
+}
 
 } // namespace
 

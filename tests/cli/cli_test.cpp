@@ -549,6 +549,7 @@ namespace {
 
 struct FakeRun {
     std::vector<std::string> written; // paths the fake writers were asked for, in order
+    std::string configuration;        // the globemesh_configuration attribute given to write_ugrid
     bool fail_gpkg = false;
     globemesh::CliLibrary lib() {
         globemesh::CliLibrary l;
@@ -564,8 +565,10 @@ struct FakeRun {
             return m;
         };
         l.triangulate_file = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
-        l.write_ugrid = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::UgridOptions& o) {
+        l.write_ugrid = [this](const globemesh::Mesh& m, const fs::path& p, const globemesh::UgridOptions& o) {
             EXPECT_NE(o.history.find("globemesh mesh --coast"), std::string::npos) << o.history;
+            for (const auto& [key, value] : m.attributes)
+                if (key == "globemesh_configuration") configuration = value;
             write_text(p, "nc");
             written.push_back(p.string());
         };
@@ -628,4 +631,19 @@ TEST(Cli, a_failing_writer_leaves_none_of_the_run_outputs) {
     EXPECT_EQ(fake.written, std::vector<std::string>{(dir / "o.nc").string()}); // it was written...
     EXPECT_TRUE(fs::is_empty(dir.path()));                                       // ...and removed
     EXPECT_EQ(r.out, "");
+}
+
+TEST(Cli, the_mesh_carries_a_configuration_that_remakes_the_run) {
+    TempDir dir;
+    FakeRun fake;
+    const std::vector<std::string> args = {"--coast", coast, "-o", (dir / "o.nc").string(), "--hmax", "3500m",
+                                           "--region", "170,-50,-170,-30", "--seed", "77", "-q"};
+    std::vector<std::string> with_sub = args;
+    with_sub.insert(with_sub.begin(), "mesh");
+    const Result r = run(with_sub, fake.lib());
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_FALSE(fake.configuration.empty());
+    write_text(dir / "from_file.toml", fake.configuration);
+    expect_same_cli(globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "from_file.toml").string()}),
+                    globemesh::parse_mesh_args(args));
 }
