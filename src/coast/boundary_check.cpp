@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -76,83 +77,92 @@ std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>&
     if (count == 0) return out;
     // Cell size: a few mean chords, bounded so the grid stays small.
     double cell = std::clamp(4.0 * total / static_cast<double>(count), 2e-5, 0.05);
-    auto key = [cell](double x, double y, double z) {
-        auto q = [cell](double v) { return static_cast<std::uint64_t>(std::floor((v + 1.5) / cell)); };
-        return (q(x) << 42) | (q(y) << 21) | q(z);
-    };
+    auto cell_of = [cell](double v) { return static_cast<std::uint64_t>(std::floor((v + 1.5) / cell)); };
     std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
-    entries.reserve(count * 4);
+    entries.reserve(count * 2);
+    struct Box {
+        double lo[3], hi[3];
+    };
+    std::vector<Box> boxes(segs.size());
     for (std::uint32_t s = 0; s < segs.size(); ++s) {
         const auto& nodes = *rings[segs[s].ring];
         const Vec3& a = nodes[segs[s].index];
         const Vec3& b = nodes[(segs[s].index + 1) % nodes.size()];
-        double ang = arc_angle(a, b);
-        int pieces = std::max(1, static_cast<int>(std::ceil(ang / (0.5 * cell))));
+        double chord = norm(a - b);
+        // The arc bulges out of the chord's box by at most chord^2 / 8 (plus rounding).
+        double bulge = 1e-12 + 0.125 * chord * chord;
+        boxes[s] = {{std::min(a.x, b.x) - bulge, std::min(a.y, b.y) - bulge, std::min(a.z, b.z) - bulge},
+                    {std::max(a.x, b.x) + bulge, std::max(a.y, b.y) + bulge, std::max(a.z, b.z) + bulge}};
+        int pieces = std::max(1, static_cast<int>(std::ceil(chord / (0.5 * cell))));
         Vec3 prev = a;
         for (int k = 1; k <= pieces; ++k) {
             Vec3 next = k == pieces ? b : arc_interpolate(a, b, double(k) / pieces);
-            double pad = 1e-9 + 0.125 * arc_angle(prev, next) * arc_angle(prev, next);
+            double piece = norm(next - prev);
+            double pad = 1e-12 + 0.125 * piece * piece;
             double lo[3] = {std::min(prev.x, next.x) - pad, std::min(prev.y, next.y) - pad,
                             std::min(prev.z, next.z) - pad};
             double hi[3] = {std::max(prev.x, next.x) + pad, std::max(prev.y, next.y) + pad,
                             std::max(prev.z, next.z) + pad};
-            for (double x = lo[0];; x += cell) {
-                double cx = std::min(x, hi[0]);
-                for (double y = lo[1];; y += cell) {
-                    double cy = std::min(y, hi[1]);
-                    for (double z = lo[2];; z += cell) {
-                        double cz = std::min(z, hi[2]);
-                        entries.push_back({key(cx, cy, cz), s});
-                        if (cz >= hi[2]) break;
-                    }
-                    if (cy >= hi[1]) break;
-                }
-                if (cx >= hi[0]) break;
-            }
+            for (std::uint64_t ix = cell_of(lo[0]); ix <= cell_of(hi[0]); ++ix)
+                for (std::uint64_t iy = cell_of(lo[1]); iy <= cell_of(hi[1]); ++iy)
+                    for (std::uint64_t iz = cell_of(lo[2]); iz <= cell_of(hi[2]); ++iz)
+                        entries.push_back({(ix << 42) | (iy << 21) | iz, s});
             prev = next;
         }
     }
     std::sort(entries.begin(), entries.end());
     entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    auto overlap = [&](std::uint32_t s, std::uint32_t t) {
+        const Box& p = boxes[s];
+        const Box& q = boxes[t];
+        return p.lo[0] <= q.hi[0] && q.lo[0] <= p.hi[0] && p.lo[1] <= q.hi[1] && q.lo[1] <= p.hi[1] &&
+               p.lo[2] <= q.hi[2] && q.lo[2] <= p.hi[2];
+    };
     for (std::size_t i = 0; i < entries.size();) {
         std::size_t j = i;
         while (j < entries.size() && entries[j].first == entries[i].first) ++j;
-        for (std::size_t p = i; p < j; ++p)
-            for (std::size_t q = p + 1; q < j; ++q) pairs.push_back({entries[p].second, entries[q].second});
+        for (std::size_t p = i; p < j; ++p) {
+            for (std::size_t q = p + 1; q < j; ++q) {
+                std::uint32_t s = std::min(entries[p].second, entries[q].second);
+                std::uint32_t t = std::max(entries[p].second, entries[q].second);
+                if (!overlap(s, t)) continue;
+                const Seg& u = segs[s];
+                const Seg& v = segs[t];
+                const auto& ru = *rings[u.ring];
+                const auto& rv = *rings[v.ring];
+                const Vec3& a = ru[u.index];
+                const Vec3& b = ru[(u.index + 1) % ru.size()];
+                const Vec3& c = rv[v.index];
+                const Vec3& d = rv[(v.index + 1) % rv.size()];
+                bool conflict;
+                if (u.ring == v.ring && ru.size() > 2 &&
+                    ((u.index + 1) % ru.size() == v.index || (v.index + 1) % ru.size() == u.index)) {
+                    // Consecutive arcs share one node: they conflict only when one folds back on
+                    // the other (a zero-width spike).
+                    bool u_first = (u.index + 1) % ru.size() == v.index;
+                    const Vec3& pp = u_first ? a : c;
+                    const Vec3& m = u_first ? b : d;
+                    const Vec3& qq = u_first ? d : b;
+                    Vec3 n = robust_cross(pp, m);
+                    double ln = norm(n);
+                    conflict = ln == 0 || (std::abs(dot((1.0 / ln) * n, qq)) < touch_eps && dot(m - pp, qq - m) < 0);
+                } else {
+                    conflict = arcs_conflict(a, b, c, d);
+                }
+                if (conflict) out.push_back({u.ring, u.index, v.ring, v.index});
+            }
+        }
         i = j;
     }
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    for (auto [s, t] : pairs) {
-        const Seg& u = segs[s];
-        const Seg& v = segs[t];
-        const auto& ru = *rings[u.ring];
-        const auto& rv = *rings[v.ring];
-        const Vec3& a = ru[u.index];
-        const Vec3& b = ru[(u.index + 1) % ru.size()];
-        const Vec3& c = rv[v.index];
-        const Vec3& d = rv[(v.index + 1) % rv.size()];
-        bool conflict;
-        if (u.ring == v.ring && ru.size() > 2 &&
-            ((u.index + 1) % ru.size() == v.index || (v.index + 1) % ru.size() == u.index)) {
-            // Consecutive arcs share one node: they conflict only when one folds back on the
-            // other (a zero-width spike).
-            bool u_first = (u.index + 1) % ru.size() == v.index;
-            const Vec3& p = u_first ? a : c;
-            const Vec3& m = u_first ? b : d;
-            const Vec3& q = u_first ? d : b;
-            Vec3 n = robust_cross(p, m);
-            double ln = norm(n);
-            conflict = ln == 0 || (std::abs(dot((1.0 / ln) * n, q)) < touch_eps && dot(m - p, q - m) < 0);
-        } else {
-            conflict = arcs_conflict(a, b, c, d);
-        }
-        if (conflict) {
-            out.push_back({u.ring, u.index, v.ring, v.index});
-            if (out.size() >= max_pairs) break;
-        }
-    }
+    auto order = [](const ArcPair& x, const ArcPair& y) {
+        return std::tie(x.ring_a, x.seg_a, x.ring_b, x.seg_b) < std::tie(y.ring_a, y.seg_a, y.ring_b, y.seg_b);
+    };
+    auto same = [](const ArcPair& x, const ArcPair& y) {
+        return x.ring_a == y.ring_a && x.seg_a == y.seg_a && x.ring_b == y.ring_b && x.seg_b == y.seg_b;
+    };
+    std::sort(out.begin(), out.end(), order);
+    out.erase(std::unique(out.begin(), out.end(), same), out.end());
+    if (out.size() > max_pairs) out.resize(max_pairs);
     return out;
 }
 

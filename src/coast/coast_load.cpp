@@ -612,8 +612,10 @@ NodeKey node_key(const LonLat& p) {
 void append_densified(PointList& out, std::vector<SegmentKind>& kinds, const LonLat& p, const LonLat& q,
                       SegmentKind kind) {
     constexpr double max_step_deg = 0.5;
-    double len = std::hypot(q.lon - p.lon, q.lat - p.lat);
-    int pieces = std::max(1, static_cast<int>(std::ceil(len / max_step_deg)));
+    double dx = q.lon - p.lon, dy = q.lat - p.lat;
+    int pieces = dx * dx + dy * dy <= max_step_deg * max_step_deg
+                     ? 1
+                     : static_cast<int>(std::ceil(std::sqrt(dx * dx + dy * dy) / max_step_deg));
     for (int k = 1; k < pieces; ++k) {
         double t = double(k) / pieces;
         kinds.push_back(kind);
