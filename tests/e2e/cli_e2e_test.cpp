@@ -3,6 +3,7 @@
 // by globemesh's own output.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -278,15 +279,25 @@ TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
+    const std::string err_path = (dir.path().parent_path() / (dir.path().filename().string() + ".err")).string();
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ), 0);
+    const int spawned = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ASSERT_EQ(spawned, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     kill(pid, SIGINT); // the process this test started, by its id
     int wstatus = 0;
     ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
     ASSERT_TRUE(WIFEXITED(wstatus)) << "killed by the signal instead of stopping cleanly";
+    std::stringstream err;
+    err << std::ifstream(err_path).rdbuf();
+    fs::remove(err_path);
     if (WEXITSTATUS(wstatus) == 0) GTEST_SKIP() << "the run finished before the signal arrived";
     EXPECT_EQ(WEXITSTATUS(wstatus), 1);
+    EXPECT_NE(err.str().find("globemesh: cancelled"), std::string::npos) << err.str();
     EXPECT_TRUE(fs::is_empty(dir.path())) << "output or temporary files left behind";
 }
 
