@@ -25,11 +25,25 @@
 // arcs (checked by check_boundary(); a violation that cannot be repaired is a DataError), ocean
 // on the left. Segments on a region edge are SegmentKind::open, every other one coast.
 //
-// Repairs stated in numbers: longitudes within 1e-9 degree of +-180 are put on it (and 180.0000..14
-// is clamped); latitudes within 0.002 degree (220 m) of a pole are put on the pole, because
-// datasets close Antarctica there; where two rings (or one ring) meet at a single point (valid
-// in GEOS, not for a mesher) each copy of that node is moved 1e-7 rad (0.64 m) into the land.
-// Lon/lat sources in the 0..360 convention are not supported (longitudes must be in -180..180).
+// Input rules: the layer is --coast-layer, else the only polygon or line layer of the source
+// (else a DataError listing the layers); --coast-srs, when given, overrides the layer's CRS;
+// polygons drawn with longitudes beyond +-180 are cut there and wrapped back by 360 degrees.
+// Coastline lines are merged at shared ends; a line whose ends lie within 0.001 degree of the
+// seam is closed along it (same side) or through the nearer pole (opposite sides, Antarctica);
+// a gap of at most 0.5 degree is closed straight; any other open line is a DataError. Land is
+// the even-odd fill of the closed lines, so their orientation does not matter.
+// Inland water (holes of the land, and in a region every water body with no edge on the region
+// outline) is dropped unless options.keep_inland_seas, or unless it is all the ocean there is
+// (then the largest body stays), together with the islands inside it.
+//
+// Repairs stated in numbers: longitudes within 1e-9 degree of +-180 are put on it (so
+// 180.00000000000014 becomes 180; for reprojected data the side is taken from the neighbouring
+// vertices); latitudes within 0.002 degree (220 m) of a pole are put on the pole, because
+// datasets close Antarctica there; rings enclosing less than 1e-14 square degree (zero-area
+// slivers, collapsed holes) are dropped; where two rings (or one ring) meet at a single point
+// (valid in GEOS, not for a mesher) each copy of that node is moved 1e-7 rad (0.64 m) into the
+// land. Ocean left on one side only of the +-180 seam (halves of an island that do not match,
+// as Fiji at 1:50m) keeps that stretch of meridian as coast.
 //
 // Units: areas km2 (GeographicLib on WGS84), lengths km (mean radius, sphere.hpp).
 // Deterministic: every container is ordered; the same input gives the same rings.

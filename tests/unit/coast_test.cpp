@@ -4,7 +4,9 @@
 // regions across +-180 and at a pole.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <fstream>
 #include <string>
 
 #include "globemesh/coast.hpp"
@@ -291,6 +293,61 @@ TEST(Coast, open_region_box_in_the_open_sea_is_all_open_boundary) {
     double perimeter, area;
     box.Compute(false, true, perimeter, area);
     EXPECT_NEAR(d.ocean_area_km2, area * 1e-6, 1e-6 * area * 1e-6);
+}
+
+TEST(Coast, region_boxes_reaching_the_south_pole_or_the_seam_keep_the_invariants) {
+    for (std::array<double, 4> box : {std::array<double, 4>{-180, -90, 180, -60}, std::array<double, 4>{-180, -50, 100, 10},
+                                      std::array<double, 4>{0, 70, 90, 90}, std::array<double, 4>{150, -60, -120, 60}}) {
+        MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+        o.region = box;
+        CoastData d = load_coast(o);
+        expect_valid(d.rings);
+        EXPECT_EQ(count_violations(d.rings), 0u) << box[0] << " " << box[1];
+        std::size_t open = 0;
+        for (const auto& r : d.rings.rings)
+            for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+                LonLat p = vec_to_lonlat(r.nodes[i]);
+                EXPECT_GE(p.lat, box[1] - 1e-9);
+                EXPECT_LE(p.lat, box[3] + 1e-9);
+                if (r.kinds[i] == SegmentKind::open) ++open;
+            }
+        EXPECT_GT(open, 0u);
+        expect_valid(shape_boundary(d, uniform(100), o));
+    }
+}
+
+TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
+    globemesh::test::TempDir dir;
+    // A 2000 km square in the North Atlantic, in Web Mercator metres.
+    auto path = (dir / "region.geojson").string();
+    std::ofstream(path) << "{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"name\",\"properties\":{\"name\":\"EPSG:3857\"}},"
+                           "\"features\":[{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+                           "\"coordinates\":[[[-4000000,4000000],[-2000000,4000000],[-2000000,7000000],[-4000000,7000000],[-4000000,4000000]]]}}]}";
+    MeshOptions o = coast_options("coast/ne_50m_land.gpkg");
+    o.region_file = path;
+    CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    EXPECT_EQ(count_violations(d.rings), 0u);
+    std::size_t open = 0;
+    for (const auto& r : d.rings.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            LonLat p = vec_to_lonlat(r.nodes[i]);
+            // -4e6 m and -2e6 m are lon -35.93 and -17.97 degrees in Web Mercator.
+            EXPECT_GE(p.lon, -35.94);
+            EXPECT_LE(p.lon, -17.96);
+            if (r.kinds[i] == SegmentKind::open) ++open;
+        }
+    EXPECT_GT(open, 0u);
+    expect_valid(shape_boundary(d, uniform(30), o));
+}
+
+TEST(Coast, attribute_filter_selects_features) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.coast_where = "scalerank = 0";
+    CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    EXPECT_LT(d.rings.rings.size(), ne110().rings.rings.size());
+    EXPECT_GT(d.ocean_area_km2, ne110().ocean_area_km2);
 }
 
 TEST(Coast, min_island_area_drops_small_islands_by_geodesic_area) {
