@@ -221,6 +221,25 @@ TEST(CoastHostile, island_in_a_lake_goes_with_the_lake_unless_inland_seas_are_ke
     EXPECT_NEAR(d.area_lost_km2, lake, 0.002 * lake);
 }
 
+TEST(CoastHostile, islands_across_a_strait_narrower_than_h_stay_apart) {
+    TempDir dir;
+    // Two comb-shaped islands whose teeth interleave 0.02 degree (2 km) apart; h = 100 km.
+    std::string a = "[[0,0],[1,0],[1,0.2],[0.2,0.2],[0.2,0.4],[1,0.4],[1,0.6],[0.2,0.6],[0.2,0.8],[1,0.8],[1,1],[0,1],[0,0]]";
+    std::string b = "[[2,0],[2,1],[1.02,1],[1.02,0.78],[0.22,0.78],[0.22,0.62],[1.02,0.62],[1.02,0.38],[0.22,0.38],"
+                    "[0.22,0.22],[1.02,0.22],[1.02,0],[2,0]]";
+    auto path = write(dir, "comb.geojson", geojson({polygon(a), polygon(b)}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 2u);
+    MeshOptions o;
+    o.min_island_triangles = 0;
+    CoastReport rep;
+    Boundary shaped = shape_boundary(d, [](const Vec3&) { return 100.0; }, o, &rep);
+    EXPECT_EQ(shaped.rings.size(), 2u);
+    EXPECT_GT(rep.conflicts_repaired, 0u); // plain Douglas-Peucker at h/2 would cross the teeth
+    EXPECT_TRUE(check_boundary(shaped).empty());
+    EXPECT_EQ(count_violations(shaped), 0u);
+}
+
 TEST(CoastHostile, empty_layer_is_refused) {
     TempDir dir;
     auto path = write(dir, "empty.geojson", "{\"type\":\"FeatureCollection\",\"features\":[]}");
