@@ -202,10 +202,9 @@ void print_stats(std::ostream& out, const MeshStats& st, bool histogram) {
         for (std::size_t i = 0; i < st.quality_histogram.size(); ++i) {
             const std::size_t c = st.quality_histogram[i];
             const int bar = largest ? static_cast<int>(std::lround(40.0 * c / largest)) : 0;
-            out << "  " << std::setprecision(1) << 0.1 * i << (i == 9 ? "-1.0]" : "-") ;
-            if (i != 9) out << 0.1 * (i + 1) << ')';
+            out << "  [" << std::setprecision(1) << 0.1 * i << ", " << 0.1 * (i + 1) << (i == 9 ? ']' : ')');
             out << ' ' << std::setw(10) << c << ' ' << std::setw(5) << std::setprecision(1)
-                << (total ? 100.0 * c / total : 0.0) << "% " << std::string(bar, '#') << "\n";
+                << (total ? 100.0 * c / total : 0.0) << '%' << (bar ? " " + std::string(bar, '#') : "") << "\n";
         }
     }
     out.flags(old_flags);
