@@ -647,3 +647,35 @@ TEST(Cli, the_mesh_carries_a_configuration_that_remakes_the_run) {
     expect_same_cli(globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "from_file.toml").string()}),
                     globemesh::parse_mesh_args(args));
 }
+
+TEST(Cli, info_reads_back_a_written_octahedron) {
+    TempDir dir;
+    globemesh::Mesh m;
+    m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+    globemesh::write_ugrid(m, dir / "octa.nc");
+    RefusingLibrary refusing;
+    auto lib = refusing.lib();
+    lib.read_ugrid = [](const fs::path& p) { return globemesh::read_ugrid(p); };
+    lib.compute_stats = [](const globemesh::Mesh& mesh) { return globemesh::compute_stats(mesh); };
+    const Result json = run({"info", (dir / "octa.nc").string(), "--json"}, lib);
+    ASSERT_EQ(json.status, 0) << json.err;
+    EXPECT_EQ(json.err, "");
+    // Closed form: V - E + F = 6 - 12 + 8 = 2; the faces tile the sphere, area 4 pi R^2.
+    EXPECT_NE(json.out.find("\"nodes\": 6,"), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"faces\": 8,"), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"edges\": 12,"), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos) << json.out;
+    std::smatch area;
+    ASSERT_TRUE(std::regex_search(json.out, area, std::regex(R"("area_km2": ([0-9.e+]+))")));
+    const double r = globemesh::earth_radius_km;
+    EXPECT_NEAR(std::stod(area[1]), 4 * M_PI * r * r, 1e-6 * 4 * M_PI * r * r);
+    // Every edge is a quarter great circle: pi/2 R.
+    std::smatch edge;
+    ASSERT_TRUE(std::regex_search(json.out, edge, std::regex(R"("edge_km": \{"min": ([0-9.e+]+))")));
+    EXPECT_NEAR(std::stod(edge[1]), M_PI / 2 * r, 1e-6 * r);
+    const Result text = run({"info", (dir / "octa.nc").string()}, lib);
+    ASSERT_EQ(text.status, 0) << text.err;
+    EXPECT_TRUE(std::regex_search(text.out, std::regex(R"(faces\s+8\n)"))) << text.out;
+    EXPECT_TRUE(std::regex_search(text.out, std::regex(R"(\[0\.9, 1\.0\]\s+8 100\.0% #+\n)"))) << text.out;
+}
