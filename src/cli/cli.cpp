@@ -87,7 +87,13 @@ std::string history_text(const std::string& sub, std::span<const std::string> ar
     std::string command = "globemesh " + sub;
     for (const auto& a : args) {
         const bool plain = !a.empty() && a.find_first_of(" \t'\"\\$`") == std::string::npos;
-        command += " " + (plain ? a : "'" + a + "'");
+        if (plain) {
+            command += " " + a;
+            continue;
+        }
+        std::string quoted = "'"; // POSIX shell quoting: ' becomes '\''
+        for (char c : a) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        command += " " + quoted + "'";
     }
     return std::string(date) + ": " + command;
 }
