@@ -70,6 +70,11 @@ public:
     /// The cavity never crosses a constrained edge. Triangles created inherit the cavity's label.
     VertexId insert(const Vec3& p, TriangleId hint = no_triangle);
 
+    /// Inserts p, which the caller knows lies in the solid triangle t, into a constrained
+    /// triangulation: t is replaced even when constraints make it non-Delaunay, and the cavity
+    /// grows from it to the triangles whose circumcircle holds p, never across a constraint.
+    VertexId insert_in_triangle(const Vec3& p, TriangleId t);
+
     /// Inserts p into the edge h (constrained or not) and keeps both halves constrained when h
     /// was. p should lie on or very near the edge's arc (e.g. its midpoint). Returns the vertex.
     VertexId split_edge(HalfEdge h, const Vec3& p);
@@ -138,7 +143,9 @@ private:
                              std::vector<VertexId>& vertex_of);
     bool visible(TriangleId t, const Vec3& p) const;
     VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
-    bool legalize_from(std::vector<HalfEdge>& stack);
+    std::size_t legalize_from(std::vector<HalfEdge>& stack);
+    bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created);
+    HalfEdge leaving(VertexId a) const;
 
     Options options_;
     std::vector<Vec3> points_;

@@ -1,0 +1,694 @@
+#include "globemesh/delaunay.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "globemesh/error.hpp"
+#include "globemesh/predicates.hpp"
+#include "hilbert.hpp"
+
+namespace globemesh {
+
+using predicates::in_circle;
+using predicates::orient;
+
+namespace {
+
+constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
+constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
+
+// True when three points are not on one line in 3-D (so they span a plane): some orient3d with
+// the origin or a coordinate axis point is non-zero (those four points are not coplanar).
+bool spans_plane(const Vec3& a, const Vec3& b, const Vec3& c) {
+    static const Vec3 probes[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (const Vec3& q : probes)
+        if (predicates::orient3d(a, b, c, q) != 0) return true;
+    return false;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Storage
+// ---------------------------------------------------------------------------------------------
+
+void SphericalDelaunay::link(HalfEdge a, HalfEdge b) {
+    // The constrained flag lives on both sides; keep whatever a carried.
+    std::uint32_t flag = links_[a] & constrained_bit;
+    links_[a] = b | flag;
+    links_[b] = a | flag;
+}
+
+void SphericalDelaunay::set_constrained(HalfEdge h, bool on) {
+    HalfEdge t = twin(h);
+    if (on) {
+        links_[h] |= constrained_bit;
+        links_[t] |= constrained_bit;
+    } else {
+        links_[h] &= link_mask;
+        links_[t] &= link_mask;
+    }
+}
+
+TriangleId SphericalDelaunay::new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label) {
+    TriangleId t;
+    if (!free_.empty()) {
+        t = free_.back();
+        free_.pop_back();
+    } else {
+        t = static_cast<TriangleId>(tri_vertices_.size() / 3);
+        tri_vertices_.resize(tri_vertices_.size() + 3);
+        links_.resize(links_.size() + 3, 0);
+        labels_.push_back(0);
+        mark_.push_back(0);
+    }
+    tri_vertices_[3 * t] = a;
+    tri_vertices_[3 * t + 1] = b;
+    tri_vertices_[3 * t + 2] = c;
+    links_[3 * t] = links_[3 * t + 1] = links_[3 * t + 2] = 0;
+    labels_[t] = label;
+    last_ = t;
+    return t;
+}
+
+void SphericalDelaunay::free_triangle(TriangleId t) {
+    tri_vertices_[3 * t] = no_vertex;
+    free_.push_back(t);
+}
+
+bool SphericalDelaunay::is_solid(TriangleId t) const {
+    return orient(points_[vertex(t, 0)], points_[vertex(t, 1)], points_[vertex(t, 2)]) > 0;
+}
+
+bool SphericalDelaunay::visible(TriangleId t, const Vec3& p) const {
+    return in_circle(points_[vertex(t, 0)], points_[vertex(t, 1)], points_[vertex(t, 2)], p) > 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Construction
+// ---------------------------------------------------------------------------------------------
+
+void SphericalDelaunay::initial_tetrahedron(std::span<const Vec3> points,
+                                            std::span<const std::uint32_t> order,
+                                            std::vector<VertexId>& vertex_of) {
+    const double tol = options_.merge_tolerance_rad;
+    // Pick, in insertion order, a first point, a distinct second, a third spanning a plane with
+    // them, and a fourth off that plane.
+    std::size_t k[4] = {0, 0, 0, 0};
+    std::size_t found = 1;
+    const std::size_t n = order.size();
+    for (std::size_t i = 1; i < n && found < 4; ++i) {
+        const Vec3& p = points[order[i]];
+        bool ok = false;
+        if (found == 1) ok = arc_angle(points[order[k[0]]], p) > tol;
+        else if (found == 2)
+            ok = arc_angle(points[order[k[0]]], p) > tol && arc_angle(points[order[k[1]]], p) > tol &&
+                 spans_plane(points[order[k[0]]], points[order[k[1]]], p);
+        else
+            ok = predicates::orient3d(points[order[k[0]]], points[order[k[1]]], points[order[k[2]]], p) != 0;
+        if (ok) k[found++] = i;
+    }
+    if (found < 3) throw DataError("fewer than 3 distinct points: nothing to triangulate");
+    if (found < 4)
+        throw DataError("all points lie on one circle of the sphere (e.g. one great circle): "
+                        "their triangulation is degenerate");
+    VertexId v[4];
+    for (int j = 0; j < 4; ++j) {
+        v[j] = static_cast<VertexId>(points_.size());
+        points_.push_back(points[order[k[j]]]);
+        vertex_of[order[k[j]]] = v[j];
+    }
+    // Faces counter-clockwise from outside: with orient3d(a,b,c,d) < 0 they are
+    // (a,b,c), (a,c,d), (a,d,b), (b,d,c) (each face has the fourth vertex below it).
+    if (predicates::orient3d(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]) > 0)
+        std::swap(v[0], v[1]);
+    const VertexId faces[4][3] = {{v[0], v[1], v[2]}, {v[0], v[2], v[3]}, {v[0], v[3], v[1]}, {v[1], v[3], v[2]}};
+    TriangleId t[4];
+    for (int f = 0; f < 4; ++f) t[f] = new_triangle(faces[f][0], faces[f][1], faces[f][2], 0);
+    // Link every pair of faces sharing an edge (each edge a->b of one face is b->a of another).
+    for (int f = 0; f < 4; ++f)
+        for (int i = 0; i < 3; ++i) {
+            VertexId a = vertex(t[f], next3(i)), b = vertex(t[f], prev3(i));
+            for (int g = 0; g < 4; ++g)
+                for (int j = 0; j < 3; ++j)
+                    if (vertex(t[g], next3(j)) == b && vertex(t[g], prev3(j)) == a)
+                        links_[half_edge(t[f], i)] = half_edge(t[g], j);
+        }
+}
+
+std::vector<VertexId> SphericalDelaunay::insert_points(std::span<const Vec3> points) {
+    std::vector<VertexId> vertex_of(points.size(), no_vertex);
+    std::vector<std::uint32_t> order = detail::brio_order(points, options_.seed);
+    // A closed triangulation of n points has 2n - 4 triangles; reserve once.
+    const std::size_t expected = points_.size() + points.size();
+    points_.reserve(expected);
+    tri_vertices_.reserve(3 * (2 * expected + 4));
+    links_.reserve(3 * (2 * expected + 4));
+    labels_.reserve(2 * expected + 4);
+    mark_.reserve(2 * expected + 4);
+    if (triangle_count() == 0) initial_tetrahedron(points, order, vertex_of);
+    TriangleId hint = last_;
+    for (std::uint32_t i : order) {
+        if (vertex_of[i] != no_vertex) continue;
+        vertex_of[i] = insert(points[i], hint);
+        hint = last_;
+    }
+    order.clear();
+    order.shrink_to_fit();
+    return vertex_of;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Location
+// ---------------------------------------------------------------------------------------------
+
+TriangleId SphericalDelaunay::locate(const Vec3& p, TriangleId hint) const {
+    TriangleId t = hint;
+    if (t == no_triangle || t >= triangle_slots() || !is_live(t)) {
+        t = last_;
+        if (t == no_triangle || !is_live(t)) {
+            for (t = 0; t < triangle_slots() && !is_live(t); ++t) {
+            }
+            if (t == triangle_slots()) return no_triangle;
+        }
+    }
+    // Visibility walk across edges that have p strictly on their right. The start edge rotates
+    // with the step count (a deterministic stand-in for the stochastic walk, which cannot cycle
+    // for ever in a Delaunay triangulation); the step bound guards constrained or ghost regions.
+    const std::size_t limit = 64 + 8 * static_cast<std::size_t>(std::sqrt(double(triangle_slots()))) * 4;
+    for (std::size_t step = 0; step < limit; ++step) {
+        const int start = static_cast<int>(((step * 2654435761u) >> 7) % 3);
+        bool moved = false;
+        for (int k = 0; k < 3; ++k) {
+            int i = (start + k) % 3;
+            const Vec3& u = points_[vertex(t, next3(i))];
+            const Vec3& w = points_[vertex(t, prev3(i))];
+            if (orient(u, w, p) < 0) {
+                t = neighbour(t, i);
+                moved = true;
+                break;
+            }
+        }
+        if (!moved) return t;
+    }
+    return t;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Insertion (Bowyer-Watson)
+// ---------------------------------------------------------------------------------------------
+
+VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
+    const TriangleId located = locate(p, hint);
+    if (located == no_triangle) throw DataError("cannot insert into an empty triangulation");
+    // Merge with a vertex of the located triangle when within tolerance (exact duplicates land here).
+    for (int i = 0; i < 3; ++i)
+        if (arc_angle(points_[vertex(located, i)], p) <= options_.merge_tolerance_rad) {
+            ++merged_;
+            return vertex(located, i);
+        }
+    const Vec3& a = points_[vertex(located, 0)];
+    const Vec3& b = points_[vertex(located, 1)];
+    const Vec3& c = points_[vertex(located, 2)];
+    const bool inside_solid = orient(a, b, c) > 0 && orient(a, b, p) >= 0 && orient(b, c, p) >= 0 &&
+                              orient(c, a, p) >= 0;
+    TriangleId seed = located;
+    if (!inside_solid && !visible(located, p)) {
+        // p is outside the solid region (in the ghost part) or the walk stopped early: search
+        // breadth-first for a triangle p is beyond. search_ lists every triangle marked.
+        seed = no_triangle;
+        search_.clear();
+        search_.push_back(located);
+        mark_[located] = 2;
+        for (std::size_t k = 0; k < search_.size() && seed == no_triangle; ++k) {
+            for (int i = 0; i < 3 && seed == no_triangle; ++i) {
+                TriangleId nb = neighbour(search_[k], i);
+                if (mark_[nb] == 2) continue;
+                mark_[nb] = 2;
+                search_.push_back(nb);
+                if (visible(nb, p)) seed = nb;
+            }
+        }
+        for (TriangleId s : search_) mark_[s] = 0;
+    }
+    if (seed == no_triangle || (inside_solid && !visible(located, p))) {
+        // p lies inside the hull of its neighbours (closer than rounding lets the hull resolve):
+        // merge it into the nearest vertex of its triangle.
+        ++merged_;
+        VertexId best = vertex(located, 0);
+        for (int i = 1; i < 3; ++i)
+            if (arc_angle(points_[vertex(located, i)], p) < arc_angle(points_[best], p)) best = vertex(located, i);
+        return best;
+    }
+    return insert_in_cavity(p, seed, no_half_edge);
+}
+
+VertexId SphericalDelaunay::insert_in_triangle(const Vec3& p, TriangleId t) {
+    for (int i = 0; i < 3; ++i) {
+        if (arc_angle(points_[vertex(t, i)], p) <= options_.merge_tolerance_rad) {
+            ++merged_;
+            return vertex(t, i);
+        }
+    }
+    // A point exactly on an edge splits it (both triangles must go).
+    for (int i = 0; i < 3; ++i)
+        if (orient(points_[vertex(t, next3(i))], points_[vertex(t, prev3(i))], p) == 0)
+            return insert_in_cavity(p, t, half_edge(t, i));
+    return insert_in_cavity(p, t, no_half_edge);
+}
+
+VertexId SphericalDelaunay::split_edge(HalfEdge h, const Vec3& p) {
+    for (VertexId v : {origin(h), destination(h)})
+        if (arc_angle(points_[v], p) <= options_.merge_tolerance_rad) {
+            ++merged_;
+            return v;
+        }
+    return insert_in_cavity(p, triangle_of(h), h);
+}
+
+// Grows the cavity from `seed` (and across `split` when given) over unconstrained edges to the
+// triangles p lies beyond, checks it is star-shaped from p, and replaces it by a fan around p.
+VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split) {
+    const bool split_constrained = split != no_half_edge && is_constrained(split);
+    const VertexId split_a = split != no_half_edge ? origin(split) : no_vertex;
+    const VertexId split_b = split != no_half_edge ? destination(split) : no_vertex;
+    const std::uint8_t label = labels_[seed];
+
+    cavity_.clear();
+    cavity_.push_back(seed);
+    mark_[seed] = 1;
+    TriangleId other = no_triangle;
+    if (split != no_half_edge) {
+        other = triangle_of(twin(split));
+        cavity_.push_back(other);
+        mark_[other] = 1;
+    }
+    for (std::size_t k = 0; k < cavity_.size(); ++k) {
+        TriangleId s = cavity_[k];
+        for (int i = 0; i < 3; ++i) {
+            HalfEdge h = half_edge(s, i);
+            if (is_constrained(h)) continue;
+            TriangleId nb = triangle_of(twin(h));
+            if (mark_[nb]) continue;
+            if (visible(nb, p)) {
+                mark_[nb] = 1;
+                cavity_.push_back(nb);
+            }
+        }
+    }
+
+    // Boundary of the cavity. Without constraints the cavity is exactly the part of the hull
+    // visible from p, a disk that every rim edge sees p from. A constraint can cut that region
+    // so that a rim edge no longer sees p on its left: then shrink the cavity (the seed
+    // triangles always stay) until every rim edge of a solid triangle does.
+    bool touches_constraint = false;
+    for (TriangleId s : cavity_)
+        for (int i = 0; i < 3; ++i)
+            if (is_constrained(half_edge(s, i))) touches_constraint = true;
+    for (;;) {
+        cavity_boundary_.clear();
+        TriangleId drop = no_triangle;
+        for (TriangleId s : cavity_) {
+            for (int i = 0; i < 3; ++i) {
+                HalfEdge h = half_edge(s, i);
+                HalfEdge o = twin(h);
+                bool inner = mark_[triangle_of(o)] == 1 && !(is_constrained(h) && h != split && o != split);
+                if (inner) continue;
+                cavity_boundary_.push_back(h);
+                if (touches_constraint && drop == no_triangle && s != seed && s != other) {
+                    const Vec3& u = points_[origin(h)];
+                    const Vec3& w = points_[destination(h)];
+                    if (orient(u, w, p) <= 0 && is_solid(s)) drop = s;
+                }
+            }
+        }
+        if (drop == no_triangle) break;
+        mark_[drop] = 0;
+        cavity_.erase(std::find(cavity_.begin(), cavity_.end(), drop));
+    }
+
+    // Merge with a boundary vertex within tolerance (the nearest vertex to p is on the boundary).
+    for (HalfEdge h : cavity_boundary_) {
+        VertexId u = origin(h);
+        if (arc_angle(points_[u], p) <= options_.merge_tolerance_rad) {
+            for (TriangleId s : cavity_) mark_[s] = 0;
+            ++merged_;
+            return u;
+        }
+    }
+
+    // Record each boundary edge's outside half-edge and flag before the cavity is freed.
+    struct Rim {
+        VertexId u, w;
+        std::uint32_t outside; // twin half-edge with its constrained flag
+    };
+    std::vector<Rim> rim;
+    rim.reserve(cavity_boundary_.size());
+    for (HalfEdge h : cavity_boundary_) rim.push_back({origin(h), destination(h), links_[h]});
+    for (TriangleId s : cavity_) {
+        mark_[s] = 0;
+        free_triangle(s);
+    }
+
+    const VertexId v = static_cast<VertexId>(points_.size());
+    points_.push_back(p);
+    // Fan: triangle (v, u, w) per rim edge u->w. Edge 0 (u->w) faces outside; edge 1 (w->v) is
+    // the twin of edge 2 (v->w) of the triangle whose rim edge starts at w.
+    std::vector<std::pair<VertexId, TriangleId>> by_start;
+    by_start.reserve(rim.size());
+    for (const Rim& r : rim) {
+        TriangleId t = new_triangle(v, r.u, r.w, label);
+        HalfEdge h = half_edge(t, 0);
+        HalfEdge o = r.outside & link_mask;
+        links_[h] = r.outside;
+        links_[o] = h | (r.outside & constrained_bit);
+        by_start.emplace_back(r.u, t);
+    }
+    std::sort(by_start.begin(), by_start.end());
+    for (const auto& [u, t] : by_start) {
+        VertexId w = vertex(t, 2);
+        auto it = std::lower_bound(by_start.begin(), by_start.end(), std::make_pair(w, TriangleId{0}));
+        TriangleId tw = it->second;
+        links_[half_edge(t, 1)] = half_edge(tw, 2);
+        links_[half_edge(tw, 2)] = half_edge(t, 1);
+    }
+    if (split_constrained) {
+        // Both halves of the split constraint stay constrained.
+        for (const auto& [u, t] : by_start) {
+            if (u == split_a || u == split_b) set_constrained(half_edge(t, 2), true); // v -> u
+        }
+    }
+    return v;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Flips, constraints, moves
+// ---------------------------------------------------------------------------------------------
+
+void SphericalDelaunay::flip(HalfEdge h) {
+    const TriangleId t = triangle_of(h);
+    const int i = edge_of(h);
+    const HalfEdge g = twin(h);
+    const TriangleId s = triangle_of(g);
+    const int j = edge_of(g);
+    const VertexId x = vertex(t, i), u = vertex(t, next3(i)), w = vertex(t, prev3(i));
+    const VertexId y = vertex(s, j);
+    // Outer half-edges (with their flags): A across w->x, B across x->u, C across u->y, D across y->w.
+    const std::uint32_t A = links_[half_edge(t, next3(i))];
+    const std::uint32_t C = links_[half_edge(s, next3(j))];
+    // t becomes (x, u, y): edge i = u->y (C), edge i+1 = y->x (diagonal), edge i+2 = x->u (B, unchanged).
+    // s becomes (y, w, x): edge j = w->x (A), edge j+1 = x->y (diagonal), edge j+2 = y->w (D, unchanged).
+    tri_vertices_[3 * t + prev3(i)] = y;
+    tri_vertices_[3 * s + prev3(j)] = x;
+    (void)u;
+    (void)w;
+    auto attach = [&](HalfEdge mine, std::uint32_t outer) {
+        links_[mine] = outer;
+        links_[outer & link_mask] = mine | (outer & constrained_bit);
+    };
+    attach(half_edge(t, i), C);
+    attach(half_edge(s, j), A);
+    links_[half_edge(t, next3(i))] = half_edge(s, next3(j));
+    links_[half_edge(s, next3(j))] = half_edge(t, next3(i));
+    last_ = t;
+}
+
+std::size_t SphericalDelaunay::legalize_from(std::vector<HalfEdge>& stack) {
+    std::size_t flips = 0;
+    while (!stack.empty()) {
+        HalfEdge h = stack.back();
+        stack.pop_back();
+        TriangleId t = triangle_of(h);
+        if (!is_live(t) || is_constrained(h)) continue;
+        HalfEdge g = twin(h);
+        TriangleId s = triangle_of(g);
+        int i = edge_of(h), j = edge_of(g);
+        const Vec3& x = points_[vertex(t, i)];
+        const Vec3& u = points_[vertex(t, next3(i))];
+        const Vec3& w = points_[vertex(t, prev3(i))];
+        const Vec3& y = points_[vertex(s, j)];
+        if (in_circle(x, u, w, y) <= 0) continue;
+        // A solid non-Delaunay edge bounds a strictly convex quadrilateral; with ghosts around,
+        // make sure the flip keeps both triangles oriented.
+        if (orient(x, u, y) <= 0 || orient(y, w, x) <= 0) {
+            if (is_solid(t) && is_solid(s)) continue;
+        }
+        flip(h);
+        ++flips;
+        // The four outer edges of the new pair.
+        stack.push_back(half_edge(t, i));
+        stack.push_back(half_edge(t, prev3(i)));
+        stack.push_back(half_edge(s, j));
+        stack.push_back(half_edge(s, prev3(j)));
+    }
+    return flips;
+}
+
+std::size_t SphericalDelaunay::make_delaunay() {
+    std::vector<HalfEdge> stack;
+    for (TriangleId t = 0; t < triangle_slots(); ++t)
+        if (is_live(t))
+            for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
+    return legalize_from(stack);
+}
+
+std::vector<HalfEdge> SphericalDelaunay::vertex_half_edges() const {
+    std::vector<HalfEdge> out(points_.size(), no_half_edge);
+    for (TriangleId t = 0; t < triangle_slots(); ++t)
+        if (is_live(t))
+            for (int i = 0; i < 3; ++i) out[vertex(t, next3(i))] = half_edge(t, i);
+    return out;
+}
+
+HalfEdge SphericalDelaunay::find_edge(HalfEdge from, VertexId b) const {
+    // Rotate around a = origin(from): in triangle t, the edge ending at a is edge prev3(i) (it
+    // joins vertex(t, i) to a), and its twin is the next half-edge leaving a.
+    HalfEdge h = from;
+    do {
+        if (destination(h) == b) return h;
+        h = twin(half_edge(triangle_of(h), prev3(edge_of(h))));
+    } while (h != from);
+    return no_half_edge;
+}
+
+HalfEdge SphericalDelaunay::leaving(VertexId a) const {
+    TriangleId t = locate(points_[a], last_);
+    for (int i = 0; i < 3; ++i)
+        if (vertex(t, next3(i)) == a) return half_edge(t, i);
+    return vertex_half_edges()[a];
+}
+
+bool SphericalDelaunay::insert_constraint(VertexId a, VertexId b) {
+    std::vector<HalfEdge> created;
+    bool ok = recover_segment(a, b, created);
+    legalize_from(created); // restore the Delaunay property around the edges the flips made
+    return ok;
+}
+
+// True when the minor arcs a-b and c-d cross at a point interior to both (exact; the sign
+// pattern of S2's CrossingSign: the endpoints of each arc straddle the other's great circle,
+// and on the same hemisphere, which rules out the antipodal intersection).
+static bool arcs_cross(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+    int acb = -orient(a, b, c);
+    int bda = orient(a, b, d);
+    if (acb == 0 || acb != bda) return false;
+    int cbd = -orient(c, d, b);
+    if (cbd != acb) return false;
+    return orient(c, d, a) == acb;
+}
+
+// True when vertex d lies on the minor arc a-b strictly between a and b.
+static bool on_arc(const Vec3& a, const Vec3& b, const Vec3& d) {
+    return orient(a, b, d) == 0 && arc_angle(a, d) < arc_angle(a, b) && arc_angle(d, b) < arc_angle(a, b);
+}
+
+bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created) {
+    if (a == b) return true;
+    const Vec3& pa = points_[a];
+    const Vec3& pb = points_[b];
+    for (int round = 0; round < 64; ++round) {
+        const HalfEdge from = leaving(a);
+        if (from == no_half_edge) return false;
+        HalfEdge e = find_edge(from, b);
+        if (e != no_half_edge) {
+            set_constrained(e, true);
+            return true;
+        }
+        // Rotate around a to the triangle (a, d, third) the arc a->b leaves through its edge
+        // d->third; a vertex exactly on the arc splits the constraint.
+        HalfEdge exit = no_half_edge;
+        HalfEdge h = from;
+        do {
+            TriangleId s = triangle_of(h);
+            int i = edge_of(h);
+            VertexId d = destination(h), third = vertex(s, i);
+            if (on_arc(pa, pb, points_[d]))
+                return recover_segment(a, d, created) && recover_segment(d, b, created);
+            if (orient(pa, points_[d], pb) > 0 && orient(pa, points_[third], pb) < 0) {
+                exit = half_edge(s, next3(i)); // d -> third, opposite a
+                break;
+            }
+            h = twin(half_edge(s, prev3(i)));
+        } while (h != from);
+        if (exit == no_half_edge) return false;
+
+        // Walk along the arc, collecting the edges it crosses.
+        std::vector<HalfEdge> crossing;
+        HalfEdge c = exit;
+        for (;;) {
+            if (is_constrained(c)) return false; // another constraint crosses a-b
+            crossing.push_back(c);
+            HalfEdge o = twin(c);
+            TriangleId r = triangle_of(o);
+            int k = edge_of(o);
+            VertexId apex = vertex(r, k);
+            if (apex == b) break;
+            int side = orient(pa, pb, points_[apex]);
+            if (side == 0) {
+                if (!on_arc(pa, pb, points_[apex])) return false;
+                return recover_segment(a, apex, created) && recover_segment(apex, b, created);
+            }
+            // r = (apex, third, d): d is right of a->b, third left; leave through the edge whose
+            // endpoints are on opposite sides.
+            c = side > 0 ? half_edge(r, next3(k)) /* d -> apex */ : half_edge(r, prev3(k)) /* apex -> third */;
+            if (crossing.size() > 4 * triangle_slots()) return false;
+        }
+        // Flip crossing edges until none crosses (Sloan 1993); a non-convex quadrilateral is
+        // retried later, after its neighbours have moved. Half-edge ids change under flips, so
+        // the queue holds vertex pairs and each is looked up again before it is flipped.
+        std::vector<std::pair<VertexId, VertexId>> queue;
+        queue.reserve(crossing.size());
+        for (HalfEdge e : crossing) queue.emplace_back(origin(e), destination(e));
+        std::size_t stall = 0;
+        std::size_t head = 0;
+        while (head < queue.size()) {
+            auto [qu, qw] = queue[head++];
+            HalfEdge e2 = find_edge(leaving(qu), qw);
+            if (e2 == no_half_edge) continue; // already flipped away
+            TriangleId s = triangle_of(e2);
+            int i = edge_of(e2);
+            HalfEdge g = twin(e2);
+            const Vec3& x = points_[vertex(s, i)];
+            const Vec3& u = points_[vertex(s, next3(i))];
+            const Vec3& w = points_[vertex(s, prev3(i))];
+            const Vec3& y = points_[vertex(triangle_of(g), edge_of(g))];
+            if (orient(x, u, y) <= 0 || orient(y, w, x) <= 0) {
+                queue.emplace_back(qu, qw);
+                if (++stall > 2 * (queue.size() - head) + 8) return false;
+                continue;
+            }
+            stall = 0;
+            flip(e2);
+            // The quadrilateral's outer edges border changed triangles: recheck them afterwards.
+            TriangleId r = triangle_of(g);
+            created.push_back(half_edge(s, i));
+            created.push_back(half_edge(s, prev3(i)));
+            created.push_back(half_edge(r, edge_of(g)));
+            created.push_back(half_edge(r, prev3(edge_of(g))));
+            HalfEdge diag = half_edge(s, next3(i)); // the new diagonal y -> x
+            VertexId d0 = origin(diag), d1 = destination(diag);
+            bool touches = d0 == a || d0 == b || d1 == a || d1 == b;
+            if (!touches && arcs_cross(pa, pb, points_[d0], points_[d1]))
+                queue.emplace_back(d0, d1);
+            else
+                created.push_back(diag);
+        }
+    }
+    return false;
+}
+
+bool SphericalDelaunay::move_vertex(VertexId v, const Vec3& p) {
+    auto star = vertex_half_edges();
+    HalfEdge from = star[v];
+    if (from == no_half_edge) return false;
+    // Every triangle of the star must stay counter-clockwise with v at p.
+    std::vector<HalfEdge> ring;
+    HalfEdge h = from;
+    do {
+        ring.push_back(h);
+        TriangleId t = triangle_of(h);
+        const Vec3& b = points_[destination(h)];
+        const Vec3& c = points_[vertex(t, edge_of(h))];
+        if (orient(p, b, c) <= 0) return false;
+        h = twin(half_edge(t, prev3(edge_of(h))));
+    } while (h != from);
+    points_[v] = p;
+    std::vector<HalfEdge> stack;
+    for (HalfEdge r : ring) {
+        TriangleId t = triangle_of(r);
+        for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
+    }
+    legalize_from(stack);
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validation
+// ---------------------------------------------------------------------------------------------
+
+std::vector<std::string> SphericalDelaunay::validate() const {
+    std::vector<std::string> problems;
+    auto fail = [&](const std::string& s) {
+        if (problems.size() < 50) problems.push_back(s);
+    };
+    std::vector<std::uint8_t> used(points_.size(), 0);
+    std::size_t faces = 0, nondelaunay = 0, ghosts = 0, flat = 0;
+    double area = 0;
+    for (TriangleId t = 0; t < triangle_slots(); ++t) {
+        if (!is_live(t)) continue;
+        ++faces;
+        VertexId a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
+        if (a >= points_.size() || b >= points_.size() || c >= points_.size() || a == b || b == c || a == c) {
+            fail("triangle " + std::to_string(t) + " has invalid or repeated vertices");
+            continue;
+        }
+        used[a] = used[b] = used[c] = 1;
+        area += spherical_triangle_area(points_[a], points_[b], points_[c]);
+        int o = orient(points_[a], points_[b], points_[c]);
+        if (o < 0) ++ghosts;
+        if (o == 0) ++flat;
+        for (int i = 0; i < 3; ++i) {
+            HalfEdge h = half_edge(t, i);
+            HalfEdge o = twin(h);
+            if (o >= links_.size() || !is_live(triangle_of(o))) {
+                fail("half-edge " + std::to_string(h) + " links to a dead triangle");
+                continue;
+            }
+            if (twin(o) != h) fail("neighbour links of half-edge " + std::to_string(h) + " are not symmetric");
+            if (origin(o) != destination(h) || destination(o) != origin(h))
+                fail("half-edge " + std::to_string(h) + " and its twin do not share endpoints");
+            if (is_constrained(o) != is_constrained(h))
+                fail("constraint flag of half-edge " + std::to_string(h) + " differs on its two sides");
+            if (!is_constrained(h) && h < o) {
+                const TriangleId s = triangle_of(o);
+                if (in_circle(points_[a], points_[b], points_[c], points_[vertex(s, edge_of(o))]) > 0)
+                    ++nondelaunay;
+            }
+        }
+    }
+    std::size_t v_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), 1));
+    if (faces % 2 != 0) fail("odd number of triangles in a closed triangulation");
+    long long euler = static_cast<long long>(v_used) - static_cast<long long>(3 * faces / 2) +
+                      static_cast<long long>(faces);
+    if (faces > 0 && euler != 2) fail("Euler characteristic V - E + F = " + std::to_string(euler) + ", not 2");
+    if (nondelaunay) fail(std::to_string(nondelaunay) + " unconstrained edges are not locally Delaunay");
+    // Orientation, globally: the signed areas of a closed surface wound once around the origin
+    // add up to 4 pi; a surface that does not enclose the origin (all points in a hemisphere)
+    // adds up to 0. Anything else is a fold.
+    // A surface around the origin that still has a triangle with det <= 0 is folded there.
+    if (faces > 0 && std::fabs(area - 4 * pi) <= 1e-6 && ghosts > 0)
+        fail(std::to_string(ghosts) + " triangles are clockwise on the sphere in a triangulation "
+                                      "around the origin: folded triangles");
+    // (Flat triangles, on a great circle through the origin, close a hull whose points all lie
+    // in a closed hemisphere; their spherical area is undefined, so the sum says nothing then.)
+    if (faces > 0 && flat == 0 && std::fabs(area - 4 * pi) > 1e-6 && std::fabs(area) > 1e-6) {
+        std::ostringstream s;
+        s << "signed spherical areas add up to " << area << " sr, not 4 pi or 0: folded triangles";
+        fail(s.str());
+    }
+    return problems;
+}
+
+} // namespace globemesh

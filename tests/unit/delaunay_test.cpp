@@ -1,0 +1,337 @@
+// Tests of the spherical Delaunay core. Oracles are independent of the implementation:
+// Euler's formula, spherical areas adding up to 4 pi, a brute-force empty-circumcircle check
+// in plain long double on small sets, and invariance of the triangle set under input shuffling
+// (the Delaunay triangulation of a perturbed point set is unique).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "globemesh/delaunay.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/predicates.hpp"
+#include "globemesh/sphere.hpp"
+
+using namespace globemesh;
+
+namespace {
+
+std::vector<Vec3> random_points(std::size_t n, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> z(-1, 1), lon(-180, 180);
+    std::vector<Vec3> p(n);
+    for (auto& v : p) v = lonlat_to_vec(lon(rng), std::asin(z(rng)) * rad_to_deg);
+    return p;
+}
+
+std::vector<Vec3> grid_points(double step_deg) {
+    std::vector<Vec3> p;
+    for (double lat = -90; lat <= 90; lat += step_deg)
+        for (double lon = -180; lon < 180; lon += step_deg) p.push_back(lonlat_to_vec(lon, lat));
+    return p; // the poles appear once per longitude: duplicates the core must merge
+}
+
+using Tri = std::array<std::array<double, 3>, 3>;
+
+// Triangles as coordinate triples, rotated to start at the lexicographically smallest corner,
+// sorted: two triangulations of the same points are equal iff these lists are.
+std::vector<Tri> canonical(const SphericalDelaunay& dt, bool solid_only) {
+    std::vector<Tri> out;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || (solid_only && !dt.is_solid(t))) continue;
+        Tri tri;
+        for (int i = 0; i < 3; ++i) {
+            const Vec3& p = dt.point(dt.vertex(t, i));
+            tri[i] = {p.x, p.y, p.z};
+        }
+        auto m = std::min_element(tri.begin(), tri.end()) - tri.begin();
+        std::rotate(tri.begin(), tri.begin() + m, tri.end());
+        out.push_back(tri);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+double solid_area(const SphericalDelaunay& dt) {
+    double a = 0;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t) && dt.is_solid(t))
+            a += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                         dt.point(dt.vertex(t, 2)));
+    return a;
+}
+
+// Brute force, independent of the predicates: no vertex strictly inside any solid triangle's
+// circumcircle by more than `slack` in the plane-distance sense (long double).
+std::size_t brute_force_violations(const SphericalDelaunay& dt, long double slack) {
+    std::size_t bad = 0;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || !dt.is_solid(t)) continue;
+        const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)), &c = dt.point(dt.vertex(t, 2));
+        long double nx = (long double)(b.y - a.y) * (c.z - a.z) - (long double)(b.z - a.z) * (c.y - a.y);
+        long double ny = (long double)(b.z - a.z) * (c.x - a.x) - (long double)(b.x - a.x) * (c.z - a.z);
+        long double nz = (long double)(b.x - a.x) * (c.y - a.y) - (long double)(b.y - a.y) * (c.x - a.x);
+        long double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+        for (VertexId v = 0; v < dt.vertex_count(); ++v) {
+            const Vec3& d = dt.point(v);
+            long double h = ((d.x - a.x) * nx + (d.y - a.y) * ny + (d.z - a.z) * nz) / len;
+            if (h > slack) ++bad;
+        }
+    }
+    return bad;
+}
+
+std::size_t euler(const SphericalDelaunay& dt) {
+    std::set<VertexId> used;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t))
+            for (int i = 0; i < 3; ++i) used.insert(dt.vertex(t, i));
+    std::size_t f = dt.triangle_count();
+    return used.size() - 3 * f / 2 + f;
+}
+
+void expect_valid_closed(const SphericalDelaunay& dt) {
+    auto problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+    EXPECT_EQ(euler(dt), 2u);
+}
+
+} // namespace
+
+TEST(Delaunay, octahedron_vertices_give_eight_triangles) {
+    std::vector<Vec3> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.triangle_count(), 8u);
+    EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-12);
+    // Every quadruple of octahedron vertices around a face pair is cocircular: any order gives
+    // the same triangulation through the perturbation.
+    std::vector<Vec3> q(p.rbegin(), p.rend());
+    SphericalDelaunay dt2;
+    dt2.insert_points(q);
+    EXPECT_EQ(canonical(dt, false), canonical(dt2, false));
+}
+
+TEST(Delaunay, random_points_1e5_are_valid_and_cover_the_sphere) {
+    auto p = random_points(100000, 1);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.vertex_count(), 100000u);
+    EXPECT_EQ(dt.triangle_count(), 2 * 100000u - 4);
+    EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-9);
+    for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(dt.point(ids[i]), p[i]);
+}
+
+TEST(Delaunay, brute_force_empty_circumcircles_on_2000_random_points) {
+    auto p = random_points(2000, 7);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(brute_force_violations(dt, 1e-15L), 0u);
+}
+
+TEST(Delaunay, shuffled_input_gives_the_same_triangulation) {
+    auto p = random_points(20000, 3);
+    SphericalDelaunay a;
+    a.insert_points(p);
+    std::mt19937_64 rng(99);
+    std::shuffle(p.begin(), p.end(), rng);
+    SphericalDelaunay b(SphericalDelaunay::Options{1e-12, 12345});
+    b.insert_points(p);
+    EXPECT_EQ(canonical(a, false), canonical(b, false));
+}
+
+TEST(Delaunay, one_degree_grid_with_both_poles_is_valid_and_order_independent) {
+    auto p = grid_points(1.0);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    // 360 x 179 distinct points plus 2 poles; the 718 other pole copies are merged.
+    EXPECT_EQ(dt.vertex_count(), 360u * 179u + 2u);
+    EXPECT_EQ(dt.merged_count(), 2u * 359u);
+    EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-9);
+    std::reverse(p.begin(), p.end());
+    SphericalDelaunay dt2(SphericalDelaunay::Options{1e-12, 77});
+    dt2.insert_points(p);
+    EXPECT_EQ(canonical(dt, false), canonical(dt2, false));
+}
+
+TEST(Delaunay, great_circle_plus_two_poles) {
+    std::vector<Vec3> p;
+    for (int i = 0; i < 360; ++i) p.push_back(lonlat_to_vec(i, 0));
+    p.push_back({0, 0, 1});
+    p.push_back({0, 0, -1});
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.triangle_count(), 720u); // a fan from each pole to every equator edge
+    EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-9);
+    std::vector<Vec3> q(p.rbegin(), p.rend());
+    SphericalDelaunay dt2;
+    dt2.insert_points(q);
+    EXPECT_EQ(canonical(dt, false), canonical(dt2, false));
+}
+
+TEST(Delaunay, clustered_points_ninety_percent_in_a_one_degree_cap) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    auto p = random_points(5000, 11);
+    Vec3 c = lonlat_to_vec(-30, 45);
+    for (int i = 0; i < 45000; ++i) {
+        double r = 0.5 * std::sqrt(u(rng)), az = 360 * u(rng);
+        p.push_back(lonlat_to_vec(-30 + r * std::cos(az * deg_to_rad) / std::cos(45 * deg_to_rad),
+                                  45 + r * std::sin(az * deg_to_rad)));
+    }
+    (void)c;
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.vertex_count() + dt.merged_count(), p.size());
+    EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-9);
+}
+
+TEST(Delaunay, duplicates_are_merged_and_reported) {
+    auto p = random_points(1000, 2);
+    std::vector<Vec3> q = p;
+    q.insert(q.end(), p.begin(), p.begin() + 100); // exact duplicates
+    Vec3 near = lonlat_to_vec(vec_to_lonlat(p[500]).lon + 1e-13 * rad_to_deg, vec_to_lonlat(p[500]).lat);
+    q.push_back(near); // within the default 1e-12 rad
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(q);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.vertex_count(), 1000u);
+    EXPECT_EQ(dt.merged_count(), 101u);
+    for (int i = 0; i < 100; ++i) EXPECT_EQ(ids[1000 + i], ids[i]);
+    EXPECT_EQ(ids.back(), ids[500]);
+}
+
+TEST(Delaunay, points_in_one_hemisphere_give_ghost_triangles_closing_the_hull) {
+    std::mt19937_64 rng(8);
+    std::uniform_real_distribution<double> lon(-40, 40), lat(10, 60);
+    std::vector<Vec3> p(3000);
+    for (auto& v : p) v = lonlat_to_vec(lon(rng), lat(rng));
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    std::size_t ghosts = 0;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t) && !dt.is_solid(t)) ++ghosts;
+    EXPECT_GT(ghosts, 0u);
+    EXPECT_EQ(brute_force_violations(dt, 1e-15L), 0u);
+    // Solid triangles tile the spherical convex hull: their area is below a hemisphere.
+    EXPECT_GT(solid_area(dt), 0.0);
+    EXPECT_LT(solid_area(dt), 2 * pi);
+}
+
+TEST(Delaunay, too_few_or_circular_points_are_refused) {
+    SphericalDelaunay a;
+    std::vector<Vec3> two = {{1, 0, 0}, {0, 1, 0}, {1, 0, 0}};
+    EXPECT_THROW(a.insert_points(two), DataError);
+    std::vector<Vec3> circle;
+    for (int i = 0; i < 50; ++i) circle.push_back(lonlat_to_vec(i * 7.0, 0));
+    SphericalDelaunay b;
+    EXPECT_THROW(b.insert_points(circle), DataError);
+    std::vector<Vec3> small_circle;
+    for (int i = 0; i < 50; ++i) small_circle.push_back(lonlat_to_vec(i * 7.0, 30));
+    SphericalDelaunay c;
+    EXPECT_THROW(c.insert_points(small_circle), DataError);
+}
+
+TEST(Delaunay, constraints_are_recovered_by_flips_and_never_flipped_again) {
+    auto p = random_points(3000, 21);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    // A closed polygon of 40 vertices around a small circle, its sides long enough to cross
+    // many Delaunay edges.
+    std::vector<VertexId> ring;
+    for (int k = 0; k < 40; ++k)
+        ring.push_back(dt.insert(lonlat_to_vec(10 + 25 * std::cos(k * 2 * pi / 40), 20 + 15 * std::sin(k * 2 * pi / 40))));
+    for (int k = 0; k < 40; ++k) ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 40]));
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    auto star = dt.vertex_half_edges();
+    for (int k = 0; k < 40; ++k) {
+        HalfEdge h = dt.find_edge(star[ring[k]], ring[(k + 1) % 40]);
+        ASSERT_NE(h, no_half_edge);
+        EXPECT_TRUE(dt.is_constrained(h));
+    }
+    // Inserting more points keeps every constraint and the constrained Delaunay property.
+    auto more = random_points(2000, 22);
+    for (const Vec3& q : more) dt.insert(q);
+    problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    star = dt.vertex_half_edges();
+    for (int k = 0; k < 40; ++k) EXPECT_NE(dt.find_edge(star[ring[k]], ring[(k + 1) % 40]), no_half_edge);
+    (void)ids;
+}
+
+TEST(Delaunay, crossing_constraint_is_refused) {
+    std::vector<Vec3> p = {lonlat_to_vec(0, 0), lonlat_to_vec(10, 0), lonlat_to_vec(5, -5), lonlat_to_vec(5, 5),
+                           {0, 0, 1}, {0, 0, -1}, lonlat_to_vec(180, 0)};
+    SphericalDelaunay dt;
+    auto id = dt.insert_points(p);
+    ASSERT_TRUE(dt.insert_constraint(id[0], id[1]));
+    EXPECT_FALSE(dt.insert_constraint(id[2], id[3]));
+    auto problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+}
+
+TEST(Delaunay, split_edge_keeps_both_halves_constrained) {
+    auto p = random_points(500, 4);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    ASSERT_TRUE(dt.insert_constraint(ids[0], ids[1]));
+    auto star = dt.vertex_half_edges();
+    HalfEdge h = dt.find_edge(star[ids[0]], ids[1]);
+    ASSERT_NE(h, no_half_edge);
+    VertexId m = dt.split_edge(h, arc_midpoint(p[0], p[1]));
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    star = dt.vertex_half_edges();
+    HalfEdge h1 = dt.find_edge(star[ids[0]], m), h2 = dt.find_edge(star[m], ids[1]);
+    ASSERT_NE(h1, no_half_edge);
+    ASSERT_NE(h2, no_half_edge);
+    EXPECT_TRUE(dt.is_constrained(h1));
+    EXPECT_TRUE(dt.is_constrained(h2));
+}
+
+TEST(Delaunay, moving_a_vertex_restores_delaunay_and_refuses_folds) {
+    auto p = random_points(2000, 6);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    VertexId v = ids[10];
+    Vec3 target = normalized(dt.point(v) + 1e-3 * Vec3{1, 1, 1});
+    dt.move_vertex(v, target);
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    // Moving a vertex across the sphere would fold its star: refused, nothing changes.
+    Vec3 before = dt.point(ids[20]);
+    EXPECT_FALSE(dt.move_vertex(ids[20], -before));
+    EXPECT_EQ(dt.point(ids[20]), before);
+    EXPECT_TRUE(dt.validate().empty());
+}
+
+TEST(Delaunay, insert_in_triangle_of_a_constrained_triangulation) {
+    auto p = random_points(400, 31);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    for (int k = 0; k + 1 < 20; k += 2) dt.insert_constraint(ids[k], ids[k + 1]);
+    // Insert the centroid of every 7th solid triangle through insert_in_triangle.
+    std::vector<std::pair<TriangleId, Vec3>> todo;
+    for (TriangleId t = 0; t < dt.triangle_slots(); t += 7)
+        if (dt.is_live(t) && dt.is_solid(t))
+            todo.emplace_back(t, normalized(dt.point(dt.vertex(t, 0)) + dt.point(dt.vertex(t, 1)) + dt.point(dt.vertex(t, 2))));
+    std::size_t before = dt.vertex_count();
+    for (auto& [t, c] : todo) {
+        TriangleId where = dt.locate(c, t);
+        dt.insert_in_triangle(c, where);
+    }
+    EXPECT_EQ(dt.vertex_count(), before + todo.size());
+    auto problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+}
