@@ -1,0 +1,33 @@
+# Shared by tools/demo and tools/test (sourced, not run): installs the Debian packages that are
+# missing (only those; nothing when all are present), then configures and builds in Release.
+# Runs as root on Debian 12; under another user it uses sudo when it needs to install.
+
+GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+# Build and run dependencies of globemesh itself.
+GLOBEMESH_BUILD_PACKAGES="g++ cmake make pkg-config libgdal-dev libgeos-dev libproj-dev
+  libgeographiclib-dev libnetcdf-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
+# What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
+# man-page lint, the independent checkers' Python modules, and QGIS for qgis-check.
+GLOBEMESH_TEST_PACKAGES="libgmp-dev mandoc man-db python3-numpy python3-scipy python3-netcdf4
+  python3-gdal python3-shapely qgis python3-qgis"
+
+install_missing() {
+    local missing=()
+    for p in "$@"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    echo "globemesh: installing missing Debian packages: ${missing[*]}" >&2
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get update -q >&2
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}" >&2
+}
+
+# configure_and_build BUILD_DIR [extra cmake args...]
+configure_and_build() {
+    local dir=$1; shift
+    cmake -S "$GLOBEMESH_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+    cmake --build "$dir" -j"$(nproc)"
+}
