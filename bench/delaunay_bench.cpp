@@ -1,0 +1,57 @@
+// Time per point of the spherical Delaunay core (sort + triangulate), against CGAL's
+// Delaunay_triangulation_on_sphere_2 on the same points in the same run when CGAL is found.
+// items_per_second is points per second; time per point = 1 / items_per_second.
+#include <benchmark/benchmark.h>
+
+#include "bench_points.hpp"
+#include "globemesh/delaunay.hpp"
+
+#ifdef GLOBEMESH_HAVE_CGAL
+#include <CGAL/Delaunay_triangulation_on_sphere_2.h>
+#include <CGAL/Delaunay_triangulation_on_sphere_traits_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#endif
+
+using namespace globemesh;
+
+static void run_globemesh(benchmark::State& state, const std::string& kind) {
+    const auto points = bench::points_of_kind(kind, static_cast<std::size_t>(state.range(0)));
+    for (auto _ : state) {
+        SphericalDelaunay dt;
+        auto ids = dt.insert_points(points);
+        benchmark::DoNotOptimize(ids.data());
+        state.counters["triangles"] = static_cast<double>(dt.triangle_count());
+    }
+    state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+static void BM_globemesh_uniform(benchmark::State& s) { run_globemesh(s, "uniform"); }
+static void BM_globemesh_clustered(benchmark::State& s) { run_globemesh(s, "clustered"); }
+BENCHMARK(BM_globemesh_uniform)->Arg(10000)->Arg(100000)->Arg(1000000)->Arg(4000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_globemesh_clustered)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
+#ifdef GLOBEMESH_HAVE_CGAL
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Traits = CGAL::Delaunay_triangulation_on_sphere_traits_2<K>;
+using DToS2 = CGAL::Delaunay_triangulation_on_sphere_2<Traits>;
+
+static void run_cgal(benchmark::State& state, const std::string& kind) {
+    const auto points = bench::points_of_kind(kind, static_cast<std::size_t>(state.range(0)));
+    std::vector<K::Point_3> cp;
+    cp.reserve(points.size());
+    for (const auto& p : points) cp.emplace_back(p.x, p.y, p.z);
+    for (auto _ : state) {
+        DToS2 dt(cp.begin(), cp.end());
+        benchmark::DoNotOptimize(dt.number_of_vertices());
+        state.counters["triangles"] = static_cast<double>(dt.number_of_faces());
+    }
+    state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+static void BM_cgal_uniform(benchmark::State& s) { run_cgal(s, "uniform"); }
+static void BM_cgal_clustered(benchmark::State& s) { run_cgal(s, "clustered"); }
+BENCHMARK(BM_cgal_uniform)->Arg(10000)->Arg(100000)->Arg(1000000)->Arg(4000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_cgal_clustered)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+#endif
+
+BENCHMARK_MAIN();
