@@ -88,6 +88,8 @@ public:
     /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
     /// Returns false and leaves v where it was when the move would fold a triangle of its star.
     bool move_vertex(VertexId v, const Vec3& p);
+    /// The same with a half-edge leaving v (origin == v), which avoids a search for the star.
+    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p);
 
     /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
     void flip(HalfEdge h);
@@ -128,6 +130,8 @@ public:
     /// The half-edge from a to b, searching the star of a from `from` (a half-edge leaving a);
     /// no_half_edge when a-b is not an edge.
     HalfEdge find_edge(HalfEdge from, VertexId b) const;
+    /// A half-edge leaving vertex a, found by walking to its point from the last triangle.
+    HalfEdge leaving(VertexId a) const;
 
     /// Every broken invariant, in words; empty when the triangulation is valid.
     std::vector<std::string> validate() const;
@@ -145,7 +149,6 @@ private:
     VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
     std::size_t legalize_from(std::vector<HalfEdge>& stack);
     bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created);
-    HalfEdge leaving(VertexId a) const;
 
     Options options_;
     std::vector<Vec3> points_;

@@ -15,12 +15,6 @@
 
 namespace globemesh {
 
-/// Seconds per named stage, in the order the stages ran.
-struct StageTimings {
-    std::vector<std::pair<std::string, double>> stages;
-    void add(const std::string& name, double seconds) { stages.emplace_back(name, seconds); }
-};
-
 /// Meshes the ocean as the options say. Throws UsageError, DataError, IoError or Cancelled.
 Mesh mesh_ocean(const MeshOptions& options, const Progress& progress = {},
                 StageTimings* timings = nullptr);

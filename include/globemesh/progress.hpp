@@ -6,7 +6,10 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "globemesh/error.hpp"
 
@@ -26,5 +29,11 @@ inline Progress sub_progress(const Progress& parent, double lo, double hi) {
 inline void report(const Progress& p, double f, std::string_view stage) {
     if (p && !p(f, stage)) throw Cancelled();
 }
+
+/// Seconds per named stage, in the order the stages ran.
+struct StageTimings {
+    std::vector<std::pair<std::string, double>> stages;
+    void add(const std::string& name, double seconds) { stages.emplace_back(name, seconds); }
+};
 
 } // namespace globemesh

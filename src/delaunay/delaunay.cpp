@@ -274,7 +274,6 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
     const bool split_constrained = split != no_half_edge && is_constrained(split);
     const VertexId split_a = split != no_half_edge ? origin(split) : no_vertex;
     const VertexId split_b = split != no_half_edge ? destination(split) : no_vertex;
-    const std::uint8_t label = labels_[seed];
 
     cavity_.clear();
     cavity_.push_back(seed);
@@ -340,13 +339,16 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
     }
 
     // Record each boundary edge's outside half-edge and flag before the cavity is freed.
+    // Each new triangle keeps the label of the cavity triangle it replaces along its rim edge:
+    // when a constrained edge is split, the two sides (e.g. ocean and land) keep their labels.
     struct Rim {
         VertexId u, w;
         std::uint32_t outside; // twin half-edge with its constrained flag
+        std::uint8_t label;
     };
     std::vector<Rim> rim;
     rim.reserve(cavity_boundary_.size());
-    for (HalfEdge h : cavity_boundary_) rim.push_back({origin(h), destination(h), links_[h]});
+    for (HalfEdge h : cavity_boundary_) rim.push_back({origin(h), destination(h), links_[h], labels_[triangle_of(h)]});
     for (TriangleId s : cavity_) {
         mark_[s] = 0;
         free_triangle(s);
@@ -359,7 +361,7 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
     std::vector<std::pair<VertexId, TriangleId>> by_start;
     by_start.reserve(rim.size());
     for (const Rim& r : rim) {
-        TriangleId t = new_triangle(v, r.u, r.w, label);
+        TriangleId t = new_triangle(v, r.u, r.w, r.label);
         HalfEdge h = half_edge(t, 0);
         HalfEdge o = r.outside & link_mask;
         links_[h] = r.outside;
@@ -600,9 +602,13 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
 }
 
 bool SphericalDelaunay::move_vertex(VertexId v, const Vec3& p) {
-    auto star = vertex_half_edges();
-    HalfEdge from = star[v];
-    if (from == no_half_edge) return false;
+    HalfEdge from = leaving(v);
+    if (from == no_half_edge || origin(from) != v) return false;
+    return move_vertex_from(from, p);
+}
+
+bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
+    const VertexId v = origin(from);
     // Every triangle of the star must stay counter-clockwise with v at p.
     std::vector<HalfEdge> ring;
     HalfEdge h = from;

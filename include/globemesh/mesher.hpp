@@ -1,0 +1,61 @@
+// globemesh/mesher.hpp: the ocean mesher (Legrand, Legat & Deleersnijder 2000, sections 3-4).
+//
+// From closed boundary rings (boundary.hpp: ocean on the left) and a size field h(x) in km, it
+//   1. inserts every boundary node into the spherical Delaunay core;
+//   2. recovers every boundary segment by edge flips, splitting a segment at its midpoint only
+//      where flips cannot recover it; recovered segments are constrained for good;
+//   3. classifies triangles by flood fill across unconstrained edges, seeded on the left of every
+//      segment, drops land and the ocean components not connected to the largest one (inland
+//      seas) unless keep_inland_seas, and reports each component by area;
+//   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
+//      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
+//      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
+//      boundary segment splits that segment at its midpoint instead (Ruppert);
+//   5. improves: sweeps of optimal-Delaunay smoothing of the interior nodes (each moved to the
+//      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
+//      with Delaunay flips after each move; boundary nodes stay fixed.
+// The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
+// input and options give the same mesh. Standard library only (sphere, delaunay).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "globemesh/boundary.hpp"
+#include "globemesh/mesh.hpp"
+#include "globemesh/progress.hpp"
+
+namespace globemesh {
+
+struct MesherOptions {
+    std::uint64_t max_nodes = 20'000'000; ///< refuse when the size field asks for more nodes
+    int smooth_iterations = 4;            ///< smoothing sweeps
+    bool keep_inland_seas = false;        ///< keep ocean components apart from the largest
+    std::uint64_t seed = 1;               ///< seed of the core's insertion order
+};
+
+struct OceanComponent {
+    double area_km2 = 0;
+    bool kept = false;
+};
+
+struct MesherReport {
+    std::size_t boundary_nodes = 0;
+    std::size_t segments_split = 0;     ///< segments split because flips could not recover them
+    std::size_t encroached_splits = 0;  ///< segments split during refinement
+    std::size_t estimated_nodes = 0;    ///< the size field's node estimate, checked against max_nodes
+    std::size_t sharp_corners = 0;      ///< boundary nodes with an ocean angle below 60 degrees
+    std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
+    std::vector<OceanComponent> components;
+};
+
+/// Meshes the ocean bounded by `boundary` (empty: the whole sphere) with edges of about
+/// size_km(x) km. Throws DataError when the rings do not close the ocean, when no ocean is left,
+/// or when the estimated node count exceeds options.max_nodes; Cancelled through progress.
+/// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
+Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
+                   const MesherOptions& options = {}, MesherReport* report = nullptr,
+                   const Progress& progress = {}, StageTimings* timings = nullptr);
+
+} // namespace globemesh

@@ -1,0 +1,429 @@
+#include "globemesh/mesher.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <queue>
+#include <string>
+
+#include "globemesh/delaunay.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/predicates.hpp"
+
+namespace globemesh {
+
+namespace {
+
+// Refinement stops when every circumradius is below this factor times that of an equilateral
+// triangle of side h: Delaunay refinement leaves most triangles well inside the bound, so a
+// factor above 1 centres the edge lengths on h after smoothing (measured: see tests).
+constexpr double circumradius_factor = 1.35;
+constexpr std::uint8_t land = 0;
+constexpr std::uint8_t ocean = 1;
+constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
+constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+using EdgeKey = std::pair<VertexId, VertexId>;
+EdgeKey key(VertexId a, VertexId b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
+
+// The state shared by the steps: the triangulation, the boundary segments with their kinds,
+// the size field.
+struct Mesher {
+    SphericalDelaunay dt;
+    const std::function<double(const Vec3&)>& size_km;
+    std::map<EdgeKey, SegmentKind> segments; // constrained boundary edges (ordered: deterministic)
+    std::vector<std::pair<VertexId, VertexId>> directed; // each segment a->b with ocean on the left
+    MesherReport& report;
+
+    Mesher(SphericalDelaunay::Options o, const std::function<double(const Vec3&)>& h, MesherReport& r)
+        : dt(o), size_km(h), report(r) {}
+
+    Vec3 centroid(TriangleId t) const {
+        return normalized(dt.point(dt.vertex(t, 0)) + dt.point(dt.vertex(t, 1)) + dt.point(dt.vertex(t, 2)));
+    }
+
+    // Recovers segment a->b, splitting it at its midpoint where flips cannot.
+    void recover(VertexId a, VertexId b, SegmentKind kind, int depth) {
+        if (a == b) return;
+        if (dt.insert_constraint(a, b)) {
+            add_segment(a, b, kind);
+            return;
+        }
+        if (depth > 30)
+            throw DataError("a boundary segment cannot be recovered: coastline rings cross or touch near " +
+                            describe(dt.point(a)));
+        VertexId m = dt.insert(arc_midpoint(dt.point(a), dt.point(b)));
+        ++report.segments_split;
+        recover(a, m, kind, depth + 1);
+        recover(m, b, kind, depth + 1);
+    }
+
+    void add_segment(VertexId a, VertexId b, SegmentKind kind) {
+        segments[key(a, b)] = kind;
+        directed.emplace_back(a, b);
+    }
+
+    static std::string describe(const Vec3& p) {
+        LonLat ll = vec_to_lonlat(p);
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "lon %.4f, lat %.4f", ll.lon, ll.lat);
+        return buf;
+    }
+
+    // Circumcentre (unit vector) and circumradius (radians) of a solid triangle.
+    void circumcircle(TriangleId t, Vec3& centre, double& radius) const {
+        const Vec3& a = dt.point(dt.vertex(t, 0));
+        const Vec3& b = dt.point(dt.vertex(t, 1));
+        const Vec3& c = dt.point(dt.vertex(t, 2));
+        centre = normalized(cross(b - a, c - a));
+        radius = arc_angle(centre, a);
+    }
+
+    // How much the triangle wants refining: > 1 means too large for the size field or too
+    // skinny (radius-edge ratio above sqrt(2), i.e. a smallest angle below about 20.7 degrees).
+    double badness(TriangleId t) const {
+        Vec3 c;
+        double r;
+        circumcircle(t, c, r);
+        const Vec3& a = dt.point(dt.vertex(t, 0));
+        const Vec3& b = dt.point(dt.vertex(t, 1));
+        const Vec3& d = dt.point(dt.vertex(t, 2));
+        double h = km_to_rad(size_km(centroid(t)));
+        double size_ratio = r / (circumradius_factor * h / std::sqrt(3.0));
+        double shortest = std::min({arc_angle(a, b), arc_angle(b, d), arc_angle(d, a)});
+        double shape_ratio = r / shortest / std::sqrt(2.0);
+        // Skinny triangles much smaller than the target are left to smoothing (refining them
+        // would only add nodes next to short boundary segments).
+        if (size_ratio < 0.5) shape_ratio = 0;
+        shape_ratio = 0; // EXPERIMENT
+        return std::max(size_ratio, shape_ratio);
+    }
+};
+
+struct Candidate {
+    double badness;
+    TriangleId t;
+    VertexId a, b, c;
+    bool operator<(const Candidate& o) const {
+        if (badness != o.badness) return badness < o.badness;
+        return t > o.t; // deterministic ties
+    }
+};
+
+} // namespace
+
+Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
+                   const MesherOptions& options, MesherReport* report_out, const Progress& progress,
+                   StageTimings* timings) {
+    MesherReport local_report;
+    MesherReport& report = report_out ? *report_out : local_report;
+    report = MesherReport{};
+    Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, report);
+    SphericalDelaunay& dt = m.dt;
+
+    // ---- 1. boundary nodes -------------------------------------------------------------------
+    auto t0 = Clock::now();
+    std::vector<Vec3> nodes;
+    std::vector<std::size_t> offsets;
+    for (const Ring& r : boundary.rings) {
+        offsets.push_back(nodes.size());
+        nodes.insert(nodes.end(), r.nodes.begin(), r.nodes.end());
+    }
+    report.boundary_nodes = nodes.size();
+    std::vector<VertexId> ids;
+    if (boundary.empty()) {
+        // An aqua-planet: start from the octahedron and let refinement do the rest.
+        std::vector<Vec3> seed = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+        dt.insert_points(seed);
+    } else {
+        if (nodes.size() < 4) throw DataError("the boundary has fewer than 4 nodes: no ocean to mesh");
+        ids = dt.insert_points(nodes);
+    }
+    globemesh::report(progress, 0.05, "insert_boundary");
+    if (timings) timings->add("insert_boundary", seconds_since(t0));
+
+    // ---- 2. recover segments -----------------------------------------------------------------
+    t0 = Clock::now();
+    for (std::size_t r = 0; r < boundary.rings.size(); ++r) {
+        const Ring& ring = boundary.rings[r];
+        const std::size_t n = ring.nodes.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            VertexId a = ids[offsets[r] + i], b = ids[offsets[r] + (i + 1) % n];
+            SegmentKind kind = i < ring.kinds.size() ? ring.kinds[i] : SegmentKind::coast;
+            m.recover(a, b, kind, 0);
+        }
+    }
+    globemesh::report(progress, 0.1, "recover");
+    if (timings) timings->add("recover", seconds_since(t0));
+
+    // ---- 3. classify -------------------------------------------------------------------------
+    t0 = Clock::now();
+    const std::size_t slots = dt.triangle_slots();
+    std::vector<std::uint32_t> component(slots, 0xffffffffu);
+    std::vector<double> component_area;
+    std::vector<TriangleId> stack;
+    auto flood = [&](TriangleId seed, std::uint32_t id) {
+        double area = 0;
+        stack.assign(1, seed);
+        component[seed] = id;
+        while (!stack.empty()) {
+            TriangleId t = stack.back();
+            stack.pop_back();
+            area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                            dt.point(dt.vertex(t, 2)));
+            for (int i = 0; i < 3; ++i) {
+                HalfEdge h = half_edge(t, i);
+                if (dt.is_constrained(h)) continue;
+                TriangleId nb = triangle_of(dt.twin(h));
+                if (component[nb] != 0xffffffffu) continue;
+                component[nb] = id;
+                stack.push_back(nb);
+            }
+        }
+        return area;
+    };
+    if (boundary.empty()) {
+        component_area.push_back(flood(dt.last_triangle(), 0));
+    } else {
+        for (auto [a, b] : m.directed) {
+            HalfEdge h = dt.find_edge(dt.leaving(a), b);
+            if (h == no_half_edge) throw DataError("internal: a recovered boundary segment is missing");
+            TriangleId left = triangle_of(h);
+            if (component[left] == 0xffffffffu)
+                component_area.push_back(flood(left, static_cast<std::uint32_t>(component_area.size())));
+        }
+        // Every segment must have land (or the outside of the region) on its right.
+        for (auto [a, b] : m.directed) {
+            HalfEdge h = dt.find_edge(dt.leaving(a), b);
+            TriangleId right = triangle_of(dt.twin(h));
+            if (component[right] != 0xffffffffu && component[right] == component[triangle_of(h)])
+                throw DataError("the boundary rings do not close the ocean: ocean on both sides of the "
+                                "boundary near " + Mesher::describe(dt.point(a)));
+            if (component[right] != 0xffffffffu) {
+                // Ocean on the right of a segment: two rings of opposite orientation face each other
+                // (e.g. an island drawn the wrong way round).
+                throw DataError("a boundary ring has the ocean on its right near " +
+                                Mesher::describe(dt.point(a)) + ": rings must keep the ocean on their left");
+            }
+        }
+    }
+    std::size_t largest = 0;
+    for (std::size_t c = 0; c < component_area.size(); ++c)
+        if (component_area[c] > component_area[largest]) largest = c;
+    std::vector<char> kept(component_area.size(), 0);
+    for (std::size_t c = 0; c < component_area.size(); ++c) {
+        kept[c] = c == largest || options.keep_inland_seas;
+        report.components.push_back({component_area[c] * earth_radius_km * earth_radius_km, kept[c] != 0});
+    }
+    if (component_area.empty()) throw DataError("no ocean is left inside the boundary");
+    for (TriangleId t = 0; t < slots; ++t)
+        if (dt.is_live(t))
+            dt.set_label(t, component[t] != 0xffffffffu && kept[component[t]] ? ocean : land);
+    globemesh::report(progress, 0.15, "classify");
+
+    // Node estimate: an equilateral triangle of side h covers sqrt(3)/4 h^2, and a large mesh has
+    // two triangles per node.
+    double estimate = 0;
+    for (TriangleId t = 0; t < slots; ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        double area = spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                              dt.point(dt.vertex(t, 2)));
+        double h = km_to_rad(size_km(m.centroid(t)));
+        for (int i = 0; i < 3; ++i) h = std::min(h, km_to_rad(size_km(dt.point(dt.vertex(t, i)))));
+        estimate += area / (std::sqrt(3.0) / 4.0 * h * h) / 2.0;
+    }
+    report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
+    if (report.estimated_nodes > options.max_nodes)
+        throw DataError("the size field asks for about " + std::to_string(report.estimated_nodes) +
+                        " nodes, more than --max-nodes " + std::to_string(options.max_nodes) +
+                        ": raise --hmin/--hmax or --max-nodes");
+    if (timings) timings->add("classify", seconds_since(t0));
+
+    // ---- 4. refine ---------------------------------------------------------------------------
+    t0 = Clock::now();
+    std::priority_queue<Candidate> queue;
+    auto consider = [&](TriangleId t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) return;
+        double b = m.badness(t);
+        if (b > 1.0) queue.push({b, t, dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)});
+    };
+    auto consider_star = [&](VertexId v) {
+        // Every triangle created by the last insertion has v as a corner: rotate around v.
+        TriangleId last = dt.last_triangle();
+        int k = 0;
+        while (k < 3 && dt.vertex(last, k) != v) ++k;
+        if (k == 3) return;
+        HalfEdge from = half_edge(last, prev3(k)); // leaves v
+        HalfEdge h = from;
+        do {
+            consider(triangle_of(h));
+            h = dt.twin(half_edge(triangle_of(h), prev3(edge_of(h))));
+        } while (h != from);
+    };
+    for (TriangleId t = 0; t < slots; ++t) consider(t);
+    const std::size_t node_limit = 4 * report.estimated_nodes + 1000;
+    std::size_t inserted = 0;
+    while (!queue.empty()) {
+        Candidate c = queue.top();
+        queue.pop();
+        const TriangleId t = c.t;
+        if (!dt.is_live(t) || dt.vertex(t, 0) != c.a || dt.vertex(t, 1) != c.b || dt.vertex(t, 2) != c.c ||
+            dt.label(t) != ocean)
+            continue;
+        if (std::getenv("GM_DEBUG") && dt.vertex_count() % 500 == 0) std::fprintf(stderr, "DBG v=%zu bad=%g R=%g queue=%zu\n", dt.vertex_count(), c.badness, 0.0, queue.size());
+        if (dt.vertex_count() > node_limit)
+            throw DataError("refinement does not converge (over " + std::to_string(node_limit) +
+                            " nodes): the size field may be too small for the boundary");
+        Vec3 centre;
+        double radius;
+        m.circumcircle(t, centre, radius);
+        // Walk from t to the circumcentre; stop at the first constrained edge in the way.
+        TriangleId cur = t;
+        HalfEdge blocked = no_half_edge;
+        for (std::size_t step = 0; step < 100000; ++step) {
+            bool moved = false;
+            for (int k = 0; k < 3; ++k) {
+                int i = (k + static_cast<int>(step % 3)) % 3;
+                const Vec3& u = dt.point(dt.vertex(cur, next3(i)));
+                const Vec3& w = dt.point(dt.vertex(cur, prev3(i)));
+                if (predicates::orient(u, w, centre) < 0) {
+                    HalfEdge h = half_edge(cur, i);
+                    if (dt.is_constrained(h)) {
+                        blocked = h;
+                    } else {
+                        cur = triangle_of(dt.twin(h));
+                        moved = true;
+                    }
+                    break;
+                }
+            }
+            if (!moved) break;
+        }
+        VertexId v;
+        if (blocked != no_half_edge) {
+            // The circumcentre lies beyond a boundary segment: split the segment, if it is
+            // not already short against the size field.
+            VertexId a = dt.origin(blocked), b = dt.destination(blocked);
+            Vec3 mid = arc_midpoint(dt.point(a), dt.point(b));
+            if (arc_angle(dt.point(a), dt.point(b)) < 0.75 * km_to_rad(size_km(mid))) continue;
+            auto it = m.segments.find(key(a, b));
+            SegmentKind kind = it != m.segments.end() ? it->second : SegmentKind::coast;
+            v = dt.split_edge(blocked, mid);
+            if (v == a || v == b) continue;
+            m.segments.erase(key(a, b));
+            m.segments[key(a, v)] = kind;
+            m.segments[key(v, b)] = kind;
+            ++report.encroached_splits;
+            consider_star(v);
+            // The triangle itself may survive the split: look at it again.
+            consider(t);
+        } else {
+            if (dt.label(cur) != ocean) continue;
+            std::size_t before = dt.vertex_count();
+            v = dt.insert_in_triangle(centre, cur);
+            if (dt.vertex_count() == before) continue; // merged with a close vertex
+            consider_star(v);
+        }
+        if ((++inserted & 0x3fff) == 0)
+            globemesh::report(progress, 0.15 + 0.6 * std::min(1.0, double(dt.vertex_count()) / double(report.estimated_nodes + 1)),
+                   "refine");
+    }
+    if (timings) timings->add("refine", seconds_since(t0));
+
+    // ---- 5. improve --------------------------------------------------------------------------
+    t0 = Clock::now();
+    std::vector<char> fixed(dt.vertex_count(), 0);
+    for (const auto& [k, kind] : m.segments) fixed[k.first] = fixed[k.second] = 1;
+    for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
+        for (VertexId v = 0; v < dt.vertex_count(); ++v) {
+            if (fixed[v]) continue;
+            HalfEdge from = dt.leaving(v);
+            if (from == no_half_edge || dt.origin(from) != v) continue;
+            // Only nodes inside the kept ocean move.
+            Vec3 sum{0, 0, 0};
+            bool inside = true;
+            HalfEdge h = from;
+            std::size_t guard = 0;
+            do {
+                TriangleId t = triangle_of(h);
+                if (dt.label(t) != ocean) {
+                    inside = false;
+                    break;
+                }
+                const Vec3& a = dt.point(dt.vertex(t, 0));
+                const Vec3& b = dt.point(dt.vertex(t, 1));
+                const Vec3& c = dt.point(dt.vertex(t, 2));
+                Vec3 n = cross(b - a, c - a); // |n| = twice the chordal area
+                double area = 0.5 * norm(n);
+                // Optimal Delaunay triangulation update (Chen & Xu): weight the circumcentres by
+                // area / h^2 so that graded meshes keep their grading.
+                double hk = size_km(normalized(a + b + c));
+                sum = sum + (area / (hk * hk)) * normalized(n);
+                h = dt.twin(half_edge(t, prev3(edge_of(h))));
+            } while (h != from && ++guard < 64);
+            if (!inside || norm(sum) == 0) continue;
+            dt.move_vertex_from(from, normalized(sum));
+        }
+        globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
+    }
+    if (timings) timings->add("improve", seconds_since(t0));
+
+    // ---- output ------------------------------------------------------------------------------
+    Mesh mesh;
+    std::vector<NodeIndex> node_of(dt.vertex_count(), 0xffffffffu);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t) && dt.label(t) == ocean)
+            for (int i = 0; i < 3; ++i) node_of[dt.vertex(t, i)] = 0;
+    for (VertexId v = 0; v < dt.vertex_count(); ++v)
+        if (node_of[v] == 0) {
+            node_of[v] = static_cast<NodeIndex>(mesh.nodes.size());
+            mesh.nodes.push_back(dt.point(v));
+        }
+    if (mesh.nodes.empty()) throw DataError("no ocean is left to mesh");
+    std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
+    std::vector<char> on_boundary(mesh.nodes.size(), 0);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        std::array<NodeIndex, 3> f = {node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]};
+        mesh.faces.push_back(f);
+        for (int i = 0; i < 3; ++i) {
+            const Vec3& p = dt.point(dt.vertex(t, i));
+            const Vec3& q = dt.point(dt.vertex(t, next3(i)));
+            const Vec3& r = dt.point(dt.vertex(t, prev3(i)));
+            ocean_angle[f[i]] += std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p));
+            HalfEdge h = half_edge(t, i);
+            TriangleId other = triangle_of(dt.twin(h));
+            if (dt.label(other) == ocean) continue;
+            VertexId a = dt.origin(h), b = dt.destination(h);
+            auto it = m.segments.find(key(a, b));
+            EdgeTag tag = it != m.segments.end() && it->second == SegmentKind::open ? EdgeTag::open : EdgeTag::coast;
+            mesh.boundary.push_back({node_of[a], node_of[b], tag});
+            on_boundary[node_of[a]] = on_boundary[node_of[b]] = 1;
+        }
+    }
+    std::vector<char> sharp(mesh.nodes.size(), 0);
+    for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
+        if (on_boundary[v] && ocean_angle[v] < 60.0 * deg_to_rad) {
+            sharp[v] = 1;
+            ++report.sharp_corners;
+        }
+    for (const auto& f : mesh.faces)
+        if (sharp[f[0]] || sharp[f[1]] || sharp[f[2]]) ++report.sharp_corner_faces;
+    Field target{"target_size", "target edge length", "km", "", {}};
+    target.values.reserve(mesh.nodes.size());
+    for (const Vec3& p : mesh.nodes) target.values.push_back(size_km(p));
+    mesh.node_fields.push_back(std::move(target));
+    globemesh::report(progress, 1.0, "improve");
+    return mesh;
+}
+
+} // namespace globemesh
