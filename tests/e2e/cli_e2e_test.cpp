@@ -145,8 +145,11 @@ ds = netCDF4.Dataset(')" + (dir / "r.nc").string() + R"(')
 mesh = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
 lon = ds.variables[mesh.node_coordinates.split()[0]][:]
 lat = ds.variables[mesh.node_coordinates.split()[1]][:]
+# The region's edges may be great-circle arcs between its corners: the northern one bulges
+# poleward up to atan(tan(N) / cos((E - W) / 2)), the southern one never below S.
+north = np.degrees(np.arctan(np.tan(np.radians(62)) / np.cos(np.radians(25 / 2))))
 assert lon.min() >= -12 - 1e-6 and lon.max() <= 13 + 1e-6, (lon.min(), lon.max())
-assert lat.min() >= 46 - 1e-6 and lat.max() <= 62 + 1e-6, (lat.min(), lat.max())
+assert lat.min() >= 46 - 1e-6 and lat.max() <= north + 1e-6, (lat.min(), lat.max(), north)
 tag = ds.variables['boundary_tag'][:]
 assert (tag == 1).any() and (tag == 2).any(), np.unique(tag)
 assert 'depth' in ds.variables
@@ -176,6 +179,8 @@ a = netCDF4.Dataset(')" + (dir / "a.nc").string() + R"(')
 b = netCDF4.Dataset(')" + (dir / "b.nc").string() + R"(')
 assert set(a.variables) == set(b.variables)
 for name in a.variables:
+    if a.variables[name].shape == ():
+        continue  # attribute containers (mesh, crs): their value carries no data
     assert np.array_equal(np.ma.filled(a.variables[name][:], -1), np.ma.filled(b.variables[name][:], -1)), name
 print('OK', len(a.variables))
 )",
