@@ -295,6 +295,12 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
 
     io::nc_check(nc_enddef(nc.id()), path, "leaving define mode", "UGRID output");
 
+    // The container variables hold no data, but NC_NOFILL leaves their bytes undefined: write
+    // them so the same mesh always gives the same file.
+    const int zero = 0;
+    io::nc_check(nc_put_var_int(nc.id(), crs, &zero), path, "writing crs", "UGRID output");
+    io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
+
     w.put(coord_vars[0], node_lon, "node longitudes");
     w.put(coord_vars[1], node_lat, "node latitudes");
     {
