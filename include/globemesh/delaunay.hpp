@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "globemesh/sphere.hpp"
@@ -64,6 +65,23 @@ public:
     /// On an empty triangulation, needs four points not on one plane: throws DataError
     /// ("fewer than 3 distinct points", "all points on one circle") otherwise.
     std::vector<VertexId> insert_points(std::span<const Vec3> points);
+
+    /// The insertion order insert_points uses: a permutation of [0, n) in BRIO rounds drawn
+    /// from `seed`, each round sorted along the Hilbert curve on the cube faces. Exposed so a
+    /// caller can time the ordering apart from the insertions. Needs n < 2^31.
+    static std::vector<std::uint32_t> insertion_order(std::span<const Vec3> points, std::uint64_t seed);
+
+    /// Inserts points into an empty triangulation without copying them: takes over `points` and
+    /// reorders them in place by `order` (a permutation from insertion_order), so vertex v is
+    /// the point at position v of that order (points() keeps every input point; a point merged
+    /// into another keeps its slot as an unused vertex, with no triangle). The order's memory
+    /// is reused for the result: for each input point, the vertex it became or was merged into.
+    /// Peak memory is the points (24 B each), the result (4 B) and the triangles (2 per point,
+    /// 25 B each). Throws DataError as insert_points, and std::invalid_argument when the
+    /// triangulation is not empty or `order` does not match `points`.
+    std::vector<VertexId> insert_points(std::vector<Vec3>&& points, std::vector<std::uint32_t>&& order);
+    /// The same with insertion_order(points, options.seed).
+    std::vector<VertexId> insert_points(std::vector<Vec3>&& points);
 
     /// Inserts one point, starting the walk at `hint` (any live triangle, or no_triangle).
     /// Returns its vertex, or the vertex it was merged into (then merged_count() grows).
@@ -137,16 +155,28 @@ public:
     std::vector<std::string> validate() const;
 
 private:
+    // A link word is the twin half-edge (below 2^30, so at most ~178 million points) with the
+    // constrained flag on top; bit 30 of a triangle's first link word is a scratch mark
+    // (cavity / search membership), always clear between calls.
     static constexpr std::uint32_t constrained_bit = 0x80000000u;
-    static constexpr std::uint32_t link_mask = 0x7fffffffu;
+    static constexpr std::uint32_t mark_bit = 0x40000000u;
+    static constexpr std::uint32_t link_mask = 0x3fffffffu;
+
+    bool marked(TriangleId t) const { return (links_[3 * t] & mark_bit) != 0; }
+    void set_mark(TriangleId t) { links_[3 * t] |= mark_bit; }
+    void clear_mark(TriangleId t) { links_[3 * t] &= ~mark_bit; }
+    void reserve_for(std::size_t points);
+    VertexId insert_vertex(const Vec3& p, VertexId id, TriangleId hint);
 
     void link(HalfEdge a, HalfEdge b);
     TriangleId new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label);
     void free_triangle(TriangleId t);
     void initial_tetrahedron(std::span<const Vec3> points, std::span<const std::uint32_t> order,
                              std::vector<VertexId>& vertex_of);
+    void make_tetrahedron(VertexId v[4]);
     bool visible(TriangleId t, const Vec3& p) const;
-    VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
+    // id: the vertex p becomes (an adopted point's slot), or no_vertex to append p.
+    VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id = no_vertex);
     std::size_t legalize_from(std::vector<HalfEdge>& stack);
     bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created);
 
@@ -159,10 +189,16 @@ private:
     std::size_t merged_ = 0;
     TriangleId last_ = no_triangle;
     // scratch buffers reused across insertions (no allocation per insertion)
+    struct Rim {
+        VertexId u, w;
+        std::uint32_t outside; // twin half-edge with its constrained flag
+        std::uint8_t label;
+    };
     std::vector<TriangleId> cavity_;
     std::vector<HalfEdge> cavity_boundary_;
-    mutable std::vector<TriangleId> search_;
-    mutable std::vector<std::uint8_t> mark_;
+    std::vector<TriangleId> search_;
+    std::vector<Rim> rim_;
+    std::vector<std::pair<VertexId, TriangleId>> by_start_;
 };
 
 } // namespace globemesh

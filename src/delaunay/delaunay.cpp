@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "globemesh/error.hpp"
@@ -26,6 +27,37 @@ bool spans_plane(const Vec3& a, const Vec3& b, const Vec3& c) {
     for (const Vec3& q : probes)
         if (predicates::orient3d(a, b, c, q) != 0) return true;
     return false;
+}
+
+// arc_angle(a, p) <= tol, skipping the atan2 when the chord already shows the points apart (the
+// chord is never longer than the arc; the 1e-14 margin dwarfs the rounding of both formulas).
+inline bool within(const Vec3& a, const Vec3& p, double tol) {
+    const double dx = a.x - p.x, dy = a.y - p.y, dz = a.z - p.z;
+    const double far = tol + 1e-14;
+    if (dx * dx + dy * dy + dz * dz > far * far) return false;
+    return arc_angle(a, p) <= tol;
+}
+
+// Picks, in the sequence at(0), at(1), ..., a first point, a distinct second, a third spanning a
+// plane with them, and a fourth off that plane; k receives their positions.
+template <class At>
+void pick_tetrahedron(At at, std::size_t n, double tol, std::size_t k[4]) {
+    k[0] = k[1] = k[2] = k[3] = 0;
+    std::size_t found = n > 0 ? 1 : 0;
+    for (std::size_t i = 1; i < n && found < 4; ++i) {
+        const Vec3& p = at(i);
+        bool ok = false;
+        if (found == 1) ok = arc_angle(at(k[0]), p) > tol;
+        else if (found == 2)
+            ok = arc_angle(at(k[0]), p) > tol && arc_angle(at(k[1]), p) > tol && spans_plane(at(k[0]), at(k[1]), p);
+        else
+            ok = predicates::orient3d(at(k[0]), at(k[1]), at(k[2]), p) != 0;
+        if (ok) k[found++] = i;
+    }
+    if (found < 3) throw DataError("fewer than 3 distinct points: nothing to triangulate");
+    if (found < 4)
+        throw DataError("all points lie on one circle of the sphere (e.g. one great circle): "
+                        "their triangulation is degenerate");
 }
 
 } // namespace
@@ -59,10 +91,12 @@ TriangleId SphericalDelaunay::new_triangle(VertexId a, VertexId b, VertexId c, s
         free_.pop_back();
     } else {
         t = static_cast<TriangleId>(tri_vertices_.size() / 3);
+        if (3 * static_cast<std::uint64_t>(t) + 3 > link_mask)
+            throw DataError("triangulation too large: more than " + std::to_string(link_mask / 3) +
+                            " triangles (about 178 million points)");
         tri_vertices_.resize(tri_vertices_.size() + 3);
         links_.resize(links_.size() + 3, 0);
         labels_.push_back(0);
-        mark_.push_back(0);
     }
     tri_vertices_[3 * t] = a;
     tri_vertices_[3 * t + 1] = b;
@@ -93,33 +127,19 @@ bool SphericalDelaunay::visible(TriangleId t, const Vec3& p) const {
 void SphericalDelaunay::initial_tetrahedron(std::span<const Vec3> points,
                                             std::span<const std::uint32_t> order,
                                             std::vector<VertexId>& vertex_of) {
-    const double tol = options_.merge_tolerance_rad;
-    // Pick, in insertion order, a first point, a distinct second, a third spanning a plane with
-    // them, and a fourth off that plane.
-    std::size_t k[4] = {0, 0, 0, 0};
-    std::size_t found = 1;
-    const std::size_t n = order.size();
-    for (std::size_t i = 1; i < n && found < 4; ++i) {
-        const Vec3& p = points[order[i]];
-        bool ok = false;
-        if (found == 1) ok = arc_angle(points[order[k[0]]], p) > tol;
-        else if (found == 2)
-            ok = arc_angle(points[order[k[0]]], p) > tol && arc_angle(points[order[k[1]]], p) > tol &&
-                 spans_plane(points[order[k[0]]], points[order[k[1]]], p);
-        else
-            ok = predicates::orient3d(points[order[k[0]]], points[order[k[1]]], points[order[k[2]]], p) != 0;
-        if (ok) k[found++] = i;
-    }
-    if (found < 3) throw DataError("fewer than 3 distinct points: nothing to triangulate");
-    if (found < 4)
-        throw DataError("all points lie on one circle of the sphere (e.g. one great circle): "
-                        "their triangulation is degenerate");
+    std::size_t k[4];
+    pick_tetrahedron([&](std::size_t i) -> const Vec3& { return points[order[i]]; }, order.size(),
+                     options_.merge_tolerance_rad, k);
     VertexId v[4];
     for (int j = 0; j < 4; ++j) {
         v[j] = static_cast<VertexId>(points_.size());
         points_.push_back(points[order[k[j]]]);
         vertex_of[order[k[j]]] = v[j];
     }
+    make_tetrahedron(v);
+}
+
+void SphericalDelaunay::make_tetrahedron(VertexId v[4]) {
     // Faces counter-clockwise from outside: with orient3d(a,b,c,d) < 0 they are
     // (a,b,c), (a,c,d), (a,d,b), (b,d,c) (each face has the fourth vertex below it).
     if (predicates::orient3d(points_[v[0]], points_[v[1]], points_[v[2]], points_[v[3]]) > 0)
@@ -138,16 +158,96 @@ void SphericalDelaunay::initial_tetrahedron(std::span<const Vec3> points,
         }
 }
 
+void SphericalDelaunay::reserve_for(std::size_t points) {
+    // A closed triangulation of n points has 2n - 4 triangles; reserve once.
+    tri_vertices_.reserve(3 * (2 * points + 4));
+    links_.reserve(3 * (2 * points + 4));
+    labels_.reserve(2 * points + 4);
+}
+
+std::vector<std::uint32_t> SphericalDelaunay::insertion_order(std::span<const Vec3> points,
+                                                              std::uint64_t seed) {
+    return detail::brio_order(points, seed);
+}
+
+std::vector<VertexId> SphericalDelaunay::insert_points(std::vector<Vec3>&& points) {
+    std::vector<std::uint32_t> order = insertion_order(points, options_.seed);
+    return insert_points(std::move(points), std::move(order));
+}
+
+std::vector<VertexId> SphericalDelaunay::insert_points(std::vector<Vec3>&& points,
+                                                       std::vector<std::uint32_t>&& order) {
+    if (!points_.empty() || triangle_slots() != 0)
+        throw std::invalid_argument("SphericalDelaunay::insert_points(vector&&) needs an empty triangulation");
+    const std::size_t n = points.size();
+    if (order.size() != n || n >= 0x80000000u)
+        throw std::invalid_argument("SphericalDelaunay::insert_points: the order does not match the points");
+    constexpr std::uint32_t seen = 0x80000000u;
+    // Reorder the points in place: new position j takes points[order[j]] (cycle by cycle; the
+    // top bit of order[j] marks a position already filled).
+    for (std::size_t j = 0; j < n; ++j) {
+        if (order[j] & seen) continue;
+        const Vec3 first = points[j];
+        std::size_t k = j;
+        for (;;) {
+            const std::size_t src = order[k];
+            order[k] |= seen;
+            if (src == j) {
+                points[k] = first;
+                break;
+            }
+            points[k] = points[src];
+            k = src;
+        }
+    }
+    for (auto& o : order) o &= ~seen;
+    // Invert the order in place: vertex_of[input index] = position (cycle by cycle, same mark).
+    std::vector<VertexId>& vertex_of = order;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (order[i] & seen) continue;
+        std::uint32_t prev = static_cast<std::uint32_t>(i), cur = order[i];
+        do {
+            const std::uint32_t next = order[cur];
+            order[cur] = prev | seen;
+            prev = cur;
+            cur = next;
+        } while (prev != i);
+    }
+    for (auto& o : order) o &= ~seen;
+
+    points_ = std::move(points);
+    points.clear();
+    reserve_for(n);
+    // The first four points not on one plane, in order, make the initial tetrahedron.
+    std::size_t k[4];
+    pick_tetrahedron([&](std::size_t i) -> const Vec3& { return points_[i]; }, n,
+                     options_.merge_tolerance_rad, k);
+    VertexId tetra[4];
+    for (int j = 0; j < 4; ++j) tetra[j] = static_cast<VertexId>(k[j]);
+    make_tetrahedron(tetra);
+    std::vector<std::pair<VertexId, VertexId>> merges; // (merged vertex, vertex it joined)
+    TriangleId hint = last_;
+    for (VertexId v = 0; v < n; ++v) {
+        if (v == tetra[0] || v == tetra[1] || v == tetra[2] || v == tetra[3]) continue;
+        const Vec3 p = points_[v];
+        VertexId got = insert_vertex(p, v, hint);
+        if (got != v) merges.emplace_back(v, got);
+        hint = last_;
+    }
+    if (!merges.empty())
+        for (auto& id : vertex_of) {
+            auto it = std::lower_bound(merges.begin(), merges.end(), std::make_pair(id, VertexId{0}));
+            if (it != merges.end() && it->first == id) id = it->second;
+        }
+    return std::move(vertex_of);
+}
+
 std::vector<VertexId> SphericalDelaunay::insert_points(std::span<const Vec3> points) {
     std::vector<VertexId> vertex_of(points.size(), no_vertex);
     std::vector<std::uint32_t> order = detail::brio_order(points, options_.seed);
-    // A closed triangulation of n points has 2n - 4 triangles; reserve once.
     const std::size_t expected = points_.size() + points.size();
     points_.reserve(expected);
-    tri_vertices_.reserve(3 * (2 * expected + 4));
-    links_.reserve(3 * (2 * expected + 4));
-    labels_.reserve(2 * expected + 4);
-    mark_.reserve(2 * expected + 4);
+    reserve_for(expected);
     if (triangle_count() == 0) initial_tetrahedron(points, order, vertex_of);
     TriangleId hint = last_;
     for (std::uint32_t i : order) {
@@ -201,11 +301,15 @@ TriangleId SphericalDelaunay::locate(const Vec3& p, TriangleId hint) const {
 // ---------------------------------------------------------------------------------------------
 
 VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
+    return insert_vertex(p, no_vertex, hint);
+}
+
+VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId hint) {
     const TriangleId located = locate(p, hint);
     if (located == no_triangle) throw DataError("cannot insert into an empty triangulation");
     // Merge with a vertex of the located triangle when within tolerance (exact duplicates land here).
     for (int i = 0; i < 3; ++i)
-        if (arc_angle(points_[vertex(located, i)], p) <= options_.merge_tolerance_rad) {
+        if (within(points_[vertex(located, i)], p, options_.merge_tolerance_rad)) {
             ++merged_;
             return vertex(located, i);
         }
@@ -221,17 +325,17 @@ VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
         seed = no_triangle;
         search_.clear();
         search_.push_back(located);
-        mark_[located] = 2;
+        set_mark(located);
         for (std::size_t k = 0; k < search_.size() && seed == no_triangle; ++k) {
             for (int i = 0; i < 3 && seed == no_triangle; ++i) {
                 TriangleId nb = neighbour(search_[k], i);
-                if (mark_[nb] == 2) continue;
-                mark_[nb] = 2;
+                if (marked(nb)) continue;
+                set_mark(nb);
                 search_.push_back(nb);
                 if (visible(nb, p)) seed = nb;
             }
         }
-        for (TriangleId s : search_) mark_[s] = 0;
+        for (TriangleId s : search_) clear_mark(s);
     }
     if (seed == no_triangle || (inside_solid && !visible(located, p))) {
         // p lies inside the hull of its neighbours (closer than rounding lets the hull resolve):
@@ -242,7 +346,7 @@ VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
             if (arc_angle(points_[vertex(located, i)], p) < arc_angle(points_[best], p)) best = vertex(located, i);
         return best;
     }
-    return insert_in_cavity(p, seed, no_half_edge);
+    return insert_in_cavity(p, seed, no_half_edge, id);
 }
 
 VertexId SphericalDelaunay::insert_in_triangle(const Vec3& p, TriangleId t) {
@@ -270,19 +374,19 @@ VertexId SphericalDelaunay::split_edge(HalfEdge h, const Vec3& p) {
 
 // Grows the cavity from `seed` (and across `split` when given) over unconstrained edges to the
 // triangles p lies beyond, checks it is star-shaped from p, and replaces it by a fan around p.
-VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split) {
+VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id) {
     const bool split_constrained = split != no_half_edge && is_constrained(split);
     const VertexId split_a = split != no_half_edge ? origin(split) : no_vertex;
     const VertexId split_b = split != no_half_edge ? destination(split) : no_vertex;
 
     cavity_.clear();
     cavity_.push_back(seed);
-    mark_[seed] = 1;
+    set_mark(seed);
     TriangleId other = no_triangle;
     if (split != no_half_edge) {
         other = triangle_of(twin(split));
         cavity_.push_back(other);
-        mark_[other] = 1;
+        set_mark(other);
     }
     for (std::size_t k = 0; k < cavity_.size(); ++k) {
         TriangleId s = cavity_[k];
@@ -290,9 +394,9 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
             HalfEdge h = half_edge(s, i);
             if (is_constrained(h)) continue;
             TriangleId nb = triangle_of(twin(h));
-            if (mark_[nb]) continue;
+            if (marked(nb)) continue;
             if (visible(nb, p)) {
-                mark_[nb] = 1;
+                set_mark(nb);
                 cavity_.push_back(nb);
             }
         }
@@ -313,7 +417,7 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
             for (int i = 0; i < 3; ++i) {
                 HalfEdge h = half_edge(s, i);
                 HalfEdge o = twin(h);
-                bool inner = mark_[triangle_of(o)] == 1 && !(is_constrained(h) && h != split && o != split);
+                bool inner = marked(triangle_of(o)) && !(is_constrained(h) && h != split && o != split);
                 if (inner) continue;
                 cavity_boundary_.push_back(h);
                 if (touches_constraint && drop == no_triangle && s != seed && s != other) {
@@ -324,15 +428,15 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
             }
         }
         if (drop == no_triangle) break;
-        mark_[drop] = 0;
+        clear_mark(drop);
         cavity_.erase(std::find(cavity_.begin(), cavity_.end(), drop));
     }
 
     // Merge with a boundary vertex within tolerance (the nearest vertex to p is on the boundary).
     for (HalfEdge h : cavity_boundary_) {
         VertexId u = origin(h);
-        if (arc_angle(points_[u], p) <= options_.merge_tolerance_rad) {
-            for (TriangleId s : cavity_) mark_[s] = 0;
+        if (within(points_[u], p, options_.merge_tolerance_rad)) {
+            for (TriangleId s : cavity_) clear_mark(s);
             ++merged_;
             return u;
         }
@@ -341,25 +445,21 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
     // Record each boundary edge's outside half-edge and flag before the cavity is freed.
     // Each new triangle keeps the label of the cavity triangle it replaces along its rim edge:
     // when a constrained edge is split, the two sides (e.g. ocean and land) keep their labels.
-    struct Rim {
-        VertexId u, w;
-        std::uint32_t outside; // twin half-edge with its constrained flag
-        std::uint8_t label;
-    };
-    std::vector<Rim> rim;
-    rim.reserve(cavity_boundary_.size());
+    for (TriangleId s : cavity_) clear_mark(s);
+    std::vector<Rim>& rim = rim_;
+    rim.clear();
     for (HalfEdge h : cavity_boundary_) rim.push_back({origin(h), destination(h), links_[h], labels_[triangle_of(h)]});
-    for (TriangleId s : cavity_) {
-        mark_[s] = 0;
-        free_triangle(s);
-    }
+    for (TriangleId s : cavity_) free_triangle(s);
 
-    const VertexId v = static_cast<VertexId>(points_.size());
-    points_.push_back(p);
+    VertexId v = id;
+    if (v == no_vertex) {
+        v = static_cast<VertexId>(points_.size());
+        points_.push_back(p);
+    }
     // Fan: triangle (v, u, w) per rim edge u->w. Edge 0 (u->w) faces outside; edge 1 (w->v) is
     // the twin of edge 2 (v->w) of the triangle whose rim edge starts at w.
-    std::vector<std::pair<VertexId, TriangleId>> by_start;
-    by_start.reserve(rim.size());
+    auto& by_start = by_start_;
+    by_start.clear();
     for (const Rim& r : rim) {
         TriangleId t = new_triangle(v, r.u, r.w, r.label);
         HalfEdge h = half_edge(t, 0);

@@ -3,26 +3,49 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 
 namespace globemesh::detail {
 
 namespace {
 
-// Hilbert index of (x, y) in a 2^order x 2^order grid (the classic rotate-and-flip loop).
-std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y, int order) {
-    const std::uint32_t mask = (1u << order) - 1;
-    std::uint64_t d = 0;
-    for (std::uint32_t s = 1u << (order - 1); s > 0; s >>= 1) {
-        std::uint32_t rx = (x & s) ? 1 : 0;
-        std::uint32_t ry = (y & s) ? 1 : 0;
-        d += static_cast<std::uint64_t>(s) * s * ((3 * rx) ^ ry);
-        if (ry == 0) { // rotate the quadrant; only the lower bits matter from here on
-            if (rx == 1) {
-                x = mask - x;
-                y = mask - y;
+// Hilbert index of (x, y) in a 2^order x 2^order grid: the classic rotate-and-flip loop, run as
+// a table-driven state machine. The loop's rotations (swap x and y; complement the lower bits)
+// compose into 4 states; one table step reads 3 bits of x and 3 of y and gives 6 bits of the
+// index and the next state. Same index as the loop, without its unpredictable branches.
+struct HilbertTable {
+    std::uint8_t digits[4][64]; // 6 output bits
+    std::uint8_t next[4][64];   // next state
+    constexpr HilbertTable() : digits{}, next{} {
+        for (int state = 0; state < 4; ++state)
+            for (int in = 0; in < 64; ++in) {
+                int swapped = state & 1, inverted = (state >> 1) & 1;
+                int out = 0;
+                for (int bit = 2; bit >= 0; --bit) {
+                    int xb = (in >> (3 + bit)) & 1, yb = (in >> bit) & 1;
+                    int rx = (swapped ? yb : xb) ^ inverted;
+                    int ry = (swapped ? xb : yb) ^ inverted;
+                    out = (out << 2) | ((3 * rx) ^ ry);
+                    if (ry == 0) {
+                        if (rx == 1) inverted ^= 1;
+                        swapped ^= 1;
+                    }
+                }
+                digits[state][in] = static_cast<std::uint8_t>(out);
+                next[state][in] = static_cast<std::uint8_t>(swapped | (inverted << 1));
             }
-            std::swap(x, y);
-        }
+    }
+};
+constexpr HilbertTable hilbert_table{};
+
+std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y, int order) {
+    // order is a multiple of 3 here (30).
+    std::uint64_t d = 0;
+    unsigned state = 0;
+    for (int shift = order - 3; shift >= 0; shift -= 3) {
+        const unsigned in = (((x >> shift) & 7u) << 3) | ((y >> shift) & 7u);
+        d = (d << 6) | hilbert_table.digits[state][in];
+        state = hilbert_table.next[state][in];
     }
     return d;
 }
@@ -53,8 +76,10 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
     for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
     std::mt19937_64 rng(seed);
     std::shuffle(order.begin(), order.end(), rng);
-    std::vector<std::uint64_t> keys(n);
-    for (std::size_t i = 0; i < n; ++i) keys[i] = hilbert_key(points[i]);
+    // (key, index) pairs in the shuffled order, sorted in place: contiguous, so the sort does not
+    // chase indices through a key array (same result as sorting indices by (key, index)).
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+    for (std::size_t j = 0; j < n; ++j) keyed[j] = {hilbert_key(points[order[j]]), order[j]};
     // Round boundaries: [0, n/2^R), [n/2^R, n/2^(R-1)), ..., [n/2, n).
     std::size_t lo = 0;
     std::vector<std::size_t> ends;
@@ -62,11 +87,10 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
     std::reverse(ends.begin(), ends.end());
     if (ends.empty() || ends.back() != n) ends.push_back(n);
     for (std::size_t end : ends) {
-        std::sort(order.begin() + lo, order.begin() + end, [&](std::uint32_t a, std::uint32_t b) {
-            return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
-        });
+        std::sort(keyed.begin() + lo, keyed.begin() + end);
         lo = end;
     }
+    for (std::size_t j = 0; j < n; ++j) order[j] = keyed[j].second;
     return order;
 }
 
