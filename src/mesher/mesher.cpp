@@ -26,6 +26,8 @@ constexpr double circumradius_factor = 1.35;
 // measured on the global 1:110m ocean at 200 km (mean q 0.903 at 1.0, 0.940 at 0.8, 0.940 at
 // 0.7 with 19% more nodes), 0.8 keeps the edge-length fit near 99%.
 constexpr double frontal_radius_factor = 0.8;
+// Largest circumradius of a frontal triangle relative to its front edge's length.
+constexpr double front_growth = 1.0;
 constexpr std::uint8_t land = 0;
 constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
@@ -327,7 +329,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             Vec3 mid = arc_midpoint(u, w);
             Vec3 left = normalized(cross(u, w));
             double half = 0.5 * arc_angle(u, w);
-            double rho = std::max(half, circumradius_factor * km_to_rad(size_km(mid)) / std::sqrt(3.0) * frontal_radius_factor);
+            // Grow from short front edges (e.g. short coast segments) at most by the edge's own
+            // length, so the mesh grades away from them instead of leaving slivers.
+            double target = circumradius_factor * km_to_rad(size_km(mid)) / std::sqrt(3.0) * frontal_radius_factor;
+            double rho = std::max(half, std::min(target, 2.0 * half * front_growth));
             double height = rho + std::sqrt(std::max(0.0, rho * rho - half * half));
             double to_centre = std::atan2(dot(centre, left), dot(centre, mid)); // signed, along the bisector
             if (to_centre > 0) {
@@ -356,6 +361,20 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 }
             }
             if (!moved) break;
+        }
+        // Ruppert's rule: a point inside the diametral circle of a boundary segment of the
+        // triangle it lands in encroaches on it; split the segment instead.
+        if (blocked == no_half_edge && dt.label(cur) == ocean) {
+            for (int i = 0; i < 3; ++i) {
+                HalfEdge h = half_edge(cur, i);
+                if (!dt.is_constrained(h)) continue;
+                const Vec3& u = dt.point(dt.origin(h));
+                const Vec3& w = dt.point(dt.destination(h));
+                if (dot(u - centre, w - centre) < 0) {
+                    blocked = h;
+                    break;
+                }
+            }
         }
         VertexId v;
         if (blocked != no_half_edge) {
@@ -420,7 +439,22 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 h = dt.twin(half_edge(t, prev3(edge_of(h))));
             } while (h != from && ++guard < 64);
             if (!inside || norm(sum) == 0) continue;
-            dt.move_vertex_from(from, normalized(sum));
+            // Refuse a move that would bring the worst triangle of the star below 0.6 and
+            // below where it was (smoothing must not flatten triangles against the coast).
+            const Vec3 target = normalized(sum);
+            double worst_before = 1, worst_after = 1;
+            h = from;
+            guard = 0;
+            do {
+                TriangleId t = triangle_of(h);
+                const Vec3& b = dt.point(dt.destination(h));
+                const Vec3& c = dt.point(dt.vertex(t, edge_of(h)));
+                worst_before = std::min(worst_before, triangle_quality(dt.point(v), b, c));
+                worst_after = std::min(worst_after, triangle_quality(target, b, c));
+                h = dt.twin(half_edge(t, prev3(edge_of(h))));
+            } while (h != from && ++guard < 64);
+            if (worst_after < 0.6 && worst_after < worst_before) continue;
+            dt.move_vertex_from(from, target);
         }
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
     }
