@@ -21,6 +21,7 @@ inline std::vector<Vec3> uniform_points(std::size_t n, std::uint64_t seed = 1) {
 
 inline std::vector<Vec3> clustered_points(std::size_t n, std::uint64_t seed = 2) {
     std::vector<Vec3> p = uniform_points(n / 10, seed);
+    p.reserve(n); // exactly n: the capacity is what the triangulation adopts and memory counts
     std::mt19937_64 rng(seed + 1);
     std::uniform_real_distribution<double> u(0, 1);
     while (p.size() < n) {

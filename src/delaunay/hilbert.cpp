@@ -72,14 +72,14 @@ std::uint64_t hilbert_key(const Vec3& p) {
 
 std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_t seed) {
     const std::size_t n = points.size();
-    std::vector<std::uint32_t> order(n);
-    for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-    std::mt19937_64 rng(seed);
-    std::shuffle(order.begin(), order.end(), rng);
-    // (key, index) pairs in the shuffled order, sorted in place: contiguous, so the sort does not
-    // chase indices through a key array (same result as sorting indices by (key, index)).
+    // (key, index) pairs, keyed in input order (sequential reads of the points), then shuffled:
+    // std::shuffle's swaps depend only on the generator and the length, so this is the shuffled
+    // index order with its keys alongside. Sorting the contiguous pairs in place then gives the
+    // same result as sorting indices by (key, index), without chasing indices through memory.
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
-    for (std::size_t j = 0; j < n; ++j) keyed[j] = {hilbert_key(points[order[j]]), order[j]};
+    for (std::size_t i = 0; i < n; ++i) keyed[i] = {hilbert_key(points[i]), static_cast<std::uint32_t>(i)};
+    std::mt19937_64 rng(seed);
+    std::shuffle(keyed.begin(), keyed.end(), rng);
     // Round boundaries: [0, n/2^R), [n/2^R, n/2^(R-1)), ..., [n/2, n).
     std::size_t lo = 0;
     std::vector<std::size_t> ends;
@@ -90,6 +90,7 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
         std::sort(keyed.begin() + lo, keyed.begin() + end);
         lo = end;
     }
+    std::vector<std::uint32_t> order(n);
     for (std::size_t j = 0; j < n; ++j) order[j] = keyed[j].second;
     return order;
 }
