@@ -149,7 +149,7 @@ public:
     /// no_half_edge when a-b is not an edge.
     HalfEdge find_edge(HalfEdge from, VertexId b) const;
     /// A half-edge leaving vertex a, found by walking to its point from the last triangle.
-    HalfEdge leaving(VertexId a) const;
+    HalfEdge leaving(VertexId a, TriangleId hint = no_triangle) const;
 
     /// Every broken invariant, in words; empty when the triangulation is valid.
     std::vector<std::string> validate() const;

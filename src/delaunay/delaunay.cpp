@@ -575,8 +575,8 @@ HalfEdge SphericalDelaunay::find_edge(HalfEdge from, VertexId b) const {
     return no_half_edge;
 }
 
-HalfEdge SphericalDelaunay::leaving(VertexId a) const {
-    TriangleId t = locate(points_[a], last_);
+HalfEdge SphericalDelaunay::leaving(VertexId a, TriangleId hint) const {
+    TriangleId t = locate(points_[a], hint != no_triangle ? hint : last_);
     for (int i = 0; i < 3; ++i)
         if (vertex(t, next3(i)) == a) return half_edge(t, i);
     return vertex_half_edges()[a];

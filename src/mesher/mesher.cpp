@@ -412,9 +412,13 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     std::vector<char> fixed(dt.vertex_count(), 0);
     for (const auto& [k, kind] : m.segments) fixed[k.first] = fixed[k.second] = 1;
     for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
+        // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
+        // (a triangle next to v) rather than an answer: the walk from it is a step or two.
+        const std::vector<HalfEdge> star = dt.vertex_half_edges();
         for (VertexId v = 0; v < dt.vertex_count(); ++v) {
-            if (fixed[v]) continue;
-            HalfEdge from = dt.leaving(v);
+            if (fixed[v] || star[v] == no_half_edge) continue;
+            HalfEdge from = star[v];
+            if (dt.origin(from) != v || !dt.is_live(triangle_of(from))) from = dt.leaving(v, triangle_of(from));
             if (from == no_half_edge || dt.origin(from) != v) continue;
             // Only nodes inside the kept ocean move.
             Vec3 sum{0, 0, 0};
