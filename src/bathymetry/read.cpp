@@ -12,6 +12,7 @@
 #include <gdal_utils.h>
 #include <ogr_srs_api.h>
 
+#include "gdal_handles.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/error.hpp"
 
@@ -19,30 +20,7 @@ namespace globemesh {
 
 namespace {
 
-/// Routes GDAL's error messages to a quiet handler for its lifetime (the library never prints);
-/// the last message stays readable through CPLGetLastErrorMsg.
-class QuietGdalErrors {
-public:
-    QuietGdalErrors() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdalErrors() { CPLPopErrorHandler(); }
-    QuietGdalErrors(const QuietGdalErrors&) = delete;
-    QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-};
-
-struct DatasetCloser {
-    void operator()(void* ds) const {
-        if (ds) GDALClose(static_cast<GDALDatasetH>(ds));
-    }
-};
-using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
-
-std::string gdal_message() {
-    std::string m = CPLGetLastErrorMsg();
-    return m.empty() ? std::string("unknown GDAL error") : m;
-}
+using gdal::DatasetPtr;
 
 /// An argv list for the GDAL utilities, freed on scope exit.
 class StringList {
@@ -77,7 +55,7 @@ DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string& path) {
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
     GDALTranslateOptionsFree(opts);
-    if (!out) throw IoError("--bathy " + path + ": cannot select band " + b + ": " + gdal_message());
+    if (!out) throw IoError("--bathy " + path + ": cannot select band " + b + ": " + gdal::last_error());
     return out;
 }
 
@@ -88,15 +66,12 @@ double finest_lonlat_step(GDALDatasetH ds) {
     double gt[6];
     OGRSpatialReferenceH src = GDALGetSpatialRef(ds);
     if (!src || GDALGetGeoTransform(ds, gt) != CE_None) return 0;
-    struct SrsDel { void operator()(void* p) const { OSRRelease(static_cast<OGRSpatialReferenceH>(p)); } };
-    struct OctDel { void operator()(void* p) const { OCTDestroyCoordinateTransformation(static_cast<OGRCoordinateTransformationH>(p)); } };
-    std::unique_ptr<void, SrsDel> dst(OSRNewSpatialReference(nullptr));
-    OSRImportFromEPSG(static_cast<OGRSpatialReferenceH>(dst.get()), 4326);
-    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(dst.get()), OAMS_TRADITIONAL_GIS_ORDER);
-    std::unique_ptr<void, SrsDel> src_copy(OSRClone(src));
-    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(src_copy.get()), OAMS_TRADITIONAL_GIS_ORDER);
-    std::unique_ptr<void, OctDel> ct(OCTNewCoordinateTransformation(
-        static_cast<OGRSpatialReferenceH>(src_copy.get()), static_cast<OGRSpatialReferenceH>(dst.get())));
+    gdal::SrsRefPtr dst(OSRNewSpatialReference(nullptr));
+    OSRImportFromEPSG(dst.get(), 4326);
+    OSRSetAxisMappingStrategy(dst.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    gdal::SrsRefPtr src_copy(OSRClone(src));
+    OSRSetAxisMappingStrategy(src_copy.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    gdal::TransformPtr ct(OCTNewCoordinateTransformation(src_copy.get(), dst.get()));
     if (!ct) return 0;
     const double nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
     double best = 0;
@@ -110,7 +85,7 @@ double finest_lonlat_step(GDALDatasetH ds) {
                 x[k] = gt[0] + qx * gt[1] + qy * gt[2];
                 y[k] = gt[3] + qx * gt[4] + qy * gt[5];
             }
-            if (!OCTTransformEx(static_cast<OGRCoordinateTransformationH>(ct.get()), 3, x, y, z, ok) ||
+            if (!OCTTransformEx(ct.get(), 3, x, y, z, ok) ||
                 !ok[0] || !ok[1] || !ok[2])
                 continue;
             for (int k = 1; k < 3; ++k) {
@@ -139,7 +114,7 @@ DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string& path) {
     GDALWarpAppOptionsFree(opts);
     if (!out)
         throw DataError("--bathy " + path + ": cannot reproject to lon/lat (EPSG:4326): " +
-                        gdal_message());
+                        gdal::last_error());
     return out;
 }
 
@@ -169,11 +144,11 @@ std::string fmt_deg(double v) {
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
                    std::size_t max_cells) {
     GDALAllRegister();
-    QuietGdalErrors quiet;
+    gdal::QuietErrors quiet;
     report(progress, 0.0, "read bathymetry");
 
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds) throw IoError("--bathy " + path + ": cannot open as a raster: " + gdal_message());
+    if (!ds) throw IoError("--bathy " + path + ": cannot open as a raster: " + gdal::last_error());
     GDALDatasetH h = ds.get();
     const int nbands = GDALGetRasterCount(h);
     if (band < 1 || band > nbands)
@@ -256,7 +231,7 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
                                     values.data() + r0 * bx, static_cast<int>(bx),
                                     static_cast<int>(r1 - r0), GDT_Float32, 0, 0, &extra);
         if (bridge.cancelled) throw Cancelled();
-        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal_message());
+        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal::last_error());
     }
 
     // Raw values -> metres, elevation positive up; nodata and NaN -> NaN.

@@ -8,7 +8,6 @@
 #include <numeric>
 #include <string>
 #include <tuple>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -22,6 +21,7 @@
 #include <ogr_srs_api.h>
 
 #include "coast_internal.hpp"
+#include "gdal_handles.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 
@@ -32,39 +32,11 @@ using coast_detail::find_conflicts;
 
 // ----------------------------------------------------------------------------- RAII owners
 
-/// Silences GDAL's default stderr handler while the library works; messages are read back with
-/// CPLGetLastErrorMsg() and turned into exceptions.
-struct QuietGdal {
-    QuietGdal() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdal() { CPLPopErrorHandler(); }
-    QuietGdal(const QuietGdal&) = delete;
-    QuietGdal& operator=(const QuietGdal&) = delete;
-};
-
-struct DatasetCloser {
-    void operator()(void* h) const { GDALClose(h); }
-};
-using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
-struct SrsDeleter {
-    void operator()(OGRSpatialReferenceH h) const { OSRDestroySpatialReference(h); }
-};
-using SrsPtr = std::unique_ptr<std::remove_pointer_t<OGRSpatialReferenceH>, SrsDeleter>;
-struct TransformDeleter {
-    void operator()(OGRCoordinateTransformationH h) const { OCTDestroyCoordinateTransformation(h); }
-};
-using TransformPtr =
-    std::unique_ptr<std::remove_pointer_t<OGRCoordinateTransformationH>, TransformDeleter>;
-struct FeatureDeleter {
-    void operator()(OGRFeatureH h) const { OGR_F_Destroy(h); }
-};
-using FeaturePtr = std::unique_ptr<std::remove_pointer_t<OGRFeatureH>, FeatureDeleter>;
-struct OgrGeometryDeleter {
-    void operator()(OGRGeometryH h) const { OGR_G_DestroyGeometry(h); }
-};
-using OgrGeometryPtr = std::unique_ptr<std::remove_pointer_t<OGRGeometryH>, OgrGeometryDeleter>;
+using gdal::DatasetPtr;
+using gdal::FeaturePtr;
+using gdal::SrsPtr;
+using gdal::TransformPtr;
+using OgrGeometryPtr = gdal::GeometryPtr; // GeomPtr below is the GEOS owner
 
 /// A GEOS context whose error handler keeps the last message.
 class Geos {
@@ -245,7 +217,7 @@ std::string layer_list(GDALDatasetH ds) {
 Source read_source(const std::string& path, const std::string& layer_name, const std::string& where,
                    const std::string& srs_override, const char* what) {
     GDALAllRegister();
-    QuietGdal quiet;
+    gdal::QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) {
         std::string msg = CPLGetLastErrorMsg();

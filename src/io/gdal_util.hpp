@@ -1,48 +1,24 @@
-// Internal to io/: small RAII owners for GDAL state used by the GeoPackage and PNG writers.
+// Internal to io/: GDAL helpers for the GeoPackage and PNG writers (the GDAL C++ dataset owner
+// and close_dataset); the general owners come from gdal_handles.hpp.
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include <cpl_conv.h>
 #include <cpl_error.h>
 #include <gdal_priv.h>
 
+#include "gdal_handles.hpp"
+
 namespace globemesh::io {
 
-/// Keeps GDAL from printing (the library never prints): errors are read with last_gdal_error().
-class QuietGdalErrors {
-public:
-    QuietGdalErrors() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdalErrors() { CPLPopErrorHandler(); }
-    QuietGdalErrors(const QuietGdalErrors&) = delete;
-    QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-};
+// The shared owners live in gdal_handles.hpp; these names keep io/'s call sites unchanged.
+using QuietGdalErrors = gdal::QuietErrors;
+using ScopedGdalConfig = gdal::ScopedConfig;
 
-inline std::string last_gdal_error() {
-    const char* m = CPLGetLastErrorMsg();
-    return m && *m ? m : "unknown GDAL error";
-}
+inline std::string last_gdal_error() { return gdal::last_error(); }
 
-/// Sets a GDAL configuration option for this thread and restores the old value.
-class ScopedGdalConfig {
-public:
-    ScopedGdalConfig(const char* key, const char* value) : key_(key) {
-        if (const char* old = CPLGetThreadLocalConfigOption(key, nullptr)) old_ = old, had_ = true;
-        CPLSetThreadLocalConfigOption(key, value);
-    }
-    ~ScopedGdalConfig() { CPLSetThreadLocalConfigOption(key_.c_str(), had_ ? old_.c_str() : nullptr); }
-    ScopedGdalConfig(const ScopedGdalConfig&) = delete;
-    ScopedGdalConfig& operator=(const ScopedGdalConfig&) = delete;
-
-private:
-    std::string key_, old_;
-    bool had_ = false;
-};
-
+/// Owns a GDALDataset through GDAL's C++ API (the writers use it); closes it with GDALClose.
 struct GdalDatasetCloser {
     void operator()(GDALDataset* ds) const {
         if (ds) GDALClose(GDALDataset::ToHandle(ds));

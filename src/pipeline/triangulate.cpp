@@ -7,7 +7,6 @@
 #include <cmath>
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -16,6 +15,7 @@
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
 
+#include "gdal_handles.hpp"
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/pipeline.hpp"
@@ -24,36 +24,10 @@ namespace globemesh {
 
 namespace {
 
-struct DatasetCloser {
-    void operator()(void* h) const {
-        if (h) GDALClose(h);
-    }
-};
-using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
-struct SrsDeleter {
-    void operator()(OGRSpatialReferenceH h) const { OSRDestroySpatialReference(h); }
-};
-using SrsPtr = std::unique_ptr<std::remove_pointer_t<OGRSpatialReferenceH>, SrsDeleter>;
-struct TransformDeleter {
-    void operator()(OGRCoordinateTransformationH h) const { OCTDestroyCoordinateTransformation(h); }
-};
-using TransformPtr = std::unique_ptr<std::remove_pointer_t<OGRCoordinateTransformationH>, TransformDeleter>;
-struct FeatureDeleter {
-    void operator()(OGRFeatureH h) const { OGR_F_Destroy(h); }
-};
-using FeaturePtr = std::unique_ptr<std::remove_pointer_t<OGRFeatureH>, FeatureDeleter>;
-
-/// Keeps GDAL quiet (the library never prints); messages are read with CPLGetLastErrorMsg.
-class QuietGdal {
-public:
-    QuietGdal() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdal() { CPLPopErrorHandler(); }
-    QuietGdal(const QuietGdal&) = delete;
-    QuietGdal& operator=(const QuietGdal&) = delete;
-};
+using gdal::DatasetPtr;
+using gdal::FeaturePtr;
+using gdal::SrsPtr;
+using gdal::TransformPtr;
 
 std::string gdal_message() {
     std::string m = CPLGetLastErrorMsg();
@@ -97,7 +71,7 @@ void collect_points(OGRGeometryH g, OGRCoordinateTransformationH to_lonlat, cons
 PointSource read_point_source(const TriangulateOptions& options, const Progress& progress) {
     const std::string& path = options.points;
     GDALAllRegister();
-    QuietGdal quiet;
+    gdal::QuietErrors quiet;
     // CSV: take lon/lat columns as the geometry and drop them from the attributes (other drivers
     // ignore these open options).
     const char* open_options[] = {"X_POSSIBLE_NAMES=lon*,long*,x", "Y_POSSIBLE_NAMES=lat*,y",

@@ -15,6 +15,7 @@
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
 
+#include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
 #include "grid.hpp"
 
@@ -22,64 +23,24 @@ namespace globemesh::detail {
 
 namespace {
 
-class QuietGdalErrors {
-public:
-    QuietGdalErrors() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdalErrors() { CPLPopErrorHandler(); }
-    QuietGdalErrors(const QuietGdalErrors&) = delete;
-    QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-};
+using gdal::DatasetPtr;
+using gdal::FeaturePtr;
+using gdal::GeometryPtr;
+using gdal::TransformPtr;
 
-struct DatasetCloser {
-    void operator()(void* p) const {
-        if (p) GDALClose(static_cast<GDALDatasetH>(p));
-    }
-};
-struct GeometryDestroyer {
-    void operator()(void* p) const {
-        if (p) OGR_G_DestroyGeometry(static_cast<OGRGeometryH>(p));
-    }
-};
-struct FeatureDestroyer {
-    void operator()(void* p) const {
-        if (p) OGR_F_Destroy(static_cast<OGRFeatureH>(p));
-    }
-};
-struct SrsReleaser {
-    void operator()(void* p) const {
-        if (p) OSRRelease(static_cast<OGRSpatialReferenceH>(p));
-    }
-};
-struct TransformDestroyer {
-    void operator()(void* p) const {
-        if (p) OCTDestroyCoordinateTransformation(static_cast<OGRCoordinateTransformationH>(p));
-    }
-};
-using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
-using GeometryPtr = std::unique_ptr<void, GeometryDestroyer>;
-using FeaturePtr = std::unique_ptr<void, FeatureDestroyer>;
-using SrsPtr = std::unique_ptr<void, SrsReleaser>;
-using TransformPtr = std::unique_ptr<void, TransformDestroyer>;
-
-std::string last_message() {
-    std::string m = CPLGetLastErrorMsg();
-    return m.empty() ? std::string("unknown error") : m;
-}
+std::string last_message() { return gdal::last_error("unknown error"); }
 
 } // namespace
 
 void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h) {
     GDALAllRegister();
-    QuietGdalErrors quiet;
+    gdal::QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) throw IoError("--size-regions " + path + ": cannot open as vector data: " + last_message());
 
-    SrsPtr wgs84(OSRNewSpatialReference(nullptr));
-    OSRImportFromEPSG(static_cast<OGRSpatialReferenceH>(wgs84.get()), 4326);
-    OSRSetAxisMappingStrategy(static_cast<OGRSpatialReferenceH>(wgs84.get()), OAMS_TRADITIONAL_GIS_ORDER);
+    gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr));
+    OSRImportFromEPSG(wgs84.get(), 4326);
+    OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);
 
     // Polygons in lon/lat with their sizes.
     std::vector<std::pair<double, GeometryPtr>> regions;
@@ -94,12 +55,12 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::v
         if (!srs)
             throw DataError("--size-regions " + path + ": layer " + OGR_L_GetName(layer) +
                             " has no CRS; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
-        TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, static_cast<OGRSpatialReferenceH>(wgs84.get())));
+        TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, wgs84.get()));
         if (!to_lonlat)
             throw DataError("--size-regions " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
-            OGRFeatureH fh = static_cast<OGRFeatureH>(f.get());
+            OGRFeatureH fh = f.get();
             OGRGeometryH geom = OGR_F_GetGeometryRef(fh);
             if (!geom || !OGR_F_IsFieldSetAndNotNull(fh, field)) continue;
             OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geom));
@@ -109,7 +70,7 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::v
                 throw DataError("--size-regions " + path + ": feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " has size_km " + OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
             GeometryPtr copy(OGR_G_Clone(geom));
-            if (OGR_G_Transform(static_cast<OGRGeometryH>(copy.get()), static_cast<OGRCoordinateTransformationH>(to_lonlat.get())) != OGRERR_NONE)
+            if (OGR_G_Transform(copy.get(), to_lonlat.get()) != OGRERR_NONE)
                 throw DataError("--size-regions " + path + ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) + " to lon/lat");
             regions.emplace_back(size, std::move(copy));
         }
@@ -122,7 +83,7 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::v
     std::vector<OGRGeometryH> geoms;
     std::vector<double> burn;
     for (auto& r : regions) {
-        geoms.push_back(static_cast<OGRGeometryH>(r.second.get()));
+        geoms.push_back(r.second.get());
         burn.push_back(r.first);
     }
 

@@ -1,0 +1,74 @@
+// Internal to globemesh_lib: the RAII owners for GDAL/OGR C handles and GDAL's error state,
+// shared by every reader and writer that calls GDAL (the library never prints, so GDAL's errors
+// are silenced and read back with last_error() to become exceptions at the call site).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <type_traits>
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+namespace globemesh::gdal {
+
+/// Routes GDAL's error messages to a quiet handler for its lifetime and clears the last error;
+/// the last message stays readable through last_error().
+class QuietErrors {
+public:
+    QuietErrors() {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        CPLErrorReset();
+    }
+    ~QuietErrors() { CPLPopErrorHandler(); }
+    QuietErrors(const QuietErrors&) = delete;
+    QuietErrors& operator=(const QuietErrors&) = delete;
+};
+
+/// GDAL's last error message, or `fallback` when there is none.
+inline std::string last_error(const char* fallback = "unknown GDAL error") {
+    const char* m = CPLGetLastErrorMsg();
+    return m && *m ? m : fallback;
+}
+
+/// Sets a GDAL configuration option for this thread and restores the old value on scope exit.
+class ScopedConfig {
+public:
+    ScopedConfig(const char* key, const char* value) : key_(key) {
+        if (const char* old = CPLGetThreadLocalConfigOption(key, nullptr)) old_ = old, had_ = true;
+        CPLSetThreadLocalConfigOption(key, value);
+    }
+    ~ScopedConfig() { CPLSetThreadLocalConfigOption(key_.c_str(), had_ ? old_.c_str() : nullptr); }
+    ScopedConfig(const ScopedConfig&) = delete;
+    ScopedConfig& operator=(const ScopedConfig&) = delete;
+
+private:
+    std::string key_, old_;
+    bool had_ = false;
+};
+
+/// Calls `Free` on a non-null handle (std::unique_ptr never passes null to its deleter).
+template <auto Free>
+struct Deleter {
+    template <class T>
+    void operator()(T* h) const {
+        Free(h);
+    }
+};
+
+template <class Handle, auto Free>
+using HandlePtr = std::unique_ptr<std::remove_pointer_t<Handle>, Deleter<Free>>;
+
+using DatasetPtr = HandlePtr<GDALDatasetH, GDALClose>;
+using FeaturePtr = HandlePtr<OGRFeatureH, OGR_F_Destroy>;
+using GeometryPtr = HandlePtr<OGRGeometryH, OGR_G_DestroyGeometry>;
+/// Deletes the spatial reference outright (OSRDestroySpatialReference).
+using SrsPtr = HandlePtr<OGRSpatialReferenceH, OSRDestroySpatialReference>;
+/// Drops one reference (OSRRelease), deleting the spatial reference when it was the last.
+using SrsRefPtr = HandlePtr<OGRSpatialReferenceH, OSRRelease>;
+using TransformPtr = HandlePtr<OGRCoordinateTransformationH, OCTDestroyCoordinateTransformation>;
+
+} // namespace globemesh::gdal
