@@ -4,6 +4,9 @@
 // pole corners split, see face_geometry.hpp), nodes (Point, every node field), boundary (runs of
 // equally tagged boundary edges as MultiLineString), mesh_info (key/value attributes), and
 // layer_styles (QGIS's own table) holding a graduated-by-quality default style for faces.
+// No polygon or line part is wider than 180 degrees of longitude (QGIS would smear it across the
+// map): a face round a pole is also cut at lon 0, and a boundary run wherever its lon extent
+// would pass 180 (the pieces share the cut vertex).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -108,6 +111,74 @@ private:
     OGRSpatialReference srs_;
 };
 
+/// Widest part the writer emits, degrees of longitude: QGIS draws straight lines in lon/lat, so a
+/// wider part (a face round a pole, a coastline loop) is smeared across the map.
+constexpr double max_part_width_deg = 180.0;
+
+std::pair<double, double> lon_range(const io::LonLatPart& part) {
+    auto [lo, hi] = std::minmax_element(part.begin(), part.end(),
+                                        [](const auto& p, const auto& q) { return p[0] < q[0]; });
+    return {(*lo)[0], (*hi)[0]};
+}
+
+/// Sutherland-Hodgman clip of a ring to lo <= lon <= hi (exact at the cut meridians).
+io::LonLatPart clip_ring_to_band(const io::LonLatPart& ring, double lo, double hi) {
+    io::LonLatPart r = ring;
+    for (int side = 0; side < 2; ++side) {
+        const double x = side ? hi : lo;
+        auto inside = [&](const io::LonLatPoint& p) { return side ? p[0] <= x : p[0] >= x; };
+        io::LonLatPart out;
+        for (std::size_t i = 0; i < r.size(); ++i) {
+            const auto &p = r[i], &q = r[(i + 1) % r.size()];
+            const bool pin = inside(p), qin = inside(q);
+            if (pin) out.push_back(p);
+            if (pin != qin) out.push_back({x, p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1])});
+        }
+        r = std::move(out);
+    }
+    return r;
+}
+
+/// The ring itself if it is at most 180 degrees wide, else its pieces between the meridians at
+/// multiples of 180 (0 for a ring within [-180, 180]), each at most 180 wide. Only a face round a
+/// pole, closed along the pole line and so lon-monotone, is that wide: each band holds one piece.
+std::vector<io::LonLatPart> narrow_rings(io::LonLatPart ring) {
+    const auto [lo, hi] = lon_range(ring);
+    if (hi - lo <= max_part_width_deg) return {std::move(ring)};
+    std::vector<io::LonLatPart> parts;
+    const double w = max_part_width_deg;
+    for (double band = std::floor(lo / w) * w; band < hi; band += w) {
+        io::LonLatPart piece = clip_ring_to_band(ring, std::max(lo, band), std::min(hi, band + w));
+        double twice_area = 0;
+        for (std::size_t i = 0; i < piece.size(); ++i) {
+            const auto &p = piece[i], &q = piece[(i + 1) % piece.size()];
+            twice_area += p[0] * q[1] - q[0] * p[1];
+        }
+        if (piece.size() >= 3 && std::fabs(twice_area) > 1e-18) parts.push_back(std::move(piece));
+    }
+    return parts;
+}
+
+/// A line cut into pieces at most 180 degrees wide: a piece ends at the vertex before the one that
+/// would widen it past 180, and the next piece starts at that same vertex (the line stays joined).
+std::vector<io::LonLatPart> narrow_lines(const io::LonLatPart& line) {
+    std::vector<io::LonLatPart> parts;
+    io::LonLatPart current;
+    double lo = 0, hi = 0;
+    for (const auto& p : line) {
+        if (!current.empty() && std::max(hi, p[0]) - std::min(lo, p[0]) > max_part_width_deg) {
+            parts.push_back(current);
+            current = {current.back()};
+            lo = hi = current.back()[0];
+        }
+        if (current.empty()) lo = hi = p[0];
+        current.push_back(p);
+        lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
+    }
+    if (current.size() >= 2) parts.push_back(std::move(current));
+    return parts;
+}
+
 OGRPolygon* polygon_of(const io::LonLatPart& ring) {
     auto* r = new OGRLinearRing();
     r->setNumPoints(int(ring.size() + 1), FALSE);
@@ -204,8 +275,8 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         if (size) feature.SetField("target_size", mean(size));
         for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
         auto* multi = new OGRMultiPolygon();
-        for (const auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-            multi->addGeometryDirectly(polygon_of(ring));
+        for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
+            for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
         feature.SetGeometryDirectly(multi);
         w.add(faces, feature);
     }
@@ -253,11 +324,12 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         }
         feature.SetField("length_km", km);
         auto* multi = new OGRMultiLineString();
-        for (const auto& part : io::polyline_parts(points)) {
-            auto* line = new OGRLineString();
-            for (const auto& p : part) line->addPoint(p[0], p[1]);
-            multi->addGeometryDirectly(line);
-        }
+        for (const auto& cut : io::polyline_parts(points))
+            for (const auto& part : narrow_lines(cut)) {
+                auto* line = new OGRLineString();
+                for (const auto& p : part) line->addPoint(p[0], p[1]);
+                multi->addGeometryDirectly(line);
+            }
         feature.SetGeometryDirectly(multi);
         w.add(boundary, feature);
     }

@@ -161,6 +161,83 @@ TEST(Gpkg, faces_crossing_the_antimeridian_are_cut_into_two_parts) {
     }
 }
 
+TEST(Gpkg, face_round_a_pole_is_cut_into_parts_no_wider_than_180) {
+    TempDir dir;
+    Mesh m = icosphere_without_pole_nodes(3);
+    write_gpkg(m, dir / "nopole.gpkg");
+    Dataset d(dir / "nopole.gpkg");
+    ASSERT_TRUE(d.ds);
+    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size())); // still one feature per face
+    auto [area, widest] = faces_area_and_widest_part(faces);
+    EXPECT_NEAR(area, 360.0 * 180.0, 1e-6); // the polar faces still reach the pole lines
+    EXPECT_LE(widest, 180.0);
+    // With no pole nodes, only the two faces round the poles reach lat +-90: each is closed along
+    // the pole line over every longitude, in parts (uncut, it is one part 360 degrees wide).
+    int round_pole = 0;
+    faces->ResetReading();
+    for (auto& f : *faces) {
+        OGREnvelope env;
+        f->GetGeometryRef()->getEnvelope(&env);
+        if (env.MaxY != 90.0 && env.MinY != -90.0) continue;
+        ++round_pole;
+        EXPECT_EQ(env.MinX, -180.0);
+        EXPECT_EQ(env.MaxX, 180.0);
+        EXPECT_GE(f->GetGeometryRef()->toMultiPolygon()->getNumGeometries(), 2);
+    }
+    EXPECT_EQ(round_pole, 2);
+}
+
+TEST(Gpkg, boundary_loops_wider_than_180_are_split_into_joined_parts) {
+    TempDir dir;
+    // Holes: a band round the globe (two loops crossing +-180) and a wide hole lon -120..120 at
+    // lat 30..50 (one loop 240 degrees wide, like the Afro-Eurasian coast), round-the-pole faces.
+    Mesh full = icosphere_without_pole_nodes(3);
+    add_fields(full);
+    Mesh m = keep_faces(full, [&](std::size_t f) {
+        const auto& t = full.faces[f];
+        LonLat c = vec_to_lonlat(normalized(full.nodes[t[0]] + full.nodes[t[1]] + full.nodes[t[2]]));
+        return !(c.lat > -20 && c.lat < -10) && !(c.lat > 30 && c.lat < 50 && std::fabs(c.lon) < 120);
+    }, [](const Vec3&, const Vec3&) { return EdgeTag::coast; });
+    write_gpkg(m, dir / "holes.gpkg");
+    Dataset d(dir / "holes.gpkg");
+    ASSERT_TRUE(d.ds);
+    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
+    EXPECT_LE(faces_area_and_widest_part(faces).second, 180.0);
+    OGRLayer* boundary = d.ds->GetLayerByName("boundary");
+    EXPECT_EQ(boundary->GetFeatureCount(), 3); // one feature per loop (all coast), as before
+    int edges = 0, split = 0;
+    double widest_feature = 0;
+    boundary->ResetReading();
+    for (auto& f : *boundary) {
+        edges += f->GetFieldAsInteger("edges");
+        OGREnvelope all;
+        f->GetGeometryRef()->getEnvelope(&all);
+        widest_feature = std::max(widest_feature, all.MaxX - all.MinX);
+        const auto* multi = f->GetGeometryRef()->toMultiLineString();
+        split += multi->getNumGeometries() > 1;
+        const OGRLineString* previous = nullptr;
+        for (const auto* line : multi) {
+            OGREnvelope env;
+            line->getEnvelope(&env);
+            EXPECT_LE(env.MaxX - env.MinX, 180.0);
+            if (previous) { // a loop's parts chain: each starts where the last ended, or across +-180
+                OGRPoint end, start;
+                previous->EndPoint(&end);
+                line->StartPoint(&start);
+                const double jump = std::fabs(start.getX() - end.getX());
+                EXPECT_NEAR(start.getY(), end.getY(), 1e-9);
+                EXPECT_TRUE(jump < 1e-9 || std::fabs(jump - 360.0) < 1e-9) << end.getX() << " -> " << start.getX();
+            }
+            previous = line;
+        }
+    }
+    EXPECT_EQ(std::size_t(edges), m.boundary.size()); // every boundary edge once
+    EXPECT_GT(widest_feature, 300.0);                  // the loops really were wide ...
+    EXPECT_EQ(split, 3);                                // ... and every one was split
+}
+
 TEST(Gpkg, default_qgis_style_colours_faces_by_quality) {
     TempDir dir;
     write_gpkg(icosphere(1), dir / "s.gpkg");

@@ -119,6 +119,32 @@ inline Mesh icosphere_with_holes(int level) {
     });
 }
 
+/// An icosphere whose pole nodes are gone: each pole's star is re-triangulated as a fan from one
+/// of its neighbours, so one face at each pole surrounds it without having it as a corner (the
+/// face a global ocean mesh has when no node lands on the pole). Pole nodes are left unused.
+inline Mesh icosphere_without_pole_nodes(int level) {
+    Mesh m = icosphere(level);
+    for (NodeIndex pole = 0; pole < m.nodes.size(); ++pole) {
+        if (m.nodes[pole].x != 0 || m.nodes[pole].y != 0) continue;
+        std::map<NodeIndex, NodeIndex> next; // star edges, counter-clockwise round the pole
+        std::vector<std::array<NodeIndex, 3>> faces;
+        for (const auto& f : m.faces) {
+            const auto it = std::find(f.begin(), f.end(), pole);
+            if (it == f.end()) {
+                faces.push_back(f);
+                continue;
+            }
+            const auto k = std::size_t(it - f.begin());
+            next[f[(k + 1) % 3]] = f[(k + 2) % 3];
+        }
+        std::vector<NodeIndex> ring = {next.begin()->first};
+        while (ring.size() < next.size()) ring.push_back(next.at(ring.back()));
+        for (std::size_t i = 1; i + 1 < ring.size(); ++i) faces.push_back({ring[0], ring[i], ring[i + 1]});
+        m.faces = std::move(faces);
+    }
+    return m;
+}
+
 /// The faces of an icosphere whose centroid lies within radius_deg of (lon, lat), tagged open.
 inline Mesh icosphere_cap(int level, double lon, double lat, double radius_deg) {
     Mesh full = icosphere(level);
