@@ -143,6 +143,12 @@ public:
     /// Origin and destination of half-edge h.
     VertexId origin(HalfEdge h) const { return vertex(triangle_of(h), (edge_of(h) + 1) % 3); }
     VertexId destination(HalfEdge h) const { return vertex(triangle_of(h), (edge_of(h) + 2) % 3); }
+    /// The next half-edge leaving origin(h), counter-clockwise around it: the twin of the edge
+    /// of h's triangle that ends at origin(h).
+    HalfEdge next_around_origin(HalfEdge h) const {
+        const int before = edge_of(h) == 0 ? 2 : edge_of(h) - 1;
+        return twin(half_edge(triangle_of(h), before));
+    }
     /// A half-edge leaving v (origin(h) == v) for every vertex; no_half_edge for merged-away ones.
     std::vector<HalfEdge> vertex_half_edges() const;
     /// The half-edge from a to b, searching the star of a from `from` (a half-edge leaving a);

@@ -277,7 +277,7 @@ TriangleId SphericalDelaunay::locate(const Vec3& p, TriangleId hint) const {
     // Visibility walk across edges that have p strictly on their right. The start edge rotates
     // with the step count (a deterministic stand-in for the stochastic walk, which cannot cycle
     // for ever in a Delaunay triangulation); the step bound guards constrained or ghost regions.
-    const std::size_t limit = 64 + 8 * static_cast<std::size_t>(std::sqrt(double(triangle_slots()))) * 4;
+    const std::size_t limit = 64 + 32 * static_cast<std::size_t>(std::sqrt(double(triangle_slots())));
     for (std::size_t step = 0; step < limit; ++step) {
         const int start = static_cast<int>(((step * 2654435761u) >> 7) % 3);
         bool moved = false;
@@ -495,7 +495,7 @@ void SphericalDelaunay::flip(HalfEdge h) {
     const HalfEdge g = twin(h);
     const TriangleId s = triangle_of(g);
     const int j = edge_of(g);
-    const VertexId x = vertex(t, i), u = vertex(t, next3(i)), w = vertex(t, prev3(i));
+    const VertexId x = vertex(t, i);
     const VertexId y = vertex(s, j);
     // Outer half-edges (with their flags): A across w->x, B across x->u, C across u->y, D across y->w.
     const std::uint32_t A = links_[half_edge(t, next3(i))];
@@ -504,8 +504,6 @@ void SphericalDelaunay::flip(HalfEdge h) {
     // s becomes (y, w, x): edge j = w->x (A), edge j+1 = x->y (diagonal), edge j+2 = y->w (D, unchanged).
     tri_vertices_[3 * t + prev3(i)] = y;
     tri_vertices_[3 * s + prev3(j)] = x;
-    (void)u;
-    (void)w;
     auto attach = [&](HalfEdge mine, std::uint32_t outer) {
         links_[mine] = outer;
         links_[outer & link_mask] = mine | (outer & constrained_bit);
@@ -565,12 +563,11 @@ std::vector<HalfEdge> SphericalDelaunay::vertex_half_edges() const {
 }
 
 HalfEdge SphericalDelaunay::find_edge(HalfEdge from, VertexId b) const {
-    // Rotate around a = origin(from): in triangle t, the edge ending at a is edge prev3(i) (it
-    // joins vertex(t, i) to a), and its twin is the next half-edge leaving a.
+    // Rotate around a = origin(from).
     HalfEdge h = from;
     do {
         if (destination(h) == b) return h;
-        h = twin(half_edge(triangle_of(h), prev3(edge_of(h))));
+        h = next_around_origin(h);
     } while (h != from);
     return no_half_edge;
 }
@@ -632,7 +629,7 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
                 exit = half_edge(s, next3(i)); // d -> third, opposite a
                 break;
             }
-            h = twin(half_edge(s, prev3(i)));
+            h = next_around_origin(h);
         } while (h != from);
         if (exit == no_half_edge) return false;
 
@@ -718,7 +715,7 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
         const Vec3& b = points_[destination(h)];
         const Vec3& c = points_[vertex(t, edge_of(h))];
         if (orient(p, b, c) <= 0) return false;
-        h = twin(half_edge(t, prev3(edge_of(h))));
+        h = next_around_origin(h);
     } while (h != from);
     points_[v] = p;
     std::vector<HalfEdge> stack;

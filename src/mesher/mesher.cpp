@@ -302,7 +302,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         HalfEdge h = from;
         do {
             consider(triangle_of(h));
-            h = dt.twin(half_edge(triangle_of(h), prev3(edge_of(h))));
+            h = dt.next_around_origin(h);
         } while (h != from);
     };
     for (TriangleId t = 0; t < slots; ++t) consider(t);
@@ -440,7 +440,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 // area / h^2 so that graded meshes keep their grading.
                 double hk = size_km(normalized(a + b + c));
                 sum = sum + (area / (hk * hk)) * normalized(n);
-                h = dt.twin(half_edge(t, prev3(edge_of(h))));
+                h = dt.next_around_origin(h);
             } while (h != from && ++guard < 64);
             if (!inside || norm(sum) == 0) continue;
             // Refuse a move that would bring the worst triangle of the star below 0.6 and
@@ -455,7 +455,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 const Vec3& c = dt.point(dt.vertex(t, edge_of(h)));
                 worst_before = std::min(worst_before, triangle_quality(dt.point(v), b, c));
                 worst_after = std::min(worst_after, triangle_quality(target, b, c));
-                h = dt.twin(half_edge(t, prev3(edge_of(h))));
+                h = dt.next_around_origin(h);
             } while (h != from && ++guard < 64);
             if (worst_after < 0.6 && worst_after < worst_before) continue;
             dt.move_vertex_from(from, target);
