@@ -35,7 +35,7 @@ struct MeshOptions {
 
     // --- size field (sizefield/), km ---
     double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh
-    double hmin_km = 0.0;       ///< --hmin: smallest edge length (km); 0 means hmax/20... set by validate
+    double hmin_km = 0.0;       ///< --hmin: smallest edge length (km); 0: a floor of max(hmax/1000, 10 m)
     double coast_size_km = 0.0; ///< --coast-size: edge length at the coast (km); 0 = off
     double coast_rate = 0.1;    ///< --coast-rate: growth of h with distance from the coast (km/km)
     double wavelength = 0.0;    ///< --wavelength: points per wavelength of the tide; 0 = off

@@ -174,7 +174,7 @@ struct MeshCommand {
 
         app.add_option("--hmax", m.hmax_km, "Largest edge length (km or m; bare number: km); alone gives a uniform mesh")
             ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
-        app.add_option("--hmin", m.hmin_km, "Smallest edge length (km or m); 0: hmax/20")
+        app.add_option("--hmin", m.hmin_km, "Smallest edge length (km or m); 0: a floor of max(hmax/1000, 10 m)")
             ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
         app.add_option("--coast-size", m.coast_size_km, "Edge length at the coast (km or m); 0: off")
             ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
