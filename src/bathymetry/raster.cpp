@@ -62,9 +62,27 @@ bool Raster::contains(double lon, double lat) const {
     return u <= static_cast<double>(nlon_) - 0.5 + 1e-9;
 }
 
+namespace {
+
+// The pair of grid lines around position u (in cell units, clamped to [0, n - 1]) and the
+// fraction of the way from the first to the second; a single line is its own pair.
+void bracket(double u, std::size_t n, std::size_t& k0, std::size_t& k1, double& f) {
+    u = std::clamp(u, 0.0, static_cast<double>(n) - 1.0);
+    if (n == 1) {
+        k0 = k1 = 0;
+        f = 0;
+        return;
+    }
+    k0 = std::min(static_cast<std::size_t>(u), n - 2);
+    k1 = k0 + 1;
+    f = u - static_cast<double>(k0);
+}
+
+} // namespace
+
 double Raster::sample(double lon, double lat) const {
     if (values_.empty() || !std::isfinite(lon) || !std::isfinite(lat)) return nan_value;
-    const double n_lon = static_cast<double>(nlon_), n_lat = static_cast<double>(nlat_);
+    const double n_lon = static_cast<double>(nlon_);
     // Column position u in cell units from column 0, and the pair of columns around it.
     std::size_t i0, i1;
     double fu;
@@ -82,29 +100,13 @@ double Raster::sample(double lon, double lat) const {
             l = west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_;
         double u = (l - lon0_) / dlon_;
         if (u > n_lon - 0.5 + 1e-9) return nan_value;
-        u = std::clamp(u, 0.0, n_lon - 1.0);
-        if (nlon_ == 1) {
-            i0 = i1 = 0;
-            fu = 0;
-        } else {
-            i0 = std::min(static_cast<std::size_t>(u), nlon_ - 2);
-            i1 = i0 + 1;
-            fu = u - static_cast<double>(i0);
-        }
+        bracket(u, nlon_, i0, i1, fu);
     }
     double v = (lat - lat0_) / dlat_;
     if (v < v_lo_ || v > v_hi_) return nan_value;
-    v = std::clamp(v, 0.0, n_lat - 1.0);
     std::size_t j0, j1;
     double fv;
-    if (nlat_ == 1) {
-        j0 = j1 = 0;
-        fv = 0;
-    } else {
-        j0 = std::min(static_cast<std::size_t>(v), nlat_ - 2);
-        j1 = j0 + 1;
-        fv = v - static_cast<double>(j0);
-    }
+    bracket(v, nlat_, j0, j1, fv);
     const double z00 = values_[j0 * nlon_ + i0], z10 = values_[j0 * nlon_ + i1];
     const double z01 = values_[j1 * nlon_ + i0], z11 = values_[j1 * nlon_ + i1];
     const double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
