@@ -30,10 +30,15 @@ namespace globemesh {
 
 struct MesherOptions {
     std::uint64_t max_nodes = 20'000'000; ///< refuse when the size field asks for more nodes
+    std::uint64_t max_memory = 0;         ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
     int smooth_iterations = 4;            ///< smoothing sweeps
     bool keep_inland_seas = false;        ///< keep ocean components apart from the largest
     std::uint64_t seed = 1;               ///< seed of the core's insertion order
 };
+
+/// Peak bytes per output node that mesh_boundary needs (the core, the refinement's queue and the
+/// smoothing's maps), used to turn the node estimate into a memory estimate before refining.
+inline constexpr std::uint64_t mesher_bytes_per_node = 800;
 
 struct OceanComponent {
     double area_km2 = 0;
@@ -52,7 +57,8 @@ struct MesherReport {
 
 /// Meshes the ocean bounded by `boundary` (empty: the whole sphere) with edges of about
 /// size_km(x) km. Throws DataError when the rings do not close the ocean, when no ocean is left,
-/// or when the estimated node count exceeds options.max_nodes; Cancelled through progress.
+/// or when the estimated node count exceeds options.max_nodes (or the estimated memory,
+/// estimated_nodes * mesher_bytes_per_node, exceeds options.max_memory); Cancelled through progress.
 /// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
 Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
                    const MesherOptions& options = {}, MesherReport* report = nullptr,

@@ -253,6 +253,13 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         throw DataError("the size field asks for about " + std::to_string(report.estimated_nodes) +
                         " nodes, more than --max-nodes " + std::to_string(options.max_nodes) +
                         ": raise --hmin/--hmax or --max-nodes");
+    if (options.max_memory != 0 &&
+        report.estimated_nodes > options.max_memory / mesher_bytes_per_node)
+        throw DataError("meshing about " + std::to_string(report.estimated_nodes) +
+                        " nodes needs about " +
+                        std::to_string(report.estimated_nodes * mesher_bytes_per_node >> 20) +
+                        " MiB, more than --max-memory " + std::to_string(options.max_memory >> 20) +
+                        " MiB: raise --hmin/--hmax or --max-memory");
     if (timings) timings->add("classify", seconds_since(t0));
 
     // ---- 4. refine ---------------------------------------------------------------------------
