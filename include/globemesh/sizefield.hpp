@@ -1,8 +1,10 @@
 // globemesh/sizefield.hpp: the target edge length h(x) in km, built once, evaluated fast.
 //
 // build_size_field() computes h on a background lon/lat grid and SizeField::size_km() evaluates
-// it bilinearly (one vec_to_lonlat and four loads: 170 ns a call at random points on the
-// 16.8 M-node global grid of the issue-5 options, mostly cache misses; see bench/). h is
+// it piecewise linearly in (lon, lat) between the grid nodes (each cell split into two triangles
+// along its south-east to north-west diagonal), and linearly in latitude from the first and
+// last rows of a global grid to one value at each pole (one vec_to_lonlat and four loads; see
+// bench/RESULTS-sizefield.md). h is
 //   h = grade_limit( clamp( min(components the options turn on, hmax), hfloor, hmax ) )
 // with the components (all km):
 //   coast      h = coast_size + coast_rate * d, d the great-circle distance to the boundary rings
@@ -18,12 +20,19 @@
 // shallow coastal water above sea level); where the raster has no data and no fill, those two
 // components are off at that node.
 // hfloor is --hmin, or when --hmin is 0 the sane floor max(hmax / 1000, 0.01 km).
-// Gradation: h is then lowered where needed so that |grad h| <= grade on the sphere, by fast
-// marching of the upwind (Godunov) eikonal scheme on the grid: after it, every node satisfies
-//   (max(h - h_west_or_east_min, 0) / dx)^2 + (max(h - h_south_or_north_min, 0) / dy)^2 <= grade^2
-// with dx, dy the great-circle distances to the neighbours (float rounding: relative 1e-5), so
-// |h(a) - h(b)| <= grade * |ab| along every grid row and column, across +-180 and across the
-// poles (row 0's southern neighbour is the node 180 degrees away on row 0).
+// Gradation: h is then lowered where needed so that the evaluated field is grade-Lipschitz on the
+// sphere: |h(p) - h(q)| <= grade * arc(p, q) for every pair of points (great-circle distance,
+// km), not only along the grid lines. The solver (grid.cpp) holds in every cell, corners 00, 10,
+// 01, 11, the two corner conditions of its triangles
+//   ((h10 - h00) / dx)^2 + ((h01 - h00) / dy)^2 <= grade^2,  ((h11 - h01) / dx)^2 + ((h11 - h10) / dy)^2 <= grade^2
+// (dx = R dlon cos(lat) at the cell's poleward row, dy = R dlat), which bound the Riemannian
+// gradient of the linear interpolant by grade everywhere in the cell, and the like conditions of
+// the polar caps. It accepts nodes in increasing order of value (fast marching with those
+// conditions in place of the upwind eikonal update), never lowers a node below the
+// smallest initial value (so hfloor still holds) and rounds down to float: the bound holds up to
+// float rounding (relative 1e-6). A regional grid holds its edge values outside its nodes: there
+// the bound holds except poleward of the grid, where a held row's east-west differences sit on
+// shorter parallels (never reached by a mesh of the region: the grid has a cell of margin).
 //
 // Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
 // nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
@@ -36,6 +45,7 @@
 // wavelength and slope components.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -68,11 +78,15 @@ double slope_size_km(double depth_m, double grad_m_per_km, double points_per_len
 class SizeField {
 public:
     SizeField() = default;
-    /// Wraps a grid of sizes (km, all finite and > 0). Throws DataError otherwise.
+    /// Wraps a grid of sizes (km, all finite and > 0). A global grid whose first (last) row lies
+    /// within one row spacing of a pole is closed by a polar cap, linear in latitude from that row
+    /// to the pole value (south_pole_km, north_pole_km; NaN: the smallest value of the row).
+    /// Throws DataError on a non-positive or non-finite size.
     explicit SizeField(Raster grid);
+    SizeField(Raster grid, double south_pole_km, double north_pole_km);
 
-    /// Target edge length at p, km: bilinear on the background grid (edge values held outside
-    /// a regional grid, first/last rows held up to the poles).
+    /// Target edge length at p, km: piecewise linear on the background grid's triangles (exact
+    /// at the nodes; edge values held outside a regional grid, polar caps on a global one).
     double size_km(const Vec3& p) const;
     double size_km(double lon_deg, double lat_deg) const;
     double operator()(const Vec3& p) const { return size_km(p); }
@@ -82,13 +96,19 @@ public:
     /// A SizeFn sharing this field's grid (cheap to copy).
     SizeFn function() const;
 
-    /// Smallest and largest node value, km.
+    /// Pole values of the caps, km (NaN where the grid has no cap).
+    double south_pole_km() const { return south_cap_ ? south_ : std::nan(""); }
+    double north_pole_km() const { return north_cap_ ? north_ : std::nan(""); }
+
+    /// Smallest and largest node value (poles included), km.
     double min_km() const { return min_; }
     double max_km() const { return max_; }
 
 private:
     std::shared_ptr<const Raster> grid_;
     double min_ = 0, max_ = 0;
+    bool south_cap_ = false, north_cap_ = false;
+    double south_ = 0, north_ = 0;
 };
 
 /// Builds the size field the options ask for (see the file comment). bathy: the bathymetry

@@ -1,5 +1,6 @@
 // The background grid, distance to the coast (nearest-point propagation) and gradient limiting
-// (fast marching of the upwind eikonal scheme, Persson 2006) on it.
+// on it (ordered like fast marching, Persson 2006, with the corner conditions of the evaluated
+// piecewise-linear field in place of the upwind eikonal update).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -49,6 +50,10 @@ BackgroundGrid::BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg
         dx_km[j] = nlon > 1 ? arc_km(node(0, j), node(1, j)) : 0.0;
     }
     dy_km = dlat * deg_to_rad * earth_radius_km;
+    if (global && nlat > 0) {
+        south_cap = lat(0) > -90.0 && lat(0) - dlat <= -90.0 + 1e-9 * dlat;
+        north_cap = lat(nlat - 1) < 90.0 && lat(nlat - 1) + dlat >= 90.0 - 1e-9 * dlat;
+    }
 }
 
 void BackgroundGrid::row_neighbours(std::size_t n, std::size_t out[2]) const {
@@ -73,9 +78,15 @@ BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std:
         w = (*o.region)[0];
         e = (*o.region)[2];
         if (e <= w) e += 360;
-        // One cell of margin, within the poles.
-        s = std::max(-90.0, (*o.region)[1] - spacing);
-        n = std::min(90.0, (*o.region)[3] + spacing);
+        // One cell of margin beyond the great circles through the region's corners (they bulge
+        // poleward of the parallels, and the mesh's open boundary follows them), within the poles.
+        const double half = 0.5 * (e - w);
+        auto bulge = [&](double lat) {
+            if (half >= 90.0 || lat == 0) return lat;
+            return std::atan(std::tan(lat * deg_to_rad) / std::cos(half * deg_to_rad)) * rad_to_deg;
+        };
+        s = std::max(-90.0, std::min((*o.region)[1], bulge((*o.region)[1])) - spacing);
+        n = std::min(90.0, std::max((*o.region)[3], bulge((*o.region)[3])) + spacing);
         global = e - w >= 360 - 2 * spacing;
         if (global) {
             w = -180;
@@ -180,64 +191,185 @@ std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b,
     return d;
 }
 
-void limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade, const Progress& progress) {
+// Gradient limiting with a guarantee for the evaluated field, not only on the grid edges.
+//
+// How SizeField evaluates the grid (sizefield.cpp): each cell, corners 00, 10, 01, 11 (rows j and
+// j+1), is split along its 10-01 diagonal into two triangles, linear in (lon, lat): h00 + u a + v c
+// (u + v <= 1) and h11 - (1-u) b - (1-v) d, with the row differences a = h10 - h00, b = h11 - h01
+// and the column differences c = h01 - h00, d = h11 - h10. The Riemannian gradient of the first
+// has east component a / (R dlon cos(lat)) and north component c / (R dlat), so
+//   |grad h|^2 <= a^2 / dx^2 + c^2 / dy^2,   and   b^2 / dx^2 + d^2 / dy^2 for the second,     (*)
+// with dx = R dlon cos(lat) at the cell's poleward row (the smallest cos in the cell) and
+// dy = R dlat. Holding both corner conditions (*) <= grade^2 in every cell bounds |grad h| by grade
+// everywhere, and since the field is continuous (across cells, the +-180 seam and the poles),
+// |h(p) - h(q)| <= grade * arc(p, q) for every pair of points. (A node-wise upwind eikonal
+// condition, what fast marching holds, does not: the interpolant of a cone's node values has a
+// gradient of sqrt(2) * grade in the cells at the apex.) Bilinear interpolation would need all four
+// corner conditions, max(a^2, b^2) / dx^2 + max(c^2, d^2) / dy^2 <= grade^2, which forbids a row
+// difference of grade * dx beside any column difference: the field would grow at about
+// 0.75 * grade along the grid axes away from a point source.
+// A polar cap (global grids) is the strip between the last row and the pole, evaluated linearly
+// in latitude between the row's linear interpolant and the pole value P: its east component is
+// (1-t) a / (R dlon cos(lat)) with cos(lat) = sin((1-t) theta) >= (1-t) sin(theta), theta the
+// cap's angular width, and its north component lies between c = P - h0 and d = P - h1 over R theta,
+// so the two corner conditions (a, c) and (a, d) with dx = R dlon cos(lat of the row) and
+// dy = R theta bound the gradient there.
+//
+// Solver: nodes are accepted in increasing order of value, as in fast marching. A node's tentative
+// value is the smallest of its initial value and, for each corner condition it takes part in, the
+// largest v for which the condition holds when it and the condition's other nodes not yet
+// accepted take the value v (the best completion: the accepted ones are all <= v). It is
+// recomputed for the unaccepted nodes of a node's conditions each time the node is accepted (it can
+// rise: a node assumed to rise with it may be accepted lower); it is never below the value just
+// accepted (the condition held with its unknown nodes at that value), so values are accepted in
+// increasing order, and when the last node of a condition is accepted the condition holds with
+// the final values. Values are stored rounded down to float, so (*) holds on the stored floats up
+// to double rounding.
+namespace {
+
+/// One corner condition: ((h[row] - h[k]) / dx)^2 + ((h[col] - h[k]) / dy)^2 <= grade^2.
+struct Corner {
+    std::size_t k, row, col;
+    double dx, dy;
+    bool involves(std::size_t n) const { return n == k || n == row || n == col; }
+};
+
+/// Largest v >= the accepted nodes for which the condition holds when its unaccepted nodes take
+/// the value v; +inf when no edge ties an unknown node to an accepted one.
+double corner_bound(const Corner& c, const std::vector<float>& h, const std::vector<std::uint8_t>& accepted,
+                    double grade) {
+    const double inf = std::numeric_limits<double>::infinity();
+    double fixed[2] = {0, 0}, partner[2] = {inf, inf};
+    const std::size_t ends[2] = {c.row, c.col};
+    for (int dir = 0; dir < 2; ++dir) {
+        const std::size_t p = c.k, q = ends[dir];
+        if (p == q) continue;
+        const bool pa = accepted[p] != 0, qa = accepted[q] != 0;
+        if (pa && qa) {
+            const double diff = static_cast<double>(h[p]) - h[q];
+            fixed[dir] = diff * diff;
+        } else if (pa) {
+            partner[dir] = h[p];
+        } else if (qa) {
+            partner[dir] = h[q];
+        }
+    }
+    const double g2 = grade * grade, ix = 1.0 / (c.dx * c.dx), iy = 1.0 / (c.dy * c.dy);
+    const bool var_x = partner[0] < inf, var_y = partner[1] < inf;
+    if (var_x && var_y) {
+        // (v - sx)^2 / dx^2 + (v - sy)^2 / dy^2 = grade^2, the larger root.
+        const double sx = partner[0], sy = partner[1];
+        const double disc = (ix + iy) * g2 - ix * iy * (sx - sy) * (sx - sy);
+        return (ix * sx + iy * sy + std::sqrt(std::max(0.0, disc))) / (ix + iy);
+    }
+    if (var_x) return partner[0] + c.dx * std::sqrt(std::max(0.0, g2 - fixed[1] * iy));
+    if (var_y) return partner[1] + c.dy * std::sqrt(std::max(0.0, g2 - fixed[0] * ix));
+    return inf;
+}
+
+} // namespace
+
+PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade, const Progress& progress) {
+    const std::size_t n_grid = g.size();
+    const std::size_t south = n_grid, north = n_grid + 1; // the pole nodes, when capped
     float top_value = 0;
     for (float v : h) top_value = std::max(top_value, v);
+    h.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
+
+    const double rad_lon = g.dlon * deg_to_rad * earth_radius_km;
+    auto row_dx = [&](long j) { return rad_lon * g.cos_lat[static_cast<std::size_t>(j)]; };
+    const long nlat = static_cast<long>(g.nlat), nlon = static_cast<long>(g.nlon);
+    const long j_first = g.south_cap ? -1 : 0, j_last = g.north_cap ? nlat - 1 : nlat - 2;
+    const double cap_dy_south = (g.lat(0) + 90.0) * deg_to_rad * earth_radius_km;
+    const double cap_dy_north = (90.0 - g.lat(g.nlat - 1)) * deg_to_rad * earth_radius_km;
+    auto node_id = [&](long i, long j) -> std::size_t {
+        return static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(((i % nlon) + nlon) % nlon);
+    };
+    // The two corner conditions of the cell with lower-left corner (i, j); 0 where there is none.
+    auto corners = [&](long i, long j, Corner out[2]) -> int {
+        if (j < j_first || j > j_last) return 0;
+        if (!g.global && (i < 0 || i > nlon - 2)) return 0;
+        if (j < 0) { // south cap: the pole below row 0
+            const std::size_t c01 = node_id(i, 0), c11 = node_id(i + 1, 0);
+            out[0] = {c01, c11, south, row_dx(0), cap_dy_south};
+            out[1] = {c11, c01, south, row_dx(0), cap_dy_south};
+            return 2;
+        }
+        if (j + 1 >= nlat) { // north cap
+            const std::size_t c00 = node_id(i, j), c10 = node_id(i + 1, j);
+            out[0] = {c00, c10, north, row_dx(j), cap_dy_north};
+            out[1] = {c10, c00, north, row_dx(j), cap_dy_north};
+            return 2;
+        }
+        const double dx = std::min(row_dx(j), row_dx(j + 1));
+        const std::size_t c00 = node_id(i, j), c10 = node_id(i + 1, j), c01 = node_id(i, j + 1),
+                          c11 = node_id(i + 1, j + 1);
+        out[0] = {c00, c10, c01, dx, g.dy_km};
+        out[1] = {c11, c01, c10, dx, g.dy_km};
+        return 2;
+    };
+    // Every corner condition a node takes part in.
+    auto for_each_corner = [&](std::size_t n, const auto& visit) {
+        Corner c[2];
+        auto cell = [&](long i, long j) {
+            const int k = corners(i, j, c);
+            for (int m = 0; m < k; ++m)
+                if (c[m].involves(n)) visit(c[m]);
+        };
+        if (n >= n_grid) {
+            const long j = n == south ? -1 : nlat - 1;
+            for (long i = 0; i < nlon; ++i) cell(i, j);
+            return;
+        }
+        const long i = static_cast<long>(n % g.nlon), j = static_cast<long>(n / g.nlon);
+        cell(i - 1, j - 1);
+        cell(i, j - 1);
+        cell(i - 1, j);
+        cell(i, j);
+    };
+
+    const std::vector<float> initial(h); // the components' values, the ceiling of every node
     MinHeap heap;
     // Nodes at the largest value never lower a neighbour: they enter only when lowered.
-    for (std::size_t n = 0; n < g.size(); ++n)
+    for (std::size_t n = 0; n < n_grid; ++n)
         if (h[n] < top_value) heap.push({h[n], static_cast<std::uint32_t>(n)});
-    std::vector<std::uint8_t> accepted(g.size(), 0);
-    const double inf = std::numeric_limits<double>::infinity();
-    const double dy = g.dy_km;
-    auto axis_min = [&](const std::size_t nb[2]) {
-        double a = inf;
-        for (int k = 0; k < 2; ++k)
-            if (nb[k] != BackgroundGrid::npos && accepted[nb[k]]) a = std::min(a, static_cast<double>(h[nb[k]]));
-        return a;
-    };
-    // The upwind eikonal value at node m from its accepted neighbours.
-    auto solve = [&](std::size_t m) {
-        std::size_t r[2], c[2];
-        g.row_neighbours(m, r);
-        g.column_neighbours(m, c);
-        const double a = axis_min(r), b = axis_min(c);
-        const double dx = g.dx_km[m / g.nlon];
-        const double ta = a + grade * dx, tb = b + grade * dy;
-        double t = std::min(ta, tb);
-        if (a < inf && b < inf && t > std::max(a, b)) {
-            // (t - a)^2 / dx^2 + (t - b)^2 / dy^2 = grade^2, the larger root.
-            const double ix = 1.0 / (dx * dx), iy = 1.0 / (dy * dy);
-            const double qa = ix + iy, qb = -2.0 * (a * ix + b * iy);
-            const double qc = a * a * ix + b * b * iy - grade * grade;
-            const double disc = qb * qb - 4.0 * qa * qc;
-            if (disc >= 0) {
-                double root = (-qb + std::sqrt(disc)) / (2.0 * qa);
-                if (root >= std::max(a, b)) t = std::min(t, root);
-            }
-        }
+    std::vector<std::uint8_t> accepted(n_grid + 2, 0);
+    std::size_t popped = 0;
+    // A node's tentative value from scratch: its bounds can rise as well as fall when another
+    // node of one of its conditions is accepted, so no running minimum is kept.
+    auto tentative = [&](std::size_t m) {
+        double t = initial[m];
+        for_each_corner(m, [&](const Corner& c) { t = std::min(t, corner_bound(c, h, accepted, grade)); });
         return t;
     };
-    std::size_t popped = 0;
+    std::vector<std::size_t> around;
     while (!heap.empty()) {
         HeapEntry top = heap.top();
         heap.pop();
-        if (accepted[top.node] || top.key > h[top.node]) continue;
+        if (accepted[top.node] || top.key != h[top.node]) continue;
         accepted[top.node] = 1;
         if (++popped % (1u << 20) == 0)
-            report(progress, std::min(0.99, static_cast<double>(popped) / static_cast<double>(g.size())), "gradation");
-        std::size_t r[2], c[2];
-        g.row_neighbours(top.node, r);
-        g.column_neighbours(top.node, c);
-        for (std::size_t m : {r[0], r[1], c[0], c[1]}) {
-            if (m == BackgroundGrid::npos || accepted[m]) continue;
-            double t = solve(m);
-            if (t < h[m]) {
-                h[m] = std::max(top.key, float_down(t));
-                heap.push({h[m], static_cast<std::uint32_t>(m)});
+            report(progress, std::min(0.99, static_cast<double>(popped) / static_cast<double>(n_grid)), "gradation");
+        around.clear();
+        for_each_corner(top.node, [&](const Corner& c) {
+            for (std::size_t m : {c.k, c.row, c.col})
+                if (!accepted[m] && std::find(around.begin(), around.end(), m) == around.end()) around.push_back(m);
+        });
+        for (std::size_t m : around) {
+            // Never below the value just accepted (the conditions held with every unknown node
+            // at that value); the max only absorbs rounding.
+            const float t = std::max(top.key, float_down(tentative(m)));
+            if (t != h[m]) {
+                h[m] = t;
+                heap.push({t, static_cast<std::uint32_t>(m)});
             }
         }
     }
+    PoleSizes poles;
+    if (g.south_cap) poles.south = h[south];
+    if (g.north_cap) poles.north = h[north];
+    h.resize(n_grid);
+    return poles;
 }
 
 } // namespace globemesh::detail

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "globemesh/boundary.hpp"
@@ -23,6 +24,10 @@ struct BackgroundGrid {
     std::vector<double> sin_lon, cos_lon, sin_lat, cos_lat;
     std::vector<double> dx_km; ///< great-circle distance between neighbours on row j
     double dy_km = 0;          ///< great-circle distance between neighbours along a column
+    /// Global grids whose first (last) row lies within one row spacing of the south (north)
+    /// pole close that gap with a polar cap: the field is linear in latitude between the row and
+    /// one value at the pole.
+    bool south_cap = false, north_cap = false;
 
     BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_deg,
                    std::size_t nlon_, std::size_t nlat_, bool global_);
@@ -51,9 +56,17 @@ BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std:
 std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b, double max_km,
                                      const Progress& progress);
 
-/// Lowers h so that the upwind |grad h| <= grade at every node (fast marching).
-void limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade,
-                    const Progress& progress);
+/// Sizes at the two poles (km) for the polar caps; NaN where the grid has no cap.
+struct PoleSizes {
+    double south = std::nan(""), north = std::nan("");
+};
+
+/// Lowers h (never below its smallest value) so that the field SizeField evaluates from it,
+/// bilinear in lon/lat in each cell and linear in latitude over the polar caps, has
+/// |grad h| <= grade everywhere on the sphere; returns the pole values of the caps. See
+/// grid.cpp for the cell condition and the ordered (Dijkstra-like) solver.
+PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade,
+                         const Progress& progress);
 
 /// min(h, size_km) over the nodes inside each polygon of an OGR source with a size_km field.
 void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h);

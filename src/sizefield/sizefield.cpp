@@ -33,8 +33,32 @@ double slope_size_km(double depth_m, double grad_m_per_km, double n) {
     return 2.0 * pi * d / (n * grad_m_per_km);
 }
 
-SizeField::SizeField(Raster grid) {
+namespace {
+
+/// The same grid with rows south to north (dlat > 0).
+Raster south_to_north(Raster grid) {
+    if (grid.dlat_deg() > 0) return grid;
+    const std::size_t nx = grid.nlon(), ny = grid.nlat();
+    std::vector<float> v(grid.values().size());
+    for (std::size_t j = 0; j < ny; ++j)
+        std::copy_n(grid.values().begin() + static_cast<std::ptrdiff_t>((ny - 1 - j) * nx), nx,
+                    v.begin() + static_cast<std::ptrdiff_t>(j * nx));
+    return Raster(grid.lon0_deg(), grid.lat_deg(ny - 1), grid.dlon_deg(), -grid.dlat_deg(), nx, ny, std::move(v));
+}
+
+double row_min(const Raster& g, std::size_t j) {
+    double m = inf;
+    for (std::size_t i = 0; i < g.nlon(); ++i) m = std::min(m, static_cast<double>(g.value(i, j)));
+    return m;
+}
+
+} // namespace
+
+SizeField::SizeField(Raster grid) : SizeField(std::move(grid), std::nan(""), std::nan("")) {}
+
+SizeField::SizeField(Raster grid, double south_pole_km, double north_pole_km) {
     if (grid.values().empty()) throw DataError("size field: empty background grid");
+    grid = south_to_north(std::move(grid));
     min_ = inf;
     max_ = 0;
     for (float v : grid.values()) {
@@ -42,26 +66,70 @@ SizeField::SizeField(Raster grid) {
         min_ = std::min(min_, static_cast<double>(v));
         max_ = std::max(max_, static_cast<double>(v));
     }
+    const double dlat = grid.dlat_deg(), first = grid.lat_deg(0), last = grid.lat_deg(grid.nlat() - 1);
+    south_cap_ = grid.global() && first > -90.0 && first - dlat <= -90.0 + 1e-9 * dlat;
+    north_cap_ = grid.global() && last < 90.0 && last + dlat >= 90.0 - 1e-9 * dlat;
+    if (south_cap_) south_ = std::isnan(south_pole_km) ? row_min(grid, 0) : south_pole_km;
+    if (north_cap_) north_ = std::isnan(north_pole_km) ? row_min(grid, grid.nlat() - 1) : north_pole_km;
+    for (double v : {south_cap_ ? south_ : 1.0, north_cap_ ? north_ : 1.0})
+        if (!(v > 0 && std::isfinite(v))) throw DataError("size field: a pole value is not a positive size");
+    if (south_cap_) min_ = std::min(min_, south_), max_ = std::max(max_, south_);
+    if (north_cap_) min_ = std::min(min_, north_), max_ = std::max(max_, north_);
     grid_ = std::make_shared<const Raster>(std::move(grid));
 }
 
 double SizeField::size_km(double lon, double lat) const {
     const Raster& g = *grid_;
-    if (!g.global()) {
-        // Hold the edge values outside a regional grid: clamp to the nearest edge.
-        const LonLatBounds b = g.bounds();
-        double l = lon;
-        if (l < b.west || l > b.east) {
-            double east_gap = std::remainder(l - b.east, 360.0), west_gap = std::remainder(b.west - l, 360.0);
-            if (east_gap >= 0 && west_gap >= 0) l = east_gap < west_gap ? b.east : b.west;
-            else l = b.west + std::remainder(l - b.west, 360.0);
-            l = std::clamp(l, b.west, b.east);
-        }
-        lat = std::clamp(lat, b.south, b.north);
-        lon = l;
+    const std::size_t nx = g.nlon(), ny = g.nlat();
+    const float* values = g.values().data();
+    // Column pair and fraction; a regional grid holds its edge columns outside.
+    double u;
+    std::size_t i0, i1;
+    if (g.global()) {
+        u = (lon - g.lon0_deg()) / g.dlon_deg();
+        u -= std::floor(u / static_cast<double>(nx)) * static_cast<double>(nx);
+        i0 = std::min(static_cast<std::size_t>(u), nx - 1);
+        i1 = i0 + 1 == nx ? 0 : i0 + 1;
+        u -= static_cast<double>(i0);
+    } else {
+        const double span = static_cast<double>(nx - 1) * g.dlon_deg();
+        const double centre = g.lon0_deg() + 0.5 * span;
+        u = std::clamp(0.5 * span + std::remainder(lon - centre, 360.0), 0.0, span) / g.dlon_deg();
+        i0 = std::min(static_cast<std::size_t>(u), nx > 1 ? nx - 2 : 0);
+        i1 = std::min(i0 + 1, nx - 1);
+        u -= static_cast<double>(i0);
     }
-    double h = g.sample(lon, lat);
-    return std::isnan(h) ? max_ : h;
+    auto row = [&](std::size_t j) {
+        const float* r = values + j * nx;
+        return (1 - u) * static_cast<double>(r[i0]) + u * static_cast<double>(r[i1]);
+    };
+    // Polar caps: linear in latitude between the edge row and the pole value.
+    const double first = g.lat0_deg(), last = g.lat_deg(ny - 1);
+    if (lat < first) {
+        if (!south_cap_) return row(0);
+        const double t = std::max(0.0, (lat + 90.0) / (first + 90.0));
+        return (1 - t) * south_ + t * row(0);
+    }
+    if (lat > last) {
+        if (!north_cap_) return row(ny - 1);
+        const double t = std::max(0.0, (90.0 - lat) / (90.0 - last));
+        return (1 - t) * north_ + t * row(ny - 1);
+    }
+    if (ny == 1) return row(0);
+    double v = (lat - first) / g.dlat_deg();
+    const std::size_t j0 = std::min(static_cast<std::size_t>(v), ny - 2);
+    v -= static_cast<double>(j0);
+    // Two triangles split along the 10-01 diagonal, linear in (lon, lat): the gradation
+    // solver's corner conditions hold their gradients below --grade (grid.cpp).
+    const float* r0 = values + j0 * nx;
+    const float* r1 = r0 + nx;
+    const double h10 = r0[i1], h01 = r1[i0];
+    if (u + v <= 1) {
+        const double h00 = r0[i0];
+        return h00 + u * (h10 - h00) + v * (h01 - h00);
+    }
+    const double h11 = r1[i1];
+    return h11 + (1 - u) * (h01 - h11) + (1 - v) * (h10 - h11);
 }
 
 double SizeField::size_km(const Vec3& p) const {
@@ -90,7 +158,9 @@ SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boun
 
     report(progress, 0.0, "size field");
     detail::BackgroundGrid g = detail::make_background_grid(o, hfloor, max_nodes);
-    std::vector<float> h(g.size(), static_cast<float>(hmax));
+    std::vector<float> h;
+    h.reserve(g.size() + 2); // the gradation solver appends the two pole nodes
+    h.assign(g.size(), static_cast<float>(hmax));
     auto lower = [&](std::size_t n, double v) {
         if (v < h[n]) h[n] = static_cast<float>(v);
     };
@@ -147,9 +217,9 @@ SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boun
     report(progress, 0.6, "size field");
 
     for (float& v : h) v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
-    detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
+    const detail::PoleSizes poles = detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
     report(progress, 1.0, "size field");
-    return SizeField(Raster(g.lon0, g.lat0, g.dlon, g.dlat, g.nlon, g.nlat, std::move(h)));
+    return SizeField(Raster(g.lon0, g.lat0, g.dlon, g.dlat, g.nlon, g.nlat, std::move(h)), poles.south, poles.north);
 }
 
 SizeFn uniform_size(double h_km) {
