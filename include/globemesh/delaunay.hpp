@@ -173,6 +173,10 @@ private:
     void clear_mark(TriangleId t) { links_[3 * t] &= ~mark_bit; }
     void reserve_for(std::size_t points);
     VertexId insert_vertex(const Vec3& p, VertexId id, TriangleId hint);
+    TriangleId start_triangle(TriangleId hint) const;
+    TriangleId walk(const Vec3& p, TriangleId start, bool& inside) const;
+    bool insert_fan(const Vec3& p, TriangleId seed, VertexId id, VertexId& result);
+    TriangleId new_slot();
 
     void link(HalfEdge a, HalfEdge b);
     TriangleId new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label);

@@ -107,6 +107,19 @@ TriangleId SphericalDelaunay::new_triangle(VertexId a, VertexId b, VertexId c, s
     return t;
 }
 
+TriangleId SphericalDelaunay::new_slot() {
+    if (!free_.empty()) {
+        const TriangleId t = free_.back();
+        free_.pop_back();
+        return t;
+    }
+    const TriangleId t = static_cast<TriangleId>(tri_vertices_.size() / 3);
+    tri_vertices_.resize(tri_vertices_.size() + 3);
+    links_.resize(links_.size() + 3, 0);
+    labels_.push_back(0);
+    return t;
+}
+
 void SphericalDelaunay::free_triangle(TriangleId t) {
     tri_vertices_[3 * t] = no_vertex;
     free_.push_back(t);
@@ -264,35 +277,60 @@ std::vector<VertexId> SphericalDelaunay::insert_points(std::span<const Vec3> poi
 // Location
 // ---------------------------------------------------------------------------------------------
 
-TriangleId SphericalDelaunay::locate(const Vec3& p, TriangleId hint) const {
+TriangleId SphericalDelaunay::start_triangle(TriangleId hint) const {
     TriangleId t = hint;
     if (t == no_triangle || t >= triangle_slots() || !is_live(t)) {
         t = last_;
-        if (t == no_triangle || !is_live(t)) {
+        if (t == no_triangle || t >= triangle_slots() || !is_live(t)) {
             for (t = 0; t < triangle_slots() && !is_live(t); ++t) {
             }
             if (t == triangle_slots()) return no_triangle;
         }
     }
-    // Visibility walk across edges that have p strictly on their right. The start edge rotates
-    // with the step count (a deterministic stand-in for the stochastic walk, which cannot cycle
-    // for ever in a Delaunay triangulation); the step bound guards constrained or ghost regions.
+    return t;
+}
+
+TriangleId SphericalDelaunay::locate(const Vec3& p, TriangleId hint) const {
+    const TriangleId t = start_triangle(hint);
+    if (t == no_triangle) return no_triangle;
+    bool inside = false;
+    return walk(p, t, inside);
+}
+
+// Visibility walk across edges that have p strictly on their right. The edge a triangle was
+// entered by has p on its left (its twin had p on its right), so only the other two are tested;
+// which of the two goes first is drawn from a small deterministic generator (a stand-in for the
+// stochastic walk, which cannot cycle for ever in a Delaunay triangulation); the step bound
+// guards constrained or ghost regions. `inside` is true when the walk stopped at a triangle
+// with p on or left of all three edges (every one tested or known), false when the bound hit.
+TriangleId SphericalDelaunay::walk(const Vec3& p, TriangleId t, bool& inside) const {
     const std::size_t limit = 64 + 32 * static_cast<std::size_t>(std::sqrt(double(triangle_slots())));
-    for (std::size_t step = 0; step < limit; ++step) {
-        const int start = static_cast<int>(((step * 2654435761u) >> 7) % 3);
-        bool moved = false;
-        for (int k = 0; k < 3; ++k) {
-            int i = (start + k) % 3;
-            const Vec3& u = points_[vertex(t, next3(i))];
-            const Vec3& w = points_[vertex(t, prev3(i))];
-            if (orient(u, w, p) < 0) {
-                t = neighbour(t, i);
-                moved = true;
-                break;
-            }
+    const VertexId* tv = tri_vertices_.data();
+    const Vec3* pts = points_.data();
+    auto right_of = [&](TriangleId s, int i) {
+        return orient(pts[tv[3 * s + next3(i)]], pts[tv[3 * s + prev3(i)]], p) < 0;
+    };
+    // The first triangle: all three edges.
+    int cross = -1;
+    for (int i = 0; i < 3 && cross < 0; ++i)
+        if (right_of(t, i)) cross = i;
+    std::uint32_t bits = 0x2545f491u;
+    for (std::size_t step = 0; cross >= 0; ++step) {
+        if (step == limit) {
+            inside = false;
+            return t;
         }
-        if (!moved) return t;
+        const HalfEdge o = twin(half_edge(t, cross));
+        t = triangle_of(o);
+        const int entry = edge_of(o);
+        bits ^= bits << 13;
+        bits ^= bits >> 17;
+        bits ^= bits << 5;
+        int first = next3(entry), second = prev3(entry);
+        if (bits & 1u) std::swap(first, second);
+        cross = right_of(t, first) ? first : right_of(t, second) ? second : -1;
     }
+    inside = true;
     return t;
 }
 
@@ -305,8 +343,10 @@ VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
 }
 
 VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId hint) {
-    const TriangleId located = locate(p, hint);
-    if (located == no_triangle) throw DataError("cannot insert into an empty triangulation");
+    const TriangleId start = start_triangle(hint);
+    if (start == no_triangle) throw DataError("cannot insert into an empty triangulation");
+    bool inside = false;
+    const TriangleId located = walk(p, start, inside);
     // Merge with a vertex of the located triangle when within tolerance (exact duplicates land here).
     for (int i = 0; i < 3; ++i)
         if (within(points_[vertex(located, i)], p, options_.merge_tolerance_rad)) {
@@ -316,10 +356,12 @@ VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId
     const Vec3& a = points_[vertex(located, 0)];
     const Vec3& b = points_[vertex(located, 1)];
     const Vec3& c = points_[vertex(located, 2)];
-    const bool inside_solid = orient(a, b, c) > 0 && orient(a, b, p) >= 0 && orient(b, c, p) >= 0 &&
-                              orient(c, a, p) >= 0;
+    // p is on or left of the three edges when the walk stopped by itself; test them otherwise.
+    const bool inside_solid = orient(a, b, c) > 0 &&
+                              (inside || (orient(a, b, p) >= 0 && orient(b, c, p) >= 0 && orient(c, a, p) >= 0));
+    const bool located_visible = visible(located, p);
     TriangleId seed = located;
-    if (!inside_solid && !visible(located, p)) {
+    if (!inside_solid && !located_visible) {
         // p is outside the solid region (in the ghost part) or the walk stopped early: search
         // breadth-first for a triangle p is beyond. search_ lists every triangle marked.
         seed = no_triangle;
@@ -337,7 +379,7 @@ VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId
         }
         for (TriangleId s : search_) clear_mark(s);
     }
-    if (seed == no_triangle || (inside_solid && !visible(located, p))) {
+    if (seed == no_triangle || (inside_solid && !located_visible)) {
         // p lies inside the hull of its neighbours (closer than rounding lets the hull resolve):
         // merge it into the nearest vertex of its triangle.
         ++merged_;
@@ -346,7 +388,104 @@ VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId
             if (arc_angle(points_[vertex(located, i)], p) < arc_angle(points_[best], p)) best = vertex(located, i);
         return best;
     }
+    VertexId v;
+    if (insert_fan(p, seed, id, v)) return v;
     return insert_in_cavity(p, seed, no_half_edge, id);
+}
+
+// The cavity of p without constraints, grown depth-first from `seed` (a triangle p is beyond)
+// so that its rim comes out in counter-clockwise order: entering a neighbour across rim edge
+// u->w replaces that edge by the neighbour's edges u->x then x->w. The fan around p then links
+// each new triangle to the next one along the rim directly, and reuses the cavity's slots.
+// Returns false, with nothing changed, when the cavity touches a constrained edge or its rim is
+// not one closed chain (a vertex swallowed by the cavity): insert_in_cavity handles those.
+bool SphericalDelaunay::insert_fan(const Vec3& p, TriangleId seed, VertexId id, VertexId& result) {
+    cavity_.clear();
+    rim_.clear();
+    auto& stack = search_;
+    stack.clear();
+    set_mark(seed);
+    cavity_.push_back(seed);
+    stack.push_back(half_edge(seed, 2));
+    stack.push_back(half_edge(seed, 1));
+    stack.push_back(half_edge(seed, 0));
+    bool ok = true;
+    while (!stack.empty()) {
+        const HalfEdge h = stack.back();
+        stack.pop_back();
+        const std::uint32_t word = links_[h];
+        if (word & constrained_bit) {
+            ok = false;
+            break;
+        }
+        const HalfEdge o = word & link_mask;
+        const TriangleId nb = triangle_of(o);
+        if (marked(nb)) continue; // an edge inside the cavity, reached from its other side
+        if (visible(nb, p)) {
+            set_mark(nb);
+            cavity_.push_back(nb);
+            const int j = edge_of(o);
+            stack.push_back(half_edge(nb, prev3(j)));
+            stack.push_back(half_edge(nb, next3(j)));
+        } else {
+            const TriangleId s = triangle_of(h);
+            const int i = edge_of(h);
+            rim_.push_back({vertex(s, next3(i)), vertex(s, prev3(i)), word, labels_[s]});
+        }
+    }
+    const std::size_t m = rim_.size();
+    if (ok) {
+        for (std::size_t r = 0; r < m && ok; ++r) ok = rim_[r].w == rim_[r + 1 == m ? 0 : r + 1].u;
+        ok = ok && m >= 3;
+    }
+    if (!ok) {
+        for (TriangleId s : cavity_) clear_mark(s);
+        return false;
+    }
+    // Merge with a rim vertex within tolerance (the nearest vertex to p is on the rim).
+    for (const Rim& r : rim_)
+        if (within(points_[r.u], p, options_.merge_tolerance_rad)) {
+            for (TriangleId s : cavity_) clear_mark(s);
+            ++merged_;
+            result = r.u;
+            return true;
+        }
+    const std::size_t k = cavity_.size();
+    if (m > k && free_.size() < m - k &&
+        3 * (static_cast<std::uint64_t>(triangle_slots()) + (m - k - free_.size())) > link_mask)
+        throw DataError("triangulation too large: more than " + std::to_string(link_mask / 3) +
+                        " triangles (about 178 million points)");
+    VertexId v = id;
+    if (v == no_vertex) {
+        v = static_cast<VertexId>(points_.size());
+        points_.push_back(p);
+    }
+    // Slots of the fan: the cavity's own, then free or new ones; a cavity larger than its fan
+    // (it swallowed a vertex) would free the rest, but the closed-chain check rules that out
+    // only for k == m - 2, so handle any k.
+    for (std::size_t r = k; r < m; ++r) cavity_.push_back(new_slot());
+    for (std::size_t r = m; r < k; ++r) {
+        clear_mark(cavity_[r]);
+        free_triangle(cavity_[r]);
+    }
+    const TriangleId* fan = cavity_.data();
+    for (std::size_t r = 0; r < m; ++r) {
+        const TriangleId t = fan[r];
+        const Rim& e = rim_[r];
+        tri_vertices_[3 * t] = v;
+        tri_vertices_[3 * t + 1] = e.u;
+        tri_vertices_[3 * t + 2] = e.w;
+        labels_[t] = e.label;
+        const HalfEdge o = e.outside & link_mask;
+        const std::uint32_t flag = e.outside & constrained_bit;
+        links_[3 * t] = o | flag;
+        links_[o] = 3 * t | flag;
+        links_[3 * t + 1] = half_edge(fan[r + 1 == m ? 0 : r + 1], 2); // w -> v
+        links_[3 * t + 2] = half_edge(fan[r == 0 ? m - 1 : r - 1], 1); // v -> u
+    }
+    last_ = fan[m - 1];
+    result = v;
+    return true;
 }
 
 VertexId SphericalDelaunay::insert_in_triangle(const Vec3& p, TriangleId t) {
