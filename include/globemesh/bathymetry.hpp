@@ -25,8 +25,15 @@
 //
 // Memory: values are stored once, as float (4 bytes a cell; exact for Int16/Int32 below 2^24
 // and Float32 rasters, relative rounding 6e-8 otherwise), read straight from GDAL's blocks into
-// that array. Rasters with more than max_cells cells (default 2^28, 1 GiB: a 1-arc-minute global
-// grid fits) are read decimated with GDAL's average resampling to at most max_cells.
+// that array; the full raster is never allocated when it is read decimated. Decimation (GDAL's
+// average resampling through RasterIO, which uses the raster's overviews when it has some and
+// only the source window a VRT maps otherwise) applies to rasters with more than max_cells
+// cells (default 2^28, 1 GiB: a 1-arc-minute global grid fits) and, through RasterLimits, to
+// cells finer than the mesh can use. read_bathymetry() asks for cells no finer than half the
+// smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and refuses
+// (DataError naming --max-memory) when the values would take more than half of
+// options.max_memory_bytes. GDAL's block cache (GDAL_CACHEMAX, 5% of RAM by default) comes on
+// top while reading.
 //
 // Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
 // exist; DataError for a raster without georeferencing, with no valid cell, or that does not
@@ -106,6 +113,17 @@ private:
     std::optional<double> fill_;
 };
 
+/// How coarsely, and within how much memory, read_raster holds a raster.
+struct RasterLimits {
+    /// Decimate (GDAL average) to at most this many cells; 0: no cap.
+    std::size_t max_cells = std::size_t{1} << 28;
+    /// Cells finer than this (degrees, each axis apart) are averaged to about this size (never
+    /// coarser: the cell count per axis is rounded up); 0: the raster's own resolution.
+    double min_cell_deg = 0;
+    /// Refuse (DataError naming --max-memory) when the values read would take more bytes; 0: no cap.
+    std::uint64_t max_bytes = 0;
+};
+
 /// Reads one band of any GDAL raster as elevation in metres (positive up); see the file comment.
 /// path: the raster; band: 1-based; depth_positive: the raster stores depth positive down;
 /// max_cells: decimate (GDAL average) rasters larger than this. Throws IoError, UsageError
@@ -113,9 +131,19 @@ private:
 Raster read_raster(const std::string& path, int band = 1, bool depth_positive = false,
                    const Progress& progress = {}, std::size_t max_cells = std::size_t{1} << 28);
 
+/// read_raster within `limits`: decimated as they say, and a DataError naming the raster's size,
+/// the bytes needed and --max-memory, before anything large is allocated, when it does not fit.
+Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
+                   const RasterLimits& limits);
+
+/// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
+/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory.
+RasterLimits bathymetry_limits(const MeshOptions& options);
+
 /// Reads options.bathy (band options.bathy_band, options.depth_positive), sets the fill to
 /// -options.bathy_fill_m when given, and checks that the raster covers options.region (the whole
-/// globe without --region; --region-file is not checked here). Throws as read_raster, and
+/// globe without --region; --region-file is not checked here), within bathymetry_limits(options).
+/// Throws as read_raster, and
 /// DataError when the raster covers only part of the region and no --bathy-fill is set.
 Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {});
 

@@ -46,6 +46,10 @@ struct MeshOptions {
 
     // --- mesher (mesher/) ---
     std::uint64_t max_nodes = 20'000'000; ///< --max-nodes: refuse runs estimated larger
+    /// --max-memory: refuse runs whose estimated peak memory exceeds this many bytes; 0 = no
+    /// limit (the library's default; the CLI's default is 3/4 of the physical memory). The
+    /// budget never changes a result: a run fits (the same mesh as without it) or is refused.
+    std::uint64_t max_memory_bytes = 0;
     int smooth_iterations = 4;            ///< --smooth: smoothing/relaxation sweeps
     std::uint64_t seed = 1;               ///< --seed: seed of every pseudo-random choice
 };

@@ -139,10 +139,33 @@ std::string fmt_deg(double v) {
     return buf;
 }
 
+std::string fmt_count(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
+}
+
+/// Bytes with an SI unit, as --max-memory takes them ("1.2 GB").
+std::string fmt_bytes(double v) {
+    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
+    int u = 0;
+    while (v >= 1000 && u < 5) v /= 1000, ++u;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
+    return buf;
+}
+
 } // namespace
 
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
                    std::size_t max_cells) {
+    RasterLimits limits;
+    limits.max_cells = max_cells;
+    return read_raster(path, band, depth_positive, progress, limits);
+}
+
+Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
+                   const RasterLimits& limits) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
     report(progress, 0.0, "read bathymetry");
@@ -190,13 +213,28 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // A node-registered global grid repeats its first meridian as the last column: drop it.
     if (nx > 1 && std::abs(static_cast<double>(nx - 1) * gt[1] - 360.0) <= 1e-6 * gt[1]) --nx;
 
-    // Decimate (GDAL average) rasters larger than max_cells.
-    std::size_t bx = nx, by = ny;
-    if (max_cells > 0 && nx * ny > max_cells) {
-        double f = std::sqrt(static_cast<double>(nx) * static_cast<double>(ny) / static_cast<double>(max_cells));
-        bx = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(nx) / f)));
-        by = std::max<std::size_t>(1, static_cast<std::size_t>(std::floor(static_cast<double>(ny) / f)));
+    // Decimate (GDAL average): cells finer than min_cell_deg, then rasters larger than max_cells.
+    // Counts stay in double until they are known to be small (a declared raster may be huge).
+    double cx = static_cast<double>(nx), cy = static_cast<double>(ny);
+    if (limits.min_cell_deg > 0) {
+        // Rounded up, so a cell never gets coarser than asked; 1e-9 absorbs the step's rounding.
+        const double fx = limits.min_cell_deg / std::abs(gt[1]), fy = limits.min_cell_deg / std::abs(gt[5]);
+        if (fx > 1) cx = std::max(1.0, std::ceil(cx / fx - 1e-9));
+        if (fy > 1) cy = std::max(1.0, std::ceil(cy / fy - 1e-9));
     }
+    if (limits.max_cells > 0 && cx * cy > static_cast<double>(limits.max_cells)) {
+        double f = std::sqrt(cx * cy / static_cast<double>(limits.max_cells));
+        cx = std::max(1.0, std::floor(cx / f));
+        cy = std::max(1.0, std::floor(cy / f));
+    }
+    const double bytes = cx * cy * static_cast<double>(sizeof(float));
+    if (limits.max_bytes > 0 && bytes > static_cast<double>(limits.max_bytes))
+        throw DataError("--bathy " + path + ": " + std::to_string(nx) + " x " + std::to_string(ny) +
+                        " cells, read as " + fmt_count(cx) + " x " + fmt_count(cy) + " (" + fmt_bytes(bytes) +
+                        "), exceed the " + fmt_bytes(static_cast<double>(limits.max_bytes)) +
+                        " that --max-memory leaves for it; raise --max-memory or --hmin, or give a "
+                        "coarser raster (gdal_translate -tr)");
+    const std::size_t bx = static_cast<std::size_t>(cx), by = static_cast<std::size_t>(cy);
     const double sx = static_cast<double>(nx) / static_cast<double>(bx);
     const double sy = static_cast<double>(ny) / static_cast<double>(by);
     const double dlon = gt[1] * sx, dlat = gt[5] * sy;
@@ -254,11 +292,21 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     return raster;
 }
 
+RasterLimits bathymetry_limits(const MeshOptions& o) {
+    // The mesh samples the raster at its nodes and on the size field's grid (spacing hfloor / 2):
+    // finer cells only alias there, so they are averaged to that size.
+    const double hfloor_km = o.hmin_km > 0 ? o.hmin_km : std::max(o.hmax_km / 1000, 0.01);
+    RasterLimits limits;
+    limits.min_cell_deg = 0.5 * hfloor_km / (earth_radius_km * deg_to_rad);
+    limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh
+    return limits;
+}
+
 Raster read_bathymetry(const MeshOptions& o, const Progress& progress) {
     if (o.bathy.empty()) throw UsageError("--bathy: no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
         throw UsageError("--bathy-fill must be a depth in metres");
-    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress);
+    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress, bathymetry_limits(o));
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
         return r;

@@ -193,6 +193,25 @@ struct MeshCommand {
 
         app.add_option("--max-nodes", m.max_nodes, "Refuse runs estimated to give more nodes")
             ->group(mesher)->type_name("N");
+        // "auto" (the default) is 3/4 of the physical memory, read here: the library reads no
+        // system state. The transform turns every form into bytes, so config files read back.
+        m.max_memory_bytes = default_memory_budget_bytes();
+        app.add_option("--max-memory", m.max_memory_bytes,
+                       "Refuse runs estimated to need more memory (B, kB, MB, GB or KiB..TiB; bare: "
+                       "bytes; 0: no limit; auto: 3/4 of the physical memory)")
+            ->group(mesher)->type_name("SIZE")
+            ->transform(CLI::Validator(
+                [](std::string& value) -> std::string {
+                    try {
+                        value = std::to_string(value == "auto" ? default_memory_budget_bytes()
+                                                               : parse_memory_bytes(value));
+                        return {};
+                    } catch (const UsageError& e) {
+                        return e.what();
+                    }
+                },
+                ""))
+            ->default_str("auto");
         app.add_option("--smooth", m.smooth_iterations, "Smoothing/relaxation sweeps")->group(mesher)->type_name("N");
         app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")->group(mesher)->type_name("N");
 

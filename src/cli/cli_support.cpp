@@ -232,6 +232,12 @@ long long peak_memory_bytes() {
     return static_cast<long long>(usage.ru_maxrss) * 1024; // Linux reports kilobytes
 }
 
+std::uint64_t default_memory_budget_bytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page_size <= 0) return 0;
+    return static_cast<std::uint64_t>(pages) / 4 * 3 * static_cast<std::uint64_t>(page_size);
+}
+
 namespace {
 
 /// True for names GDAL resolves itself: /vsi... paths and "SCHEME:..." connection strings.

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <csignal>
+#include <cstdint>
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -82,6 +84,15 @@ void print_timings(std::ostream& out, const StageTimings& timings);
 
 /// Peak resident memory of this process in bytes (getrusage ru_maxrss).
 long long peak_memory_bytes();
+
+/// "4GB", "500MB", "2GiB", "123" (bytes) -> bytes: SI units B, kB, MB, GB, TB (powers of 1000)
+/// and binary KiB, MiB, GiB, TiB (powers of 1024). Throws UsageError for a non-number, a
+/// negative value or an unknown unit.
+std::uint64_t parse_memory_bytes(std::string_view text);
+
+/// The default of --max-memory: 3/4 of the physical memory (sysconf), leaving room for the
+/// system and other programs; 0 (no limit) when the system does not say.
+std::uint64_t default_memory_budget_bytes();
 
 /// Throws IoError when `path`'s folder does not exist, or when `path` exists and !overwrite.
 /// `what` names the option, e.g. "--gpkg".

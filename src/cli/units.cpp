@@ -2,10 +2,12 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
 #include "globemesh/cli.hpp"
+#include "cli_support.hpp"
 #include "globemesh/error.hpp"
 
 namespace globemesh {
@@ -68,5 +70,21 @@ double parse_duration_h(std::string_view text) {
 double parse_depth_m(std::string_view text) {
     return parse_quantity(text, {{"m", 1.0}, {"km", 1e3}}, "50m");
 }
+
+namespace cli {
+
+std::uint64_t parse_memory_bytes(std::string_view text) {
+    const double bytes = parse_quantity(text,
+                                        {{"B", 1.0}, {"kB", 1e3}, {"MB", 1e6}, {"GB", 1e9}, {"TB", 1e12},
+                                         {"KiB", 1024.0}, {"MiB", 1048576.0}, {"GiB", 1073741824.0},
+                                         {"TiB", 1099511627776.0}},
+                                        "4GB or 500MB");
+    // 2^63: far beyond any machine, and exactly representable.
+    if (bytes < 0 || bytes >= 9223372036854775808.0)
+        throw UsageError("'" + std::string(text) + "' is not a memory size (e.g. 4GB or 500MB; 0: no limit)");
+    return static_cast<std::uint64_t>(std::llround(bytes));
+}
+
+} // namespace cli
 
 } // namespace globemesh

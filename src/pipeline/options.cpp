@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "globemesh/error.hpp"
@@ -13,6 +14,9 @@ void require(bool ok, const std::string& message) {
 }
 
 bool positive(double v) { return std::isfinite(v) && v > 0; }
+
+/// Below this no run fits: the smallest meshes and GDAL's own buffers take more.
+constexpr std::uint64_t min_memory_budget_bytes = 1'000'000;
 
 } // namespace
 
@@ -33,6 +37,8 @@ void validate(const MeshOptions& o) {
             "--min-island-area must be a positive area, e.g. 100km2");
     require(o.bathy_band >= 1, "--bathy-band must be 1 or more");
     require(o.max_nodes >= 3, "--max-nodes must be at least 3");
+    require(o.max_memory_bytes == 0 || o.max_memory_bytes >= min_memory_budget_bytes,
+            "--max-memory must be 0 (no limit) or at least 1MB, e.g. 4GB");
     require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000, "--smooth must be in 0..1000");
     if (o.region) {
         const auto& r = *o.region;

@@ -1,7 +1,10 @@
 // mesh_ocean(): the one function that calls every module, in the order of DESIGN.md's flow.
 #include "globemesh/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -40,6 +43,66 @@ std::string number(double v) {
     return s.str();
 }
 
+/// Bytes with an SI unit, as --max-memory takes them ("1.2 GB").
+std::string bytes_text(double v) {
+    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
+    int u = 0;
+    while (v >= 1000 && u < 5) v /= 1000, ++u;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
+    return buf;
+}
+
+/// Largest background grid of the size field: 2^22 nodes (about 10 km at the equator
+/// globally) builds in a few seconds; regional grids are finer for the same count.
+constexpr std::size_t size_grid_max_nodes = std::size_t{1} << 22;
+
+/// Peak bytes per node of the background grid while it is built (sizefield/grid.cpp): the
+/// values, the coast distance's keys, nearest sources, flags and distances, the gradation's
+/// copy, flags and heap, the depths; 44 counted, rounded up.
+constexpr std::uint64_t size_grid_bytes_per_node = 64;
+
+/// Bytes per node of the full-resolution coast rings kept until the mesh is done (a Vec3 and
+/// its segment tag, with the vector's slack).
+constexpr std::uint64_t ring_bytes_per_node = 40;
+
+/// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
+/// the region plus a cell of margin, at most size_grid_max_nodes).
+double size_grid_nodes(const MeshOptions& o) {
+    const double hfloor = o.hmin_km > 0 ? o.hmin_km : std::max(o.hmax_km / 1000, 0.01);
+    const double spacing = std::max(1e-6, 0.5 * hfloor / earth_radius_km * rad_to_deg);
+    double lon_span = 360, lat_span = 180;
+    if (o.region) {
+        const auto& r = *o.region;
+        lon_span = std::min(360.0, (r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360) + 2 * spacing);
+        lat_span = std::min(180.0, r[3] - r[1] + 2 * spacing);
+    }
+    const double nodes = (std::ceil(lon_span / spacing) + 1) * (std::ceil(lat_span / spacing) + 1);
+    return std::min(nodes, static_cast<double>(size_grid_max_nodes));
+}
+
+/// The --max-memory budget: what the stages already hold, and a check before each large
+/// allocation. The budget never changes a result; it only refuses, naming the stage.
+class MemoryBudget {
+public:
+    explicit MemoryBudget(std::uint64_t total) : total_(total) {}
+    void hold(double bytes) { held_ += bytes; }
+    /// Bytes left for the next stages (0: the budget is spent); meaningless without a budget.
+    std::uint64_t left() const { return held_ >= static_cast<double>(total_) ? 0 : total_ - static_cast<std::uint64_t>(held_); }
+    /// Throws DataError when `bytes` more do not fit; `what` says what needs them.
+    void require(double bytes, const std::string& what, const std::string& remedy) const {
+        if (total_ == 0 || held_ + bytes <= static_cast<double>(total_)) return;
+        throw DataError(what + " needs about " + bytes_text(bytes) + ", more than the " +
+                        bytes_text(static_cast<double>(left())) + " left of --max-memory " +
+                        bytes_text(static_cast<double>(total_)) + " after reading the inputs (" +
+                        bytes_text(held_) + "); raise --max-memory" + remedy);
+    }
+
+private:
+    std::uint64_t total_;
+    double held_ = 0;
+};
+
 } // namespace
 
 Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* timings) {
@@ -47,11 +110,18 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     if (o.coast.empty()) throw UsageError("--coast is required: a land polygon or coastline file (any OGR source)");
     StageClock clock(timings);
 
+    // load_coast and read_bathymetry check their own reads against --max-memory (the coast
+    // counts its vertices while reading, the raster is read no finer than the mesh needs).
+    MemoryBudget budget(o.max_memory_bytes);
     CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
+    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
     clock.lap("read_coast");
 
     std::optional<Raster> bathy;
-    if (!o.bathy.empty()) bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15));
+    if (!o.bathy.empty()) {
+        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15));
+        budget.hold(static_cast<double>(bathy->values().size() * sizeof(float)));
+    }
     clock.lap("read_bathy");
 
     // --hmax alone is a uniform field: no background grid needed.
@@ -61,11 +131,14 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     if (uniform) {
         size = uniform_size(std::max(o.hmax_km, o.hmin_km));
     } else {
-        // A background grid of 2^22 nodes (about 10 km at the equator globally) builds in a few
-        // seconds; regional grids are finer for the same count.
+        const double grid_nodes = size_grid_nodes(o);
+        budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
+                       "the size field's background grid (" + number(std::round(grid_nodes)) + " nodes)",
+                       " or --hmin");
         field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
-                                 sub_progress(progress, 0.15, 0.25), std::size_t{1} << 22);
+                                 sub_progress(progress, 0.15, 0.25), size_grid_max_nodes);
         size = field.function();
+        budget.hold(static_cast<double>(field.grid().values().size() * sizeof(float)));
     }
     clock.lap("size_field");
 
@@ -75,6 +148,11 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
 
     MesherOptions mo;
     mo.max_nodes = o.max_nodes;
+    if (o.max_memory_bytes > 0) {
+        // The mesher refuses from its node estimate against what the inputs left.
+        budget.require(static_cast<double>(mesher_bytes_per_node), "meshing", " or --hmin/--hmax");
+        mo.max_memory = budget.left();
+    }
     mo.smooth_iterations = o.smooth_iterations;
     mo.keep_inland_seas = o.keep_inland_seas;
     mo.seed = o.seed;

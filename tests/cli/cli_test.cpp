@@ -3,7 +3,10 @@
 // fails the test if it is reached. The runs through the real library are in tests/e2e.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <csignal>
+#include <cstdint>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -108,6 +111,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.size_regions, b.size_regions);
     EXPECT_EQ(a.grade, b.grade);
     EXPECT_EQ(a.max_nodes, b.max_nodes);
+    EXPECT_EQ(a.max_memory_bytes, b.max_memory_bytes);
     EXPECT_EQ(a.smooth_iterations, b.smooth_iterations);
     EXPECT_EQ(a.seed, b.seed);
 }
@@ -134,10 +138,24 @@ std::vector<std::string> every_option(const std::string& out_dir) {
             "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
             "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
-            "--max-nodes", "123456", "--smooth", "7", "--seed", "42",
+            "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--seed", "42",
             "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
             "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
             "--overwrite", "--verbose", "--check"};
+}
+
+/// Three quarters of the physical memory (the documented default of --max-memory), from sysconf.
+std::uint64_t three_quarters_of_ram() {
+    const auto pages = static_cast<std::uint64_t>(sysconf(_SC_PHYS_PAGES));
+    const auto page = static_cast<std::uint64_t>(sysconf(_SC_PAGE_SIZE));
+    return pages / 4 * 3 * page;
+}
+
+/// MeshOptions{} as the CLI fills it when no option is given.
+globemesh::MeshOptions cli_default_options() {
+    globemesh::MeshOptions o;
+    o.max_memory_bytes = three_quarters_of_ram();
+    return o;
 }
 
 } // namespace
@@ -176,6 +194,26 @@ TEST(Cli, unknown_units_and_non_numbers_are_usage_errors) {
     EXPECT_THROW(globemesh::parse_length_km("10km2"), globemesh::UsageError);
 }
 
+TEST(Cli, memory_sizes_take_si_and_binary_units_and_auto) {
+    auto bytes = [](const std::string& text) {
+        return globemesh::parse_mesh_args(std::vector<std::string>{"--max-memory", text}).mesh.max_memory_bytes;
+    };
+    EXPECT_EQ(bytes("4GB"), 4'000'000'000u);
+    EXPECT_EQ(bytes("500MB"), 500'000'000u);
+    EXPECT_EQ(bytes("2.5 kB"), 2500u);
+    EXPECT_EQ(bytes("2GiB"), std::uint64_t{2} << 30);
+    EXPECT_EQ(bytes("3MiB"), std::uint64_t{3} << 20);
+    EXPECT_EQ(bytes("123456"), 123456u); // bare: bytes
+    EXPECT_EQ(bytes("0"), 0u);           // no limit
+    EXPECT_EQ(bytes("auto"), three_quarters_of_ram());
+    for (const char* bad : {"4G", "4gb", "-1GB", "lots", "1e30TB"})
+        EXPECT_THROW(bytes(bad), globemesh::UsageError) << bad;
+    // Values below 1MB (other than 0) cannot hold any run: refused before reading anything.
+    const Result r = run_refused({"mesh", "--coast", coast, "-o", "x.nc", "--max-memory", "1kB"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--max-memory"), std::string::npos) << r.err;
+}
+
 TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
     const auto a = globemesh::parse_mesh_args(std::vector<std::string>{
         "--hmax", "5000m", "--hmin", "0.5", "--min-island-area", "1e6m2", "--coast-size", "2km",
@@ -193,7 +231,10 @@ TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
 
 TEST(Cli, defaults_are_those_of_mesh_options) {
     const auto a = globemesh::parse_mesh_args(std::vector<std::string>{});
-    expect_same_options(a.mesh, globemesh::MeshOptions{});
+    // All but --max-memory, which the library leaves off and the CLI sets from the machine.
+    expect_same_options(a.mesh, cli_default_options());
+    EXPECT_EQ(globemesh::MeshOptions{}.max_memory_bytes, 0u);
+    EXPECT_GT(a.mesh.max_memory_bytes, 0u);
     EXPECT_FALSE(a.mesh.region.has_value());
     EXPECT_FALSE(a.mesh.bathy_fill_m.has_value());
     EXPECT_EQ(a.format, "netcdf4");
@@ -270,7 +311,9 @@ TEST(Cli, print_config_of_defaults_reads_back_as_the_defaults) {
     write_text(dir / "d.toml", printed.out);
     SCOPED_TRACE(printed.out);
     const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "d.toml").string()});
-    expect_same_cli(again, globemesh::CliOptions{});
+    globemesh::CliOptions defaults;
+    defaults.mesh = cli_default_options();
+    expect_same_cli(again, defaults);
 }
 
 TEST(Cli, a_missing_config_file_is_an_error_naming_it) {

@@ -277,10 +277,13 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return info.param.name; });
 
 TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
+    // A global 15 km mesh of the 1:50m land (about 3.7 M nodes) takes minutes: the signal lands
+    // mid-run. The test sends it to the process it started, by its id.
     TempDir dir;
     const std::string output = (dir / "big.nc").string();
-    std::vector<std::string> args = {exe, "mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "8km",
-                                     "--max-nodes", "100000000", "-o", output, "-q"};
+    std::vector<std::string> args = {exe,      "mesh",  "--coast", land50, "--coast-layer", "land",
+                                     "--hmax", "15km",  "--gpkg",  (dir / "big.gpkg").string(),
+                                     "-o",     output,  "-q"};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -288,22 +291,156 @@ TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    // Run it in the test's folder, so that a temporary file written next to the cwd would show.
+    posix_spawn_file_actions_addchdir_np(&actions, dir.path().c_str());
     pid_t pid = 0;
     const int spawned = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     ASSERT_EQ(spawned, 0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-    kill(pid, SIGINT); // the process this test started, by its id
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+    const auto sent = std::chrono::steady_clock::now();
+    kill(pid, SIGINT);
     int wstatus = 0;
     ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
+    const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
     ASSERT_TRUE(WIFEXITED(wstatus)) << "killed by the signal instead of stopping cleanly";
     std::stringstream err;
     err << std::ifstream(err_path).rdbuf();
     fs::remove(err_path);
-    if (WEXITSTATUS(wstatus) == 0) GTEST_SKIP() << "the run finished before the signal arrived";
-    EXPECT_EQ(WEXITSTATUS(wstatus), 1);
-    EXPECT_NE(err.str().find("globemesh: cancelled"), std::string::npos) << err.str();
+    ASSERT_NE(WEXITSTATUS(wstatus), 0) << "the run finished within 2.5 s: it is too short for this test";
+    EXPECT_EQ(WEXITSTATUS(wstatus), 1); // cli.hpp: cancellation is status 1
+    EXPECT_EQ(err.str(), "globemesh: cancelled, no output written\n"); // one line, nothing else
     EXPECT_TRUE(fs::is_empty(dir.path())) << "output or temporary files left behind";
+    EXPECT_LT(stop_s, 10.0) << "the run took " << stop_s << " s to stop after the signal";
+}
+
+namespace {
+
+/// Writes a GeoPackage of `features` square-ish polygons of `vertices_each` vertices (a circle
+/// of radius 0.4 degree around a distinct centre each) with python3's GDAL bindings, from WKB
+/// built with numpy: an independent writer, and fast enough for 1e7 vertices.
+void write_many_vertex_layer(const fs::path& path, int features, int vertices_each, const fs::path& dir) {
+    python("import numpy as np, struct\n"
+           "from osgeo import ogr, osr\n"
+           "ogr.UseExceptions()\n"
+           "ds = ogr.GetDriverByName('GPKG').CreateDataSource('" + path.string() + "')\n"
+           "srs = osr.SpatialReference(); srs.ImportFromEPSG(4326)\n"
+           "lyr = ds.CreateLayer('dense_land', srs, ogr.wkbPolygon)\n"
+           "n = " + std::to_string(vertices_each) + "\n"
+           "t = np.linspace(0, 2 * np.pi, n)  # n vertices, the last equal to the first\n"
+           "lyr.StartTransaction()\n"
+           "for k in range(" + std::to_string(features) + "):\n"
+           "    cx, cy = -170 + (k % 100) * 3.0, -60 + (k // 100) * 3.0\n"
+           "    xy = np.empty((n, 2)); xy[:, 0] = cx + 0.4 * np.cos(t); xy[:, 1] = cy + 0.4 * np.sin(t)\n"
+           "    xy[-1] = xy[0]\n"
+           "    wkb = struct.pack('<BIII', 1, 3, 1, n) + xy.astype('<f8').tobytes()\n"
+           "    f = ogr.Feature(lyr.GetLayerDefn()); f.SetGeometry(ogr.CreateGeometryFromWkb(wkb))\n"
+           "    lyr.CreateFeature(f)\n"
+           "lyr.CommitTransaction()\n"
+           "ds = None\n",
+           dir);
+}
+
+/// Runs `globemesh mesh ARGS` in-process through the real library.
+int run_mesh_in_process(std::vector<std::string> args, std::string& out, std::string& err) {
+    args.insert(args.begin(), "mesh");
+    std::ostringstream o, e;
+    const int status = globemesh::run_cli(args, o, e);
+    out = o.str();
+    err = e.str();
+    return status;
+}
+
+} // namespace
+
+TEST(CliE2e, a_coastline_of_ten_million_vertices_is_refused_in_one_line_without_exhausting_memory) {
+    TempDir dir;
+    const fs::path coast = dir / "dense.gpkg";
+    write_many_vertex_layer(coast, 100, 100'000, dir.path()); // 1e7 vertices, 160 MB of WKB
+    std::string out, err;
+    // 1 GB keeps at most 5e6 vertices (200 B each): the loader stops keeping them half-way and
+    // only counts the rest.
+    const int status = run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "o.nc").string(),
+                                            "--max-memory", "1GB", "-q"},
+                                           out, err);
+    EXPECT_EQ(status, 1);
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_NE(err.find("layer 'dense_land' has 10000000 vertices"), std::string::npos) << err;
+    EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
+    EXPECT_EQ(out, "");
+    EXPECT_FALSE(fs::exists(dir / "o.nc"));
+}
+
+TEST(CliE2e, a_coastline_within_the_budget_is_read_and_meshed) {
+    // The same loader below the limit: 4 features of 5000 vertices, 1 MB per 5000 vertices.
+    TempDir dir;
+    const fs::path coast = dir / "dense.gpkg";
+    write_many_vertex_layer(coast, 4, 5000, dir.path());
+    std::string out, err;
+    EXPECT_EQ(run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "refused.nc").string(),
+                                   "--max-memory", "3MB", "--hmax", "500km", "-q"}, out, err), 1);
+    EXPECT_NE(err.find("has 20000 vertices, more than the 15000"), std::string::npos) << err;
+    ASSERT_EQ(run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "o.nc").string(),
+                                   "--max-memory", "500MB", "--hmax", "500km", "-q"}, out, err), 0)
+        << err;
+    expect_mesh_verify(dir / "o.nc");
+}
+
+TEST(CliE2e, a_four_gigabyte_raster_is_read_coarse_or_refused_without_reading_it_whole) {
+    // A VRT declares 69120 x 34560 Int16 cells (4.8 GB) over the 10-minute ETOPO5 fixture,
+    // each source cell repeated 32 x 32 times (cells of 0.3125 arc-minute).
+    TempDir dir;
+    const fs::path vrt = dir / "huge.vrt";
+    std::ofstream(vrt) << "<VRTDataset rasterXSize=\"69120\" rasterYSize=\"34560\">\n"
+                          "  <SRS>EPSG:4326</SRS>\n"
+                          "  <GeoTransform>-180, 0.005208333333333333, 0, 90, 0, -0.005208333333333333</GeoTransform>\n"
+                          "  <VRTRasterBand dataType=\"Int16\" band=\"1\">\n"
+                          "    <SimpleSource>\n"
+                          "      <SourceFilename relativeToVRT=\"0\">"
+                       << fixture("bathy/etopo5_global_10min.nc").string()
+                       << "</SourceFilename>\n"
+                          "      <SourceBand>1</SourceBand>\n"
+                          "      <SrcRect xOff=\"0\" yOff=\"0\" xSize=\"2160\" ySize=\"1080\"/>\n"
+                          "      <DstRect xOff=\"0\" yOff=\"0\" xSize=\"69120\" ySize=\"34560\"/>\n"
+                          "    </SimpleSource>\n"
+                          "  </VRTRasterBand>\n"
+                          "</VRTDataset>\n";
+    std::string out, err;
+    // Fine sizes ask for cells of 1 km: refused before any large allocation, naming the option.
+    EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
+                                   "--hmax", "300km", "--hmin", "2km", "--coast-size", "100km",
+                                   "--max-memory", "200MB", "-o", (dir / "fine.nc").string(), "-q"},
+                                  out, err), 1);
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_NE(err.find("--bathy " + vrt.string() + ": 69120 x 34560 cells"), std::string::npos) << err;
+    EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir / "fine.nc"));
+    // Coarse sizes (hmin 100 km: cells of 50 km) read about 800 x 400 cells and mesh.
+    ASSERT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
+                                   "--hmax", "300km", "--hmin", "100km",
+                                   "--max-memory", "200MB", "-o", (dir / "coarse.nc").string(), "-q"},
+                                  out, err), 0)
+        << err;
+    expect_mesh_verify(dir / "coarse.nc");
+}
+
+TEST(CliE2e, a_size_field_grid_or_a_mesh_beyond_the_budget_is_refused_before_it_is_built) {
+    TempDir dir;
+    std::string out, err;
+    // 2^22 grid nodes at 64 B: 268 MB.
+    EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--hmax", "100km",
+                                   "--hmin", "1km", "--coast-size", "5km", "--max-memory", "100MB",
+                                   "-o", (dir / "o.nc").string(), "-q"}, out, err), 1);
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_NE(err.find("background grid"), std::string::npos) << err;
+    EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
+    // A uniform 5 km mesh: about 25 M nodes, far beyond 1 GB at the mesher's 800 B a node.
+    EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--hmax", "5km",
+                                   "--max-nodes", "1000000000", "--max-memory", "1GB",
+                                   "-o", (dir / "o.nc").string(), "-q"}, out, err), 1);
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
+    EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 TEST(CliE2e, run_cli_in_process_prints_the_summary_on_out_only) {

@@ -2,7 +2,9 @@
 // and the real ETOPO5 fixtures checked against an independent read (netCDF-C coordinates and
 // values, GDALRasterIO of single pixels).
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <iomanip>
 #include <limits>
 #include <random>
 #include <string>
@@ -367,4 +369,101 @@ TEST(Bathymetry, etopo5_nwshelf_geotiff_nodes_sit_on_whole_5_minutes) {
     EXPECT_GT(r.elevation_m(-4.0, 57.0), 100); // Scottish Highlands
     // The whole globe is not covered.
     EXPECT_THROW(read_bathymetry(options_for(path)), DataError);
+}
+
+namespace {
+
+/// A VRT of nx x ny Int16 cells over the globe whose source is the whole 10-minute ETOPO5
+/// fixture (2160 x 1080) stretched onto it: 69120 x 34560 declares 4.8 GB and costs nothing.
+std::string huge_global_vrt(const TempDir& dir, int nx, int ny) {
+    const std::string path = (dir / "huge.vrt").string();
+    const double dx = 360.0 / nx, dy = 180.0 / ny;
+    std::ofstream(path) << "<VRTDataset rasterXSize=\"" << nx << "\" rasterYSize=\"" << ny << "\">\n"
+                        << "  <SRS>EPSG:4326</SRS>\n"
+                        << std::setprecision(17) << "  <GeoTransform>-180, " << dx << ", 0, 90, 0, " << -dy
+                        << "</GeoTransform>\n"
+                        << "  <VRTRasterBand dataType=\"Int16\" band=\"1\">\n"
+                        << "    <SimpleSource>\n"
+                        << "      <SourceFilename relativeToVRT=\"0\">"
+                        << fixture("bathy/etopo5_global_10min.nc").string() << "</SourceFilename>\n"
+                        << "      <SourceBand>1</SourceBand>\n"
+                        << "      <SrcRect xOff=\"0\" yOff=\"0\" xSize=\"2160\" ySize=\"1080\"/>\n"
+                        << "      <DstRect xOff=\"0\" yOff=\"0\" xSize=\"" << nx << "\" ySize=\"" << ny << "\"/>\n"
+                        << "    </SimpleSource>\n"
+                        << "  </VRTRasterBand>\n"
+                        << "</VRTDataset>\n";
+    return path;
+}
+
+} // namespace
+
+TEST(Bathymetry, four_gigabyte_raster_is_read_at_the_cell_size_asked_and_equals_its_source) {
+    TempDir dir;
+    const std::string vrt = huge_global_vrt(dir, 69120, 34560); // 32 x 32 copies of each cell
+    RasterLimits limits;
+    limits.min_cell_deg = 1.0 / 6; // the source's own 10 minutes
+    limits.max_bytes = 64'000'000;
+    Raster r = read_raster(vrt, 1, false, {}, limits);
+    ASSERT_EQ(r.nlon(), 2160u);
+    ASSERT_EQ(r.nlat(), 1080u);
+    EXPECT_TRUE(r.global());
+    // The average of 32 x 32 equal Int16 values is that value: every cell equals the fixture's
+    // cell read independently by GDALRasterIO.
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    GDALDatasetH ds = GDALOpen(source.c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    std::vector<double> truth(2160 * 1080);
+    ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, 2160, 1080, truth.data(), 2160, 1080,
+                           GDT_Float64, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    std::size_t differ = 0;
+    for (std::size_t j = 0; j < 1080; ++j)
+        for (std::size_t i = 0; i < 2160; ++i) differ += r.value(i, j) != truth[j * 2160 + i];
+    EXPECT_EQ(differ, 0u);
+    EXPECT_NEAR(r.lon_deg(0), -180 + 1.0 / 12, 1e-9);
+    EXPECT_NEAR(r.lat_deg(0), 90 - 1.0 / 12, 1e-9);
+}
+
+TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_memory) {
+    TempDir dir;
+    const std::string vrt = huge_global_vrt(dir, 69120, 34560);
+    MeshOptions o = options_for(vrt);
+    o.hmin_km = 1;                     // cells of 0.5 km asked: more than the 2^28-cell cap
+    o.max_memory_bytes = 500'000'000;  // half of it for the raster: less than 2^28 floats
+    try {
+        read_bathymetry(o);
+        FAIL() << "a 1 GiB read within a 250 MB share";
+    } catch (const DataError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
+        EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+    // Coarser sizes fit: hmin 40 km asks for cells of 20 km (0.18 degree), rounded up in count.
+    o.hmin_km = 40;
+    o.hmax_km = 100;
+    const RasterLimits limits = bathymetry_limits(o);
+    EXPECT_NEAR(limits.min_cell_deg, 20.0 / (earth_radius_km * deg_to_rad), 1e-12);
+    EXPECT_EQ(limits.max_bytes, 250'000'000u);
+    Raster r = read_bathymetry(o);
+    const double cell = 20.0 / (earth_radius_km * deg_to_rad);
+    EXPECT_EQ(r.nlon(), static_cast<std::size_t>(std::ceil(360 / cell)));
+    EXPECT_EQ(r.nlat(), static_cast<std::size_t>(std::ceil(180 / cell)));
+    EXPECT_LE(r.dlon_deg(), cell);
+}
+
+TEST(Bathymetry, without_a_budget_or_a_floor_the_raster_is_read_at_full_resolution) {
+    // The default limits change nothing for a raster within the cell cap.
+    const std::string path = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    MeshOptions o = options_for(path);
+    o.bathy_fill_m = 10.0;
+    const RasterLimits limits = bathymetry_limits(o); // hmin 0, hmax 100: cells of 50 m
+    EXPECT_EQ(limits.max_bytes, 0u);
+    Raster r = read_bathymetry(o);
+    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    EXPECT_EQ(r.nlon(), static_cast<std::size_t>(GDALGetRasterXSize(ds)));
+    EXPECT_EQ(r.nlat(), static_cast<std::size_t>(GDALGetRasterYSize(ds)));
+    GDALClose(ds);
 }
