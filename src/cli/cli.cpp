@@ -128,6 +128,7 @@ struct MeshCommand {
     CliOptions o;
     std::vector<double> region;
     double bathy_fill_m = 0;
+    std::string max_memory_text = "auto";
     CLI::App app{"Mesh the ocean between the coastlines, graded by the size options.", "globemesh mesh"};
     CLI::Option* region_opt = nullptr;
     CLI::Option* bathy_fill_opt = nullptr;
@@ -193,25 +194,23 @@ struct MeshCommand {
 
         app.add_option("--max-nodes", m.max_nodes, "Refuse runs estimated to give more nodes")
             ->group(mesher)->type_name("N");
-        // "auto" (the default) is 3/4 of the physical memory, read here: the library reads no
-        // system state. The transform turns every form into bytes, so config files read back.
-        m.max_memory_bytes = default_memory_budget_bytes();
-        app.add_option("--max-memory", m.max_memory_bytes,
+        // Kept as text ("auto", "4GB") so that --print-config and the mesh's configuration say
+        // what was asked, not this machine's memory; converted in parse(). "auto" is 3/4 of the
+        // physical memory, read here: the library reads no system state.
+        app.add_option("--max-memory", max_memory_text,
                        "Refuse runs estimated to need more memory (B, kB, MB, GB or KiB..TiB; bare: "
                        "bytes; 0: no limit; auto: 3/4 of the physical memory)")
             ->group(mesher)->type_name("SIZE")
-            ->transform(CLI::Validator(
+            ->check(CLI::Validator(
                 [](std::string& value) -> std::string {
                     try {
-                        value = std::to_string(value == "auto" ? default_memory_budget_bytes()
-                                                               : parse_memory_bytes(value));
+                        if (value != "auto") parse_memory_bytes(value);
                         return {};
                     } catch (const UsageError& e) {
                         return e.what();
                     }
                 },
-                ""))
-            ->default_str("auto");
+                ""));
         app.add_option("--smooth", m.smooth_iterations, "Smoothing/relaxation sweeps")->group(mesher)->type_name("N");
         app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")->group(mesher)->type_name("N");
 
@@ -249,6 +248,8 @@ struct MeshCommand {
         if (region_opt->count() > 0 && region.size() == 4)
             o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
         if (bathy_fill_opt->count() > 0) o.mesh.bathy_fill_m = bathy_fill_m;
+        o.mesh.max_memory_bytes =
+            max_memory_text == "auto" ? default_memory_budget_bytes() : parse_memory_bytes(max_memory_text);
         if (o.quiet && o.verbose) throw UsageError("--quiet and --verbose exclude each other");
     }
 };

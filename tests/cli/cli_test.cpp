@@ -208,6 +208,11 @@ TEST(Cli, memory_sizes_take_si_and_binary_units_and_auto) {
     EXPECT_EQ(bytes("auto"), three_quarters_of_ram());
     for (const char* bad : {"4G", "4gb", "-1GB", "lots", "1e30TB"})
         EXPECT_THROW(bytes(bad), globemesh::UsageError) << bad;
+    // The configuration says what was asked ("auto", "4GB"), not this machine's memory.
+    const Result asked = run_refused({"mesh", "--max-memory", "4GB", "--print-config"});
+    EXPECT_NE(asked.out.find("max-memory=\"4GB\""), std::string::npos) << asked.out;
+    const Result by_default = run_refused({"mesh", "--print-config"});
+    EXPECT_NE(by_default.out.find("max-memory=\"auto\""), std::string::npos) << by_default.out;
     // Values below 1MB (other than 0) cannot hold any run: refused before reading anything.
     const Result r = run_refused({"mesh", "--coast", coast, "-o", "x.nc", "--max-memory", "1kB"});
     EXPECT_EQ(r.status, 2);
