@@ -458,9 +458,10 @@ GeomPtr polygonize_lines(Geos& geos, const std::vector<PointList>& lines, const 
         if (pts.size() < 2) continue;
         LonLat a = pts.front(), b = pts.back();
         if (a.lon != b.lon || a.lat != b.lat) {
-            // Open ends within 0.001 degree (110 m) of the seam were cut there.
+            // Open ends within 0.001 degree (110 m) of the seam, on either side, were cut there
+            // (an end far beyond it, lon 199 of a line drawn in [0, 360), is not).
             for (LonLat* e : {&pts.front(), &pts.back()})
-                if (std::abs(e->lon) > 180.0 - line_end_snap_deg) e->lon = e->lon > 0 ? 180.0 : -180.0;
+                if (std::abs(std::abs(e->lon) - 180.0) <= line_end_snap_deg) e->lon = e->lon > 0 ? 180.0 : -180.0;
             a = pts.front(), b = pts.back();
             bool a_seam = std::abs(a.lon) == 180.0, b_seam = std::abs(b.lon) == 180.0;
             double gap = std::hypot(a.lon - b.lon, a.lat - b.lat);
