@@ -133,7 +133,8 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     } else {
         const double grid_nodes = size_grid_nodes(o);
         budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
-                       "the size field's background grid (" + number(std::round(grid_nodes)) + " nodes)",
+                       "the size field's background grid (" +
+                           std::to_string(static_cast<std::uint64_t>(grid_nodes)) + " nodes)",
                        " or --hmin");
         field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
                                  sub_progress(progress, 0.15, 0.25), size_grid_max_nodes);
