@@ -29,6 +29,7 @@
 // opposite vertex(t, i). A half-edge is encoded as 3*t + i. Standard library only.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -71,14 +72,15 @@ public:
     /// caller can time the ordering apart from the insertions. Needs n < 2^31.
     static std::vector<std::uint32_t> insertion_order(std::span<const Vec3> points, std::uint64_t seed);
 
-    /// Inserts points into an empty triangulation without copying them: takes over `points` and
-    /// reorders them in place by `order` (a permutation from insertion_order), so vertex v is
-    /// the point at position v of that order (points() keeps every input point; a point merged
-    /// into another keeps its slot as an unused vertex, with no triangle). The order's memory
-    /// is reused for the result: for each input point, the vertex it became or was merged into.
-    /// Peak memory is the points (24 B each), the result (4 B) and the triangles (2 per point,
-    /// 25 B each). Throws DataError as insert_points, and std::invalid_argument when the
-    /// triangulation is not empty or `order` does not match `points`.
+    /// Inserts points into an empty triangulation, taking over `points`: they are gathered into
+    /// the order of `order` (a permutation from insertion_order), so vertex v is the point at
+    /// position v of that order (points() keeps every input point; a point merged into another
+    /// keeps its slot as an unused vertex, with no triangle). Returns, for each input point, the
+    /// vertex it became or was merged into. Peak memory is the points (24 B each), the result
+    /// (4 B) and the triangles (2 per point, 25 B each); the gathered copy of the points and the
+    /// order are released before the first triangle (56 B/point at most then). Throws DataError
+    /// as insert_points, and std::invalid_argument when the triangulation is not empty or
+    /// `order` is not a permutation of [0, points.size()).
     std::vector<VertexId> insert_points(std::vector<Vec3>&& points, std::vector<std::uint32_t>&& order);
     /// The same with insertion_order(points, options.seed).
     std::vector<VertexId> insert_points(std::vector<Vec3>&& points);
@@ -177,6 +179,8 @@ private:
     TriangleId walk(const Vec3& p, TriangleId start, bool& inside) const;
     bool insert_fan(const Vec3& p, TriangleId seed, VertexId id, VertexId& result);
     TriangleId new_slot();
+    // Every coordinate at most 2 in magnitude (false for NaN): unit vectors, with room to spare.
+    static bool bounded(const Vec3& p) { return std::fabs(p.x) <= 2 && std::fabs(p.y) <= 2 && std::fabs(p.z) <= 2; }
 
     void link(HalfEdge a, HalfEdge b);
     TriangleId new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label);
@@ -198,6 +202,7 @@ private:
     std::vector<TriangleId> free_;
     std::size_t merged_ = 0;
     TriangleId last_ = no_triangle;
+    bool bounded_ = true; // every point ever stored is bounded(): the walk's static filter holds
     // scratch buffers reused across insertions (no allocation per insertion)
     struct Rim {
         VertexId u, w;

@@ -39,7 +39,7 @@ struct HilbertTable {
 constexpr HilbertTable hilbert_table{};
 
 std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y, int order) {
-    // order is a multiple of 3 here (30).
+    // order is a multiple of 3 here (15).
     std::uint64_t d = 0;
     unsigned state = 0;
     for (int shift = order - 3; shift >= 0; shift -= 3) {
@@ -52,10 +52,10 @@ std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y, int order) {
 
 } // namespace
 
-std::uint64_t hilbert_key(const Vec3& p) {
-    constexpr int order = 30;
+std::uint32_t hilbert_key(const Vec3& p) {
+    constexpr int order = 15;
     double ax = std::fabs(p.x), ay = std::fabs(p.y), az = std::fabs(p.z);
-    int face;
+    std::uint32_t face;
     double u, v, m;
     if (ax >= ay && ax >= az) { face = p.x >= 0 ? 0 : 1; m = ax; u = p.y; v = p.z; }
     else if (ay >= az) { face = p.y >= 0 ? 2 : 3; m = ay; u = p.z; v = p.x; }
@@ -67,17 +67,19 @@ std::uint64_t hilbert_key(const Vec3& p) {
         t = std::clamp(t, 0.0, 1.0);
         return static_cast<std::uint32_t>(t * scale);
     };
-    return (static_cast<std::uint64_t>(face) << 61) | hilbert_index(cell(u), cell(v), order);
+    return (face << 29) | static_cast<std::uint32_t>(hilbert_index(cell(u), cell(v), order) >> 1);
 }
 
 std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_t seed) {
     const std::size_t n = points.size();
-    // (key, index) pairs, keyed in input order (sequential reads of the points), then shuffled:
-    // std::shuffle's swaps depend only on the generator and the length, so this is the shuffled
-    // index order with its keys alongside. Sorting the contiguous pairs in place then gives the
-    // same result as sorting indices by (key, index), without chasing indices through memory.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
-    for (std::size_t i = 0; i < n; ++i) keyed[i] = {hilbert_key(points[i]), static_cast<std::uint32_t>(i)};
+    // One 64-bit word per point: its 32-bit Hilbert key above its index, so sorting the words
+    // sorts by (key, index). Keyed in input order (sequential reads
+    // of the points), then shuffled: std::shuffle's swaps depend only on the generator and the
+    // length, so this is the shuffled index order with its keys alongside. Half the bytes of
+    // (key, index) pairs, and a plain integer comparison.
+    std::vector<std::uint64_t> keyed(n);
+    for (std::size_t i = 0; i < n; ++i)
+        keyed[i] = (std::uint64_t{hilbert_key(points[i])} << 32) | static_cast<std::uint32_t>(i);
     std::mt19937_64 rng(seed);
     std::shuffle(keyed.begin(), keyed.end(), rng);
     // Round boundaries: [0, n/2^R), [n/2^R, n/2^(R-1)), ..., [n/2, n).
@@ -91,7 +93,7 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
         lo = end;
     }
     std::vector<std::uint32_t> order(n);
-    for (std::size_t j = 0; j < n; ++j) order[j] = keyed[j].second;
+    for (std::size_t j = 0; j < n; ++j) order[j] = static_cast<std::uint32_t>(keyed[j]);
     return order;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
@@ -334,4 +335,57 @@ TEST(Delaunay, insert_in_triangle_of_a_constrained_triangulation) {
     EXPECT_EQ(dt.vertex_count(), before + todo.size());
     auto problems = dt.validate();
     EXPECT_TRUE(problems.empty()) << problems.front();
+}
+
+TEST(Delaunay, adopted_points_in_brio_order_give_the_same_triangulation_as_the_span_insert) {
+    auto p = random_points(20000, 41);
+    SphericalDelaunay by_span;
+    auto ids_span = by_span.insert_points(std::span<const Vec3>(p));
+    SphericalDelaunay adopted;
+    auto order = SphericalDelaunay::insertion_order(p, 1);
+    auto ids = adopted.insert_points(std::vector<Vec3>(p), std::move(order));
+    expect_valid_closed(adopted);
+    EXPECT_EQ(canonical(adopted, false), canonical(by_span, false));
+    ASSERT_EQ(ids.size(), p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        EXPECT_EQ(adopted.point(ids[i]), p[i]);
+        EXPECT_EQ(by_span.point(ids_span[i]), p[i]);
+    }
+}
+
+TEST(Delaunay, adopting_insert_refuses_an_order_that_is_not_a_permutation) {
+    auto p = random_points(100, 42);
+    std::vector<std::uint32_t> repeated(100);
+    for (std::uint32_t i = 0; i < 100; ++i) repeated[i] = i;
+    repeated[7] = 3;
+    SphericalDelaunay dt;
+    EXPECT_THROW(dt.insert_points(std::vector<Vec3>(p), std::move(repeated)), std::invalid_argument);
+    std::vector<std::uint32_t> out_of_range(100);
+    for (std::uint32_t i = 0; i < 100; ++i) out_of_range[i] = i;
+    out_of_range[99] = 100;
+    SphericalDelaunay dt2;
+    EXPECT_THROW(dt2.insert_points(std::vector<Vec3>(p), std::move(out_of_range)), std::invalid_argument);
+    EXPECT_EQ(dt2.triangle_count(), 0u);
+}
+
+TEST(Delaunay, locate_from_any_hint_finds_a_triangle_containing_the_point) {
+    auto p = random_points(5000, 43);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    auto q = random_points(500, 44);
+    std::size_t k = 0;
+    for (const Vec3& x : q) {
+        // Hints: none, a far live slot, and an out-of-range id.
+        const TriangleId hints[] = {no_triangle, static_cast<TriangleId>((k * 7919) % dt.triangle_slots()), 0xfffffff0u};
+        for (TriangleId h : hints) {
+            TriangleId t = dt.locate(x, h);
+            ASSERT_NE(t, no_triangle);
+            ASSERT_TRUE(dt.is_live(t));
+            const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)), &c = dt.point(dt.vertex(t, 2));
+            EXPECT_GE(predicates::orient(a, b, x), 0);
+            EXPECT_GE(predicates::orient(b, c, x), 0);
+            EXPECT_GE(predicates::orient(c, a, x), 0);
+        }
+        ++k;
+    }
 }
