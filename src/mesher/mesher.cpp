@@ -50,6 +50,17 @@ double seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// Angular distance from p to the minor arc a-b.
+double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p) {
+    Vec3 n = cross(a, b);
+    double ln = norm(n);
+    if (ln > 1e-15) {
+        n = (1.0 / ln) * n;
+        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0) return std::asin(std::min(1.0, std::abs(dot(n, p))));
+    }
+    return std::min(arc_angle(a, p), arc_angle(p, b));
+}
+
 using EdgeKey = std::pair<VertexId, VertexId>;
 EdgeKey key(VertexId a, VertexId b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
 
@@ -185,6 +196,36 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     } else {
         if (nodes.size() < 4) throw DataError("the boundary has fewer than 4 nodes: no ocean to mesh");
         ids = dt.insert_points(nodes);
+        // When every boundary node lies in one hemisphere, ghost triangles (delaunay.hpp) close
+        // the far side, and the far side may be ocean: add fixed far points until every triangle
+        // is solid. A candidate closer than 1e-4 rad to a boundary arc is skipped, so none lies
+        // on a segment; the flood fill below classifies them like any vertex.
+        auto has_ghost = [&] {
+            for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+                if (dt.is_live(t) && !dt.is_solid(t)) return true;
+            return false;
+        };
+        if (has_ghost()) {
+            std::vector<Vec3> far;
+            for (double x : {-1.0, 1.0}) {
+                far.push_back({x, 0, 0});
+                far.push_back({0, x, 0});
+                far.push_back({0, 0, x});
+            }
+            for (double x : {-1.0, 1.0})
+                for (double y : {-1.0, 1.0})
+                    for (double z : {-1.0, 1.0}) far.push_back(normalized(Vec3{x, y, z}));
+            for (const Vec3& p : far) {
+                bool clear = true;
+                for (std::size_t r = 0; r < boundary.rings.size() && clear; ++r) {
+                    const auto& rn = boundary.rings[r].nodes;
+                    for (std::size_t i = 0; i < rn.size() && clear; ++i)
+                        clear = arc_distance(rn[i], rn[(i + 1) % rn.size()], p) > 1e-4;
+                }
+                if (clear) dt.insert(p);
+                if (!has_ghost()) break;
+            }
+        }
     }
     globemesh::report(progress, 0.05, "insert_boundary");
     if (timings) timings->add("insert_boundary", seconds_since(t0));

@@ -52,7 +52,7 @@ namespace {
 // tests/unit/property_test.cpp): clockwise faces, and refinement that runs away. Tolerated while
 // this is true so that the fuzzer looks further (a hang without progress reports still counts
 // as a finding through -timeout); set it to false once the mesher is fixed.
-constexpr bool known_mesher_bugs = true;
+constexpr bool known_mesher_bugs = false;
 
 std::string g_json;  // for failure messages
 bool g_print = false; // GLOBEMESH_FUZZ_PRINT set: print every decoded input (to replay a finding)

@@ -423,21 +423,21 @@ std::string mesh_problem(const Mesh& m) {
     return {};
 }
 
-// Known mesher bug (MesherProperty.DISABLED_nine_node_island_across_180_meshes_counter_clockwise):
+// Mesher bug, fixed (MesherProperty.nine_node_island_across_180_meshes_counter_clockwise: ghost triangles were labelled ocean):
 // mesh_boundary (src/mesher, owned by the lead) sometimes returns a clockwise face. While this is
 // true the batteries below count such meshes apart instead of failing; every other problem
 // fails. Set it to false once the mesher is fixed.
-constexpr bool known_clockwise_faces = true;
+constexpr bool known_clockwise_faces = false;
 
 bool known_mesher_issue(const std::string& problem) {
     return known_clockwise_faces && problem.rfind("a face is clockwise", 0) == 0;
 }
 
-// Known mesher bug (MesherProperty.DISABLED_nine_node_island_rotated_7_degrees_meshes_in_bounded_memory):
+// Mesher bug, fixed (MesherProperty.nine_node_island_rotated_7_degrees_meshes_in_bounded_memory: ghost triangles were labelled ocean):
 // refinement sometimes runs away. Refinement reports progress every 16384 insertions; with at
 // most 20000 nodes asked for, a 5th report means a runaway: the run is cancelled there and
 // counted apart while this is true (a failure otherwise).
-constexpr bool known_runaway = true;
+constexpr bool known_runaway = false;
 
 struct RunawayGuard {
     std::size_t reports = 0;
@@ -598,7 +598,7 @@ TEST(CoastProperty, hundreds_of_hostile_small_coasts_mesh_validly_or_raise_a_cle
         const CoastCase c = coast_case(seed);
         MemFile file("property_coast_" + std::to_string(seed) + ".geojson", c.json);
         int outcome = run_case_isolated(c, file.path(), 2);
-        // Known mesher hang (MesherProperty.DISABLED_hostile_coast_seed_32_meshes_in_bounded_time):
+        // Mesher hang, fixed (MesherProperty.hostile_coast_seed_32_meshes_in_bounded_time):
         // refinement loops without reporting progress; counted apart while known_runaway.
         if (outcome == -1 && known_runaway) outcome = known_bug;
         ASSERT_GE(outcome, 0) << "seed " << seed << ": " << (outcome == -1 ? "no result in 2 s" : "crashed") << "\n" << c.json;
@@ -723,7 +723,7 @@ TEST(CoastProperty, removing_land_never_removes_ocean) {
         }
         ++compared;
     }
-    EXPECT_GE(compared, 8); // (12 while the mesher has no known bug)
+    EXPECT_EQ(compared, 12);
 }
 
 // Found by tests/fuzz/fuzz_coast: an open coastline LineString drawn in [0, 360) longitudes
@@ -778,7 +778,7 @@ TEST(CoastProperty, polygon_drawn_beyond_minus_180_loads_as_one_valid_ring) {
 // uniform 400 km returns a clockwise face with the mesher at 9bc775c, and did not return at all
 // (refinement going round consider_star) with the lead's work in progress at the time
 // (src/mesher/mesher.cpp, owned by the lead). Disabled until the mesher is fixed.
-TEST(MesherProperty, DISABLED_sliver_ring_at_lat_minus_61_meshes_in_bounded_time) {
+TEST(MesherProperty, sliver_ring_at_lat_minus_61_meshes_in_bounded_time) {
     Ring ring;
     ring.nodes = {{-0x1.edb694b4fe40bp-2, 0x0p+0, -0x1.c08f4971e5fb1p-1},
                   {-0x1.e91b104b07eaep-2, -0x1.b35b0396f29a5p-5, -0x1.c0ff02ca5174ep-1},
@@ -823,7 +823,7 @@ Boundary nine_node_island(double rotate_deg) {
 }
 } // namespace
 
-TEST(MesherProperty, DISABLED_nine_node_island_across_180_meshes_counter_clockwise) {
+TEST(MesherProperty, nine_node_island_across_180_meshes_counter_clockwise) {
     const Boundary b = nine_node_island(0);
     ASSERT_TRUE(check_boundary(b).empty());
     MesherOptions mo;
@@ -832,7 +832,7 @@ TEST(MesherProperty, DISABLED_nine_node_island_across_180_meshes_counter_clockwi
     EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
 }
 
-TEST(MesherProperty, DISABLED_nine_node_island_rotated_7_degrees_meshes_in_bounded_memory) {
+TEST(MesherProperty, nine_node_island_rotated_7_degrees_meshes_in_bounded_memory) {
     const Boundary b = nine_node_island(7);
     ASSERT_TRUE(check_boundary(b).empty());
     MesherOptions mo;
@@ -901,7 +901,7 @@ TEST(DelaunayProperty, DISABLED_points_near_the_south_pole_merge_only_into_near_
 // stages pass (check_boundary is empty) but mesh_boundary at 9bc775c never returns, and its
 // refinement loop reports no progress, so it cannot be cancelled (src/mesher, the lead's).
 // Disabled until fixed there; run it with a timeout.
-TEST(MesherProperty, DISABLED_hostile_coast_seed_32_meshes_in_bounded_time) {
+TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
     CoastCase c = coast_case(32);
     MemFile file("seed32.geojson", c.json);
     c.options.coast = file.path();
@@ -921,7 +921,7 @@ TEST(MesherProperty, DISABLED_hostile_coast_seed_32_meshes_in_bounded_time) {
 // which src/mesher/mesher.cpp (line 251 at 9bc775c) casts to std::size_t: undefined behaviour,
 // and without UBSan "the size field asks for about 18446744073709551615 nodes". The lead's;
 // disabled until fixed there.
-TEST(MesherProperty, DISABLED_land_triangle_larger_than_a_hemisphere_meshes_or_is_refused_clearly) {
+TEST(MesherProperty, land_triangle_larger_than_a_hemisphere_meshes_or_is_refused_clearly) {
     MemFile file("big_triangle.geojson",
                  feature_collection({"{\"type\":\"LineString\",\"coordinates\":[[60.983829486990587,-8.8619760051369667],"
                                      "[-138.53512844803578,-90],[-88.655388964279055,77.532267049028874],"
