@@ -8,9 +8,10 @@ GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 GLOBEMESH_BUILD_PACKAGES="g++ cmake make pkg-config libgdal-dev libgeos-dev libproj-dev
   libgeographiclib-dev libnetcdf-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
-# man-page lint, the independent checkers' Python modules, and QGIS for qgis-check.
+# man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
+# its runtime (libFuzzer) for tools/fuzz.
 GLOBEMESH_TEST_PACKAGES="libgmp-dev mandoc man-db python3-numpy python3-scipy python3-netcdf4
-  python3-gdal python3-shapely qgis python3-qgis"
+  python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev"
 
 install_missing() {
     local missing=()
