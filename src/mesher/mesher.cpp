@@ -7,12 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <queue>
+#include <new>
 #include <string>
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/predicates.hpp"
+#include "../delaunay/hilbert.hpp"
 
 namespace globemesh {
 
@@ -143,7 +144,10 @@ struct Mesher {
         // only its size counts (Ruppert's algorithm needs input angles of 60 degrees or more).
         if (is_sharp(dt.vertex(t, 0)) || is_sharp(dt.vertex(t, 1)) || is_sharp(dt.vertex(t, 2)))
             return size_ratio;
-        double shortest = std::min({arc_angle(a, b), arc_angle(b, d), arc_angle(d, a)});
+        // The shortest arc is the shortest chord: one arc_angle instead of three.
+        const Vec3 ab = b - a, bd = d - b, da = a - d;
+        const double cab = dot(ab, ab), cbd = dot(bd, bd), cda = dot(da, da);
+        double shortest = cab <= cbd && cab <= cda ? arc_angle(a, b) : cbd <= cda ? arc_angle(b, d) : arc_angle(d, a);
         double shape_ratio = r / shortest / shape_bound;
         // Below a floor, shape does not count: pinch points of the coast (rings moved 0.64 m
         // apart where they touched) would otherwise be refined down to their own scale.
@@ -156,16 +160,90 @@ struct Mesher {
     }
 };
 
+// A refinement candidate: 16 bytes. `stamp` is the generation of slot t when it was queued
+// (twice, plus 1 when the triangle was on the front); a slot's generation grows each time the
+// core puts a new triangle in it, so an entry whose stamp no longer matches is stale.
 struct Candidate {
-    bool active; // next to an accepted triangle or to the boundary: on the front
     double badness;
     TriangleId t;
-    VertexId a, b, c;
+    std::uint32_t stamp;
+    bool active() const { return (stamp & 1u) != 0; } // next to an accepted triangle or the boundary
     bool operator<(const Candidate& o) const {
-        if (active != o.active) return !active;
+        if (active() != o.active()) return !active();
         if (badness != o.badness) return badness < o.badness;
         return t > o.t; // deterministic ties
     }
+};
+
+// Cache-line aligned storage for the heap below.
+template <class T>
+struct LineAllocator {
+    using value_type = T;
+    LineAllocator() = default;
+    template <class U>
+    LineAllocator(const LineAllocator<U>&) {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
+    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
+    template <class U>
+    bool operator==(const LineAllocator<U>&) const { return true; }
+};
+
+// A max-heap of candidates with four children per node: half the depth of a binary heap, and
+// the four children of a node (16 bytes each) fill one 64-byte cache line, so a sift-down
+// touches one line per level. Node i lives at index i + 3, which puts the children 4i+1..4i+4
+// at indices 4(i+1)..4(i+1)+3 of a 64-byte aligned array. Pops come in the order of
+// Candidate::operator< (entries that compare equal are interchangeable: the same triangle,
+// badness and front flag, so either identical or stale).
+class CandidateHeap {
+public:
+    bool empty() const { return size() == 0; }
+    std::size_t size() const { return a_.size() - pad; }
+    void push(const Candidate& c) {
+        a_.push_back(c);
+        std::size_t i = size() - 1;
+        while (i > 0) {
+            const std::size_t parent = (i - 1) / 4;
+            if (!(at(parent) < c)) break;
+            at(i) = at(parent);
+            i = parent;
+        }
+        at(i) = c;
+    }
+    Candidate pop() {
+        const Candidate top = at(0);
+        const Candidate last = a_.back();
+        a_.pop_back();
+        if (!empty()) sift_down(0, last);
+        return top;
+    }
+    /// Drops the entries for which `drop` holds and restores the heap.
+    template <class F>
+    void remove_if(F drop) {
+        std::erase_if(a_, [&](const Candidate& c) { return &c >= a_.data() + pad && drop(c); });
+        for (std::size_t i = size() / 4 + 1; i-- > 0;)
+            if (i < size()) sift_down(i, at(i));
+    }
+    void release() { std::vector<Candidate, LineAllocator<Candidate>>().swap(a_); }
+
+private:
+    static constexpr std::size_t pad = 3;
+    Candidate& at(std::size_t i) { return a_[i + pad]; }
+    void sift_down(std::size_t i, const Candidate c) { // c by value: it may be at(i)
+        const std::size_t n = size();
+        for (;;) {
+            const std::size_t first = 4 * i + 1;
+            if (first >= n) break;
+            std::size_t best = first;
+            const std::size_t end = std::min(first + 4, n);
+            for (std::size_t k = first + 1; k < end; ++k)
+                if (at(best) < at(k)) best = k;
+            if (!(c < at(best))) break;
+            at(i) = at(best);
+            i = best;
+        }
+        at(i) = c;
+    }
+    std::vector<Candidate, LineAllocator<Candidate>> a_ = std::vector<Candidate, LineAllocator<Candidate>>(pad);
 };
 
 } // namespace
@@ -356,7 +434,26 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // ---- 4. refine ---------------------------------------------------------------------------
     t0 = Clock::now();
-    std::priority_queue<Candidate> queue;
+    // Badness per triangle slot, computed once when the core creates the triangle: a triangle
+    // never changes while it lives (its corners, their fixed/sharp flags and the size field are
+    // all fixed), and every triangle an insertion creates has the new vertex as a corner.
+    std::vector<double> bad(dt.triangle_slots(), 0.0);
+    std::vector<std::uint32_t> generation(dt.triangle_slots(), 0);
+    CandidateHeap queue;
+    auto refresh = [&](TriangleId t) {
+        if (t >= bad.size()) {
+            bad.resize(dt.triangle_slots(), 0.0);
+            generation.resize(dt.triangle_slots(), 0);
+        }
+        ++generation[t];
+        bad[t] = dt.label(t) == ocean ? m.badness(t) : 0.0;
+    };
+    auto push = [&](double b, TriangleId t, bool active) {
+        queue.push({b, t, generation[t] << 1 | (active ? 1u : 0u)});
+    };
+    auto stale = [&](const Candidate& c) {
+        return !dt.is_live(c.t) || generation[c.t] != c.stamp >> 1 || dt.label(c.t) != ocean;
+    };
     // Frontal order (Rebay 1993): a bad triangle whose edge borders an accepted triangle or the
     // boundary is on the front and goes first; its new node is placed off that edge.
     auto front_edge = [&](TriangleId t) -> int {
@@ -365,9 +462,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         for (int i = 0; i < 3; ++i) {
             HalfEdge h = half_edge(t, i);
             TriangleId nb = triangle_of(dt.twin(h));
-            bool accepted = dt.is_constrained(h) || dt.label(nb) != ocean || m.badness(nb) <= 1.0;
+            bool accepted = dt.is_constrained(h) || dt.label(nb) != ocean || bad[nb] <= 1.0;
             if (!accepted) continue;
-            double len = arc_angle(dt.point(dt.origin(h)), dt.point(dt.destination(h)));
+            const Vec3 d = dt.point(dt.destination(h)) - dt.point(dt.origin(h));
+            const double len = dot(d, d); // the shortest chord is the shortest arc
             if (best < 0 || len < best_len) {
                 best = i;
                 best_len = len;
@@ -377,43 +475,54 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     };
     auto consider = [&](TriangleId t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) return;
-        double b = m.badness(t);
+        double b = bad[t];
         if (b > 1.0) {
-            queue.push({front_edge(t) >= 0, b, t, dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)});
+            push(b, t, front_edge(t) >= 0);
         } else {
             // An accepted triangle puts its bad neighbours on the front.
             for (int i = 0; i < 3; ++i) {
                 TriangleId nb = triangle_of(dt.twin(half_edge(t, i)));
                 if (dt.label(nb) == ocean && !dt.is_constrained(half_edge(t, i))) {
-                    double bn = m.badness(nb);
-                    if (bn > 1.0) queue.push({true, bn, nb, dt.vertex(nb, 0), dt.vertex(nb, 1), dt.vertex(nb, 2)});
+                    double bn = bad[nb];
+                    if (bn > 1.0) push(bn, nb, true);
                 }
             }
         }
     };
+    std::vector<TriangleId> star_triangles;
     auto consider_star = [&](VertexId v) {
-        // Every triangle created by the last insertion has v as a corner: rotate around v.
+        // Every triangle created by the last insertion has v as a corner: rotate around v, give
+        // each its badness first (front_edge reads the neighbours'), then consider each.
         TriangleId last = dt.last_triangle();
         int k = 0;
         while (k < 3 && dt.vertex(last, k) != v) ++k;
         if (k == 3) return;
         HalfEdge from = half_edge(last, prev3(k)); // leaves v
         HalfEdge h = from;
+        star_triangles.clear();
         do {
-            consider(triangle_of(h));
+            star_triangles.push_back(triangle_of(h));
+            refresh(triangle_of(h));
             h = dt.next_around_origin(h);
         } while (h != from);
+        for (TriangleId t : star_triangles) consider(t);
     };
+    for (TriangleId t = 0; t < slots; ++t)
+        if (dt.is_live(t) && dt.label(t) == ocean) bad[t] = m.badness(t);
     for (TriangleId t = 0; t < slots; ++t) consider(t);
     const std::size_t node_limit = 4 * report.estimated_nodes + 1000;
     std::size_t inserted = 0;
+    // Stale entries are dropped whenever the heap doubles since the last sweep (this keeps the
+    // pop order: only entries that would be skipped go).
+    std::size_t compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
     while (!queue.empty()) {
-        Candidate c = queue.top();
-        queue.pop();
+        if (queue.size() >= compact_at) {
+            queue.remove_if(stale);
+            compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
+        }
+        const Candidate c = queue.pop();
         const TriangleId t = c.t;
-        if (!dt.is_live(t) || dt.vertex(t, 0) != c.a || dt.vertex(t, 1) != c.b || dt.vertex(t, 2) != c.c ||
-            dt.label(t) != ocean)
-            continue;
+        if (stale(c)) continue;
         if (dt.vertex_count() > node_limit)
             throw DataError("refinement does not converge (over " + std::to_string(node_limit) +
                             " nodes): the size field may be too small for the boundary");
@@ -509,14 +618,30 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // ---- 5. improve --------------------------------------------------------------------------
     t0 = Clock::now();
-    std::vector<char> fixed(dt.vertex_count(), 0);
-    for (const auto& [k, kind] : m.segments) fixed[k.first] = fixed[k.second] = 1;
+    // The refinement's memory goes before the smoothing's: the heap and the per-slot arrays.
+    queue.release();
+    std::vector<double>().swap(bad);
+    std::vector<std::uint32_t>().swap(generation);
+    // Nodes are visited along the Hilbert curve, so that consecutive stars share their cache
+    // lines whatever order the refinement numbered them in (id order misses the cache more
+    // and more as the mesh grows). Boundary nodes (fixed) are left out.
+    std::vector<VertexId> visit;
+    {
+        using Key = decltype(detail::hilbert_key(Vec3{}));
+        std::vector<std::pair<Key, VertexId>> keyed;
+        keyed.reserve(dt.vertex_count());
+        for (VertexId v = 0; v < dt.vertex_count(); ++v)
+            if (!m.is_fixed(v)) keyed.emplace_back(detail::hilbert_key(dt.point(v)), v);
+        std::sort(keyed.begin(), keyed.end());
+        visit.reserve(keyed.size());
+        for (const auto& kv : keyed) visit.push_back(kv.second);
+    }
     for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
         // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
         // (a triangle next to v) rather than an answer: the walk from it is a step or two.
         const std::vector<HalfEdge> star = dt.vertex_half_edges();
-        for (VertexId v = 0; v < dt.vertex_count(); ++v) {
-            if (fixed[v] || star[v] == no_half_edge) continue;
+        for (VertexId v : visit) {
+            if (star[v] == no_half_edge) continue;
             HalfEdge from = star[v];
             if (dt.origin(from) != v || !dt.is_live(triangle_of(from))) from = dt.leaving(v, triangle_of(from));
             if (from == no_half_edge || dt.origin(from) != v) continue;
@@ -546,18 +671,21 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // Refuse a move that would bring the worst triangle of the star below 0.6 and
             // below where it was (smoothing must not flatten triangles against the coast).
             const Vec3 target = normalized(sum);
-            double worst_before = 1, worst_after = 1;
-            h = from;
-            guard = 0;
-            do {
-                TriangleId t = triangle_of(h);
-                const Vec3& b = dt.point(dt.destination(h));
-                const Vec3& c = dt.point(dt.vertex(t, edge_of(h)));
-                worst_before = std::min(worst_before, triangle_quality(dt.point(v), b, c));
-                worst_after = std::min(worst_after, triangle_quality(target, b, c));
-                h = dt.next_around_origin(h);
-            } while (h != from && ++guard < 64);
-            if (worst_after < 0.6 && worst_after < worst_before) continue;
+            // The quality before the move is needed only when the move would go below 0.6.
+            auto worst_of_star = [&](const Vec3& p) {
+                double worst = 1;
+                HalfEdge e = from;
+                std::size_t n = 0;
+                do {
+                    const Vec3& b = dt.point(dt.destination(e));
+                    const Vec3& c = dt.point(dt.vertex(triangle_of(e), edge_of(e)));
+                    worst = std::min(worst, triangle_quality(p, b, c));
+                    e = dt.next_around_origin(e);
+                } while (e != from && ++n < 64);
+                return worst;
+            };
+            const double worst_after = worst_of_star(target);
+            if (worst_after < 0.6 && worst_after < worst_of_star(dt.point(v))) continue;
             dt.move_vertex_from(from, target);
         }
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
