@@ -23,7 +23,10 @@
 // tolerance (default 1e-12 rad, 6 micrometres on the Earth) are merged and reported. Rounded unit
 // vectors lie up to ~1e-16 off the sphere, so a point within ~1e-8 rad of existing ones can fall
 // inside the hull of its neighbours; such a point is merged into its nearest vertex too (reported
-// the same way) rather than breaking the structure.
+// the same way) rather than breaking the structure. Conversely a new point can put an existing
+// vertex inside the hull (its whole star in the new point's cavity): the nearer of the two
+// survives and the other is merged into its nearest vertex, so every point maps to a vertex of
+// the triangulation within ~1e-8 rad of it.
 //
 // Edge convention: edge i of triangle t joins vertex(t, i+1) to vertex(t, i+2) (indices mod 3),
 // opposite vertex(t, i). A half-edge is encoded as 3*t + i. Standard library only.
@@ -87,6 +90,10 @@ public:
 
     /// Inserts one point, starting the walk at `hint` (any live triangle, or no_triangle).
     /// Returns its vertex, or the vertex it was merged into (then merged_count() grows).
+    /// An unconstrained vertex whose whole star p's cavity takes (it lies within rounding of
+    /// the hull of p and its neighbours) either takes p (p merges into it, when p is nearer to it
+    /// than any vertex of the cavity's rim) or leaves the triangulation, merged into its nearest
+    /// rim vertex (merged_count() grows; insert_points maps its points there).
     /// The cavity never crosses a constrained edge. Triangles created inherit the cavity's label.
     VertexId insert(const Vec3& p, TriangleId hint = no_triangle);
 
@@ -96,7 +103,9 @@ public:
     VertexId insert_in_triangle(const Vec3& p, TriangleId t);
 
     /// Inserts p into the edge h (constrained or not) and keeps both halves constrained when h
-    /// was. p should lie on or very near the edge's arc (e.g. its midpoint). Returns the vertex.
+    /// was. p should lie on or very near the edge's arc (e.g. its midpoint). Returns the vertex,
+    /// or the existing vertex p merged into (an end of h, or, as for insert(), a vertex within
+    /// rounding of p: then vertex_count() does not grow).
     VertexId split_edge(HalfEdge h, const Vec3& p);
 
     /// Makes a-b an edge of the triangulation and constrains it, by flipping the edges that cross
@@ -106,7 +115,9 @@ public:
     bool insert_constraint(VertexId a, VertexId b);
 
     /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
-    /// Returns false and leaves v where it was when the move would fold a triangle of its star.
+    /// Returns false and leaves v and every triangle as they were when the move would fold a
+    /// triangle of its star, when its star holds a ghost triangle, or when flips cannot restore
+    /// the property (v at p inside the hull of its neighbours: closer than rounding resolves).
     bool move_vertex(VertexId v, const Vec3& p);
     /// The same with a half-edge leaving v (origin == v), which avoids a search for the star.
     bool move_vertex_from(HalfEdge leaving_v, const Vec3& p);
@@ -193,6 +204,9 @@ private:
     VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id = no_vertex);
     std::size_t legalize_from(std::vector<HalfEdge>& stack);
     bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created);
+    VertexId nearest_vertex(const Vec3& p, TriangleId t) const;
+    // Maps each vertex left by a swallowing cavity (see insert) to the vertex it merged into.
+    void resolve_dropped(std::vector<VertexId>& map) const;
 
     Options options_;
     std::vector<Vec3> points_;
@@ -201,6 +215,8 @@ private:
     std::vector<std::uint8_t> labels_;
     std::vector<TriangleId> free_;
     std::size_t merged_ = 0;
+    std::vector<std::pair<VertexId, VertexId>> dropped_; // (vertex left by a cavity, merged into)
+    std::vector<VertexId> swallowed_, rim_vertices_;     // scratch of insert_in_cavity
     TriangleId last_ = no_triangle;
     bool bounded_ = true; // every point ever stored is bounded(): the walk's static filter holds
     // scratch buffers reused across insertions (no allocation per insertion)

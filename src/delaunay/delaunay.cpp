@@ -246,6 +246,7 @@ std::vector<VertexId> SphericalDelaunay::insert_points(std::vector<Vec3>&& point
             auto it = std::lower_bound(merges.begin(), merges.end(), std::make_pair(id, VertexId{0}));
             if (it != merges.end() && it->first == id) id = it->second;
         }
+    resolve_dropped(vertex_of);
     return vertex_of;
 }
 
@@ -264,6 +265,7 @@ std::vector<VertexId> SphericalDelaunay::insert_points(std::span<const Vec3> poi
     }
     order.clear();
     order.shrink_to_fit();
+    resolve_dropped(vertex_of);
     return vertex_of;
 }
 
@@ -347,6 +349,46 @@ TriangleId SphericalDelaunay::walk(const Vec3& p, TriangleId t, bool& inside) co
 // Insertion (Bowyer-Watson)
 // ---------------------------------------------------------------------------------------------
 
+// Greedy descent over the vertex graph from the vertices of t: move to a neighbour closer to p
+// while there is one. In a Delaunay triangulation a vertex that is not the nearest to p has a
+// neighbour closer to p, so this ends at the nearest vertex (Bose and Morin, "Online routing in
+// triangulations", 2004); the distance falls strictly at each step, so it ends.
+VertexId SphericalDelaunay::nearest_vertex(const Vec3& p, TriangleId t) const {
+    HalfEdge best = half_edge(t, 0);
+    double best_d = arc_angle(points_[origin(best)], p);
+    for (int i = 1; i < 3; ++i) {
+        const double d = arc_angle(points_[origin(half_edge(t, i))], p);
+        if (d < best_d) best = half_edge(t, i), best_d = d;
+    }
+    for (bool moved = true; moved;) {
+        moved = false;
+        HalfEdge h = best;
+        std::size_t guard = 0;
+        do {
+            const double d = arc_angle(points_[destination(h)], p);
+            if (d < best_d) {
+                best_d = d;
+                best = twin(h); // leaves the closer vertex
+                moved = true;
+                break;
+            }
+            h = next_around_origin(h);
+        } while (h != best && ++guard < triangle_slots());
+    }
+    return origin(best);
+}
+
+void SphericalDelaunay::resolve_dropped(std::vector<VertexId>& map) const {
+    if (dropped_.empty()) return;
+    std::vector<VertexId> into(points_.size(), no_vertex);
+    for (const auto& [w, u] : dropped_) into[w] = u;
+    for (VertexId& v : map) {
+        if (v >= into.size()) continue;
+        std::size_t guard = 0;
+        while (into[v] != no_vertex && ++guard <= dropped_.size()) v = into[v];
+    }
+}
+
 VertexId SphericalDelaunay::insert(const Vec3& p, TriangleId hint) {
     return insert_vertex(p, no_vertex, hint);
 }
@@ -390,12 +432,10 @@ VertexId SphericalDelaunay::insert_vertex(const Vec3& p, VertexId id, TriangleId
     }
     if (seed == no_triangle || (inside_solid && !located_visible)) {
         // p lies inside the hull of its neighbours (closer than rounding lets the hull resolve):
-        // merge it into the nearest vertex of its triangle.
+        // merge it into its nearest vertex. That need not be a vertex of the located triangle:
+        // the walk can stop on a flat triangle of a great circle through p far from p's twin.
         ++merged_;
-        VertexId best = vertex(located, 0);
-        for (int i = 1; i < 3; ++i)
-            if (arc_angle(points_[vertex(located, i)], p) < arc_angle(points_[best], p)) best = vertex(located, i);
-        return best;
+        return nearest_vertex(p, located);
     }
     VertexId v;
     if (insert_fan(p, seed, id, v)) return v;
@@ -589,6 +629,51 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
         }
     }
 
+    // A vertex of the cavity that is not on its rim would leave the triangulation with the
+    // cavity ("swallowed": p's cavity holds its whole star, possible only when it lies within
+    // rounding of the hull of p and its neighbours). When p is nearer to it than any rim vertex
+    // is, p merges into it and nothing changes; otherwise it is dropped and merged into its
+    // nearest rim vertex (a twin a few ulps away), recorded so that insert_points maps it there.
+    // (Sorted lists: a cavity can be large, e.g. every ghost triangle for a far point.)
+    swallowed_.clear();
+    by_start_.clear();
+    rim_vertices_.clear();
+    for (HalfEdge h : cavity_boundary_) rim_vertices_.push_back(origin(h));
+    std::sort(rim_vertices_.begin(), rim_vertices_.end());
+    for (TriangleId s : cavity_)
+        for (int i = 0; i < 3; ++i)
+            if (!std::binary_search(rim_vertices_.begin(), rim_vertices_.end(), vertex(s, i)))
+                swallowed_.push_back(vertex(s, i));
+    std::sort(swallowed_.begin(), swallowed_.end());
+    swallowed_.erase(std::unique(swallowed_.begin(), swallowed_.end()), swallowed_.end());
+    std::size_t drops = 0;
+    if (!swallowed_.empty()) {
+        VertexId closest = no_vertex; // the swallowed vertex nearest to p that p is nearest to
+        double closest_d = 0;
+        for (const VertexId w : swallowed_) {
+            const double to_p = arc_angle(points_[w], p);
+            VertexId target = no_vertex;
+            double target_d = to_p;
+            for (HalfEdge h : cavity_boundary_) {
+                const double d = arc_angle(points_[w], points_[origin(h)]);
+                if (d < target_d) target = origin(h), target_d = d;
+            }
+            // The ends of a split edge stay (the caller holds them): p merges into one instead.
+            if (target == no_vertex || w == split_a || w == split_b) {
+                if (closest == no_vertex || to_p < closest_d) closest = w, closest_d = to_p;
+            } else {
+                by_start_.emplace_back(w, target); // scratch: (dropped, into)
+                ++drops;
+            }
+        }
+        if (closest != no_vertex) {
+            by_start_.clear();
+            for (TriangleId s : cavity_) clear_mark(s);
+            ++merged_;
+            return closest;
+        }
+    }
+
     // Record each boundary edge's outside half-edge and flag before the cavity is freed.
     // Each new triangle keeps the label of the cavity triangle it replaces along its rim edge:
     // when a constrained edge is split, the two sides (e.g. ocean and land) keep their labels.
@@ -597,6 +682,10 @@ VertexId SphericalDelaunay::insert_in_cavity(const Vec3& p, TriangleId seed, Hal
     rim.clear();
     for (HalfEdge h : cavity_boundary_) rim.push_back({origin(h), destination(h), links_[h], labels_[triangle_of(h)]});
     for (TriangleId s : cavity_) free_triangle(s);
+    if (drops > 0) {
+        dropped_.insert(dropped_.end(), by_start_.begin(), by_start_.end());
+        merged_ += drops;
+    }
 
     VertexId v = id;
     if (v == no_vertex) {
@@ -854,7 +943,9 @@ bool SphericalDelaunay::move_vertex(VertexId v, const Vec3& p) {
 
 bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
     const VertexId v = origin(from);
-    // Every triangle of the star must stay counter-clockwise with v at p.
+    // Every triangle of the star must be solid before the move and stay counter-clockwise with v
+    // at p. (Moving v out of a ghost triangle changes whether the hull holds the origin, which
+    // can leave ghosts far from v that no flip around v reaches.)
     std::vector<HalfEdge> ring;
     HalfEdge h = from;
     do {
@@ -862,9 +953,11 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
         TriangleId t = triangle_of(h);
         const Vec3& b = points_[destination(h)];
         const Vec3& c = points_[vertex(t, edge_of(h))];
-        if (orient(p, b, c) <= 0) return false;
+        if (orient(p, b, c) <= 0 || orient(points_[v], b, c) <= 0) return false;
         h = next_around_origin(h);
     } while (h != from);
+    const Vec3 was = points_[v];
+    const bool was_bounded = bounded_;
     points_[v] = p;
     bounded_ = bounded_ && bounded(p);
     std::vector<HalfEdge> stack;
@@ -872,8 +965,66 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
         TriangleId t = triangle_of(r);
         for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
     }
-    legalize_from(stack);
-    return true;
+    // Lawson flips, journaled: a non-Delaunay edge whose quadrilateral is not convex means v at
+    // p lies inside the hull of its neighbours (closer than rounding resolves), which flips
+    // cannot mend; then every flip is undone and v goes back.
+    struct Saved {
+        TriangleId t, s;
+        VertexId tv[3], sv[3];
+        std::uint32_t tl[3], sl[3];
+    };
+    std::vector<Saved> journal;
+    bool stuck = false;
+    while (!stack.empty() && !stuck) {
+        const HalfEdge e = stack.back();
+        stack.pop_back();
+        const TriangleId t = triangle_of(e);
+        if (!is_live(t) || is_constrained(e)) continue;
+        const HalfEdge g = twin(e);
+        const TriangleId s = triangle_of(g);
+        const int i = edge_of(e), j = edge_of(g);
+        const Vec3& x = points_[vertex(t, i)];
+        const Vec3& u = points_[vertex(t, next3(i))];
+        const Vec3& w = points_[vertex(t, prev3(i))];
+        const Vec3& y = points_[vertex(s, j)];
+        if (in_circle(x, u, w, y) <= 0) continue;
+        if ((orient(x, u, y) <= 0 || orient(y, w, x) <= 0) && is_solid(t) && is_solid(s)) {
+            stuck = true;
+            break;
+        }
+        Saved rec{t, s, {}, {}, {}, {}};
+        for (int k = 0; k < 3; ++k) {
+            rec.tv[k] = tri_vertices_[3 * t + k];
+            rec.sv[k] = tri_vertices_[3 * s + k];
+            rec.tl[k] = links_[3 * t + k];
+            rec.sl[k] = links_[3 * s + k];
+        }
+        journal.push_back(rec);
+        flip(e);
+        stack.push_back(half_edge(t, i));
+        stack.push_back(half_edge(t, prev3(i)));
+        stack.push_back(half_edge(s, j));
+        stack.push_back(half_edge(s, prev3(j)));
+    }
+    if (!stuck) return true;
+    // Undo, newest first: restore both triangles and the outer half-edges' links to them.
+    for (auto r = journal.rbegin(); r != journal.rend(); ++r) {
+        for (int k = 0; k < 3; ++k) {
+            tri_vertices_[3 * r->t + k] = r->tv[k];
+            tri_vertices_[3 * r->s + k] = r->sv[k];
+            links_[3 * r->t + k] = r->tl[k];
+            links_[3 * r->s + k] = r->sl[k];
+        }
+        for (int k = 0; k < 3; ++k) {
+            const HalfEdge ht = half_edge(r->t, k), hs = half_edge(r->s, k);
+            links_[twin(ht)] = ht | (links_[ht] & constrained_bit);
+            links_[twin(hs)] = hs | (links_[hs] & constrained_bit);
+        }
+    }
+    points_[v] = was;
+    bounded_ = was_bounded;
+    last_ = triangle_of(from);
+    return false;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -9,13 +9,14 @@
 //   * insert_points either succeeds or throws DataError only when every point lies on one plane
 //     (checked in floating point with a wide margin);
 //   * validate() is empty; every input point maps to a vertex within 1e-7 rad of it; the
-//     vertices used by triangles are exactly the distinct vertices of the map (one known core
-//     bug tolerated, see known_map_bug), and with V of them there are 2V - 4 triangles
+//     vertices used by triangles are exactly the distinct vertices of the map, and with V of
+//     them there are 2V - 4 triangles
 //     (V - E + F = 2, E = 3F/2);
 //   * when no two distinct points are within 1e-7 rad (closer ones merge order-dependently),
 //     the triangle set does not depend on the insertion order: BRIO with another seed, and
 //     one-by-one insert() in input order, give the same triangles;
-//   * after a few insert_constraint and move_vertex calls validate() is still empty.
+//   * after a few insert_constraint and move_vertex calls validate() is still empty, and each
+//     moved vertex is at its target (or where it was, when move_vertex refused).
 // A failure prints the points as hex floats and aborts (a libFuzzer crash).
 #include <fuzzer/FuzzedDataProvider.h>
 
@@ -48,20 +49,10 @@ std::string g_ops;          // the constraint and move calls made, for failure m
     std::abort();
 }
 
-// Known core bug (DelaunayProperty.DISABLED_move_vertex_in_a_tiny_cluster_keeps_every_edge_delaunay
-// in tests/unit/property_test.cpp): after move_vertex in a cluster of points 1e-8 rad apart some
-// unconstrained edges are left non-Delaunay. Tolerated (the calls stop there) while this is
-// true, so that the fuzzer looks further; set it to false once the core is fixed.
-constexpr bool known_move_bug = true;
-
-/// Fails on any problem validate() reports; returns false instead when the only problem is the
-/// known move_vertex one and `after_move` is set.
-bool expect_valid(const SphericalDelaunay& d, const char* stage, bool after_move = false) {
+/// Fails on any problem validate() reports.
+void expect_valid(const SphericalDelaunay& d, const char* stage) {
     const auto problems = d.validate();
-    if (problems.empty()) return true;
-    if (known_move_bug && after_move && problems.size() == 1 &&
-        problems.front().find("not locally Delaunay") != std::string::npos)
-        return false;
+    if (problems.empty()) return;
     std::fprintf(stderr, "triangles:\n");
     for (TriangleId t = 0; t < d.triangle_slots(); ++t) {
         if (!d.is_live(t)) continue;
@@ -235,21 +226,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             for (int k = 0; k < 3; ++k) used.insert(d.vertex(t, k));
     for (VertexId v : used)
         if (!distinct.count(v)) fail("a triangle uses a vertex no input point maps to");
-    bool silent_merge = false;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (used.count(map[i])) continue;
-        // Known core bug (DelaunayProperty.DISABLED_merged_point_maps_to_a_vertex_of_the_triangulation
-        // in tests/unit/property_test.cpp): a point merged into a neighbour a few ulps away is
-        // reported as its own, unused vertex (and merged_count() does not count it). Tolerated while known_map_bug is true, so that the
-        // fuzzer looks further; set it to false once the core is fixed.
-        constexpr bool known_map_bug = true;
-        bool near_used = false;
-        for (VertexId v : used) near_used = near_used || arc_angle(d.point(v), pts[i]) <= 1e-7;
-        silent_merge = true;
-        if (!known_map_bug || !near_used)
+    for (std::size_t i = 0; i < pts.size(); ++i)
+        if (!used.count(map[i]))
             fail("input point " + std::to_string(i) + " maps to vertex " + std::to_string(map[i]) +
                  ", which no triangle uses");
-    }
     if (d.triangle_count() != 2 * used.size() - 4)
         fail("F = " + std::to_string(d.triangle_count()) + " triangles for V = " + std::to_string(used.size()) +
              " vertices, not 2V - 4");
@@ -258,7 +238,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // Which of two close points survives (merged within 1e-12 rad, or within ~1e-8 rad when it
     // falls inside its neighbours' hull) depends on the order: compare orders only without them
     // (equal points are fine: whichever copy survives has the same coordinates).
-    bool comparable = !silent_merge;
+    bool comparable = true;
     for (std::size_t i = 0; i < pts.size() && comparable; ++i)
         for (std::size_t j = i + 1; j < pts.size() && comparable; ++j)
             comparable = pts[i] == pts[j] || arc_angle(pts[i], pts[j]) >= 1e-7;
@@ -314,8 +294,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         char buf[160];
         std::snprintf(buf, sizeof buf, "  move_vertex(%u, {%a, %a, %a})\n", v, to.x, to.y, to.z);
         g_ops += buf;
-        d.move_vertex(v, to);
-        if (!expect_valid(d, "move_vertex", true)) break;
+        const Vec3 before = d.point(v);
+        const bool moved = d.move_vertex(v, to);
+        if (!(d.point(v) == (moved ? to : before))) fail("move_vertex left the vertex elsewhere");
+        expect_valid(d, "move_vertex");
     }
     return 0;
 }

@@ -177,23 +177,14 @@ void expect_valid_triangulation(const std::vector<Vec3>& pts, std::uint64_t seed
     for (TriangleId t = 0; t < d.triangle_slots(); ++t)
         if (d.is_live(t))
             for (int k = 0; k < 3; ++k) used.insert(d.vertex(t, k));
-    bool silent_merge = false;
     for (std::size_t i = 0; i < pts.size(); ++i) {
-        ASSERT_LE(arc_angle(d.point(map[i]), pts[i]), 1e-7);
-        // A point mapped to a vertex no triangle uses: the core bug of
-        // DelaunayProperty.DISABLED_point_ulps_from_another_maps_to_a_vertex_of_the_triangulation,
-        // tolerated here only when a used vertex lies within the merge distance.
-        if (!used.count(map[i])) {
-            bool near_used = false;
-            for (VertexId v : used) near_used = near_used || arc_angle(d.point(v), pts[i]) <= 1e-7;
-            ASSERT_TRUE(near_used) << "seed " << seed << ": point " << i << " is in no triangle\n" << describe(pts);
-            silent_merge = true;
-        }
+        ASSERT_LE(arc_angle(d.point(map[i]), pts[i]), 1e-7) << "seed " << seed << ": point " << i << "\n" << describe(pts);
+        ASSERT_TRUE(used.count(map[i])) << "seed " << seed << ": point " << i << " is in no triangle\n" << describe(pts);
     }
     ASSERT_EQ(d.triangle_count(), 2 * used.size() - 4) << "seed " << seed << "\n" << describe(pts);
-    // Which of two close points survives (merged within 1e-12 rad, or within ~1e-8 rad when it
-    // falls inside its neighbours' hull) depends on the order: compare orders only without them.
-    if (silent_merge) return;
+    // Which of two close points survives (merged within 1e-12 rad, or within ~1e-8 rad when one
+    // falls inside the hull of the other and its neighbours) depends on the order: compare orders
+    // only without them.
     for (std::size_t i = 0; i < pts.size(); ++i)
         for (std::size_t j = i + 1; j < pts.size(); ++j)
             if (!(pts[i] == pts[j]) && arc_angle(pts[i], pts[j]) < 1e-7) return;
@@ -338,12 +329,12 @@ TEST(SphereProperty, areas_of_a_hull_with_points_ulps_from_antipodal_add_up_to_z
 }
 
 // Found by tests/fuzz/fuzz_delaunay: points 0 and 1 are 2 ulps apart (1e-16 rad, far below the
-// 1e-12 rad merge tolerance). insert_points maps point 1 to its own vertex 3, but no triangle
-// uses vertex 3 and merged_count() is 0: the point was dropped silently instead of being merged
-// into vertex 2 (point 0) and reported. Core bug (src/delaunay, owned by "core"); disabled
-// until fixed there. Expected: every returned vertex is used by a triangle, or merged_count() > 0
-// and the point maps to the vertex it was merged into.
-TEST(DelaunayProperty, DISABLED_point_ulps_from_another_maps_to_a_vertex_of_the_triangulation) {
+// 1e-12 rad merge tolerance). insert_points mapped point 1 to its own vertex, but no triangle
+// used it and merged_count() was 0: inserting point 0 afterwards, its cavity held the whole star
+// of point 1's vertex (a point 2 ulps off puts its twin inside the hull), so the fan over the
+// cavity's rim dropped that vertex silently. Fixed in src/delaunay: a swallowed vertex either
+// takes the new point (the nearer one, as here) or is merged into its nearest rim vertex.
+TEST(DelaunayProperty, point_ulps_from_another_maps_to_a_vertex_of_the_triangulation) {
     const std::vector<Vec3> pts{{-0x1.09684c36307edp-13, 0x1.ce03f13427331p-14, -0x1.ffffff8718964p-1},
                                 {-0x1.09684c36307ebp-13, 0x1.ce03f1342732ep-14, -0x1.ffffff8718962p-1},
                                 {0x1.2cf2304755a5cp-1, 0x0p+0, -0x1.9e3779b97f4a9p-1},
@@ -849,10 +840,12 @@ TEST(MesherProperty, nine_node_island_rotated_7_degrees_meshes_in_bounded_memory
 }
 
 // Found by tests/fuzz/fuzz_delaunay: ten points in a cluster 1e-8 rad wide plus (0, 1, 0) (so a
-// hull with ghost triangles); moving vertex 3 by 2e-12 rad leaves 3 unconstrained edges not
-// locally Delaunay although move_vertex promises to restore the property by flips. Core bug
-// (src/delaunay, owned by "core"); disabled until fixed there.
-TEST(DelaunayProperty, DISABLED_move_vertex_in_a_tiny_cluster_keeps_every_edge_delaunay) {
+// hull with ghost triangles); moving the vertex of point 0 by 2e-12 rad left 3 unconstrained
+// edges not locally Delaunay although move_vertex promises to restore the property by flips:
+// at the new position the vertex lies inside the hull of its neighbours (their spacing is
+// below what rounding to the sphere resolves), and the flips it needs have non-convex
+// quadrilaterals. Fixed in src/delaunay: such a move is undone (every flip) and refused.
+TEST(DelaunayProperty, move_vertex_in_a_tiny_cluster_keeps_every_edge_delaunay) {
     const std::vector<Vec3> pts{{0x1.11fba5b721a52p-1, 0x1.7e082b3bf67fdp-1, -0x1.959afc23beadap-2},
                                 {0x1.11fba5b721a55p-1, 0x1.7e082b3bf67fdp-1, -0x1.959afc23bead8p-2},
                                 {0x1.11fba5c0d7b1fp-1, 0x1.7e082b3cf4ff4p-1, -0x1.959afc05c2a0cp-2},
@@ -863,19 +856,73 @@ TEST(DelaunayProperty, DISABLED_move_vertex_in_a_tiny_cluster_keeps_every_edge_d
                                 {0x1.11fba5bed0265p-1, 0x1.7e082b36b66e2p-1, -0x1.959afc22c50f6p-2},
                                 {0x1.11fba5b5f87eep-1, 0x1.7e082b41e1185p-1, -0x1.959afc10974a3p-2},
                                 {0x1.11fba5b8ffb1dp-1, 0x1.7e082b41b5638p-1, -0x1.959afc090d64ep-2}};
-    SphericalDelaunay d;
-    d.insert_points(std::span<const Vec3>(pts));
-    ASSERT_TRUE(d.validate().empty());
-    d.move_vertex(3, {0x1.11fba5b722f5cp-1, 0x1.7e082b3bf67ep-1, -0x1.959afc23bb26cp-2});
-    const auto problems = d.validate();
-    EXPECT_TRUE(problems.empty()) << problems.front();
+    const Vec3 to{0x1.11fba5b722f5cp-1, 0x1.7e082b3bf67ep-1, -0x1.959afc23bb26cp-2};
+    // Every insertion order (the failure did not depend on it), every vertex moved to `to`.
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        SphericalDelaunay::Options o;
+        o.seed = seed;
+        SphericalDelaunay d(o);
+        const auto map = d.insert_points(std::span<const Vec3>(pts));
+        ASSERT_TRUE(d.validate().empty());
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            SphericalDelaunay e = d;
+            const VertexId v = map[i];
+            const Vec3 before = e.point(v);
+            const std::size_t triangles = e.triangle_count();
+            const bool moved = e.move_vertex(v, to);
+            EXPECT_TRUE(moved ? e.point(v) == to : e.point(v) == before) << "seed " << seed << " point " << i;
+            EXPECT_EQ(e.triangle_count(), triangles);
+            const auto problems = e.validate();
+            EXPECT_TRUE(problems.empty()) << "seed " << seed << " point " << i << ": " << problems.front();
+            if (!moved) { // refused: every triangle as it was
+                for (TriangleId t = 0; t < d.triangle_slots(); ++t) {
+                    ASSERT_EQ(e.is_live(t), d.is_live(t));
+                    if (!d.is_live(t)) continue;
+                    for (int k = 0; k < 3; ++k) {
+                        ASSERT_EQ(e.vertex(t, k), d.vertex(t, k));
+                        ASSERT_EQ(e.twin(half_edge(t, k)), d.twin(half_edge(t, k)));
+                    }
+                }
+            }
+        }
+    }
+}
+
+// Found by tests/fuzz/fuzz_delaunay (finding 7ce1c8e5): five distinct points that lie in one
+// hemisphere (the south pole S, and C, C' 1 ulp apart near the north pole), so the hull has ghost
+// triangles, three of them around S. Moving S by 0.09 rad turned those three solid, so the hull
+// now held the origin, but the ghost (C', C, A) away from S stayed: a clockwise triangle in a
+// hull around the origin (and C' left with two triangles, a flat pillow). Flips around S cannot
+// reach it. Fixed in src/delaunay: move_vertex refuses a move whose star holds a ghost triangle.
+TEST(DelaunayProperty, move_vertex_out_of_ghost_triangles_never_folds_the_hull) {
+    const std::vector<Vec3> pts{{0x1.5db3d742c2655p-1, 0x1.5db3d742c2656p-1, 0x1.0907dc193069p-2},
+                                {0x0p+0, 0x0p+0, -0x1p+0},
+                                {-0x1.e46cf4030bfdfp-2, -0x1.28d7fe19827b2p-8, 0x1.c31407c3ab563p-1},
+                                {-0x1.93916ca738b0dp-7, 0x1.3e44de35261afp-12, 0x1.fff60d8ed9a6cp-1},
+                                {-0x1.93916ca738b0ep-7, 0x1.3e44de35261aep-12, 0x1.fff60d8ed9a6bp-1}};
+    const Vec3 to{0x1.725d42a841345p-4, 0x0p+0, -0x1.fde714c2de1a2p-1};
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        SphericalDelaunay::Options o;
+        o.seed = seed;
+        SphericalDelaunay d(o);
+        const auto map = d.insert_points(std::span<const Vec3>(pts));
+        ASSERT_TRUE(d.validate().empty());
+        const bool moved = d.move_vertex(map[1], to);
+        EXPECT_TRUE(moved ? d.point(map[1]) == to : d.point(map[1]) == pts[1]);
+        const auto problems = d.validate();
+        EXPECT_TRUE(problems.empty()) << "seed " << seed << ": " << problems.front();
+    }
 }
 
 // Found by tests/fuzz/fuzz_delaunay (after 219000 executions): twelve points within 1e-5 rad of
-// the south pole (several exactly on it or ulps from it) and two near (0, 1, 0). insert_points
-// maps an input point to a vertex more than 1e-7 rad away, beyond both merge distances the
-// header states (1e-12 rad, ~1e-8 rad). Core bug (src/delaunay); disabled until fixed there.
-TEST(DelaunayProperty, DISABLED_points_near_the_south_pole_merge_only_into_near_vertices) {
+// the south pole (several exactly on it or ulps from it, most on the meridian plane y = 0) and
+// two near (0, 1, 0). An input point was mapped to a vertex 1e-6 rad away, beyond both merge
+// distances the header states: an exact duplicate of an earlier point, whose walk stopped on a
+// flat triangle of the meridian (every orientation 0) far from its twin; no face sees a duplicate,
+// so it was merged into the nearest vertex of that flat triangle. Fixed in src/delaunay: merged
+// into its nearest vertex, found by greedy descent from there. The insertion order of the
+// failure changed with the BRIO keys of cd45ae4, so shuffled orders and one-by-one insert() too.
+TEST(DelaunayProperty, points_near_the_south_pole_merge_only_into_near_vertices) {
     const std::vector<Vec3> pts{{-0x1.8bd7366f31c64p-39, 0x0p+0, -0x1p+0},
                                 {0x0p+0, 0x0p+0, -0x1p+0},
                                 {-0x1.f6a7a2f9da303p-20, 0x0p+0, -0x1.fffffffffc251p-1},
@@ -888,11 +935,40 @@ TEST(DelaunayProperty, DISABLED_points_near_the_south_pole_merge_only_into_near_
                                 {-0x1.0c5ec5635e0ep-20, 0x0p+0, -0x1.fffffffffee6bp-1},
                                 {0x1.1a62633145c07p-54, 0x1p+0, 0x0p+0},
                                 {-0x1.bb3e01f5ad6d1p-44, 0x1p+0, 0x1.38d1165e73437p-46}};
-    SphericalDelaunay d;
-    const auto map = d.insert_points(std::span<const Vec3>(pts));
-    EXPECT_TRUE(d.validate().empty());
-    for (std::size_t i = 0; i < pts.size(); ++i)
-        EXPECT_LE(arc_angle(d.point(map[i]), pts[i]), 1e-7) << "point " << i << " -> vertex " << map[i];
+    std::mt19937_64 rng(5);
+    for (int run = 0; run < 400; ++run) {
+        std::vector<Vec3> p = pts;
+        std::shuffle(p.begin(), p.end(), rng);
+        SphericalDelaunay d;
+        std::vector<VertexId> map;
+        if (run % 2 == 0) {
+            map = d.insert_points(std::span<const Vec3>(p));
+        } else {
+            // The shortest prefix spanning a tetrahedron by insert_points, the rest one by one.
+            std::size_t prefix = 4;
+            for (; prefix <= p.size(); ++prefix) {
+                SphericalDelaunay probe;
+                try {
+                    probe.insert_points(std::span<const Vec3>(p.data(), prefix));
+                    break;
+                } catch (const DataError&) {
+                }
+            }
+            ASSERT_LE(prefix, p.size());
+            map = d.insert_points(std::span<const Vec3>(p.data(), prefix));
+            for (std::size_t i = prefix; i < p.size(); ++i) map.push_back(d.insert(p[i], d.last_triangle()));
+        }
+        const auto problems = d.validate();
+        ASSERT_TRUE(problems.empty()) << "run " << run << ": " << problems.front();
+        std::set<VertexId> used;
+        for (TriangleId t = 0; t < d.triangle_slots(); ++t)
+            if (d.is_live(t))
+                for (int k = 0; k < 3; ++k) used.insert(d.vertex(t, k));
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            ASSERT_LE(arc_angle(d.point(map[i]), p[i]), 1e-7) << "run " << run << " point " << i << " -> vertex " << map[i];
+            ASSERT_TRUE(used.count(map[i])) << "run " << run << " point " << i;
+        }
+    }
 }
 
 // Found by CoastProperty.hundreds_of_hostile_small_coasts_mesh_validly_or_raise_a_clean_error,
