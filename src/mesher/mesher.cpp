@@ -161,8 +161,8 @@ struct Mesher {
 };
 
 // A refinement candidate: 16 bytes. `stamp` is the generation of slot t when it was queued
-// (twice, plus 1 when the triangle was on the front); a slot's generation grows each time the
-// core puts a new triangle in it, so an entry whose stamp no longer matches is stale.
+// (twice, plus 1 when the triangle was on the front); a slot's generation (24 bits) grows each
+// time the core puts a new triangle in it, so an entry whose stamp no longer matches is stale.
 struct Candidate {
     double badness;
     TriangleId t;
@@ -438,21 +438,29 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // never changes while it lives (its corners, their fixed/sharp flags and the size field are
     // all fixed), and every triangle an insertion creates has the new vertex as a corner.
     std::vector<double> bad(dt.triangle_slots(), 0.0);
-    std::vector<std::uint32_t> generation(dt.triangle_slots(), 0);
+    // Per slot: the generation of its triangle (bits 8-31, grows each time the core puts a new
+    // triangle in the slot) and how many copies of its candidate, off the front (bits 0-3) and
+    // on it (bits 4-7), are queued. Copies of one candidate are identical, so the heap holds one
+    // entry for them and puts it back after each pop while copies remain: the same pops as one
+    // entry per copy, with a smaller heap and fewer stale pops.
+    std::vector<std::uint32_t> slot_state(dt.triangle_slots(), 0);
     CandidateHeap queue;
     auto refresh = [&](TriangleId t) {
         if (t >= bad.size()) {
             bad.resize(dt.triangle_slots(), 0.0);
-            generation.resize(dt.triangle_slots(), 0);
+            slot_state.resize(dt.triangle_slots(), 0);
         }
-        ++generation[t];
+        slot_state[t] = ((slot_state[t] >> 8) + 1) << 8;
         bad[t] = dt.label(t) == ocean ? m.badness(t) : 0.0;
     };
     auto push = [&](double b, TriangleId t, bool active) {
-        queue.push({b, t, generation[t] << 1 | (active ? 1u : 0u)});
+        const int shift = active ? 4 : 0;
+        const std::uint32_t copies = (slot_state[t] >> shift) & 15u;
+        if (copies == 0) queue.push({b, t, (slot_state[t] >> 8) << 1 | (active ? 1u : 0u)});
+        if (copies < 15) slot_state[t] += 1u << shift; // (more than 15 copies: counted as 15)
     };
     auto stale = [&](const Candidate& c) {
-        return !dt.is_live(c.t) || generation[c.t] != c.stamp >> 1 || dt.label(c.t) != ocean;
+        return !dt.is_live(c.t) || slot_state[c.t] >> 8 != c.stamp >> 1 || dt.label(c.t) != ocean;
     };
     // Frontal order (Rebay 1993): a bad triangle whose edge borders an accepted triangle or the
     // boundary is on the front and goes first; its new node is placed off that edge.
@@ -523,6 +531,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         const Candidate c = queue.pop();
         const TriangleId t = c.t;
         if (stale(c)) continue;
+        const int shift = c.active() ? 4 : 0;
+        slot_state[t] -= 1u << shift;
+        if ((slot_state[t] >> shift & 15u) != 0) queue.push(c); // the next copy
         if (dt.vertex_count() > node_limit)
             throw DataError("refinement does not converge (over " + std::to_string(node_limit) +
                             " nodes): the size field may be too small for the boundary");
@@ -621,7 +632,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // The refinement's memory goes before the smoothing's: the heap and the per-slot arrays.
     queue.release();
     std::vector<double>().swap(bad);
-    std::vector<std::uint32_t>().swap(generation);
+    std::vector<std::uint32_t>().swap(slot_state);
     // Nodes are visited along the Hilbert curve, so that consecutive stars share their cache
     // lines whatever order the refinement numbered them in (id order misses the cache more
     // and more as the mesh grows). Boundary nodes (fixed) are left out.
@@ -694,10 +705,17 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // ---- output ------------------------------------------------------------------------------
     Mesh mesh;
+    // Sized once (no doubling, no copy while growing): the output is most of the peak.
     std::vector<NodeIndex> node_of(dt.vertex_count(), 0xffffffffu);
+    std::size_t face_count = 0, node_count = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (dt.is_live(t) && dt.label(t) == ocean)
+        if (dt.is_live(t) && dt.label(t) == ocean) {
+            ++face_count;
             for (int i = 0; i < 3; ++i) node_of[dt.vertex(t, i)] = 0;
+        }
+    for (VertexId v = 0; v < dt.vertex_count(); ++v) node_count += node_of[v] == 0;
+    mesh.nodes.reserve(node_count);
+    mesh.faces.reserve(face_count);
     for (VertexId v = 0; v < dt.vertex_count(); ++v)
         if (node_of[v] == 0) {
             node_of[v] = static_cast<NodeIndex>(mesh.nodes.size());
