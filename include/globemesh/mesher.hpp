@@ -10,10 +10,13 @@
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
-//      boundary segment splits that segment at its midpoint instead (Ruppert);
+//      boundary segment splits that segment at its midpoint instead (Ruppert). Each triangle's
+//      badness is computed once, when the core creates it; candidates wait in a 4-ary heap of
+//      16-byte entries stamped with their slot's generation (a stale entry is skipped);
 //   5. improves: sweeps of optimal-Delaunay smoothing of the interior nodes (each moved to the
 //      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
-//      with Delaunay flips after each move; boundary nodes stay fixed.
+//      with Delaunay flips after each move; boundary nodes stay fixed. Nodes are visited along
+//      the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share cache lines.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -36,8 +39,10 @@ struct MesherOptions {
     std::uint64_t seed = 1;               ///< seed of the core's insertion order
 };
 
-/// Peak bytes per output node that mesh_boundary needs (the core, the refinement's queue and the
-/// smoothing's maps), used to turn the node estimate into a memory estimate before refining.
+/// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory
+/// estimate before refining. mesh_boundary itself peaks at about 150 B/node from 1e6 nodes up
+/// (the core's 78, the refinement's per-slot badness and heap, then the returned Mesh;
+/// bench/mesher_memory); 800 also covers the UGRID writer's tables that follow in the pipeline.
 inline constexpr std::uint64_t mesher_bytes_per_node = 800;
 
 struct OceanComponent {

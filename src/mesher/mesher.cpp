@@ -722,17 +722,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             mesh.nodes.push_back(dt.point(v));
         }
     if (mesh.nodes.empty()) throw DataError("no ocean is left to mesh");
-    std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
-    std::vector<char> on_boundary(mesh.nodes.size(), 0);
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-        std::array<NodeIndex, 3> f = {node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]};
-        mesh.faces.push_back(f);
+        mesh.faces.push_back({node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]});
         for (int i = 0; i < 3; ++i) {
-            const Vec3& p = dt.point(dt.vertex(t, i));
-            const Vec3& q = dt.point(dt.vertex(t, next3(i)));
-            const Vec3& r = dt.point(dt.vertex(t, prev3(i)));
-            ocean_angle[f[i]] += std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p));
             HalfEdge h = half_edge(t, i);
             TriangleId other = triangle_of(dt.twin(h));
             if (dt.label(other) == ocean) continue;
@@ -740,9 +733,21 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             auto it = m.segments.find(key(a, b));
             EdgeTag tag = it != m.segments.end() && it->second == SegmentKind::open ? EdgeTag::open : EdgeTag::coast;
             mesh.boundary.push_back({node_of[a], node_of[b], tag});
-            on_boundary[node_of[a]] = on_boundary[node_of[b]] = 1;
         }
     }
+    // The triangulation is no longer needed: free it before the per-node arrays below.
+    std::vector<NodeIndex>().swap(node_of);
+    m.dt = SphericalDelaunay{};
+    std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
+    std::vector<char> on_boundary(mesh.nodes.size(), 0);
+    for (const auto& f : mesh.faces)
+        for (int i = 0; i < 3; ++i) {
+            const Vec3& p = mesh.nodes[f[i]];
+            const Vec3& q = mesh.nodes[f[next3(i)]];
+            const Vec3& r = mesh.nodes[f[prev3(i)]];
+            ocean_angle[f[i]] += std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p));
+        }
+    for (const auto& e : mesh.boundary) on_boundary[e.a] = on_boundary[e.b] = 1;
     std::vector<char> sharp(mesh.nodes.size(), 0);
     for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
         if (on_boundary[v] && ocean_angle[v] < 60.0 * deg_to_rad) {

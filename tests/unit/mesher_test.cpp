@@ -8,6 +8,7 @@
 #include <iterator>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -199,4 +200,22 @@ TEST(Mesher, too_many_nodes_are_refused_before_refining) {
     } catch (const DataError& e) {
         EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
     }
+}
+
+TEST(Mesher, smoothing_leaves_every_ring_node_in_place_and_sharp_corners_match_the_faces) {
+    MeshOptions o = land_110m(200);
+    CoastData coast = load_coast(o);
+    Boundary b = shape_boundary(coast, uniform_size(200), o);
+    MesherReport report;
+    Mesh mesh = mesh_boundary(b, uniform_size(200), {}, &report);
+    // Boundary nodes are fixed: every ring node is an output node with the very same coordinates.
+    std::set<std::tuple<double, double, double>> nodes;
+    for (const Vec3& p : mesh.nodes) nodes.insert({p.x, p.y, p.z});
+    std::size_t missing = 0;
+    for (const Ring& r : b.rings)
+        for (const Vec3& p : r.nodes) missing += nodes.count({p.x, p.y, p.z}) == 0;
+    EXPECT_EQ(missing, 0u);
+    // Faces at sharp corners, recounted from the faces alone (ocean angle below 60 degrees).
+    EXPECT_EQ(report.sharp_corner_faces, quality(mesh).corner_faces);
+    EXPECT_GT(report.sharp_corners, 0u); // the 1:110m coast has sharp corners at 200 km
 }

@@ -1,0 +1,75 @@
+// The ocean mesher's own cost at one size: reads and shapes a coast (not timed), then runs
+// mesh_boundary alone `repeats` times with a uniform size field and prints, per run, the nodes,
+// the seconds (wall clock, and CPU time of the process, which a shared machine disturbs less)
+// and us/node of the whole call, the wall-clock us/node of each stage (insert_boundary, recover,
+// classify, refine, improve), and the peak bytes per node of the call itself: the process's
+// high-water mark (VmHWM, reset through /proc/self/clear_refs just before the call) minus its
+// resident size before the call, so the coast, the boundary and the writer are not counted; the
+// returned Mesh is. Linux only. Usage: mesher_memory COAST LAYER HMAX_KM [REPEATS]
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "globemesh/coast.hpp"
+#include "globemesh/mesher.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/sizefield.hpp"
+
+namespace {
+
+long vm_kib(const char* key) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    while (std::getline(f, line))
+        if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
+    return -1;
+}
+
+bool reset_peak() {
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
+    return static_cast<bool>(f);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 4) {
+        std::fprintf(stderr, "usage: mesher_memory COAST LAYER HMAX_KM [REPEATS]\n");
+        return 2;
+    }
+    globemesh::MeshOptions o;
+    o.coast = argv[1];
+    o.coast_layer = argv[2];
+    o.hmax_km = std::atof(argv[3]);
+    const int repeats = argc > 4 ? std::atoi(argv[4]) : 1;
+    const globemesh::SizeFn size = globemesh::uniform_size(o.hmax_km);
+    globemesh::Boundary boundary;
+    {
+        globemesh::CoastData coast = globemesh::load_coast(o);
+        boundary = globemesh::shape_boundary(coast, size, o);
+    }
+    for (int r = 0; r < repeats; ++r) {
+        const bool peak_ok = reset_peak();
+        const long base = vm_kib("VmRSS:");
+        globemesh::StageTimings timings;
+        globemesh::MesherReport report;
+        const std::clock_t c0 = std::clock();
+        auto t0 = std::chrono::steady_clock::now();
+        globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, {}, &report, {}, &timings);
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
+        const long peak = vm_kib("VmHWM:");
+        const double n = static_cast<double>(mesh.nodes.size());
+        std::printf("h %.0f km: %zu nodes, mesh %.3f s = %.2f us/node, CPU %.2f us/node (", o.hmax_km,
+                    mesh.nodes.size(), s, 1e6 * s / n, 1e6 * cpu / n);
+        for (const auto& [name, sec] : timings.stages) std::printf(" %s %.2f", name.c_str(), 1e6 * sec / n);
+        std::printf(" ), peak %.0f B/node%s\n", peak_ok ? 1024.0 * double(peak - base) / n : -1.0,
+                    peak_ok ? "" : " (clear_refs refused: not measured)");
+        std::fflush(stdout);
+    }
+    return 0;
+}
