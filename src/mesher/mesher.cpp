@@ -651,7 +651,12 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
         // (a triangle next to v) rather than an answer: the walk from it is a step or two.
         const std::vector<HalfEdge> star = dt.vertex_half_edges();
-        for (VertexId v : visit) {
+        for (std::size_t k = 0; k < visit.size(); ++k) {
+            const VertexId v = visit[k];
+            // The next stars' entries are far apart in memory: ask for them ahead.
+            if (k + 16 < visit.size()) __builtin_prefetch(&star[visit[k + 16]]);
+            if (k + 8 < visit.size() && star[visit[k + 8]] != no_half_edge)
+                __builtin_prefetch(&dt.point(dt.destination(star[visit[k + 8]])));
             if (star[v] == no_half_edge) continue;
             HalfEdge from = star[v];
             if (dt.origin(from) != v || !dt.is_live(triangle_of(from))) from = dt.leaving(v, triangle_of(from));
