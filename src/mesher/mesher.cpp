@@ -604,8 +604,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             if (arc_angle(dt.point(a), dt.point(b)) < 2 * refine_floor * km_to_rad(size_km(mid))) continue;
             auto it = m.segments.find(key(a, b));
             SegmentKind kind = it != m.segments.end() ? it->second : SegmentKind::coast;
+            const std::size_t before = dt.vertex_count();
             v = dt.split_edge(blocked, mid);
-            if (v == a || v == b) continue;
+            // Merged with a or b, or (within rounding) with another vertex: the edge is unsplit.
+            if (v == a || v == b || dt.vertex_count() == before) continue;
             m.segments.erase(key(a, b));
             m.segments[key(a, v)] = kind;
             m.segments[key(v, b)] = kind;
