@@ -111,12 +111,13 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     test::expect_mesh_verify(dir / "g.nc", "--size-var target_size --min-size-fit 0.95");
     QualityCheck q = quality(mesh);
     // Issue 4 asks for mean >= 0.93, 99% above 0.8 and worst >= 0.6 away from sharp corners.
-    // Measured here: mean 0.951, 96.7% above 0.8, but a worst face of 0.02 away from sharp
-    // corners (skinny triangles on very short coast segments in narrow straits). The assertions
-    // hold what is reached so a regression fails; the gap is in the closing note of issue 4.
+    // Measured here (c96179f): mean 0.951, 96.2% above 0.8, 84 faces (0.11%) below 0.6 away from
+    // sharp corners, the worst 0.19, all in channels narrower than the refinement floor h/20
+    // (tapering rivers such as the James River). The assertions hold what is reached so a
+    // regression fails; the gap is in the closing note of issue 4.
     EXPECT_GE(q.mean, 0.93);
     EXPECT_GE(q.above_0_8, 0.96);
-    EXPECT_LT(q.below_0_6_away_from_corners, 0.01);
+    EXPECT_LT(q.below_0_6_away_from_corners, 0.003);
     EXPECT_LT(q.corner_faces, mesh.faces.size() / 100);
 }
 
