@@ -767,9 +767,14 @@ std::size_t SphericalDelaunay::legalize_from(std::vector<HalfEdge>& stack) {
         const Vec3& w = points_[vertex(t, prev3(i))];
         const Vec3& y = points_[vertex(s, j)];
         if (in_circle(x, u, w, y) <= 0) continue;
-        // A solid non-Delaunay edge bounds a strictly convex quadrilateral; with ghosts around,
-        // make sure the flip keeps both triangles oriented.
-        if (orient(x, u, y) <= 0 || orient(y, w, x) <= 0) {
+        // A solid non-Delaunay edge bounds a convex quadrilateral; with ghosts around, make sure
+        // the flip keeps both triangles oriented. Convex, not strictly: in_circle's perturbation
+        // scales points radially, which keeps every orient() sign, zeros included, so a new
+        // triangle with orient() == 0 is flat in the perturbed set too (three vertices on one
+        // great circle, e.g. a rounded point exactly on the chord of two others: a flat face of
+        // a hull in a closed hemisphere, as insertion makes). Skipping that flip would leave
+        // the edge not locally Delaunay; only a clockwise (folded) triangle is refused.
+        if (orient(x, u, y) < 0 || orient(y, w, x) < 0) {
             if (is_solid(t) && is_solid(s)) continue;
         }
         flip(h);

@@ -389,3 +389,55 @@ TEST(Delaunay, locate_from_any_hint_finds_a_triangle_containing_the_point) {
         ++k;
     }
 }
+
+// fuzz_delaunay finding 1b15f159 (insert_constraint), minimized. Points 0..3 are rounded unit
+// vectors ~2.5e-12 rad apart on one great circle, and point 1 is bit-exactly the midpoint of
+// the chord 0-2 (collinear in space, impossible for points exactly on the sphere). Points 4, 5
+// lie about 2 rad away, so all six are in a closed hemisphere: flat and ghost triangles close
+// the hull. Recovering the edge 2-4 leaves the edge from point 1 to a far point needing a flip
+// whose new triangle (0, 1, 2) is flat (orient() == 0); in_circle()'s radial perturbation keeps
+// that zero, so the flip is legal there, but legalize_from refused it as if it folded and left
+// an edge that is not locally Delaunay. Reproduces with g++ and clang++ (the input is hex).
+TEST(Delaunay, constraint_recovery_flips_to_a_flat_triangle_on_three_collinear_rounded_points) {
+    const std::vector<Vec3> p = {
+        {-0x1.b602699904241p-4, -0x1.4626cbb5399d1p-1, -0x1.86dc23c464258p-1},
+        {-0x1.b60269990c4d2p-4, -0x1.4626cbb53fb0ap-1, -0x1.86dc23c45eeeep-1},
+        {-0x1.b602699914763p-4, -0x1.4626cbb545c43p-1, -0x1.86dc23c459b84p-1},
+        {-0x1.b60269991c9f4p-4, -0x1.4626cbb54bd7cp-1, -0x1.86dc23c45481ap-1},
+        {-0x1.c11dd5c05fb99p-2, -0x1.c46ad831d8a59p-10, 0x1.cc207f367f37fp-1},
+        {-0x1.c11dd5bd6382ep-2, -0x1.c46ad8d4e110ep-10, 0x1.cc207f37398b5p-1},
+    };
+    // The premise, checked exactly: p1 = (p0 + p2) / 2 with no rounding (halving and adding
+    // these doubles is exact here), so p0, p1, p2 lie on one line and on one great circle.
+    EXPECT_EQ(p[1], 0.5 * (p[0] + p[2]));
+    EXPECT_EQ(predicates::orient(p[0], p[1], p[2]), 0);
+    EXPECT_EQ(predicates::orient(p[0], p[1], p[3]), 0);
+
+    SphericalDelaunay dt;
+    const auto id = dt.insert_points(p);
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    ASSERT_EQ(std::set<VertexId>(id.begin(), id.end()).size(), p.size()); // nothing merged
+    ASSERT_TRUE(dt.insert_constraint(id[2], id[4]));
+    problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+
+    const HalfEdge h = dt.find_edge(dt.vertex_half_edges()[id[2]], id[4]);
+    ASSERT_NE(h, no_half_edge);
+    EXPECT_TRUE(dt.is_constrained(h));
+    // Independently of validate(): every unconstrained edge is locally Delaunay (the opposite
+    // vertex is not inside the circumcircle).
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t)) continue;
+        for (int i = 0; i < 3; ++i) {
+            const HalfEdge e = half_edge(t, i);
+            if (dt.is_constrained(e)) continue;
+            const HalfEdge g = dt.twin(e);
+            const Vec3& opposite = dt.point(dt.vertex(triangle_of(g), edge_of(g)));
+            EXPECT_LE(predicates::in_circle(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                            dt.point(dt.vertex(t, 2)), opposite),
+                      0)
+                << "edge " << dt.origin(e) << "-" << dt.destination(e);
+        }
+    }
+}
