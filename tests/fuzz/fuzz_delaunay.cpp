@@ -76,12 +76,20 @@ Vec3 rotate(const Vec3& v, const Vec3& axis, double angle) { // Rodrigues, axis 
     return c * v + s * cross(axis, v) + ((1 - c) * dot(axis, v)) * axis;
 }
 
+// Longitude, then latitude, in that order: as two arguments of one call their order of
+// evaluation is unspecified (g++ on x86-64 goes right to left, clang++ left to right), and the
+// same input decoded to other points under each compiler.
+Vec3 consume_lonlat(FuzzedDataProvider& in) {
+    const double lon = in.ConsumeFloatingPointInRange<double>(-180, 180);
+    const double lat = in.ConsumeFloatingPointInRange<double>(-90, 90);
+    return lonlat_to_vec(lon, lat);
+}
+
 std::vector<Vec3> decode(FuzzedDataProvider& in) {
     std::vector<Vec3> pts;
     const std::size_t n = in.ConsumeIntegralInRange<std::size_t>(0, 48);
     // A shared small circle (axis, radius) and great circle (normal) for co-circular groups.
-    const Vec3 axis = lonlat_to_vec(in.ConsumeFloatingPointInRange<double>(-180, 180),
-                                    in.ConsumeFloatingPointInRange<double>(-90, 90));
+    const Vec3 axis = consume_lonlat(in);
     const double radius = in.ConsumeFloatingPointInRange<double>(1e-9, pi / 2);
     Vec3 start = cross(axis, Vec3{0.3, -0.5, 0.8});
     start = norm(start) > 1e-6 ? normalized(start) : Vec3{1, 0, 0};
@@ -91,14 +99,12 @@ std::vector<Vec3> decode(FuzzedDataProvider& in) {
         const int mode = in.ConsumeIntegralInRange<int>(0, 8);
         const auto earlier = [&] { return pts[in.ConsumeIntegralInRange<std::size_t>(0, pts.size() - 1)]; };
         if (pts.empty() && (mode >= 1 && mode <= 3)) {
-            pts.push_back(lonlat_to_vec(in.ConsumeFloatingPointInRange<double>(-180, 180),
-                                        in.ConsumeFloatingPointInRange<double>(-90, 90)));
+            pts.push_back(consume_lonlat(in));
             continue;
         }
         switch (mode) {
         case 0:
-            pts.push_back(lonlat_to_vec(in.ConsumeFloatingPointInRange<double>(-180, 180),
-                                        in.ConsumeFloatingPointInRange<double>(-90, 90)));
+            pts.push_back(consume_lonlat(in));
             break;
         case 1: pts.push_back(earlier()); break;
         case 2: {
