@@ -58,4 +58,7 @@ struct MeshOptions {
 /// the option. Opens no file.
 void validate(const MeshOptions& options);
 
+/// Bytes with an SI unit, as --max-memory takes them: memory_text(1.2e9) == "1.2 GB".
+std::string memory_text(double bytes);
+
 } // namespace globemesh

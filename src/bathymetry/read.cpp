@@ -145,16 +145,6 @@ std::string fmt_count(double v) {
     return buf;
 }
 
-/// Bytes with an SI unit, as --max-memory takes them ("1.2 GB").
-std::string fmt_bytes(double v) {
-    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
-    int u = 0;
-    while (v >= 1000 && u < 5) v /= 1000, ++u;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
-    return buf;
-}
-
 } // namespace
 
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
@@ -230,8 +220,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     const double bytes = cx * cy * static_cast<double>(sizeof(float));
     if (limits.max_bytes > 0 && bytes > static_cast<double>(limits.max_bytes))
         throw DataError("--bathy " + path + ": " + std::to_string(nx) + " x " + std::to_string(ny) +
-                        " cells, read as " + fmt_count(cx) + " x " + fmt_count(cy) + " (" + fmt_bytes(bytes) +
-                        "), exceed the " + fmt_bytes(static_cast<double>(limits.max_bytes)) +
+                        " cells, read as " + fmt_count(cx) + " x " + fmt_count(cy) + " (" + memory_text(bytes) +
+                        "), exceed the " + memory_text(static_cast<double>(limits.max_bytes)) +
                         " that --max-memory leaves for it; raise --max-memory or --hmin, or give a "
                         "coarser raster (gdal_translate -tr)");
     const std::size_t bx = static_cast<std::size_t>(cx), by = static_cast<std::size_t>(cy);

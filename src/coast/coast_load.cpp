@@ -215,15 +215,6 @@ std::uint64_t vertex_count(OGRGeometryH g) {
 /// with the mesh included; rounded up.
 constexpr std::uint64_t coast_bytes_per_vertex = 200;
 
-std::string fmt_bytes(double v) {
-    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
-    int u = 0;
-    while (v >= 1000 && u < 5) v /= 1000, ++u;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
-    return buf;
-}
-
 bool is_area_or_line(OGRwkbGeometryType t) {
     t = wkbFlatten(t);
     return OGR_GT_IsSubClassOf(t, wkbCurvePolygon) || OGR_GT_IsSubClassOf(t, wkbMultiSurface) ||
@@ -341,7 +332,7 @@ Source read_source(const std::string& path, const std::string& layer_name, const
     }
     if (too_many)
         throw DataError(where_msg + " has " + std::to_string(vertices) + " vertices, more than the " +
-                        std::to_string(max_vertices) + " that --max-memory " + fmt_bytes(static_cast<double>(max_bytes)) +
+                        std::to_string(max_vertices) + " that --max-memory " + memory_text(static_cast<double>(max_bytes)) +
                         " allows (about " + std::to_string(coast_bytes_per_vertex) +
                         " bytes each); raise --max-memory, or simplify the layer first (e.g. ogr2ogr -simplify 0.001)");
     if (src.features == 0 && !where.empty() && CPLGetLastErrorType() >= CE_Failure)

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "globemesh/error.hpp"
@@ -50,6 +51,15 @@ void validate(const MeshOptions& o) {
         require(r[0] != r[2], "--region W and E must differ (W > E crosses +-180)");
     }
     require(!(o.region && !o.region_file.empty()), "--region and --region-file cannot be used together");
+}
+
+std::string memory_text(double bytes) {
+    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
+    int u = 0;
+    while (bytes >= 1000 && u < 5) bytes /= 1000, ++u;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g %s", bytes, units[u]);
+    return buf;
 }
 
 } // namespace globemesh

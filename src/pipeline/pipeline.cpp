@@ -43,16 +43,6 @@ std::string number(double v) {
     return s.str();
 }
 
-/// Bytes with an SI unit, as --max-memory takes them ("1.2 GB").
-std::string bytes_text(double v) {
-    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
-    int u = 0;
-    while (v >= 1000 && u < 5) v /= 1000, ++u;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g %s", v, units[u]);
-    return buf;
-}
-
 /// Largest background grid of the size field: 2^22 nodes (about 10 km at the equator
 /// globally) builds in a few seconds; regional grids are finer for the same count.
 constexpr std::size_t size_grid_max_nodes = std::size_t{1} << 22;
@@ -92,10 +82,10 @@ public:
     /// Throws DataError when `bytes` more do not fit; `what` says what needs them.
     void require(double bytes, const std::string& what, const std::string& remedy) const {
         if (total_ == 0 || held_ + bytes <= static_cast<double>(total_)) return;
-        throw DataError(what + " needs about " + bytes_text(bytes) + ", more than the " +
-                        bytes_text(static_cast<double>(left())) + " left of --max-memory " +
-                        bytes_text(static_cast<double>(total_)) + " after reading the inputs (" +
-                        bytes_text(held_) + "); raise --max-memory" + remedy);
+        throw DataError(what + " needs about " + memory_text(bytes) + ", more than the " +
+                        memory_text(static_cast<double>(left())) + " left of --max-memory " +
+                        memory_text(static_cast<double>(total_)) + " after reading the inputs (" +
+                        memory_text(held_) + "); raise --max-memory" + remedy);
     }
 
 private:
