@@ -110,8 +110,10 @@ public:
 
     /// Makes a-b an edge of the triangulation and constrains it, by flipping the edges that cross
     /// the arc a-b (never inserting points). When a vertex lies exactly on the arc, the
-    /// constraint is split there. Returns false (and changes nothing) when an existing constrained
-    /// edge crosses the arc.
+    /// constraint is split there. Returns false and changes nothing when an existing constrained
+    /// edge crosses the arc, or when flips cannot make the edge Delaunay-constrained: near
+    /// vertices closer than about 1e-7 rad, whose rounding off the unit sphere outweighs its
+    /// curvature, the points need not be in convex position (split the arc there instead).
     bool insert_constraint(VertexId a, VertexId b);
 
     /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
@@ -202,8 +204,24 @@ private:
     bool visible(TriangleId t, const Vec3& p) const;
     // id: the vertex p becomes (an adopted point's slot), or no_vertex to append p.
     VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id = no_vertex);
-    std::size_t legalize_from(std::vector<HalfEdge>& stack);
-    bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created);
+    // Both triangles of a flip as they were (vertices and link words), to undo it exactly.
+    struct FlipRecord {
+        TriangleId t, s;
+        VertexId tv[3], sv[3];
+        std::uint32_t tl[3], sl[3];
+    };
+    // flip(h), first recording it in *journal when there is one.
+    void flip_recorded(HalfEdge h, std::vector<FlipRecord>* journal);
+    // Undoes the journal's flips, newest first, and clears it.
+    void undo_flips(std::vector<FlipRecord>& journal);
+    // Lawson flips from the half-edges on `stack` until each edge reached is locally Delaunay.
+    // A non-Delaunay edge between solid triangles whose flip would fold one (or make it flat,
+    // when flat_folds) cannot be mended: without a journal it is skipped; with one, every flip
+    // is recorded and the run stops there, returning false. Counts flips in *flips if given.
+    bool legalize_from(std::vector<HalfEdge>& stack, std::vector<FlipRecord>* journal, bool flat_folds,
+                       std::size_t* flips);
+    bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created, std::vector<FlipRecord>& journal,
+                         std::vector<std::pair<VertexId, VertexId>>& constrained);
     VertexId nearest_vertex(const Vec3& p, TriangleId t) const;
     // Maps each vertex left by a swallowing cavity (see insert) to the vertex it merged into.
     void resolve_dropped(std::vector<VertexId>& map) const;

@@ -752,8 +752,42 @@ void SphericalDelaunay::flip(HalfEdge h) {
     last_ = t;
 }
 
-std::size_t SphericalDelaunay::legalize_from(std::vector<HalfEdge>& stack) {
-    std::size_t flips = 0;
+void SphericalDelaunay::flip_recorded(HalfEdge h, std::vector<FlipRecord>* journal) {
+    if (journal) {
+        const TriangleId t = triangle_of(h), s = triangle_of(twin(h));
+        FlipRecord rec{t, s, {}, {}, {}, {}};
+        for (int k = 0; k < 3; ++k) {
+            rec.tv[k] = tri_vertices_[3 * t + k];
+            rec.sv[k] = tri_vertices_[3 * s + k];
+            rec.tl[k] = links_[3 * t + k];
+            rec.sl[k] = links_[3 * s + k];
+        }
+        journal->push_back(rec);
+    }
+    flip(h);
+}
+
+void SphericalDelaunay::undo_flips(std::vector<FlipRecord>& journal) {
+    // Newest first: restore both triangles, then the outer half-edges' links to them.
+    for (auto r = journal.rbegin(); r != journal.rend(); ++r) {
+        for (int k = 0; k < 3; ++k) {
+            tri_vertices_[3 * r->t + k] = r->tv[k];
+            tri_vertices_[3 * r->s + k] = r->sv[k];
+            links_[3 * r->t + k] = r->tl[k];
+            links_[3 * r->s + k] = r->sl[k];
+        }
+        for (int k = 0; k < 3; ++k) {
+            const HalfEdge ht = half_edge(r->t, k), hs = half_edge(r->s, k);
+            links_[twin(ht)] = ht | (links_[ht] & constrained_bit);
+            links_[twin(hs)] = hs | (links_[hs] & constrained_bit);
+        }
+    }
+    if (!journal.empty()) last_ = journal.front().t;
+    journal.clear();
+}
+
+bool SphericalDelaunay::legalize_from(std::vector<HalfEdge>& stack, std::vector<FlipRecord>* journal, bool flat_folds,
+                                      std::size_t* flips) {
     while (!stack.empty()) {
         HalfEdge h = stack.back();
         stack.pop_back();
@@ -767,25 +801,31 @@ std::size_t SphericalDelaunay::legalize_from(std::vector<HalfEdge>& stack) {
         const Vec3& w = points_[vertex(t, prev3(i))];
         const Vec3& y = points_[vertex(s, j)];
         if (in_circle(x, u, w, y) <= 0) continue;
-        // A solid non-Delaunay edge bounds a convex quadrilateral; with ghosts around, make sure
-        // the flip keeps both triangles oriented. Convex, not strictly: in_circle's perturbation
-        // scales points radially, which keeps every orient() sign, zeros included, so a new
-        // triangle with orient() == 0 is flat in the perturbed set too (three vertices on one
-        // great circle, e.g. a rounded point exactly on the chord of two others: a flat face of
-        // a hull in a closed hemisphere, as insertion makes). Skipping that flip would leave
-        // the edge not locally Delaunay; only a clockwise (folded) triangle is refused.
-        if (orient(x, u, y) < 0 || orient(y, w, x) < 0) {
-            if (is_solid(t) && is_solid(s)) continue;
+        // A solid non-Delaunay edge bounds a convex quadrilateral when the points lie on the
+        // sphere; with ghosts around, make sure the flip keeps both triangles oriented. Convex,
+        // not strictly: in_circle's perturbation scales points radially, which keeps every
+        // orient() sign, zeros included, so a new triangle with orient() == 0 is flat in the
+        // perturbed set too (three vertices on one great circle, e.g. a rounded point exactly on
+        // the chord of two others: a flat face of a hull in a closed hemisphere, as insertion
+        // makes). Skipping that flip would leave the edge not locally Delaunay; only a clockwise
+        // (folded) triangle is refused, and a flat one too when the caller asks.
+        const int o1 = orient(x, u, y), o2 = orient(y, w, x);
+        if ((o1 < 0 || o2 < 0 || (flat_folds && (o1 == 0 || o2 == 0))) && is_solid(t) && is_solid(s)) {
+            // Rounded points are not exactly on the sphere: within ~1e-7 rad of each other their
+            // radial rounding outweighs the sphere's curvature, and a vertex can sit inside the
+            // hull of its neighbours, where no flip mends the edge.
+            if (journal) return false;
+            continue;
         }
-        flip(h);
-        ++flips;
+        flip_recorded(h, journal);
+        if (flips) ++*flips;
         // The four outer edges of the new pair.
         stack.push_back(half_edge(t, i));
         stack.push_back(half_edge(t, prev3(i)));
         stack.push_back(half_edge(s, j));
         stack.push_back(half_edge(s, prev3(j)));
     }
-    return flips;
+    return true;
 }
 
 std::size_t SphericalDelaunay::make_delaunay() {
@@ -793,7 +833,9 @@ std::size_t SphericalDelaunay::make_delaunay() {
     for (TriangleId t = 0; t < triangle_slots(); ++t)
         if (is_live(t))
             for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
-    return legalize_from(stack);
+    std::size_t flips = 0;
+    legalize_from(stack, nullptr, false, &flips);
+    return flips;
 }
 
 std::vector<HalfEdge> SphericalDelaunay::vertex_half_edges() const {
@@ -822,10 +864,23 @@ HalfEdge SphericalDelaunay::leaving(VertexId a, TriangleId hint) const {
 }
 
 bool SphericalDelaunay::insert_constraint(VertexId a, VertexId b) {
+    // Journaled, so that a failure changes nothing: flips that cannot finish the edge (another
+    // constraint crosses it, or the rounded points near it are not in convex position) would
+    // otherwise leave edges that are not locally Delaunay.
     std::vector<HalfEdge> created;
-    bool ok = recover_segment(a, b, created);
-    legalize_from(created); // restore the Delaunay property around the edges the flips made
-    return ok;
+    std::vector<FlipRecord> journal;
+    std::vector<std::pair<VertexId, VertexId>> constrained;
+    if (recover_segment(a, b, created, journal, constrained) && legalize_from(created, &journal, false, nullptr))
+        return true;
+    undo_flips(journal);
+    // An edge constrained here that no undone flip restored lies between two triangles the
+    // flips never touched: it was an edge before, unconstrained.
+    for (auto [u, v] : constrained) {
+        const HalfEdge from = leaving(u);
+        const HalfEdge e = from == no_half_edge ? no_half_edge : find_edge(from, v);
+        if (e != no_half_edge) set_constrained(e, false);
+    }
+    return false;
 }
 
 // True when the minor arcs a-b and c-d cross at a point interior to both (exact; the sign
@@ -845,7 +900,9 @@ static bool on_arc(const Vec3& a, const Vec3& b, const Vec3& d) {
     return orient(a, b, d) == 0 && arc_angle(a, d) < arc_angle(a, b) && arc_angle(d, b) < arc_angle(a, b);
 }
 
-bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created) {
+bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created,
+                                        std::vector<FlipRecord>& journal,
+                                        std::vector<std::pair<VertexId, VertexId>>& constrained) {
     if (a == b) return true;
     const Vec3& pa = points_[a];
     const Vec3& pb = points_[b];
@@ -854,7 +911,10 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
         if (from == no_half_edge) return false;
         HalfEdge e = find_edge(from, b);
         if (e != no_half_edge) {
-            set_constrained(e, true);
+            if (!is_constrained(e)) {
+                set_constrained(e, true);
+                constrained.emplace_back(a, b);
+            }
             return true;
         }
         // Rotate around a to the triangle (a, d, third) the arc a->b leaves through its edge
@@ -866,7 +926,8 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
             int i = edge_of(h);
             VertexId d = destination(h), third = vertex(s, i);
             if (on_arc(pa, pb, points_[d]))
-                return recover_segment(a, d, created) && recover_segment(d, b, created);
+                return recover_segment(a, d, created, journal, constrained) &&
+                       recover_segment(d, b, created, journal, constrained);
             if (orient(pa, points_[d], pb) > 0 && orient(pa, points_[third], pb) < 0) {
                 exit = half_edge(s, next3(i)); // d -> third, opposite a
                 break;
@@ -889,7 +950,8 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
             int side = orient(pa, pb, points_[apex]);
             if (side == 0) {
                 if (!on_arc(pa, pb, points_[apex])) return false;
-                return recover_segment(a, apex, created) && recover_segment(apex, b, created);
+                return recover_segment(a, apex, created, journal, constrained) &&
+                       recover_segment(apex, b, created, journal, constrained);
             }
             // r = (apex, third, d): d is right of a->b, third left; leave through the edge whose
             // endpoints are on opposite sides.
@@ -921,7 +983,7 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
                 continue;
             }
             stall = 0;
-            flip(e2);
+            flip_recorded(e2, &journal);
             // The quadrilateral's outer edges border changed triangles: recheck them afterwards.
             TriangleId r = triangle_of(g);
             created.push_back(half_edge(s, i));
@@ -970,62 +1032,13 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
         TriangleId t = triangle_of(r);
         for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
     }
-    // Lawson flips, journaled: a non-Delaunay edge whose quadrilateral is not convex means v at
-    // p lies inside the hull of its neighbours (closer than rounding resolves), which flips
-    // cannot mend; then every flip is undone and v goes back.
-    struct Saved {
-        TriangleId t, s;
-        VertexId tv[3], sv[3];
-        std::uint32_t tl[3], sl[3];
-    };
-    std::vector<Saved> journal;
-    bool stuck = false;
-    while (!stack.empty() && !stuck) {
-        const HalfEdge e = stack.back();
-        stack.pop_back();
-        const TriangleId t = triangle_of(e);
-        if (!is_live(t) || is_constrained(e)) continue;
-        const HalfEdge g = twin(e);
-        const TriangleId s = triangle_of(g);
-        const int i = edge_of(e), j = edge_of(g);
-        const Vec3& x = points_[vertex(t, i)];
-        const Vec3& u = points_[vertex(t, next3(i))];
-        const Vec3& w = points_[vertex(t, prev3(i))];
-        const Vec3& y = points_[vertex(s, j)];
-        if (in_circle(x, u, w, y) <= 0) continue;
-        if ((orient(x, u, y) <= 0 || orient(y, w, x) <= 0) && is_solid(t) && is_solid(s)) {
-            stuck = true;
-            break;
-        }
-        Saved rec{t, s, {}, {}, {}, {}};
-        for (int k = 0; k < 3; ++k) {
-            rec.tv[k] = tri_vertices_[3 * t + k];
-            rec.sv[k] = tri_vertices_[3 * s + k];
-            rec.tl[k] = links_[3 * t + k];
-            rec.sl[k] = links_[3 * s + k];
-        }
-        journal.push_back(rec);
-        flip(e);
-        stack.push_back(half_edge(t, i));
-        stack.push_back(half_edge(t, prev3(i)));
-        stack.push_back(half_edge(s, j));
-        stack.push_back(half_edge(s, prev3(j)));
-    }
-    if (!stuck) return true;
-    // Undo, newest first: restore both triangles and the outer half-edges' links to them.
-    for (auto r = journal.rbegin(); r != journal.rend(); ++r) {
-        for (int k = 0; k < 3; ++k) {
-            tri_vertices_[3 * r->t + k] = r->tv[k];
-            tri_vertices_[3 * r->s + k] = r->sv[k];
-            links_[3 * r->t + k] = r->tl[k];
-            links_[3 * r->s + k] = r->sl[k];
-        }
-        for (int k = 0; k < 3; ++k) {
-            const HalfEdge ht = half_edge(r->t, k), hs = half_edge(r->s, k);
-            links_[twin(ht)] = ht | (links_[ht] & constrained_bit);
-            links_[twin(hs)] = hs | (links_[hs] & constrained_bit);
-        }
-    }
+    // Lawson flips, journaled: a non-Delaunay edge whose quadrilateral is not convex (or makes
+    // a flat triangle, which has no place in a mesh) means v at p lies inside the hull of its
+    // neighbours (closer than rounding resolves), which flips cannot mend; then every flip is
+    // undone and v goes back.
+    std::vector<FlipRecord> journal;
+    if (legalize_from(stack, &journal, true, nullptr)) return true;
+    undo_flips(journal);
     points_[v] = was;
     bounded_ = was_bounded;
     last_ = triangle_of(from);

@@ -15,8 +15,10 @@
 //   * when no two distinct points are within 1e-7 rad (closer ones merge order-dependently),
 //     the triangle set does not depend on the insertion order: BRIO with another seed, and
 //     one-by-one insert() in input order, give the same triangles;
-//   * after a few insert_constraint and move_vertex calls validate() is still empty, and each
-//     moved vertex is at its target (or where it was, when move_vertex refused).
+//   * after a few insert_constraint and move_vertex calls validate() is still empty; a refused
+//     constraint changed no triangle and no flag, an accepted one is a constrained edge (or a
+//     chain of them through vertices on its arc); each moved vertex is at its target (or where
+//     it was, when move_vertex refused).
 // A failure prints the points as hex floats and aborts (a libFuzzer crash).
 #include <fuzzer/FuzzedDataProvider.h>
 
@@ -33,6 +35,7 @@
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
+#include "globemesh/predicates.hpp"
 #include "globemesh/sphere.hpp"
 
 using namespace globemesh;
@@ -189,6 +192,17 @@ using Key = std::array<double, 9>;
 
 /// The triangles as point coordinates, each rotated to start at its lexicographically smallest
 /// vertex (orientation kept), as a sorted set.
+// Constrained edges as (smaller, larger) vertex pairs.
+std::set<std::pair<VertexId, VertexId>> constrained_edges(const SphericalDelaunay& d) {
+    std::set<std::pair<VertexId, VertexId>> out;
+    for (TriangleId t = 0; t < d.triangle_slots(); ++t)
+        for (int i = 0; i < 3 && d.is_live(t); ++i) {
+            const HalfEdge h = half_edge(t, i);
+            if (d.is_constrained(h)) out.emplace(std::min(d.origin(h), d.destination(h)), std::max(d.origin(h), d.destination(h)));
+        }
+    return out;
+}
+
 std::set<Key> triangle_set(const SphericalDelaunay& d) {
     std::set<Key> out;
     for (TriangleId t = 0; t < d.triangle_slots(); ++t) {
@@ -287,8 +301,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const VertexId b = verts[in.ConsumeIntegralInRange<std::size_t>(0, verts.size() - 1)];
         if (a == b || arc_angle(d.point(a), d.point(b)) > 0.9 * pi) continue;
         g_ops += "  insert_constraint(" + std::to_string(a) + ", " + std::to_string(b) + ")\n";
-        d.insert_constraint(a, b);
+        const auto triangles = triangle_set(d);
+        const auto flags = constrained_edges(d);
+        const bool ok = d.insert_constraint(a, b);
         expect_valid(d, "insert_constraint");
+        if (!ok && (triangle_set(d) != triangles || constrained_edges(d) != flags))
+            fail("insert_constraint returned false but changed the triangulation");
+        if (ok) {
+            // The edge is there and constrained, unless a vertex on the arc split it.
+            const HalfEdge e = d.find_edge(d.vertex_half_edges()[a], b);
+            bool split = false; // some vertex lies exactly on the arc a-b
+            const Vec3 &pa = d.point(a), &pb = d.point(b);
+            for (VertexId v : verts)
+                split = split || (v != a && v != b && predicates::orient(pa, pb, d.point(v)) == 0 &&
+                                  arc_angle(pa, d.point(v)) < arc_angle(pa, pb) &&
+                                  arc_angle(d.point(v), pb) < arc_angle(pa, pb));
+            if (e != no_half_edge ? !d.is_constrained(e) : !split)
+                fail("insert_constraint returned true but a-b is not a constrained edge");
+        }
     }
     const int moves = in.ConsumeIntegralInRange<int>(0, 3);
     for (int m = 0; m < moves && !verts.empty(); ++m) {

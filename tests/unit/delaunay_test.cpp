@@ -441,3 +441,54 @@ TEST(Delaunay, constraint_recovery_flips_to_a_flat_triangle_on_three_collinear_r
         }
     }
 }
+
+// fuzz_delaunay finding d3073a7a (insert_constraint), minimized to 7 points. Rounded unit
+// vectors 1e-12..1e-10 rad apart: their distances from the sphere (~1e-16) outweigh its
+// curvature over that span (~1e-21), so the points, as the 3D points the predicates see, are not
+// in convex position: a vertex can lie inside the hull of its neighbours. Recovering an edge
+// there by flips gets stuck, and the half-done flips left an edge that is not locally Delaunay
+// and that no flip can mend (its quadrilateral is not convex). insert_constraint must then
+// change nothing; where it succeeds, the edge is there and constrained.
+TEST(Delaunay, constraint_that_flips_cannot_recover_leaves_the_triangulation_unchanged) {
+    const std::vector<Vec3> p = {
+        {-0x1.11e5d7e388a1dp-2, -0x1.74254068c618ep-2, -0x1.c8e8baafc9b31p-1},
+        {-0x1.11e5d7e2af555p-2, -0x1.7425406971476p-2, -0x1.c8e8baafc768cp-1},
+        {-0x1.11e5d7e1a7286p-2, -0x1.7425406980139p-2, -0x1.c8e8baafebfc9p-1},
+        {-0x1.11e5d7e386007p-2, -0x1.74254068c24d5p-2, -0x1.c8e8baafcaddfp-1},
+        {-0x1.11e5d7e418caap-2, -0x1.7425406989befp-2, -0x1.c8e8baaf8c41cp-1},
+        {-0x1.11e5d7e41b6c2p-2, -0x1.742540698d8aap-2, -0x1.c8e8baaf8b172p-1},
+        {-0x1.11e5d7e45a0a2p-2, -0x1.742540680f87ap-2, -0x1.c8e8baafcf7dep-1},
+    };
+    // The premise: all within 2e-10 rad, closer than rounding off the sphere resolves.
+    for (const Vec3& a : p)
+        for (const Vec3& b : p) EXPECT_LT(arc_angle(a, b), 2e-10);
+
+    SphericalDelaunay dt;
+    const auto id = dt.insert_points(p);
+    ASSERT_TRUE(dt.validate().empty());
+    const auto before = canonical(dt, false);
+    std::set<VertexId> used(id.begin(), id.end());
+    int refused = 0, recovered = 0;
+    for (VertexId a : used)
+        for (VertexId b : used) {
+            if (a == b) continue;
+            SphericalDelaunay d = dt;
+            const bool ok = d.insert_constraint(a, b);
+            const auto problems = d.validate();
+            EXPECT_TRUE(problems.empty()) << a << "-" << b << ": " << problems.front();
+            if (ok) {
+                ++recovered;
+                const HalfEdge e = d.find_edge(d.vertex_half_edges()[a], b);
+                ASSERT_NE(e, no_half_edge) << a << "-" << b; // no vertex lies on these arcs
+                EXPECT_TRUE(d.is_constrained(e));
+            } else {
+                ++refused;
+                EXPECT_EQ(canonical(d, false), before) << a << "-" << b;
+                for (TriangleId t = 0; t < d.triangle_slots(); ++t)
+                    for (int i = 0; i < 3 && d.is_live(t); ++i) EXPECT_FALSE(d.is_constrained(half_edge(t, i)));
+            }
+        }
+    // Both outcomes occur here (the finding's pair is refused), so both branches were checked.
+    EXPECT_GT(refused, 0);
+    EXPECT_GT(recovered, 0);
+}
