@@ -964,9 +964,14 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
         std::vector<std::pair<VertexId, VertexId>> queue;
         queue.reserve(crossing.size());
         for (HalfEdge e : crossing) queue.emplace_back(origin(e), destination(e));
-        std::size_t stall = 0;
+        // In the plane these flips end (Sloan), after O(k^2) of them for k crossings at worst;
+        // where rounded points are not in convex position (see insert_constraint) they can
+        // cycle, so their number is bounded.
+        const std::size_t max_flips = 4 * crossing.size() * crossing.size() + 64;
+        std::size_t stall = 0, flips = 0;
         std::size_t head = 0;
         while (head < queue.size()) {
+            if (flips > max_flips) return false;
             auto [qu, qw] = queue[head++];
             HalfEdge e2 = find_edge(leaving(qu), qw);
             if (e2 == no_half_edge) continue; // already flipped away
@@ -983,6 +988,7 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
                 continue;
             }
             stall = 0;
+            ++flips;
             flip_recorded(e2, &journal);
             // The quadrilateral's outer edges border changed triangles: recheck them afterwards.
             TriangleId r = triangle_of(g);

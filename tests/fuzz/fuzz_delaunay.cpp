@@ -19,7 +19,9 @@
 //     constraint changed no triangle and no flag, an accepted one is a constrained edge (or a
 //     chain of them through vertices on its arc); each moved vertex is at its target (or where
 //     it was, when move_vertex refused).
-// A failure prints the points as hex floats and aborts (a libFuzzer crash).
+// A failure prints the points as hex floats and aborts (a libFuzzer crash); with
+// GLOBEMESH_FUZZ_PRINT set, each input's points and calls are printed as they are made (to
+// replay a hang).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
@@ -222,6 +224,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FuzzedDataProvider in(data, size);
     g_points = decode(in);
     g_ops.clear();
+    static const bool print = std::getenv("GLOBEMESH_FUZZ_PRINT") != nullptr;
+    if (print) { // replaying one input: show it as it goes (a hang never reaches fail())
+        std::fprintf(stderr, "points (%zu):\n", g_points.size());
+        for (const Vec3& p : g_points) std::fprintf(stderr, "  {%a, %a, %a},\n", p.x, p.y, p.z);
+    }
     const std::vector<Vec3>& pts = g_points;
 
     SphericalDelaunay d;
@@ -301,6 +308,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const VertexId b = verts[in.ConsumeIntegralInRange<std::size_t>(0, verts.size() - 1)];
         if (a == b || arc_angle(d.point(a), d.point(b)) > 0.9 * pi) continue;
         g_ops += "  insert_constraint(" + std::to_string(a) + ", " + std::to_string(b) + ")\n";
+        if (print) std::fprintf(stderr, "  insert_constraint(%u, %u)\n", a, b);
         const auto triangles = triangle_set(d);
         const auto flags = constrained_edges(d);
         const bool ok = d.insert_constraint(a, b);
@@ -330,6 +338,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         char buf[160];
         std::snprintf(buf, sizeof buf, "  move_vertex(%u, {%a, %a, %a})\n", v, to.x, to.y, to.z);
         g_ops += buf;
+        if (print) std::fputs(buf, stderr);
         const Vec3 before = d.point(v);
         const bool moved = d.move_vertex(v, to);
         if (!(d.point(v) == (moved ? to : before))) fail("move_vertex left the vertex elsewhere");
