@@ -352,13 +352,33 @@ TriangleId SphericalDelaunay::walk(const Vec3& p, TriangleId t, bool& inside) co
 // Greedy descent over the vertex graph from the vertices of t: move to a neighbour closer to p
 // while there is one. In a Delaunay triangulation a vertex that is not the nearest to p has a
 // neighbour closer to p, so this ends at the nearest vertex (Bose and Morin, "Online routing in
-// triangulations", 2004); the distance falls strictly at each step, so it ends.
+// triangulations", 2004); the distance falls strictly at each step, so it ends. A flat region
+// (triangles on one great circle through the origin, closing a hull in a closed hemisphere) is
+// no Delaunay triangulation of its points in this sense: the walk stops on any flat triangle of
+// the great circle p lies on, whose vertices need not neighbour p's nearest. So the descent
+// starts from the nearest vertex of the flat region around t and of the triangles bordering it.
 VertexId SphericalDelaunay::nearest_vertex(const Vec3& p, TriangleId t) const {
     HalfEdge best = half_edge(t, 0);
     double best_d = arc_angle(points_[origin(best)], p);
-    for (int i = 1; i < 3; ++i) {
-        const double d = arc_angle(points_[origin(half_edge(t, i))], p);
-        if (d < best_d) best = half_edge(t, i), best_d = d;
+    auto consider = [&](TriangleId s) {
+        for (int i = 0; i < 3; ++i) {
+            const double d = arc_angle(points_[origin(half_edge(s, i))], p);
+            if (d < best_d) best = half_edge(s, i), best_d = d;
+        }
+    };
+    auto flat = [&](TriangleId s) {
+        return orient(points_[vertex(s, 0)], points_[vertex(s, 1)], points_[vertex(s, 2)]) == 0;
+    };
+    consider(t);
+    if (flat(t)) {
+        std::vector<TriangleId> region{t};
+        for (std::size_t k = 0; k < region.size(); ++k)
+            for (int i = 0; i < 3; ++i) {
+                const TriangleId nb = neighbour(region[k], i);
+                if (std::find(region.begin(), region.end(), nb) != region.end()) continue;
+                consider(nb);
+                if (flat(nb)) region.push_back(nb);
+            }
     }
     for (bool moved = true; moved;) {
         moved = false;

@@ -539,3 +539,33 @@ TEST(Delaunay, constraint_flips_that_would_cycle_end_and_change_nothing) {
     EXPECT_TRUE(dt.validate().empty());
     check_every_constraint(p);
 }
+
+// fuzz_delaunay finding e2cdd810 (insert_points). Every point but p6 lies on the great circle
+// y = 0 (the pole too), so the hull closes with flat triangles in that plane. p9 is an exact
+// copy of p7 and came in after it; the walk stopped on a flat triangle of that great circle
+// without p7's vertex, and the greedy descent to the nearest vertex, which holds for Delaunay
+// triangulations, stalled at p4's vertex, 1e-6 rad away, which does not neighbour p7's: p9 was
+// merged there. The nearest vertex is now sought over the flat region around the triangle.
+TEST(Delaunay, duplicate_landing_on_a_flat_triangle_merges_into_its_twin) {
+    const std::vector<Vec3> p = {
+        {0x0p+0, 0x0p+0, 0x1p+0},
+        {-0x1.c45bad246bb71p-44, 0x1.42f30c52d67f8p-58, 0x1p+0},
+        {-0x1.c45bad246bb71p-44, 0x1.42f30c52d67f8p-58, 0x1p+0},
+        {-0x1.999999999999ap-1, 0x0p+0, -0x1.3333333333334p-1},
+        {-0x1.999999999af4ap-1, 0x0p+0, -0x1.3333333331649p-1},
+        {0x1.1498b953a0096p-35, 0x1.7fe0bff3e70a7p-35, 0x1p+0},
+        {0x1.2d6eae2110c18p-3, -0x1.fa6c843761f3dp-1, 0x1.1a62633145c06p-54},
+        {-0x1.9999adbb8eac8p-1, 0x0p+0, -0x1.3333185b3fefap-1},
+        {-0x1.9999c1dd81fdp-1, 0x0p+0, -0x1.3332fd834b5a4p-1},
+        {-0x1.9999adbb8eac8p-1, 0x0p+0, -0x1.3333185b3fefap-1},
+    };
+    ASSERT_EQ(p[7], p[9]);
+    SphericalDelaunay dt;
+    const auto id = dt.insert_points(p);
+    const auto problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+    EXPECT_EQ(id[9], id[7]);
+    // Every point maps to a vertex no farther than the merge distance of points the hull cannot
+    // resolve (about 1e-8 rad; p4 is 1e-12 from p3, the near-pole points 1e-13 and 5e-11).
+    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_LT(arc_angle(dt.point(id[i]), p[i]), 1e-7) << "point " << i;
+}
