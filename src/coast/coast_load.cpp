@@ -96,11 +96,36 @@ struct Source {
 };
 
 constexpr double seam_snap_deg = 1e-9;
+/// A vertex this close to +-180 (11 m at the equator) next to a vertex on it goes onto it too.
+/// Natural Earth stores coordinates on a grid of 1/20480 degree, and a corner of a polygon cut
+/// at the antimeridian can sit one step off it: Chukotka's western half at 1:50m ends at
+/// -179.999951, leaving a 27 km wedge of "ocean" 2 m wide between the two halves (a face of
+/// quality 1e-4 at 20 km).
+constexpr double seam_notch_deg = 1e-4;
 constexpr double pole_snap_deg = 2e-3;
 constexpr double line_end_snap_deg = 1e-3;
 constexpr double max_line_gap_deg = 0.5;
 /// Rings enclosing less than this (planar lon/lat, 1e-14 deg2, about 1e-4 m2) are slivers.
 constexpr double min_ring_area_deg2 = 1e-14;
+
+/// Moves onto the seam each vertex within seam_notch_deg of it whose neighbour along the ring
+/// lies on it, on the same side (neighbours judged as they were before this pass).
+void close_seam_notches(PointList& pts) {
+    std::size_t n = pts.size();
+    const bool closed = n > 1 && pts.front().lon == pts.back().lon && pts.front().lat == pts.back().lat;
+    if (closed) --n;
+    if (n < 3) return;
+    const PointList was(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        const double lon = was[i].lon;
+        const double seam = lon > 0 ? 180.0 : -180.0;
+        if (std::abs(lon) == 180.0 || std::abs(lon) <= 180.0 - seam_notch_deg) continue;
+        const bool has_prev = closed || i > 0, has_next = closed || i + 1 < n;
+        if ((has_prev && was[(i + n - 1) % n].lon == seam) || (has_next && was[(i + 1) % n].lon == seam))
+            pts[i].lon = seam;
+    }
+    if (closed) pts.back() = pts.front();
+}
 
 /// Snaps coordinates of one ring or line to the +-180 seam and the poles (see coast.hpp).
 void snap_coordinates(PointList& pts, bool transformed) {
@@ -113,6 +138,7 @@ void snap_coordinates(PointList& pts, bool transformed) {
             if (std::abs(p.lon - 180.0) < seam_snap_deg) p.lon = 180.0;
             if (std::abs(p.lon + 180.0) < seam_snap_deg) p.lon = -180.0;
         }
+        close_seam_notches(pts);
         return;
     }
     // A projection's inverse may return either +180 or -180 on the seam: a run of vertices on
@@ -146,6 +172,7 @@ void snap_coordinates(PointList& pts, bool transformed) {
         k = end;
     }
     if (n < pts.size()) pts.back() = pts.front();
+    close_seam_notches(pts);
 }
 
 PointList read_points(OGRGeometryH g, bool transformed) {

@@ -143,6 +143,35 @@ TEST(CoastHostile, island_split_at_the_antimeridian_is_stitched_into_one_ring) {
     }
 }
 
+// Natural Earth stores coordinates on a 1/20480-degree grid: at 1:50m the western half of
+// Chukotka ends its cut at -179.999951 rather than -180, which left a wedge of ocean 2 m wide
+// and 27 km long between the halves (a face of quality 1e-4 in a 20 km mesh). A vertex within
+// 1e-4 degree of the seam next to a vertex on it now goes onto the seam, and the halves glue.
+TEST(CoastHostile, island_halves_cut_one_grid_step_off_the_antimeridian_are_stitched_without_a_notch) {
+    TempDir dir;
+    auto path = write(dir, "notch.geojson",
+                      geojson({"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10],[180,10],[170,10],[170,-10]]],"
+                               "[[[-180,-10],[-170,-10],[-170,10],[-179.999951171875,10],[-180,5],[-180,-10]]]]}"}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    expect_valid_both_stages(d);
+    // No node on or near the cut except where the coast crosses it (lat +-10): the notch's
+    // corner (-180, 5) is gone.
+    for (const auto& v : d.rings.rings[0].nodes) {
+        LonLat p = vec_to_lonlat(v);
+        if (std::abs(std::abs(p.lon) - 180) < 1e-3) {
+            EXPECT_NEAR(std::abs(p.lat), 10.0, 1e-9) << p.lon << " " << p.lat;
+        }
+    }
+    // A real coast vertex that near the seam but not next to it stays where it is.
+    auto far = write(dir, "far.geojson", geojson({polygon("[[170,-10],[179.99995,0],[170,10],[170,-10]]")}));
+    CoastData e = load_coast(options_for(far));
+    ASSERT_EQ(e.rings.rings.size(), 1u);
+    double max_lon = -180;
+    for (const auto& v : e.rings.rings[0].nodes) max_lon = std::max(max_lon, vec_to_lonlat(v).lon);
+    EXPECT_NEAR(max_lon, 179.99995, 1e-9);
+}
+
 TEST(CoastHostile, polygon_covering_the_north_pole_becomes_a_ring_around_it) {
     TempDir dir;
     auto path = write(dir, "cap.geojson", geojson({polygon("[[-180,80],[180,80],[180,90],[-180,90],[-180,80]]")}));
