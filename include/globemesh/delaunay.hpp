@@ -246,6 +246,8 @@ private:
     std::vector<TriangleId> cavity_;
     std::vector<HalfEdge> cavity_boundary_;
     std::vector<TriangleId> search_;
+    std::vector<HalfEdge> move_stack_;       // scratch of move_vertex_from
+    std::vector<FlipRecord> move_journal_;   // scratch of move_vertex_from
     std::vector<Rim> rim_;
     std::vector<std::pair<VertexId, TriangleId>> by_start_;
 };

@@ -1039,30 +1039,30 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
     // Every triangle of the star must be solid before the move and stay counter-clockwise with v
     // at p. (Moving v out of a ghost triangle changes whether the hull holds the origin, which
     // can leave ghosts far from v that no flip around v reaches.)
-    std::vector<HalfEdge> ring;
+    // The edges the move can make non-Delaunay: each spoke v->b once, and each link edge b->c
+    // (opposite v). Scratch buffers: smoothing calls this for every node, sweep after sweep.
+    std::vector<HalfEdge>& stack = move_stack_;
+    stack.clear();
     HalfEdge h = from;
     do {
-        ring.push_back(h);
         TriangleId t = triangle_of(h);
         const Vec3& b = points_[destination(h)];
         const Vec3& c = points_[vertex(t, edge_of(h))];
         if (orient(p, b, c) <= 0 || orient(points_[v], b, c) <= 0) return false;
+        stack.push_back(h);
+        stack.push_back(half_edge(t, next3(edge_of(h))));
         h = next_around_origin(h);
     } while (h != from);
     const Vec3 was = points_[v];
     const bool was_bounded = bounded_;
     points_[v] = p;
     bounded_ = bounded_ && bounded(p);
-    std::vector<HalfEdge> stack;
-    for (HalfEdge r : ring) {
-        TriangleId t = triangle_of(r);
-        for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
-    }
     // Lawson flips, journaled: a non-Delaunay edge whose quadrilateral is not convex (or makes
     // a flat triangle, which has no place in a mesh) means v at p lies inside the hull of its
     // neighbours (closer than rounding resolves), which flips cannot mend; then every flip is
     // undone and v goes back.
-    std::vector<FlipRecord> journal;
+    std::vector<FlipRecord>& journal = move_journal_;
+    journal.clear();
     if (legalize_from(stack, &journal, true, nullptr)) return true;
     undo_flips(journal);
     points_[v] = was;
