@@ -588,6 +588,26 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
 }
 
 
+/// The part of a valid polygonal geometry inside a lon/lat box: a copy when it lies inside,
+/// else GEOS's overlay intersection with the box (valid output). Not GEOSClipByRect: its
+/// polygon reconnection leaks memory and can build wrong polygons when edges run along the box
+/// (GEOS 3.11; libgeos/geos#605), as edges on a +-180 cut do (found by fuzz_coast: a leak).
+GeomPtr clip_to_box(Geos& geos, const GEOSGeometry* g, double x0, double y0, double x1, double y1, const char* what) {
+    double a0, b0, a1, b1;
+    if (GEOSGeom_getExtent_r(geos.get(), g, &a0, &b0, &a1, &b1) != 0 && a0 >= x0 && a1 <= x1 && b0 >= y0 && b1 <= y1)
+        return own(geos, GEOSGeom_clone_r(geos.get(), g), what);
+    GeomPtr box = own(geos, GEOSGeom_createRectangle_r(geos.get(), x0, y0, x1, y1), what);
+    GeomPtr out = own(geos, GEOSIntersection_r(geos.get(), g, box.get()), what);
+    const int type = GEOSGeomTypeId_r(geos.get(), out.get());
+    if (type == GEOS_POLYGON || type == GEOS_MULTIPOLYGON) return out;
+    // A part touching the box along an edge comes back as a line too: keep the polygons.
+    std::vector<const GEOSGeometry*> polys;
+    polygons_of(geos, out.get(), polys);
+    std::vector<GeomPtr> parts;
+    for (const auto* q : polys) parts.push_back(own(geos, GEOSGeom_clone_r(geos.get(), q), what));
+    return make_collection(geos, parts);
+}
+
 /// Adds a valid polygonal geometry to `parts`, cutting what lies beyond +-180 (a ring drawn
 /// across the antimeridian with longitudes such as 190) and wrapping it back by 360 degrees.
 void add_wrapped(Geos& geos, GeomPtr g, std::vector<GeomPtr>& parts) {
@@ -599,8 +619,7 @@ void add_wrapped(Geos& geos, GeomPtr g, std::vector<GeomPtr>& parts) {
     }
     for (int k = static_cast<int>(std::floor((x0 + 180.0) / 360.0)); k * 360.0 - 180.0 < x1; ++k) {
         double shift = -360.0 * k;
-        GeomPtr piece = own(geos, GEOSClipByRect_r(geos.get(), g.get(), -180.0 - shift, -90.0, 180.0 - shift, 90.0),
-                            "cut at the antimeridian");
+        GeomPtr piece = clip_to_box(geos, g.get(), -180.0 - shift, -90.0, 180.0 - shift, 90.0, "cut at the antimeridian");
         if (GEOSisEmpty_r(geos.get(), piece.get())) continue;
         auto move = [](double* x, double*, void* user) {
             *x += *static_cast<double*>(user);
@@ -1064,8 +1083,7 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         double a0, b0, a1, b1;
         GEOSGeom_getExtent_r(geos.get(), g.get(), &a0, &b0, &a1, &b1);
         if (a1 < x0 || a0 > x1 || b1 < y0 || b0 > y1) continue;
-        near.push_back(own(geos, GEOSClipByRect_r(geos.get(), g.get(), x0, y0, x1, y1), "clip the land"));
-        if (GEOSisValid_r(geos.get(), near.back().get()) != 1) near.back() = make_valid(geos, near.back().get());
+        near.push_back(clip_to_box(geos, g.get(), x0, y0, x1, y1, "clip the land"));
     }
     GeomPtr land_near = make_collection(geos, near);
     land_near = own(geos, GEOSUnaryUnion_r(geos.get(), land_near.get()), "dissolve the land");
