@@ -93,15 +93,6 @@ std::string attribute_name(const std::string& key) {
     return s;
 }
 
-void lonlat_of(const std::vector<Vec3>& points, std::vector<double>& lon, std::vector<double>& lat) {
-    lon.resize(points.size());
-    lat.resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        LonLat p = vec_to_lonlat(points[i]);
-        lon[i] = p.lon, lat[i] = p.lat;
-    }
-}
-
 void field_attributes(UgridWriter& w, int v, const Field& f, const char* location, const char* coords) {
     w.text(v, "mesh", "mesh");
     w.text(v, "location", location);
@@ -139,24 +130,10 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_nodes.size(),
                       nb = topo.boundary_edges.size();
 
-    // Values computed before the file is opened, so a failure here leaves nothing to clean up.
-    std::vector<double> node_lon, node_lat, face_lon, face_lat, edge_lon, edge_lat;
-    lonlat_of(mesh.nodes, node_lon, node_lat);
-    std::vector<Vec3> centres(nf), midpoints(ne);
-    std::vector<double> quality(nf);
-    for (std::size_t f = 0; f < nf; ++f) {
-        const Vec3 &a = mesh.nodes[mesh.faces[f][0]], &b = mesh.nodes[mesh.faces[f][1]], &c = mesh.nodes[mesh.faces[f][2]];
-        centres[f] = normalized(a + b + c);
-        quality[f] = triangle_quality(a, b, c);
-    }
-    for (std::size_t e = 0; e < ne; ++e)
-        midpoints[e] = arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
-    lonlat_of(centres, face_lon, face_lat);
-    lonlat_of(midpoints, edge_lon, edge_lat);
-    std::vector<double> area = io::geodesic_face_areas_m2(mesh);
-    std::vector<std::array<std::int32_t, 2>> boundary_nodes(nb);
-    for (std::size_t i = 0; i < nb; ++i) boundary_nodes[i] = topo.edge_nodes[topo.boundary_edges[i]];
-
+    // Coordinates, quality and area are computed one variable at a time while writing, each in
+    // a buffer freed before the next: all of them at once were most of the writer's peak (about
+    // 250 bytes per node). Nothing of that can fail; a failure of the file itself leaves only
+    // the temporary output, which OutputFile removes.
     io::NcHandle nc;
     const int mode = options.classic ? (NC_NOCLOBBER | NC_64BIT_OFFSET) : (NC_NOCLOBBER | NC_NETCDF4);
     io::nc_check(nc_create(out.temp_path().c_str(), mode, nc.out()), path, "creating the file", "UGRID output");
@@ -301,8 +278,25 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     io::nc_check(nc_put_var_int(nc.id(), crs, &zero), path, "writing crs", "UGRID output");
     io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
 
-    w.put(coord_vars[0], node_lon, "node longitudes");
-    w.put(coord_vars[1], node_lat, "node latitudes");
+    std::vector<double> buffer;
+    // Longitudes (lon = true) or latitudes of n points, point(i) for i < n.
+    auto put_coordinate = [&](int v, std::size_t n, bool lon, const auto& point, const char* what) {
+        buffer.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const LonLat p = vec_to_lonlat(point(i));
+            buffer[i] = lon ? p.lon : p.lat;
+        }
+        w.put(v, buffer, what);
+    };
+    auto node = [&](std::size_t i) { return mesh.nodes[i]; };
+    auto centre = [&](std::size_t f) {
+        return normalized(mesh.nodes[mesh.faces[f][0]] + mesh.nodes[mesh.faces[f][1]] + mesh.nodes[mesh.faces[f][2]]);
+    };
+    auto midpoint = [&](std::size_t e) {
+        return arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
+    };
+    put_coordinate(coord_vars[0], nn, true, node, "node longitudes");
+    put_coordinate(coord_vars[1], nn, false, node, "node latitudes");
     {
         std::vector<std::array<std::int32_t, 3>> faces(nf);
         for (std::size_t f = 0; f < nf; ++f)
@@ -310,18 +304,26 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         w.put(v_face_nodes, faces, "face nodes");
     }
     if (options.after_partial_write) options.after_partial_write();
-    w.put(coord_vars[2], face_lon, "face longitudes");
-    w.put(coord_vars[3], face_lat, "face latitudes");
-    w.put(coord_vars[4], edge_lon, "edge longitudes");
-    w.put(coord_vars[5], edge_lat, "edge latitudes");
+    put_coordinate(coord_vars[2], nf, true, centre, "face longitudes");
+    put_coordinate(coord_vars[3], nf, false, centre, "face latitudes");
+    put_coordinate(coord_vars[4], ne, true, midpoint, "edge longitudes");
+    put_coordinate(coord_vars[5], ne, false, midpoint, "edge latitudes");
     w.put(v_edge_nodes, topo.edge_nodes, "edge nodes");
     w.put(v_face_edges, topo.face_edges, "face edges");
     w.put(v_face_links, topo.face_faces, "face neighbours");
     w.put(v_edge_faces, topo.edge_faces, "edge faces");
-    if (nb) w.put(v_bnd, boundary_nodes, "boundary nodes");
+    if (nb) {
+        std::vector<std::array<std::int32_t, 2>> boundary_nodes(nb);
+        for (std::size_t i = 0; i < nb; ++i) boundary_nodes[i] = topo.edge_nodes[topo.boundary_edges[i]];
+        w.put(v_bnd, boundary_nodes, "boundary nodes");
+    }
     for (std::size_t i = 0; i < node_vars.size(); ++i) w.put(node_vars[i], mesh.node_fields[i].values, mesh.node_fields[i].name.c_str());
-    w.put(v_quality, quality, "quality");
-    w.put(v_area, area, "area");
+    buffer.resize(nf);
+    for (std::size_t f = 0; f < nf; ++f)
+        buffer[f] = triangle_quality(mesh.nodes[mesh.faces[f][0]], mesh.nodes[mesh.faces[f][1]], mesh.nodes[mesh.faces[f][2]]);
+    w.put(v_quality, buffer, "quality");
+    std::vector<double>().swap(buffer);
+    w.put(v_area, io::geodesic_face_areas_m2(mesh), "area");
     for (std::size_t i = 0; i < face_vars.size(); ++i) w.put(face_vars[i], extra_face_fields[i]->values, extra_face_fields[i]->name.c_str());
     w.put(v_tag, topo.edge_tags, "boundary tags");
     nc.close(path, "UGRID output");
