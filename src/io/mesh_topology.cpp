@@ -28,46 +28,61 @@ MeshTopology build_topology(const Mesh& mesh) {
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
             throw DataError("mesh: face " + std::to_string(f) + " repeats a node");
     }
-    // Half-edges sorted by (key, half-edge index): equal keys are adjacent, first face first.
-    std::vector<std::uint64_t> keys(3 * nf);
-    for (std::size_t f = 0; f < nf; ++f)
-        for (int k = 0; k < 3; ++k) keys[3 * f + k] = edge_key(mesh.faces[f][k], mesh.faces[f][(k + 1) % 3]);
-    std::vector<std::uint32_t> order(3 * nf);
-    std::iota(order.begin(), order.end(), 0u);
-    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
-        return keys[x] != keys[y] ? keys[x] < keys[y] : x < y;
-    });
+    // Half-edges in the order of (smaller node, larger node, half-edge index): equal edges are
+    // adjacent, first face first. Bucketed by the smaller node (a counting sort), then each
+    // bucket (a node's few edges) sorted by the larger node: no global sort, and 56 bytes per
+    // node of scratch instead of 72 for sorting keys and indices.
+    const std::size_t nh = 3 * nf;
+    auto ends = [&](std::size_t h) {
+        const auto& face = mesh.faces[h / 3];
+        std::uint32_t a = face[h % 3], b = face[(h % 3 + 1) % 3];
+        return a < b ? std::pair{a, b} : std::pair{b, a};
+    };
+    std::vector<std::uint32_t> start(nn + 1, 0);
+    for (std::size_t h = 0; h < nh; ++h) ++start[ends(h).first + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> bucket(nh); // (larger node, half-edge)
+    {
+        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        for (std::size_t h = 0; h < nh; ++h) {
+            auto [lo, hi] = ends(h);
+            bucket[fill[lo]++] = {hi, std::uint32_t(h)};
+        }
+    }
+    for (std::size_t v = 0; v < nn; ++v) std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1]);
 
     MeshTopology t;
     t.face_edges.assign(nf, {-1, -1, -1});
-    t.face_faces.assign(nf, {-1, -1, -1});
-    t.edge_nodes.reserve(3 * nf / 2 + 16);
-    t.edge_faces.reserve(3 * nf / 2 + 16);
-    for (std::size_t i = 0; i < order.size();) {
-        std::size_t j = i + 1;
-        while (j < order.size() && keys[order[j]] == keys[order[i]]) ++j;
-        if (j - i > 2) {
-            std::uint64_t key = keys[order[i]];
-            throw DataError("mesh: edge " + std::to_string(key >> 32) + "-" + std::to_string(key & 0xffffffffu) +
-                            " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
+    t.edge_nodes.reserve(nh / 2 + 16);
+    t.edge_faces.reserve(nh / 2 + 16);
+    for (std::size_t v = 0; v < nn; ++v) {
+        for (std::size_t i = start[v], end = start[v + 1]; i < end;) {
+            std::size_t j = i + 1;
+            while (j < end && bucket[j].first == bucket[i].first) ++j;
+            if (j - i > 2)
+                throw DataError("mesh: edge " + std::to_string(v) + "-" + std::to_string(bucket[i].first) +
+                                " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
+            auto e = std::int32_t(t.edge_nodes.size());
+            std::uint32_t h0 = bucket[i].second;
+            std::int32_t f0 = std::int32_t(h0 / 3);
+            int k0 = int(h0 % 3);
+            t.edge_nodes.push_back({std::int32_t(mesh.faces[f0][k0]), std::int32_t(mesh.faces[f0][(k0 + 1) % 3])});
+            t.face_edges[f0][k0] = e;
+            if (j - i == 2) {
+                std::uint32_t h1 = bucket[i + 1].second;
+                std::int32_t f1 = std::int32_t(h1 / 3);
+                t.face_edges[f1][h1 % 3] = e;
+                t.edge_faces.push_back({f0, f1});
+            } else {
+                t.edge_faces.push_back({f0, -1});
+                t.boundary_edges.push_back(e);
+            }
+            i = j;
         }
-        auto e = std::int32_t(t.edge_nodes.size());
-        std::uint32_t h0 = order[i];
-        std::int32_t f0 = std::int32_t(h0 / 3);
-        int k0 = int(h0 % 3);
-        t.edge_nodes.push_back({std::int32_t(mesh.faces[f0][k0]), std::int32_t(mesh.faces[f0][(k0 + 1) % 3])});
-        t.face_edges[f0][k0] = e;
-        if (j - i == 2) {
-            std::uint32_t h1 = order[i + 1];
-            std::int32_t f1 = std::int32_t(h1 / 3);
-            t.face_edges[f1][h1 % 3] = e;
-            t.edge_faces.push_back({f0, f1});
-        } else {
-            t.edge_faces.push_back({f0, -1});
-            t.boundary_edges.push_back(e);
-        }
-        i = j;
     }
+    std::vector<std::uint32_t>().swap(start);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(bucket);
+    t.face_faces.assign(nf, {-1, -1, -1}); // after the buckets are gone: the peak is lower
     for (std::size_t f = 0; f < nf; ++f) {
         int n = 0;
         for (int k = 0; k < 3; ++k) {
