@@ -70,6 +70,11 @@ Vec3 arc_midpoint(const Vec3& a, const Vec3& b);
 /// The point at fraction t in [0, 1] along the shorter great-circle arc a-b (slerp), unit vector.
 Vec3 arc_interpolate(const Vec3& a, const Vec3& b, double t);
 
+/// Angular distance (radians) from the unit vector p to the shorter great-circle arc a-b: to the
+/// arc's great circle when p lies between the planes through a and b normal to it, else to the
+/// nearer end.
+double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p);
+
 /// Area of the spherical triangle abc on the unit sphere, steradians, signed: positive when abc
 /// is counter-clockwise seen from outside (Van Oosterom-Strackee formula).
 double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);

@@ -31,18 +31,6 @@ double left_area_sr(const std::vector<Vec3>& nodes) {
     return s;
 }
 
-/// Angular distance from p to the arc a-b.
-double distance_to_arc(const Vec3& a, const Vec3& b, const Vec3& p) {
-    Vec3 n = cross(a, b);
-    double ln = norm(n);
-    if (ln > 1e-15) {
-        n = (1.0 / ln) * n;
-        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0)
-            return std::asin(std::min(1.0, std::abs(dot(n, p))));
-    }
-    return std::min(arc_angle(a, p), arc_angle(p, b));
-}
-
 struct ShapedRing {
     const Ring* ring;
     std::vector<double> h_rad;        // target size at every node, radians
@@ -65,7 +53,7 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, std::v
         double worst = 0;
         std::uint32_t at = a + 1;
         for (std::uint32_t k = a + 1; k < b; ++k) {
-            double r = distance_to_arc(pa, pb, nodes[k % n]) / (0.5 * s.h_rad[k % n]);
+            double r = arc_distance(pa, pb, nodes[k % n]) / (0.5 * s.h_rad[k % n]);
             if (r > worst) {
                 worst = r;
                 at = k;
@@ -171,7 +159,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
                 std::uint32_t nn = next % n;
                 // Only when the merged arc stays short and close to the dropped node.
                 if (arc_angle(ring.nodes[last], ring.nodes[nn]) < max_simplified_arc &&
-                    distance_to_arc(ring.nodes[last], ring.nodes[nn], ring.nodes[i]) < 0.5 * s.h_rad[i]) {
+                    arc_distance(ring.nodes[last], ring.nodes[nn], ring.nodes[i]) < 0.5 * s.h_rad[i]) {
                     keep[i] = false;
                     continue;
                 }
@@ -206,7 +194,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             double worst = -1;
             std::uint32_t at = a + 1;
             for (std::uint32_t k = a + 1; k < b; ++k) {
-                double d = distance_to_arc(pa, pb, s.ring->nodes[k % n]);
+                double d = arc_distance(pa, pb, s.ring->nodes[k % n]);
                 if (d > worst) {
                     worst = d;
                     at = k;

@@ -51,17 +51,6 @@ double seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Angular distance from p to the minor arc a-b.
-double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p) {
-    Vec3 n = cross(a, b);
-    double ln = norm(n);
-    if (ln > 1e-15) {
-        n = (1.0 / ln) * n;
-        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0) return std::asin(std::min(1.0, std::abs(dot(n, p))));
-    }
-    return std::min(arc_angle(a, p), arc_angle(p, b));
-}
-
 using EdgeKey = std::pair<VertexId, VertexId>;
 EdgeKey key(VertexId a, VertexId b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
 

@@ -40,6 +40,16 @@ double arc_angle(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a,
 
 Vec3 arc_midpoint(const Vec3& a, const Vec3& b) { return normalized(a + b); }
 
+double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p) {
+    Vec3 n = cross(a, b);
+    double ln = norm(n);
+    if (ln > 1e-15) {
+        n = (1.0 / ln) * n;
+        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0) return std::asin(std::min(1.0, std::abs(dot(n, p))));
+    }
+    return std::min(arc_angle(a, p), arc_angle(p, b));
+}
+
 Vec3 arc_interpolate(const Vec3& a, const Vec3& b, double t) {
     double w = arc_angle(a, b);
     if (w < 1e-9) return normalized((1.0 - t) * a + t * b);

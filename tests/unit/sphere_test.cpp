@@ -30,6 +30,22 @@ TEST(Sphere, arc_angle_matches_haversine_and_is_accurate_when_tiny) {
     EXPECT_NEAR(arc_km(lonlat_to_vec(0, 0), lonlat_to_vec(0, 1)), earth_radius_km * deg_to_rad, 1e-9);
 }
 
+// Along the equator from lon 0 to 40: a point at latitude phi above the arc is phi away (the
+// meridian through it meets the arc at a right angle); beyond an end it is its distance to that
+// end; on the arc it is 0.
+TEST(Sphere, arc_distance_is_to_the_great_circle_between_the_ends_and_to_an_end_beyond) {
+    const Vec3 a = lonlat_to_vec(0, 0), b = lonlat_to_vec(40, 0);
+    EXPECT_NEAR(arc_distance(a, b, lonlat_to_vec(15, 0)), 0, 1e-15);
+    EXPECT_NEAR(arc_distance(a, b, lonlat_to_vec(15, 12)), 12 * deg_to_rad, 1e-15);
+    EXPECT_NEAR(arc_distance(a, b, lonlat_to_vec(25, -30)), 30 * deg_to_rad, 1e-15);
+    const Vec3 beyond = lonlat_to_vec(50, 5);
+    EXPECT_DOUBLE_EQ(arc_distance(a, b, beyond), arc_angle(b, beyond));
+    EXPECT_DOUBLE_EQ(arc_distance(b, a, beyond), arc_angle(b, beyond)); // either direction
+    const Vec3 before = lonlat_to_vec(-20, -3);
+    EXPECT_DOUBLE_EQ(arc_distance(a, b, before), arc_angle(a, before));
+    EXPECT_DOUBLE_EQ(arc_distance(a, a, before), arc_angle(a, before)); // a zero-length arc
+}
+
 TEST(Sphere, octant_triangle_area_is_an_eighth_of_the_sphere) {
     double area = spherical_triangle_area({1, 0, 0}, {0, 1, 0}, {0, 0, 1});
     EXPECT_NEAR(area, 4 * pi / 8, 1e-15);
