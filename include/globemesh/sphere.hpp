@@ -75,6 +75,10 @@ Vec3 arc_interpolate(const Vec3& a, const Vec3& b, double t);
 /// nearer end.
 double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p);
 
+/// How much the line a, b, c turns at b: the angle (radians, in [0, pi]) between the great
+/// circles a-b and b-c; 0 when a = b or b = c.
+double turn_angle(const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// Area of the spherical triangle abc on the unit sphere, steradians, signed: positive when abc
 /// is counter-clockwise seen from outside (Van Oosterom-Strackee formula).
 double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,16 +32,31 @@ double left_area_sr(const std::vector<Vec3>& nodes) {
     return s;
 }
 
+/// Douglas-Peucker tolerance, as a fraction of the local size: every resampled node lies on the
+/// simplified line, so within this of the source (the mesher's fidelity target is h/4).
+constexpr double simplify_tolerance = 0.3;
+
+/// A kept node where the simplified line turns by more than this is a corner: the resampled ring
+/// passes through it. Elsewhere resampling cuts across the simplified line's small bends.
+constexpr double corner_turn = 40.0 * deg_to_rad;
+
 struct ShapedRing {
     const Ring* ring;
     std::vector<double> h_rad;        // target size at every node, radians
     std::vector<std::uint32_t> kept;  // indices of kept nodes, increasing
     std::vector<bool> anchor;         // nodes that must stay
+    std::vector<bool> corner;         // nodes the resampled ring must pass through
+};
+
+/// A node of a resampled ring: on the kept arc kept[arc] -> kept[arc + 1].
+struct Sample {
+    Vec3 p;
+    std::uint32_t arc;
 };
 
 /// Douglas-Peucker between kept nodes i < j (indices modulo n): keeps the node farthest from the
-/// arc while it is farther than half the local size, or while the arc is too long.
-void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, std::vector<bool>& keep) {
+/// arc while it is farther than `tolerance` times the local size, or while the arc is too long.
+void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, double tolerance, std::vector<bool>& keep) {
     const auto& nodes = s.ring->nodes;
     std::uint32_t n = static_cast<std::uint32_t>(nodes.size());
     std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i, j}};
@@ -53,7 +69,7 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, std::v
         double worst = 0;
         std::uint32_t at = a + 1;
         for (std::uint32_t k = a + 1; k < b; ++k) {
-            double r = arc_distance(pa, pb, nodes[k % n]) / (0.5 * s.h_rad[k % n]);
+            double r = arc_distance(pa, pb, nodes[k % n]) / (tolerance * s.h_rad[k % n]);
             if (r > worst) {
                 worst = r;
                 at = k;
@@ -69,10 +85,73 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, std::v
     }
 }
 
-std::vector<Vec3> kept_nodes(const ShapedRing& s) {
-    std::vector<Vec3> out;
-    out.reserve(s.kept.size());
-    for (auto k : s.kept) out.push_back(s.ring->nodes[k]);
+/// The ring resampled evenly: every corner stays, and each run of the simplified line between
+/// two corners is cut into pieces of equal length in units of the local size (the integral of
+/// ds / h along the line), as many as round that length, so that coast segments are about h long
+/// and neighbours differ little. A ring without corners is one closed run from its first node.
+template <class H>
+std::vector<Sample> resample(const ShapedRing& s, const H& h_at) {
+    const auto& nodes = s.ring->nodes;
+    const std::uint32_t m = static_cast<std::uint32_t>(s.kept.size());
+    auto at = [&](std::uint32_t k) -> const Vec3& { return nodes[s.kept[k % m]]; };
+    std::vector<std::uint32_t> corners;
+    for (std::uint32_t k = 0; k < m; ++k)
+        if (s.corner[s.kept[k]]) corners.push_back(k);
+    if (corners.empty()) corners.push_back(0);
+    // Per run: its arcs' cumulative size-length at sample points, and the pieces it gets.
+    struct Point {
+        double along; // integral of ds / h from the run's start
+        std::uint32_t arc;
+        double t; // fraction along the arc
+    };
+    std::vector<std::vector<Point>> runs(corners.size());
+    std::vector<long> pieces(corners.size());
+    for (std::size_t c = 0; c < corners.size(); ++c) {
+        std::uint32_t first = corners[c];
+        std::uint32_t last = c + 1 < corners.size() ? corners[c + 1] : corners[0] + m;
+        auto& run = runs[c];
+        double along = 0;
+        run.push_back({0, first % m, 0});
+        for (std::uint32_t k = first; k < last; ++k) {
+            const Vec3& a = at(k);
+            const Vec3& b = at(k + 1);
+            const double len = arc_angle(a, b);
+            const double ha = s.h_rad[s.kept[k % m]], hb = s.h_rad[s.kept[(k + 1) % m]];
+            const int steps = static_cast<int>(std::clamp(std::ceil(len / (0.25 * std::min(ha, hb))), 1.0, 4096.0));
+            double h_prev = ha;
+            for (int i = 1; i <= steps; ++i) {
+                const double t = double(i) / steps;
+                const double h = i == steps ? hb : h_at(arc_interpolate(a, b, t));
+                along += len / steps * 0.5 * (1 / h_prev + 1 / h);
+                run.push_back({along, k % m, t});
+                h_prev = h;
+            }
+        }
+        pieces[c] = std::max(1L, std::lround(along));
+    }
+    // A ring needs three nodes: add pieces where they are longest.
+    for (long total = 0; (total = std::accumulate(pieces.begin(), pieces.end(), 0L)) < 3;) {
+        std::size_t best = 0;
+        for (std::size_t c = 1; c < runs.size(); ++c)
+            if (runs[c].back().along / pieces[c] > runs[best].back().along / pieces[best]) best = c;
+        ++pieces[best];
+    }
+    std::vector<Sample> out;
+    for (std::size_t c = 0; c < runs.size(); ++c) {
+        const auto& run = runs[c];
+        out.push_back({at(corners[c]), corners[c] % m});
+        std::size_t i = 1;
+        for (long p = 1; p < pieces[c]; ++p) {
+            const double want = run.back().along * double(p) / double(pieces[c]);
+            while (run[i].along < want) ++i;
+            const Point& lo = run[i - 1];
+            const Point& hi = run[i];
+            const double f = hi.along > lo.along ? (want - lo.along) / (hi.along - lo.along) : 0.0;
+            const double t0 = lo.arc == hi.arc ? lo.t : 0.0;
+            const double t = t0 + f * (hi.t - t0);
+            out.push_back({arc_interpolate(at(hi.arc), at(hi.arc + 1), t), hi.arc});
+        }
+    }
     return out;
 }
 
@@ -101,7 +180,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     std::vector<ShapedRing> shaped;
     bool dropped_water = false;
     for (const Ring& ring : coast.rings.rings) {
-        ShapedRing s{&ring, {}, {}, {}};
+        ShapedRing s{&ring, {}, {}, {}, {}};
         s.h_rad.reserve(ring.nodes.size());
         for (const auto& v : ring.nodes) s.h_rad.push_back(h_at(v));
         bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; });
@@ -141,14 +220,15 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             if (ring.kinds[i] != ring.kinds[(i + n - 1) % n]) keep[i] = true;
         keep[0] = keep[n / 3] = keep[(2 * n) / 3] = true;
         s.anchor = keep;
-        std::vector<std::uint32_t> anchors;
-        for (std::uint32_t i = 0; i < n; ++i)
-            if (keep[i]) anchors.push_back(i);
-        for (std::size_t a = 0; a < anchors.size(); ++a) {
-            std::uint32_t i = anchors[a];
-            std::uint32_t j = a + 1 < anchors.size() ? anchors[a + 1] : anchors[0] + n;
-            simplify_span(s, i, j, keep);
-        }
+        // The shape at the scale of h (tolerance h/2, nodes at least h/2 apart) gives the corners.
+        auto simplify = [&](double tolerance) {
+            std::vector<std::uint32_t> from;
+            for (std::uint32_t i = 0; i < n; ++i)
+                if (keep[i]) from.push_back(i);
+            for (std::size_t a = 0; a < from.size(); ++a)
+                simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance, keep);
+        };
+        simplify(0.5);
         // Thin nodes closer than half the local size to the previous kept node.
         std::uint32_t last = 0;
         for (std::uint32_t i = 1; i < n; ++i) {
@@ -166,46 +246,100 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             }
             last = i;
         }
+        // Corners: where the kind changes, and where the line turns sharply at the scale of h;
+        // of two corners less than h/2 apart along the line, the one that turns less goes.
+        s.corner.assign(n, false);
+        {
+            std::vector<std::uint32_t> coarse;
+            for (std::uint32_t i = 0; i < n; ++i)
+                if (keep[i]) coarse.push_back(i);
+            const std::size_t m = coarse.size();
+            std::vector<double> turn(m, 0.0);
+            std::vector<char> must(m, 0);
+            for (std::size_t k = 0; k < m; ++k) {
+                const std::uint32_t i = coarse[k];
+                must[k] = ring.kinds[i] != ring.kinds[(i + n - 1) % n];
+                turn[k] = turn_angle(ring.nodes[coarse[(k + m - 1) % m]], ring.nodes[i], ring.nodes[coarse[(k + 1) % m]]);
+            }
+            std::size_t prev = m; // the last corner kept, m: none yet
+            double since = 0;     // line length from it, in units of h
+            for (std::size_t k = 0; k < m; ++k) {
+                if (k > 0) {
+                    const std::uint32_t a = coarse[k - 1], b = coarse[k];
+                    since += arc_angle(ring.nodes[a], ring.nodes[b]) / std::min(s.h_rad[a], s.h_rad[b]);
+                }
+                if (!must[k] && !(turn[k] > corner_turn)) continue;
+                if (prev < m && since < 0.5) {
+                    if (must[prev] || (!must[k] && turn[prev] >= turn[k])) continue; // k goes
+                    s.corner[coarse[prev]] = false;                                // prev goes
+                }
+                s.corner[coarse[k]] = true;
+                prev = k;
+                since = 0;
+            }
+        }
+        // The line the nodes are placed on: within simplify_tolerance * h of the source.
+        simplify(simplify_tolerance);
         for (std::uint32_t i = 0; i < n; ++i)
             if (keep[i]) s.kept.push_back(i);
     }
-    report(progress, 0.5, "checking coast topology");
+    report(progress, 0.5, "resampling coast");
 
-    // 3. Topology: re-insert original nodes into every simplified arc that touches or crosses
-    //    another arc, until none does. The full-resolution rings do not conflict, so this ends.
+    // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
+    //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
+    //    This ends: with every source node a corner, the arcs lie on the source rings, which do
+    //    not conflict.
+    std::vector<std::vector<Sample>> samples(shaped.size());
     for (int round = 0;; ++round) {
-        std::vector<std::vector<Vec3>> rings;
-        rings.reserve(shaped.size());
-        for (const auto& s : shaped) rings.push_back(kept_nodes(s));
+        std::vector<std::vector<Vec3>> rings(shaped.size());
+        for (std::size_t r = 0; r < shaped.size(); ++r) {
+            samples[r] = resample(shaped[r], h_at);
+            rings[r].reserve(samples[r].size());
+            for (const auto& x : samples[r]) rings[r].push_back(x.p);
+        }
         std::vector<const std::vector<Vec3>*> ptrs;
         for (const auto& r : rings) ptrs.push_back(&r);
         auto conflicts = coast_detail::find_conflicts(ptrs);
         if (conflicts.empty()) break;
-        bool progress_made = false;
         std::vector<std::vector<std::uint32_t>> insert(shaped.size());
         auto refine = [&](std::uint32_t r, std::uint32_t seg) {
             const auto& s = shaped[r];
-            std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
-            std::uint32_t a = s.kept[seg];
-            std::uint32_t b = seg + 1 < s.kept.size() ? s.kept[seg + 1] : s.kept[0] + n;
-            if (b <= a + 1) return;
-            const Vec3& pa = s.ring->nodes[a % n];
-            const Vec3& pb = s.ring->nodes[b % n];
+            const auto& x = samples[r];
+            const std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
+            const std::uint32_t m = static_cast<std::uint32_t>(s.kept.size());
+            const Sample& p = x[seg];
+            const Sample& q = x[(seg + 1) % x.size()];
+            std::uint32_t a = s.kept[p.arc];
+            std::uint32_t b = s.kept[(q.arc + 1) % m];
+            if (b <= a) b += n;
             double worst = -1;
-            std::uint32_t at = a + 1;
+            std::uint32_t at = n;
             for (std::uint32_t k = a + 1; k < b; ++k) {
-                double d = arc_distance(pa, pb, s.ring->nodes[k % n]);
+                if (s.corner[k % n]) continue;
+                double d = arc_distance(p.p, q.p, s.ring->nodes[k % n]);
                 if (d > worst) {
                     worst = d;
-                    at = k;
+                    at = k % n;
                 }
             }
-            insert[r].push_back(at % n);
-            progress_made = true;
+            if (at < n) insert[r].push_back(at);
         };
         for (const auto& c : conflicts) {
             refine(c.ring_a, c.seg_a);
             refine(c.ring_b, c.seg_b);
+        }
+        bool progress_made = false;
+        for (std::size_t r = 0; r < shaped.size(); ++r) {
+            auto& s = shaped[r];
+            for (auto i : insert[r]) {
+                if (s.corner[i]) continue;
+                s.corner[i] = true;
+                s.kept.push_back(i);
+                ++rep.conflicts_repaired;
+                progress_made = true;
+            }
+            std::sort(s.kept.begin(), s.kept.end());
+            s.kept.erase(std::unique(s.kept.begin(), s.kept.end()), s.kept.end());
         }
         if (!progress_made) {
             const auto& c = conflicts.front();
@@ -213,38 +347,20 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             throw DataError("coast: rings touch or cross near lon " + std::to_string(at.lon) + ", lat " +
                             std::to_string(at.lat) + " at full resolution; repair the coastline there");
         }
-        for (std::size_t r = 0; r < shaped.size(); ++r) {
-            if (insert[r].empty()) continue;
-            auto& kept = shaped[r].kept;
-            kept.insert(kept.end(), insert[r].begin(), insert[r].end());
-            std::sort(kept.begin(), kept.end());
-            kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
-            rep.conflicts_repaired += insert[r].size();
-        }
-        report(progress, 0.5 + 0.3 * (1.0 - 1.0 / (round + 2)), "checking coast topology");
+        report(progress, 0.5 + 0.4 * (1.0 - 1.0 / (round + 2)), "checking coast topology");
     }
-    report(progress, 0.8, "resampling coast");
 
-    // 4. Resample: split every kept arc into pieces of about the local size.
     Boundary out;
-    for (const auto& s : shaped) {
-        const Ring& ring = *s.ring;
-        Ring r;
-        std::size_t m = s.kept.size();
-        for (std::size_t k = 0; k < m; ++k) {
-            const Vec3& a = ring.nodes[s.kept[k]];
-            const Vec3& b = ring.nodes[s.kept[(k + 1) % m]];
-            SegmentKind kind = ring.kinds[s.kept[k]];
-            double h = h_at(arc_midpoint(a, b));
-            int pieces = std::max(1, static_cast<int>(std::lround(arc_angle(a, b) / h)));
-            r.nodes.push_back(a);
-            r.kinds.push_back(kind);
-            for (int p = 1; p < pieces; ++p) {
-                r.nodes.push_back(arc_interpolate(a, b, double(p) / pieces));
-                r.kinds.push_back(kind);
-            }
+    for (std::size_t r = 0; r < shaped.size(); ++r) {
+        const auto& s = shaped[r];
+        Ring ring;
+        ring.nodes.reserve(samples[r].size());
+        ring.kinds.reserve(samples[r].size());
+        for (const auto& x : samples[r]) {
+            ring.nodes.push_back(x.p);
+            ring.kinds.push_back(s.ring->kinds[s.kept[x.arc]]);
         }
-        out.rings.push_back(std::move(r));
+        out.rings.push_back(std::move(ring));
     }
 
     auto issues = check_boundary(out, 1);

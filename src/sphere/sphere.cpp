@@ -111,6 +111,13 @@ double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 namespace globemesh {
 
+double turn_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 n1 = cross(a, b), n2 = cross(b, c);
+    const double l1 = norm(n1), l2 = norm(n2);
+    if (l1 == 0 || l2 == 0) return 0;
+    return std::acos(std::clamp(dot(n1, n2) / (l1 * l2), -1.0, 1.0));
+}
+
 double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {
     double la = norm(b - c), lb = norm(c - a), lc = norm(a - b);
     double area = 0.5 * norm(cross(b - a, c - a));

@@ -191,6 +191,33 @@ TEST(Coast, shaping_at_100_and_10_km_keeps_every_invariant) {
     }
 }
 
+// The fidelity target: boundary nodes within h/4 of the source coast (95th percentile),
+// measured by brute force against every source arc; and coast segments near h, so that the
+// mesher's triangles on them can be near equilateral (runs between corners are cut evenly).
+TEST(Coast, shaped_nodes_stay_near_the_source_and_segments_near_the_size) {
+    const double h = 200;
+    MeshOptions o;
+    Boundary b = shape_boundary(ne110(), uniform(h), o);
+    std::vector<double> distance, length;
+    for (const auto& r : b.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            const Vec3& p = r.nodes[i];
+            double nearest = pi;
+            for (const auto& s : ne110().rings.rings)
+                for (std::size_t k = 0; k < s.nodes.size(); ++k)
+                    nearest = std::min(nearest, arc_distance(s.nodes[k], s.nodes[(k + 1) % s.nodes.size()], p));
+            distance.push_back(nearest * earth_radius_km);
+            length.push_back(arc_km(p, r.nodes[(i + 1) % r.nodes.size()]));
+        }
+    std::sort(distance.begin(), distance.end());
+    EXPECT_LT(distance[distance.size() * 95 / 100], h / 4);
+    EXPECT_LT(distance.back(), h / 2);
+    const auto near_h = std::count_if(length.begin(), length.end(), [&](double l) { return l >= 0.7 * h && l <= 1.4 * h; });
+    std::printf("nodes %zu: distance p95 %.1f km, max %.1f km; segments in [0.7, 1.4] h: %.1f%%\n", distance.size(),
+                distance[distance.size() * 95 / 100], distance.back(), 100.0 * near_h / length.size());
+    EXPECT_GT(double(near_h), 0.8 * length.size());
+}
+
 TEST(Coast, shaping_follows_a_varying_size) {
     // h = 20 km north of the equator, 200 km south of it.
     auto size = [](const Vec3& v) { return v.z > 0 ? 20.0 : 200.0; };

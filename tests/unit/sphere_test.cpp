@@ -46,6 +46,21 @@ TEST(Sphere, arc_distance_is_to_the_great_circle_between_the_ends_and_to_an_end_
     EXPECT_DOUBLE_EQ(arc_distance(a, a, before), arc_angle(a, before)); // a zero-length arc
 }
 
+// Along the equator the line goes straight on; turning north at lon 10 along the meridian is a
+// right angle either way round; going back is pi; a repeated point does not turn.
+TEST(Sphere, turn_angle_is_the_angle_between_the_two_great_circles) {
+    const Vec3 a = lonlat_to_vec(0, 0), b = lonlat_to_vec(10, 0);
+    EXPECT_NEAR(turn_angle(a, b, lonlat_to_vec(20, 0)), 0, 1e-7);
+    EXPECT_NEAR(turn_angle(a, b, lonlat_to_vec(10, 15)), pi / 2, 1e-15);
+    EXPECT_NEAR(turn_angle(a, b, lonlat_to_vec(10, -15)), pi / 2, 1e-15);
+    EXPECT_NEAR(turn_angle(a, b, lonlat_to_vec(5, 0)), pi, 1e-7);
+    // The meridian lon 10 from the pole, then the small-circle-free turn onto lon 10 + 30: at
+    // the pole two meridians meet at their longitude difference.
+    const Vec3 pole{0, 0, 1};
+    EXPECT_NEAR(turn_angle(lonlat_to_vec(10, 40), pole, lonlat_to_vec(190 + 30, 40)), 30 * deg_to_rad, 1e-12);
+    EXPECT_EQ(turn_angle(a, a, b), 0);
+}
+
 TEST(Sphere, octant_triangle_area_is_an_eighth_of_the_sphere) {
     double area = spherical_triangle_area({1, 0, 0}, {0, 1, 0}, {0, 0, 1});
     EXPECT_NEAR(area, 4 * pi / 8, 1e-15);
