@@ -41,6 +41,9 @@ constexpr double quality_goal = 0.6;
 // their own width. Measured on 1:50m land at 100 km: 0.5 leaves 247 faces below q 0.6 away
 // from sharp corners, 0.05 leaves 84 for 1.8% more nodes.
 constexpr double refine_floor = 0.05;
+// Rounds of the last, quality-driven smoothing of the nodes of triangles below q 0.8.
+// Measured on 1:50m land at 100 km: interior faces below q 0.8 0.89% -> 0.13%.
+constexpr int improve_rounds = 3;
 constexpr std::uint8_t land = 0;
 constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
@@ -696,6 +699,75 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             dt.move_vertex_from(from, target);
         }
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
+    }
+    // Then the interior nodes of the triangles still below q 0.8 (next to the coast, or at
+    // valence defects), a few rounds: each goes where the worst triangle of its star is best
+    // among the mean of the apexes that would make each star triangle equilateral on its far
+    // edge, the mean of its neighbours, and halfway to either, when that beats where it is.
+    // (Sliding boundary nodes along the coast gained 0.1% of faces above 0.8: not done.)
+    {
+        std::vector<VertexId> todo;
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+            if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+            const Vec3& a = dt.point(dt.vertex(t, 0));
+            const Vec3& b = dt.point(dt.vertex(t, 1));
+            const Vec3& c = dt.point(dt.vertex(t, 2));
+            if (triangle_quality(a, b, c) >= 0.8) continue;
+            for (int i = 0; i < 3; ++i)
+                if (!m.is_fixed(dt.vertex(t, i))) todo.push_back(dt.vertex(t, i));
+        }
+        std::sort(todo.begin(), todo.end());
+        todo.erase(std::unique(todo.begin(), todo.end()), todo.end());
+        std::vector<std::pair<Vec3, Vec3>> far; // the star's triangles v, b, c (counter-clockwise)
+        std::vector<Vec3> candidates;
+        for (int round = 0; round < improve_rounds; ++round) {
+            for (VertexId v : todo) {
+                const HalfEdge from = dt.leaving(v);
+                if (from == no_half_edge) continue;
+                far.clear();
+                bool inside = true;
+                HalfEdge h = from;
+                do {
+                    if (dt.label(triangle_of(h)) != ocean) {
+                        inside = false;
+                        break;
+                    }
+                    far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(triangle_of(h), edge_of(h))));
+                    h = dt.next_around_origin(h);
+                } while (h != from && far.size() < 64);
+                if (!inside || h != from) continue;
+                Vec3 apex{0, 0, 0}, mean{0, 0, 0};
+                for (const auto& [b, c] : far) {
+                    const double d = 0.5 * std::sqrt(3.0) * arc_angle(b, c);
+                    apex = apex + (std::cos(d) * arc_midpoint(b, c) + std::sin(d) * normalized(cross(b, c)));
+                    mean = mean + b;
+                }
+                const Vec3& p0 = dt.point(v);
+                candidates.clear();
+                for (const Vec3& p : {normalized(apex), normalized(mean)}) {
+                    candidates.push_back(p);
+                    candidates.push_back(normalized(p0 + p));
+                }
+                auto worst_at = [&](const Vec3& p) {
+                    double worst = 1;
+                    for (const auto& [b, c] : far) {
+                        if (predicates::orient(p, b, c) <= 0) return -1.0;
+                        worst = std::min(worst, triangle_quality(p, b, c));
+                    }
+                    return worst;
+                };
+                double best = worst_at(p0);
+                Vec3 to = p0;
+                for (const Vec3& p : candidates) {
+                    const double w = worst_at(p);
+                    if (w > best + 1e-9) {
+                        best = w;
+                        to = p;
+                    }
+                }
+                if (!(to == p0)) dt.move_vertex_from(from, to);
+            }
+        }
     }
     if (timings) timings->add("improve", seconds_since(t0));
 
