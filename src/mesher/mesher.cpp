@@ -707,7 +707,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // edge, the mean of its neighbours, and halfway to either, when that beats where it is.
     // (Sliding boundary nodes along the coast gained 0.1% of faces above 0.8: not done.)
     {
-        std::vector<VertexId> todo;
+        // Each node with a triangle next to it: the hint that finds its star in a step or two.
+        std::vector<std::pair<VertexId, TriangleId>> todo;
         for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
             if (!dt.is_live(t) || dt.label(t) != ocean) continue;
             const Vec3& a = dt.point(dt.vertex(t, 0));
@@ -715,16 +716,18 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const Vec3& c = dt.point(dt.vertex(t, 2));
             if (triangle_quality(a, b, c) >= 0.9) continue;
             for (int i = 0; i < 3; ++i)
-                if (!m.is_fixed(dt.vertex(t, i))) todo.push_back(dt.vertex(t, i));
+                if (!m.is_fixed(dt.vertex(t, i))) todo.emplace_back(dt.vertex(t, i), t);
         }
         std::sort(todo.begin(), todo.end());
-        todo.erase(std::unique(todo.begin(), todo.end()), todo.end());
+        todo.erase(std::unique(todo.begin(), todo.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+                   todo.end());
         std::vector<std::pair<Vec3, Vec3>> far; // the star's triangles v, b, c (counter-clockwise)
         std::vector<Vec3> candidates;
         for (int round = 0; round < improve_rounds; ++round) {
-            for (VertexId v : todo) {
-                const HalfEdge from = dt.leaving(v);
-                if (from == no_half_edge) continue;
+            for (auto& [v, hint] : todo) {
+                const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
+                if (from == no_half_edge || dt.origin(from) != v) continue;
+                hint = triangle_of(from);
                 far.clear();
                 bool inside = true;
                 HalfEdge h = from;
