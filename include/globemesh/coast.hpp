@@ -14,11 +14,13 @@
 //      rings then become great-circle polylines (planar edges longer than 0.5 degree are first
 //      densified in lon/lat) and are verified on the sphere.
 //   2. shape_boundary(): drop islands (and closed water bodies) smaller than
-//      options.min_island_triangles equilateral triangles of the local size, simplify each ring
-//      to the local size (Douglas-Peucker on the sphere with tolerance h/2, then nodes closer
-//      than h/2 are thinned), re-insert original nodes wherever a simplified arc would touch or
-//      cross another arc (topology preserved: rings never cross, islands never merge), and split
-//      every remaining arc so that consecutive nodes are about h(x) apart along great circles.
+//      options.min_island_triangles equilateral triangles of the local size; find each ring's
+//      corners at the scale of h (Douglas-Peucker on the sphere with tolerance h/2, nodes closer
+//      than h/2 thinned, then the nodes where that line turns by more than 40 degrees, at least
+//      h/2 apart); simplify again to 0.3 h and cut each run of that line between corners into
+//      equal pieces of about h(x) (boundary nodes lie within about 0.3 h of the source); make
+//      an original node a corner wherever a resampled arc would touch or cross another arc
+//      (topology preserved: rings never cross, islands never merge).
 //
 // Invariants of every Boundary returned (boundary.hpp): rings closed, >= 3 nodes, no two
 // consecutive nodes equal or antipodal, rings simple and mutually non-crossing as great-circle
@@ -90,15 +92,15 @@ struct CoastReport {
     std::size_t nodes = 0;            ///< nodes in the shaped boundary
     std::size_t islands_removed = 0;  ///< by --min-island-area (stage 1) and by size (stage 2)
     std::size_t lakes_removed = 0;    ///< holes and closed water bodies removed (both stages)
-    std::size_t conflicts_repaired = 0; ///< simplified arcs refined because they touched another
+    std::size_t conflicts_repaired = 0; ///< corners added because resampled arcs touched another
     double area_lost_km2 = 0;         ///< ocean removed: dropped lakes + net loss of simplification
     double area_gained_km2 = 0;       ///< ocean added: dropped islands + net gain of simplification
     double ocean_area_km2 = 0;        ///< geodesic area enclosed by the shaped boundary
 };
 
 /// Stage 2: drops rings smaller than options.min_island_triangles triangles of the local size,
-/// simplifies to the local size with topology preserved and resamples every ring so consecutive
-/// nodes are about size_km(x) apart along great-circle arcs. Throws DataError when the shaped
+/// simplifies to the local size with topology preserved and resamples every ring evenly between
+/// its corners so consecutive nodes are about size_km(x) apart along great-circle arcs. Throws DataError when the shaped
 /// rings cannot be made to satisfy boundary.hpp, Cancelled.
 Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
                         CoastReport* report = nullptr, const Progress& progress = {});

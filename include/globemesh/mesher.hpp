@@ -17,6 +17,9 @@
 //      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
 //      with Delaunay flips after each move; boundary nodes stay fixed. Nodes are visited along
 //      the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share cache lines.
+//      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
+//      few candidates (the mean of the apexes that would make each star triangle equilateral,
+//      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
