@@ -236,7 +236,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     OutputFile out(path, options.overwrite, "GeoPackage output");
     const io::MeshTopology topo = io::build_topology(mesh);
     const MeshStats stats = io::compute_stats(mesh, topo);
-    const std::vector<double> area = io::geodesic_face_areas_m2(mesh);
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;
@@ -269,7 +268,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         feature.SetFID(GIntBig(i) + 1);
         feature.SetField("face", int(i));
         feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-        feature.SetField("area_km2", area[i] * 1e-6);
+        feature.SetField("area_km2", io::geodesic_face_area_m2(mesh, i) * 1e-6);
         auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
         if (depth) feature.SetField("depth", mean(depth));
         if (size) feature.SetField("target_size", mean(size));
