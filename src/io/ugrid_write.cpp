@@ -158,7 +158,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     OutputFile out(path, options.overwrite, "UGRID output");
     const io::MeshTopology topo = io::build_topology(mesh);
     const MeshStats stats = io::compute_stats(mesh, topo);
-    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_nodes.size(),
+    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count(),
                       nb = topo.boundary_edges.size();
 
     // Coordinates, quality and area are computed one variable at a time while writing, each in
@@ -317,7 +317,8 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         return normalized(mesh.nodes[mesh.faces[f][0]] + mesh.nodes[mesh.faces[f][1]] + mesh.nodes[mesh.faces[f][2]]);
     };
     auto midpoint = [&](std::size_t e) {
-        return arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
+        const auto ends = topo.edge_nodes(e);
+        return arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]);
     };
     w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return lon(mesh.nodes[i]); }, "node longitudes");
     w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return lat(mesh.nodes[i]); }, "node latitudes");
@@ -330,12 +331,18 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.put_values<double>(coord_vars[3], nf, [&](std::size_t f) { return lat(centre(f)); }, "face latitudes");
     w.put_values<double>(coord_vars[4], ne, [&](std::size_t e) { return lon(midpoint(e)); }, "edge longitudes");
     w.put_values<double>(coord_vars[5], ne, [&](std::size_t e) { return lat(midpoint(e)); }, "edge latitudes");
-    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes[e]; }, "edge nodes");
-    w.put_rows<int, 3>(v_face_edges, nf, [&](std::size_t f) { return topo.face_edges[f]; }, "face edges");
-    w.put_rows<int, 3>(v_face_links, nf, [&](std::size_t f) { return topo.face_faces[f]; }, "face neighbours");
-    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces[e]; }, "edge faces");
+    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
+    {
+        const std::vector<std::int32_t> face_edges = io::face_edges(topo); // 12 bytes a face, freed after
+        w.put_rows<int, 3>(v_face_edges, nf, [&](std::size_t f) {
+            return std::array<int, 3>{face_edges[3 * f], face_edges[3 * f + 1], face_edges[3 * f + 2]};
+        }, "face edges");
+        w.put_rows<int, 3>(v_face_links, nf, [&](std::size_t f) { return io::face_faces(topo, face_edges, f); },
+                           "face neighbours");
+    }
+    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); }, "edge faces");
     if (nb)
-        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes[topo.boundary_edges[i]]; },
+        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); },
                            "boundary nodes");
     for (std::size_t i = 0; i < node_vars.size(); ++i) {
         const Field& f = mesh.node_fields[i];
@@ -350,7 +357,12 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         const Field& f = *extra_face_fields[i];
         w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());
     }
-    w.put_values<int>(v_tag, ne, [&](std::size_t e) { return topo.edge_tags[e]; }, "boundary tags");
+    std::size_t next_boundary = 0; // rows come in ascending order, as boundary_edges
+    w.put_values<int>(v_tag, ne, [&](std::size_t e) {
+        if (next_boundary < nb && std::size_t(topo.boundary_edges[next_boundary]) == e)
+            return topo.boundary_tags[next_boundary++];
+        return int(EdgeTag::interior);
+    }, "boundary tags");
     nc.close(path, "UGRID output");
     out.commit();
 }
