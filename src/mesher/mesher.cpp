@@ -9,6 +9,8 @@
 #include <map>
 #include <new>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
@@ -49,6 +51,17 @@ constexpr std::uint8_t land = 0;
 constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
 constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
+
+/// The worst quality of the star triangles p, b, c for the star's far edges b -> c (counter-
+/// clockwise around the star's centre), or -1 when p would fold one of them (move_vertex's test).
+double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far) {
+    double worst = 1;
+    for (const auto& [b, c] : far) {
+        if (predicates::orient(p, b, c) <= 0) return -1.0;
+        worst = std::min(worst, triangle_quality(p, b, c));
+    }
+    return worst;
+}
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
@@ -642,6 +655,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         visit.reserve(keyed.size());
         for (const auto& kv : keyed) visit.push_back(kv.second);
     }
+    std::vector<std::pair<Vec3, Vec3>> far; // a star's far edges b -> c (triangles v, b, c)
     for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
         // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
         // (a triangle next to v) rather than an answer: the walk from it is a step or two.
@@ -661,12 +675,14 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             bool inside = true;
             HalfEdge h = from;
             std::size_t guard = 0;
+            far.clear();
             do {
                 TriangleId t = triangle_of(h);
                 if (dt.label(t) != ocean) {
                     inside = false;
                     break;
                 }
+                far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(t, edge_of(h))));
                 const Vec3& a = dt.point(dt.vertex(t, 0));
                 const Vec3& b = dt.point(dt.vertex(t, 1));
                 const Vec3& c = dt.point(dt.vertex(t, 2));
@@ -682,21 +698,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // Refuse a move that would bring the worst triangle of the star below 0.6 and
             // below where it was (smoothing must not flatten triangles against the coast).
             const Vec3 target = normalized(sum);
-            // The quality before the move is needed only when the move would go below 0.6.
-            auto worst_of_star = [&](const Vec3& p) {
-                double worst = 1;
-                HalfEdge e = from;
-                std::size_t n = 0;
-                do {
-                    const Vec3& b = dt.point(dt.destination(e));
-                    const Vec3& c = dt.point(dt.vertex(triangle_of(e), edge_of(e)));
-                    worst = std::min(worst, triangle_quality(p, b, c));
-                    e = dt.next_around_origin(e);
-                } while (e != from && ++n < 64);
-                return worst;
-            };
-            const double worst_after = worst_of_star(target);
-            if (worst_after < 0.6 && worst_after < worst_of_star(dt.point(v))) continue;
+            // The quality before the move is needed only when the move would go below 0.6. (A
+            // move that would fold the star counts as -1: move_vertex_from refuses it anyway.)
+            const double worst_after = star_worst_quality(target, far);
+            if (worst_after < 0.6 && worst_after < star_worst_quality(dt.point(v), far)) continue;
             dt.move_vertex_from(from, target);
         }
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
@@ -721,7 +726,6 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         std::sort(todo.begin(), todo.end());
         todo.erase(std::unique(todo.begin(), todo.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
                    todo.end());
-        std::vector<std::pair<Vec3, Vec3>> far; // the star's triangles v, b, c (counter-clockwise)
         std::vector<Vec3> candidates;
         for (int round = 0; round < improve_rounds; ++round) {
             for (auto& [v, hint] : todo) {
@@ -752,18 +756,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     candidates.push_back(p);
                     candidates.push_back(normalized(p0 + p));
                 }
-                auto worst_at = [&](const Vec3& p) {
-                    double worst = 1;
-                    for (const auto& [b, c] : far) {
-                        if (predicates::orient(p, b, c) <= 0) return -1.0;
-                        worst = std::min(worst, triangle_quality(p, b, c));
-                    }
-                    return worst;
-                };
-                double best = worst_at(p0);
+                double best = star_worst_quality(p0, far);
                 Vec3 to = p0;
                 for (const Vec3& p : candidates) {
-                    const double w = worst_at(p);
+                    const double w = star_worst_quality(p, far);
                     if (w > best + 1e-9) {
                         best = w;
                         to = p;
