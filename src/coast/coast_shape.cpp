@@ -289,11 +289,15 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
     //    not conflict.
+    //    Only the rings that got a corner are resampled again.
     std::vector<std::vector<Sample>> samples(shaped.size());
+    std::vector<std::vector<Vec3>> rings(shaped.size());
+    std::vector<char> changed(shaped.size(), 1);
     for (int round = 0;; ++round) {
-        std::vector<std::vector<Vec3>> rings(shaped.size());
         for (std::size_t r = 0; r < shaped.size(); ++r) {
+            if (!changed[r]) continue;
             samples[r] = resample(shaped[r], h_at);
+            rings[r].clear();
             rings[r].reserve(samples[r].size());
             for (const auto& x : samples[r]) rings[r].push_back(x.p);
         }
@@ -331,13 +335,16 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
         bool progress_made = false;
         for (std::size_t r = 0; r < shaped.size(); ++r) {
             auto& s = shaped[r];
+            changed[r] = 0;
             for (auto i : insert[r]) {
                 if (s.corner[i]) continue;
                 s.corner[i] = true;
                 s.kept.push_back(i);
                 ++rep.conflicts_repaired;
-                progress_made = true;
+                changed[r] = 1;
             }
+            if (!changed[r]) continue;
+            progress_made = true;
             std::sort(s.kept.begin(), s.kept.end());
             s.kept.erase(std::unique(s.kept.begin(), s.kept.end()), s.kept.end());
         }
