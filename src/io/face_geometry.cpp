@@ -122,19 +122,15 @@ std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes) {
     return parts;
 }
 
-std::vector<double> geodesic_face_areas_m2(const Mesh& mesh) {
-    std::vector<double> area(mesh.faces.size());
+double geodesic_face_area_m2(const Mesh& mesh, std::size_t face) {
     GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
-    std::vector<LonLat> ll(mesh.nodes.size());
-    for (std::size_t i = 0; i < ll.size(); ++i) ll[i] = vec_to_lonlat(mesh.nodes[i]);
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-        poly.Clear();
-        for (auto v : mesh.faces[f]) poly.AddPoint(ll[v].lat, ll[v].lon);
-        double perimeter = 0, a = 0;
-        poly.Compute(false, true, perimeter, a);
-        area[f] = std::fabs(a);
+    for (auto v : mesh.faces[face]) {
+        const LonLat p = vec_to_lonlat(mesh.nodes[v]);
+        poly.AddPoint(p.lat, p.lon);
     }
-    return area;
+    double perimeter = 0, area = 0;
+    poly.Compute(false, true, perimeter, area);
+    return std::fabs(area);
 }
 
 } // namespace globemesh::io

@@ -196,33 +196,38 @@ struct BoundaryRun {
 };
 
 std::vector<BoundaryRun> boundary_runs(const io::MeshTopology& topo) {
-    std::map<std::int32_t, std::vector<std::int32_t>> outgoing; // node -> boundary edges leaving it
-    for (auto e : topo.boundary_edges) outgoing[topo.edge_nodes[e][0]].push_back(e);
-    std::map<std::int32_t, bool> used;
+    // Boundary edges are named here by their position b in topo.boundary_edges (ascending edge
+    // index), the index of their tag in topo.boundary_tags.
+    const std::size_t nb = topo.boundary_edges.size();
+    auto nodes = [&](std::size_t b) { return topo.edge_nodes(std::size_t(topo.boundary_edges[b])); };
+    std::map<std::int32_t, std::vector<std::size_t>> outgoing; // node -> boundary edges leaving it
+    for (std::size_t b = 0; b < nb; ++b) outgoing[nodes(b)[0]].push_back(b);
+    std::vector<char> used(nb, 0);
     std::vector<BoundaryRun> runs;
     int loop = 0;
-    for (auto start : topo.boundary_edges) {
+    for (std::size_t start = 0; start < nb; ++start) {
         if (used[start]) continue;
-        std::vector<std::int32_t> edges;
-        for (std::int32_t e = start; e >= 0 && !used[e];) {
-            used[e] = true;
-            edges.push_back(e);
-            std::int32_t next = -1;
-            for (auto cand : outgoing[topo.edge_nodes[e][1]])
+        std::vector<std::size_t> edges;
+        for (std::size_t b = start; b < nb && !used[b];) {
+            used[b] = 1;
+            edges.push_back(b);
+            std::size_t next = nb;
+            for (auto cand : outgoing[nodes(b)[1]])
                 if (!used[cand]) { next = cand; break; }
-            e = next;
+            b = next;
         }
         // Start at a change of tag, so a run never wraps round the start of the loop.
+        const auto& tags = topo.boundary_tags;
         std::size_t first = 0;
         for (std::size_t i = 0; i < edges.size(); ++i)
-            if (topo.edge_tags[edges[i]] != topo.edge_tags[edges[(i + edges.size() - 1) % edges.size()]]) { first = i; break; }
+            if (tags[edges[i]] != tags[edges[(i + edges.size() - 1) % edges.size()]]) { first = i; break; }
         std::rotate(edges.begin(), edges.begin() + std::ptrdiff_t(first), edges.end());
         for (std::size_t i = 0; i < edges.size(); ++i) {
-            int tag = topo.edge_tags[edges[i]];
+            int tag = tags[edges[i]];
             if (i == 0 || tag != runs.back().tag || runs.back().loop != loop) {
-                runs.push_back({{NodeIndex(topo.edge_nodes[edges[i]][0])}, tag, loop});
+                runs.push_back({{NodeIndex(nodes(edges[i])[0])}, tag, loop});
             }
-            runs.back().nodes.push_back(NodeIndex(topo.edge_nodes[edges[i]][1]));
+            runs.back().nodes.push_back(NodeIndex(nodes(edges[i])[1]));
         }
         ++loop;
     }
@@ -236,7 +241,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     OutputFile out(path, options.overwrite, "GeoPackage output");
     const io::MeshTopology topo = io::build_topology(mesh);
     const MeshStats stats = io::compute_stats(mesh, topo);
-    const std::vector<double> area = io::geodesic_face_areas_m2(mesh);
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;
@@ -269,7 +273,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         feature.SetFID(GIntBig(i) + 1);
         feature.SetField("face", int(i));
         feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-        feature.SetField("area_km2", area[i] * 1e-6);
+        feature.SetField("area_km2", io::geodesic_face_area_m2(mesh, i) * 1e-6);
         auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
         if (depth) feature.SetField("depth", mean(depth));
         if (size) feature.SetField("target_size", mean(size));

@@ -1,6 +1,8 @@
 // Summary statistics of a mesh: see MeshStats in globemesh/ugrid.hpp.
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "globemesh/ugrid.hpp"
 #include "mesh_topology.hpp"
@@ -9,11 +11,48 @@ namespace globemesh {
 
 namespace io {
 
+namespace {
+
+/// Counts of positive values in bins of width 1/1024 up to 4 and one bin for the rest: enough to
+/// find which few bins hold the middle ranks, so that the exact median needs only their values
+/// (a few thousand at 1e6 edges) instead of a table of all of them.
+class RatioBins {
+public:
+    static constexpr std::size_t bin_count = 4 * 1024 + 1;
+    std::size_t bin(double r) const { return r < 4.0 ? std::size_t(r * 1024.0) : bin_count - 1; }
+    void add(double r) {
+        ++counts_[bin(r)];
+        ++count_;
+    }
+    std::size_t count() const { return count_; }
+    /// Number of values in the bins before bin b.
+    std::size_t count_below(std::size_t b) const {
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < b; ++i) n += counts_[i];
+        return n;
+    }
+    /// The bins of the lower and upper middle values (ranks (count-1)/2 and count/2, 0-based).
+    std::pair<std::size_t, std::size_t> middle_bins() const {
+        return {bin_of_rank((count_ - 1) / 2), bin_of_rank(count_ / 2)};
+    }
+
+private:
+    std::size_t bin_of_rank(std::size_t rank) const {
+        std::size_t b = 0, below = counts_[0];
+        while (below <= rank) below += counts_[++b];
+        return b;
+    }
+    std::vector<std::size_t> counts_ = std::vector<std::size_t>(bin_count, 0);
+    std::size_t count_ = 0;
+};
+
+} // namespace
+
 MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
     MeshStats s;
     s.nodes = mesh.nodes.size();
     s.faces = mesh.faces.size();
-    s.edges = topo.edge_nodes.size();
+    s.edges = topo.edge_count();
     s.boundary_edges = topo.boundary_edges.size();
     s.boundary_loops = count_boundary_loops(topo, mesh.nodes.size());
     if (!mesh.nodes.empty()) {
@@ -44,29 +83,50 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
     }
     const Field* size = mesh.node_field("target_size");
     s.has_size = size && size->values.size() == mesh.nodes.size();
-    if (!topo.edge_nodes.empty()) {
+    if (topo.edge_count() > 0) {
         s.edge_km_min = 1e300;
         double sum = 0;
-        std::vector<double> ratios;
-        if (s.has_size) ratios.reserve(topo.edge_nodes.size());
-        for (const auto& e : topo.edge_nodes) {
-            double km = arc_km(mesh.nodes[e[0]], mesh.nodes[e[1]]);
+        auto edge_km = [&](std::size_t e) {
+            const auto n = topo.edge_nodes(e);
+            return arc_km(mesh.nodes[n[0]], mesh.nodes[n[1]]);
+        };
+        // Edge length over the mean target of its ends, for edges whose target is positive and
+        // finite; NaN for the others.
+        auto ratio = [&](std::size_t e, double km) {
+            const auto n = topo.edge_nodes(e);
+            const double target = 0.5 * (size->values[n[0]] + size->values[n[1]]);
+            return target > 0 && std::isfinite(target) ? km / target : std::nan("");
+        };
+        RatioBins bins;
+        std::size_t in = 0;
+        for (std::size_t e = 0; e < topo.edge_count(); ++e) {
+            const double km = edge_km(e);
             s.edge_km_min = std::min(s.edge_km_min, km);
             s.edge_km_max = std::max(s.edge_km_max, km);
             sum += km;
             if (s.has_size) {
-                double target = 0.5 * (size->values[e[0]] + size->values[e[1]]);
-                if (target > 0 && std::isfinite(target)) ratios.push_back(km / target);
+                const double r = ratio(e, km);
+                if (std::isnan(r)) continue;
+                bins.add(r);
+                if (r >= 0.7 && r <= 1.4) ++in;
             }
         }
-        s.edge_km_mean = sum / double(topo.edge_nodes.size());
-        if (!ratios.empty()) {
-            std::size_t in = std::count_if(ratios.begin(), ratios.end(), [](double r) { return r >= 0.7 && r <= 1.4; });
-            s.size_ratio_in_range = double(in) / double(ratios.size());
-            auto mid = ratios.begin() + std::ptrdiff_t(ratios.size() / 2);
-            std::nth_element(ratios.begin(), mid, ratios.end());
+        s.edge_km_mean = sum / double(topo.edge_count());
+        if (bins.count() > 0) {
+            s.size_ratio_in_range = double(in) / double(bins.count());
+            // Second pass: only the ratios in the bins of the middle ranks are kept.
+            const auto [first, last] = bins.middle_bins();
+            std::vector<double> middle;
+            middle.reserve(bins.count_below(last + 1) - bins.count_below(first));
+            for (std::size_t e = 0; e < topo.edge_count(); ++e) {
+                const double r = ratio(e, edge_km(e));
+                if (!std::isnan(r) && bins.bin(r) >= first && bins.bin(r) <= last) middle.push_back(r);
+            }
+            // Rank of the upper middle value (the median for an odd count) among `middle`.
+            auto mid = middle.begin() + std::ptrdiff_t(bins.count() / 2 - bins.count_below(first));
+            std::nth_element(middle.begin(), mid, middle.end());
             double median = *mid;
-            if (ratios.size() % 2 == 0) median = 0.5 * (median + *std::max_element(ratios.begin(), mid));
+            if (bins.count() % 2 == 0) median = 0.5 * (median + *std::max_element(middle.begin(), mid));
             s.size_ratio_median = median;
         }
     }

@@ -30,79 +30,88 @@ MeshTopology build_topology(const Mesh& mesh) {
     }
     // Half-edges in the order of (smaller node, larger node, half-edge index): equal edges are
     // adjacent, first face first. Bucketed by the smaller node (a counting sort), then each
-    // bucket (a node's few edges) sorted by the larger node: no global sort, and 56 bytes per
-    // node of scratch instead of 72 for sorting keys and indices.
+    // bucket (a node's few half-edges) sorted by the larger node, which is looked up again in
+    // the face rather than stored: 4 bytes per half-edge, 28 to 32 bytes per node of scratch.
     const std::size_t nh = 3 * nf;
-    auto ends = [&](std::size_t h) {
+    auto ends = [&](std::uint32_t h) {
         const auto& face = mesh.faces[h / 3];
         std::uint32_t a = face[h % 3], b = face[(h % 3 + 1) % 3];
         return a < b ? std::pair{a, b} : std::pair{b, a};
     };
     std::vector<std::uint32_t> start(nn + 1, 0);
-    for (std::size_t h = 0; h < nh; ++h) ++start[ends(h).first + 1];
+    for (std::uint32_t h = 0; h < nh; ++h) ++start[ends(h).first + 1];
     std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> bucket(nh); // (larger node, half-edge)
+    std::vector<std::uint32_t> bucket(nh);
     {
         std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-        for (std::size_t h = 0; h < nh; ++h) {
-            auto [lo, hi] = ends(h);
-            bucket[fill[lo]++] = {hi, std::uint32_t(h)};
-        }
+        for (std::uint32_t h = 0; h < nh; ++h) bucket[fill[ends(h).first]++] = h;
     }
-    for (std::size_t v = 0; v < nn; ++v) std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1]);
+    auto by_larger_node = [&](std::uint32_t a, std::uint32_t b) {
+        return std::pair{ends(a).second, a} < std::pair{ends(b).second, b};
+    };
+    for (std::size_t v = 0; v < nn; ++v) std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
 
-    MeshTopology t;
-    t.face_edges.assign(nf, {-1, -1, -1});
-    t.edge_nodes.reserve(nh / 2 + 16);
-    t.edge_faces.reserve(nh / 2 + 16);
-    for (std::size_t v = 0; v < nn; ++v) {
-        for (std::size_t i = start[v], end = start[v + 1]; i < end;) {
-            std::size_t j = i + 1;
-            while (j < end && bucket[j].first == bucket[i].first) ++j;
-            if (j - i > 2)
-                throw DataError("mesh: edge " + std::to_string(v) + "-" + std::to_string(bucket[i].first) +
-                                " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
-            auto e = std::int32_t(t.edge_nodes.size());
-            std::uint32_t h0 = bucket[i].second;
-            std::int32_t f0 = std::int32_t(h0 / 3);
-            int k0 = int(h0 % 3);
-            t.edge_nodes.push_back({std::int32_t(mesh.faces[f0][k0]), std::int32_t(mesh.faces[f0][(k0 + 1) % 3])});
-            t.face_edges[f0][k0] = e;
-            if (j - i == 2) {
-                std::uint32_t h1 = bucket[i + 1].second;
-                std::int32_t f1 = std::int32_t(h1 / 3);
-                t.face_edges[f1][h1 % 3] = e;
-                t.edge_faces.push_back({f0, f1});
-            } else {
-                t.edge_faces.push_back({f0, -1});
-                t.boundary_edges.push_back(e);
+    // Calls edge(i, j) for each edge in order: its half-edges are bucket[i..j), one or two.
+    auto for_each_edge = [&](const auto& edge) {
+        for (std::size_t v = 0; v < nn; ++v) {
+            for (std::size_t i = start[v], end = start[v + 1]; i < end;) {
+                const std::uint32_t larger = ends(bucket[i]).second;
+                std::size_t j = i + 1;
+                while (j < end && ends(bucket[j]).second == larger) ++j;
+                if (j - i > 2)
+                    throw DataError("mesh: edge " + std::to_string(v) + "-" + std::to_string(larger) +
+                                    " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
+                edge(i, j);
+                i = j;
             }
-            i = j;
         }
-    }
+    };
+    std::size_t ne = 0;
+    for_each_edge([&](std::size_t, std::size_t) { ++ne; });
+    MeshTopology t;
+    t.mesh = &mesh;
+    t.edge_halves.reserve(ne); // exactly: growing by push_back would double it
+    for_each_edge([&](std::size_t i, std::size_t j) {
+        if (j - i == 1) t.boundary_edges.push_back(std::int32_t(t.edge_halves.size()));
+        t.edge_halves.push_back({bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge});
+    });
     std::vector<std::uint32_t>().swap(start);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(bucket);
-    t.face_faces.assign(nf, {-1, -1, -1}); // after the buckets are gone: the peak is lower
-    for (std::size_t f = 0; f < nf; ++f) {
-        int n = 0;
-        for (int k = 0; k < 3; ++k) {
-            const auto& ef = t.edge_faces[t.face_edges[f][k]];
-            std::int32_t other = ef[0] == std::int32_t(f) ? ef[1] : ef[0];
-            if (other >= 0) t.face_faces[f][n++] = other;
-        }
-    }
+    std::vector<std::uint32_t>().swap(bucket);
+
     // Tags: boundary edges from mesh.boundary by node pair (binary search on sorted keys).
-    t.edge_tags.assign(t.edge_nodes.size(), int(EdgeTag::interior));
     std::vector<std::pair<std::uint64_t, int>> tagged;
     tagged.reserve(mesh.boundary.size());
     for (const auto& b : mesh.boundary) tagged.emplace_back(edge_key(b.a, b.b), int(b.tag));
     std::sort(tagged.begin(), tagged.end());
+    t.boundary_tags.reserve(t.boundary_edges.size());
     for (auto e : t.boundary_edges) {
-        std::uint64_t key = edge_key(std::uint32_t(t.edge_nodes[e][0]), std::uint32_t(t.edge_nodes[e][1]));
+        const auto nodes = t.edge_nodes(std::size_t(e));
+        std::uint64_t key = edge_key(std::uint32_t(nodes[0]), std::uint32_t(nodes[1]));
         auto it = std::lower_bound(tagged.begin(), tagged.end(), std::make_pair(key, -1));
-        t.edge_tags[e] = (it != tagged.end() && it->first == key && it->second != 0) ? it->second : int(EdgeTag::coast);
+        t.boundary_tags.push_back((it != tagged.end() && it->first == key && it->second != 0) ? it->second
+                                                                                             : int(EdgeTag::coast));
     }
     return t;
+}
+
+std::vector<std::int32_t> face_edges(const MeshTopology& topo) {
+    std::vector<std::int32_t> edges(3 * topo.mesh->faces.size(), -1);
+    for (std::size_t e = 0; e < topo.edge_count(); ++e)
+        for (std::uint32_t h : topo.edge_halves[e])
+            if (h != MeshTopology::no_half_edge) edges[h] = std::int32_t(e);
+    return edges;
+}
+
+std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::vector<std::int32_t>& face_edges,
+                                       std::size_t f) {
+    std::array<std::int32_t, 3> neighbours = {-1, -1, -1};
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+        const auto ef = topo.edge_faces(std::size_t(face_edges[3 * f + std::size_t(k)]));
+        const std::int32_t other = ef[0] == std::int32_t(f) ? ef[1] : ef[0];
+        if (other >= 0) neighbours[n++] = other;
+    }
+    return neighbours;
 }
 
 std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_count) {
@@ -114,7 +123,8 @@ std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_coun
     };
     std::vector<char> on_boundary(node_count, 0);
     for (auto e : topo.boundary_edges) {
-        auto a = std::uint32_t(topo.edge_nodes[e][0]), b = std::uint32_t(topo.edge_nodes[e][1]);
+        const auto nodes = topo.edge_nodes(std::size_t(e));
+        auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
         on_boundary[a] = on_boundary[b] = 1;
         a = find(a), b = find(b);
         if (a != b) parent[a] = b;

@@ -1,8 +1,15 @@
 // Internal to io/: edges, neighbours and boundary of a triangle mesh, derived from its faces.
 //
-// Edges are numbered in the order of their sorted node pair (min, max), so the numbering depends
-// only on the faces. An edge is oriented as the first face (lowest face index) that uses it, so a
-// boundary edge has the mesh on its left. Fill (-1) entries come last in a row.
+// Half-edge h = 3 * f + k runs from node k to node k+1 of face f. Edges are numbered in the order
+// of their sorted node pair (min, max), so the numbering depends only on the faces. An edge is
+// oriented as its first half-edge (lowest face index), so a boundary edge has the mesh on its
+// left. Fill (-1) entries come last in a row.
+//
+// Memory: the edges are stored as their two half-edges, 8 bytes an edge (about 24 bytes per
+// node); edge nodes, edge faces and face neighbours are computed from them and the mesh when
+// asked for. The face-to-edge table (another 24 bytes per node) is built only by the writer that
+// needs it (face_edges). Building the edges takes 28 to 32 bytes per node of scratch, freed
+// before it returns.
 #pragma once
 
 #include <array>
@@ -15,18 +22,38 @@
 namespace globemesh::io {
 
 struct MeshTopology {
-    std::vector<std::array<std::int32_t, 2>> edge_nodes; ///< oriented as its first face
-    std::vector<std::array<std::int32_t, 2>> edge_faces; ///< second is -1 on the boundary
-    std::vector<std::array<std::int32_t, 3>> face_edges; ///< face_edges[f][k]: nodes k -> k+1
-    std::vector<std::array<std::int32_t, 3>> face_faces; ///< neighbours, -1 entries last
-    std::vector<std::int32_t> boundary_edges;            ///< edge indices with one face, ascending
-    std::vector<int> edge_tags;                          ///< EdgeTag per edge
+    static constexpr std::uint32_t no_half_edge = UINT32_MAX;
+
+    const Mesh* mesh = nullptr; ///< the mesh it was built from, which must outlive it
+    std::vector<std::array<std::uint32_t, 2>> edge_halves; ///< second is no_half_edge on the boundary
+    std::vector<std::int32_t> boundary_edges;              ///< edge indices with one face, ascending
+    std::vector<int> boundary_tags;                        ///< EdgeTag of each of boundary_edges
+
+    std::size_t edge_count() const { return edge_halves.size(); }
+    /// Nodes of edge e, oriented as its first face.
+    std::array<std::int32_t, 2> edge_nodes(std::size_t e) const {
+        const std::uint32_t h = edge_halves[e][0];
+        const auto& face = mesh->faces[h / 3];
+        return {std::int32_t(face[h % 3]), std::int32_t(face[(h % 3 + 1) % 3])};
+    }
+    /// Faces on each side of edge e; the second is -1 on the boundary.
+    std::array<std::int32_t, 2> edge_faces(std::size_t e) const {
+        const auto& h = edge_halves[e];
+        return {std::int32_t(h[0] / 3), h[1] == no_half_edge ? -1 : std::int32_t(h[1] / 3)};
+    }
 };
 
-/// Builds the topology. Throws DataError on a face with an out-of-range or repeated node, or an
+/// Builds the edges. Throws DataError on a face with an out-of-range or repeated node, or an
 /// edge shared by more than two faces. Boundary edges take their tag from mesh.boundary (matched
 /// by node pair); untagged boundary edges are coast.
 MeshTopology build_topology(const Mesh& mesh);
+
+/// The edge of each half-edge: face_edges[3 * f + k] joins nodes k and k+1 of face f.
+std::vector<std::int32_t> face_edges(const MeshTopology& topo);
+
+/// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from face_edges.
+std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::vector<std::int32_t>& face_edges,
+                                       std::size_t f);
 
 /// Number of boundary loops: connected groups of boundary edges (joined at shared nodes).
 std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_count);

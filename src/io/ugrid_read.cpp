@@ -279,7 +279,8 @@ Mesh read_ugrid(const std::filesystem::path& path) {
         }
     }();
     for (auto e : topology.boundary_edges) {
-        auto a = std::uint32_t(topology.edge_nodes[e][0]), b = std::uint32_t(topology.edge_nodes[e][1]);
+        const auto nodes = topology.edge_nodes(std::size_t(e));
+        auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
         std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
         auto it = std::lower_bound(edge_tags.begin(), edge_tags.end(), std::make_pair(key, 0));
         EdgeTag tag = (it != edge_tags.end() && it->first == key) ? EdgeTag(it->second) : EdgeTag::coast;

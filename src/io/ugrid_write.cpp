@@ -57,7 +57,7 @@ public:
             std::vector<std::size_t> chunk(dims.size());
             for (std::size_t k = 0; k < dims.size(); ++k) {
                 io::nc_check(nc_inq_dimlen(id_, dims[k], &chunk[k]), file_, std::string("sizing ") + name);
-                chunk[k] = std::max<std::size_t>(1, k == 0 ? std::min<std::size_t>(chunk[k], 65536) : chunk[k]);
+                chunk[k] = std::max<std::size_t>(1, k == 0 ? std::min(chunk[k], block_rows) : chunk[k]);
             }
             io::nc_check(nc_def_var_chunking(id_, v, NC_CHUNKED, chunk.data()), file_, std::string("chunking ") + name);
             io::nc_check(nc_set_var_chunk_cache(id_, v, 1u << 20, 7, 1.0f), file_, std::string("caching ") + name);
@@ -78,20 +78,39 @@ public:
                      std::string("writing attribute ") + name);
     }
     bool has_att(int v, const char* name) const { return nc_inq_attid(id_, v, name, nullptr) == NC_NOERR; }
-    void put(int v, const std::vector<double>& data, const char* name) {
-        io::nc_check(nc_put_var_double(id_, v, data.data()), file_, std::string("writing ") + name);
+    /// Writes the n rows of variable v in blocks of block_rows (one chunk each), N values of
+    /// type T (double or int, as the variable) a row: row(i) returns row i as std::array<T, N>.
+    /// Rows are asked for in ascending order. Only one block is in memory at a time.
+    template <class T, std::size_t N, class Row>
+    void put_rows(int v, std::size_t n, const Row& row, const char* name) {
+        std::vector<T> block;
+        for (std::size_t first = 0; first < n; first += block_rows) {
+            const std::size_t count = std::min(block_rows, n - first);
+            block.resize(count * N);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::array<T, N> r = row(first + i);
+                std::copy(r.begin(), r.end(), block.begin() + std::ptrdiff_t(i * N));
+            }
+            const std::size_t start[2] = {first, 0}, counts[2] = {count, N};
+            io::nc_check(put_block(v, start, counts, block.data()), file_, std::string("writing ") + name);
+        }
     }
-    template <std::size_t N>
-    void put(int v, const std::vector<std::array<std::int32_t, N>>& data, const char* name) {
-        static_assert(sizeof(std::array<std::int32_t, N>) == N * sizeof(std::int32_t));
-        io::nc_check(nc_put_var_int(id_, v, data.empty() ? nullptr : data.front().data()), file_,
-                     std::string("writing ") + name);
-    }
-    void put(int v, const std::vector<int>& data, const char* name) {
-        io::nc_check(nc_put_var_int(id_, v, data.data()), file_, std::string("writing ") + name);
+    /// put_rows for a variable of one value per row: value(i) returns row i's value.
+    template <class T, class Value>
+    void put_values(int v, std::size_t n, const Value& value, const char* name) {
+        put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; }, name);
     }
 
+    static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
+
 private:
+    int put_block(int v, const std::size_t* start, const std::size_t* count, const double* data) {
+        return nc_put_vara_double(id_, v, start, count, data);
+    }
+    int put_block(int v, const std::size_t* start, const std::size_t* count, const int* data) {
+        return nc_put_vara_int(id_, v, start, count, data);
+    }
+
     int id_;
     const std::filesystem::path& file_;
     bool compress_;
@@ -139,7 +158,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     OutputFile out(path, options.overwrite, "UGRID output");
     const io::MeshTopology topo = io::build_topology(mesh);
     const MeshStats stats = io::compute_stats(mesh, topo);
-    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_nodes.size(),
+    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count(),
                       nb = topo.boundary_edges.size();
 
     // Coordinates, quality and area are computed one variable at a time while writing, each in
@@ -290,54 +309,60 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     io::nc_check(nc_put_var_int(nc.id(), crs, &zero), path, "writing crs", "UGRID output");
     io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
 
-    std::vector<double> buffer;
-    // Longitudes (lon = true) or latitudes of n points, point(i) for i < n.
-    auto put_coordinate = [&](int v, std::size_t n, bool lon, const auto& point, const char* what) {
-        buffer.resize(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const LonLat p = vec_to_lonlat(point(i));
-            buffer[i] = lon ? p.lon : p.lat;
-        }
-        w.put(v, buffer, what);
-    };
-    auto node = [&](std::size_t i) { return mesh.nodes[i]; };
+    // Every variable is computed block by block while it is written (UgridWriter::put_rows):
+    // no table of the file is ever whole in memory, beside the mesh and its topology.
+    auto lon = [&](const Vec3& p) { return vec_to_lonlat(p).lon; };
+    auto lat = [&](const Vec3& p) { return vec_to_lonlat(p).lat; };
     auto centre = [&](std::size_t f) {
         return normalized(mesh.nodes[mesh.faces[f][0]] + mesh.nodes[mesh.faces[f][1]] + mesh.nodes[mesh.faces[f][2]]);
     };
     auto midpoint = [&](std::size_t e) {
-        return arc_midpoint(mesh.nodes[topo.edge_nodes[e][0]], mesh.nodes[topo.edge_nodes[e][1]]);
+        const auto ends = topo.edge_nodes(e);
+        return arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]);
     };
-    put_coordinate(coord_vars[0], nn, true, node, "node longitudes");
-    put_coordinate(coord_vars[1], nn, false, node, "node latitudes");
-    {
-        std::vector<std::array<std::int32_t, 3>> faces(nf);
-        for (std::size_t f = 0; f < nf; ++f)
-            for (int k = 0; k < 3; ++k) faces[f][k] = std::int32_t(mesh.faces[f][k]);
-        w.put(v_face_nodes, faces, "face nodes");
-    }
+    w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return lon(mesh.nodes[i]); }, "node longitudes");
+    w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return lat(mesh.nodes[i]); }, "node latitudes");
+    w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
+        const auto& t = mesh.faces[f];
+        return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
+    }, "face nodes");
     if (options.after_partial_write) options.after_partial_write();
-    put_coordinate(coord_vars[2], nf, true, centre, "face longitudes");
-    put_coordinate(coord_vars[3], nf, false, centre, "face latitudes");
-    put_coordinate(coord_vars[4], ne, true, midpoint, "edge longitudes");
-    put_coordinate(coord_vars[5], ne, false, midpoint, "edge latitudes");
-    w.put(v_edge_nodes, topo.edge_nodes, "edge nodes");
-    w.put(v_face_edges, topo.face_edges, "face edges");
-    w.put(v_face_links, topo.face_faces, "face neighbours");
-    w.put(v_edge_faces, topo.edge_faces, "edge faces");
-    if (nb) {
-        std::vector<std::array<std::int32_t, 2>> boundary_nodes(nb);
-        for (std::size_t i = 0; i < nb; ++i) boundary_nodes[i] = topo.edge_nodes[topo.boundary_edges[i]];
-        w.put(v_bnd, boundary_nodes, "boundary nodes");
+    w.put_values<double>(coord_vars[2], nf, [&](std::size_t f) { return lon(centre(f)); }, "face longitudes");
+    w.put_values<double>(coord_vars[3], nf, [&](std::size_t f) { return lat(centre(f)); }, "face latitudes");
+    w.put_values<double>(coord_vars[4], ne, [&](std::size_t e) { return lon(midpoint(e)); }, "edge longitudes");
+    w.put_values<double>(coord_vars[5], ne, [&](std::size_t e) { return lat(midpoint(e)); }, "edge latitudes");
+    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
+    {
+        const std::vector<std::int32_t> face_edges = io::face_edges(topo); // 12 bytes a face, freed after
+        w.put_rows<int, 3>(v_face_edges, nf, [&](std::size_t f) {
+            return std::array<int, 3>{face_edges[3 * f], face_edges[3 * f + 1], face_edges[3 * f + 2]};
+        }, "face edges");
+        w.put_rows<int, 3>(v_face_links, nf, [&](std::size_t f) { return io::face_faces(topo, face_edges, f); },
+                           "face neighbours");
     }
-    for (std::size_t i = 0; i < node_vars.size(); ++i) w.put(node_vars[i], mesh.node_fields[i].values, mesh.node_fields[i].name.c_str());
-    buffer.resize(nf);
-    for (std::size_t f = 0; f < nf; ++f)
-        buffer[f] = triangle_quality(mesh.nodes[mesh.faces[f][0]], mesh.nodes[mesh.faces[f][1]], mesh.nodes[mesh.faces[f][2]]);
-    w.put(v_quality, buffer, "quality");
-    std::vector<double>().swap(buffer);
-    w.put(v_area, io::geodesic_face_areas_m2(mesh), "area");
-    for (std::size_t i = 0; i < face_vars.size(); ++i) w.put(face_vars[i], extra_face_fields[i]->values, extra_face_fields[i]->name.c_str());
-    w.put(v_tag, topo.edge_tags, "boundary tags");
+    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); }, "edge faces");
+    if (nb)
+        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); },
+                           "boundary nodes");
+    for (std::size_t i = 0; i < node_vars.size(); ++i) {
+        const Field& f = mesh.node_fields[i];
+        w.put_values<double>(node_vars[i], nn, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());
+    }
+    w.put_values<double>(v_quality, nf, [&](std::size_t f) {
+        const auto& t = mesh.faces[f];
+        return triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
+    }, "quality");
+    w.put_values<double>(v_area, nf, [&](std::size_t f) { return io::geodesic_face_area_m2(mesh, f); }, "area");
+    for (std::size_t i = 0; i < face_vars.size(); ++i) {
+        const Field& f = *extra_face_fields[i];
+        w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());
+    }
+    std::size_t next_boundary = 0; // rows come in ascending order, as boundary_edges
+    w.put_values<int>(v_tag, ne, [&](std::size_t e) {
+        if (next_boundary < nb && std::size_t(topo.boundary_edges[next_boundary]) == e)
+            return topo.boundary_tags[next_boundary++];
+        return int(EdgeTag::interior);
+    }, "boundary tags");
     nc.close(path, "UGRID output");
     out.commit();
 }

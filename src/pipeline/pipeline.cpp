@@ -52,8 +52,9 @@ constexpr std::size_t size_grid_max_nodes = std::size_t{1} << 22;
 /// copy, flags and heap, the depths; 44 counted, rounded up.
 constexpr std::uint64_t size_grid_bytes_per_node = 64;
 
-/// Bytes per node of the full-resolution coast rings kept until the mesh is done (a Vec3 and
-/// its segment tag, with the vector's slack).
+/// Bytes per node of the full-resolution coast rings (a Vec3 and its segment tag, with the
+/// vector's slack). They are freed once the boundary is shaped, before meshing, but the budget
+/// still counts them there: it errs on the safe side.
 constexpr std::uint64_t ring_bytes_per_node = 40;
 
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
@@ -136,6 +137,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     CoastReport coast_report;
     Boundary boundary = shape_boundary(coast, size, o, &coast_report, sub_progress(progress, 0.25, 0.3));
     clock.lap("boundary");
+    coast.rings = Boundary{}; // done with: the mesher reuses their memory (only coast.layer is used below)
 
     MesherOptions mo;
     mo.max_nodes = o.max_nodes;

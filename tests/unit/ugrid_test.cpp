@@ -10,6 +10,7 @@
 
 #include <fstream>
 #include <iterator>
+#include <set>
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
@@ -143,6 +144,39 @@ TEST(Ugrid, closed_icosphere_passes_mesh_verify_and_round_trips_its_statistics) 
     EXPECT_EQ(back.node_field("depth")->standard_name, "sea_floor_depth_below_geoid");
     ASSERT_NE(back.face_field("quality"), nullptr);
     expect_same_stats(compute_stats(back), s);
+}
+
+TEST(Ugrid, size_ratio_median_is_the_median_of_all_edge_ratios) {
+    // compute_stats finds the median from bin counts and the values of the middle bins only:
+    // check it against sorting every ratio, for sizes putting ratios far below 1 and beyond the
+    // last bin (4), for an even count and, with the edges at a pole left out (a negative target), an
+    // odd one.
+    Mesh m = icosphere(3);
+    add_fields(m);
+    Field& size = m.node_fields[1];
+    auto sorted_median = [&] {
+        std::set<std::pair<NodeIndex, NodeIndex>> edges;
+        for (const auto& f : m.faces)
+            for (int k = 0; k < 3; ++k) edges.insert(std::minmax(f[k], f[(k + 1) % 3]));
+        std::vector<double> ratios;
+        for (auto [a, b] : edges) {
+            const double target = 0.5 * (size.values[a] + size.values[b]);
+            if (target > 0) ratios.push_back(arc_km(m.nodes[a], m.nodes[b]) / target);
+        }
+        std::sort(ratios.begin(), ratios.end());
+        const std::size_t n = ratios.size();
+        return std::pair{n, n % 2 ? ratios[n / 2] : 0.5 * (ratios[n / 2] + ratios[n / 2 - 1])};
+    };
+    for (int spread : {0, 1, 2}) {
+        for (std::size_t i = 0; i < m.nodes.size(); ++i)
+            size.values[i] = spread == 0 ? 500.0 + 100.0 * m.nodes[i].y : 10.0 + 3000.0 * double(i % 7) / spread;
+        for (bool odd : {false, true}) {
+            if (odd) size.values[0] = -1e9; // node 0, the north pole, has 5 edges
+            const auto [count, median] = sorted_median();
+            EXPECT_EQ(count % 2, odd ? 1u : 0u);
+            EXPECT_EQ(compute_stats(m).size_ratio_median, median) << "spread " << spread << " odd " << odd;
+        }
+    }
 }
 
 TEST(Ugrid, mesh_with_holes_keeps_tagged_boundary_loops_and_passes_mesh_verify) {
