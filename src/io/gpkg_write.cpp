@@ -240,7 +240,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
     OutputFile out(path, options.overwrite, "GeoPackage output");
     const io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = io::compute_stats(mesh, topo);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;

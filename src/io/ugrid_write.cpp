@@ -157,7 +157,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
 
     OutputFile out(path, options.overwrite, "UGRID output");
     const io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = io::compute_stats(mesh, topo);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
     const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count(),
                       nb = topo.boundary_edges.size();
 
