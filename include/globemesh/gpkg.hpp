@@ -15,8 +15,13 @@
 
 namespace globemesh {
 
+struct MeshStats;
+
 struct GpkgOptions {
     bool overwrite = false; ///< replace an existing file; otherwise an existing output is an IoError
+    /// compute_stats of this same mesh when the caller has it (mesh_info takes it as it is);
+    /// null: the writer computes it.
+    const MeshStats* stats = nullptr;
     /// Test hook: called once after the faces are written, before the rename.
     std::function<void()> after_partial_write;
 };

@@ -18,11 +18,16 @@
 
 namespace globemesh {
 
+struct MeshStats;
+
 struct UgridOptions {
     bool classic = false;   ///< --format classic: netCDF-3 classic model instead of NetCDF-4+deflate
     bool overwrite = false; ///< replace an existing file; otherwise an existing output is an IoError
     std::string title = "globemesh ocean mesh";
     std::string history;    ///< the full command line and date (the CLI fills it)
+    /// compute_stats of this same mesh when the caller has it (the global attributes take it
+    /// as it is); null: the writer computes it.
+    const MeshStats* stats = nullptr;
     /// Test hook: called once after the data is partly written, before the rename.
     std::function<void()> after_partial_write;
 };

@@ -358,18 +358,23 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
                             "; please report this with the command line");
     }
 
+    // Computed once for the report and both writers (each would otherwise build the topology
+    // again for it).
+    const MeshStats stats = lib.compute_stats(mesh);
     OutputsGuard written;
     const auto tw = std::chrono::steady_clock::now();
     UgridOptions ugrid;
     ugrid.classic = o.format == "classic";
     ugrid.overwrite = o.overwrite;
     ugrid.history = history_text("mesh", args);
+    ugrid.stats = &stats;
     lib.write_ugrid(mesh, o.output, ugrid);
     written.add(o.output);
     throw_if_interrupted();
     if (!o.gpkg.empty()) {
         GpkgOptions gpkg;
         gpkg.overwrite = o.overwrite;
+        gpkg.stats = &stats;
         lib.write_gpkg(mesh, o.gpkg, gpkg);
         written.add(o.gpkg);
         throw_if_interrupted();
@@ -386,7 +391,6 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     }
     timings.add("write", seconds_since(tw));
 
-    const MeshStats stats = lib.compute_stats(mesh);
     const double total_s = seconds_since(t0);
     const long long peak = peak_memory_bytes();
     if (!o.timings.empty()) {

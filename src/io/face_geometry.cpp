@@ -122,12 +122,9 @@ std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes) {
     return parts;
 }
 
-double geodesic_face_area_m2(const Mesh& mesh, std::size_t face) {
+double geodesic_triangle_area_m2(const LonLat& a, const LonLat& b, const LonLat& c) {
     GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
-    for (auto v : mesh.faces[face]) {
-        const LonLat p = vec_to_lonlat(mesh.nodes[v]);
-        poly.AddPoint(p.lat, p.lon);
-    }
+    for (const LonLat* p : {&a, &b, &c}) poly.AddPoint(p->lat, p->lon);
     double perimeter = 0, area = 0;
     poly.Compute(false, true, perimeter, area);
     return std::fabs(area);

@@ -23,8 +23,8 @@ std::vector<LonLatPart> face_polygons(const Vec3& a, const Vec3& b, const Vec3& 
 /// A polyline of unit vectors (straight in lon/lat between nodes) cut at +-180 into parts.
 std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes);
 
-/// Geodesic area of one face (index into mesh.faces) on the WGS84 ellipsoid, m2 (GeographicLib
-/// PolygonArea). One face at a time, so a writer needs no table of all the areas.
-double geodesic_face_area_m2(const Mesh& mesh, std::size_t face);
+/// Geodesic area of the triangle abc on the WGS84 ellipsoid, m2 (GeographicLib PolygonArea).
+/// One face at a time, so a writer needs no table of all the areas.
+double geodesic_triangle_area_m2(const LonLat& a, const LonLat& b, const LonLat& c);
 
 } // namespace globemesh::io

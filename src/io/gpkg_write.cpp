@@ -240,7 +240,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
     OutputFile out(path, options.overwrite, "GeoPackage output");
     const io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = io::compute_stats(mesh, topo);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;
@@ -273,7 +273,9 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         feature.SetFID(GIntBig(i) + 1);
         feature.SetField("face", int(i));
         feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-        feature.SetField("area_km2", io::geodesic_face_area_m2(mesh, i) * 1e-6);
+        const LonLat corners[3] = {vec_to_lonlat(mesh.nodes[t[0]]), vec_to_lonlat(mesh.nodes[t[1]]),
+                                   vec_to_lonlat(mesh.nodes[t[2]])};
+        feature.SetField("area_km2", io::geodesic_triangle_area_m2(corners[0], corners[1], corners[2]) * 1e-6);
         auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
         if (depth) feature.SetField("depth", mean(depth));
         if (size) feature.SetField("target_size", mean(size));

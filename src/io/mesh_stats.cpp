@@ -1,6 +1,7 @@
 // Summary statistics of a mesh: see MeshStats in globemesh/ugrid.hpp.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -15,14 +16,18 @@ namespace {
 
 /// Counts of positive values in bins of width 1/1024 up to 4 and one bin for the rest: enough to
 /// find which few bins hold the middle ranks, so that the exact median needs only their values
-/// (a few thousand at 1e6 edges) instead of a table of all of them.
+/// (a few thousand at 1e6 edges) instead of a table of all of them (8 bytes an edge; the caller
+/// keeps each edge's bin, 2 bytes, to find them again).
 class RatioBins {
 public:
     static constexpr std::size_t bin_count = 4 * 1024 + 1;
-    std::size_t bin(double r) const { return r < 4.0 ? std::size_t(r * 1024.0) : bin_count - 1; }
-    void add(double r) {
-        ++counts_[bin(r)];
+    static constexpr std::uint16_t no_bin = UINT16_MAX; ///< above every bin
+    /// Counts r (>= 0) and returns its bin.
+    std::uint16_t add(double r) {
+        const std::size_t b = r < 4.0 ? std::size_t(r * 1024.0) : bin_count - 1;
+        ++counts_[b];
         ++count_;
+        return std::uint16_t(b);
     }
     std::size_t count() const { return count_; }
     /// Number of values in the bins before bin b.
@@ -98,6 +103,9 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
             return target > 0 && std::isfinite(target) ? km / target : std::nan("");
         };
         RatioBins bins;
+        // The bin of each edge's ratio, so that the second pass recomputes only the ratios in the
+        // middle bins (2 bytes an edge).
+        std::vector<std::uint16_t> edge_bin(s.has_size ? topo.edge_count() : 0, RatioBins::no_bin);
         std::size_t in = 0;
         for (std::size_t e = 0; e < topo.edge_count(); ++e) {
             const double km = edge_km(e);
@@ -107,21 +115,19 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
             if (s.has_size) {
                 const double r = ratio(e, km);
                 if (std::isnan(r)) continue;
-                bins.add(r);
+                edge_bin[e] = bins.add(r);
                 if (r >= 0.7 && r <= 1.4) ++in;
             }
         }
         s.edge_km_mean = sum / double(topo.edge_count());
         if (bins.count() > 0) {
             s.size_ratio_in_range = double(in) / double(bins.count());
-            // Second pass: only the ratios in the bins of the middle ranks are kept.
+            // Second pass: the ratios in the bins of the middle ranks, computed again.
             const auto [first, last] = bins.middle_bins();
             std::vector<double> middle;
             middle.reserve(bins.count_below(last + 1) - bins.count_below(first));
-            for (std::size_t e = 0; e < topo.edge_count(); ++e) {
-                const double r = ratio(e, edge_km(e));
-                if (!std::isnan(r) && bins.bin(r) >= first && bins.bin(r) <= last) middle.push_back(r);
-            }
+            for (std::size_t e = 0; e < edge_bin.size(); ++e)
+                if (edge_bin[e] >= first && edge_bin[e] <= last) middle.push_back(ratio(e, edge_km(e)));
             // Rank of the upper middle value (the median for an odd count) among `middle`.
             auto mid = middle.begin() + std::ptrdiff_t(bins.count() / 2 - bins.count_below(first));
             std::nth_element(middle.begin(), mid, middle.end());

@@ -157,7 +157,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
 
     OutputFile out(path, options.overwrite, "UGRID output");
     const io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = io::compute_stats(mesh, topo);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
     const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count(),
                       nb = topo.boundary_edges.size();
 
@@ -310,7 +310,9 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
 
     // Every variable is computed block by block while it is written (UgridWriter::put_rows):
-    // no table of the file is ever whole in memory, beside the mesh and its topology.
+    // no table of the file is ever whole in memory. Beside the mesh and its topology, two helper
+    // tables live one after the other: face_edges (12 bytes a face), then the node lon/lat (16
+    // bytes a node), which the heap gives the memory of the first.
     auto lon = [&](const Vec3& p) { return vec_to_lonlat(p).lon; };
     auto lat = [&](const Vec3& p) { return vec_to_lonlat(p).lat; };
     auto centre = [&](std::size_t f) {
@@ -320,8 +322,6 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         const auto ends = topo.edge_nodes(e);
         return arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]);
     };
-    w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return lon(mesh.nodes[i]); }, "node longitudes");
-    w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return lat(mesh.nodes[i]); }, "node latitudes");
     w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
         const auto& t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
@@ -340,6 +340,18 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         w.put_rows<int, 3>(v_face_links, nf, [&](std::size_t f) { return io::face_faces(topo, face_edges, f); },
                            "face neighbours");
     }
+    {
+        // Node lon/lat converted once for the node coordinates and the face areas (16 bytes a
+        // node, after the larger face_edges table is freed).
+        std::vector<LonLat> ll(nn);
+        for (std::size_t i = 0; i < nn; ++i) ll[i] = vec_to_lonlat(mesh.nodes[i]);
+        w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return ll[i].lon; }, "node longitudes");
+        w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return ll[i].lat; }, "node latitudes");
+        w.put_values<double>(v_area, nf, [&](std::size_t f) {
+            const auto& t = mesh.faces[f];
+            return io::geodesic_triangle_area_m2(ll[t[0]], ll[t[1]], ll[t[2]]);
+        }, "area");
+    }
     w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); }, "edge faces");
     if (nb)
         w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); },
@@ -352,7 +364,6 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         const auto& t = mesh.faces[f];
         return triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
     }, "quality");
-    w.put_values<double>(v_area, nf, [&](std::size_t f) { return io::geodesic_face_area_m2(mesh, f); }, "area");
     for (std::size_t i = 0; i < face_vars.size(); ++i) {
         const Field& f = *extra_face_fields[i];
         w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());

@@ -179,6 +179,25 @@ TEST(Ugrid, size_ratio_median_is_the_median_of_all_edge_ratios) {
     }
 }
 
+TEST(Ugrid, statistics_passed_in_the_options_are_written_as_given) {
+    TempDir dir;
+    Mesh m = icosphere(2);
+    MeshStats s = compute_stats(m);
+    s.quality_min = 0.125; // not this mesh's: shows the writer took them instead of computing its own
+    UgridOptions options;
+    options.stats = &s;
+    write_ugrid(m, dir / "given.nc", options);
+    write_ugrid(m, dir / "own.nc");
+    for (const auto& [name, expected] : {std::pair{"given.nc", 0.125}, std::pair{"own.nc", compute_stats(m).quality_min}}) {
+        int nc;
+        ASSERT_EQ(nc_open((dir / name).c_str(), NC_NOWRITE, &nc), NC_NOERR);
+        double q = -1;
+        EXPECT_EQ(nc_get_att_double(nc, NC_GLOBAL, "quality_min", &q), NC_NOERR);
+        EXPECT_EQ(q, expected) << name;
+        nc_close(nc);
+    }
+}
+
 TEST(Ugrid, mesh_with_holes_keeps_tagged_boundary_loops_and_passes_mesh_verify) {
     TempDir dir;
     Mesh m = icosphere_with_holes(3);
