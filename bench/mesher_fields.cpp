@@ -38,8 +38,9 @@ int main(int argc, char** argv) {
         globemesh::MesherReport report;
         globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, {}, &report);
         globemesh::write_ugrid(mesh, argv[4]);
-        std::printf("%s: %zu nodes, %zu faces, %zu sharp corners touching %zu faces\n", field.c_str(),
-                    mesh.nodes.size(), mesh.faces.size(), report.sharp_corners, report.sharp_corner_faces);
+        std::printf("%s: %zu nodes, %zu faces, %zu sharp corners touching %zu faces, %zu inlets closed (%.0f km2)\n",
+                    field.c_str(), mesh.nodes.size(), mesh.faces.size(), report.sharp_corners,
+                    report.sharp_corner_faces, report.inlets_closed, report.inlet_area_km2);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mesher_fields: %s\n", e.what());
         return 1;

@@ -6,7 +6,10 @@
 //      where flips cannot recover it; recovered segments are constrained for good;
 //   3. classifies triangles by flood fill across unconstrained edges, seeded on the left of every
 //      segment, drops land and the ocean components not connected to the largest one (inland
-//      seas) unless keep_inland_seas, and reports each component by area;
+//      seas) unless keep_inland_seas, and reports each component by area; then closes the
+//      inlets narrower than inlet_width * h (an edge between two nodes of one ring, shorter than
+//      that, becomes coast when the water behind it is under inlet_area * h^2; repeated, so a
+//      dead-end channel closes whole), which no triangle of size h could fill but slivers;
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
@@ -39,6 +42,8 @@ struct MesherOptions {
     std::uint64_t max_memory = 0;         ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
     int smooth_iterations = 4;            ///< smoothing sweeps
     bool keep_inland_seas = false;        ///< keep ocean components apart from the largest
+    double inlet_width = 0.5;             ///< close inlets narrower than this times h (0: none)
+    double inlet_area = 1.0;              ///< ... holding at most this times h^2 of water
     std::uint64_t seed = 1;               ///< seed of the core's insertion order
 };
 
@@ -60,6 +65,8 @@ struct MesherReport {
     std::size_t estimated_nodes = 0;    ///< the size field's node estimate, checked against max_nodes
     std::size_t sharp_corners = 0;      ///< boundary nodes with an ocean angle below 60 degrees
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
+    std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
+    double inlet_area_km2 = 0;          ///< the water they held
     std::vector<OceanComponent> components;
 };
 

@@ -51,6 +51,9 @@ struct MeshOptions {
     /// budget never changes a result: a run fits (the same mesh as without it) or is refused.
     std::uint64_t max_memory_bytes = 0;
     int smooth_iterations = 4;            ///< --smooth: smoothing/relaxation sweeps
+    /// --inlet-width: close inlets and lagoons whose mouth is narrower than this times the local
+    /// size and whose water is under the local size squared; 0 keeps every inlet.
+    double inlet_width = 0.5;
     std::uint64_t seed = 1;               ///< --seed: seed of every pseudo-random choice
 };
 

@@ -211,6 +211,9 @@ struct MeshCommand {
                     }
                 },
                 ""));
+        app.add_option("--inlet-width", m.inlet_width,
+                       "Close inlets narrower than F times the edge length at their mouth (0: none)")
+            ->group(mesher)->type_name("F");
         app.add_option("--smooth", m.smooth_iterations, "Smoothing/relaxation sweeps")->group(mesher)->type_name("N");
         app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")->group(mesher)->type_name("N");
 

@@ -83,6 +83,14 @@ struct Mesher {
 
     bool is_sharp(VertexId v) const { return v < sharp.size() && sharp[v]; }
     std::vector<char> fixed; // per vertex: on a boundary segment (never moved by smoothing)
+    // Per vertex: the ring whose segments end there (no_ring: none; shared_ring: several).
+    static constexpr std::uint32_t no_ring = 0xffffffffu, shared_ring = 0xfffffffeu;
+    std::vector<std::uint32_t> ring_of;
+    std::uint32_t current_ring = no_ring; // the ring recover() is working on
+    void set_ring(VertexId v) {
+        if (v >= ring_of.size()) ring_of.resize(v + 1, no_ring);
+        ring_of[v] = ring_of[v] == no_ring || ring_of[v] == current_ring ? current_ring : shared_ring;
+    }
     bool is_fixed(VertexId v) const { return v < fixed.size() && fixed[v]; }
     void mark_fixed(VertexId v) {
         if (v >= fixed.size()) fixed.resize(v + 1, 0);
@@ -117,6 +125,8 @@ struct Mesher {
         directed.emplace_back(a, b);
         mark_fixed(a);
         mark_fixed(b);
+        set_ring(a);
+        set_ring(b);
     }
 
     static std::string describe(const Vec3& p) {
@@ -252,6 +262,102 @@ private:
     std::vector<Candidate, LineAllocator<Candidate>> a_ = std::vector<Candidate, LineAllocator<Candidate>>(pad);
 };
 
+// Closes the inlets narrower than options.inlet_width times h, on the triangulation of the
+// boundary nodes alone (before refinement, which would otherwise fill them with slivers). An
+// unconstrained ocean edge a-b between two nodes of one ring cuts the ocean in two: the ring's
+// arc from a to b and the edge close a curve. When a-b is shorter than inlet_width * h at its
+// midpoint and one side holds at most inlet_area * h^2 of ocean, with no open (sea) boundary
+// and no other ring (every ring stays a boundary loop), that side becomes land and a-b a coast
+// segment. A dead-end channel narrower than the bound closes whole, a bit at a time; water
+// behind a narrow mouth closes when it is small (a lagoon), and stays when it is large (the
+// Black Sea behind the Bosphorus).
+void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report) {
+    SphericalDelaunay& dt = m.dt;
+    struct Chord {
+        double length;
+        HalfEdge h;
+        VertexId a, b;
+    };
+    auto ring = [&](VertexId v) { return v < m.ring_of.size() ? m.ring_of[v] : Mesher::no_ring; };
+    std::vector<Chord> chords;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        for (int i = 0; i < 3; ++i) {
+            const HalfEdge h = half_edge(t, i);
+            const VertexId a = dt.origin(h), b = dt.destination(h);
+            // Each edge once (both its triangles are ocean: the flood fill crossed it).
+            if (a > b || dt.is_constrained(h) || ring(a) >= Mesher::shared_ring || ring(a) != ring(b)) continue;
+            const double length = arc_angle(dt.point(a), dt.point(b));
+            if (length < options.inlet_width * km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b)))))
+                chords.push_back({length, h, a, b});
+        }
+    }
+    std::sort(chords.begin(), chords.end(), [](const Chord& x, const Chord& y) {
+        if (x.length != y.length) return x.length > y.length;
+        return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
+    std::vector<std::uint32_t> mark(dt.triangle_slots(), 0);
+    std::uint32_t stamp = 0;
+    // The ocean on one side of `cut` from `seed`, or -1 when it holds more than `cap` (square
+    // radians), touches an open boundary or another ring than `own`, or reaches `other` (the cut
+    // does not separate).
+    auto flood = [&](TriangleId seed, HalfEdge cut, TriangleId other, std::uint32_t own, double cap,
+                     std::vector<TriangleId>& out) {
+        ++stamp;
+        out.assign(1, seed);
+        mark[seed] = stamp;
+        double area = 0;
+        for (std::size_t k = 0; k < out.size(); ++k) {
+            const TriangleId t = out[k];
+            area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                            dt.point(dt.vertex(t, 2)));
+            if (area > cap) return -1.0;
+            for (int i = 0; i < 3; ++i) {
+                const HalfEdge e = half_edge(t, i);
+                if (e == cut || e == dt.twin(cut)) continue;
+                if (dt.is_constrained(e)) {
+                    // Another ring inside (an island) would vanish with the inlet: keep it open.
+                    if (ring(dt.origin(e)) != own || ring(dt.destination(e)) != own) return -1.0;
+                    auto it = m.segments.find(key(dt.origin(e), dt.destination(e)));
+                    if (it != m.segments.end() && it->second == SegmentKind::open) return -1.0;
+                    continue;
+                }
+                const TriangleId nb = triangle_of(dt.twin(e));
+                if (nb == other) return -1.0;
+                if (mark[nb] == stamp || dt.label(nb) != ocean) continue;
+                mark[nb] = stamp;
+                out.push_back(nb);
+            }
+        }
+        return area;
+    };
+    // Passes until nothing closes: a closed tip makes the water behind the next edge out small
+    // enough, so a dead-end channel narrower than the bound closes whole, whatever the order.
+    std::vector<TriangleId> side[2];
+    for (bool closed = true; closed;) {
+        closed = false;
+        for (const Chord& c : chords) {
+            const TriangleId left = triangle_of(c.h), right = triangle_of(dt.twin(c.h));
+            if (dt.label(left) != ocean || dt.label(right) != ocean) continue; // closed already
+            const double h = km_to_rad(m.size_km(arc_midpoint(dt.point(c.a), dt.point(c.b))));
+            const double cap = options.inlet_area * h * h;
+            const double area_left = flood(left, c.h, right, ring(c.a), cap, side[0]);
+            const double area_right = flood(right, c.h, left, ring(c.a), cap, side[1]);
+            if (area_left < 0 && area_right < 0) continue;
+            const int s = area_right < 0 || (area_left >= 0 && area_left <= area_right) ? 0 : 1;
+            for (TriangleId t : side[s]) dt.set_label(t, land);
+            dt.set_constrained(c.h, true);
+            m.current_ring = m.ring_of[c.a];
+            // The ocean stays on the segment's left.
+            if (s == 0) m.add_segment(c.b, c.a, SegmentKind::coast);
+            else m.add_segment(c.a, c.b, SegmentKind::coast);
+            ++report.inlets_closed;
+            report.inlet_area_km2 += (s == 0 ? area_left : area_right) * earth_radius_km * earth_radius_km;
+            closed = true;
+        }
+    }
+}
+
 } // namespace
 
 Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
@@ -319,6 +425,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     for (std::size_t r = 0; r < boundary.rings.size(); ++r) {
         const Ring& ring = boundary.rings[r];
         const std::size_t n = ring.nodes.size();
+        m.current_ring = static_cast<std::uint32_t>(r);
         for (std::size_t i = 0; i < n; ++i) {
             VertexId a = ids[offsets[r] + i], b = ids[offsets[r] + (i + 1) % n];
             SegmentKind kind = i < ring.kinds.size() ? ring.kinds[i] : SegmentKind::coast;
@@ -391,6 +498,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     for (TriangleId t = 0; t < slots; ++t)
         if (dt.is_live(t))
             dt.set_label(t, component[t] != 0xffffffffu && kept[component[t]] ? ocean : land);
+    if (options.inlet_width > 0 && !boundary.empty()) close_inlets(m, options, report);
     globemesh::report(progress, 0.15, "classify");
 
     // Sharp corners: boundary vertices whose ocean angle (the sum of their ocean triangles'

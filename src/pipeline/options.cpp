@@ -41,6 +41,8 @@ void validate(const MeshOptions& o) {
     require(o.max_memory_bytes == 0 || o.max_memory_bytes >= min_memory_budget_bytes,
             "--max-memory must be 0 (no limit) or at least 1MB, e.g. 4GB");
     require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000, "--smooth must be in 0..1000");
+    require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,
+            "--inlet-width must be in 0..2 (a fraction of the local edge length; 0 keeps every inlet)");
     if (o.region) {
         const auto& r = *o.region;
         for (double v : r) require(std::isfinite(v), "--region values must be numbers: W,S,E,N in degrees");

@@ -148,6 +148,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     }
     mo.smooth_iterations = o.smooth_iterations;
     mo.keep_inland_seas = o.keep_inland_seas;
+    mo.inlet_width = o.inlet_width;
     mo.seed = o.seed;
     MesherReport report;
     StageTimings mesher_times;
@@ -178,6 +179,8 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("lakes_removed", std::to_string(coast_report.lakes_removed));
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
+    a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +
+                                        number(report.inlet_area_km2) + " km2)");
     a.emplace_back("sharp_coast_corners", std::to_string(report.sharp_corners));
     a.emplace_back("faces_at_sharp_corners", std::to_string(report.sharp_corner_faces));
     std::ostringstream comps;

@@ -113,6 +113,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.max_nodes, b.max_nodes);
     EXPECT_EQ(a.max_memory_bytes, b.max_memory_bytes);
     EXPECT_EQ(a.smooth_iterations, b.smooth_iterations);
+    EXPECT_EQ(a.inlet_width, b.inlet_width);
     EXPECT_EQ(a.seed, b.seed);
 }
 
@@ -138,7 +139,7 @@ std::vector<std::string> every_option(const std::string& out_dir) {
             "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
             "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
-            "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--seed", "42",
+            "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--inlet-width", "0.25", "--seed", "42",
             "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
             "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
             "--overwrite", "--verbose", "--check"};
