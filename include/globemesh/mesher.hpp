@@ -15,7 +15,8 @@
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
 //      boundary segment splits that segment at its midpoint instead (Ruppert). Each triangle's
 //      badness is computed once, when the core creates it; candidates wait in a 4-ary heap of
-//      16-byte entries stamped with their slot's generation (a stale entry is skipped);
+//      16-byte entries stamped with their slot's generation (a stale entry is skipped), ordered
+//      by badness in steps of 2^(1/8) and, within a step, along the Hilbert curve (locality);
 //   5. improves: sweeps of optimal-Delaunay smoothing of the interior nodes (each moved to the
 //      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
 //      with Delaunay flips after each move; boundary nodes stay fixed. Nodes are visited along
