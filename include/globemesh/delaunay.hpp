@@ -142,6 +142,13 @@ public:
     bool is_live(TriangleId t) const { return tri_vertices_[3 * t] != no_vertex; }
     const Vec3& point(VertexId v) const { return points_[v]; }
     const std::vector<Vec3>& points() const { return points_; }
+    /// Moves the points out (indexed by VertexId) and leaves an empty triangulation: for a caller
+    /// done with the triangles, without a copy of the points.
+    std::vector<Vec3> release_points() {
+        std::vector<Vec3> p = std::move(points_);
+        *this = SphericalDelaunay(options_);
+        return p;
+    }
     VertexId vertex(TriangleId t, int i) const { return tri_vertices_[3 * t + i]; }
     /// The half-edge on the other side of h.
     HalfEdge twin(HalfEdge h) const { return links_[h] & link_mask; }

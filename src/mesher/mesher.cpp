@@ -893,8 +893,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     if (timings) timings->add("improve", seconds_since(t0));
 
     // ---- output ------------------------------------------------------------------------------
+    // The faces first, then the triangulation goes and its points become the nodes in place: the
+    // triangulation and the output nodes never coexist (this is the mesher's peak).
     Mesh mesh;
-    // Sized once (no doubling, no copy while growing): the output is most of the peak.
     std::vector<NodeIndex> node_of(dt.vertex_count(), 0xffffffffu);
     std::size_t face_count = 0, node_count = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
@@ -902,15 +903,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             ++face_count;
             for (int i = 0; i < 3; ++i) node_of[dt.vertex(t, i)] = 0;
         }
-    for (VertexId v = 0; v < dt.vertex_count(); ++v) node_count += node_of[v] == 0;
-    mesh.nodes.reserve(node_count);
-    mesh.faces.reserve(face_count);
     for (VertexId v = 0; v < dt.vertex_count(); ++v)
-        if (node_of[v] == 0) {
-            node_of[v] = static_cast<NodeIndex>(mesh.nodes.size());
-            mesh.nodes.push_back(dt.point(v));
-        }
-    if (mesh.nodes.empty()) throw DataError("no ocean is left to mesh");
+        if (node_of[v] == 0) node_of[v] = static_cast<NodeIndex>(node_count++);
+    if (node_count == 0) throw DataError("no ocean is left to mesh");
+    mesh.faces.reserve(face_count); // sized once: no doubling, no copy while growing
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
         mesh.faces.push_back({node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]});
@@ -924,9 +920,13 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             mesh.boundary.push_back({node_of[a], node_of[b], tag});
         }
     }
-    // The triangulation is no longer needed: free it before the per-node arrays below.
+    // Node k is the k-th vertex used by a face, so moving each down to its index is in place.
+    mesh.nodes = m.dt.release_points();
+    for (VertexId v = 0; v < node_of.size(); ++v)
+        if (node_of[v] != 0xffffffffu) mesh.nodes[node_of[v]] = mesh.nodes[v];
+    mesh.nodes.resize(node_count);
+    mesh.nodes.shrink_to_fit(); // the triangulation is gone: the copy is not the peak
     std::vector<NodeIndex>().swap(node_of);
-    m.dt = SphericalDelaunay{};
     std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
     std::vector<char> on_boundary(mesh.nodes.size(), 0);
     for (const auto& f : mesh.faces)

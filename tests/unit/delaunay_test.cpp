@@ -117,6 +117,21 @@ TEST(Delaunay, octahedron_vertices_give_eight_triangles) {
     EXPECT_EQ(canonical(dt, false), canonical(dt2, false));
 }
 
+TEST(Delaunay, release_points_hands_over_the_vertices_and_empties_the_triangulation) {
+    std::vector<Vec3> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    SphericalDelaunay dt;
+    const std::vector<VertexId> ids = dt.insert_points(p);
+    const std::vector<Vec3> released = dt.release_points();
+    ASSERT_EQ(released.size(), p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_EQ(released[ids[i]], p[i]);
+    EXPECT_EQ(dt.vertex_count(), 0u);
+    EXPECT_EQ(dt.triangle_slots(), 0u);
+    // Empty, not broken: it triangulates again.
+    dt.insert_points(p);
+    expect_valid_closed(dt);
+    EXPECT_EQ(dt.triangle_count(), 8u);
+}
+
 TEST(Delaunay, random_points_1e5_are_valid_and_cover_the_sphere) {
     auto p = random_points(100000, 1);
     SphericalDelaunay dt;
