@@ -61,7 +61,7 @@ public:
             }
             io::nc_check(nc_def_var_chunking(id_, v, NC_CHUNKED, chunk.data()), file_, std::string("chunking ") + name);
             io::nc_check(nc_set_var_chunk_cache(id_, v, 1u << 20, 7, 1.0f), file_, std::string("caching ") + name);
-            io::nc_check(nc_def_var_deflate(id_, v, 1, 1, 4), file_, std::string("compressing ") + name);
+            io::nc_check(nc_def_var_deflate(id_, v, 1, 1, 1), file_, std::string("compressing ") + name);
         }
         return v;
     }
