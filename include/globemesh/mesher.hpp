@@ -19,8 +19,10 @@
 //      by badness in steps of 2^(1/8) and, within a step, along the Hilbert curve (locality);
 //   5. improves: sweeps of optimal-Delaunay smoothing of the interior nodes (each moved to the
 //      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
-//      with Delaunay flips after each move; boundary nodes stay fixed. Nodes are visited along
-//      the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share cache lines.
+//      with Delaunay flips after each move; boundary nodes stay fixed. A node whose move would
+//      be under 1% of h stays, and sits out the next sweep unless a neighbour moved. Nodes are
+//      visited along the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share
+//      cache lines.
 //      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
 //      few candidates (the mean of the apexes that would make each star triangle equilateral,
 //      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
