@@ -830,7 +830,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const Vec3 target = normalized(sum);
             // The quality before the move is needed only when the move would go below 0.6. (A
             // move that would fold the star counts as -1: move_vertex_from refuses it anyway.)
-            if (arc_angle(target, dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
+            if (norm(target - dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
             const double worst_after = star_worst_quality(target, far);
             if (worst_after < 0.6 && worst_after < star_worst_quality(dt.point(v), far)) continue;
             if (!dt.move_vertex_from(from, target)) continue;
