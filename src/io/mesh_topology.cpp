@@ -94,20 +94,19 @@ MeshTopology build_topology(const Mesh& mesh) {
     return t;
 }
 
-std::vector<std::int32_t> face_edges(const MeshTopology& topo) {
-    std::vector<std::int32_t> edges(3 * topo.mesh->faces.size(), -1);
+void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out) {
+    out.assign(3 * count, -1);
+    const std::size_t lo = 3 * first, hi = 3 * (first + count);
     for (std::size_t e = 0; e < topo.edge_count(); ++e)
         for (std::uint32_t h : topo.edge_halves[e])
-            if (h != MeshTopology::no_half_edge) edges[h] = std::int32_t(e);
-    return edges;
+            if (h != MeshTopology::no_half_edge && h >= lo && h < hi) out[h - lo] = std::int32_t(e);
 }
 
-std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::vector<std::int32_t>& face_edges,
-                                       std::size_t f) {
+std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::int32_t* edges_of_f, std::size_t f) {
     std::array<std::int32_t, 3> neighbours = {-1, -1, -1};
     int n = 0;
     for (int k = 0; k < 3; ++k) {
-        const auto ef = topo.edge_faces(std::size_t(face_edges[3 * f + std::size_t(k)]));
+        const auto ef = topo.edge_faces(std::size_t(edges_of_f[k]));
         const std::int32_t other = ef[0] == std::int32_t(f) ? ef[1] : ef[0];
         if (other >= 0) neighbours[n++] = other;
     }

@@ -7,8 +7,8 @@
 //
 // Memory: the edges are stored as their two half-edges, 8 bytes an edge (about 24 bytes per
 // node); edge nodes, edge faces and face neighbours are computed from them and the mesh when
-// asked for. The face-to-edge table (another 24 bytes per node) is built only by the writer that
-// needs it (face_edges). Building the edges takes 28 to 32 bytes per node of scratch, freed
+// asked for. The face-to-edge table is built a block of faces at a time (face_edges), by the
+// writer that needs it. Building the edges takes 28 to 32 bytes per node of scratch, freed
 // before it returns.
 #pragma once
 
@@ -48,12 +48,12 @@ struct MeshTopology {
 /// by node pair); untagged boundary edges are coast.
 MeshTopology build_topology(const Mesh& mesh);
 
-/// The edge of each half-edge: face_edges[3 * f + k] joins nodes k and k+1 of face f.
-std::vector<std::int32_t> face_edges(const MeshTopology& topo);
+/// The edges of faces first .. first + count - 1: out[3 * i + k] is the edge joining nodes k and
+/// k+1 of face first + i. One pass over all the edges, so callers take large blocks.
+void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out);
 
-/// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from face_edges.
-std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::vector<std::int32_t>& face_edges,
-                                       std::size_t f);
+/// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from its three edges.
+std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::int32_t* edges_of_f, std::size_t f);
 
 /// Number of boundary loops: connected groups of boundary edges (joined at shared nodes).
 std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_count);

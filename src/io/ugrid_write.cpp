@@ -11,6 +11,7 @@
 #include <cstring>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "globemesh/error.hpp"
@@ -99,6 +100,33 @@ public:
     template <class T, class Value>
     void put_values(int v, std::size_t n, const Value& value, const char* name) {
         put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; }, name);
+    }
+
+    /// Writes rows first .. first + count - 1 of variable v (N ints a row) from data.
+    void put_int_rows(int v, std::size_t first, std::size_t count, std::size_t n_per_row, const int* data,
+                      const char* name) {
+        const std::size_t start[2] = {first, 0}, counts[2] = {count, n_per_row};
+        io::nc_check(put_block(v, start, counts, data), file_, std::string("writing ") + name);
+    }
+    /// put_values with each block's values computed on every core, in contiguous slices:
+    /// value(i) must be safe to call from several threads at once. The file is the same.
+    template <class Value>
+    void put_values_parallel(int v, std::size_t n, const Value& value, const char* name) {
+        const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+        std::vector<double> block;
+        for (std::size_t first = 0; first < n; first += block_rows) {
+            const std::size_t count = std::min(block_rows, n - first);
+            block.resize(count);
+            auto slice = [&](std::size_t k) {
+                for (std::size_t i = count * k / threads; i < count * (k + 1) / threads; ++i) block[i] = value(first + i);
+            };
+            std::vector<std::thread> pool;
+            for (std::size_t k = 1; k < threads; ++k) pool.emplace_back(slice, k);
+            slice(0);
+            for (auto& t : pool) t.join();
+            const std::size_t start[1] = {first}, counts[1] = {count};
+            io::nc_check(put_block(v, start, counts, block.data()), file_, std::string("writing ") + name);
+        }
     }
 
     static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
@@ -310,9 +338,8 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
 
     // Every variable is computed block by block while it is written (UgridWriter::put_rows):
-    // no table of the file is ever whole in memory. Beside the mesh and its topology, two helper
-    // tables live one after the other: face_edges (12 bytes a face), then the node lon/lat (16
-    // bytes a node), which the heap gives the memory of the first.
+    // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
+    // table: the node lon/lat (16 bytes a node).
     auto lon = [&](const Vec3& p) { return vec_to_lonlat(p).lon; };
     auto lat = [&](const Vec3& p) { return vec_to_lonlat(p).lat; };
     auto centre = [&](std::size_t f) {
@@ -333,21 +360,30 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.put_values<double>(coord_vars[5], ne, [&](std::size_t e) { return lat(midpoint(e)); }, "edge latitudes");
     w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
     {
-        const std::vector<std::int32_t> face_edges = io::face_edges(topo); // 12 bytes a face, freed after
-        w.put_rows<int, 3>(v_face_edges, nf, [&](std::size_t f) {
-            return std::array<int, 3>{face_edges[3 * f], face_edges[3 * f + 1], face_edges[3 * f + 2]};
-        }, "face edges");
-        w.put_rows<int, 3>(v_face_links, nf, [&](std::size_t f) { return io::face_faces(topo, face_edges, f); },
-                           "face neighbours");
+        // Face edges and face neighbours a block of faces at a time, from one pass over the edges
+        // a block: no face-to-edge table of the whole mesh (12 bytes a face) at the writer's peak.
+        std::vector<std::int32_t> edges;
+        std::vector<int> links;
+        for (std::size_t first = 0; first < nf; first += UgridWriter::block_rows) {
+            const std::size_t count = std::min(UgridWriter::block_rows, nf - first);
+            io::face_edges(topo, first, count, edges);
+            w.put_int_rows(v_face_edges, first, count, 3, edges.data(), "face edges");
+            links.resize(3 * count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const auto nb = io::face_faces(topo, &edges[3 * i], first + i);
+                std::copy(nb.begin(), nb.end(), links.begin() + std::ptrdiff_t(3 * i));
+            }
+            w.put_int_rows(v_face_links, first, count, 3, links.data(), "face neighbours");
+        }
     }
     {
-        // Node lon/lat converted once for the node coordinates and the face areas (16 bytes a
-        // node, after the larger face_edges table is freed).
+        // Node lon/lat converted once for the node coordinates and the face areas.
         std::vector<LonLat> ll(nn);
         for (std::size_t i = 0; i < nn; ++i) ll[i] = vec_to_lonlat(mesh.nodes[i]);
         w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return ll[i].lon; }, "node longitudes");
         w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return ll[i].lat; }, "node latitudes");
-        w.put_values<double>(v_area, nf, [&](std::size_t f) {
+        // Three geodesic problems a face: most of the writer's time, so on every core.
+        w.put_values_parallel(v_area, nf, [&](std::size_t f) {
             const auto& t = mesh.faces[f];
             return io::geodesic_triangle_area_m2(ll[t[0]], ll[t[1]], ll[t[2]]);
         }, "area");
