@@ -26,6 +26,7 @@
 //      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
 //      few candidates (the mean of the apexes that would make each star triangle equilateral,
 //      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
+//      Last, two rounds of a pattern search over the nodes of triangles still below q 0.6.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once

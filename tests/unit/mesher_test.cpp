@@ -111,14 +111,15 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     test::expect_mesh_verify(dir / "g.nc", "--size-var target_size --min-size-fit 0.95");
     QualityCheck q = quality(mesh);
     // Issue 4 asks for mean >= 0.93, 99% above 0.8 and worst >= 0.6 away from sharp corners.
-    // Measured here with inlets narrower than h/2 closed (the default): mean 0.953, 97.3% above
-    // 0.8, 28 faces (0.04%) below 0.6 away from sharp corners, the worst 0.44. With every inlet
-    // kept (--inlet-width 0): 96.6%, 0.15%, 0.024 (slivers in lagoons and fjords). The assertions
-    // hold what is reached so a regression fails; the gap is in the closing note of issue 4.
+    // Measured here: mean 0.952, 97.3% above 0.8, 9 faces (0.012%) below 0.6 away from sharp
+    // corners (Chesapeake Bay, Puget Sound, a Ganges mouth), the worst 0.535. Without the
+    // pattern search on those stars: 38 faces, 0.445; before inlets were closed (session 4):
+    // 96.6%, 113 faces, 0.024. The assertions hold what is reached so a regression fails; the
+    // gap is in the closing note of issue 4.
     EXPECT_GE(q.mean, 0.93);
     EXPECT_GE(q.above_0_8, 0.97);
-    EXPECT_LT(q.below_0_6_away_from_corners, 0.001);
-    EXPECT_GT(q.worst_away_from_corners, 0.4);
+    EXPECT_LT(q.below_0_6_away_from_corners, 0.0003);
+    EXPECT_GT(q.worst_away_from_corners, 0.5);
     EXPECT_LT(q.corner_faces, mesh.faces.size() / 100);
 }
 
