@@ -417,6 +417,16 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     written.commit();
 
     print_stats(out, stats, false);
+    // What the run changed of the coast, from the pipeline's attributes.
+    auto attribute = [&](const char* key) {
+        for (const auto& [k, v] : mesh.attributes)
+            if (k == key) return v;
+        return std::string("?");
+    };
+    out << "coast             " << attribute("boundary_rings") << " rings kept, islands dropped "
+        << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
+        << ", inlets closed " << attribute("inlets_closed") << "\n"
+        << "ocean components  " << attribute("ocean_components") << "\n";
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"

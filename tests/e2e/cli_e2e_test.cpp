@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -89,6 +90,10 @@ TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
     EXPECT_NE(out.find("nodes"), std::string::npos) << out;
     EXPECT_NE(out.find("peak memory"), std::string::npos) << out;
     EXPECT_NE(err.find("100 - done."), std::string::npos) << err;
+    // The summary's coast line: rings kept, each one boundary loop of the mesh (checked below).
+    std::smatch rings;
+    ASSERT_TRUE(std::regex_search(out, rings, std::regex(R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, inlets closed \d+ \()")))
+        << out;
     // Exactly the outputs asked for: no temporary file left beside them.
     EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"g.nc", "g.gpkg", "g.png", "r.json", "t.json"}));
     expect_mesh_verify(dir / "g.nc");
@@ -110,6 +115,7 @@ for k in ('mesh', 'write'):
     assert k in t['stages'], t
 assert all(v >= 0 for v in t['stages'].values())
 assert 0.6 * 400 < r['mesh']['edge_km']['mean'] < 1.3 * 400, r['mesh']['edge_km']
+assert r['mesh']['boundary_loops'] == )" + rings[1].str() + R"(, r['mesh']['boundary_loops']
 print('OK', lon.shape[0])
 )",
                                        dir.path());
