@@ -7,7 +7,8 @@
 # peak bytes per node of the whole process (reading, meshing and writing the UGRID file).
 # Part 2, when BUILD/bench/mesher_memory exists (target mesher_memory): mesh_boundary alone,
 # wall-clock and CPU us/node (CPU time is less disturbed by other work on a shared machine) and
-# the peak bytes per node of that call alone (VmHWM reset before it; the writer not counted).
+# the peak bytes per node of that call alone (VmHWM reset before it; the writer not counted);
+# then the process's peak in each step (read_coast, boundary, each mesher stage, write).
 #
 # Usage: bench/mesh_scale.sh [BUILD_DIR | globemesh binary] [sizes in km...]
 #        (default build/release; sizes 200 64 20 10)
@@ -42,7 +43,7 @@ PY
 done
 if [[ -x $mem ]]; then
     echo "mesh_boundary alone (bench/mesher_memory)"
-    for h in $sizes; do "$mem" "$coast" land "$h" 1; done
+    for h in $sizes; do "$mem" "$coast" land "$h" 1 "$tmp/mm.nc"; done
 else
     echo "($mem not built: cmake --build BUILD --target mesher_memory for the mesher's own peak)"
 fi

@@ -30,10 +30,15 @@ inline void report(const Progress& p, double f, std::string_view stage) {
     if (p && !p(f, stage)) throw Cancelled();
 }
 
-/// Seconds per named stage, in the order the stages ran.
+/// Seconds per named stage, in the order the stages ran. `after_stage`, when set, is called as
+/// each stage is added, while nothing of the next has run (a benchmark samples memory there).
 struct StageTimings {
     std::vector<std::pair<std::string, double>> stages;
-    void add(const std::string& name, double seconds) { stages.emplace_back(name, seconds); }
+    std::function<void(const std::string& stage)> after_stage;
+    void add(const std::string& name, double seconds) {
+        stages.emplace_back(name, seconds);
+        if (after_stage) after_stage(name);
+    }
 };
 
 } // namespace globemesh
