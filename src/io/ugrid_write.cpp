@@ -11,6 +11,7 @@
 #include <cstring>
 #include <set>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -121,7 +122,13 @@ public:
                 for (std::size_t i = count * k / threads; i < count * (k + 1) / threads; ++i) block[i] = value(first + i);
             };
             std::vector<std::thread> pool;
-            for (std::size_t k = 1; k < threads; ++k) pool.emplace_back(slice, k);
+            std::size_t k = 1;
+            try {
+                for (; k < threads; ++k) pool.emplace_back(slice, k);
+            } catch (const std::system_error&) {
+                // No more threads (a process limit): this thread does the slices left.
+            }
+            for (; k < threads; ++k) slice(k);
             slice(0);
             for (auto& t : pool) t.join();
             const std::size_t start[1] = {first}, counts[1] = {count};
