@@ -58,7 +58,7 @@ constexpr double badness_levels_per_doubling = 8;
 constexpr double settle_fraction = 0.01;
 // Then the nodes of triangles below this quality (away from sharp corners) get a pattern search
 // for their star's best worst triangle, for this many rounds. Measured on 1:50m land at 100 km:
-// faces below 0.6 away from sharp corners 38 -> 9, the worst 0.445 -> 0.543, faces below 0.8
+// faces below 0.6 away from sharp corners 38 -> 9, the worst 0.445 -> 0.535, faces below 0.8
 // 2,070 -> 2,086; Gulf Stream field 46 -> 15, 0.469 -> 0.525 (4 rounds: the same).
 constexpr double worst_goal = 0.6;
 constexpr int search_rounds = 2;
@@ -293,7 +293,8 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
     SphericalDelaunay& dt = m.dt;
     struct Chord {
         double length;
-        HalfEdge h;
+        double h; // the size at its midpoint, radians
+        HalfEdge edge;
         VertexId a, b;
     };
     auto ring = [&](VertexId v) { return v < m.ring_of.size() ? m.ring_of[v] : Mesher::no_ring; };
@@ -306,8 +307,8 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
             // Each edge once (both its triangles are ocean: the flood fill crossed it).
             if (a > b || dt.is_constrained(h) || ring(a) >= Mesher::shared_ring || ring(a) != ring(b)) continue;
             const double length = arc_angle(dt.point(a), dt.point(b));
-            if (length < options.inlet_width * km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b)))))
-                chords.push_back({length, h, a, b});
+            const double size = km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b))));
+            if (length < options.inlet_width * size) chords.push_back({length, size, h, a, b});
         }
     }
     std::sort(chords.begin(), chords.end(), [](const Chord& x, const Chord& y) {
@@ -355,16 +356,15 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
     for (bool closed = true; closed;) {
         closed = false;
         for (const Chord& c : chords) {
-            const TriangleId left = triangle_of(c.h), right = triangle_of(dt.twin(c.h));
+            const TriangleId left = triangle_of(c.edge), right = triangle_of(dt.twin(c.edge));
             if (dt.label(left) != ocean || dt.label(right) != ocean) continue; // closed already
-            const double h = km_to_rad(m.size_km(arc_midpoint(dt.point(c.a), dt.point(c.b))));
-            const double cap = options.inlet_area * h * h;
-            const double area_left = flood(left, c.h, right, ring(c.a), cap, side[0]);
-            const double area_right = flood(right, c.h, left, ring(c.a), cap, side[1]);
+            const double cap = options.inlet_area * c.h * c.h;
+            const double area_left = flood(left, c.edge, right, ring(c.a), cap, side[0]);
+            const double area_right = flood(right, c.edge, left, ring(c.a), cap, side[1]);
             if (area_left < 0 && area_right < 0) continue;
             const int s = area_right < 0 || (area_left >= 0 && area_left <= area_right) ? 0 : 1;
             for (TriangleId t : side[s]) dt.set_label(t, land);
-            dt.set_constrained(c.h, true);
+            dt.set_constrained(c.edge, true);
             m.current_ring = m.ring_of[c.a];
             // The ocean stays on the segment's left.
             if (s == 0) m.add_segment(c.b, c.a, SegmentKind::coast);
@@ -853,36 +853,40 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // edge, the mean of its neighbours, and halfway to either, when that beats where it is.
     // (Sliding boundary nodes along the coast gained 0.1% of faces above 0.8: not done.)
     {
-        // Each node with a triangle next to it: the hint that finds its star in a step or two.
+        // The interior nodes of the ocean triangles below `below` (those at a sharp corner left
+        // out when `skip_sharp`), each with a triangle next to it: the hint that finds its star
+        // in a step or two.
         std::vector<std::pair<VertexId, TriangleId>> todo;
-        for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-            if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-            const Vec3& a = dt.point(dt.vertex(t, 0));
-            const Vec3& b = dt.point(dt.vertex(t, 1));
-            const Vec3& c = dt.point(dt.vertex(t, 2));
-            if (triangle_quality(a, b, c) >= 0.9) continue;
-            for (int i = 0; i < 3; ++i)
-                if (!m.is_fixed(dt.vertex(t, i))) todo.emplace_back(dt.vertex(t, i), t);
-        }
-        std::sort(todo.begin(), todo.end());
-        todo.erase(std::unique(todo.begin(), todo.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-                   todo.end());
+        auto collect = [&](double below, bool skip_sharp) {
+            todo.clear();
+            for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+                if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+                const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
+                if (skip_sharp && (m.is_sharp(a) || m.is_sharp(b) || m.is_sharp(c))) continue;
+                if (triangle_quality(dt.point(a), dt.point(b), dt.point(c)) >= below) continue;
+                for (VertexId u : {a, b, c})
+                    if (!m.is_fixed(u)) todo.emplace_back(u, t);
+            }
+            std::sort(todo.begin(), todo.end());
+            todo.erase(std::unique(todo.begin(), todo.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+                       todo.end());
+        };
         std::vector<Vec3> candidates;
         // Moves v to the best candidate; with `search`, a star still below worst_goal then gets
         // a pattern search for its best worst triangle (eight directions, the step halved when
-        // none is better). Returns the star's worst quality.
+        // none is better).
         auto improve_node = [&](VertexId v, TriangleId& hint, bool search) {
             const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
-            if (from == no_half_edge || dt.origin(from) != v) return 1.0;
+            if (from == no_half_edge || dt.origin(from) != v) return;
             hint = triangle_of(from);
             far.clear();
             HalfEdge h = from;
             do {
-                if (dt.label(triangle_of(h)) != ocean) return 1.0;
+                if (dt.label(triangle_of(h)) != ocean) return;
                 far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(triangle_of(h), edge_of(h))));
                 h = dt.next_around_origin(h);
             } while (h != from && far.size() < 64);
-            if (h != from) return 1.0;
+            if (h != from) return;
             Vec3 apex{0, 0, 0}, mean{0, 0, 0};
             double step = 0;
             for (const auto& [b, c] : far) {
@@ -924,26 +928,15 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     else to = next;
                 }
             }
-            if (!(to == p0) && !dt.move_vertex_from(from, to)) return star_worst_quality(p0, far);
-            return best;
+            if (!(to == p0)) dt.move_vertex_from(from, to);
         };
+        collect(0.9, false);
         for (int round = 0; round < improve_rounds; ++round)
             for (auto& [v, hint] : todo) improve_node(v, hint, false);
-        // Last, the nodes of the triangles still below worst_goal (away from sharp corners),
-        // until none of their stars improves.
+        // Last, search_rounds rounds over the nodes of the triangles still below worst_goal
+        // (away from sharp corners), collected again each round.
         for (int round = 0; round < search_rounds; ++round) {
-            todo.clear();
-            for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-                if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-                const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
-                if (m.is_sharp(a) || m.is_sharp(b) || m.is_sharp(c)) continue;
-                if (triangle_quality(dt.point(a), dt.point(b), dt.point(c)) >= worst_goal) continue;
-                for (int i = 0; i < 3; ++i)
-                    if (!m.is_fixed(dt.vertex(t, i))) todo.emplace_back(dt.vertex(t, i), t);
-            }
-            std::sort(todo.begin(), todo.end());
-            todo.erase(std::unique(todo.begin(), todo.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
-                       todo.end());
+            collect(worst_goal, true);
             if (todo.empty()) break;
             for (auto& [v, hint] : todo) improve_node(v, hint, true);
         }
