@@ -93,8 +93,7 @@ public:
                 const std::array<T, N> r = row(first + i);
                 std::copy(r.begin(), r.end(), block.begin() + std::ptrdiff_t(i * N));
             }
-            const std::size_t start[2] = {first, 0}, counts[2] = {count, N};
-            io::nc_check(put_block(v, start, counts, block.data()), file_, std::string("writing ") + name);
+            put_block_rows(v, first, count, N, block.data(), name);
         }
     }
     /// put_rows for a variable of one value per row: value(i) returns row i's value.
@@ -103,9 +102,11 @@ public:
         put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; }, name);
     }
 
-    /// Writes rows first .. first + count - 1 of variable v (N ints a row) from data.
-    void put_int_rows(int v, std::size_t first, std::size_t count, std::size_t n_per_row, const int* data,
-                      const char* name) {
+    /// Writes rows first .. first + count - 1 of variable v (n_per_row values of type T, double or
+    /// int as the variable, a row) from data.
+    template <class T>
+    void put_block_rows(int v, std::size_t first, std::size_t count, std::size_t n_per_row, const T* data,
+                        const char* name) {
         const std::size_t start[2] = {first, 0}, counts[2] = {count, n_per_row};
         io::nc_check(put_block(v, start, counts, data), file_, std::string("writing ") + name);
     }
@@ -131,8 +132,7 @@ public:
             for (; k < threads; ++k) slice(k);
             slice(0);
             for (auto& t : pool) t.join();
-            const std::size_t start[1] = {first}, counts[1] = {count};
-            io::nc_check(put_block(v, start, counts, block.data()), file_, std::string("writing ") + name);
+            put_block_rows(v, first, count, 1, block.data(), name);
         }
     }
 
@@ -374,13 +374,13 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         for (std::size_t first = 0; first < nf; first += UgridWriter::block_rows) {
             const std::size_t count = std::min(UgridWriter::block_rows, nf - first);
             io::face_edges(topo, first, count, edges);
-            w.put_int_rows(v_face_edges, first, count, 3, edges.data(), "face edges");
+            w.put_block_rows(v_face_edges, first, count, 3, edges.data(), "face edges");
             links.resize(3 * count);
             for (std::size_t i = 0; i < count; ++i) {
                 const auto nb = io::face_faces(topo, &edges[3 * i], first + i);
                 std::copy(nb.begin(), nb.end(), links.begin() + std::ptrdiff_t(3 * i));
             }
-            w.put_int_rows(v_face_links, first, count, 3, links.data(), "face neighbours");
+            w.put_block_rows(v_face_links, first, count, 3, links.data(), "face neighbours");
         }
     }
     {
