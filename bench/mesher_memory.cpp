@@ -8,7 +8,8 @@
 // is. Then one line of the process's peak in each step, bytes per output node: read_coast,
 // boundary (shaping), each stage of mesh_boundary, and write (UGRID to OUT.nc, when given), the
 // high-water mark reset at the start of each. Linux only.
-// Usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc]
+// Usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc] [LATTICE]
+// (LATTICE 0: no lattice, MesherOptions::lattice_km; by default HMAX_KM).
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -47,7 +48,7 @@ bool reset_peak() {
 
 int main(int argc, char** argv) {
     if (argc < 4) {
-        std::fprintf(stderr, "usage: mesher_memory COAST LAYER HMAX_KM [REPEATS]\n");
+        std::fprintf(stderr, "usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc] [LATTICE]\n");
         return 2;
     }
     globemesh::MeshOptions o;
@@ -59,6 +60,8 @@ int main(int argc, char** argv) {
 #endif
     const int repeats = argc > 4 ? std::atoi(argv[4]) : 1;
     const globemesh::SizeFn size = globemesh::uniform_size(o.hmax_km);
+    globemesh::MesherOptions mo;
+    mo.lattice_km = argc > 6 && std::atoi(argv[6]) == 0 ? 0.0 : o.hmax_km;
     // The process's peak in each step (kiB), the high-water mark reset as a step starts.
     std::vector<std::pair<std::string, long>> step_peaks;
     auto step_done = [&](const std::string& step) {
@@ -82,7 +85,7 @@ int main(int argc, char** argv) {
         globemesh::MesherReport report;
         const std::clock_t c0 = std::clock();
         auto t0 = std::chrono::steady_clock::now();
-        globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, {}, &report, {}, &timings);
+        globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, mo, &report, {}, &timings);
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
         const long peak = vm_kib("VmHWM:");
@@ -95,7 +98,7 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         if (r == repeats - 1) last = std::move(mesh);
     }
-    if (argc > 5) {
+    if (argc > 5 && argv[5][0] != '\0') {
         reset_peak();
         globemesh::UgridOptions u;
         u.overwrite = true;

@@ -49,6 +49,10 @@ struct MesherOptions {
     double inlet_width = 0.5;             ///< close inlets narrower than this times h (0: none)
     double inlet_area = 1.0;              ///< ... holding at most this times h^2 of water
     std::uint64_t seed = 1;               ///< seed of the core's insertion order
+    /// The size field's largest value (km): where the field reaches it, away from the boundary,
+    /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
+    /// refinement fills the rest. 0: no lattice, every node from the refinement.
+    double lattice_km = 0;
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory
@@ -71,6 +75,7 @@ struct MesherReport {
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
     std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
     double inlet_area_km2 = 0;          ///< the water they held
+    std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
     std::vector<OceanComponent> components;
 };
 

@@ -66,6 +66,15 @@ constexpr int search_rounds = 2;
 // Measured on 1:50m land at 100 km (nodes of faces below 0.9): interior faces below q 0.8
 // 0.89% -> 0.12%; 6 rounds instead of 3 gain 0.02%.
 constexpr int improve_rounds = 3;
+// The icosahedral lattice (fill_lattice): n subdivisions of an icosahedron's edge give a median
+// chord of lattice_edge_scale / n (its chords lie within [0.74, 1.09] of the median, its
+// triangles' q above 0.88). A lattice node is kept where the size field reaches lattice_level
+// times the lattice's size, and no boundary segment or other node lies within lattice_clearance
+// times that size.
+constexpr double lattice_edge_scale = 1.2185;
+constexpr double lattice_level = 0.99;
+constexpr double lattice_clearance = 1.5;
+constexpr double lattice_jitter = 1e-6;
 constexpr std::uint8_t land = 0;
 constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
@@ -376,6 +385,111 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
     }
 }
 
+// Fills the open ocean where the size field reaches s_km, its largest value, with the nodes of
+// an icosahedral lattice of that spacing: each of the icosahedron's 20 faces cut into n^2
+// triangles and projected onto the sphere from its centre. Its triangles are close to
+// equilateral and the right size, so the refinement then only fills the band between the
+// lattice and the coast (or smaller sizes), growing fronts from both. The points are chosen on
+// the triangulation of the boundary alone, whose triangles are large (walked face by face, row
+// by row, each row the other way than the last, so each walk is a step), then inserted as any
+// point set (the core's BRIO order keeps every cavity small). Returns the number inserted.
+std::size_t fill_lattice(Mesher& m, double s_km) {
+    SphericalDelaunay& dt = m.dt;
+    const double s = km_to_rad(s_km);
+    const double n = std::max(1.0, std::round(lattice_edge_scale / s));
+    const double g = 0.5 * (1.0 + std::sqrt(5.0));
+    const std::array<Vec3, 12> corner = {
+        normalized(Vec3{-1, g, 0}), normalized(Vec3{1, g, 0}),  normalized(Vec3{-1, -g, 0}),
+        normalized(Vec3{1, -g, 0}), normalized(Vec3{0, -1, g}), normalized(Vec3{0, 1, g}),
+        normalized(Vec3{0, -1, -g}), normalized(Vec3{0, 1, -g}), normalized(Vec3{g, 0, -1}),
+        normalized(Vec3{g, 0, 1}),  normalized(Vec3{-g, 0, -1}), normalized(Vec3{-g, 0, 1})};
+    static constexpr int face[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                        {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                        {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                        {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+    // A node shared by faces (on an edge or a corner) is made by the first face that has it.
+    auto owner = [](int a, int b) { // the first face with the edge a-b, or with the corner a when b < 0
+        for (int f = 0; f < 20; ++f) {
+            const int* v = face[f];
+            const bool has_a = v[0] == a || v[1] == a || v[2] == a;
+            const bool has_b = b < 0 || v[0] == b || v[1] == b || v[2] == b;
+            if (has_a && has_b) return f;
+        }
+        return -1;
+    };
+    const double clearance = lattice_clearance * s;
+    const double sin2 = std::pow(std::sin(clearance), 2);
+    const double chord2 = std::pow(2.0 * std::sin(0.5 * clearance), 2);
+    std::vector<TriangleId> seen;
+    // Whether p, in the ocean triangle t, has no boundary segment and no node within the
+    // clearance: the triangles whose edges come that close, from t.
+    auto clear = [&](const Vec3& p, TriangleId t) {
+        seen.assign(1, t);
+        for (std::size_t k = 0; k < seen.size(); ++k) {
+            for (int i = 0; i < 3; ++i) {
+                const HalfEdge e = half_edge(seen[k], i);
+                const Vec3& u = dt.point(dt.origin(e));
+                const Vec3& w = dt.point(dt.destination(e));
+                if (dot(u - p, u - p) < chord2) return false;
+                const Vec3 c = cross(u, w);
+                const double d = dot(p, c);
+                if (d * d >= sin2 * dot(c, c) || arc_distance(u, w, p) >= clearance) continue; // far from the arc's circle, or its ends
+                if (dt.is_constrained(e)) return false;
+                const TriangleId nb = triangle_of(dt.twin(e));
+                if (std::find(seen.begin(), seen.end(), nb) != seen.end()) continue;
+                if (seen.size() == 64) return false; // a fan of long edges: leave it to the refinement
+                seen.push_back(nb);
+            }
+        }
+        return true;
+    };
+    std::vector<Vec3> points;
+    TriangleId hint = no_triangle;
+    const int rows = static_cast<int>(n);
+    for (int f = 0; f < 20; ++f) {
+        const int ia = face[f][0], ib = face[f][1], ic = face[f][2];
+        const Vec3 &a = corner[ia], &b = corner[ib], &c = corner[ic];
+        for (int i = 0; i <= rows; ++i) {
+            const int len = rows - i;
+            for (int step = 0; step <= len; ++step) {
+                const int j = i % 2 == 0 ? step : len - step;
+                const int k = rows - i - j;
+                // Weights i, j, k on corners a, b, c: a node on the edge opposite a corner (its
+                // weight 0) or at a corner belongs to the first face that has it.
+                const int zeros = (i == 0) + (j == 0) + (k == 0);
+                if (zeros == 2) {
+                    const int v = i > 0 ? ia : j > 0 ? ib : ic;
+                    if (owner(v, -1) != f) continue;
+                } else if (zeros == 1) {
+                    const int u = i == 0 ? ib : ia, w = k == 0 ? ib : ic;
+                    if (owner(u, w) != f) continue;
+                }
+                // Each point moved by a pseudo-random 1e-6 of the spacing (its index hashed,
+                // splitmix64): the lattice's mirror symmetries make many four points exactly
+                // cocircular, each an in-circle test that only exact arithmetic decides.
+                std::uint64_t x = (static_cast<std::uint64_t>(f) << 42) ^ (static_cast<std::uint64_t>(i) << 21) ^
+                                  static_cast<std::uint64_t>(j);
+                Vec3 shift;
+                for (double* e : {&shift.x, &shift.y, &shift.z}) {
+                    x += 0x9e3779b97f4a7c15ull;
+                    std::uint64_t z = x;
+                    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+                    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+                    *e = double((z ^ (z >> 31)) >> 11) * 0x1p-53 - 0.5;
+                }
+                const Vec3 p = normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
+                                          (lattice_jitter * s) * shift);
+                if (m.size_km(p) < lattice_level * s_km) continue;
+                hint = dt.locate(p, hint);
+                if (dt.label(hint) == ocean && clear(p, hint)) points.push_back(p);
+            }
+        }
+    }
+    const std::size_t before = dt.vertex_count();
+    dt.insert_points(points);
+    return dt.vertex_count() - before;
+}
+
 } // namespace
 
 Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
@@ -566,6 +680,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // ---- 4. refine ---------------------------------------------------------------------------
     t0 = Clock::now();
+    const auto lattice_first = static_cast<VertexId>(dt.vertex_count()); // the lattice nodes follow
+    if (options.lattice_km > 0) report.lattice_nodes = fill_lattice(m, options.lattice_km);
     // Badness per triangle slot, computed once when the core creates the triangle: a triangle
     // never changes while it lives (its corners, their fixed/sharp flags and the size field are
     // all fixed), and every triangle an insertion creates has the new vertex as a corner.
@@ -651,9 +767,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         } while (h != from);
         for (TriangleId t : star_triangles) consider(t);
     };
-    for (TriangleId t = 0; t < slots; ++t)
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
         if (dt.is_live(t) && dt.label(t) == ocean) bad[t] = m.badness(t);
-    for (TriangleId t = 0; t < slots; ++t) consider(t);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) consider(t);
     const std::size_t node_limit = 4 * report.estimated_nodes + 1000;
     std::size_t inserted = 0;
     // Stale entries are dropped whenever the heap doubles since the last sweep (this keeps the
@@ -789,6 +905,25 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // shorter than settle_fraction of h stays and stays off the next sweep, unless a neighbour
     // moves.
     std::vector<std::uint8_t> active(dt.vertex_count(), 1);
+    // Per vertex: a lattice node among lattice nodes only that has not moved. Such a node is
+    // about where smoothing would leave it (inside a face of the icosahedron, the move is under
+    // 0.3% of the spacing, below settle_fraction), so it starts settled and moves only when a
+    // neighbour does; and a triangle of three is the lattice's own (q above 0.88), which the
+    // quality rounds below leave as it is.
+    std::vector<char> as_made(dt.vertex_count(), 0);
+    if (report.lattice_nodes > 0) {
+        const VertexId lattice_end = lattice_first + static_cast<VertexId>(report.lattice_nodes);
+        std::fill(as_made.begin() + lattice_first, as_made.begin() + lattice_end, 1);
+        std::vector<char> lattice_star(as_made); // every neighbour a lattice node too
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+            if (!dt.is_live(t)) continue;
+            const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
+            if (!as_made[a] || !as_made[b] || !as_made[c]) lattice_star[a] = lattice_star[b] = lattice_star[c] = 0;
+        }
+        as_made.swap(lattice_star);
+        for (VertexId v = lattice_first; v < lattice_end; ++v)
+            if (as_made[v]) active[v] = 0;
+    }
     for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
         // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
         // (a triangle next to v) rather than an answer: the walk from it is a step or two.
@@ -842,6 +977,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             if (worst_after < 0.6 && worst_after < star_worst_quality(dt.point(v), far)) continue;
             if (!dt.move_vertex_from(from, target)) continue;
             active[v] |= 2;
+            as_made[v] = 0;
             for (VertexId u : ring) active[u] |= 2;
         }
         for (auto& a : active) a >>= 1;
@@ -863,6 +999,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 if (!dt.is_live(t) || dt.label(t) != ocean) continue;
                 const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
                 if (skip_sharp && (m.is_sharp(a) || m.is_sharp(b) || m.is_sharp(c))) continue;
+                if (as_made[a] && as_made[b] && as_made[c]) continue;
                 if (triangle_quality(dt.point(a), dt.point(b), dt.point(c)) >= below) continue;
                 for (VertexId u : {a, b, c})
                     if (!m.is_fixed(u)) todo.emplace_back(u, t);
@@ -928,7 +1065,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     else to = next;
                 }
             }
-            if (!(to == p0)) dt.move_vertex_from(from, to);
+            if (!(to == p0) && dt.move_vertex_from(from, to)) as_made[v] = 0;
         };
         collect(0.9, false);
         for (int round = 0; round < improve_rounds; ++round)
@@ -980,14 +1117,15 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     std::vector<NodeIndex>().swap(node_of);
     std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
     std::vector<char> on_boundary(mesh.nodes.size(), 0);
+    for (const auto& e : mesh.boundary) on_boundary[e.a] = on_boundary[e.b] = 1;
     for (const auto& f : mesh.faces)
         for (int i = 0; i < 3; ++i) {
+            if (!on_boundary[f[i]]) continue;
             const Vec3& p = mesh.nodes[f[i]];
             const Vec3& q = mesh.nodes[f[next3(i)]];
             const Vec3& r = mesh.nodes[f[prev3(i)]];
             ocean_angle[f[i]] += std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p));
         }
-    for (const auto& e : mesh.boundary) on_boundary[e.a] = on_boundary[e.b] = 1;
     std::vector<char> sharp(mesh.nodes.size(), 0);
     for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
         if (on_boundary[v] && ocean_angle[v] < 60.0 * deg_to_rad) {

@@ -149,6 +149,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     mo.smooth_iterations = o.smooth_iterations;
     mo.keep_inland_seas = o.keep_inland_seas;
     mo.inlet_width = o.inlet_width;
+    mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
     MesherReport report;
     StageTimings mesher_times;
@@ -181,6 +182,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +
                                         number(report.inlet_area_km2) + " km2)");
+    a.emplace_back("lattice_nodes", std::to_string(report.lattice_nodes));
     a.emplace_back("sharp_coast_corners", std::to_string(report.sharp_corners));
     a.emplace_back("faces_at_sharp_corners", std::to_string(report.sharp_corner_faces));
     std::ostringstream comps;
