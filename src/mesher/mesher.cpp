@@ -392,11 +392,14 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
 // lattice and the coast (or smaller sizes), growing fronts from both. The points are chosen on
 // the triangulation of the boundary alone, whose triangles are large (walked face by face, row
 // by row, each row the other way than the last, so each walk is a step), then inserted as any
-// point set (the core's BRIO order keeps every cavity small). Returns the number inserted.
-std::size_t fill_lattice(Mesher& m, double s_km) {
+// point set (the core's BRIO order keeps every cavity small). The lattice is walked over the
+// whole sphere, so it is skipped (returns 0) when it has more than `max_points` points: a small
+// region at a fine size. Returns the number inserted.
+std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     SphericalDelaunay& dt = m.dt;
     const double s = km_to_rad(s_km);
     const double n = std::max(1.0, std::round(lattice_edge_scale / s));
+    if (10 * n * n + 2 > max_points) return 0;
     const double g = 0.5 * (1.0 + std::sqrt(5.0));
     const std::array<Vec3, 12> corner = {
         normalized(Vec3{-1, g, 0}), normalized(Vec3{1, g, 0}),  normalized(Vec3{-1, -g, 0}),
@@ -681,7 +684,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // ---- 4. refine ---------------------------------------------------------------------------
     t0 = Clock::now();
     const auto lattice_first = static_cast<VertexId>(dt.vertex_count()); // the lattice nodes follow
-    if (options.lattice_km > 0) report.lattice_nodes = fill_lattice(m, options.lattice_km);
+    // The lattice's points over the whole sphere may be a few times the nodes asked for (the
+    // global ocean: 1.5 times), not more.
+    if (options.lattice_km > 0)
+        report.lattice_nodes = fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000);
     // Badness per triangle slot, computed once when the core creates the triangle: a triangle
     // never changes while it lives (its corners, their fixed/sharp flags and the size field are
     // all fixed), and every triangle an insertion creates has the new vertex as a corner.
