@@ -76,6 +76,7 @@ struct MesherReport {
     std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
     double inlet_area_km2 = 0;          ///< the water they held
     std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
+    std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
     std::vector<OceanComponent> components;
 };
 
