@@ -541,6 +541,7 @@ int run_case_isolated(const CoastCase& c, const std::string& path, int limit_s) 
             MesherOptions mo;
             mo.keep_inland_seas = options.keep_inland_seas;
             mo.max_nodes = 20000;
+            mo.lattice_km = c.h; // as the pipeline: the lattice where the field is at its largest
             RunawayGuard guard;
             try {
                 const Mesh mesh = mesh_boundary(boundary, size, mo, nullptr, guard.progress());
@@ -655,6 +656,7 @@ Mesh mesh_islands(const std::vector<std::vector<LonLat>>& islands, const std::st
     MesherOptions mo;
     mo.keep_inland_seas = true;
     mo.max_nodes = 20000;
+    mo.lattice_km = h;
     RunawayGuard guard;
     try {
         return mesh_boundary(boundary, size, mo, nullptr, guard.progress());
@@ -987,6 +989,7 @@ TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
     MesherOptions mo;
     mo.keep_inland_seas = c.options.keep_inland_seas;
     mo.max_nodes = 20000;
+    mo.lattice_km = c.h;
     const Mesh mesh = mesh_boundary(boundary, size, mo);
     EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
 }
