@@ -127,6 +127,9 @@ void close_seam_notches(PointList& pts) {
     if (closed) pts.back() = pts.front();
 }
 
+/// Longitudes beyond this (degrees) are refused: no ring needs more than one wrap.
+constexpr double max_abs_lon_deg = 540.0;
+
 /// Snaps coordinates of one ring or line to the +-180 seam and the poles (see coast.hpp).
 void snap_coordinates(PointList& pts, bool transformed) {
     for (auto& p : pts) {
@@ -179,9 +182,18 @@ PointList read_points(OGRGeometryH g, bool transformed) {
     int n = OGR_G_GetPointCount(g);
     PointList pts(static_cast<std::size_t>(std::max(n, 0)));
     for (int i = 0; i < n; ++i) pts[i] = {OGR_G_GetX(g, i), OGR_G_GetY(g, i)};
-    for (const auto& p : pts)
+    for (const auto& p : pts) {
         if (!std::isfinite(p.lon) || !std::isfinite(p.lat))
             throw DataError("coast: a vertex has a non-finite coordinate (failed reprojection?)");
+        // A ring drawn across the antimeridian may reach past +-180 (lon 190, or [0, 360)), and
+        // add_wrapped cuts it back once per 360 degrees: further out, the layer is not in degrees.
+        if (std::abs(p.lon) > max_abs_lon_deg) {
+            char text[160];
+            std::snprintf(text, sizeof text, "coast: a vertex has longitude %.6g, beyond +-%.0f degrees: is the layer in "
+                          "lon/lat? (--coast-srs names its CRS)", p.lon, max_abs_lon_deg);
+            throw DataError(text);
+        }
+    }
     snap_coordinates(pts, transformed);
     return pts;
 }

@@ -358,6 +358,21 @@ TEST(CoastHostile, bad_attribute_filter_is_a_usage_error) {
     EXPECT_NE(m.find("no features"), std::string::npos) << m;
 }
 
+TEST(CoastHostile, longitude_far_beyond_the_antimeridian_is_refused_at_once) {
+    // Found by fuzz_coast: a vertex at lon 8.9e57 made the antimeridian cut loop once per 360
+    // degrees. A ring drawn across the seam needs one wrap (lon 190, or [0, 360)); one beyond
+    // +-540 is not in degrees.
+    TempDir dir;
+    auto path = write(dir, "huge.geojson",
+                      geojson({polygon("[[-38.77,-20.07],[-38.77,-20.08],[8.872457321089761e+57,-20.08],[-38.77,-20.07]]")}));
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("longitude 8.87246e+57"), std::string::npos) << m;
+    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+    // One wrap is fine: an island drawn from 170 to 190.
+    path = write(dir, "wrap.geojson", geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
+    EXPECT_EQ(load_coast(options_for(path)).rings.rings.size(), 1u);
+}
+
 TEST(CoastHostile, open_coastline_far_from_the_seam_is_refused) {
     TempDir dir;
     auto path = write(dir, "open.geojson", geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,0],[10,10],[0,10]]}"}));
