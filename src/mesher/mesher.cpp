@@ -439,14 +439,32 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
 // lattice and the coast (or smaller sizes), growing fronts from both. The points are chosen on
 // the triangulation of the boundary alone, whose triangles are large (walked face by face, row
 // by row, each row the other way than the last, so each walk is a step), then inserted as any
-// point set (the core's BRIO order keeps every cavity small). The lattice is walked over the
-// whole sphere, so it is skipped (returns 0) when it has more than `max_points` points: a small
-// region at a fine size. Returns the number inserted.
+// point set (the core's BRIO order keeps every cavity small). Only the lattice's points in a
+// cap around the ocean are walked (a region's), and none when those are more than `max_points`
+// (about 10 n^2 times the cap's share of the sphere). Returns the number inserted.
 std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     SphericalDelaunay& dt = m.dt;
     const double s = km_to_rad(s_km);
     const double n = std::max(1.0, std::round(lattice_edge_scale / s));
-    if (10 * n * n + 2 > max_points) return 0;
+    // The cap: around the mean of the ocean triangles' corners, out to the farthest corner. A
+    // cap narrower than a hemisphere holds each triangle whose corners it holds; a wider one
+    // is taken as the whole sphere (cos_r -1).
+    Vec3 centre{0, 0, 0};
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t) && dt.label(t) == ocean)
+            for (int i = 0; i < 3; ++i) centre = centre + dt.point(dt.vertex(t, i));
+    double cos_r = -1;
+    if (norm(centre) > 0) {
+        centre = normalized(centre);
+        cos_r = 1;
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+            if (dt.is_live(t) && dt.label(t) == ocean)
+                for (int i = 0; i < 3; ++i) cos_r = std::min(cos_r, dot(dt.point(dt.vertex(t, i)), centre));
+        const double r = std::acos(cos_r) + 2 * s; // a margin for the jitter
+        cos_r = r < 1.5 ? std::cos(r) : -1;
+    }
+    if ((10 * n * n + 2) * 0.5 * (1 - cos_r) > max_points) return 0;
+    auto in_cap = [&](const Vec3& p) { return dot(p, centre) >= cos_r * norm(p); }; // p need not be unit
     const double g = 0.5 * (1.0 + std::sqrt(5.0));
     const std::array<Vec3, 12> corner = {
         normalized(Vec3{-1, g, 0}), normalized(Vec3{1, g, 0}),  normalized(Vec3{-1, -g, 0}),
@@ -499,10 +517,46 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     for (int f = 0; f < 20; ++f) {
         const int ia = face[f][0], ib = face[f][1], ic = face[f][2];
         const Vec3 &a = corner[ia], &b = corner[ib], &c = corner[ic];
+        // Skip a face whose cap (0.6524 rad from its centre to its corners) misses the ocean's.
+        if (cos_r > -1 && std::acos(std::clamp(dot(normalized(a + b + c), centre), -1.0, 1.0)) > 0.6524 + std::acos(cos_r))
+            continue;
         for (int i = 0; i <= rows; ++i) {
             const int len = rows - i;
-            for (int step = 0; step <= len; ++step) {
-                const int j = i % 2 == 0 ? step : len - step;
+            // Row i is an arc of a great circle (weights j on b, len - j on c): its points in the
+            // cap are an interval of j around the point nearest the cap's centre, found by a
+            // ternary search (the cosine to the centre is unimodal along an arc under pi), and
+            // its ends by bisection.
+            int lo = 0, hi = len;
+            if (cos_r > -1) {
+                auto at = [&](int j) { return double(i) * a + double(j) * b + double(len - j) * c; };
+                auto closeness = [&](int j) { const Vec3 q = at(j); return dot(q, centre) / norm(q); };
+                int x0 = 0, x1 = len;
+                while (x1 - x0 > 2) {
+                    const int m1 = x0 + (x1 - x0) / 3, m2 = x1 - (x1 - x0) / 3;
+                    if (closeness(m1) < closeness(m2)) x0 = m1 + 1;
+                    else x1 = m2;
+                }
+                int best = x0;
+                for (int j = x0 + 1; j <= x1; ++j)
+                    if (closeness(j) > closeness(best)) best = j;
+                if (!in_cap(at(best))) continue;
+                int l = 0, r = best; // the first j in the cap
+                while (l < r) {
+                    const int mid = l + (r - l) / 2;
+                    if (in_cap(at(mid))) r = mid;
+                    else l = mid + 1;
+                }
+                lo = l;
+                l = best, r = len; // the last
+                while (l < r) {
+                    const int mid = l + (r - l + 1) / 2;
+                    if (in_cap(at(mid))) l = mid;
+                    else r = mid - 1;
+                }
+                hi = l;
+            }
+            for (int step = 0; step <= hi - lo; ++step) {
+                const int j = i % 2 == 0 ? lo + step : hi - step;
                 const int k = rows - i - j;
                 // Weights i, j, k on corners a, b, c: a node on the edge opposite a corner (its
                 // weight 0) or at a corner belongs to the first face that has it.
