@@ -173,7 +173,6 @@ struct Mesher {
         return buf;
     }
 
-    // Circumcentre (unit vector) of a solid triangle.
     // Walks from triangle t towards p. Returns the triangle holding p, or the last one before
     // the first constrained edge in the way; `blocked` is that edge or, when p lands in an ocean
     // triangle inside the diametral circle of one of its boundary segments (p encroaches on it,
@@ -212,6 +211,7 @@ struct Mesher {
         return t;
     }
 
+    // Circumcentre (unit vector) of a solid triangle.
     Vec3 circumcentre(TriangleId t) const {
         const Vec3& a = dt.point(dt.vertex(t, 0));
         const Vec3& b = dt.point(dt.vertex(t, 1));
@@ -517,9 +517,9 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     for (int f = 0; f < 20; ++f) {
         const int ia = face[f][0], ib = face[f][1], ic = face[f][2];
         const Vec3 &a = corner[ia], &b = corner[ib], &c = corner[ic];
-        // Skip a face whose cap (0.6524 rad from its centre to its corners) misses the ocean's.
-        if (cos_r > -1 && std::acos(std::clamp(dot(normalized(a + b + c), centre), -1.0, 1.0)) > 0.6524 + std::acos(cos_r))
-            continue;
+        // Skip a face whose cap (from its centre out to its corners) misses the ocean's.
+        const Vec3 face_centre = normalized(a + b + c);
+        if (cos_r > -1 && arc_angle(face_centre, centre) > arc_angle(face_centre, a) + std::acos(cos_r)) continue;
         for (int i = 0; i <= rows; ++i) {
             const int len = rows - i;
             // Row i is an arc of a great circle (weights j on b, len - j on c): its points in the
