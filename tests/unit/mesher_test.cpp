@@ -127,6 +127,7 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
 TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     test::TempDir dir;
     MeshOptions o = land_110m(160);
+    o.coast = fixture("coast/ne_50m_land.gpkg").string();
     Vec3 centre = lonlat_to_vec(-65, 38);
     SizeFn h = gulf_stream_size(centre, 20, 160, 1500);
     CoastData coast = load_coast(o);
@@ -151,6 +152,15 @@ TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     ASSERT_GT(near_n, 0u);
     EXPECT_NEAR(near_sum / near_n, 20, 6);
     EXPECT_NEAR(far_sum / far_n, 160, 40);
+    // Issue 4's quality bounds on the 1:50m coast, as at 100 km above. Measured here: mean
+    // 0.957, 97.3% above 0.8, worst 0.6002 away from sharp corners (0.5996 at the tip of
+    // Sakhalin before the mending could split a segment). The share above 0.8 holds what is
+    // reached so a regression fails; the gap is in the closing note of issue 4.
+    QualityCheck q = quality(mesh);
+    EXPECT_GE(q.mean, 0.93);
+    EXPECT_GE(q.above_0_8, 0.97);
+    EXPECT_EQ(q.below_0_6_away_from_corners, 0.0);
+    EXPECT_GE(q.worst_away_from_corners, 0.6);
 }
 
 TEST(Mesher, latitude_field_is_small_at_the_equator) {
