@@ -25,6 +25,10 @@ struct Ring {
 
 struct Boundary {
     std::vector<Ring> rings;
+    /// Islands the coast shaping dropped (too small for the size field), each a closed ring of
+    /// unit vectors, not repeated at the end: meshed over as ocean, but the mesher keeps face
+    /// centroids off them where it can (a model that samples depth at face centres).
+    std::vector<std::vector<Vec3>> dropped_islands;
     /// True when no ring exists and the whole sphere is ocean (an aqua-planet).
     bool empty() const { return rings.empty(); }
 };

@@ -26,7 +26,13 @@
 //      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
 //      few candidates (the mean of the apexes that would make each star triangle equilateral,
 //      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
-//      Last, two rounds of a pattern search over the nodes of triangles still below q 0.6.
+//      Last, two rounds of a pattern search over the nodes of triangles still below q 0.6,
+//      and triangles with two or three boundary corners still below 0.6 get a node (their
+//      circumcentre, or the midpoint of the segment in its way);
+//   6. keeps face centroids off the islands the coast shaping dropped (Boundary::
+//      dropped_islands): a face centred on one gets a free corner moved so that its centroid
+//      leaves the island, where no triangle of the corner's star falls below min(0.8, its
+//      quality); the faces left are reported.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -76,6 +82,8 @@ struct MesherReport {
     std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
     double inlet_area_km2 = 0;          ///< the water they held
     std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
+    std::size_t island_centroids_moved = 0; ///< faces moved off islands the shaping dropped
+    std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
     std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
     std::vector<OceanComponent> components;
 };

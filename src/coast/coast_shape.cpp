@@ -178,6 +178,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
     //    water bodies (ocean on the left that small); rings with an open segment always stay.
     std::vector<ShapedRing> shaped;
+    std::vector<std::vector<Vec3>> dropped_islands;
     bool dropped_water = false;
     for (const Ring& ring : coast.rings.rings) {
         ShapedRing s{&ring, {}, {}, {}, {}};
@@ -200,6 +201,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             } else if (4 * pi - left < threshold) {
                 ++rep.islands_removed;
                 rep.area_gained_km2 += (4 * pi - left) * r2;
+                dropped_islands.push_back(ring.nodes);
                 continue;
             }
         }
@@ -370,6 +372,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
         out.rings.push_back(std::move(ring));
     }
 
+    out.dropped_islands = std::move(dropped_islands);
     auto issues = check_boundary(out, 1);
     if (!issues.empty()) {
         const auto& is = issues.front();

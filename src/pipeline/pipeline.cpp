@@ -178,6 +178,8 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("boundary_nodes", std::to_string(coast_report.nodes));
     a.emplace_back("islands_removed", std::to_string(coast_report.islands_removed));
     a.emplace_back("lakes_removed", std::to_string(coast_report.lakes_removed));
+    a.emplace_back("faces_on_removed_islands", std::to_string(report.island_centroids_left) + " (" +
+                                                   std::to_string(report.island_centroids_moved) + " moved off)");
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +

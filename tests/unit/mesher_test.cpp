@@ -203,6 +203,60 @@ TEST(Mesher, lattice_fills_an_aqua_planet_with_near_equilateral_triangles) {
     test::expect_mesh_verify(dir / "aqua.nc", "--size-var target_size --min-size-fit 0.95");
 }
 
+// A point in a lon/lat polygon (even-odd rule on straight lon/lat sides): the land test of
+// mesh-verify, independent of the mesher's gnomonic one. The polygons here are a few km wide,
+// away from the antimeridian and the poles.
+bool in_lonlat_polygon(const LonLat& p, const std::vector<LonLat>& ring) {
+    bool in = false;
+    for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+        if ((ring[i].lat > p.lat) != (ring[j].lat > p.lat) &&
+            p.lon < ring[j].lon + (p.lat - ring[j].lat) * (ring[i].lon - ring[j].lon) / (ring[i].lat - ring[j].lat))
+            in = !in;
+    return in;
+}
+
+TEST(Mesher, face_centroids_leave_the_islands_the_shaping_dropped) {
+    // An aqua-planet at 400 km, then the same with a small square island (24 km across, land
+    // on the right of its ring) around the centroids of some faces away from the poles: the
+    // mesh is the same until the last step, so each of those faces starts on its island and
+    // must be moved off it.
+    MesherOptions mo;
+    mo.lattice_km = 400;
+    const Mesh plain = mesh_boundary(Boundary{}, uniform_size(400), mo);
+    Boundary b;
+    std::vector<std::vector<LonLat>> islands;
+    for (std::size_t f = 0; f < plain.faces.size() && islands.size() < 40; f += 37) {
+        const auto& fc = plain.faces[f];
+        const LonLat c = vec_to_lonlat(normalized(plain.nodes[fc[0]] + plain.nodes[fc[1]] + plain.nodes[fc[2]]));
+        if (std::abs(c.lat) > 60 || std::abs(c.lon) > 170) continue;
+        const double dlat = 12.0 / 111.0, dlon = dlat / std::cos(c.lat * pi / 180);
+        std::vector<LonLat> ring = {{c.lon - dlon, c.lat - dlat}, {c.lon - dlon, c.lat + dlat},
+                                    {c.lon + dlon, c.lat + dlat}, {c.lon + dlon, c.lat - dlat}}; // clockwise
+        std::vector<Vec3> nodes;
+        for (const auto& ll : ring) nodes.push_back(lonlat_to_vec(ll));
+        b.dropped_islands.push_back(nodes);
+        islands.push_back(ring);
+    }
+    ASSERT_EQ(islands.size(), 40u);
+    MesherReport report;
+    const Mesh mesh = mesh_boundary(b, uniform_size(400), mo, &report);
+    std::size_t on = 0;
+    for (const auto& fc : mesh.faces) {
+        const LonLat c = vec_to_lonlat(normalized(mesh.nodes[fc[0]] + mesh.nodes[fc[1]] + mesh.nodes[fc[2]]));
+        for (const auto& ring : islands) on += in_lonlat_polygon(c, ring);
+    }
+    EXPECT_EQ(on, report.island_centroids_left);
+    EXPECT_GE(report.island_centroids_moved, 40u);
+    EXPECT_EQ(on, 0u);
+    // The moves keep the quality bounds of a mesh without a coast.
+    QualityCheck q = quality(mesh);
+    EXPECT_GE(q.worst_away_from_corners, 0.8);
+    EXPECT_GE(q.above_0_8, 0.99);
+    test::TempDir dir;
+    write_ugrid(mesh, dir / "islands.nc");
+    test::expect_mesh_verify(dir / "islands.nc", "--size-var target_size --min-size-fit 0.95");
+}
+
 TEST(Mesher, regional_box_has_open_boundary_edges) {
     test::TempDir dir;
     MeshOptions o = land_110m(150);
