@@ -237,6 +237,20 @@ struct Mesher {
         return t;
     }
 
+    // The far edges b -> c of the star of from's origin (counter-clockwise around it, as
+    // star_worst_quality takes them), into `far`; false when a triangle of the star is not
+    // ocean or the star has more than 64.
+    bool ocean_star(HalfEdge from, std::vector<std::pair<Vec3, Vec3>>& far) const {
+        far.clear();
+        HalfEdge h = from;
+        do {
+            if (dt.label(triangle_of(h)) != ocean) return false;
+            far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(triangle_of(h), edge_of(h))));
+            h = dt.next_around_origin(h);
+        } while (h != from && far.size() < 64);
+        return h == from;
+    }
+
     // Circumcentre (unit vector) of a solid triangle.
     Vec3 circumcentre(TriangleId t) const {
         const Vec3& a = dt.point(dt.vertex(t, 0));
@@ -556,16 +570,7 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
                 const VertexId v = dt.vertex(t, k);
                 if (m.is_fixed(v)) continue;
                 const HalfEdge from = dt.leaving(v, t);
-                if (from == no_half_edge || dt.origin(from) != v) continue;
-                far.clear();
-                HalfEdge h = from;
-                bool ok = true;
-                do {
-                    if (dt.label(triangle_of(h)) != ocean) ok = false;
-                    far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(triangle_of(h), edge_of(h))));
-                    h = dt.next_around_origin(h);
-                } while (ok && h != from && far.size() < 64);
-                if (!ok || h != from) continue;
+                if (from == no_half_edge || dt.origin(from) != v || !m.ocean_star(from, far)) continue;
                 const Vec3& p0 = dt.point(v);
                 for (const Vec3& shift : shifts) {
                     const Vec3 to = normalized(p0 + 3.0 * shift);
@@ -1245,14 +1250,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
             if (from == no_half_edge || dt.origin(from) != v) return;
             hint = triangle_of(from);
-            far.clear();
-            HalfEdge h = from;
-            do {
-                if (dt.label(triangle_of(h)) != ocean) return;
-                far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(triangle_of(h), edge_of(h))));
-                h = dt.next_around_origin(h);
-            } while (h != from && far.size() < 64);
-            if (h != from) return;
+            if (!m.ocean_star(from, far)) return;
             Vec3 apex{0, 0, 0}, mean{0, 0, 0};
             double step = 0;
             for (const auto& [b, c] : far) {
