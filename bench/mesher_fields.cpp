@@ -50,10 +50,10 @@ int main(int argc, char** argv) {
         globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, mo, &report);
         globemesh::write_ugrid(mesh, argv[4]);
         std::printf("%s: %zu nodes (%zu from the lattice), %zu faces, %zu sharp corners touching %zu faces, "
-                    "%zu inlets closed (%.0f km2), %zu triangles of boundary corners mended, %zu faces moved off "
+                    "%zu inlets closed (%.0f km2), %zu flips towards valence 6, %zu triangles of boundary corners mended, %zu faces moved off "
                     "dropped islands (%zu left on them)\n",
                     field.c_str(), mesh.nodes.size(), report.lattice_nodes, mesh.faces.size(), report.sharp_corners,
-                    report.sharp_corner_faces, report.inlets_closed, report.inlet_area_km2, report.corners_mended,
+                    report.sharp_corner_faces, report.inlets_closed, report.inlet_area_km2, report.valence_flips, report.corners_mended,
                     report.island_centroids_moved, report.island_centroids_left);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mesher_fields: %s\n", e.what());

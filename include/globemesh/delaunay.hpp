@@ -124,11 +124,19 @@ public:
     /// The same with a half-edge leaving v (origin == v), which avoids a search for the star.
     bool move_vertex_from(HalfEdge leaving_v, const Vec3& p);
 
+    /// Moves the origin of leaving_v to p without flips, so the triangulation may stop being
+    /// Delaunay until make_delaunay(). Returns false and changes nothing when a triangle of its
+    /// star would not stay counter-clockwise with v at p.
+    bool place_vertex_from(HalfEdge leaving_v, const Vec3& p);
+
     /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
     void flip(HalfEdge h);
 
     /// Flips unconstrained non-Delaunay edges until none remains (Lawson). Returns the flips made.
     std::size_t make_delaunay();
+    /// The same from the half-edges in `edges` only (consumed): enough after changes confined
+    /// to the triangles those edges bound.
+    std::size_t make_delaunay(std::vector<HalfEdge>& edges);
 
     /// A live triangle whose spherical cone contains p, or that p is beyond (for points outside
     /// the solid region). Walks from `hint`.

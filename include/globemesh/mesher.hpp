@@ -23,6 +23,10 @@
 //      be under 1% of h stays, and sits out the next sweep unless a neighbour moved. Nodes are
 //      visited along the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share
 //      cache lines.
+//      After the last sweep, relaxation towards valence 6 (Frey & Field): edges whose four
+//      corners are away from the boundary (not on it nor next to it) are flipped where that
+//      lowers the corners' sum of squared valence defects, the nodes around move to the mean of
+//      their neighbours without flips, and Lawson flips make the mesh Delaunay again there.
 //      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
 //      few candidates (the mean of the apexes that would make each star triangle equilateral,
 //      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
@@ -84,6 +88,7 @@ struct MesherReport {
     std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
     std::size_t island_centroids_moved = 0; ///< faces moved off islands the shaping dropped
     std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
+    std::size_t valence_flips = 0;      ///< flips towards valence 6 before the last restoration
     std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
     std::vector<OceanComponent> components;
 };

@@ -853,8 +853,12 @@ std::size_t SphericalDelaunay::make_delaunay() {
     for (TriangleId t = 0; t < triangle_slots(); ++t)
         if (is_live(t))
             for (int i = 0; i < 3; ++i) stack.push_back(half_edge(t, i));
+    return make_delaunay(stack);
+}
+
+std::size_t SphericalDelaunay::make_delaunay(std::vector<HalfEdge>& edges) {
     std::size_t flips = 0;
-    legalize_from(stack, nullptr, false, &flips);
+    legalize_from(edges, nullptr, false, &flips);
     return flips;
 }
 
@@ -1069,6 +1073,19 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
     bounded_ = was_bounded;
     last_ = triangle_of(from);
     return false;
+}
+
+bool SphericalDelaunay::place_vertex_from(HalfEdge from, const Vec3& p) {
+    const VertexId v = origin(from);
+    HalfEdge h = from;
+    do {
+        const TriangleId t = triangle_of(h);
+        if (orient(p, points_[destination(h)], points_[vertex(t, edge_of(h))]) <= 0) return false;
+        h = next_around_origin(h);
+    } while (h != from);
+    points_[v] = p;
+    bounded_ = bounded_ && bounded(p);
+    return true;
 }
 
 // ---------------------------------------------------------------------------------------------

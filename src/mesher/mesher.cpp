@@ -80,6 +80,9 @@ constexpr int improve_rounds = 3;
 // triangles' q above 0.88). A lattice node is kept where the size field reaches lattice_level
 // times the lattice's size, and no boundary segment or other node lies within lattice_clearance
 // times that size.
+constexpr int relax_passes = 4;
+constexpr int relax_rounds = 6;
+constexpr double relax_floor = 0.3;
 constexpr double lattice_edge_scale = 1.2185;
 constexpr double lattice_level = 0.99;
 constexpr double lattice_clearance = 1.5;
@@ -600,6 +603,105 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
         }
     }
     return left;
+}
+
+// Relaxation by flips towards valence 6 (Frey & Field): an unconstrained edge between two ocean
+// triangles with four free corners is flipped when that lowers the sum of squared valence
+// defects (valence - 6) of those corners. The flipped corners and their free neighbours then
+// move, without flips, to the mean of their neighbours for a few rounds, so that the new
+// connectivity can become the Delaunay one; last, Lawson flips restore the constrained-Delaunay
+// property (undoing the few flips the moves could not make Delaunay). Boundary nodes take no
+// part: counting their ideal valence from their ocean angle (one triangle per 60 degrees) and
+// flipping there too made more coast faces below q 0.8 than it mended. Returns the flips made;
+// the nodes moved get their bit in `active` and lose `as_made`.
+std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std::uint8_t>& active) {
+    SphericalDelaunay& dt = m.dt;
+    const std::size_t nv = dt.vertex_count();
+    std::vector<int> defect(nv, -6);
+    std::vector<char> coastal(nv, 0); // a boundary node or its neighbour
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
+        ++defect[a], ++defect[b], ++defect[c];
+        if (m.is_fixed(a) || m.is_fixed(b) || m.is_fixed(c)) coastal[a] = coastal[b] = coastal[c] = 1;
+    }
+    // A flip needs a corner of positive defect at one end of its edge: only the triangles with
+    // one are tried (few where the lattice or smoothing left valence 6).
+    std::vector<TriangleId> tried;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
+        if ((defect[a] > 0 && !coastal[a]) || (defect[b] > 0 && !coastal[b]) || (defect[c] > 0 && !coastal[c])) tried.push_back(t);
+    }
+    std::vector<VertexId> move;
+    std::size_t flips = 0;
+    for (int pass = 0; pass < relax_passes; ++pass) {
+        std::size_t made = 0;
+        for (TriangleId t : tried) {
+            if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+            for (int i = 0; i < 3; ++i) {
+                const HalfEdge h = half_edge(t, i);
+                const HalfEdge g = dt.twin(h);
+                if (dt.is_constrained(h) || dt.label(triangle_of(g)) != ocean) continue;
+                const VertexId a = dt.origin(h), b = dt.destination(h);
+                const VertexId c = dt.vertex(t, i), d = dt.vertex(triangle_of(g), edge_of(g));
+                // The sum of squares drops by 2 (gain - 2).
+                if (defect[a] + defect[b] - defect[c] - defect[d] < 3) continue;
+                if (coastal[a] || coastal[b] || coastal[c] || coastal[d]) continue;
+                const Vec3 &pa = dt.point(a), &pb = dt.point(b), &pc = dt.point(c), &pd = dt.point(d);
+                if (predicates::orient(pa, pd, pc) <= 0 || predicates::orient(pd, pb, pc) <= 0) continue;
+                if (std::min(triangle_quality(pa, pd, pc), triangle_quality(pd, pb, pc)) < relax_floor) continue;
+                dt.flip(h);
+                --defect[a], --defect[b], ++defect[c], ++defect[d];
+                move.insert(move.end(), {a, b, c, d});
+                ++made;
+                break; // t is another triangle now
+            }
+        }
+        flips += made;
+        if (made == 0) break;
+    }
+    if (flips == 0) return 0;
+    // The flipped corners' free neighbours move too, each from a half-edge leaving it (the moves
+    // below change no connectivity, so one lookup serves every round).
+    const std::vector<HalfEdge> star = dt.vertex_half_edges();
+    for (std::size_t k = 0, n = move.size(); k < n; ++k) {
+        const HalfEdge from = star[move[k]];
+        HalfEdge h = from;
+        do {
+            if (!coastal[dt.destination(h)]) move.push_back(dt.destination(h));
+            h = dt.next_around_origin(h);
+        } while (h != from);
+    }
+    std::sort(move.begin(), move.end());
+    move.erase(std::unique(move.begin(), move.end()), move.end());
+    // A move that would bring the star's worst triangle below 0.6, and below where it was, is
+    // refused (as in the smoothing sweeps).
+    std::vector<std::pair<Vec3, Vec3>> far;
+    for (int round = 0; round < relax_rounds; ++round)
+        for (VertexId v : move) {
+            const HalfEdge from = star[v];
+            if (!m.ocean_star(from, far)) continue;
+            Vec3 sum{0, 0, 0};
+            for (const auto& bc : far) sum = sum + bc.first;
+            const Vec3 to = normalized(sum);
+            const double worst = star_worst_quality(to, far);
+            if (worst < 0.8 && worst < star_worst_quality(dt.point(v), far)) continue;
+            if (dt.place_vertex_from(from, to)) as_made[v] = 0, active[v] = 1;
+        }
+    // Only the triangles around the moved nodes changed (the flipped corners are among them).
+    std::vector<HalfEdge> edges;
+    for (VertexId v : move) {
+        const HalfEdge from = star[v];
+        HalfEdge h = from;
+        do {
+            edges.push_back(h);
+            edges.push_back(half_edge(triangle_of(h), next3(edge_of(h)))); // the link edge opposite v
+            h = dt.next_around_origin(h);
+        } while (h != from);
+    }
+    dt.make_delaunay(edges);
+    return flips;
 }
 
 // Fills the open ocean where the size field reaches s_km, its largest value, with the nodes of
@@ -1215,6 +1317,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             for (VertexId u : ring) active[u] |= 2;
         }
         for (auto& a : active) a >>= 1;
+        if (sweep == options.smooth_iterations - 1) report.valence_flips = relax_valence(m, as_made, active);
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
     }
     // Then the interior nodes of the triangles still below q 0.9 (next to the coast, or at

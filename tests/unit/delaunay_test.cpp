@@ -332,6 +332,37 @@ TEST(Delaunay, moving_a_vertex_restores_delaunay_and_refuses_folds) {
     EXPECT_TRUE(dt.validate().empty());
 }
 
+TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_restores_the_property) {
+    auto p = random_points(2000, 7);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    const VertexId v = ids[10];
+    const HalfEdge from = dt.leaving(v);
+    // Across the sphere would fold the star: refused, nothing changes.
+    const Vec3 before = dt.point(v);
+    EXPECT_FALSE(dt.place_vertex_from(from, -before));
+    EXPECT_EQ(dt.point(v), before);
+    // Most of the way to a neighbour: no fold, but circumcircles now hold points.
+    for (HalfEdge h = from; !dt.place_vertex_from(from, normalized(0.3 * before + 0.7 * dt.point(dt.destination(h))));) {
+        h = dt.next_around_origin(h);
+        ASSERT_NE(h, from) << "no neighbour could be approached";
+    }
+    EXPECT_NE(dt.point(v), before);
+    EXPECT_GT(brute_force_violations(dt, 1e-15L), 0u);
+    // The links are intact: the same triangle count, every triangle counter-clockwise.
+    EXPECT_EQ(euler(dt), 2u);
+    std::vector<HalfEdge> edges;
+    for (HalfEdge h = dt.leaving(v);;) {
+        edges.push_back(h);
+        edges.push_back(half_edge(triangle_of(h), (edge_of(h) + 1) % 3));
+        h = dt.next_around_origin(h);
+        if (h == edges.front()) break;
+    }
+    EXPECT_GT(dt.make_delaunay(edges), 0u);
+    EXPECT_EQ(brute_force_violations(dt, 1e-15L), 0u);
+    EXPECT_TRUE(dt.validate().empty());
+}
+
 TEST(Delaunay, insert_in_triangle_of_a_constrained_triangulation) {
     auto p = random_points(400, 31);
     SphericalDelaunay dt;

@@ -203,6 +203,31 @@ TEST(Mesher, lattice_fills_an_aqua_planet_with_near_equilateral_triangles) {
     test::expect_mesh_verify(dir / "aqua.nc", "--size-var target_size --min-size-fit 0.95");
 }
 
+TEST(Mesher, relaxation_leaves_no_node_of_valence_4_or_8_on_a_graded_sphere) {
+    // Refinement and smoothing of a graded field leave pairs of valence 5 and 7 (the grading
+    // needs them) but also nodes of valence 4 and 8, whose triangles no smoothing can make good:
+    // every edge of an 8 to a 6 across two 5s, or of a 4's neighbours, is a flip that lowers the
+    // sum of squared defects (Frey & Field). The relaxation must leave none, and the mesh must
+    // still be Delaunay (mesh-verify).
+    MesherReport report;
+    Mesh mesh = mesh_boundary(Boundary{}, latitude_size(100, 400), {}, &report);
+    std::vector<int> valence(mesh.nodes.size(), 0);
+    for (const auto& f : mesh.faces)
+        for (NodeIndex v : f) ++valence[v];
+    std::size_t odd = 0, fives_and_sevens = 0;
+    for (int v : valence) {
+        odd += v <= 4 || v >= 8;
+        fives_and_sevens += v == 5 || v == 7;
+    }
+    EXPECT_GT(report.valence_flips, 0u);
+    EXPECT_GT(fives_and_sevens, 100u); // the grading's own defects stay
+    EXPECT_EQ(odd, 0u);
+    EXPECT_GE(quality(mesh).above_0_8, 0.99);
+    test::TempDir dir;
+    write_ugrid(mesh, dir / "graded.nc");
+    test::expect_mesh_verify(dir / "graded.nc", "--size-var target_size --min-size-fit 0.95");
+}
+
 // A point in a lon/lat polygon (even-odd rule on straight lon/lat sides): the land test of
 // mesh-verify, independent of the mesher's gnomonic one. The polygons here are a few km wide,
 // away from the antimeridian and the poles.
