@@ -23,6 +23,17 @@ struct Ring {
     std::vector<SegmentKind> kinds; ///< kinds[i] tags the segment nodes[i] -> nodes[i+1]
 };
 
+/// The land the rings leave out, at full resolution: asked by the mesher which face centroids
+/// lie on land (coast.hpp's LandMask reads it from the coast's polygons).
+class LandTest {
+public:
+    virtual ~LandTest() = default;
+    /// True when p lies on land.
+    virtual bool contains(const Vec3& p) const = 0;
+    /// True when the coast comes within `angle` radians of p (on the sphere).
+    virtual bool coast_within(const Vec3& p, double angle) const = 0;
+};
+
 struct Boundary {
     std::vector<Ring> rings;
     /// Islands the coast shaping dropped (too small for the size field), each a closed ring of

@@ -55,6 +55,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,32 @@
 
 namespace globemesh {
 
+/// The land of the cleaned coast at full resolution, as GIS software (and mesh-verify) sees it:
+/// polygons in planar lon/lat, after validation, dissolving, --min-island-area and the region
+/// clip. The mesher asks it which face centroids lie on land and how near the coast a node is
+/// (MesherOptions::land). GEOS prepared polygons under an STR tree of their envelopes, and the
+/// outlines as unit vectors in short pieces under a second one; one GEOS context of its own.
+class LandMask final : public LandTest {
+public:
+    /// Each polygon is its shell, then its holes (lon/lat rings, first == last).
+    explicit LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons);
+    ~LandMask();
+    LandMask(const LandMask&) = delete;
+    LandMask& operator=(const LandMask&) = delete;
+    /// True when p lies strictly inside a land polygon (not in one of its holes, not on its
+    /// outline). Not thread-safe (polygons are prepared on first use).
+    bool contains(const Vec3& p) const override;
+    /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
+    /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
+    bool coast_within(const Vec3& p, double angle) const override;
+    std::size_t vertices() const { return vertices_; }
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    std::size_t vertices_ = 0;
+};
+
 /// The cleaned ocean domain at full resolution (stage 1).
 struct CoastData {
     Boundary rings;            ///< ocean on the left, segments tagged coast/open, no resampling
@@ -74,6 +101,7 @@ struct CoastData {
     double area_gained_km2 = 0;      ///< ocean added by dropping islands
     double area_lost_km2 = 0;        ///< ocean lost by dropping lakes and inland seas
     std::string layer;               ///< name of the layer that was read
+    std::shared_ptr<const LandMask> land; ///< the land those rings leave out, for the mesher
 };
 
 /// Reads, reprojects, cleans and clips the coast of options.coast (and options.region /

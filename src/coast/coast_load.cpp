@@ -1216,6 +1216,16 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
         rings = region_rings(geos, land, options, where, out);
     }
     report(progress, 0.85, "checking rings");
+    {
+        std::vector<PolygonRings> polygons;
+        for (const auto& g : land) {
+            PolygonRings rings_of{ring_points(geos, GEOSGetExteriorRing_r(geos.get(), g.get()))};
+            for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), g.get()); ++h)
+                rings_of.push_back(ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), g.get(), h)));
+            polygons.push_back(std::move(rings_of));
+        }
+        out.land = std::make_shared<const LandMask>(polygons);
+    }
 
     for (const auto& c : rings) {
         Ring r = to_sphere(c);

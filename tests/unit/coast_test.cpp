@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <random>
 #include <string>
 
 #include "globemesh/coast.hpp"
@@ -386,6 +388,79 @@ TEST(Coast, min_island_area_drops_small_islands_by_geodesic_area) {
     EXPECT_LT(d.rings.rings.size(), ne110().rings.rings.size());
     EXPECT_NEAR(d.ocean_area_km2 - ne110().ocean_area_km2, d.area_gained_km2 - d.area_lost_km2 + ne110().area_lost_km2,
                 1e-6 * ne110().ocean_area_km2);
+}
+
+// The land test the mesher uses to keep face centres off land, against OGR's own point-in-polygon
+// on the source features (GIS semantics: a lake, a hole of the land, is not land), and its coast
+// distance against a brute-force distance to the loaded rings on the sphere.
+TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
+    const CoastData& d = ne110();
+    ASSERT_TRUE(d.land);
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpenEx(fixture("coast/ne_110m_land.gpkg").string().c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+    ASSERT_NE(ds, nullptr);
+    OGRLayerH layer = GDALDatasetGetLayerByName(ds, "land");
+    std::vector<OGRGeometryH> source;
+    OGR_L_ResetReading(layer);
+    while (OGRFeatureH f = OGR_L_GetNextFeature(layer)) {
+        source.push_back(OGR_G_Clone(OGR_F_GetGeometryRef(f)));
+        OGR_F_Destroy(f);
+    }
+    GDALClose(ds);
+    auto ogr_land = [&](const LonLat& ll) {
+        OGRGeometryH pt = OGR_G_CreateGeometry(wkbPoint);
+        OGR_G_SetPoint_2D(pt, 0, ll.lon, ll.lat);
+        bool in = false;
+        for (auto g : source) in = in || OGR_G_Contains(g, pt);
+        OGR_G_DestroyGeometry(pt);
+        return in;
+    };
+    std::mt19937 rng(11);
+    std::normal_distribution<double> gauss;
+    std::size_t land = 0, disagree = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 p = normalized(Vec3{gauss(rng), gauss(rng), gauss(rng)});
+        const bool in = d.land->contains(p);
+        land += in;
+        disagree += in != ogr_land(vec_to_lonlat(p));
+    }
+    EXPECT_EQ(disagree, 0u);
+    EXPECT_NEAR(double(land) / 3000, 0.29, 0.03); // land covers 29% of the Earth
+    EXPECT_TRUE(d.land->contains(lonlat_to_vec(15, 25)));    // the Sahara
+    EXPECT_FALSE(d.land->contains(lonlat_to_vec(-30, 30)));  // the Atlantic
+    EXPECT_FALSE(d.land->contains(lonlat_to_vec(50.5, 42))); // the Caspian, a hole of the land
+    // The source's rings (shells and holes: lake shores are coast too) as arcs on the sphere.
+    std::vector<std::vector<Vec3>> outlines;
+    std::function<void(OGRGeometryH)> collect = [&](OGRGeometryH g) {
+        if (OGR_G_GetGeometryCount(g) > 0) {
+            for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i) collect(OGR_G_GetGeometryRef(g, i));
+            return;
+        }
+        std::vector<Vec3> ring;
+        for (int i = 0; i < OGR_G_GetPointCount(g); ++i) ring.push_back(lonlat_to_vec(OGR_G_GetX(g, i), OGR_G_GetY(g, i)));
+        outlines.push_back(std::move(ring));
+    };
+    for (auto g : source) collect(g);
+    for (auto g : source) OGR_G_DestroyGeometry(g);
+
+    // coast_within agrees with the brute-force distance on the sphere, at every latitude and
+    // across +-180 (the source splits land there; a cap that crosses it must find both sides).
+    std::uniform_real_distribution<double> lon(-180, 180), lat(-85, 85), reach(0.002, 0.1);
+    int yes = 0, no = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3 p = i < 20 ? lonlat_to_vec(i % 2 ? 179.9 : -179.9, 66 + i * 0.3) : lonlat_to_vec(lon(rng), lat(rng));
+        const double a = reach(rng);
+        double nearest = pi;
+        for (const auto& r : outlines)
+            for (std::size_t k = 0; k + 1 < r.size(); ++k) nearest = std::min(nearest, arc_distance(r[k], r[k + 1], p));
+        if (std::abs(nearest - a) < 1e-9) continue; // a tie: either answer is right
+        const bool within = d.land->coast_within(p, a);
+        EXPECT_EQ(within, nearest <= a) << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat << " reach " << a
+                                        << " nearest " << nearest;
+        (within ? yes : no) += 1;
+    }
+    EXPECT_GT(yes, 30);
+    EXPECT_GT(no, 30);
 }
 
 TEST(Coast, missing_coast_option_is_a_usage_error) {
