@@ -74,6 +74,7 @@ int main(int argc, char** argv) {
         globemesh::CoastData coast = globemesh::load_coast(o);
         step_done("read_coast");
         boundary = globemesh::shape_boundary(coast, size, o);
+        mo.land = coast.land;
     }
     step_done("boundary");
     globemesh::Mesh last;

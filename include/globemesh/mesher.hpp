@@ -36,13 +36,29 @@
 //   6. keeps face centroids off the islands the coast shaping dropped (Boundary::
 //      dropped_islands): a face centred on one gets a free corner moved so that its centroid
 //      leaves the island, where no triangle of the corner's star falls below min(0.8, its
-//      quality); the faces left are reported.
+//      quality); the faces left are reported;
+//   7. with MesherOptions::land, removes the faces whose centroid lies on the source land (under
+//      capes the shaped coast cuts across, on dropped islands, spanning water narrower than a
+//      face), alone or in small groups, all of a group or none, where the mesh stays a
+//      manifold and in one piece: at each corner the faces left form at most one fan, and the
+//      arcs along which a group touches the boundary lie on different loops. A group touching
+//      no loop opens a hole (a dropped island comes back); one touching two or more joins them
+//      (narrow water between two rings closes), only where most of the face is land; two arcs
+//      on one loop would cut the mesh, so a face across the mouth of a basin goes only with
+//      the water behind it, when that holds at most inlet_area * h^2 (a bay, or a river
+//      narrower than its faces); a sea behind a strait stays connected (Gibraltar, the
+//      Bosphorus at 100 km). Otherwise a face goes with the one or two water faces between it
+//      and the boundary at a corner. A node it leaves on the boundary lies within h/2 of the
+//      coast (LandTest::coast_within). Removing faces keeps every other
+//      face and edge, so the mesh stays constrained Delaunay. The faces left on land are
+//      reported: those in straits kept open.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "globemesh/boundary.hpp"
@@ -63,6 +79,10 @@ struct MesherOptions {
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
     double lattice_km = 0;
+    /// The source land at full resolution (e.g. coast.hpp's LandMask): faces whose centroid lies
+    /// on it are removed at the end where the mesh stays a manifold with the same boundary loops
+    /// and near the coast (step 7 above). Null: no such step.
+    std::shared_ptr<const LandTest> land;
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory
@@ -90,6 +110,11 @@ struct MesherReport {
     std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
     std::size_t valence_flips = 0;      ///< flips towards valence 6 before the last restoration
     std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
+    std::size_t land_faces_removed = 0; ///< faces removed because their centroid lies on land
+    std::size_t land_faces_left = 0;    ///< faces centred on land that could not go (MesherOptions::land)
+    std::size_t water_faces_removed = 0; ///< faces removed with them so that the mesh stays a manifold
+    std::size_t land_holes = 0;         ///< boundary loops those removals opened (islands back)
+    std::size_t land_loops_joined = 0;  ///< boundary loops those removals joined to another (narrow water closed)
     std::vector<OceanComponent> components;
 };
 

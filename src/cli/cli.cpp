@@ -426,6 +426,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     out << "coast             " << attribute("boundary_rings") << " rings kept, islands dropped "
         << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
         << ", inlets closed " << attribute("inlets_closed") << "\n"
+        << "faces on land     " << attribute("faces_on_land") << "\n"
         << "ocean components  " << attribute("ocean_components") << "\n";
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"

@@ -57,6 +57,11 @@ constexpr std::uint64_t size_grid_bytes_per_node = 64;
 /// still counts them there: it errs on the safe side.
 constexpr std::uint64_t ring_bytes_per_node = 40;
 
+/// Bytes per vertex of the land test (LandMask) while meshing: GEOS coordinates (24), the
+/// prepared polygons' segment index, the outline as unit vectors (24) and its pieces' envelopes,
+/// rounded up.
+constexpr std::uint64_t land_bytes_per_vertex = 100;
+
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
 /// the region plus a cell of margin, at most size_grid_max_nodes).
 double size_grid_nodes(const MeshOptions& o) {
@@ -151,6 +156,11 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     mo.inlet_width = o.inlet_width;
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
+    if (coast.land) {
+        // The land test holds the land polygons (GEOS coordinates and their prepared index).
+        budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex));
+        mo.land = coast.land;
+    }
     MesherReport report;
     StageTimings mesher_times;
     auto mesh_start = Clock::now();
@@ -180,6 +190,10 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("lakes_removed", std::to_string(coast_report.lakes_removed));
     a.emplace_back("faces_on_removed_islands", std::to_string(report.island_centroids_left) + " (" +
                                                    std::to_string(report.island_centroids_moved) + " moved off)");
+    a.emplace_back("faces_on_land", std::to_string(report.land_faces_left) + " (" +
+                                        std::to_string(report.land_faces_removed) + " removed, opening " +
+                                        std::to_string(report.land_holes) + " holes, joining " +
+                                        std::to_string(report.land_loops_joined) + " loops)");
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +

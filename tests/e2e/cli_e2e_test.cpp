@@ -90,10 +90,15 @@ TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
     EXPECT_NE(out.find("nodes"), std::string::npos) << out;
     EXPECT_NE(out.find("peak memory"), std::string::npos) << out;
     EXPECT_NE(err.find("100 - done."), std::string::npos) << err;
-    // The summary's coast line: rings kept, each one boundary loop of the mesh (checked below).
-    std::smatch rings;
+    // The summary's coast line: rings kept, each one boundary loop of the mesh (checked below),
+    // and the holes that removing faces centred on land opened, each one more loop, and the
+    // loops it joined, each one fewer.
+    std::smatch rings, holes;
     ASSERT_TRUE(std::regex_search(out, rings, std::regex(R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, inlets closed \d+ \()")))
         << out;
+    ASSERT_TRUE(std::regex_search(out, holes, std::regex(R"(\nfaces on land +\d+ \(\d+ removed, opening (\d+) holes, joining (\d+) loops\))")))
+        << out;
+    const int loops = std::stoi(rings[1].str()) + std::stoi(holes[1].str()) - std::stoi(holes[2].str());
     // Exactly the outputs asked for: no temporary file left beside them.
     EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"g.nc", "g.gpkg", "g.png", "r.json", "t.json"}));
     expect_mesh_verify(dir / "g.nc");
@@ -115,7 +120,7 @@ for k in ('mesh', 'write'):
     assert k in t['stages'], t
 assert all(v >= 0 for v in t['stages'].values())
 assert 0.6 * 400 < r['mesh']['edge_km']['mean'] < 1.3 * 400, r['mesh']['edge_km']
-assert r['mesh']['boundary_loops'] == )" + rings[1].str() + R"(, r['mesh']['boundary_loops']
+assert r['mesh']['boundary_loops'] == )" + std::to_string(loops) + R"(, r['mesh']['boundary_loops']
 print('OK', lon.shape[0])
 )",
                                        dir.path());
