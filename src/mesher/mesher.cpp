@@ -654,25 +654,72 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     // The boundary: each boundary half-edge's origin -> destination (one per boundary vertex in
-    // a manifold), and the vertices on it or next to it.
+    // a manifold). Every edge between ocean and land is a segment: each loop is found from its
+    // first segment not yet seen and traced around its vertices, so that the step costs what
+    // the coast has, not what the ocean has.
     std::unordered_map<VertexId, VertexId> next_on_boundary;
-    std::vector<char> near(dt.vertex_count(), 0);
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-        if (!is_ocean(t)) continue;
-        for (int i = 0; i < 3; ++i) {
-            const HalfEdge h = half_edge(t, i);
-            if (is_ocean(triangle_of(dt.twin(h)))) continue;
-            next_on_boundary.emplace(dt.origin(h), dt.destination(h));
-            near[dt.vertex(t, 0)] = near[dt.vertex(t, 1)] = near[dt.vertex(t, 2)] = 1;
+    std::vector<HalfEdge> boundary_edges; // ocean on the left
+    {
+        // The boundary half-edge after h (ocean on the left of both): clockwise around h's
+        // destination, through the ocean, from the edge of h's triangle that leaves it.
+        auto next_on_loop = [&](HalfEdge h) {
+            HalfEdge g = half_edge(triangle_of(h), next3(edge_of(h)));
+            for (int turns = 0; is_ocean(triangle_of(dt.twin(g))) && turns < 1000; ++turns) {
+                const HalfEdge back = dt.twin(g);
+                g = half_edge(triangle_of(back), next3(edge_of(back)));
+            }
+            return g;
+        };
+        auto seen = [&](VertexId a, VertexId b) {
+            auto it = next_on_boundary.find(a);
+            return it != next_on_boundary.end() && it->second == b;
+        };
+        TriangleId hint = no_triangle;
+        for (const auto& [segment, kind] : m.segments) {
+            const auto [a, b] = segment;
+            if (seen(a, b) || seen(b, a)) continue;
+            const HalfEdge from = dt.leaving(a, hint);
+            const HalfEdge e = from == no_half_edge ? no_half_edge : dt.find_edge(from, b);
+            if (e == no_half_edge) continue;
+            hint = triangle_of(e);
+            for (const HalfEdge start : {e, dt.twin(e)}) {
+                if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start)))) continue;
+                HalfEdge h = start;
+                do {
+                    next_on_boundary.emplace(dt.origin(h), dt.destination(h));
+                    boundary_edges.push_back(h);
+                    h = next_on_loop(h);
+                } while (h != start && boundary_edges.size() <= m.segments.size());
+            }
         }
     }
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) // and the vertices next to those
-        if (is_ocean(t) && (near[dt.vertex(t, 0)] & 1 || near[dt.vertex(t, 1)] & 1 || near[dt.vertex(t, 2)] & 1))
-            for (int k = 0; k < 3; ++k) near[dt.vertex(t, k)] |= 2;
-    std::vector<TriangleId> faces;
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (is_ocean(t) && (near[dt.vertex(t, 0)] | near[dt.vertex(t, 1)] | near[dt.vertex(t, 2)]) && land_test.contains(m.centroid(t)))
-            faces.push_back(t);
+    // The faces looked at: the ocean faces around the corners of the faces on the boundary
+    // (near 1) and around those corners' neighbours (near 2).
+    std::vector<char> near(dt.vertex_count(), 0);
+    std::vector<std::pair<VertexId, HalfEdge>> near_list; // each once, with a half-edge leaving it
+    auto mark = [&](TriangleId t, char bit) {
+        for (int k = 0; k < 3; ++k) {
+            const VertexId v = dt.vertex(t, k);
+            if (!near[v]) near_list.emplace_back(v, half_edge(t, prev3(k)));
+            near[v] |= bit;
+        }
+    };
+    auto for_star = [&](HalfEdge from, auto&& visit) {
+        HalfEdge h = from;
+        do {
+            if (is_ocean(triangle_of(h))) visit(triangle_of(h));
+            h = dt.next_around_origin(h);
+        } while (h != from);
+    };
+    for (const HalfEdge h : boundary_edges) mark(triangle_of(h), 1);
+    const std::size_t first_ring = near_list.size();
+    for (std::size_t i = 0; i < first_ring; ++i) for_star(near_list[i].second, [&](TriangleId t) { mark(t, 2); });
+    std::vector<TriangleId> faces, candidates;
+    for (const auto& [v, from] : near_list) for_star(from, [&](TriangleId t) { candidates.push_back(t); });
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    for (TriangleId t : candidates)
+        if (land_test.contains(m.centroid(t))) faces.push_back(t);
     std::vector<char>().swap(near);
     for (TriangleId t : island_faces)
         if (is_ocean(t) && land_test.contains(m.centroid(t))) faces.push_back(t);
