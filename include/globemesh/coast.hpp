@@ -79,7 +79,7 @@ public:
     LandMask(const LandMask&) = delete;
     LandMask& operator=(const LandMask&) = delete;
     /// True when p lies strictly inside a land polygon (not in one of its holes, not on its
-    /// outline). Not thread-safe (polygons are prepared on first use).
+    /// outline). Not thread-safe (one GEOS context).
     bool contains(const Vec3& p) const override;
     /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.

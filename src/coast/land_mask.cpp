@@ -18,7 +18,7 @@ constexpr std::size_t piece_vertices = 16;
 struct LandMask::Impl {
     GEOSContextHandle_t ctx = GEOS_init_r();
     std::vector<GEOSGeometry*> polygons;
-    mutable std::vector<const GEOSPreparedGeometry*> prepared; // made on first use
+    std::vector<const GEOSPreparedGeometry*> prepared;
     GEOSSTRtree* tree = nullptr;
     // The outlines (shells and holes) as unit vectors, cut into pieces of piece_vertices
     // vertices (the last one shared with the next piece), under an STR tree of their lon/lat
@@ -70,6 +70,7 @@ struct LandMask::Impl {
 
 LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons) : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
+    std::vector<LonLat> probes; // a point of each polygon's shell
     for (const auto& rings : polygons) {
         if (rings.empty() || rings[0].size() < 4) continue;
         GEOSGeometry* shell = m.ring(rings[0]);
@@ -79,13 +80,25 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons
         GEOSGeometry* poly = GEOSGeom_createPolygon_r(m.ctx, shell, holes.data(), static_cast<unsigned>(holes.size()));
         if (!poly) throw DataError("coast: GEOS failed to build a land polygon for the land test");
         m.polygons.push_back(poly);
+        probes.push_back(rings[0][0]);
         for (const auto& r : rings) {
             if (r.size() >= 4) m.add_outline(r);
             vertices_ += r.size();
         }
     }
     m.piece_start.push_back(m.outline.size());
+    // Every polygon prepared now, its point locator built by a first test (GEOS builds it
+    // lazily): the index belongs to loading the coast, not to the meshing that asks it.
     m.prepared.assign(m.polygons.size(), nullptr);
+    for (std::size_t i = 0; i < m.polygons.size(); ++i) {
+        m.prepared[i] = GEOSPrepare_r(m.ctx, m.polygons[i]);
+        if (!m.prepared[i]) throw DataError("coast: GEOS failed to prepare a land polygon for the land test");
+        GEOSGeometry* probe = GEOSGeom_createPointFromXY_r(m.ctx, probes[i].lon, probes[i].lat);
+        if (probe) {
+            GEOSPreparedContains_r(m.ctx, m.prepared[i], probe);
+            GEOSGeom_destroy_r(m.ctx, probe);
+        }
+    }
     m.tree = GEOSSTRtree_create_r(m.ctx, 10);
     for (std::size_t i = 0; i < m.polygons.size(); ++i)
         GEOSSTRtree_insert_r(m.ctx, m.tree, m.polygons[i], reinterpret_cast<void*>(i));
@@ -113,9 +126,7 @@ bool LandMask::contains(const Vec3& p) const {
             auto& q = *static_cast<Query*>(data);
             if (q.inside) return;
             const auto i = reinterpret_cast<std::size_t>(item);
-            auto& prep = q.m->prepared[i];
-            if (!prep) prep = GEOSPrepare_r(q.m->ctx, q.m->polygons[i]);
-            q.inside = prep && GEOSPreparedContains_r(q.m->ctx, prep, q.point) == 1;
+            q.inside = GEOSPreparedContains_r(q.m->ctx, q.m->prepared[i], q.point) == 1;
         },
         &q);
     GEOSGeom_destroy_r(m.ctx, point);
