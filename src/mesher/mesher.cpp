@@ -721,8 +721,12 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     for (TriangleId t : candidates)
         if (land_test.contains(m.centroid(t))) faces.push_back(t);
     std::vector<char>().swap(near);
+    // The faces around dropped islands not tested already (the islands' lists overlap).
+    std::sort(island_faces.begin(), island_faces.end());
+    island_faces.erase(std::unique(island_faces.begin(), island_faces.end()), island_faces.end());
     for (TriangleId t : island_faces)
-        if (is_ocean(t) && land_test.contains(m.centroid(t))) faces.push_back(t);
+        if (is_ocean(t) && !std::binary_search(candidates.begin(), candidates.end(), t) && land_test.contains(m.centroid(t)))
+            faces.push_back(t);
     std::sort(faces.begin(), faces.end());
     faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
     if (faces.empty()) return 0;
