@@ -51,7 +51,8 @@
 //      and the boundary at a corner. A node it leaves on the boundary lies within h/2 of the
 //      coast (LandTest::coast_within). Removing faces keeps every other
 //      face and edge, so the mesh stays constrained Delaunay. The faces left on land are
-//      reported: those in straits kept open.
+//      reported (in straits kept open, or where a removal would leave a node too far from the
+//      coast or pinch the mesh).
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
