@@ -654,10 +654,14 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     // The boundary: each boundary half-edge's origin -> destination (one per boundary vertex in
-    // a manifold). Every edge between ocean and land is a segment: each loop is found from its
-    // first segment not yet seen and traced around its vertices, so that the step costs what
-    // the coast has, not what the ocean has.
+    // a manifold), and the loop of each boundary vertex (an id: only equality counts, through
+    // loop_root: loops that a removal joins share their root). Every edge between ocean and
+    // land is a segment: each loop is found from its first segment not yet seen and traced
+    // around its vertices, so that the step costs what the coast has, not what the ocean has.
     std::unordered_map<VertexId, VertexId> next_on_boundary;
+    std::unordered_map<VertexId, std::uint32_t> loop_of;
+    std::vector<std::uint32_t> loop_parent;
+    std::uint32_t loops = 0;
     std::vector<HalfEdge> boundary_edges; // ocean on the left
     {
         // The boundary half-edge after h (ocean on the left of both): clockwise around h's
@@ -687,9 +691,11 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
                 HalfEdge h = start;
                 do {
                     next_on_boundary.emplace(dt.origin(h), dt.destination(h));
+                    loop_of.emplace(dt.origin(h), loops);
                     boundary_edges.push_back(h);
                     h = next_on_loop(h);
                 } while (h != start && boundary_edges.size() <= m.segments.size());
+                loop_parent.push_back(loops++);
             }
         }
     }
@@ -731,25 +737,10 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
     if (faces.empty()) return 0;
 
-    // The loop of each boundary vertex (an id: only equality counts, through loop_root: loops
-    // that a removal joins share their root).
-    std::unordered_map<VertexId, std::uint32_t> loop_of;
-    std::vector<std::uint32_t> loop_parent;
     auto loop_root = [&](std::uint32_t l) {
         while (loop_parent[l] != l) l = loop_parent[l];
         return l;
     };
-    std::uint32_t loops = 0;
-    for (const auto& [start, unused] : next_on_boundary) {
-        if (loop_of.count(start)) continue;
-        for (VertexId v = start; !loop_of.count(v);) {
-            loop_of.emplace(v, loops);
-            auto it = next_on_boundary.find(v);
-            if (it == next_on_boundary.end()) break;
-            v = it->second;
-        }
-        loop_parent.push_back(loops++);
-    }
     // The fans of ocean faces that meet at the origin of `from` (an interior vertex has one).
     auto fans_at = [&](HalfEdge from) {
         HalfEdge start = from;
