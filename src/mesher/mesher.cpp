@@ -575,6 +575,7 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
             }
         };
         gather();
+        bool moved = false;
         for (const TriangleId t : near) {
             if (!dt.is_live(t) || dt.label(t) != ocean || !inside(m.centroid(t))) continue; // moved already
             // The ways out: from the centroid to the nearest point of each side of the outline,
@@ -626,11 +627,15 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
                     }
                 }
             }
-            if (best_from != no_half_edge && dt.move_vertex_from(best_from, best_to)) ++report.island_centroids_moved;
+            if (best_from != no_half_edge && dt.move_vertex_from(best_from, best_to)) {
+                ++report.island_centroids_moved;
+                moved = true;
+            }
         }
         // What is left (the flips after a move may make another such face): counted, not chased.
-        // The faces around go to the land test, which reads the island at full resolution.
-        gather();
+        // The faces around go to the land test, which reads the island at full resolution. With
+        // no move the first gathering still holds.
+        if (moved) gather();
         left += near.size();
         nearby.insert(nearby.end(), around.begin(), around.end());
     }
