@@ -81,8 +81,8 @@ struct MesherOptions {
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
     double lattice_km = 0;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): faces whose centroid lies
-    /// on it are removed at the end where the mesh stays a manifold with the same boundary loops
-    /// and near the coast (step 7 above). Null: no such step.
+    /// on it are removed at the end where the mesh stays one manifold and its new boundary nodes
+    /// near the coast (step 7 above). Null: no such step.
     std::shared_ptr<const LandTest> land;
 };
 

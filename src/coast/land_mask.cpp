@@ -1,5 +1,6 @@
 // The land test of the coast at full resolution (coast.hpp, LandMask): GEOS point-in-polygon in
-// planar lon/lat, the way GIS software and mesh-verify read land polygons.
+// planar lon/lat, the way GIS software and mesh-verify read land polygons, and the distance to
+// the outlines on the sphere.
 #include <cmath>
 #include <string>
 #include <vector>

@@ -643,21 +643,25 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
 }
 
 // Removes the faces whose centroid lies on the source land (MesherOptions::land): under the
-// capes the shaped coast cuts across, and on the islands it dropped. A model that samples depth
-// at face centres then meets no land there (ocean models cull such cells the same way). A face
-// goes only where the mesh stays a manifold with the same boundary loops: it has a neighbour
-// in the ocean, the corners already on the boundary lie on one loop, and at each corner the
-// faces left form one fan; and where every corner it leaves on the boundary lies within
-// land_exposed_reach h of the coast. A face with no corner on the
-// boundary opens a hole: a dropped island comes back. Passes repeat while faces go, since one
-// gone may free the next. Then a face that would pinch the mesh goes with water faces (see
-// land_fan_faces), all or none. The faces looked at: those with a corner on the boundary or
-// next to it, and `island_faces`. Returns the faces left on land; the faces removed and the
-// holes opened go to `report`.
+// capes the shaped coast cuts across, on the islands it dropped, and across water narrower than
+// a face. A model that samples depth at face centres then meets no land there (ocean models
+// cull such cells the same way). The faces looked at: those around the corners of the faces
+// on the boundary and around those corners' neighbours, and `island_faces`. Each goes alone or
+// in a small group, all or none, where the mesh stays one manifold (try_remove below): a hole
+// opens where it touches no loop, loops join where it touches several, a group that would cut
+// the mesh in two is refused; a sea behind a strait therefore stays connected. Passes repeat
+// while faces go, since one gone may free the next. Returns the faces left on land; the faces
+// removed, the holes opened and the loops joined go to `report`.
 std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<TriangleId> island_faces,
                               double pocket_area, MesherReport& report) {
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
+    // The next half-edge leaving origin(h) clockwise around it (next_around_origin's reverse):
+    // the edge after h's twin in the twin's triangle.
+    auto clockwise_around_origin = [&](HalfEdge h) {
+        const HalfEdge back = dt.twin(h);
+        return half_edge(triangle_of(back), next3(edge_of(back)));
+    };
     // The boundary: each boundary half-edge's origin -> destination (one per boundary vertex in
     // a manifold), and the loop of each boundary vertex (an id: only equality counts, through
     // loop_root: loops that a removal joins share their root). Every edge between ocean and
@@ -673,10 +677,7 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
         // destination, through the ocean, from the edge of h's triangle that leaves it.
         auto next_on_loop = [&](HalfEdge h) {
             HalfEdge g = half_edge(triangle_of(h), next3(edge_of(h)));
-            for (int turns = 0; is_ocean(triangle_of(dt.twin(g))) && turns < 1000; ++turns) {
-                const HalfEdge back = dt.twin(g);
-                g = half_edge(triangle_of(back), next3(edge_of(back)));
-            }
+            for (int turns = 0; is_ocean(triangle_of(dt.twin(g))) && turns < 1000; ++turns) g = clockwise_around_origin(g);
             return g;
         };
         auto seen = [&](VertexId a, VertexId b) {
@@ -800,7 +801,7 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
         members.erase(std::unique(members.begin(), members.end()), members.end());
         corners.clear();
         for (TriangleId t : members)
-            for (int k = 0; k < 3; ++k) corners.emplace_back(dt.vertex(t, k), half_edge(t, next3(next3(k))));
+            for (int k = 0; k < 3; ++k) corners.emplace_back(dt.vertex(t, k), half_edge(t, prev3(k)));
         std::sort(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
         corners.erase(std::unique(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
                       corners.end());
@@ -902,15 +903,10 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
             // The faces around corner k from t each way to the first face not in the ocean.
             std::vector<TriangleId> sides[2];
             for (int side = 0; side < 2; ++side) {
-                const HalfEdge from = half_edge(t, next3(next3(k))); // leaves vertex k
+                const HalfEdge from = half_edge(t, prev3(k)); // leaves vertex k
                 HalfEdge h2 = from;
                 while (sides[side].size() <= land_fan_faces) {
-                    if (side == 0) {
-                        h2 = dt.next_around_origin(h2); // counter-clockwise
-                    } else {
-                        const HalfEdge back = dt.twin(h2); // clockwise: the edge after h2's twin
-                        h2 = half_edge(triangle_of(back), next3(edge_of(back)));
-                    }
+                    h2 = side == 0 ? dt.next_around_origin(h2) : clockwise_around_origin(h2);
                     if (!is_ocean(triangle_of(h2)) || triangle_of(h2) == t) break;
                     sides[side].push_back(triangle_of(h2));
                 }
