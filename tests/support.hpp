@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace globemesh::test {
 
@@ -50,6 +51,16 @@ inline int run_command(const std::string& command, std::string& output) {
     int status = pclose(pipe);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+/// ECMAScript regular expressions (support_regex.cpp, compiled once for every test). True when
+/// `pattern` matches part of `text` (regex_search) or all of it (regex_match); the groups of
+/// the match go into `groups`, the whole match first.
+bool regex_search(const std::string& text, const std::string& pattern, std::vector<std::string>* groups = nullptr);
+bool regex_match(const std::string& text, const std::string& pattern, std::vector<std::string>* groups = nullptr);
+/// Group `group` of every match of `pattern` in `text`, in order.
+std::vector<std::string> regex_all(const std::string& text, const std::string& pattern, int group = 0);
+/// `text` with every match of `pattern` replaced by `with` (std::regex_replace's format).
+std::string regex_replace(const std::string& text, const std::string& pattern, const std::string& with);
 
 inline std::filesystem::path mesh_verify_path() {
     return std::filesystem::path(GLOBEMESH_SHARED_DIR) / "tools" / "mesh-verify";
