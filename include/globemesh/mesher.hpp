@@ -8,8 +8,9 @@
 //      segment, drops land and the ocean components not connected to the largest one (inland
 //      seas) unless keep_inland_seas, and reports each component by area; then closes the
 //      inlets narrower than inlet_width * h (an edge between two nodes of one ring, shorter than
-//      that, becomes coast when the water behind it is under inlet_area * h^2; repeated, so a
-//      dead-end channel closes whole), which no triangle of size h could fill but slivers;
+//      that, becomes coast when the water behind it is under inlet_area * h^2, or narrower on
+//      average than inlet_width * h and under 25 h^2; repeated, so a dead-end channel closes
+//      whole), which no triangle of size h could fill but slivers;
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
@@ -74,7 +75,7 @@ struct MesherOptions {
     int smooth_iterations = 4;            ///< smoothing sweeps
     bool keep_inland_seas = false;        ///< keep ocean components apart from the largest
     double inlet_width = 0.5;             ///< close inlets narrower than this times h (0: none)
-    double inlet_area = 1.0;              ///< ... holding at most this times h^2 of water
+    double inlet_area = 1.0;              ///< ... holding at most this times h^2 of water (or narrow on average)
     std::uint64_t seed = 1;               ///< seed of the core's insertion order
     /// The size field's largest value (km): where the field reaches it, away from the boundary,
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the

@@ -121,8 +121,9 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     Mesh mesh = mesh_ocean(o);
     // Faces centred on land: mesh-verify's count against the 1:50m polygons is at most what the
     // mesher reports left (577 before the mesher removed them, 129 when it kept every loop
-    // apart; 50 now: 21 in the straits kept open, Gibraltar, the Bosphorus, the Dardanelles,
-    // the Great Belt, the Strait of Magellan, the mouth of Lake Maracaibo; the rest where a
+    // apart, 50 with groups and joins; 48 now that narrow basins close whole (Lake Maracaibo):
+    // about 20 in the straits kept open, Gibraltar, the Bosphorus, the Dardanelles, the Great
+    // Belt, the Strait of Magellan; the rest where a
     // removal would bring a node more than h/2 from the coast onto the boundary or pinch the
     // mesh). Each hole the removals opened is one more boundary loop, each join one fewer;
     // narrow water between islands and the mainland closes in a few dozen places.
@@ -490,6 +491,40 @@ TEST(Mesher, narrow_inlets_close_while_wide_bays_large_lagoons_and_straits_stay)
     EXPECT_GT(faces_in(open, 17, 4.9, 20, 5.1), 0u);
     EXPECT_EQ(open_report.inlets_closed, 0u);
     EXPECT_EQ(open_report.inlet_area_km2, 0.0);
+}
+
+// A river 0.3 degrees wide (33 km, under h/2 at h = 100 km) runs 6 degrees into a continent
+// to a lake 0.6 degrees wide (67 km: no line across it is under h/2) and on to a dead end: 4.2
+// square degrees behind its mouth (52,000 km2, 5.2 h^2) that no triangle of size h fits. Twice
+// its area over its shore is 0.36 degrees (40 km), under h/2: it all closes (before, only the
+// dead end did: the lake is over h^2). With the lake 3
+// degrees wide instead (mean width 1.0 degree), the lake and the river to it stay.
+TEST(Mesher, a_river_with_a_narrow_lake_closes_and_a_wide_lake_stays) {
+    auto continent = [](double lake) {
+        Boundary b;
+        b.rings.push_back(ring_through({{0, -10}, {0, 10}, {20, 10}, {20, 0.15}, {14, 0.15}, {14, lake}, {11, lake},
+                                        {11, 0.15}, {9, 0.15}, {9, -0.15}, {11, -0.15}, {11, -lake},
+                                        {14, -lake}, {14, -0.15}, {20, -0.15}, {20, -10}}));
+        return b;
+    };
+    const SizeFn h = uniform_size(100);
+    MesherReport report;
+    const Mesh narrow = mesh_boundary(continent(0.3), h, {}, &report);
+    EXPECT_EQ(faces_in(narrow, 9, -0.3, 20, 0.3), 0u); // river and lake are land
+    // The river, the lake and the dead end: (6 + 2) x 0.3 + 3 x 0.6 square degrees at the equator.
+    const double deg2 = 111.195 * 111.195;
+    EXPECT_NEAR(report.inlet_area_km2, 4.2 * deg2, 0.02 * 4.2 * deg2);
+    EXPECT_EQ(compute_stats(narrow).boundary_loops, 1u);
+    test::TempDir dir;
+    write_ugrid(narrow, dir / "narrow.nc");
+    test::expect_mesh_verify(dir / "narrow.nc");
+
+    const Mesh wide = mesh_boundary(continent(1.5), h, {}, &report);
+    EXPECT_GT(faces_in(wide, 11, -1.5, 14, 1.5), 15u); // the lake is meshed (about 30 faces)
+    EXPECT_GT(faces_in(wide, 14, -0.15, 20, 0.15), 0u); // and so is the river to it
+    EXPECT_EQ(faces_in(wide, 9, -0.15, 11, 0.15), 0u);  // the dead end beyond it closes
+    write_ugrid(wide, dir / "wide.nc");
+    test::expect_mesh_verify(dir / "wide.nc");
 }
 
 TEST(Mesher, inlet_width_out_of_range_is_a_usage_error_naming_it) {
