@@ -204,7 +204,11 @@ void print_stats(std::ostream& out, const MeshStats& st, bool histogram) {
             const int bar = largest ? static_cast<int>(std::lround(40.0 * c / largest)) : 0;
             out << "  [" << std::setprecision(1) << 0.1 * i << ", " << 0.1 * (i + 1) << (i == 9 ? ']' : ')');
             out << ' ' << std::setw(10) << c << ' ' << std::setw(5) << std::setprecision(1)
-                << (total ? 100.0 * c / total : 0.0) << '%' << (bar ? " " + std::string(bar, '#') : "") << "\n";
+                << (total ? 100.0 * c / total : 0.0) << '%';
+            // (The bar is written on its own: " " + std::string(bar, '#') trips GCC 12's
+            // known -Wrestrict false positive.)
+            if (bar) out << ' ' << std::string(bar, '#');
+            out << '\n';
         }
     }
     out.flags(old_flags);
