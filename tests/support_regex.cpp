@@ -6,24 +6,27 @@
 
 namespace globemesh::test {
 
-bool regex_search(const std::string& text, const std::string& pattern, std::vector<std::string>* groups) {
-    std::smatch m;
-    if (!std::regex_search(text, m, std::regex(pattern))) return false;
-    if (groups) {
+namespace {
+
+// The groups of a match into `groups` when it was found.
+bool take(bool found, const std::smatch& m, std::vector<std::string>* groups) {
+    if (found && groups) {
         groups->clear();
         for (const auto& g : m) groups->push_back(g.str());
     }
-    return true;
+    return found;
+}
+
+} // namespace
+
+bool regex_search(const std::string& text, const std::string& pattern, std::vector<std::string>* groups) {
+    std::smatch m;
+    return take(std::regex_search(text, m, std::regex(pattern)), m, groups);
 }
 
 bool regex_match(const std::string& text, const std::string& pattern, std::vector<std::string>* groups) {
     std::smatch m;
-    if (!std::regex_match(text, m, std::regex(pattern))) return false;
-    if (groups) {
-        groups->clear();
-        for (const auto& g : m) groups->push_back(g.str());
-    }
-    return true;
+    return take(std::regex_match(text, m, std::regex(pattern)), m, groups);
 }
 
 std::vector<std::string> regex_all(const std::string& text, const std::string& pattern, int group) {
