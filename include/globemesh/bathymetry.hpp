@@ -29,7 +29,9 @@
 // average resampling through RasterIO, which uses the raster's overviews when it has some and
 // only the source window a VRT maps otherwise) applies to rasters with more than max_cells
 // cells (default 2^28, 1 GiB: a 1-arc-minute global grid fits) and, through RasterLimits, to
-// cells finer than the mesh can use. read_bathymetry() asks for cells no finer than half the
+// cells finer than the mesh can use. With --region, only the cells that cover the region (and
+// a margin: 1% of its larger side and three cells) are read: a regional run reads a small window of a global raster,
+// at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half the
 // smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and refuses
 // (DataError naming --max-memory) when the values would take more than half of
 // options.max_memory_bytes. GDAL's block cache (GDAL_CACHEMAX, 5% of RAM by default) comes on
@@ -122,6 +124,11 @@ struct RasterLimits {
     double min_cell_deg = 0;
     /// Refuse (DataError naming --max-memory) when the values read would take more bytes; 0: no cap.
     std::uint64_t max_bytes = 0;
+    /// Read only the cells that cover this box (degrees; east > west, east may exceed 180), with
+    /// a margin of three cells (of the raster's own size or min_cell_deg, the larger), instead of
+    /// the whole raster. A box across the seam of a global raster reads every column of its rows;
+    /// a box the raster does not meet reads the whole raster. nullopt: the whole raster.
+    std::optional<LonLatBounds> window;
 };
 
 /// Reads one band of any GDAL raster as elevation in metres (positive up); see the file comment.
@@ -137,7 +144,9 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
                    const RasterLimits& limits);
 
 /// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
-/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory.
+/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory, and with
+/// --region the window of the region widened by 1% of its larger side (the size field's grid
+/// reaches a cell beyond the region).
 RasterLimits bathymetry_limits(const MeshOptions& options);
 
 /// Reads options.bathy (band options.bathy_band, options.depth_positive), sets the fill to

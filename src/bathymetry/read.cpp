@@ -118,6 +118,46 @@ DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string& path) {
     return out;
 }
 
+/// Columns [c_lo, c_hi) and rows [r_lo, r_hi) of an nx x ny lon/lat raster (geotransform gt,
+/// not rotated) that cover box b and a margin of three cells (the raster's own, or min_cell_deg
+/// when larger). The box is taken at whichever of its 360-degree shifts meets the raster most;
+/// where it runs across the raster's east or west edge on a global raster (the seam), every
+/// column is kept; a box the raster does not meet keeps the whole raster.
+struct Window {
+    std::size_t c_lo, c_hi, r_lo, r_hi;
+};
+
+Window window_of(const LonLatBounds& b, const double gt[6], std::size_t nx, std::size_t ny, double min_cell_deg) {
+    const Window whole{0, nx, 0, ny};
+    const double mx = 3 * std::max(std::abs(gt[1]), min_cell_deg), my = 3 * std::max(std::abs(gt[5]), min_cell_deg);
+    const double r_west = gt[0], r_east = gt[0] + static_cast<double>(nx) * gt[1];
+    const bool global = std::abs(r_east - r_west - 360.0) <= 1e-6 * std::abs(gt[1]);
+    // Columns: the shift of the box that overlaps the raster most.
+    const double west = b.west - mx, east = b.east + mx;
+    double best_overlap = 0, lo = 0, hi = 0;
+    for (int k = -2; k <= 2; ++k) {
+        const double w = west + 360.0 * k, e = east + 360.0 * k;
+        const double overlap = std::min(e, r_east) - std::max(w, r_west);
+        if (overlap > best_overlap) {
+            best_overlap = overlap;
+            lo = w;
+            hi = e;
+        }
+    }
+    if (best_overlap <= 0) return whole;
+    Window out = whole;
+    if (hi - lo < 360 && (!global || (lo >= r_west && hi <= r_east))) {
+        out.c_lo = static_cast<std::size_t>(std::clamp(std::floor((std::max(lo, r_west) - r_west) / gt[1]), 0.0, double(nx)));
+        out.c_hi = static_cast<std::size_t>(std::clamp(std::ceil((std::min(hi, r_east) - r_west) / gt[1]), 0.0, double(nx)));
+    }
+    // Rows (north-up or south-up).
+    const double y_s = (b.south - my - gt[3]) / gt[5], y_n = (b.north + my - gt[3]) / gt[5];
+    out.r_lo = static_cast<std::size_t>(std::clamp(std::floor(std::min(y_s, y_n)), 0.0, double(ny)));
+    out.r_hi = static_cast<std::size_t>(std::clamp(std::ceil(std::max(y_s, y_n)), 0.0, double(ny)));
+    if (out.c_hi <= out.c_lo || out.r_hi <= out.r_lo) return whole;
+    return out;
+}
+
 struct ProgressBridge {
     const Progress* progress;
     double lo, hi;
@@ -203,6 +243,16 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // A node-registered global grid repeats its first meridian as the last column: drop it.
     if (nx > 1 && std::abs(static_cast<double>(nx - 1) * gt[1] - 360.0) <= 1e-6 * gt[1]) --nx;
 
+    // The window of limits.window: columns c0 .. c0 + nx - 1 and rows r0 .. r0 + ny - 1.
+    std::size_t c0 = 0, r0 = 0;
+    if (limits.window) {
+        const auto [c_lo, c_hi, r_lo, r_hi] = window_of(*limits.window, gt, nx, ny, limits.min_cell_deg);
+        c0 = c_lo;
+        r0 = r_lo;
+        nx = c_hi - c_lo;
+        ny = r_hi - r_lo;
+    }
+
     // Decimate (GDAL average): cells finer than min_cell_deg, then rasters larger than max_cells.
     // Counts stay in double until they are known to be small (a declared raster may be huge).
     double cx = static_cast<double>(nx), cy = static_cast<double>(ny);
@@ -234,30 +284,30 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     int block_x = 0, block_y = 0;
     GDALGetBlockSize(read_band, &block_x, &block_y);
     std::size_t strip = std::max<std::size_t>(1, std::min<std::size_t>(by, std::max(block_y, 64)));
-    for (std::size_t r0 = 0; r0 < by; r0 += strip) {
-        std::size_t r1 = std::min(by, r0 + strip);
+    for (std::size_t s0 = 0; s0 < by; s0 += strip) {
+        std::size_t s1 = std::min(by, s0 + strip);
         GDALRasterIOExtraArg extra;
         INIT_RASTERIO_EXTRA_ARG(extra);
-        ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(r0) / static_cast<double>(by),
-                              0.05 + 0.9 * static_cast<double>(r1) / static_cast<double>(by)};
+        ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
+                              0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by)};
         if (progress) {
             extra.pfnProgress = gdal_progress;
             extra.pProgressData = &bridge;
         }
-        double y0 = static_cast<double>(r0) * sy, y1 = static_cast<double>(r1) * sy;
+        double y0 = static_cast<double>(s0) * sy, y1 = static_cast<double>(s1) * sy;
         int iy0 = static_cast<int>(std::floor(y0));
         int iy1 = std::min(static_cast<int>(ny), static_cast<int>(std::ceil(y1 - 1e-9)));
         if (bx != nx || by != ny) {
             extra.eResampleAlg = GRIORA_Average;
             extra.bFloatingPointWindowValidity = TRUE;
-            extra.dfXOff = 0;
+            extra.dfXOff = static_cast<double>(c0);
             extra.dfXSize = static_cast<double>(nx);
-            extra.dfYOff = y0;
+            extra.dfYOff = static_cast<double>(r0) + y0;
             extra.dfYSize = y1 - y0;
         }
-        CPLErr err = GDALRasterIOEx(read_band, GF_Read, 0, iy0, static_cast<int>(nx), iy1 - iy0,
-                                    values.data() + r0 * bx, static_cast<int>(bx),
-                                    static_cast<int>(r1 - r0), GDT_Float32, 0, 0, &extra);
+        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0), static_cast<int>(r0) + iy0,
+                                    static_cast<int>(nx), iy1 - iy0, values.data() + s0 * bx, static_cast<int>(bx),
+                                    static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
         if (bridge.cancelled) throw Cancelled();
         if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal::last_error());
     }
@@ -274,7 +324,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         v = static_cast<float>(depth_positive ? -z : z);
     }
 
-    Raster raster(gt[0] + 0.5 * dlon, gt[3] + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
+    const double west = gt[0] + static_cast<double>(c0) * gt[1], top = gt[3] + static_cast<double>(r0) * gt[5];
+    Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
     if (raster.valid_count() == 0)
         throw DataError("--bathy " + path + ": band " + std::to_string(band) +
                         " holds no valid value (all nodata)");
@@ -289,6 +340,13 @@ RasterLimits bathymetry_limits(const MeshOptions& o) {
     RasterLimits limits;
     limits.min_cell_deg = 0.5 * hfloor_km / (earth_radius_km * deg_to_rad);
     limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh
+    if (o.region) {
+        // The region and 1% of its larger side: the size field's grid over it reaches a cell
+        // beyond, and its cells are at most 1/2048 of that side (pipeline.cpp, 2^22 nodes).
+        const auto& r = *o.region;
+        const double east = r[2] > r[0] ? r[2] : r[2] + 360, pad = 0.01 * std::max(east - r[0], r[3] - r[1]);
+        limits.window = LonLatBounds{r[0] - pad, std::max(-90.0, r[1] - pad), east + pad, std::min(90.0, r[3] + pad)};
+    }
     return limits;
 }
 

@@ -354,16 +354,31 @@ TEST(Bathymetry, etopo5_global_netcdf_matches_its_own_coordinates_and_values) {
 TEST(Bathymetry, etopo5_nwshelf_geotiff_nodes_sit_on_whole_5_minutes) {
     const std::string path = fixture("bathy/etopo5_nwshelf_5min.tif").string();
     MeshOptions o = options_for(path);
+    // The whole file: 301 x 193 nodes, PixelIsPoint: node 0 at 12 W, 62 N.
+    Raster whole = read_raster(path);
+    EXPECT_EQ(whole.nlon(), 301u);
+    EXPECT_EQ(whole.nlat(), 193u);
+    EXPECT_NEAR(whole.lon_deg(0), -12.0, 1e-9);
+    EXPECT_NEAR(whole.lat_deg(0), 62.0, 1e-9);
+    // With --region only the file's nodes near the region are read (a margin of 1% of 20 degrees
+    // and three 5-minute cells: 0.45 degree), still on the file's nodes.
     o.region = std::array<double, 4>{-10, 48, 10, 60};
     Raster r = read_bathymetry(o);
-    EXPECT_EQ(r.nlon(), 301u);
-    EXPECT_EQ(r.nlat(), 193u);
-    EXPECT_NEAR(r.lon_deg(0), -12.0, 1e-9); // PixelIsPoint: node 0 at 12 W, 62 N
-    EXPECT_NEAR(r.lat_deg(0), 62.0, 1e-9);
-    for (int j = 0; j < 193; j += 19)
-        for (int i = 0; i < 301; i += 23) {
-            double lon = -12.0 + i / 12.0, lat = 62.0 - j / 12.0;
-            EXPECT_NEAR(r.elevation_m(lon, lat), gdal_pixel(path, i, j), 1e-9) << lon << " " << lat;
+    const LonLatBounds b = r.bounds();
+    EXPECT_LE(b.west, -10.45);
+    EXPECT_GT(b.west, -10.45 - 1.0 / 12);
+    EXPECT_GE(b.east, 10.45);
+    EXPECT_LT(b.east, 10.45 + 1.0 / 12);
+    EXPECT_LE(b.south, 47.55);
+    EXPECT_GE(b.north, 60.45);
+    EXPECT_LT(b.north, 60.45 + 1.0 / 12);
+    const int i0 = static_cast<int>(std::lround((r.lon_deg(0) + 12) * 12)), j0 = static_cast<int>(std::lround((62 - r.lat_deg(0)) * 12));
+    EXPECT_NEAR(r.lon_deg(0), -12.0 + i0 / 12.0, 1e-9);
+    EXPECT_NEAR(r.lat_deg(0), 62.0 - j0 / 12.0, 1e-9);
+    for (std::size_t j = 0; j < r.nlat(); j += 15)
+        for (std::size_t i = 0; i < r.nlon(); i += 23) {
+            double lon = r.lon_deg(i), lat = r.lat_deg(j);
+            EXPECT_NEAR(r.elevation_m(lon, lat), gdal_pixel(path, int(i) + i0, int(j) + j0), 1e-9) << lon << " " << lat;
         }
     EXPECT_LT(r.elevation_m(3.0, 56.0), 0);   // North Sea
     EXPECT_GT(r.elevation_m(-4.0, 57.0), 100); // Scottish Highlands
@@ -395,6 +410,20 @@ std::string huge_global_vrt(const TempDir& dir, int nx, int ny) {
     return path;
 }
 
+/// The 2160 x 1080 cells of the 10-minute ETOPO5 fixture, read by GDALRasterIO alone (empty
+/// when that fails).
+std::vector<double> etopo5_cells() {
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    GDALDatasetH ds = GDALOpen(source.c_str(), GA_ReadOnly);
+    if (!ds) return {};
+    std::vector<double> cells(2160 * 1080);
+    if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, 2160, 1080, cells.data(), 2160, 1080, GDT_Float64, 0, 0) !=
+        CE_None)
+        cells.clear();
+    GDALClose(ds);
+    return cells;
+}
+
 } // namespace
 
 TEST(Bathymetry, four_gigabyte_raster_is_read_at_the_cell_size_asked_and_equals_its_source) {
@@ -409,14 +438,8 @@ TEST(Bathymetry, four_gigabyte_raster_is_read_at_the_cell_size_asked_and_equals_
     EXPECT_TRUE(r.global());
     // The average of 32 x 32 equal Int16 values is that value: every cell equals the fixture's
     // cell read independently by GDALRasterIO.
-    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
-    GDALDatasetH ds = GDALOpen(source.c_str(), GA_ReadOnly);
-    ASSERT_NE(ds, nullptr);
-    std::vector<double> truth(2160 * 1080);
-    ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, 2160, 1080, truth.data(), 2160, 1080,
-                           GDT_Float64, 0, 0),
-              CE_None);
-    GDALClose(ds);
+    const std::vector<double> truth = etopo5_cells();
+    ASSERT_EQ(truth.size(), 2160u * 1080u);
     std::size_t differ = 0;
     for (std::size_t j = 0; j < 1080; ++j)
         for (std::size_t i = 0; i < 2160; ++i) differ += r.value(i, j) != truth[j * 2160 + i];
@@ -451,6 +474,67 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     EXPECT_EQ(r.nlon(), static_cast<std::size_t>(std::ceil(360 / cell)));
     EXPECT_EQ(r.nlat(), static_cast<std::size_t>(std::ceil(180 / cell)));
     EXPECT_LE(r.dlon_deg(), cell);
+}
+
+TEST(Bathymetry, a_region_reads_only_its_window_of_a_four_gigabyte_global_raster) {
+    TempDir dir;
+    const std::string vrt = huge_global_vrt(dir, 69120, 34560); // cells of 1/192 degree
+    MeshOptions o = options_for(vrt);
+    o.hmin_km = 1;                    // cells of 0.5 km asked (0.0045 degree): finer than the file's
+    o.max_memory_bytes = 500'000'000; // the whole globe at that size is refused (test above)
+    o.region = std::array<double, 4>{-10, 40, 0, 50};
+    // A run on the region reads a few million cells of the 2.4 billion, within the budget.
+    const Raster run = read_bathymetry(o);
+    EXPECT_LT(run.nlon() * run.nlat(), 4'500'000u);
+    EXPECT_GE(run.nlon() * run.nlat(), 1920u * 1920u);
+    // The window alone: the box and a margin of three of the file's cells (1/64 degree) on each
+    // side, 10 + 2/64 degrees at 192 cells a degree, from column (180 - 10 - 1/64) * 192 = 32637
+    // and row 7677.
+    RasterLimits limits = bathymetry_limits(o);
+    limits.window = LonLatBounds{-10, 40, 0, 50};
+    Raster r = read_raster(vrt, 1, false, {}, limits);
+    ASSERT_EQ(r.nlon(), 1926u);
+    ASSERT_EQ(r.nlat(), 1926u);
+    EXPECT_FALSE(r.global());
+    EXPECT_NEAR(r.lon_deg(0), -10 - 1.0 / 64 + 0.5 / 192, 1e-9);
+    EXPECT_NEAR(r.lat_deg(0), 50 + 1.0 / 64 - 0.5 / 192, 1e-9);
+    // Every cell is its 10-minute fixture cell (32 x 32 copies each), read independently.
+    const std::vector<double> truth = etopo5_cells();
+    ASSERT_EQ(truth.size(), 2160u * 1080u);
+    std::size_t differ = 0;
+    for (std::size_t j = 0; j < r.nlat(); ++j)
+        for (std::size_t i = 0; i < r.nlon(); ++i)
+            differ += r.value(i, j) != truth[(j + 7677) / 32 * 2160 + (i + 32637) / 32];
+    EXPECT_EQ(differ, 0u);
+}
+
+TEST(Bathymetry, a_region_across_the_antimeridian_reads_its_rows_and_wraps) {
+    TempDir dir;
+    auto z = [](double lon, double lat) { return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000; };
+    for (double west : {0.0, -180.0}) {
+        const std::string path = (dir / (west == 0 ? "g360.tif" : "g180.tif")).string();
+        write_tiff(path, {west, 90, 1, 1, 360, 180}, z);
+        MeshOptions o = options_for(path);
+        o.region = std::array<double, 4>{170, -10, -170, 10};
+        Raster r = read_bathymetry(o);
+        // 1-degree cells; a margin of 1% of 20 degrees and three cells, 3.2 degrees: the cells
+        // from 14 N to 14 S. In 0..360 the region lies inside the file (the cells from 166 to
+        // 194 E); in -180..180 it runs across the file's seam, so every column is read and the
+        // grid stays global.
+        EXPECT_EQ(r.nlat(), 28u) << path;
+        if (west == 0) {
+            EXPECT_EQ(r.nlon(), 28u);
+            EXPECT_FALSE(r.global());
+        } else {
+            EXPECT_EQ(r.nlon(), 360u);
+            EXPECT_TRUE(r.global());
+        }
+        for (double lat : {-9.5, 0.5, 9.5})
+            for (double lon : {170.5, 179.5, -179.5, -170.5})
+                EXPECT_NEAR(r.elevation_m(lon, lat), z(lon, lat), 1e-9) << path << " " << lon << " " << lat;
+        // Across 180: halfway between the cells at 179.5 and -179.5.
+        EXPECT_NEAR(r.elevation_m(180, 0.5), 0.5 * (z(179.5, 0.5) + z(-179.5, 0.5)), 1e-9) << path;
+    }
 }
 
 TEST(Bathymetry, without_a_budget_or_a_floor_the_raster_is_read_at_full_resolution) {
