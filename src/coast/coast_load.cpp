@@ -7,6 +7,8 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
+#include <array>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -260,6 +262,11 @@ bool is_area_or_line(OGRwkbGeometryType t) {
            OGR_GT_IsSubClassOf(t, wkbCurve) || OGR_GT_IsSubClassOf(t, wkbMultiCurve);
 }
 
+bool is_polygon_type(OGRwkbGeometryType t) {
+    t = wkbFlatten(t);
+    return OGR_GT_IsSubClassOf(t, wkbCurvePolygon) || OGR_GT_IsSubClassOf(t, wkbMultiSurface);
+}
+
 std::string layer_list(GDALDatasetH ds) {
     std::string list;
     for (int i = 0; i < GDALDatasetGetLayerCount(ds); ++i) {
@@ -271,13 +278,20 @@ std::string layer_list(GDALDatasetH ds) {
 }
 
 /// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
-/// `what` names the option for messages (--coast or --region-file).
+/// `what` names the option for messages (--coast or --region-file). With `near` (a --region
+/// W,S,E,N) a polygon layer is read through OGR's spatial filter: only the features whose
+/// envelope meets the box widened by 1% of its larger side (its latitude band when it crosses
+/// +-180), in the layer's CRS; the land elsewhere plays no part in a region (region_rings cuts
+/// it off), and a layer with an index (GeoPackage, a shapefile's .qix) is then not read whole.
+/// A filter that leaves no feature is dropped (the errors below stay those of the whole layer).
+/// Line layers are read whole: their lines close into land only together.
 /// max_bytes (0: no limit): the layer's vertices are counted while they are read; once they
 /// pass max_bytes / coast_bytes_per_vertex nothing more is kept (memory stays bounded by one
 /// feature), the rest is only counted, and a DataError names the layer, the count and
 /// --max-memory.
 Source read_source(const std::string& path, const std::string& layer_name, const std::string& where,
-                   const std::string& srs_override, const char* what, std::uint64_t max_bytes = 0) {
+                   const std::string& srs_override, const char* what, std::uint64_t max_bytes = 0,
+                   const std::optional<std::array<double, 4>>& near = std::nullopt) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
@@ -341,6 +355,27 @@ Source read_source(const std::string& path, const std::string& layer_name, const
                             CPLGetLastErrorMsg() + ")");
     }
 
+    bool filtered = false;
+    if (near && is_polygon_type(OGR_L_GetGeomType(layer))) {
+        auto [w, s, e, n] = *near;
+        if (e <= w) w = -180, e = 180;
+        const double pad = 0.01 * std::max(e - w, n - s);
+        w = std::max(-180.0, w - pad), e = std::min(180.0, e + pad);
+        s = std::max(-90.0, s - pad), n = std::min(90.0, n + pad);
+        double x0 = w, y0 = s, x1 = e, y1 = n;
+        bool ok = true;
+        if (transform) {
+            // The box in the layer's CRS (densified edges); a CRS that cannot take it: no filter.
+            TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84.get(), source_srs.get()));
+            ok = to_layer && OCTTransformBounds(to_layer.get(), w, s, e, n, &x0, &y0, &x1, &y1, 21) && x0 < x1 &&
+                 y0 < y1 && std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) && std::isfinite(y1);
+        }
+        if (ok) {
+            OGR_L_SetSpatialFilterRect(layer, x0, y0, x1, y1);
+            filtered = true;
+        }
+    }
+
     OGR_L_ResetReading(layer);
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
@@ -348,6 +383,13 @@ Source read_source(const std::string& path, const std::string& layer_name, const
     bool too_many = false;
     for (;;) {
         FeaturePtr f(OGR_L_GetNextFeature(layer));
+        if (!f && filtered && src.features == 0) {
+            // Nothing near the region: read the whole layer, as without a region.
+            OGR_L_SetSpatialFilter(layer, nullptr);
+            OGR_L_ResetReading(layer);
+            filtered = false;
+            continue;
+        }
         if (!f) break;
         ++src.features;
         OGRGeometryH g = OGR_F_GetGeometryRef(f.get());
@@ -1160,7 +1202,7 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
     report(progress, 0.0, "reading coast");
     CoastData out;
     Source src = read_source(options.coast, options.coast_layer, options.coast_where, options.coast_srs, "--coast",
-                             options.max_memory_bytes);
+                             options.max_memory_bytes, options.region);
     out.layer = src.layer;
     const std::string where = "--coast " + options.coast + " layer '" + src.layer + "'";
     report(progress, 0.25, "cleaning coast");

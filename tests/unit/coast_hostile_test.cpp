@@ -373,6 +373,30 @@ TEST(CoastHostile, longitude_far_beyond_the_antimeridian_is_refused_at_once) {
     EXPECT_EQ(load_coast(options_for(path)).rings.rings.size(), 1u);
 }
 
+TEST(CoastHostile, a_region_reads_only_the_polygons_near_it) {
+    // With --region a polygon layer is read through a spatial filter: a polygon far from the
+    // region is not read at all, so one the whole layer refuses (a longitude beyond +-540) leaves
+    // a run on the region alone.
+    TempDir dir;
+    auto path = write(dir, "two.geojson", geojson({polygon("[[10,10],[12,10],[12,12],[10,12],[10,10]]"),
+                                                   polygon("[[600,-20],[601,-20],[601,-19],[600,-20]]")}));
+    auto m = message_of<DataError>(options_for(path));
+    EXPECT_NE(m.find("longitude 60"), std::string::npos) << m;
+    MeshOptions o = options_for(path);
+    o.region = std::array<double, 4>{5, 5, 20, 20};
+    CoastData d = load_coast(o);
+    // The box's edges (open) and the island's coast: two rings.
+    ASSERT_EQ(d.rings.rings.size(), 2u);
+    std::size_t coast = 0;
+    for (const auto& r : d.rings.rings)
+        for (SegmentKind k : r.kinds) coast += k == SegmentKind::coast;
+    EXPECT_GE(coast, 4u);
+    // A region that meets no polygon reads the whole layer, as without a region.
+    o.region = std::array<double, 4>{-50, -50, -40, -40};
+    m = message_of<DataError>(o);
+    EXPECT_NE(m.find("longitude 60"), std::string::npos) << m;
+}
+
 TEST(CoastHostile, open_coastline_far_from_the_seam_is_refused) {
     TempDir dir;
     auto path = write(dir, "open.geojson", geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,0],[10,10],[0,10]]}"}));
