@@ -130,11 +130,16 @@ constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
 
 /// The worst quality of the star triangles p, b, c for the star's far edges b -> c (counter-
 /// clockwise around the star's centre), or -1 when p would fold one of them (move_vertex's test).
-double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far) {
+/// With `floor`, stops at the first triangle at or below it and returns that triangle's
+/// quality: a value at or below floor, no smaller than the worst (for callers that only ask
+/// whether the worst beats floor; the moves of the improve stage evaluate candidates so).
+double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far,
+                          double floor = -2.0) {
     double worst = 1;
     for (const auto& [b, c] : far) {
         if (predicates::orient(p, b, c) <= 0) return -1.0;
         worst = std::min(worst, triangle_quality(p, b, c));
+        if (worst <= floor) return worst;
     }
     return worst;
 }
@@ -1026,7 +1031,8 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
             Vec3 sum{0, 0, 0};
             for (const auto& bc : far) sum = sum + bc.first;
             const Vec3 to = normalized(sum);
-            const double worst = star_worst_quality(to, far);
+            double worst = star_worst_quality(to, far, std::nextafter(relax_move_floor, 0.0));
+            if (worst < relax_move_floor) worst = star_worst_quality(to, far); // the whole worst, to compare
             if (worst < relax_move_floor && worst < star_worst_quality(dt.point(v), far)) continue;
             if (dt.place_vertex_from(from, to)) as_made[v] = 0, active[v] = 1;
         }
@@ -1650,7 +1656,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // The quality before the move is needed only when the move would go below 0.6. (A
             // move that would fold the star counts as -1: move_vertex_from refuses it anyway.)
             if (norm(target - dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
-            const double worst_after = star_worst_quality(target, far);
+            double worst_after = star_worst_quality(target, far, std::nextafter(0.6, 0.0));
+            if (worst_after < 0.6) worst_after = star_worst_quality(target, far); // the whole worst, to compare
             if (worst_after < 0.6 && worst_after < star_worst_quality(dt.point(v), far)) continue;
             if (!dt.move_vertex_from(from, target)) continue;
             active[v] |= 2;
@@ -1689,8 +1696,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         std::vector<Vec3> candidates;
         // Moves v to the best candidate; with `search`, a star still below worst_goal then gets
         // a pattern search for its best worst triangle (eight directions, the step halved when
-        // none is better).
-        auto improve_node = [&](VertexId v, TriangleId& hint, bool search) {
+        // none is better). With `changed`, v's move marks v and its neighbours there.
+        auto improve_node = [&](VertexId v, TriangleId& hint, bool search, std::vector<char>* changed = nullptr) {
             const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
             if (from == no_half_edge || dt.origin(from) != v) return;
             hint = triangle_of(from);
@@ -1712,7 +1719,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             double best = star_worst_quality(p0, far);
             Vec3 to = p0;
             for (const Vec3& p : candidates) {
-                const double w = star_worst_quality(p, far);
+                const double w = star_worst_quality(p, far, best + 1e-9);
                 if (w > best + 1e-9) {
                     best = w;
                     to = p;
@@ -1726,7 +1733,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     Vec3 next = to;
                     for (int k = 0; k < 8; ++k) {
                         const Vec3 p = normalized(to + step * (std::cos(k * pi / 4) * e1 + std::sin(k * pi / 4) * e2));
-                        const double w = star_worst_quality(p, far);
+                        const double w = star_worst_quality(p, far, best + 1e-9);
                         if (w > best + 1e-9) {
                             best = w;
                             next = p;
@@ -1736,11 +1743,29 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     else to = next;
                 }
             }
-            if (!(to == p0) && dt.move_vertex_from(from, to)) as_made[v] = 0;
+            if (to == p0 || !dt.move_vertex_from(from, to)) return;
+            as_made[v] = 0;
+            if (!changed) return;
+            HalfEdge h = from; // moved without flips: the star is the same
+            do {
+                (*changed)[dt.destination(h)] = 1;
+                h = dt.next_around_origin(h);
+            } while (h != from);
+            (*changed)[v] = 1;
         };
         collect(0.9, false);
-        for (int round = 0; round < improve_rounds; ++round)
-            for (auto& [v, hint] : todo) improve_node(v, hint, false);
+        {
+            // A node's move depends on its star's points alone, and no flip happens here: a node
+            // whose star has not changed since it last stayed would stay again, and is skipped
+            // (the same mesh, fewer evaluations).
+            std::vector<char> changed(dt.vertex_count(), 1);
+            for (int round = 0; round < improve_rounds; ++round)
+                for (auto& [v, hint] : todo)
+                    if (changed[v]) {
+                        changed[v] = 0;
+                        improve_node(v, hint, false, &changed);
+                    }
+        }
         // Last, search_rounds rounds over the nodes of the triangles still below worst_goal
         // (away from sharp corners), collected again each round.
         for (int round = 0; round < search_rounds; ++round) {
