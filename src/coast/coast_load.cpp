@@ -256,15 +256,14 @@ std::uint64_t vertex_count(OGRGeometryH g) {
 /// with the mesh included; rounded up.
 constexpr std::uint64_t coast_bytes_per_vertex = 200;
 
-bool is_area_or_line(OGRwkbGeometryType t) {
-    t = wkbFlatten(t);
-    return OGR_GT_IsSubClassOf(t, wkbCurvePolygon) || OGR_GT_IsSubClassOf(t, wkbMultiSurface) ||
-           OGR_GT_IsSubClassOf(t, wkbCurve) || OGR_GT_IsSubClassOf(t, wkbMultiCurve);
-}
-
 bool is_polygon_type(OGRwkbGeometryType t) {
     t = wkbFlatten(t);
     return OGR_GT_IsSubClassOf(t, wkbCurvePolygon) || OGR_GT_IsSubClassOf(t, wkbMultiSurface);
+}
+
+bool is_area_or_line(OGRwkbGeometryType t) {
+    t = wkbFlatten(t);
+    return is_polygon_type(t) || OGR_GT_IsSubClassOf(t, wkbCurve) || OGR_GT_IsSubClassOf(t, wkbMultiCurve);
 }
 
 std::string layer_list(GDALDatasetH ds) {

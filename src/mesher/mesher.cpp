@@ -144,6 +144,14 @@ double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>
     return worst;
 }
 
+/// True when moving the star's centre from `at` to `to` (far: its far edges) would bring the
+/// star's worst triangle below `floor` and below where it was: the smoothing moves' refusal
+/// test. The whole worst after the move is computed only when it falls below floor.
+bool lowers_worst_below(const Vec3& to, const Vec3& at, const std::vector<std::pair<Vec3, Vec3>>& far, double floor) {
+    if (star_worst_quality(to, far, std::nextafter(floor, 0.0)) >= floor) return false;
+    return star_worst_quality(to, far) < star_worst_quality(at, far);
+}
+
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -1031,9 +1039,7 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
             Vec3 sum{0, 0, 0};
             for (const auto& bc : far) sum = sum + bc.first;
             const Vec3 to = normalized(sum);
-            double worst = star_worst_quality(to, far, std::nextafter(relax_move_floor, 0.0));
-            if (worst < relax_move_floor) worst = star_worst_quality(to, far); // the whole worst, to compare
-            if (worst < relax_move_floor && worst < star_worst_quality(dt.point(v), far)) continue;
+            if (lowers_worst_below(to, dt.point(v), far, relax_move_floor)) continue;
             if (dt.place_vertex_from(from, to)) as_made[v] = 0, active[v] = 1;
         }
     // Only the triangles around the moved nodes changed (the flipped corners are among them).
@@ -1656,9 +1662,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // The quality before the move is needed only when the move would go below 0.6. (A
             // move that would fold the star counts as -1: move_vertex_from refuses it anyway.)
             if (norm(target - dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
-            double worst_after = star_worst_quality(target, far, std::nextafter(0.6, 0.0));
-            if (worst_after < 0.6) worst_after = star_worst_quality(target, far); // the whole worst, to compare
-            if (worst_after < 0.6 && worst_after < star_worst_quality(dt.point(v), far)) continue;
+            if (lowers_worst_below(target, dt.point(v), far, 0.6)) continue;
             if (!dt.move_vertex_from(from, target)) continue;
             active[v] |= 2;
             as_made[v] = 0;
