@@ -116,6 +116,31 @@ public:
     /// curvature, the points need not be in convex position (split the arc there instead).
     bool insert_constraint(VertexId a, VertexId b);
 
+    /// Marks an entry of replace_region's `adjacent` as a border edge: patch_border | k is
+    /// border[k].
+    static constexpr std::uint32_t patch_border = 0x80000000u;
+
+    /// Replaces a region by a triangulation the caller already knows (e.g. a lattice patch),
+    /// without locating or testing its points one by one. `border` lists the half-edges of the
+    /// region's boundary, each with the region on its left; the region is every triangle reached
+    /// from them without crossing one. `points` become new vertices, numbered from
+    /// vertex_count(), each inside the region. `triangles` holds three vertex ids per new
+    /// triangle (existing vertices of the border, or new ones), counter-clockwise, and `adjacent`
+    /// per new half-edge 3r + i (the edge convention above) either the new half-edge on its other
+    /// side or patch_border | k when it takes border[k]'s place, with border[k]'s ends and
+    /// constrained flag. New triangles get `label`; with `slots`, new triangle r is put in
+    /// (*slots)[r]. The three vectors are emptied (each released once copied, so the peak stays
+    /// near the grown triangulation's) when it returns true, left as they were when it returns
+    /// false and changes nothing: when the pieces do not fit (a new triangle not
+    /// counter-clockwise under predicates::orient, links not symmetric, a border edge missing or
+    /// taken twice, a region holding a constrained edge or a vertex off the border, or a region
+    /// whose triangle count is not the patch's less twice its new points: the patch and the
+    /// region must tile the same surface). The Delaunay property is not restored:
+    /// make_delaunay(edges) from the new half-edges does that.
+    bool replace_region(std::span<const HalfEdge> border, std::vector<Vec3>& points,
+                        std::vector<VertexId>& triangles, std::vector<std::uint32_t>& adjacent,
+                        std::uint8_t label, std::vector<TriangleId>* slots = nullptr);
+
     /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
     /// Returns false and leaves v and every triangle as they were when the move would fold a
     /// triangle of its star, when its star holds a ghost triangle, or when flips cannot restore
@@ -184,7 +209,8 @@ public:
     /// The half-edge from a to b, searching the star of a from `from` (a half-edge leaving a);
     /// no_half_edge when a-b is not an edge.
     HalfEdge find_edge(HalfEdge from, VertexId b) const;
-    /// A half-edge leaving vertex a, found by walking to its point from the last triangle.
+    /// A half-edge leaving vertex a: from the hint when a is one of its corners, else found by
+    /// walking to its point from the hint (or the last triangle).
     HalfEdge leaving(VertexId a, TriangleId hint = no_triangle) const;
 
     /// Every broken invariant, in words; empty when the triangulation is valid.

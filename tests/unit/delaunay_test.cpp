@@ -615,3 +615,132 @@ TEST(Delaunay, duplicate_landing_on_a_flat_triangle_merges_into_its_twin) {
     // resolve (about 1e-8 rad; p4 is 1e-12 from p3, the near-pole points 1e-13 and 5e-11).
     for (std::size_t i = 0; i < p.size(); ++i) EXPECT_LT(arc_angle(dt.point(id[i]), p[i]), 1e-7) << "point " << i;
 }
+
+namespace {
+
+// The patch that puts a new point (index first + r) at the centroid of each triangle in `ts`:
+// three triangles per point, the triangle's own half-edges as the border (adjacent triangles of
+// `ts` share a border edge from both sides).
+struct CentroidPatch {
+    std::vector<HalfEdge> border;
+    std::vector<Vec3> points;
+    std::vector<VertexId> triangles;
+    std::vector<std::uint32_t> adjacent;
+};
+
+CentroidPatch centroid_patch(const SphericalDelaunay& dt, const std::vector<TriangleId>& ts) {
+    CentroidPatch p;
+    for (TriangleId t : ts) {
+        const VertexId v[3] = {dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)};
+        const auto c = static_cast<VertexId>(dt.vertex_count() + p.points.size());
+        p.points.push_back(normalized(dt.point(v[0]) + dt.point(v[1]) + dt.point(v[2])));
+        const auto r0 = static_cast<std::uint32_t>(p.triangles.size() / 3);
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t next = r0 + (i + 1) % 3, prev = r0 + (i + 2) % 3;
+            p.triangles.insert(p.triangles.end(), {v[(i + 1) % 3], v[(i + 2) % 3], c});
+            p.adjacent.insert(p.adjacent.end(), {3 * next + 1, 3 * prev + 0,
+                                                 SphericalDelaunay::patch_border | static_cast<std::uint32_t>(p.border.size())});
+            p.border.push_back(half_edge(t, i));
+        }
+    }
+    return p;
+}
+
+// replace_region on copies of the patch's vectors: it empties them when it succeeds, and leaves
+// them as they were when it refuses.
+bool replace(SphericalDelaunay& dt, const CentroidPatch& q, std::uint8_t label) {
+    std::vector<Vec3> points = q.points;
+    std::vector<VertexId> triangles = q.triangles;
+    std::vector<std::uint32_t> adjacent = q.adjacent;
+    const bool done = dt.replace_region(q.border, points, triangles, adjacent, label);
+    EXPECT_EQ(points.empty() && triangles.empty() && adjacent.empty(), done);
+    if (!done) {
+        EXPECT_EQ(points, q.points);
+        EXPECT_EQ(triangles, q.triangles);
+        EXPECT_EQ(adjacent, q.adjacent);
+    }
+    return done;
+}
+
+std::vector<HalfEdge> all_half_edges(const SphericalDelaunay& dt) {
+    std::vector<HalfEdge> h;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t))
+            for (int i = 0; i < 3; ++i) h.push_back(half_edge(t, i));
+    return h;
+}
+
+} // namespace
+
+TEST(Delaunay, replacing_regions_by_known_patches_then_flipping_gives_the_delaunay_triangulation_of_all_points) {
+    const auto p = random_points(3000, 17);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    // Every third triangle: many of them neighbours, so border edges are taken from both sides.
+    std::vector<TriangleId> ts;
+    for (TriangleId t = 0; t < dt.triangle_slots(); t += 3)
+        if (dt.is_live(t)) ts.push_back(t);
+    const CentroidPatch patch = centroid_patch(dt, ts);
+    std::size_t shared = 0;
+    for (HalfEdge h : patch.border)
+        shared += std::find(patch.border.begin(), patch.border.end(), dt.twin(h)) != patch.border.end();
+    ASSERT_GT(shared, 100u);
+    const std::size_t before = dt.triangle_count();
+    ASSERT_TRUE(replace(dt, patch, 7));
+    EXPECT_EQ(dt.vertex_count(), p.size() + ts.size());
+    EXPECT_EQ(dt.triangle_count(), before + 2 * ts.size());
+    EXPECT_EQ(euler(dt), 2u);
+    std::size_t labelled = 0;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) labelled += dt.is_live(t) && dt.label(t) == 7;
+    EXPECT_EQ(labelled, 3 * ts.size());
+    // Centroids are not Delaunay where a neighbour's circumcircle holds them: the flips mend that,
+    // and the result is the triangulation of all the points inserted one by one.
+    auto edges = all_half_edges(dt);
+    EXPECT_GT(dt.make_delaunay(edges), 0u);
+    expect_valid_closed(dt);
+    std::vector<Vec3> all = p;
+    all.insert(all.end(), patch.points.begin(), patch.points.end());
+    SphericalDelaunay ref;
+    ref.insert_points(all);
+    EXPECT_EQ(canonical(dt, false), canonical(ref, false));
+}
+
+TEST(Delaunay, a_patch_that_does_not_fit_its_region_is_refused_and_changes_nothing) {
+    const auto p = random_points(500, 23);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    const auto before = canonical(dt, false);
+    const std::vector<TriangleId> ts = {4, 5, 40};
+    const CentroidPatch good = centroid_patch(dt, ts);
+    auto refused = [&](const CentroidPatch& q) {
+        EXPECT_FALSE(replace(dt, q, 1));
+        EXPECT_EQ(dt.vertex_count(), p.size());
+        EXPECT_EQ(canonical(dt, false), before);
+        EXPECT_TRUE(dt.validate().empty());
+    };
+    // A border edge no new triangle takes.
+    CentroidPatch q = good;
+    q.border.push_back(dt.twin(q.border[0]) == q.border[1] ? q.border[2] : dt.twin(q.border[0]));
+    refused(q);
+    // A new triangle clockwise.
+    q = good;
+    std::swap(q.triangles[0], q.triangles[1]);
+    refused(q);
+    // One new point fewer than the region needs (its three triangles' corner an old vertex off
+    // the border).
+    q = good;
+    q.points.pop_back();
+    for (std::size_t i = q.triangles.size() - 9; i < q.triangles.size(); ++i)
+        if (q.triangles[i] >= p.size()) q.triangles[i] = dt.vertex(dt.triangle_slots() - 1, 0);
+    refused(q);
+    // The border turned round (the region's outside on its left): no new edge matches its ends.
+    q = good;
+    const TriangleId t = ts[0];
+    for (int i = 0; i < 3; ++i) q.border[i] = dt.twin(half_edge(t, i)); // the region's outside
+    refused(q);
+    // The right patch still fits after all the refusals.
+    ASSERT_TRUE(replace(dt, good, 1));
+    auto edges = all_half_edges(dt);
+    dt.make_delaunay(edges);
+    expect_valid_closed(dt);
+}
