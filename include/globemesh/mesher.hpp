@@ -108,6 +108,7 @@ struct MesherReport {
     std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
     double inlet_area_km2 = 0;          ///< the water they held
     std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
+    std::size_t lattice_patched = 0;    ///< of which placed with their lattice triangles, not inserted one by one
     std::size_t island_centroids_moved = 0; ///< faces moved off islands the shaping dropped
     std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
     std::size_t valence_flips = 0;      ///< flips towards valence 6 before the last restoration

@@ -162,6 +162,10 @@ TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     MesherReport report;
     Mesh mesh = mesh_boundary(b, h, mo, &report);
     EXPECT_GT(report.lattice_nodes, 0u);
+    // Most lattice nodes are placed with their own triangles (the rest, next to the coast, the
+    // graded region and the icosahedron's edges, are inserted); mesh-verify checks that the
+    // result is still constrained Delaunay.
+    EXPECT_GT(report.lattice_patched, report.lattice_nodes / 2);
     expect_verified(mesh, "gs.nc");
     // Edges near the centre are about 20 km, far away about 160 km.
     double near_sum = 0, far_sum = 0;
@@ -214,6 +218,9 @@ TEST(Mesher, lattice_fills_an_aqua_planet_with_near_equilateral_triangles) {
     Mesh mesh = mesh_boundary(Boundary{}, uniform_size(400), mo, &report);
     EXPECT_EQ(2 * mesh.nodes.size(), mesh.faces.size() + 4);
     EXPECT_GT(report.lattice_nodes, mesh.nodes.size() * 9 / 10);
+    // All but the nodes on the icosahedron's edges and around the octahedron's come with their
+    // lattice triangles.
+    EXPECT_GT(report.lattice_patched, report.lattice_nodes * 7 / 10);
     QualityCheck q = quality(mesh);
     EXPECT_GE(q.worst_away_from_corners, 0.6);
     EXPECT_GE(q.above_0_8, 0.99);
@@ -260,14 +267,17 @@ TEST(Mesher, face_centroids_leave_the_islands_the_shaping_dropped) {
     // An aqua-planet at 400 km, then the same with a small square island (24 km across, land
     // on the right of its ring) around the centroids of some faces away from the poles: the
     // mesh is the same until the last step, so each of those faces starts on its island and
-    // must be moved off it.
+    // must be moved off it. The faces share no node, so that no move takes another off its
+    // island.
     MesherOptions mo;
     mo.lattice_km = 400;
     const Mesh plain = mesh_boundary(Boundary{}, uniform_size(400), mo);
     Boundary b;
     std::vector<std::vector<LonLat>> islands;
+    std::set<NodeIndex> taken;
     for (std::size_t f = 0; f < plain.faces.size() && islands.size() < 40; f += 37) {
         const auto& fc = plain.faces[f];
+        if (taken.count(fc[0]) || taken.count(fc[1]) || taken.count(fc[2])) continue;
         const LonLat c = vec_to_lonlat(normalized(plain.nodes[fc[0]] + plain.nodes[fc[1]] + plain.nodes[fc[2]]));
         if (std::abs(c.lat) > 60 || std::abs(c.lon) > 170) continue;
         const double dlat = 12.0 / 111.0, dlon = dlat / std::cos(c.lat * pi / 180);
@@ -277,6 +287,7 @@ TEST(Mesher, face_centroids_leave_the_islands_the_shaping_dropped) {
         for (const auto& ll : ring) nodes.push_back(lonlat_to_vec(ll));
         b.dropped_islands.push_back(nodes);
         islands.push_back(ring);
+        taken.insert(fc.begin(), fc.end());
     }
     ASSERT_EQ(islands.size(), 40u);
     MesherReport report;
