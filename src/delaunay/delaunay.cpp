@@ -319,6 +319,9 @@ TriangleId SphericalDelaunay::walk(const Vec3& p, TriangleId t, bool& inside) co
             if (det < -0x1p-45) return true;
             if (det > 0x1p-45) return false;
         }
+        // p at an end of the edge (a walk to a vertex's own point): orient is 0, which only the
+        // exact stage would tell.
+        if (p == u || p == w) return false;
         return orient(u, w, p) < 0;
     };
     // The first triangle: all three edges.
