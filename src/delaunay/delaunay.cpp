@@ -895,23 +895,22 @@ bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::ve
     if (nt == 0) return border.empty() && points.empty();
     if (end >= link_mask || nt < 2 * points.size()) return false;
     auto at = [&](VertexId v) -> const Vec3& { return v < first ? points_[v] : points[v - first]; };
-    // The border, sorted for lookup: (half-edge, k).
+    // The border's half-edges and vertices, flagged (the triangulation before the patch is
+    // the small one), and sorted for the index of a border half-edge: (half-edge, k).
+    std::vector<char> is_border(links_.size(), 0), on_border(points_.size(), 0);
     std::vector<std::pair<HalfEdge, std::uint32_t>> by_edge(border.size());
     for (std::size_t k = 0; k < border.size(); ++k) {
         const HalfEdge h = border[k];
-        if (h >= links_.size() || !is_live(triangle_of(h))) return false;
+        if (h >= links_.size() || !is_live(triangle_of(h)) || is_border[h]) return false;
+        is_border[h] = 1;
+        on_border[origin(h)] = 1;
         by_edge[k] = {h, static_cast<std::uint32_t>(k)};
     }
     std::sort(by_edge.begin(), by_edge.end());
-    for (std::size_t k = 1; k < by_edge.size(); ++k)
-        if (by_edge[k].first == by_edge[k - 1].first) return false;
     auto border_index = [&](HalfEdge h) -> std::uint32_t {
-        auto it = std::lower_bound(by_edge.begin(), by_edge.end(), std::make_pair(h, std::uint32_t{0}));
-        return it != by_edge.end() && it->first == h ? it->second : no_half_edge;
+        if (!is_border[h]) return no_half_edge;
+        return std::lower_bound(by_edge.begin(), by_edge.end(), std::make_pair(h, std::uint32_t{0}))->second;
     };
-    std::vector<VertexId> on_border(border.size());
-    for (std::size_t k = 0; k < border.size(); ++k) on_border[k] = origin(border[k]);
-    std::sort(on_border.begin(), on_border.end());
     // The patch alone: corners (new, or on the border), orientation, symmetric links, each
     // border edge taken once with its own ends. taker[k]: the new half-edge in border[k]'s place.
     std::vector<std::uint32_t> taker(border.size(), no_half_edge);
@@ -919,7 +918,7 @@ bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::ve
         const VertexId* v = &triangles[3 * r];
         if (v[0] >= end || v[1] >= end || v[2] >= end || v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) return false;
         for (int i = 0; i < 3; ++i)
-            if (v[i] < first && !std::binary_search(on_border.begin(), on_border.end(), v[i])) return false;
+            if (v[i] < first && !on_border[v[i]]) return false;
         if (predicates::orient(at(v[0]), at(v[1]), at(v[2])) <= 0) return false;
         for (int i = 0; i < 3; ++i) {
             const std::uint32_t a = adjacent[3 * r + i];
@@ -955,9 +954,9 @@ bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::ve
             if (region.size() + 2 * points.size() > nt) return fail(); // larger than the patch: a leak
             const TriangleId t = region[q];
             for (int i = 0; i < 3; ++i) {
-                if (!std::binary_search(on_border.begin(), on_border.end(), vertex(t, i))) return fail();
+                if (!on_border[vertex(t, i)]) return fail();
                 const HalfEdge e = half_edge(t, i);
-                if (border_index(e) != no_half_edge) continue;
+                if (is_border[e]) continue;
                 if (is_constrained(e)) return fail();
                 const TriangleId nb = triangle_of(twin(e));
                 if (!marked(nb)) {
@@ -970,7 +969,7 @@ bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::ve
     if (region.size() + 2 * points.size() != nt) return fail();
     for (std::size_t k = 0; k < border.size(); ++k) {
         const HalfEdge o = outside[k] & link_mask;
-        if (marked(triangle_of(o)) && border_index(o) == no_half_edge) return fail();
+        if (marked(triangle_of(o)) && !is_border[o]) return fail();
     }
     for (TriangleId t : region) clear_mark(t);
 
