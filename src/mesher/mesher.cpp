@@ -1511,16 +1511,22 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     if (boundary.empty()) {
         component_area.push_back(flood(dt.last_triangle(), 0));
     } else {
+        // Consecutive segments of a ring share a node: each edge's triangle is the next one's
+        // hint, which saves a walk from the last triangle across the whole triangulation.
+        TriangleId hint = no_triangle;
         for (auto [a, b] : m.directed) {
-            HalfEdge h = dt.find_edge(dt.leaving(a), b);
+            HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
             if (h == no_half_edge) throw DataError("internal: a recovered boundary segment is missing");
+            hint = triangle_of(h);
             TriangleId left = triangle_of(h);
             if (component[left] == 0xffffffffu)
                 component_area.push_back(flood(left, static_cast<std::uint32_t>(component_area.size())));
         }
         // Every segment must have land (or the outside of the region) on its right.
+        hint = no_triangle;
         for (auto [a, b] : m.directed) {
-            HalfEdge h = dt.find_edge(dt.leaving(a), b);
+            HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
+            hint = triangle_of(h);
             TriangleId right = triangle_of(dt.twin(h));
             if (component[right] != 0xffffffffu && component[right] == component[triangle_of(h)])
                 throw DataError("the boundary rings do not close the ocean: ocean on both sides of the "
