@@ -1057,6 +1057,169 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
     return flips;
 }
 
+// The lattice points walked, per face of the icosahedron and row: row i of face f walks j in
+// [lo, hi] (weights i, j, rows - i - j on the face's corners), its cells at cell[start + j -
+// lo], each the index of its point or `none` (not kept).
+struct LatticeCells {
+    static constexpr std::uint32_t none = 0xffffffffu;
+    struct Row {
+        int lo = 1, hi = 0;
+        std::size_t start = 0;
+    };
+    int rows = 0;
+    std::vector<Row> row_of; // 20 * (rows + 1)
+    std::vector<std::uint32_t> cell;
+
+    const Row& row(int f, int i) const { return row_of[static_cast<std::size_t>(f) * (rows + 1) + i]; }
+    /// The cell of (i, j) in face f, or SIZE_MAX outside the face or the rows walked.
+    std::size_t index(int f, int i, int j) const {
+        if (i < 0 || i > rows || j < 0 || j > rows - i) return SIZE_MAX;
+        const Row& r = row(f, i);
+        return j < r.lo || j > r.hi ? SIZE_MAX : r.start + static_cast<std::size_t>(j - r.lo);
+    }
+    /// The point at (i, j) of face f, or none.
+    std::uint32_t kept(int f, int i, int j) const {
+        const std::size_t c = index(f, i, j);
+        return c == SIZE_MAX ? none : cell[c];
+    }
+};
+
+// Adds the lattice's points (those `grid` names) to the triangulation. A node inside its face
+// whose six neighbours are kept too is "inner": its whole star is the lattice's six
+// triangles. The others (on the lattice's rim, or on the icosahedron's edges) are inserted as
+// any points; their triangulation with the boundary's then holds every edge of a lattice
+// triangle whose corners are all kept (its circumcircle holds no other lattice node, and no
+// boundary node or segment, which are lattice_clearance away), so the region of each face's
+// whole lattice triangles is bounded by such edges, and the lattice's triangles replace
+// whatever triangles the rim nodes made there (replace_region). Lawson flips then mend any
+// lattice edge the rounding or the icosahedron's distortion left non-Delaunay: the result is
+// the triangulation point insertion would give, without locating each point and testing its
+// cavity. Returns the number of nodes added.
+std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& points) {
+    SphericalDelaunay& dt = m.dt;
+    constexpr std::uint32_t none = LatticeCells::none;
+    const int rows = grid.rows;
+    const std::vector<std::uint32_t>& cell = grid.cell;
+    auto kept = [&](int f, int i, int j) { return grid.kept(f, i, j); };
+    const std::size_t before = dt.vertex_count();
+    std::vector<char> inner(points.size(), 0);
+    for (int f = 0; f < 20; ++f)
+        for (int i = 1; i < rows; ++i) {
+            const LatticeCells::Row& row = grid.row(f, i);
+            for (int j = std::max(row.lo, 1); j <= std::min(row.hi, rows - i - 1); ++j) {
+                const std::uint32_t id = cell[row.start + static_cast<std::size_t>(j - row.lo)];
+                if (id == none) continue;
+                inner[id] = kept(f, i + 1, j) != none && kept(f, i - 1, j) != none && kept(f, i, j + 1) != none &&
+                            kept(f, i, j - 1) != none && kept(f, i + 1, j - 1) != none && kept(f, i - 1, j + 1) != none;
+            }
+        }
+    std::vector<Vec3> rim, inside;
+    std::vector<VertexId> vertex_of(points.size(), no_vertex); // point -> vertex (inner: filled below)
+    for (std::size_t q = 0; q < points.size(); ++q) (inner[q] ? inside : rim).push_back(points[q]);
+    if (!rim.empty()) {
+        const std::vector<VertexId> ids = dt.insert_points(rim);
+        for (std::size_t q = 0, r = 0; q < points.size(); ++q)
+            if (!inner[q]) vertex_of[q] = ids[r++];
+    }
+    points.clear();
+    points.shrink_to_fit();
+    for (std::size_t q = 0, r = 0; q < vertex_of.size(); ++q)
+        if (inner[q]) vertex_of[q] = static_cast<VertexId>(dt.vertex_count() + r++);
+    inner.clear();
+    inner.shrink_to_fit();
+    // The lattice triangles whose corners are all kept: up (i, j), (i + 1, j), (i, j + 1) at
+    // the cell of (i, j), and down (i + 1, j - 1), (i + 1, j), (i, j) at the cell of (i, j),
+    // numbered first so that each can name its neighbours; counter-clockwise as the faces are
+    // (replace_region checks).
+    std::vector<std::uint32_t> up(cell.size(), none), down(cell.size(), none);
+    std::uint32_t count = 0;
+    for (int f = 0; f < 20; ++f)
+        for (int i = 0; i < rows; ++i) {
+            const LatticeCells::Row& row = grid.row(f, i);
+            for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
+                const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
+                if (cell[c] == none || kept(f, i + 1, j) == none) continue;
+                if (kept(f, i, j + 1) != none) up[c] = count++;
+                if (kept(f, i + 1, j - 1) != none) down[c] = count++;
+            }
+        }
+    std::vector<VertexId> triangles(3 * static_cast<std::size_t>(count));
+    std::vector<std::uint32_t> adjacent(3 * static_cast<std::size_t>(count));
+    std::vector<HalfEdge> border;
+    const std::vector<HalfEdge> star = dt.vertex_half_edges();
+    bool fits = true;
+    auto tri_at = [&](const std::vector<std::uint32_t>& of, int f, int i, int j) {
+        const std::size_t c = grid.index(f, i, j);
+        return c == SIZE_MAX ? none : of[c];
+    };
+    // Half-edge e of new triangle r (corners v): its neighbour's half-edge `other` (from
+    // triangle t's edge e2, none when t is none), or the border edge of the rim nodes'
+    // triangulation that it replaces.
+    auto set_edge = [&](std::uint32_t r, int e, const VertexId* v, std::uint32_t t, int e2) {
+        if (t != none) {
+            adjacent[3 * r + e] = 3 * t + e2;
+            return;
+        }
+        const VertexId from = v[next3(e)], to = v[prev3(e)];
+        const HalfEdge h = from < star.size() ? dt.find_edge(star[from], to) : no_half_edge;
+        fits = fits && h != no_half_edge;
+        adjacent[3 * r + e] = SphericalDelaunay::patch_border | static_cast<std::uint32_t>(border.size());
+        border.push_back(h);
+    };
+    for (int f = 0; f < 20 && fits; ++f)
+        for (int i = 0; i < rows && fits; ++i) {
+            const LatticeCells::Row& row = grid.row(f, i);
+            for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
+                const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
+                if (const std::uint32_t r = up[c]; r != none) {
+                    VertexId* v = &triangles[3 * r];
+                    v[0] = vertex_of[cell[c]], v[1] = vertex_of[kept(f, i + 1, j)], v[2] = vertex_of[kept(f, i, j + 1)];
+                    // Edge 0, (i + 1, j) -> (i, j + 1), is the down triangle's at (i, j + 1)
+                    // edge 1; edge 1, (i, j + 1) -> (i, j), that at (i - 1, j + 1) edge 2;
+                    // edge 2, (i, j) -> (i + 1, j), that at (i, j) edge 0.
+                    set_edge(r, 0, v, tri_at(down, f, i, j + 1), 1);
+                    set_edge(r, 1, v, tri_at(down, f, i - 1, j + 1), 2);
+                    set_edge(r, 2, v, down[c], 0);
+                }
+                if (const std::uint32_t r = down[c]; r != none) {
+                    VertexId* w = &triangles[3 * r];
+                    w[0] = vertex_of[kept(f, i + 1, j - 1)], w[1] = vertex_of[kept(f, i + 1, j)], w[2] = vertex_of[cell[c]];
+                    // Edge 0, (i + 1, j) -> (i, j), is the up triangle's at (i, j) edge 2; edge
+                    // 1, (i, j) -> (i + 1, j - 1), that at (i, j - 1) edge 0; edge 2,
+                    // (i + 1, j - 1) -> (i + 1, j), that at (i + 1, j - 1) edge 1.
+                    set_edge(r, 0, w, up[c], 2);
+                    set_edge(r, 1, w, tri_at(up, f, i, j - 1), 0);
+                    set_edge(r, 2, w, tri_at(up, f, i + 1, j - 1), 1);
+                }
+            }
+        }
+    up.clear(), up.shrink_to_fit(), down.clear(), down.shrink_to_fit();
+    grid.cell.clear(), grid.cell.shrink_to_fit();
+    std::vector<TriangleId> slots;
+    vertex_of.clear();
+    vertex_of.shrink_to_fit();
+    const std::size_t n_inside = inside.size();
+    if (!fits || !dt.replace_region(border, inside, triangles, adjacent, ocean, &slots)) {
+        // Only if rounding kept an edge of the lattice's rim out of the rim nodes' triangulation
+        // (not seen; replace_region's checks are the guard): insert the inner nodes as points.
+        dt.insert_points(inside);
+        return dt.vertex_count() - before;
+    }
+    // Every new edge once (an edge between two new triangles from its smaller half-edge).
+    std::vector<char> is_new(dt.triangle_slots(), 0);
+    for (TriangleId t : slots) is_new[t] = 1;
+    std::vector<HalfEdge> to_check;
+    to_check.reserve(3 * slots.size() / 2 + border.size());
+    for (TriangleId t : slots)
+        for (int e = 0; e < 3; ++e) {
+            const HalfEdge h = half_edge(t, e), o = dt.twin(h);
+            if (h < o || !is_new[triangle_of(o)]) to_check.push_back(h);
+        }
+    dt.make_delaunay(to_check);
+    m.report.lattice_patched = n_inside;
+    return dt.vertex_count() - before;
+}
+
 // Fills the open ocean where the size field reaches s_km, its largest value, with the nodes of
 // an icosahedral lattice of that spacing: each of the icosahedron's 20 faces cut into n^2
 // triangles and projected onto the sphere from its centre. Its triangles are close to
@@ -1138,26 +1301,14 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
         }
         return true;
     };
-    // The points walked, per face and row: row i of face f walks j in [lo, hi], its cells at
-    // cell[start + j - lo], each the index of its point in `points` or `none` (not kept, or a
-    // node of an edge or corner that another face owns, filled in below).
-    constexpr std::uint32_t none = 0xffffffffu;
+    // The points walked (a node of an edge or corner that another face owns is filled in
+    // after the walk).
+    constexpr std::uint32_t none = LatticeCells::none;
     const int rows = static_cast<int>(n);
-    struct Row {
-        int lo = 1, hi = 0;
-        std::size_t start = 0;
-    };
-    std::vector<Row> row_of(20 * static_cast<std::size_t>(rows + 1));
-    std::vector<std::uint32_t> cell;
-    auto cell_index = [&](int f, int i, int j) -> std::size_t { // the cell of (i, j), or SIZE_MAX
-        if (i < 0 || i > rows || j < 0 || j > rows - i) return SIZE_MAX;
-        const Row& r = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
-        return j < r.lo || j > r.hi ? SIZE_MAX : r.start + static_cast<std::size_t>(j - r.lo);
-    };
-    auto kept = [&](int f, int i, int j) {
-        const std::size_t c = cell_index(f, i, j);
-        return c == SIZE_MAX ? none : cell[c];
-    };
+    LatticeCells grid;
+    grid.rows = rows;
+    grid.row_of.resize(20 * static_cast<std::size_t>(rows + 1));
+    std::vector<std::uint32_t>& cell = grid.cell;
     // The nodes on the icosahedron's 30 edges (by their smaller corner and the steps from it)
     // and at its 12 corners, shared by the faces that have them.
     std::array<std::array<int, 12>, 12> edge_id{};
@@ -1227,7 +1378,7 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
                 }
                 hi = l;
             }
-            Row& row = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
+            LatticeCells::Row& row = grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
             row = {lo, hi, cell.size()};
             cell.resize(cell.size() + static_cast<std::size_t>(hi - lo + 1), none);
             for (int step = 0; step <= hi - lo; ++step) {
@@ -1268,141 +1419,17 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
             }
         }
     }
-    const std::size_t before = dt.vertex_count();
     if (points.empty()) return 0;
     // Every face's edge and corner cells from their owners.
     for (int f = 0; f < 20; ++f)
         for (int i = 0; i <= rows; ++i) {
-            const Row& row = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
+            const LatticeCells::Row& row = grid.row(f, i);
             for (int j = row.lo; j <= row.hi; ++j)
                 if (const std::uint32_t* shared = shared_node(f, i, j, rows - i - j))
                     cell[row.start + static_cast<std::size_t>(j - row.lo)] = *shared;
         }
-    // A node inside its face whose six neighbours are kept too is "inner": its whole star is
-    // the lattice's six triangles. The others (on the lattice's rim, or on the icosahedron's
-    // edges) are inserted as any points; their triangulation with the boundary's then holds
-    // every edge of a lattice triangle whose corners are all kept (its circumcircle holds no
-    // other lattice node, and no boundary node or segment, which are lattice_clearance away),
-    // so the region of each face's whole lattice triangles is bounded by such edges, and the
-    // lattice's triangles replace whatever triangles the rim nodes made there. Lawson flips
-    // then mend any lattice edge the rounding or the icosahedron's distortion left
-    // non-Delaunay: the result is the triangulation point insertion would give, without
-    // locating each point and testing its cavity.
-    std::vector<char> inner(points.size(), 0);
-    for (int f = 0; f < 20; ++f)
-        for (int i = 1; i < rows; ++i) {
-            const Row& row = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
-            for (int j = std::max(row.lo, 1); j <= std::min(row.hi, rows - i - 1); ++j) {
-                const std::uint32_t id = cell[row.start + static_cast<std::size_t>(j - row.lo)];
-                if (id == none) continue;
-                inner[id] = kept(f, i + 1, j) != none && kept(f, i - 1, j) != none && kept(f, i, j + 1) != none &&
-                            kept(f, i, j - 1) != none && kept(f, i + 1, j - 1) != none && kept(f, i - 1, j + 1) != none;
-            }
-        }
-    std::vector<Vec3> rim, inside;
-    std::vector<VertexId> vertex_of(points.size(), no_vertex); // point -> vertex (inner: filled below)
-    for (std::size_t q = 0; q < points.size(); ++q) (inner[q] ? inside : rim).push_back(points[q]);
-    if (!rim.empty()) {
-        const std::vector<VertexId> ids = dt.insert_points(rim);
-        for (std::size_t q = 0, r = 0; q < points.size(); ++q)
-            if (!inner[q]) vertex_of[q] = ids[r++];
-    }
-    points.clear();
-    points.shrink_to_fit();
-    for (std::size_t q = 0, r = 0; q < vertex_of.size(); ++q)
-        if (inner[q]) vertex_of[q] = static_cast<VertexId>(dt.vertex_count() + r++);
-    inner.clear();
-    inner.shrink_to_fit();
-    // The lattice triangles whose corners are all kept: up (i, j), (i + 1, j), (i, j + 1) at
-    // the cell of (i, j), and down (i + 1, j - 1), (i + 1, j), (i, j) at the cell of (i, j),
-    // numbered first so that each can name its neighbours; counter-clockwise as the faces are
-    // (replace_region checks).
-    std::vector<std::uint32_t> up(cell.size(), none), down(cell.size(), none);
-    std::uint32_t count = 0;
-    for (int f = 0; f < 20; ++f)
-        for (int i = 0; i < rows; ++i) {
-            const Row& row = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
-            for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
-                const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
-                if (cell[c] == none || kept(f, i + 1, j) == none) continue;
-                if (kept(f, i, j + 1) != none) up[c] = count++;
-                if (kept(f, i + 1, j - 1) != none) down[c] = count++;
-            }
-        }
-    std::vector<VertexId> triangles(3 * static_cast<std::size_t>(count));
-    std::vector<std::uint32_t> adjacent(3 * static_cast<std::size_t>(count));
-    std::vector<HalfEdge> border;
-    const std::vector<HalfEdge> star = dt.vertex_half_edges();
-    bool fits = true;
-    auto tri_at = [&](const std::vector<std::uint32_t>& of, int f, int i, int j) {
-        const std::size_t c = cell_index(f, i, j);
-        return c == SIZE_MAX ? none : of[c];
-    };
-    // Half-edge e of new triangle r (corners v): its neighbour's half-edge `other` (from
-    // triangle t's edge e2, none when t is none), or the border edge of the rim nodes'
-    // triangulation that it replaces.
-    auto set_edge = [&](std::uint32_t r, int e, const VertexId* v, std::uint32_t t, int e2) {
-        if (t != none) {
-            adjacent[3 * r + e] = 3 * t + e2;
-            return;
-        }
-        const VertexId from = v[next3(e)], to = v[prev3(e)];
-        const HalfEdge h = from < star.size() ? dt.find_edge(star[from], to) : no_half_edge;
-        fits = fits && h != no_half_edge;
-        adjacent[3 * r + e] = SphericalDelaunay::patch_border | static_cast<std::uint32_t>(border.size());
-        border.push_back(h);
-    };
-    for (int f = 0; f < 20 && fits; ++f)
-        for (int i = 0; i < rows && fits; ++i) {
-            const Row& row = row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
-            for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
-                const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
-                if (const std::uint32_t r = up[c]; r != none) {
-                    VertexId* v = &triangles[3 * r];
-                    v[0] = vertex_of[cell[c]], v[1] = vertex_of[kept(f, i + 1, j)], v[2] = vertex_of[kept(f, i, j + 1)];
-                    // Edge 0, (i + 1, j) -> (i, j + 1), is the down triangle's at (i, j + 1)
-                    // edge 1; edge 1, (i, j + 1) -> (i, j), that at (i - 1, j + 1) edge 2;
-                    // edge 2, (i, j) -> (i + 1, j), that at (i, j) edge 0.
-                    set_edge(r, 0, v, tri_at(down, f, i, j + 1), 1);
-                    set_edge(r, 1, v, tri_at(down, f, i - 1, j + 1), 2);
-                    set_edge(r, 2, v, down[c], 0);
-                }
-                if (const std::uint32_t r = down[c]; r != none) {
-                    VertexId* w = &triangles[3 * r];
-                    w[0] = vertex_of[kept(f, i + 1, j - 1)], w[1] = vertex_of[kept(f, i + 1, j)], w[2] = vertex_of[cell[c]];
-                    // Edge 0, (i + 1, j) -> (i, j), is the up triangle's at (i, j) edge 2; edge
-                    // 1, (i, j) -> (i + 1, j - 1), that at (i, j - 1) edge 0; edge 2,
-                    // (i + 1, j - 1) -> (i + 1, j), that at (i + 1, j - 1) edge 1.
-                    set_edge(r, 0, w, up[c], 2);
-                    set_edge(r, 1, w, tri_at(up, f, i, j - 1), 0);
-                    set_edge(r, 2, w, tri_at(up, f, i + 1, j - 1), 1);
-                }
-            }
-        }
-    up.clear(), up.shrink_to_fit(), down.clear(), down.shrink_to_fit(), cell.clear(), cell.shrink_to_fit();
-    std::vector<TriangleId> slots;
-    vertex_of.clear();
-    vertex_of.shrink_to_fit();
-    const std::size_t n_inside = inside.size();
-    if (!fits || !dt.replace_region(border, inside, triangles, adjacent, ocean, &slots)) {
-        // Only if rounding kept an edge of the lattice's rim out of the rim nodes' triangulation
-        // (not seen; replace_region's checks are the guard): insert the inner nodes as points.
-        dt.insert_points(inside);
-        return dt.vertex_count() - before;
-    }
-    // Every new edge once (an edge between two new triangles from its smaller half-edge).
-    std::vector<char> is_new(dt.triangle_slots(), 0);
-    for (TriangleId t : slots) is_new[t] = 1;
-    std::vector<HalfEdge> to_check;
-    to_check.reserve(3 * slots.size() / 2 + border.size());
-    for (TriangleId t : slots)
-        for (int e = 0; e < 3; ++e) {
-            const HalfEdge h = half_edge(t, e), o = dt.twin(h);
-            if (h < o || !is_new[triangle_of(o)]) to_check.push_back(h);
-        }
-    dt.make_delaunay(to_check);
-    m.report.lattice_patched = n_inside;
-    return dt.vertex_count() - before;
+    edge_node.clear(), edge_node.shrink_to_fit();
+    return place_lattice(m, grid, points);
 }
 
 } // namespace
