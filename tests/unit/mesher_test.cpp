@@ -382,6 +382,24 @@ TEST(Mesher, faces_centred_on_land_go_where_the_mesh_stays_a_manifold_near_the_c
     expect_verified(mesh, "holes.nc"); // a manifold, oriented, constrained Delaunay
 }
 
+TEST(Mesher, a_regional_lattice_comes_with_its_triangles_inside_the_cap) {
+    // The cap around a region walks each row of the icosahedron's faces only where it meets
+    // the cap: the inner nodes of those partial rows must still be placed with their lattice
+    // triangles, and the mesh stay constrained Delaunay (mesh-verify).
+    MeshOptions o = land_110m(150);
+    o.region = std::array<double, 4>{-70, 10, -10, 55};
+    const SizeFn h = uniform_size(150);
+    CoastData coast = load_coast(o);
+    Boundary b = shape_boundary(coast, h, o);
+    MesherOptions mo;
+    mo.lattice_km = 150;
+    MesherReport report;
+    const Mesh mesh = mesh_boundary(b, h, mo, &report);
+    EXPECT_GT(report.lattice_nodes, mesh.nodes.size() / 4);
+    EXPECT_GT(report.lattice_patched, report.lattice_nodes / 2);
+    expect_verified(mesh, "atl_lattice.nc", "0.9");
+}
+
 TEST(Mesher, regional_box_has_open_boundary_edges) {
     MeshOptions o = land_110m(150);
     o.region = std::array<double, 4>{-70, 10, -10, 55};
