@@ -1152,9 +1152,9 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
         const std::size_t c = grid.index(f, i, j);
         return c == SIZE_MAX ? none : of[c];
     };
-    // Half-edge e of new triangle r (corners v): its neighbour's half-edge `other` (from
-    // triangle t's edge e2, none when t is none), or the border edge of the rim nodes'
-    // triangulation that it replaces.
+    // Links half-edge e of new triangle r (corners v) to edge e2 of new triangle t on its other
+    // side or, when t is none, to the edge of the rim nodes' triangulation that it replaces
+    // (a border edge; `fits` turns false when that edge is missing).
     auto set_edge = [&](std::uint32_t r, int e, const VertexId* v, std::uint32_t t, int e2) {
         if (t != none) {
             adjacent[3 * r + e] = 3 * t + e2;
