@@ -228,6 +228,20 @@ TEST(Mesher, lattice_fills_an_aqua_planet_with_near_equilateral_triangles) {
     expect_verified(mesh, "aqua.nc");
 }
 
+TEST(Mesher, coarse_lattices_of_a_few_rows_give_valid_meshes) {
+    // Lattices of 1 to 4 rows per icosahedron face: few or no inner nodes, nodes on the
+    // icosahedron's edges and corners everywhere, patches of a triangle or two.
+    for (const double h : {1500.0, 2500.0, 4000.0, 8000.0}) {
+        MesherOptions mo;
+        mo.lattice_km = h;
+        MesherReport report;
+        const Mesh mesh = mesh_boundary(Boundary{}, uniform_size(h), mo, &report);
+        EXPECT_EQ(2 * mesh.nodes.size(), mesh.faces.size() + 4) << h;
+        EXPECT_LE(report.lattice_patched, report.lattice_nodes) << h;
+        expect_verified(mesh, "coarse_lattice.nc");
+    }
+}
+
 TEST(Mesher, relaxation_leaves_no_node_of_valence_4_or_8_on_a_graded_sphere) {
     // Refinement and smoothing of a graded field leave pairs of valence 5 and 7 (the grading
     // needs them) but also nodes of valence 4 and 8, whose triangles no smoothing can make good:
