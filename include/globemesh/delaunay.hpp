@@ -147,7 +147,10 @@ public:
     /// the property (v at p inside the hull of its neighbours: closer than rounding resolves).
     bool move_vertex(VertexId v, const Vec3& p);
     /// The same with a half-edge leaving v (origin == v), which avoids a search for the star.
-    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p);
+    /// With `flipped`, a successful move appends the corners of every quadrilateral whose
+    /// diagonal it flipped (with repeats; nothing when no flip was needed): with v and its
+    /// neighbours before the move, every vertex whose star the move changed.
+    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p, std::vector<VertexId>* flipped = nullptr);
 
     /// Moves the origin of leaving_v to p without flips, so the triangulation may stop being
     /// Delaunay until make_delaunay(). Returns false and changes nothing when a triangle of its

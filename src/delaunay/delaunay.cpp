@@ -1193,7 +1193,7 @@ bool SphericalDelaunay::move_vertex(VertexId v, const Vec3& p) {
     return move_vertex_from(from, p);
 }
 
-bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
+bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p, std::vector<VertexId>* flipped) {
     const VertexId v = origin(from);
     // Every triangle of the star must be solid before the move and stay counter-clockwise with v
     // at p. (Moving v out of a ghost triangle changes whether the hull holds the origin, which
@@ -1222,7 +1222,14 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p) {
     // undone and v goes back.
     std::vector<FlipRecord>& journal = move_journal_;
     journal.clear();
-    if (legalize_from(stack, &journal, true, nullptr)) return true;
+    if (legalize_from(stack, &journal, true, nullptr)) {
+        if (flipped)
+            for (const FlipRecord& f : journal) {
+                flipped->insert(flipped->end(), f.tv, f.tv + 3);
+                flipped->insert(flipped->end(), f.sv, f.sv + 3);
+            }
+        return true;
+    }
     undo_flips(journal);
     points_[v] = was;
     bounded_ = was_bounded;

@@ -332,6 +332,45 @@ TEST(Delaunay, moving_a_vertex_restores_delaunay_and_refuses_folds) {
     EXPECT_TRUE(dt.validate().empty());
 }
 
+TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_changed_star) {
+    // Each vertex's neighbours before and after moves that need flips: every vertex whose
+    // neighbours changed is the moved one, one of its neighbours before, or a corner
+    // move_vertex_from reports.
+    auto p = random_points(2000, 9);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    auto neighbours = [&] {
+        std::vector<std::set<VertexId>> n(dt.vertex_count());
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+            if (dt.is_live(t))
+                for (int i = 0; i < 3; ++i) n[dt.vertex(t, i)].insert(dt.vertex(t, (i + 1) % 3));
+        return n;
+    };
+    std::size_t with_flips = 0;
+    for (std::size_t k = 0; k < 200 && with_flips < 20; ++k) {
+        const VertexId v = ids[k];
+        const HalfEdge from = dt.leaving(v);
+        const Vec3 to = normalized(0.45 * dt.point(v) + 0.55 * dt.point(dt.destination(from)));
+        const auto before = neighbours();
+        std::vector<VertexId> flipped;
+        if (!dt.move_vertex_from(from, to, &flipped)) continue;
+        ASSERT_TRUE(dt.validate().empty());
+        const auto after = neighbours();
+        std::set<VertexId> covered(flipped.begin(), flipped.end());
+        covered.insert(v);
+        covered.insert(before[v].begin(), before[v].end());
+        for (VertexId u = 0; u < dt.vertex_count(); ++u)
+            if (before[u] != after[u]) {
+                EXPECT_TRUE(covered.count(u)) << "vertex " << u << " after moving " << v;
+            }
+        with_flips += !flipped.empty();
+        if (flipped.empty()) {
+            EXPECT_EQ(before, after);
+        }
+    }
+    EXPECT_GE(with_flips, 20u);
+}
+
 TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_restores_the_property) {
     auto p = random_points(2000, 7);
     SphericalDelaunay dt;
