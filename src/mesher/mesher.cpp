@@ -1917,6 +1917,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                        todo.end());
         };
         std::vector<Vec3> candidates;
+        std::vector<VertexId> touched; // improve_node's scratch
         // Moves v to the best candidate; with `search`, a star still below worst_goal then gets
         // a pattern search for its best worst triangle (eight directions, the step halved when
         // none is better). With `changed`, v's move marks v and its neighbours there.
@@ -1966,21 +1967,28 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                     else to = next;
                 }
             }
-            if (to == p0 || !dt.move_vertex_from(from, to)) return;
+            if (to == p0) return;
+            // With `changed`: v's neighbours before the move, then the corners of any flip.
+            touched.clear();
+            if (changed) {
+                HalfEdge h = from;
+                do {
+                    touched.push_back(dt.destination(h));
+                    h = dt.next_around_origin(h);
+                } while (h != from);
+            }
+            if (!dt.move_vertex_from(from, to, changed ? &touched : nullptr)) return;
             as_made[v] = 0;
             if (!changed) return;
-            HalfEdge h = from; // moved without flips: the star is the same
-            do {
-                (*changed)[dt.destination(h)] = 1;
-                h = dt.next_around_origin(h);
-            } while (h != from);
             (*changed)[v] = 1;
+            for (VertexId u : touched) (*changed)[u] = 1;
         };
         collect(0.9, false);
         {
-            // A node's move depends on its star's points alone, and no flip happens here: a node
-            // whose star has not changed since it last stayed would stay again, and is skipped
-            // (the same mesh, fewer evaluations).
+            // A node's move depends on its star's points alone: a node whose star has not
+            // changed since it last stayed would stay again, and is skipped (the same mesh,
+            // fewer evaluations). A move changes the stars of the node, its neighbours and,
+            // when it needs flips, the corners of the flipped edges' quadrilaterals.
             std::vector<char> changed(dt.vertex_count(), 1);
             for (int round = 0; round < improve_rounds; ++round)
                 for (auto& [v, hint] : todo)
