@@ -1077,11 +1077,13 @@ struct LatticeCells {
         const Row& r = row(f, i);
         return j < r.lo || j > r.hi ? SIZE_MAX : r.start + static_cast<std::size_t>(j - r.lo);
     }
-    /// The point at (i, j) of face f, or none.
-    std::uint32_t kept(int f, int i, int j) const {
+    /// The entry of (i, j) of face f in `of` (an array over the cells), or none outside.
+    std::uint32_t at(const std::vector<std::uint32_t>& of, int f, int i, int j) const {
         const std::size_t c = index(f, i, j);
-        return c == SIZE_MAX ? none : cell[c];
+        return c == SIZE_MAX ? none : of[c];
     }
+    /// The point at (i, j) of face f, or none.
+    std::uint32_t kept(int f, int i, int j) const { return at(cell, f, i, j); }
 };
 
 // Adds the lattice's points (those `grid` names) to the triangulation. A node inside its face
@@ -1148,10 +1150,6 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
     std::vector<HalfEdge> border;
     const std::vector<HalfEdge> star = dt.vertex_half_edges();
     bool fits = true;
-    auto tri_at = [&](const std::vector<std::uint32_t>& of, int f, int i, int j) {
-        const std::size_t c = grid.index(f, i, j);
-        return c == SIZE_MAX ? none : of[c];
-    };
     // Links half-edge e of new triangle r (corners v) to edge e2 of new triangle t on its other
     // side or, when t is none, to the edge of the rim nodes' triangulation that it replaces
     // (a border edge; `fits` turns false when that edge is missing).
@@ -1177,8 +1175,8 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
                     // Edge 0, (i + 1, j) -> (i, j + 1), is the down triangle's at (i, j + 1)
                     // edge 1; edge 1, (i, j + 1) -> (i, j), that at (i - 1, j + 1) edge 2;
                     // edge 2, (i, j) -> (i + 1, j), that at (i, j) edge 0.
-                    set_edge(r, 0, v, tri_at(down, f, i, j + 1), 1);
-                    set_edge(r, 1, v, tri_at(down, f, i - 1, j + 1), 2);
+                    set_edge(r, 0, v, grid.at(down, f, i, j + 1), 1);
+                    set_edge(r, 1, v, grid.at(down, f, i - 1, j + 1), 2);
                     set_edge(r, 2, v, down[c], 0);
                 }
                 if (const std::uint32_t r = down[c]; r != none) {
@@ -1188,8 +1186,8 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
                     // 1, (i, j) -> (i + 1, j - 1), that at (i, j - 1) edge 0; edge 2,
                     // (i + 1, j - 1) -> (i + 1, j), that at (i + 1, j - 1) edge 1.
                     set_edge(r, 0, w, up[c], 2);
-                    set_edge(r, 1, w, tri_at(up, f, i, j - 1), 0);
-                    set_edge(r, 2, w, tri_at(up, f, i + 1, j - 1), 1);
+                    set_edge(r, 1, w, grid.at(up, f, i, j - 1), 0);
+                    set_edge(r, 2, w, grid.at(up, f, i + 1, j - 1), 1);
                 }
             }
         }
