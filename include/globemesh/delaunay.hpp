@@ -34,6 +34,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <utility>
@@ -150,7 +151,11 @@ public:
     /// With `flipped`, a successful move appends the corners of every quadrilateral whose
     /// diagonal it flipped (with repeats; nothing when no flip was needed): with v and its
     /// neighbours before the move, every vertex whose star the move changed.
-    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p, std::vector<VertexId>* flipped = nullptr);
+    /// With `accept`, called once v is at p and its flips are made (after `flipped` is filled):
+    /// when it returns false, the flips are undone and v goes back, so that every triangle is
+    /// exactly as before the call, which then returns false. It must not change the triangulation.
+    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p, std::vector<VertexId>* flipped = nullptr,
+                          const std::function<bool()>& accept = {});
 
     /// Moves the origin of leaving_v to p without flips, so the triangulation may stop being
     /// Delaunay until make_delaunay(). Returns false and changes nothing when a triangle of its

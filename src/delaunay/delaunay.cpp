@@ -1193,7 +1193,8 @@ bool SphericalDelaunay::move_vertex(VertexId v, const Vec3& p) {
     return move_vertex_from(from, p);
 }
 
-bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p, std::vector<VertexId>* flipped) {
+bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p, std::vector<VertexId>* flipped,
+                                         const std::function<bool()>& accept) {
     const VertexId v = origin(from);
     // Every triangle of the star must be solid before the move and stay counter-clockwise with v
     // at p. (Moving v out of a ghost triangle changes whether the hull holds the origin, which
@@ -1228,7 +1229,7 @@ bool SphericalDelaunay::move_vertex_from(HalfEdge from, const Vec3& p, std::vect
                 flipped->insert(flipped->end(), f.tv, f.tv + 3);
                 flipped->insert(flipped->end(), f.sv, f.sv + 3);
             }
-        return true;
+        if (!accept || accept()) return true;
     }
     undo_flips(journal);
     points_[v] = was;

@@ -371,6 +371,47 @@ TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_change
     EXPECT_GE(with_flips, 20u);
 }
 
+TEST(Delaunay, a_move_its_caller_refuses_leaves_every_triangle_as_it_was) {
+    // Moves that need flips, refused by `accept` after seeing the moved state: the point and
+    // every slot's corners and links come back exactly; accepted, the same move stays.
+    auto p = random_points(2000, 11);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    auto snapshot = [&] {
+        std::vector<std::array<VertexId, 6>> s(dt.triangle_slots());
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+            for (int i = 0; i < 3; ++i) {
+                s[t][i] = dt.vertex(t, i);
+                s[t][3 + i] = dt.is_live(t) ? dt.twin(half_edge(t, i)) : no_half_edge;
+            }
+        return s;
+    };
+    std::size_t refused = 0;
+    for (std::size_t k = 0; k < 200 && refused < 20; ++k) {
+        const VertexId v = ids[k];
+        const HalfEdge from = dt.leaving(v);
+        const Vec3 to = normalized(0.45 * dt.point(v) + 0.55 * dt.point(dt.destination(from)));
+        const Vec3 was = dt.point(v);
+        const auto before = snapshot();
+        std::vector<VertexId> flipped;
+        bool seen_moved = false;
+        const bool moved = dt.move_vertex_from(from, to, &flipped, [&] {
+            seen_moved = dt.point(v) == to && dt.validate().empty();
+            return false;
+        });
+        EXPECT_FALSE(moved);
+        if (!seen_moved) continue; // refused by the fold test: accept never ran
+        EXPECT_EQ(dt.point(v), was);
+        EXPECT_EQ(snapshot(), before) << "after refusing the move of " << v;
+        ASSERT_TRUE(dt.validate().empty());
+        refused += !flipped.empty();
+        EXPECT_TRUE(dt.move_vertex_from(dt.leaving(v), to, nullptr, [] { return true; }));
+        EXPECT_EQ(dt.point(v), to);
+        ASSERT_TRUE(dt.validate().empty());
+    }
+    EXPECT_GE(refused, 20u);
+}
+
 TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_restores_the_property) {
     auto p = random_points(2000, 7);
     SphericalDelaunay dt;
