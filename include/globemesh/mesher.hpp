@@ -20,7 +20,7 @@
 //      by badness in steps of 2^(1/8) and, within a step, along the Hilbert curve (locality);
 //   5. improves: sweeps of optimal-Delaunay smoothing of the interior nodes (each moved to the
 //      area-weighted mean of its triangles' circumcentres, refused where a triangle would fold),
-//      with Delaunay flips after each move; boundary nodes stay fixed. A node whose move would
+//      with Delaunay flips after each move; boundary nodes stay put. A node whose move would
 //      be under 1% of h stays, and sits out the next sweep unless a neighbour moved. Nodes are
 //      visited along the Hilbert curve (src/delaunay/hilbert.hpp), so consecutive stars share
 //      cache lines.
@@ -28,9 +28,16 @@
 //      corners are away from the boundary (not on it nor next to it) are flipped where that
 //      lowers the corners' sum of squared valence defects, the nodes around move to the mean of
 //      their neighbours without flips, and Lawson flips make the mesh Delaunay again there.
-//      Then three rounds over the nodes of triangles below q 0.9: each moves to whichever of a
-//      few candidates (the mean of the apexes that would make each star triangle equilateral,
-//      the mean of its neighbours, halfway to either) best raises its star's worst triangle.
+//      Then six rounds over the nodes of triangles below q 0.9: each interior node moves where
+//      its star has the best worst triangle up to 0.6, then the most triangles above q 0.8,
+//      then the highest sum of qualities capped at 0.82 (a pattern search from the best of a
+//      few candidates: the mean of the apexes that would make each star triangle equilateral,
+//      the mean of its neighbours, halfway to either). With MesherOptions::land, each boundary
+//      node between two coast segments of one ring slides the same way, within 0.2 h of the
+//      source coast (LandTest::coast_within), where no coast corner becomes sharper than 60
+//      degrees and no more of its faces are centred on land. Every move is checked on the
+//      triangles its flips leave (none below the star's worst or 0.6, none of two or three
+//      boundary corners below 0.6) and undone otherwise.
 //      Last, two rounds of a pattern search over the nodes of triangles still below q 0.6,
 //      and triangles with two or three boundary corners still below 0.6 get a node (their
 //      circumcentre, or the midpoint of the segment in its way);
@@ -81,9 +88,10 @@ struct MesherOptions {
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
     double lattice_km = 0;
-    /// The source land at full resolution (e.g. coast.hpp's LandMask): faces whose centroid lies
-    /// on it are removed at the end where the mesh stays one manifold and its new boundary nodes
-    /// near the coast (step 7 above). Null: no such step.
+    /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
+    /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where
+    /// the mesh stays one manifold and its new boundary nodes near the coast (step 7). Null:
+    /// boundary nodes stay where the rings put them, and no face is removed.
     std::shared_ptr<const LandTest> land;
 };
 
