@@ -52,11 +52,11 @@ int main(int argc, char** argv) {
         globemesh::write_ugrid(mesh, argv[4]);
         std::printf("%s: %zu nodes (%zu from the lattice), %zu faces, %zu sharp corners touching %zu faces, "
                     "%zu inlets closed (%.0f km2), %zu flips towards valence 6, %zu triangles of boundary corners mended, %zu faces moved off "
-                    "dropped islands (%zu left on them), %zu faces on land removed with %zu of water (%zu holes, %zu loops joined, %zu left)\n",
+                    "dropped islands (%zu left on them), %zu faces on land removed with %zu of water (%zu holes, %zu loops joined, %zu moved off, %zu left)\n",
                     field.c_str(), mesh.nodes.size(), report.lattice_nodes, mesh.faces.size(), report.sharp_corners,
                     report.sharp_corner_faces, report.inlets_closed, report.inlet_area_km2, report.valence_flips, report.corners_mended,
                     report.island_centroids_moved, report.island_centroids_left, report.land_faces_removed, report.water_faces_removed, report.land_holes,
-                    report.land_loops_joined, report.land_faces_left);
+                    report.land_loops_joined, report.land_faces_nudged, report.land_faces_left);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mesher_fields: %s\n", e.what());
         return 1;

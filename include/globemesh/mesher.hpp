@@ -58,9 +58,13 @@
 //      Bosphorus at 100 km). Otherwise a face goes with the one or two water faces between it
 //      and the boundary at a corner. A node it leaves on the boundary lies within h/2 of the
 //      coast (LandTest::coast_within). Removing faces keeps every other
-//      face and edge, so the mesh stays constrained Delaunay. The faces left on land are
-//      reported (in straits kept open, or where a removal would leave a node too far from the
-//      coast or pinch the mesh).
+//      face and edge, so the mesh stays constrained Delaunay. A face left on land then gets one
+//      corner moved (a boundary corner slides, as in step 5) so that its centroid goes to the
+//      water nearest it in the face, where no triangle falls below min(its star's worst, 0.6)
+//      and fewer faces are centred on land; the edges between ocean and land are constrained
+//      first, so no flip crosses the boundary. The faces left on land are reported (in narrow
+//      straits kept open, or where a removal would leave a node too far from the coast or
+//      pinch the mesh).
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -123,6 +127,7 @@ struct MesherReport {
     std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
     std::size_t land_faces_removed = 0; ///< faces removed because their centroid lies on land
     std::size_t land_faces_left = 0;    ///< faces centred on land that could not go (MesherOptions::land)
+    std::size_t land_faces_nudged = 0;  ///< faces that a corner's move took off land instead
     std::size_t water_faces_removed = 0; ///< faces removed with them so that the mesh stays a manifold
     std::size_t land_holes = 0;         ///< boundary loops those removals opened (islands back)
     std::size_t land_loops_joined = 0;  ///< boundary loops those removals joined to another (narrow water closed)

@@ -193,7 +193,8 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("faces_on_land", std::to_string(report.land_faces_left) + " (" +
                                         std::to_string(report.land_faces_removed) + " removed, opening " +
                                         std::to_string(report.land_holes) + " holes, joining " +
-                                        std::to_string(report.land_loops_joined) + " loops)");
+                                        std::to_string(report.land_loops_joined) + " loops, " +
+                                        std::to_string(report.land_faces_nudged) + " moved off)");
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +
