@@ -205,12 +205,15 @@ double star_count_best(std::size_t n) { return count_worst_weight * worst_goal +
 /// none is accepted, until it is no longer above `stop`. Returns where it ends.
 template <class Consider>
 Vec3 pattern_search(Vec3 to, double step, double stop, Consider&& consider) {
+    // cos and sin of k pi / 4.
+    constexpr double r = 0.70710678118654752440;
+    constexpr double cosines[8] = {1, r, 0, -r, -1, -r, 0, r}, sines[8] = {0, r, 1, r, 0, -r, -1, -r};
     while (step > stop) {
         const Vec3 e1 = normalized(cross(to, std::abs(to.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
         const Vec3 e2 = cross(to, e1);
         Vec3 next = to;
         for (int k = 0; k < 8; ++k) {
-            const Vec3 p = normalized(to + step * (std::cos(k * pi / 4) * e1 + std::sin(k * pi / 4) * e2));
+            const Vec3 p = normalized(to + step * (cosines[k] * e1 + sines[k] * e2));
             if (consider(p)) next = p;
         }
         if (next == to) step *= 0.5;

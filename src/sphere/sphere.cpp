@@ -118,14 +118,4 @@ double turn_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
     return std::acos(std::clamp(dot(n1, n2) / (l1 * l2), -1.0, 1.0));
 }
 
-double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {
-    double la = norm(b - c), lb = norm(c - a), lc = norm(a - b);
-    double area = 0.5 * norm(cross(b - a, c - a));
-    double perimeter = la + lb + lc;
-    double lmax = std::max({la, lb, lc});
-    if (perimeter == 0 || lmax == 0) return 0.0;
-    double inradius = 2.0 * area / perimeter;
-    return 2.0 * std::sqrt(3.0) * inradius / lmax;
-}
-
 } // namespace globemesh
