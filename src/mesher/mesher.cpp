@@ -93,7 +93,10 @@ constexpr double count_worst_weight = 1000; // the worst up to worst_goal comes 
 // their centroid on land. Measured on 1:50m land, 100 km / Gulf Stream field: q > 0.8
 // 98.90 / 98.87% without slides, 99.61 / 99.57% with; boundary node to coast p95 0.233 / 0.223 h
 // -> 0.227 / 0.212 h; face centroids on land 52 / 47 -> 48 / 39 (66 / 45 when slides may put
-// more centroids on land).
+// more centroids on land). The coast and land rules checked only on the points the search
+// improved through, from the best back, instead of on each: mesh_boundary at 64 km 2,339 ->
+// 2,204 million instructions; after the nudge below, faces on land 19 / 14 -> 18 / 15, p95
+// 0.227 / 0.212 -> 0.228 / 0.218 h, q > 0.8 99.54 / 99.49 -> 99.54 / 99.50%.
 constexpr double slide_reach = 0.2;
 // Relaxation towards valence 6 (relax_valence): passes of flips over the candidate triangles, a
 // flip refused where either new triangle would be below q relax_floor; then rounds of moves to
@@ -2193,6 +2196,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         std::vector<Vec3> candidates;
         std::vector<VertexId> touched;                 // move_checked's scratch
         std::vector<std::pair<Vec3, Vec3>> land_far;   // slide_node's: the star's far edges on land
+        std::vector<Vec3> chain;                       // slide_node's: the points its search improved through
         // Moves v (`from` leaves it) to `to` (Mesher::move_if) when the ocean triangles the move
         // and its flips leave near it all keep q >= floor and none with two or three boundary
         // corners falls below quality_goal (the mending would have to split it); `ends` as in
@@ -2279,23 +2283,31 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 for (const auto& [b, c] : far) n += options.land->contains(normalized(p + b + c));
                 return n;
             };
-            const int land0 = on_land(p0);
+            // The search scores the star alone; the coast and land rules are checked on the points
+            // it improved through, from the best back.
+            chain.clear();
             Vec3 to = p0;
             auto consider = [&](const Vec3& p) {
                 for (const auto& [b, c] : land_far)
                     if (predicates::orient(p, b, c) <= 0) return false;
                 const double score = star_count_score(p, far, floor, best + 1e-12);
-                if (score <= best + 1e-12 || !options.land->coast_within(p, reach)) return false;
-                if (on_land(p) > land0) return false;
+                if (score <= best + 1e-12) return false;
                 best = score;
                 to = p;
+                chain.push_back(p);
                 return true;
             };
             for (VertexId e : ends)
                 for (double f : {0.1, 0.2, 0.3}) consider(normalized((1 - f) * p0 + f * dt.point(e)));
             const double step = 0.5 * reach;
-            to = pattern_search(to, step, step / 8, consider);
-            if (to != p0) move_checked(v, from, to, floor, changed, ends);
+            pattern_search(to, step, step / 8, consider);
+            if (chain.empty()) return;
+            const int land0 = on_land(p0);
+            for (auto it = chain.rbegin(); it != chain.rend(); ++it)
+                if (options.land->coast_within(*it, reach) && on_land(*it) <= land0) {
+                    move_checked(v, from, *it, floor, changed, ends);
+                    return;
+                }
         };
         // The search rounds' move: to the candidate, then, when the star is still below
         // worst_goal, the point of a pattern search, that best raises the star's worst.

@@ -123,8 +123,8 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     // mesher reports left (577 before the mesher removed them, 129 when it kept every loop
     // apart, 50 with groups and joins; 48 once narrow basins closed whole (Lake Maracaibo),
     // about 20 of them in straits kept open, the rest where a removal would bring a node more
-    // than h/2 from the coast onto the boundary or pinch the mesh; 19 now that a corner's move
-    // takes 29 of those off: the Dardanelles, Johnstone Strait, the Strait of Bonifacio, the
+    // than h/2 from the coast onto the boundary or pinch the mesh; 18 now that a corner's move
+    // takes 28 more off: the Dardanelles, Johnstone Strait, the Strait of Bonifacio, the
     // Amazon mouths, Magellan, the Canadian Arctic). Each hole the removals opened is one more
     // boundary loop, each join one fewer; narrow water between islands and the mainland closes
     // in a few dozen places.
