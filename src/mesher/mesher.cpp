@@ -1146,13 +1146,15 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
 
 // Moves the faces still centred on land (`faces`, from remove_land_faces: in straits kept
 // open, or where a removal would pinch the mesh or leave a node far from the coast) off it
-// where one interior corner can take them: the corner goes nudge_reach times the way from
-// the centroid to the nearest water point of the face (a triangular grid of nudge_grid
-// rows), so that the centroid lands in that water. A move is kept when, on the triangles
-// around the corner and its flips' corners, no triangle falls below min(the star's worst,
-// nudge_floor) and fewer faces are centred on land than in the corner's star before. The
-// edges between ocean and land are constrained first, so that no flip crosses the boundary
-// the removals made. Returns how many fewer faces are centred on land.
+// where one corner can take them: an interior corner, or a boundary corner that may slide
+// (Mesher::slide_star, within slide_reach h of the coast), goes nudge_reaches times the way
+// from the centroid to one of the nudge_water points of the face nearest it that lie in the
+// water (a triangular grid of nudge_grid rows), the first that works. A move is kept when,
+// on the triangles around the corner and its flips' corners (Mesher::move_if), no triangle
+// falls below min(the star's worst, nudge_floor) and fewer faces are centred on land than in
+// the corner's star before. The edges between ocean and land are constrained first, so that
+// no flip crosses the boundary the removals made. Returns how many fewer faces are centred
+// on land.
 std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces) {
     SphericalDelaunay& dt = m.dt;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
