@@ -59,8 +59,8 @@
 //      and the boundary at a corner. A node it leaves on the boundary lies within h/2 of the
 //      coast (LandTest::coast_within). Removing faces keeps every other
 //      face and edge, so the mesh stays constrained Delaunay. A face left on land then gets one
-//      corner moved (a boundary corner slides, as in step 5) so that its centroid goes to the
-//      water nearest it in the face, where no triangle falls below min(its star's worst, 0.6)
+//      corner moved (a boundary corner slides as in step 5; one the removals put on the
+//      boundary stays within h/2 of the coast) so that its centroid goes to the water near it, where no triangle falls below min(its star's worst, 0.6)
 //      and fewer faces are centred on land; the edges between ocean and land are constrained
 //      first, so no flip crosses the boundary. The faces left on land are reported (in narrow
 //      straits kept open, or where a removal would leave a node too far from the coast or

@@ -145,7 +145,10 @@ constexpr std::size_t land_fan_faces = 2;
 // left on land at 100 km / Gulf Stream field: no nudge 48 / 39; interior corners only, the 3
 // nearest points at 3.3: 26 / 24 (q > 0.8 99.61 -> 99.53%), floor 0.7 35 / 32, 4 times 31 / 27,
 // 5 times 34 / 29; boundary corners sliding too (slide_reach), 3.1: 21 / 15; the 8 nearest at
-// 2, 3.1 and 4: 19 / 14 (q > 0.8 99.54 / 99.49%); a second pass: the same.
+// 2, 3.1 and 4: 19 / 14 (q > 0.8 99.54 / 99.49%); a second pass: the same. (18 / 15 with the
+// slides' lazy checks.) Nodes that the removals put on the boundary sliding too, within the
+// land_exposed_reach that admitted them: 12 / 13 (99.52 / 99.50%); a grid of 24 rows or a
+// reach of 1.5 as well: 12 / 12-13.
 constexpr double nudge_reaches[3] = {2.0, 3.1, 4.0};
 constexpr int nudge_grid = 12;
 constexpr double nudge_floor = 0.6;
@@ -370,10 +373,14 @@ struct Mesher {
     // ring's node between two coast segments, neither it nor their other ends a sharp corner.
     // Fills `far` with its ocean triangles' far edges, `land_far` with its other triangles',
     // and `ends` with the segments' other ends; false (and nothing to rely on) otherwise.
+    // With `exposed`, also a node that the removal of faces centred on land put on the boundary
+    // (remove_land_faces; those edges constrained by then): an edge that is no segment counts
+    // as coast, and a corner below 60 degrees as sharp.
     bool slide_star(HalfEdge from, std::vector<std::pair<Vec3, Vec3>>& far, std::vector<std::pair<Vec3, Vec3>>& land_far,
-                    VertexId ends[2]) const {
+                    VertexId ends[2], bool exposed = false) const {
         const VertexId v = dt.origin(from);
-        if (is_sharp(v) || v >= ring_of.size() || ring_of[v] >= shared_ring) return false;
+        if (is_sharp(v)) return false;
+        if (!exposed && (v >= ring_of.size() || ring_of[v] >= shared_ring)) return false;
         far.clear();
         land_far.clear();
         int constrained = 0;
@@ -390,8 +397,12 @@ struct Mesher {
         if (h != from || constrained != 2 || far.empty()) return false;
         for (int k = 0; k < 2; ++k) {
             auto it = segments.find(key(v, ends[k]));
-            if (is_sharp(ends[k]) || it == segments.end() || it->second != SegmentKind::coast) return false;
+            if (is_sharp(ends[k])) return false;
+            if (it == segments.end() ? !exposed : it->second != SegmentKind::coast) return false;
         }
+        if (exposed)
+            for (VertexId u : {v, ends[0], ends[1]})
+                if (ocean_angle(u, triangle_of(from)) < 60.0 * deg_to_rad) return false;
         return true;
     }
 
@@ -1187,12 +1198,13 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
         for (int k = 0; k < 3 && !done; ++k) {
             const VertexId v = dt.vertex(t, k);
             const HalfEdge from = half_edge(t, prev3(k)); // leaves v
-            // A boundary node slides as in the quality rounds (Mesher::slide_star, slide_reach).
-            const bool slide = m.is_fixed(v);
+            // A boundary node slides as in the quality rounds (Mesher::slide_star, slide_reach);
+            // one the removals put on the boundary within the reach they allowed it.
             VertexId ends[2];
-            if (slide ? !m.slide_star(from, far, land_far, ends) : !m.ocean_star(from, far)) continue;
+            const bool slide = !m.ocean_star(from, far);
+            if (slide && !m.slide_star(from, far, land_far, ends, true)) continue;
             const Vec3 p0 = dt.point(v);
-            const double reach = slide_reach * km_to_rad(m.size_km(p0));
+            const double reach = (m.is_fixed(v) ? slide_reach : land_exposed_reach) * km_to_rad(m.size_km(p0));
             double worst = 1;
             int land_before = 0;
             for (const auto& [x, y] : far) {
