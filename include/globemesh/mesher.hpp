@@ -128,6 +128,7 @@ struct MesherReport {
     std::size_t land_faces_removed = 0; ///< faces removed because their centroid lies on land
     std::size_t land_faces_left = 0;    ///< faces centred on land that could not go (MesherOptions::land)
     std::size_t land_faces_nudged = 0;  ///< faces that a corner's move took off land instead
+    std::vector<Vec3> land_faces_at;    ///< the centroids of the land_faces_left
     std::size_t water_faces_removed = 0; ///< faces removed with them so that the mesh stays a manifold
     std::size_t land_holes = 0;         ///< boundary loops those removals opened (islands back)
     std::size_t land_loops_joined = 0;  ///< boundary loops those removals joined to another (narrow water closed)

@@ -426,8 +426,15 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     out << "coast             " << attribute("boundary_rings") << " rings kept, islands dropped "
         << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
         << ", inlets closed " << attribute("inlets_closed") << "\n"
-        << "faces on land     " << attribute("faces_on_land") << "\n"
-        << "ocean components  " << attribute("ocean_components") << "\n";
+        << "faces on land     " << attribute("faces_on_land") << "\n";
+    if (std::string at = attribute("faces_on_land_at"); at != "?") {
+        // The first six places (lon lat); all of them, up to 50, are the attribute.
+        std::size_t cut = 0;
+        for (int i = 0; i < 6 && cut != std::string::npos; ++i) cut = at.find(", ", cut + (i > 0 ? 2 : 0));
+        if (cut != std::string::npos) at = at.substr(0, cut) + ", ... (faces_on_land_at)";
+        out << "                  at " << at << "\n";
+    }
+    out << "ocean components  " << attribute("ocean_components") << "\n";
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"

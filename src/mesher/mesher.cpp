@@ -1165,8 +1165,9 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
 // falls below min(the star's worst, nudge_floor) and fewer faces are centred on land than in
 // the corner's star before. The edges between ocean and land are constrained first, so that
 // no flip crosses the boundary the removals made. Returns how many fewer faces are centred
-// on land.
-std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces) {
+// on land; `left_at` gets the centroids of those still on land.
+std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces,
+                           std::vector<Vec3>& left_at) {
     SphericalDelaunay& dt = m.dt;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
@@ -1179,6 +1180,12 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
     std::vector<std::pair<Vec3, Vec3>> far, land_far;
     std::vector<VertexId> touched;
     std::vector<std::pair<double, Vec3>> water;
+    // The corners of the faces and every vertex a move changed the star of: the faces centred
+    // on land at the end all lie around them.
+    std::vector<std::pair<VertexId, TriangleId>> around; // each with a triangle near it
+    for (const TriangleId t : faces)
+        if (dt.is_live(t))
+            for (int k = 0; k < 3; ++k) around.emplace_back(dt.vertex(t, k), t);
     std::size_t fewer = 0;
     for (const TriangleId t : faces) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
@@ -1229,6 +1236,7 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
                 if (!m.move_if(from, to, slide ? ends : nullptr, touched, holds, [&] { return land_after < land_before; }))
                     return false;
                 fewer += static_cast<std::size_t>(land_before - land_after);
+                for (const VertexId u : touched) around.emplace_back(u, triangle_of(from));
                 return true;
             };
             for (const auto& [dist, w] : water)
@@ -1236,6 +1244,23 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
                     if (!done) done = try_move(normalized(p0 + reach_factor * (w - c)));
         }
     }
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+                 around.end());
+    std::vector<TriangleId> on;
+    for (const auto& [u, near] : around) {
+        const HalfEdge first = dt.leaving(u, near);
+        HalfEdge h = first;
+        do {
+            const TriangleId t = triangle_of(h);
+            if (dt.label(t) == ocean && land_test.contains(m.centroid(t))) on.push_back(t);
+            h = dt.next_around_origin(h);
+        } while (h != first);
+    }
+    std::sort(on.begin(), on.end());
+    on.erase(std::unique(on.begin(), on.end()), on.end());
+    left_at.clear();
+    for (const TriangleId t : on) left_at.push_back(m.centroid(t));
     return fewer;
 }
 
@@ -2431,8 +2456,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         t0 = Clock::now();
         std::vector<TriangleId> left;
         report.land_faces_left = remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left);
-        report.land_faces_nudged = nudge_off_land(m, *options.land, left);
-        report.land_faces_left -= std::min(report.land_faces_left, report.land_faces_nudged);
+        report.land_faces_nudged = nudge_off_land(m, *options.land, left, report.land_faces_at);
+        report.land_faces_left = report.land_faces_at.size();
         if (timings) timings->add("land", seconds_since(t0));
     }
 

@@ -195,6 +195,18 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
                                         std::to_string(report.land_holes) + " holes, joining " +
                                         std::to_string(report.land_loops_joined) + " loops, " +
                                         std::to_string(report.land_faces_nudged) + " moved off)");
+    if (!report.land_faces_at.empty()) {
+        // Where they are (lon lat, degrees), for --size-regions: the first 50.
+        std::string at;
+        char buf[48];
+        for (std::size_t i = 0; i < report.land_faces_at.size() && i < 50; ++i) {
+            const LonLat ll = vec_to_lonlat(report.land_faces_at[i]);
+            std::snprintf(buf, sizeof buf, "%s%.2f %.2f", i ? ", " : "", ll.lon, ll.lat);
+            at += buf;
+        }
+        if (report.land_faces_at.size() > 50) at += ", ...";
+        a.emplace_back("faces_on_land_at", at);
+    }
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +

@@ -8,6 +8,7 @@
 #include <iterator>
 #include <map>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include "globemesh/coast.hpp"
@@ -133,6 +134,21 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     ASSERT_TRUE(test::regex_match(on_land, R"((\d+) \((\d+) removed, opening (\d+) holes, joining (\d+) loops, (\d+) moved off\))", &m)) << on_land;
     EXPECT_LT(std::stoul(m[1]), 20u);
     EXPECT_GT(std::stoul(m[5]), 25u);
+    // faces_on_land_at lists each of them (lon lat): the centroid of a face of the mesh.
+    std::istringstream at(attribute(mesh, "faces_on_land_at"));
+    std::size_t listed = 0;
+    for (std::string item; std::getline(at, item, ',');) {
+        std::istringstream ll(item);
+        double lon = 0, lat = 0;
+        ASSERT_TRUE(ll >> lon >> lat) << item;
+        const Vec3 p = lonlat_to_vec(lon, lat);
+        double nearest = pi;
+        for (const auto& f : mesh.faces)
+            nearest = std::min(nearest, arc_angle(p, normalized(mesh.nodes[f[0]] + mesh.nodes[f[1]] + mesh.nodes[f[2]])));
+        EXPECT_LT(rad_to_km(nearest), 1.0) << item;
+        ++listed;
+    }
+    EXPECT_EQ(listed, std::stoul(m[1]));
     EXPECT_GT(std::stoul(m[2]), 450u);
     EXPECT_GT(std::stoul(m[4]), 10u);
     EXPECT_EQ(compute_stats(mesh).boundary_loops, std::stoul(attribute(mesh, "boundary_rings")) + std::stoul(m[3]) - std::stoul(m[4]));
@@ -394,6 +410,8 @@ TEST(Mesher, faces_centred_on_land_go_where_the_mesh_stays_a_manifold_near_the_c
     const Mesh mesh = mesh_boundary(b, uniform_size(400), mo, &report);
     const std::size_t on = count_on_land(mesh);
     EXPECT_EQ(on, report.land_faces_left);
+    ASSERT_EQ(report.land_faces_at.size(), on); // where they are: each on a square
+    for (const Vec3& c : report.land_faces_at) EXPECT_TRUE(on_land(c));
     EXPECT_LT(on, on_before / 4);
     // The same faces until this last step, each removed, moved off by a corner, or left.
     EXPECT_EQ(report.land_faces_removed + report.land_faces_nudged + on, on_before);
