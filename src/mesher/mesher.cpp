@@ -2299,7 +2299,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // Half the search rounds' first step, and 4 halvings instead of 6.
             const double step = 0.5 * star_candidates(p0);
             for (const Vec3& p : candidates) consider(p);
-            to = pattern_search(to, step, step / 16, consider);
+            if (best < star_count_best(far.size())) to = pattern_search(to, step, step / 16, consider);
             if (to != p0) move_checked(v, from, to, floor, changed);
         };
         // The same for boundary node v, between two coast segments of one ring, neither end a
@@ -2339,7 +2339,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             for (VertexId e : ends)
                 for (double f : {0.1, 0.2, 0.3}) consider(normalized((1 - f) * p0 + f * dt.point(e)));
             const double step = 0.5 * reach;
-            pattern_search(to, step, step / 8, consider);
+            if (best < star_count_best(far.size())) pattern_search(to, step, step / 8, consider);
             if (chain.empty()) return;
             const int land0 = on_land(p0);
             for (auto it = chain.rbegin(); it != chain.rend(); ++it)
