@@ -60,11 +60,12 @@
 //      coast (LandTest::coast_within). Removing faces keeps every other
 //      face and edge, so the mesh stays constrained Delaunay. A face left on land then gets one
 //      corner moved (a boundary corner slides as in step 5; one the removals put on the
-//      boundary stays within h/2 of the coast) so that its centroid goes to the water near it, where no triangle falls below min(its star's worst, 0.6)
-//      and fewer faces are centred on land; the edges between ocean and land are constrained
-//      first, so no flip crosses the boundary. The faces left on land are reported (in narrow
-//      straits kept open, or where a removal would leave a node too far from the coast or
-//      pinch the mesh).
+//      boundary stays within h/2 of the coast) so that its centroid goes to the water near it,
+//      where no triangle falls below min(its star's worst, 0.6) and fewer faces are centred on
+//      land; the edges between ocean and land are constrained first, so no flip crosses the
+//      boundary. The faces left on land are reported with their centroids (in narrow straits
+//      kept open, or where a removal would leave a node too far from the coast or pinch the
+//      mesh).
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
