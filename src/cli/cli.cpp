@@ -407,7 +407,12 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
           << "  \"outputs\": {\"netcdf\": " << json_string(o.output);
         if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
         if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
-        r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n"
+        r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n";
+        // What the run did to the coast and the land, as the NetCDF file's global attributes say.
+        r << "  \"attributes\": {";
+        for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
+            r << (i ? ", " : "") << json_string(mesh.attributes[i].first) << ": " << json_string(mesh.attributes[i].second);
+        r << "},\n"
           << "  \"stages\": " << stages_json(timings) << ",\n"
           << "  \"total_seconds\": " << json_number(total_s) << ",\n"
           << "  \"peak_memory_bytes\": " << peak << "\n}\n";

@@ -120,6 +120,9 @@ for k in ('mesh', 'write'):
 assert all(v >= 0 for v in t['stages'].values())
 assert 0.6 * 400 < r['mesh']['edge_km']['mean'] < 1.3 * 400, r['mesh']['edge_km']
 assert r['mesh']['boundary_loops'] == )" + std::to_string(loops) + R"(, r['mesh']['boundary_loops']
+# The run's attributes, as in the NetCDF file's global attributes.
+for k in ('coast_file', 'boundary_rings', 'faces_on_land', 'inlets_closed'):
+    assert r['attributes'][k] == ds.getncattr(k), (k, r['attributes'].get(k), ds.getncattr(k))
 print('OK', lon.shape[0])
 )",
                                        dir.path());
