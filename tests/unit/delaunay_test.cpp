@@ -332,6 +332,16 @@ TEST(Delaunay, moving_a_vertex_restores_delaunay_and_refuses_folds) {
     EXPECT_TRUE(dt.validate().empty());
 }
 
+namespace {
+
+// A move's target that usually needs flips: 55% of the way from the origin of `from` to its
+// destination.
+Vec3 past_halfway(const SphericalDelaunay& dt, HalfEdge from) {
+    return normalized(0.45 * dt.point(dt.origin(from)) + 0.55 * dt.point(dt.destination(from)));
+}
+
+} // namespace
+
 TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_changed_star) {
     // Each vertex's neighbours before and after moves that need flips: every vertex whose
     // neighbours changed is the moved one, one of its neighbours before, or a corner
@@ -350,7 +360,7 @@ TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_change
     for (std::size_t k = 0; k < 200 && with_flips < 20; ++k) {
         const VertexId v = ids[k];
         const HalfEdge from = dt.leaving(v);
-        const Vec3 to = normalized(0.45 * dt.point(v) + 0.55 * dt.point(dt.destination(from)));
+        const Vec3 to = past_halfway(dt, from);
         const auto before = neighbours();
         std::vector<VertexId> flipped;
         if (!dt.move_vertex_from(from, to, &flipped)) continue;
@@ -390,7 +400,7 @@ TEST(Delaunay, a_move_its_caller_refuses_leaves_every_triangle_as_it_was) {
     for (std::size_t k = 0; k < 200 && refused < 20; ++k) {
         const VertexId v = ids[k];
         const HalfEdge from = dt.leaving(v);
-        const Vec3 to = normalized(0.45 * dt.point(v) + 0.55 * dt.point(dt.destination(from)));
+        const Vec3 to = past_halfway(dt, from);
         const Vec3 was = dt.point(v);
         const auto before = snapshot();
         std::vector<VertexId> flipped;
