@@ -203,6 +203,13 @@ double star_count_score(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>&
     return count_worst_weight * worst + score;
 }
 
+/// How many of the star triangles p, b, c (far edges b -> c) have their centroid on land.
+int star_faces_on_land(const LandTest& land, const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far) {
+    int n = 0;
+    for (const auto& [b, c] : far) n += land.contains(normalized(p + b + c));
+    return n;
+}
+
 /// The highest star_count_score of a star of n triangles: all above count_cap.
 double star_count_best(std::size_t n) { return count_worst_weight * worst_goal + double(n) * (1 + count_cap); }
 
@@ -366,9 +373,6 @@ struct Mesher {
         return t;
     }
 
-    // The far edges b -> c of the star of from's origin (counter-clockwise around it, as
-    // star_worst_quality takes them), into `far`; false when a triangle of the star is not
-    // ocean or the star has more than 64.
     // For a boundary node that may slide along the coast (from: a half-edge leaving it): one
     // ring's node between two coast segments, neither it nor their other ends a sharp corner.
     // Fills `far` with its ocean triangles' far edges, `land_far` with its other triangles',
@@ -476,6 +480,9 @@ struct Mesher {
     }
     std::vector<TriangleId> seen_; // move_if's scratch
 
+    // The far edges b -> c of the star of from's origin (counter-clockwise around it, as
+    // star_worst_quality takes them), into `far`; false when a triangle of the star is not
+    // ocean or the star has more than 64.
     bool ocean_star(HalfEdge from, std::vector<std::pair<Vec3, Vec3>>& far) const {
         far.clear();
         HalfEdge h = from;
@@ -1212,13 +1219,8 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
             if (slide && !m.slide_star(from, far, land_far, ends, true)) continue;
             const Vec3 p0 = dt.point(v);
             const double reach = (m.is_fixed(v) ? slide_reach : land_exposed_reach) * km_to_rad(m.size_km(p0));
-            double worst = 1;
-            int land_before = 0;
-            for (const auto& [x, y] : far) {
-                worst = std::min(worst, triangle_quality(p0, x, y));
-                land_before += land_test.contains(normalized(p0 + x + y));
-            }
-            const double floor = std::min(worst, nudge_floor);
+            const int land_before = star_faces_on_land(land_test, p0, far);
+            const double floor = std::min(star_worst_quality(p0, far), nudge_floor);
             auto try_move = [&](const Vec3& to) {
                 if (star_worst_quality(to, far, floor) < floor) return false;
                 if (slide) {
@@ -2316,12 +2318,6 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const double floor = std::min(star_worst_quality(p0, far), worst_goal);
             double best = star_count_score(p0, far, floor);
             if (best >= star_count_best(far.size())) return; // every triangle above count_cap
-            // The star's faces centred on the source land with v at p.
-            auto on_land = [&](const Vec3& p) {
-                int n = 0;
-                for (const auto& [b, c] : far) n += options.land->contains(normalized(p + b + c));
-                return n;
-            };
             // The search scores the star alone; the coast and land rules are checked on the points
             // it improved through, from the best back.
             chain.clear();
@@ -2341,9 +2337,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const double step = 0.5 * reach;
             if (best < star_count_best(far.size())) pattern_search(to, step, step / 8, consider);
             if (chain.empty()) return;
-            const int land0 = on_land(p0);
+            const int land0 = star_faces_on_land(*options.land, p0, far);
             for (auto it = chain.rbegin(); it != chain.rend(); ++it)
-                if (options.land->coast_within(*it, reach) && on_land(*it) <= land0) {
+                if (options.land->coast_within(*it, reach) && star_faces_on_land(*options.land, *it, far) <= land0) {
                     move_checked(v, from, *it, floor, changed, ends);
                     return;
                 }
@@ -2392,9 +2388,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             }
         }
         // Last, search_rounds rounds over the nodes of the triangles still below worst_goal
-        // (away from sharp corners), collected again each round.
-        // A triangle below worst_goal now was below 0.9 before the quality rounds, or a move
-        // changed it: only the triangles with a corner marked in `dirty` are looked at.
+        // (away from sharp corners), collected again each round. Such a triangle was below 0.9
+        // before the quality rounds, or a move changed it: only the triangles with a corner
+        // marked in `dirty` are looked at.
         for (int round = 0; round < search_rounds; ++round) {
             collect(worst_goal, true, nullptr, &dirty);
             if (todo.empty()) break;
@@ -2455,7 +2451,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     if (options.land) {
         t0 = Clock::now();
         std::vector<TriangleId> left;
-        report.land_faces_left = remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left);
+        remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left);
         report.land_faces_nudged = nudge_off_land(m, *options.land, left, report.land_faces_at);
         report.land_faces_left = report.land_faces_at.size();
         if (timings) timings->add("land", seconds_since(t0));
