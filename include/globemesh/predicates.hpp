@@ -145,4 +145,31 @@ inline int in_circle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
     return s != 0 ? s : detail::in_circle_exact(a, b, c, d);
 }
 
+/// What orient(a, b, c) computes from b and c alone, kept for testing many a against one edge
+/// b -> c (the far edges of a star, in the mesher's searches): the minors b x c and each
+/// coordinate column's largest magnitude over b and c. orient(a, OrientEdge(b, c)) is
+/// orient(a, b, c), the same rounded determinant and bound, with the exact stage behind.
+struct OrientEdge {
+    Vec3 b, c;
+    Vec3 minors; // b x c, rounded as orient_filter rounds it
+    Vec3 extent; // max(|b.x|, |c.x|), and the same for y and z
+    OrientEdge(const Vec3& b_, const Vec3& c_)
+        : b(b_), c(c_), minors{b_.y * c_.z - b_.z * c_.y, b_.z * c_.x - b_.x * c_.z, b_.x * c_.y - b_.y * c_.x},
+          extent{std::max(std::fabs(b_.x), std::fabs(c_.x)), std::max(std::fabs(b_.y), std::fabs(c_.y)),
+                 std::max(std::fabs(b_.z), std::fabs(c_.z))} {}
+};
+
+inline int orient(const Vec3& a, const OrientEdge& e) {
+    const double det = a.x * e.minors.x + a.y * e.minors.y + a.z * e.minors.z;
+    const double mx = std::max(std::fabs(a.x), e.extent.x);
+    const double my = std::max(std::fabs(a.y), e.extent.y);
+    const double mz = std::max(std::fabs(a.z), e.extent.z);
+    const double bound = detail::orient_bound * mx * my * mz;
+    if (detail::filter_range(mx, my, mz)) {
+        if (det > bound) return 1;
+        if (det < -bound) return -1;
+    }
+    return detail::orient_exact(a, e.b, e.c);
+}
+
 } // namespace globemesh::predicates

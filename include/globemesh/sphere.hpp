@@ -91,17 +91,22 @@ inline constexpr double rad_to_km(double rad) { return rad * earth_radius_km; }
 
 namespace globemesh {
 
-/// Shape quality of the chordal (flat) triangle through three unit vectors:
-/// q = 2*sqrt(3)*inradius/longest edge, 1 for equilateral, 0 for degenerate (mesh-verify's q).
-/// Inline: the improve stage's searches evaluate it some 1e6 times per 1e5 nodes.
-inline double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {
-    const double la = norm(b - c), lb = norm(c - a), lc = norm(a - b);
+/// triangle_quality below with la = |b - c| already known: the improve stage's searches try
+/// many a against one b, c, some 1e6 times per 1e5 nodes (hence inline).
+inline double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c, double la) {
+    const double lb = norm(c - a), lc = norm(a - b);
     const double area = 0.5 * norm(cross(b - a, c - a));
     const double perimeter = la + lb + lc;
     const double lmax = std::max({la, lb, lc});
     if (perimeter == 0 || lmax == 0) return 0.0;
     const double inradius = 2.0 * area / perimeter;
     return 2.0 * std::sqrt(3.0) * inradius / lmax;
+}
+
+/// Shape quality of the chordal (flat) triangle through three unit vectors:
+/// q = 2*sqrt(3)*inradius/longest edge, 1 for equilateral, 0 for degenerate (mesh-verify's q).
+inline double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {
+    return triangle_quality(a, b, c, norm(b - c));
 }
 
 } // namespace globemesh

@@ -165,17 +165,24 @@ constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
 constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
 
+/// A far edge b -> c of a star (its triangle v, b, c for the centre v), with what the tests of
+/// many candidate centres p share: the minors of orient(p, b, c) and |b - c|.
+struct FarEdge : predicates::OrientEdge {
+    double length;
+    FarEdge(const Vec3& b_, const Vec3& c_) : OrientEdge(b_, c_), length(norm(b_ - c_)) {}
+};
+
 /// The worst quality of the star triangles p, b, c for the star's far edges b -> c (counter-
 /// clockwise around the star's centre), or -1 when p would fold one of them (move_vertex's test).
 /// With `floor`, stops at the first triangle at or below it and returns that triangle's
 /// quality: a value at or below floor, no smaller than the worst (for callers that only ask
 /// whether the worst beats floor; the moves of the improve stage evaluate candidates so).
-double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far,
+double star_worst_quality(const Vec3& p, const std::vector<FarEdge>& far,
                           double floor = -2.0) {
     double worst = 1;
-    for (const auto& [b, c] : far) {
-        if (predicates::orient(p, b, c) <= 0) return -1.0;
-        worst = std::min(worst, triangle_quality(p, b, c));
+    for (const FarEdge& e : far) {
+        if (predicates::orient(p, e) <= 0) return -1.0;
+        worst = std::min(worst, triangle_quality(p, e.b, e.c, e.length));
         if (worst <= floor) return worst;
     }
     return worst;
@@ -187,12 +194,12 @@ double star_worst_quality(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>
 /// triangles above count_quality or, as many, closer to it. -1 when p would fold a triangle or
 /// bring one below `floor`. With `beat`, returns as soon as the score can no longer exceed it
 /// (a value at or below beat).
-double star_count_score(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far, double floor,
+double star_count_score(const Vec3& p, const std::vector<FarEdge>& far, double floor,
                         double beat = -2.0) {
     double score = 0, worst = worst_goal, left = static_cast<double>(far.size());
-    for (const auto& [b, c] : far) {
-        if (predicates::orient(p, b, c) <= 0) return -1.0;
-        const double q = triangle_quality(p, b, c);
+    for (const FarEdge& e : far) {
+        if (predicates::orient(p, e) <= 0) return -1.0;
+        const double q = triangle_quality(p, e.b, e.c, e.length);
         if (q < floor) return -1.0;
         worst = std::min(worst, q);
         score += (q > count_quality ? 1.0 : 0.0) + std::min(q, count_cap);
@@ -204,9 +211,9 @@ double star_count_score(const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>&
 }
 
 /// How many of the star triangles p, b, c (far edges b -> c) have their centroid on land.
-int star_faces_on_land(const LandTest& land, const Vec3& p, const std::vector<std::pair<Vec3, Vec3>>& far) {
+int star_faces_on_land(const LandTest& land, const Vec3& p, const std::vector<FarEdge>& far) {
     int n = 0;
-    for (const auto& [b, c] : far) n += land.contains(normalized(p + b + c));
+    for (const FarEdge& e : far) n += land.contains(normalized(p + e.b + e.c));
     return n;
 }
 
@@ -238,7 +245,7 @@ Vec3 pattern_search(Vec3 to, double step, double stop, Consider&& consider) {
 /// True when moving the star's centre from `at` to `to` (far: its far edges) would bring the
 /// star's worst triangle below `floor` and below where it was: the smoothing moves' refusal
 /// test. The whole worst after the move is computed only when it falls below floor.
-bool lowers_worst_below(const Vec3& to, const Vec3& at, const std::vector<std::pair<Vec3, Vec3>>& far, double floor) {
+bool lowers_worst_below(const Vec3& to, const Vec3& at, const std::vector<FarEdge>& far, double floor) {
     if (star_worst_quality(to, far, std::nextafter(floor, 0.0)) >= floor) return false;
     return star_worst_quality(to, far) < star_worst_quality(at, far);
 }
@@ -380,7 +387,7 @@ struct Mesher {
     // With `exposed`, also a node that the removal of faces centred on land put on the boundary
     // (remove_land_faces; those edges constrained by then): an edge that is no segment counts
     // as coast, and a corner below 60 degrees as sharp.
-    bool slide_star(HalfEdge from, std::vector<std::pair<Vec3, Vec3>>& far, std::vector<std::pair<Vec3, Vec3>>& land_far,
+    bool slide_star(HalfEdge from, std::vector<FarEdge>& far, std::vector<FarEdge>& land_far,
                     VertexId ends[2], bool exposed = false) const {
         const VertexId v = dt.origin(from);
         if (is_sharp(v)) return false;
@@ -483,7 +490,7 @@ struct Mesher {
     // The far edges b -> c of the star of from's origin (counter-clockwise around it, as
     // star_worst_quality takes them), into `far`; false when a triangle of the star is not
     // ocean or the star has more than 64.
-    bool ocean_star(HalfEdge from, std::vector<std::pair<Vec3, Vec3>>& far) const {
+    bool ocean_star(HalfEdge from, std::vector<FarEdge>& far) const {
         far.clear();
         HalfEdge h = from;
         do {
@@ -739,7 +746,7 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
     std::size_t left = 0;
     std::vector<double> px, py;
     std::vector<TriangleId> near, around, stack;
-    std::vector<std::pair<Vec3, Vec3>> far;
+    std::vector<FarEdge> far;
     std::vector<std::array<double, 3>> exits; // distance, unit direction in the projection
     std::vector<Vec3> shifts;                 // the centroid's move for each way out
     std::vector<std::uint32_t> seen(dt.triangle_slots(), 0);
@@ -834,10 +841,10 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
                 for (const Vec3& shift : shifts) {
                     const Vec3 to = normalized(p0 + 3.0 * shift);
                     double worst = 1;
-                    for (const auto& [b, cc] : far) {
-                        const double q = triangle_quality(to, b, cc);
-                        if (predicates::orient(to, b, cc) <= 0 || inside(normalized(to + b + cc)) ||
-                            q < std::min(island_quality_floor, triangle_quality(p0, b, cc))) {
+                    for (const FarEdge& e : far) {
+                        const double q = triangle_quality(to, e.b, e.c, e.length);
+                        if (predicates::orient(to, e) <= 0 || inside(normalized(to + e.b + e.c)) ||
+                            q < std::min(island_quality_floor, triangle_quality(p0, e.b, e.c, e.length))) {
                             worst = -1;
                             break;
                         }
@@ -1184,7 +1191,7 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
     auto quality_of = [&](TriangleId t) {
         return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)), dt.point(dt.vertex(t, 2)));
     };
-    std::vector<std::pair<Vec3, Vec3>> far, land_far;
+    std::vector<FarEdge> far, land_far;
     std::vector<VertexId> touched;
     std::vector<std::pair<double, Vec3>> water;
     // The corners of the faces and every vertex a move changed the star of: the faces centred
@@ -1224,8 +1231,8 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
             auto try_move = [&](const Vec3& to) {
                 if (star_worst_quality(to, far, floor) < floor) return false;
                 if (slide) {
-                    for (const auto& [x, y] : land_far)
-                        if (predicates::orient(to, x, y) <= 0) return false;
+                    for (const FarEdge& e : land_far)
+                        if (predicates::orient(to, e) <= 0) return false;
                     if (!land_test.coast_within(to, reach)) return false;
                 }
                 // The ocean triangles near v after the move: each at or above floor, fewer centred
@@ -1338,13 +1345,13 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
     move.erase(std::unique(move.begin(), move.end()), move.end());
     // A move that would bring the star's worst triangle below relax_move_floor, and below where
     // it was, is refused.
-    std::vector<std::pair<Vec3, Vec3>> far;
+    std::vector<FarEdge> far;
     for (int round = 0; round < relax_rounds; ++round)
         for (VertexId v : move) {
             const HalfEdge from = star[v];
             if (!m.ocean_star(from, far)) continue;
             Vec3 sum{0, 0, 0};
-            for (const auto& bc : far) sum = sum + bc.first;
+            for (const FarEdge& e : far) sum = sum + e.b;
             const Vec3 to = normalized(sum);
             if (lowers_worst_below(to, dt.point(v), far, relax_move_floor)) continue;
             if (dt.place_vertex_from(from, to)) as_made[v] = 0, active[v] = 1;
@@ -2112,7 +2119,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         visit.reserve(keyed.size());
         for (const auto& kv : keyed) visit.push_back(kv.second);
     }
-    std::vector<std::pair<Vec3, Vec3>> far; // a star's far edges b -> c (triangles v, b, c)
+    std::vector<FarEdge> far; // a star's far edges b -> c (triangles v, b, c)
     std::vector<VertexId> ring;             // the star's outer vertices
     // Per vertex, bit 0: visit in this sweep, bit 1: in the next. A node whose move would be
     // shorter than settle_fraction of h stays and stays off the next sweep, unless a neighbour
@@ -2236,7 +2243,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         };
         std::vector<Vec3> candidates;
         std::vector<VertexId> touched;                 // move_checked's scratch
-        std::vector<std::pair<Vec3, Vec3>> land_far;   // slide_node's: the star's far edges on land
+        std::vector<FarEdge> land_far;   // slide_node's: the star's far edges on land
         std::vector<Vec3> chain;                       // slide_node's: the points its search improved through
         // Moves v (`from` leaves it) to `to` (Mesher::move_if) when the ocean triangles the move
         // and its flips leave near it all keep q >= floor and none with two or three boundary
@@ -2266,10 +2273,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         auto star_candidates = [&](const Vec3& p0) {
             Vec3 apex{0, 0, 0}, mean{0, 0, 0};
             double step = 0;
-            for (const auto& [b, c] : far) {
-                const double d = 0.5 * std::sqrt(3.0) * arc_angle(b, c);
-                apex = apex + (std::cos(d) * arc_midpoint(b, c) + std::sin(d) * normalized(cross(b, c)));
-                mean = mean + b;
+            for (const FarEdge& e : far) {
+                const double d = 0.5 * std::sqrt(3.0) * arc_angle(e.b, e.c);
+                apex = apex + (std::cos(d) * arc_midpoint(e.b, e.c) + std::sin(d) * normalized(cross(e.b, e.c)));
+                mean = mean + e.b;
                 step += d;
             }
             candidates.clear();
@@ -2323,8 +2330,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             chain.clear();
             Vec3 to = p0;
             auto consider = [&](const Vec3& p) {
-                for (const auto& [b, c] : land_far)
-                    if (predicates::orient(p, b, c) <= 0) return false;
+                for (const FarEdge& e : land_far)
+                    if (predicates::orient(p, e) <= 0) return false;
                 const double score = star_count_score(p, far, floor, best + 1e-12);
                 if (score <= best + 1e-12) return false;
                 best = score;

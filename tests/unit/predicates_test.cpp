@@ -292,6 +292,25 @@ TEST(Predicates, orient_matches_gmp_on_random_and_adversarial_triples) {
     EXPECT_GT(zeros, 0); // the generators do reach exact degeneracy
 }
 
+TEST(Predicates, orient_against_a_kept_edge_matches_gmp) {
+    // orient(a, OrientEdge(b, c)) keeps what orient(a, b, c) computes from b and c alone; its
+    // signs must be the exact ones, through the filter and the exact stage alike.
+    Gen g;
+    int zeros = 0;
+    for (const auto& q : adversarial_quadruples(g, 36000)) {
+        const predicates::OrientEdge e(q[1], q[2]);
+        ASSERT_EQ(orient(q[0], e), gmp_orient(q[0], q[1], q[2])) << describe(q);
+        ASSERT_EQ(orient(q[3], e), gmp_orient(q[3], q[1], q[2])) << describe(q);
+        zeros += gmp_orient(q[3], q[1], q[2]) == 0;
+    }
+    EXPECT_GT(zeros, 0);
+    for (int i = 0; i < 3000; ++i) {
+        const int x = g.pick(1200) - 600; // 2^-600 .. 2^600
+        const Vec3 a = scaled(g.unit(), x), b = scaled(g.unit(), x), c = scaled(g.unit(), x);
+        ASSERT_EQ(orient(a, predicates::OrientEdge(b, c)), gmp_orient(a, b, c)) << x;
+    }
+}
+
 TEST(Predicates, orient3d_matches_gmp_on_random_and_adversarial_quadruples) {
     Gen g;
     int zeros = 0;
