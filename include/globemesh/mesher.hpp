@@ -63,9 +63,14 @@
 //      boundary stays within h/2 of the coast) so that its centroid goes to the water near it,
 //      where no triangle falls below min(its star's worst, 0.6) and fewer faces are centred on
 //      land; the edges between ocean and land are constrained first, so no flip crosses the
-//      boundary. The faces left on land are reported with their centroids (in narrow straits
-//      kept open, or where a removal would leave a node too far from the coast or pinch the
-//      mesh).
+//      boundary. The faces still on land lie across straits narrower than a face, or where a
+//      removal would leave a node too far from the coast. With MesherOptions::close_straits
+//      (the default) they go as above but may also cut the mesh in two, the sea behind
+//      becoming a basin of its own (the Black Sea behind the Dardanelles at 100 km; reported,
+//      and a piece under inlet_area * h^2 goes too), or close the strait at a node between two
+//      fans of water (the output gives each fan after the first a node of its own, 0.64 m into
+//      it, so the mesh stays a manifold), and the nodes they put on the boundary may lie up to
+//      0.75 h from the coast. The faces left on land are reported with their centroids.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -98,6 +103,9 @@ struct MesherOptions {
     /// the mesh stays one manifold and its new boundary nodes near the coast (step 7). Null:
     /// boundary nodes stay where the rings put them, and no face is removed.
     std::shared_ptr<const LandTest> land;
+    /// With `land`: close the straits narrower than a face that faces centred on land are left
+    /// across (step 7), rather than keep them open with those faces.
+    bool close_straits = true;
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory
@@ -133,6 +141,11 @@ struct MesherReport {
     std::size_t water_faces_removed = 0; ///< faces removed with them so that the mesh stays a manifold
     std::size_t land_holes = 0;         ///< boundary loops those removals opened (islands back)
     std::size_t land_loops_joined = 0;  ///< boundary loops those removals joined to another (narrow water closed)
+    std::size_t straits_closed = 0;     ///< of the faces removed, those that closed a strait (MesherOptions::close_straits)
+    std::vector<Vec3> straits_closed_at; ///< their centroids
+    std::vector<double> seas_cut_off;   ///< km2 of each basin those closings cut off (kept)
+    double straits_water_km2 = 0;       ///< water cut off with them and closed (MesherOptions::inlet_area)
+    std::size_t nodes_split = 0;        ///< nodes added where a strait closed at a node between two fans of water
     std::vector<OceanComponent> components;
 };
 

@@ -26,6 +26,9 @@ struct MeshOptions {
     /// Islands whose area is below this many equilateral triangles of the local size are dropped.
     double min_island_triangles = 4;
     bool keep_inland_seas = false; ///< --keep-inland-seas: keep water bodies not connected to the ocean
+    /// --keep-straits: keep open the straits narrower than a triangle, with their triangles
+    /// centred on land, instead of closing them (MesherOptions::close_straits)
+    bool keep_straits = false;
 
     // --- bathymetry (bathymetry/) ---
     std::string bathy;             ///< --bathy: any GDAL raster of elevation (or depth)

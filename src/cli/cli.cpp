@@ -162,6 +162,9 @@ struct MeshCommand {
             ->group(coast)->type_name("AREA")->transform(unit_transform(parse_area_km2, ""));
         app.add_flag("--keep-inland-seas", m.keep_inland_seas, "Keep water bodies not connected to the ocean")
             ->group(coast);
+        app.add_flag("--keep-straits", m.keep_straits,
+                     "Keep straits narrower than a triangle open, their triangles centred on land")
+            ->group(coast);
 
         app.add_option("--bathy", m.bathy, "Elevation (or depth) raster: any GDAL raster; default none")
             ->group(bathy)->type_name("RASTER");
@@ -432,12 +435,19 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
         << ", inlets closed " << attribute("inlets_closed") << "\n"
         << "faces on land     " << attribute("faces_on_land") << "\n";
-    if (std::string at = attribute("faces_on_land_at"); at != "?") {
-        // The first six places (lon lat); all of them, up to 50, are the attribute.
+    // The first six places (lon lat) of a list attribute; all of them, up to 50, are the attribute.
+    auto places = [&](const char* key) {
+        std::string at = attribute(key);
+        if (at == "?") return;
         std::size_t cut = 0;
         for (int i = 0; i < 6 && cut != std::string::npos; ++i) cut = at.find(", ", cut + (i > 0 ? 2 : 0));
-        if (cut != std::string::npos) at = at.substr(0, cut) + ", ... (faces_on_land_at)";
+        if (cut != std::string::npos) at = at.substr(0, cut) + ", ... (" + key + ")";
         out << "                  at " << at << "\n";
+    };
+    places("faces_on_land_at");
+    if (std::string closed = attribute("straits_closed"); closed != "?" && closed.rfind("0 ", 0) != 0) {
+        out << "straits closed    " << closed << "\n";
+        places("straits_closed_at");
     }
     out << "ocean components  " << attribute("ocean_components") << "\n";
     print_timings(out, timings);

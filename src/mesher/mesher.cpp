@@ -154,6 +154,19 @@ constexpr int nudge_grid = 12;
 constexpr double nudge_floor = 0.6;
 constexpr std::size_t nudge_water = 8;
 constexpr double land_exposed_reach = 0.5;
+// The faces still centred on land after the nudge lie across straits narrower than a face
+// (close_straits). Closing one may cut the mesh in two (the sea behind becomes a basin of its
+// own: the Black Sea behind the Dardanelles at 100 km; a piece under close_inlets' rule goes
+// too: the rest of the strait, or a narrow sound behind it) or leave a node between two fans
+// of water (the strait closed at a point: the output splits the node, pinch_apart radians
+// into each fan); a node it puts on the boundary may lie up to strait_exposed_reach h from the
+// coast. Measured on 1:50m land, faces left centred on land at 100 km: 12 before; cuts allowed
+// 6; nodes between two fans too 2; the last two (Roosevelt Island and Kolguyev, dropped by the
+// shaping, where a corner would come onto the boundary 0.5-0.75 h from their coast) with the
+// reach 0.75: 0. Gulf Stream field 13 -> 0, 20 km 29 -> 0; boundary node to coast p95 at 100 km
+// 0.228 -> 0.230 h.
+constexpr double strait_exposed_reach = 0.75;
+constexpr double pinch_apart = 1e-7; // 0.64 m
 // A face centred on land whose removal would join two boundary loops goes only when at least
 // this many of its 6 halfway points (remove_land_faces, land_points) are on land too.
 constexpr int join_land_points = 3;
@@ -267,6 +280,8 @@ struct Mesher {
     std::vector<std::pair<VertexId, VertexId>> directed; // each segment a->b with ocean on the left
     MesherReport& report;
     std::vector<char> sharp; // per vertex: a boundary corner with an ocean angle below 60 degrees
+    std::vector<VertexId> pinched; // boundary vertices a closed strait left between fans of ocean
+    std::vector<TriangleId> cut_sides; // ocean faces beside closings that cut the mesh in two
 
     bool is_sharp(VertexId v) const { return v < sharp.size() && sharp[v]; }
     std::vector<char> fixed; // per vertex: on a boundary segment (moved only by the slides)
@@ -879,11 +894,18 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
 // on the boundary and around those corners' neighbours, and `island_faces`. Each goes alone or
 // in a small group, all or none, where the mesh stays one manifold (try_remove below): a hole
 // opens where it touches no loop, loops join where it touches several, a group that would cut
-// the mesh in two is refused; a sea behind a strait therefore stays connected. Passes repeat
-// while faces go, since one gone may free the next. Returns the faces left on land (listed in
+// the mesh in two is refused, so a sea behind a strait stays connected. Passes repeat while
+// faces go, since one gone may free the next. Returns the faces left on land (listed in
 // `left_faces`); the faces removed, the holes opened and the loops joined go to `report`.
+//
+// With `straits` (close_straits), the faces looked at are `island_faces` alone, and a removal
+// may also cut the mesh in two or leave a node between two fans of water (in Mesher::pinched;
+// the output splits it); nodes it puts on the boundary may lie up to strait_exposed_reach h
+// from the coast. The ocean faces beside each removal that cut the mesh go to `cut_sides`,
+// and each removal that closed a strait (cut, joined or pinched) to report.straits_closed.
 std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<TriangleId> island_faces,
-                              double pocket_area, MesherReport& report, std::vector<TriangleId>& left_faces) {
+                              double pocket_area, MesherReport& report, std::vector<TriangleId>& left_faces,
+                              bool straits = false, std::vector<TriangleId>* cut_sides = nullptr) {
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     // The next half-edge leaving origin(h) clockwise around it (next_around_origin's reverse):
@@ -914,24 +936,34 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
             auto it = next_on_boundary.find(a);
             return it != next_on_boundary.end() && it->second == b;
         };
-        TriangleId hint = no_triangle;
-        for (const auto& [segment, kind] : m.segments) {
-            const auto [a, b] = segment;
-            if (seen(a, b) || seen(b, a)) continue;
-            const HalfEdge from = dt.leaving(a, hint);
-            const HalfEdge e = from == no_half_edge ? no_half_edge : dt.find_edge(from, b);
-            if (e == no_half_edge) continue;
-            hint = triangle_of(e);
-            for (const HalfEdge start : {e, dt.twin(e)}) {
-                if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start)))) continue;
-                HalfEdge h = start;
-                do {
-                    next_on_boundary.emplace(dt.origin(h), dt.destination(h));
-                    loop_of.emplace(dt.origin(h), loops);
-                    boundary_edges.push_back(h);
-                    h = next_on_loop(h);
-                } while (h != start && boundary_edges.size() <= m.segments.size());
-                loop_parent.push_back(loops++);
+        auto trace = [&](HalfEdge start, std::size_t at_most) {
+            if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start)))) return;
+            if (seen(dt.origin(start), dt.destination(start))) return;
+            HalfEdge h = start;
+            do {
+                next_on_boundary.emplace(dt.origin(h), dt.destination(h));
+                loop_of.emplace(dt.origin(h), loops);
+                boundary_edges.push_back(h);
+                h = next_on_loop(h);
+            } while (h != start && boundary_edges.size() <= at_most);
+            loop_parent.push_back(loops++);
+        };
+        if (straits) {
+            // Earlier removals made boundary edges that are no segments: every edge between
+            // ocean and land starts a loop not traced yet.
+            for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+                if (is_ocean(t))
+                    for (int i = 0; i < 3; ++i) trace(half_edge(t, i), 3 * dt.triangle_slots());
+        } else {
+            TriangleId hint = no_triangle;
+            for (const auto& [segment, kind] : m.segments) {
+                const auto [a, b] = segment;
+                if (seen(a, b) || seen(b, a)) continue;
+                const HalfEdge from = dt.leaving(a, hint);
+                const HalfEdge e = from == no_half_edge ? no_half_edge : dt.find_edge(from, b);
+                if (e == no_half_edge) continue;
+                hint = triangle_of(e);
+                for (const HalfEdge start : {e, dt.twin(e)}) trace(start, m.segments.size());
             }
         }
     }
@@ -953,11 +985,13 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
             h = dt.next_around_origin(h);
         } while (h != from);
     };
-    for (const HalfEdge h : boundary_edges) mark(triangle_of(h), 1);
-    const std::size_t first_ring = near_list.size();
-    for (std::size_t i = 0; i < first_ring; ++i) for_star(near_list[i].second, [&](TriangleId t) { mark(t, 2); });
     std::vector<TriangleId> faces, candidates;
-    for (const auto& [v, from] : near_list) for_star(from, [&](TriangleId t) { candidates.push_back(t); });
+    if (!straits) {
+        for (const HalfEdge h : boundary_edges) mark(triangle_of(h), 1);
+        const std::size_t first_ring = near_list.size();
+        for (std::size_t i = 0; i < first_ring; ++i) for_star(near_list[i].second, [&](TriangleId t) { mark(t, 2); });
+        for (const auto& [v, from] : near_list) for_star(from, [&](TriangleId t) { candidates.push_back(t); });
+    }
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
     for (TriangleId t : candidates)
@@ -1051,23 +1085,28 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
                 const HalfEdge h = half_edge(t, i);
                 if (!is_ocean(triangle_of(dt.twin(h)))) arc_parent[arc_root(index_of(dt.origin(h)))] = arc_root(index_of(dt.destination(h)));
             }
-        std::vector<std::uint32_t> arc_loops; // one per contact arc
+        std::vector<std::uint32_t> arc_loops; // one per loop touched
+        bool cuts = false;                    // two contact arcs on one loop
         for (VertexId i = 0; i < corners.size(); ++i) {
             auto it = loop_of.find(corners[i].first);
             if (it == loop_of.end() || arc_root(i) != i) continue;
             const std::uint32_t root = loop_root(it->second);
-            if (std::find(arc_loops.begin(), arc_loops.end(), root) != arc_loops.end()) return false; // would cut the mesh
+            if (std::find(arc_loops.begin(), arc_loops.end(), root) != arc_loops.end()) {
+                if (!straits) return false; // would cut the mesh
+                cuts = true;
+                continue;
+            }
             arc_loops.push_back(root);
         }
-        if (arc_loops.size() > 1 && land_points(needed) < join_land_points) return false;
+        if ((arc_loops.size() > 1 || cuts) && land_points(needed) < join_land_points) return false;
         for (TriangleId t : members) dt.set_label(t, land);
         bool ok = true;
+        const double reach = straits ? strait_exposed_reach : land_exposed_reach;
         for (const auto& [v, from] : corners) {
             const int fans = fans_at(from);
             const bool was_on_boundary = loop_of.count(v) > 0;
-            if (fans > 1 || (!was_on_boundary && fans == 0)) ok = false;
-            else if (!was_on_boundary &&
-                     !land_test.coast_within(dt.point(v), land_exposed_reach * km_to_rad(m.size_km(dt.point(v)))))
+            if ((fans > 1 && !(straits && was_on_boundary)) || (!was_on_boundary && fans == 0)) ok = false;
+            else if (!was_on_boundary && !land_test.coast_within(dt.point(v), reach * km_to_rad(m.size_km(dt.point(v)))))
                 ok = false;
             if (!ok) break;
         }
@@ -1086,6 +1125,24 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
             joins += arc_loops.size() - 1;
         }
         for (const auto& c : corners) loop_of.emplace(c.first, loop);
+        if (straits) {
+            // A strait closed: the removal cut the mesh, joined loops or pinched it at a node
+            // (not an island coming back as a hole, or a bite into one coast).
+            bool pinched = false;
+            for (const auto& [v, from] : corners)
+                if (fans_at(from) > 1) {
+                    m.pinched.push_back(v);
+                    pinched = true;
+                }
+            if (cuts || pinched || arc_loops.size() > 1) {
+                ++report.straits_closed;
+                report.straits_closed_at.push_back(m.centroid(needed));
+            }
+        }
+        if (cuts && cut_sides)
+            for (TriangleId t : members)
+                for (int i = 0; i < 3; ++i)
+                    if (is_ocean(dt.neighbour(t, i))) cut_sides->push_back(dt.neighbour(t, i));
         removed_faces += members.size();
         return true;
     };
@@ -1179,9 +1236,9 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
 // falls below min(the star's worst, nudge_floor) and fewer faces are centred on land than in
 // the corner's star before. The edges between ocean and land are constrained first, so that
 // no flip crosses the boundary the removals made. Returns how many fewer faces are centred
-// on land; `left_at` gets the centroids of those still on land.
+// on land; `left` and `left_at` get those still on land and their centroids.
 std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces,
-                           std::vector<Vec3>& left_at) {
+                           std::vector<TriangleId>& left, std::vector<Vec3>& left_at) {
     SphericalDelaunay& dt = m.dt;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
@@ -1270,7 +1327,102 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
     on.erase(std::unique(on.begin(), on.end()), on.end());
     left_at.clear();
     for (const TriangleId t : on) left_at.push_back(m.centroid(t));
+    left = std::move(on);
     return fewer;
+}
+
+// Closes the straits narrower than a face that `faces` (those still centred on land after the
+// nudge) lie across (MesherOptions::close_straits): remove_land_faces with `straits`. Of the
+// pieces a closing cut the mesh into, the largest stays; the others go under close_inlets'
+// rule (at most inlet_area h^2 of water, or narrow on average and at most inlet_narrow_area
+// h^2: the rest of the strait, a narrow sound behind it) unless they touch an open boundary,
+// and stay otherwise as basins of their own (report.seas_cut_off). Leaves in `faces` those
+// still on land.
+void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>& faces, const MesherOptions& options,
+                   MesherReport& report) {
+    SphericalDelaunay& dt = m.dt;
+    auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
+    std::vector<TriangleId> sides, left;
+    remove_land_faces(m, land_test, faces, options.inlet_area, report, left, true, &sides);
+    // The pieces beside the cuts, each flooded until whole or over inlet_narrow_area h^2 (then
+    // it stays whatever it is: the ocean, or a sea cut off). Floods that meet are one piece
+    // (union-find over the floods).
+    struct Flood {
+        std::vector<TriangleId> faces; // visited; those before `next` counted in the root's sums
+        std::size_t next = 0;
+        std::uint32_t parent;
+        double area = 0, perimeter = 0; // the piece's, at its root (radians)
+        bool open = false;              // the piece touches an open (sea) boundary
+    };
+    std::vector<Flood> floods;
+    std::unordered_map<TriangleId, std::uint32_t> piece;
+    auto root = [&](std::uint32_t f) {
+        while (floods[f].parent != f) f = floods[f].parent = floods[floods[f].parent].parent;
+        return f;
+    };
+    for (const TriangleId t : sides)
+        if (is_ocean(t) && piece.emplace(t, static_cast<std::uint32_t>(floods.size())).second)
+            floods.push_back({{t}, 0, static_cast<std::uint32_t>(floods.size())});
+    for (std::uint32_t f = 0; f < floods.size(); ++f) {
+        const double h = km_to_rad(m.size_km(m.centroid(floods[f].faces[0])));
+        const double cap = inlet_narrow_area * h * h;
+        while (floods[f].next < floods[f].faces.size() && floods[root(f)].area <= cap) {
+            const TriangleId t = floods[f].faces[floods[f].next++];
+            Flood& r = floods[root(f)];
+            r.area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)), dt.point(dt.vertex(t, 2)));
+            for (int i = 0; i < 3; ++i) {
+                const TriangleId n = dt.neighbour(t, i);
+                if (!is_ocean(n)) {
+                    const VertexId x = dt.vertex(t, next3(i)), y = dt.vertex(t, prev3(i));
+                    r.perimeter += arc_angle(dt.point(x), dt.point(y));
+                    const auto it = m.segments.find(key(x, y));
+                    r.open = r.open || (it != m.segments.end() && it->second == SegmentKind::open);
+                    continue;
+                }
+                const auto [it, added] = piece.emplace(n, f);
+                if (added) {
+                    floods[f].faces.push_back(n);
+                } else if (const std::uint32_t g = root(it->second), rf = root(f); g != rf) {
+                    floods[g].parent = rf; // the same piece: its sums go to one root
+                    floods[rf].area += floods[g].area;
+                    floods[rf].perimeter += floods[g].perimeter;
+                    floods[rf].open = floods[rf].open || floods[g].open;
+                }
+            }
+        }
+    }
+    // A piece is whole when none of its floods has faces left to count. The whole ones go
+    // under the inlet rule, but for the largest when no piece is left growing (every piece
+    // beside the cuts small: one of them stays).
+    std::vector<std::uint32_t> whole;
+    std::vector<char> growing(floods.size(), 0);
+    for (std::uint32_t f = 0; f < floods.size(); ++f)
+        if (floods[f].next < floods[f].faces.size()) growing[root(f)] = 1;
+    for (std::uint32_t f = 0; f < floods.size(); ++f)
+        if (root(f) == f && !growing[f]) whole.push_back(f);
+    if (std::find(growing.begin(), growing.end(), 1) == growing.end() && !whole.empty())
+        whole.erase(std::max_element(whole.begin(), whole.end(),
+                                     [&](std::uint32_t x, std::uint32_t y) { return floods[x].area < floods[y].area; }));
+    for (const std::uint32_t k : whole) {
+        const Flood& p = floods[k];
+        const double h = km_to_rad(m.size_km(m.centroid(p.faces[0])));
+        const bool small = p.area <= options.inlet_area * h * h ||
+                           (p.area <= inlet_narrow_area * h * h && 2 * p.area < options.inlet_width * h * p.perimeter);
+        if (p.open || !small) continue;
+        report.straits_water_km2 += p.area * earth_radius_km * earth_radius_km;
+        for (std::uint32_t f = 0; f < floods.size(); ++f)
+            if (root(f) == k)
+                for (const TriangleId t : floods[f].faces) {
+                    dt.set_label(t, land);
+                    ++(land_test.contains(m.centroid(t)) ? report.land_faces_removed : report.water_faces_removed);
+                }
+    }
+    // Where the cuts are, for the count of basins they made (mesh_boundary's output).
+    for (const TriangleId t : sides)
+        if (is_ocean(t)) m.cut_sides.push_back(t);
+    faces.clear();
+    for (const TriangleId t : left)
+        if (is_ocean(t)) faces.push_back(t);
 }
 
 // Relaxation by flips towards valence 6 (Frey & Field): an unconstrained edge between two ocean
@@ -2459,7 +2611,12 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         t0 = Clock::now();
         std::vector<TriangleId> left;
         remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left);
-        report.land_faces_nudged = nudge_off_land(m, *options.land, left, report.land_faces_at);
+        report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+        if (options.close_straits && !left.empty()) {
+            close_straits(m, *options.land, left, options, report);
+            report.land_faces_at.clear();
+            if (!left.empty()) report.land_faces_nudged += nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+        }
         report.land_faces_left = report.land_faces_at.size();
         if (timings) timings->add("land", seconds_since(t0));
     }
@@ -2478,10 +2635,69 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     for (VertexId v = 0; v < dt.vertex_count(); ++v)
         if (node_of[v] == 0) node_of[v] = static_cast<NodeIndex>(node_count++);
     if (node_count == 0) throw DataError("no ocean is left to mesh");
+    // A vertex between two or more fans of ocean (close_straits closed a strait there at a
+    // point): each fan after the first gets a node of its own, pinch_apart into the fan, so
+    // that the mesh is a manifold. (fan_corner, fan_node): the corners of those fans' faces and
+    // their nodes, sorted; fan_point: the new nodes' points, numbered from node_count.
+    std::vector<std::pair<TriangleId, VertexId>> fan_corner;
+    std::vector<NodeIndex> fan_node;
+    std::vector<Vec3> fan_point;
+    {
+        std::sort(m.pinched.begin(), m.pinched.end());
+        m.pinched.erase(std::unique(m.pinched.begin(), m.pinched.end()), m.pinched.end());
+        std::vector<std::tuple<TriangleId, VertexId, NodeIndex>> corners;
+        std::vector<TriangleId> fan;
+        for (const VertexId v : m.pinched) {
+            // From a triangle outside the ocean, around v: each run of ocean triangles a fan.
+            const HalfEdge any = dt.leaving(v, no_triangle);
+            HalfEdge start = any;
+            while (dt.label(triangle_of(start)) == ocean) {
+                start = dt.next_around_origin(start);
+                if (start == any) break;
+            }
+            if (dt.label(triangle_of(start)) == ocean) continue; // one fan all round
+            const Vec3& p = dt.point(v);
+            int fans = 0;
+            auto end_fan = [&] {
+                if (++fans > 1) {
+                    // Towards the centroid of the fan's middle face: inside the fan's angle.
+                    const Vec3 into = m.centroid(fan[fan.size() / 2]) - p;
+                    fan_point.push_back(normalized(p + pinch_apart * normalized(into - dot(into, p) * p)));
+                    const auto node = static_cast<NodeIndex>(node_count + fan_point.size() - 1);
+                    for (const TriangleId t : fan) corners.emplace_back(t, v, node);
+                }
+                fan.clear();
+            };
+            HalfEdge h = start;
+            do {
+                const TriangleId t = triangle_of(h);
+                if (dt.label(t) == ocean) {
+                    fan.push_back(t);
+                } else if (!fan.empty()) {
+                    end_fan();
+                }
+                h = dt.next_around_origin(h);
+            } while (h != start);
+            if (!fan.empty()) end_fan();
+        }
+        std::sort(corners.begin(), corners.end());
+        for (const auto& [t, v, node] : corners) {
+            fan_corner.emplace_back(t, v);
+            fan_node.push_back(node);
+        }
+        report.nodes_split = fan_point.size();
+    }
+    auto node_at = [&](TriangleId t, VertexId v) {
+        if (!fan_corner.empty()) {
+            const auto it = std::lower_bound(fan_corner.begin(), fan_corner.end(), std::pair{t, v});
+            if (it != fan_corner.end() && *it == std::pair{t, v}) return fan_node[std::size_t(it - fan_corner.begin())];
+        }
+        return node_of[v];
+    };
     mesh.faces.reserve(face_count); // sized once: no doubling, no copy while growing
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-        mesh.faces.push_back({node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]});
+        mesh.faces.push_back({node_at(t, dt.vertex(t, 0)), node_at(t, dt.vertex(t, 1)), node_at(t, dt.vertex(t, 2))});
         for (int i = 0; i < 3; ++i) {
             HalfEdge h = half_edge(t, i);
             TriangleId other = triangle_of(dt.twin(h));
@@ -2489,16 +2705,45 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             VertexId a = dt.origin(h), b = dt.destination(h);
             auto it = m.segments.find(key(a, b));
             EdgeTag tag = it != m.segments.end() && it->second == SegmentKind::open ? EdgeTag::open : EdgeTag::coast;
-            mesh.boundary.push_back({node_of[a], node_of[b], tag});
+            mesh.boundary.push_back({node_at(t, a), node_at(t, b), tag});
         }
     }
+    std::vector<NodeIndex> cut_nodes; // a node of each face beside a cut
+    for (const TriangleId t : m.cut_sides)
+        if (dt.is_live(t) && dt.label(t) == ocean) cut_nodes.push_back(node_at(t, dt.vertex(t, 0)));
     // Node k is the k-th vertex used by a face, so moving each down to its index is in place.
     mesh.nodes = m.dt.release_points();
     for (VertexId v = 0; v < node_of.size(); ++v)
         if (node_of[v] != 0xffffffffu) mesh.nodes[node_of[v]] = mesh.nodes[v];
     mesh.nodes.resize(node_count);
+    mesh.nodes.insert(mesh.nodes.end(), fan_point.begin(), fan_point.end());
     mesh.nodes.shrink_to_fit(); // the triangulation is gone: the copy is not the peak
     std::vector<NodeIndex>().swap(node_of);
+    if (!cut_nodes.empty()) {
+        // The basins the closed straits cut off: the mesh's pieces (union-find over the nodes
+        // through the faces) beside a cut, but for the largest.
+        std::vector<NodeIndex> parent(mesh.nodes.size());
+        for (NodeIndex i = 0; i < parent.size(); ++i) parent[i] = i;
+        auto find = [&](NodeIndex i) {
+            while (parent[i] != i) i = parent[i] = parent[parent[i]];
+            return i;
+        };
+        for (const auto& f : mesh.faces) {
+            const NodeIndex r = find(f[0]);
+            for (int k = 1; k < 3; ++k) parent[find(f[k])] = r;
+        }
+        std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
+        for (const NodeIndex n : cut_nodes) area.emplace(find(n), 0.0);
+        std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
+        for (const auto& f : mesh.faces) ++faces_of[find(f[0])];
+        const NodeIndex largest = static_cast<NodeIndex>(std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
+        area.erase(largest);
+        for (const auto& f : mesh.faces)
+            if (auto it = area.find(find(f[0])); it != area.end())
+                it->second += spherical_triangle_area(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]);
+        for (const auto& [r, a] : area) report.seas_cut_off.push_back(a * earth_radius_km * earth_radius_km);
+        std::sort(report.seas_cut_off.rbegin(), report.seas_cut_off.rend());
+    }
     std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
     std::vector<char> on_boundary(mesh.nodes.size(), 0);
     for (const auto& e : mesh.boundary) on_boundary[e.a] = on_boundary[e.b] = 1;

@@ -153,6 +153,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     }
     mo.smooth_iterations = o.smooth_iterations;
     mo.keep_inland_seas = o.keep_inland_seas;
+    mo.close_straits = !o.keep_straits;
     mo.inlet_width = o.inlet_width;
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
@@ -195,17 +196,28 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
                                         std::to_string(report.land_holes) + " holes, joining " +
                                         std::to_string(report.land_loops_joined) + " loops, " +
                                         std::to_string(report.land_faces_nudged) + " moved off)");
-    if (!report.land_faces_at.empty()) {
-        // Where they are (lon lat, degrees), for --size-regions: the first 50.
+    // Places as lon lat (degrees), the first 50.
+    auto places = [](const std::vector<Vec3>& points) {
         std::string at;
         char buf[48];
-        for (std::size_t i = 0; i < report.land_faces_at.size() && i < 50; ++i) {
-            const LonLat ll = vec_to_lonlat(report.land_faces_at[i]);
+        for (std::size_t i = 0; i < points.size() && i < 50; ++i) {
+            const LonLat ll = vec_to_lonlat(points[i]);
             std::snprintf(buf, sizeof buf, "%s%.2f %.2f", i ? ", " : "", ll.lon, ll.lat);
             at += buf;
         }
-        if (report.land_faces_at.size() > 50) at += ", ...";
-        a.emplace_back("faces_on_land_at", at);
+        if (points.size() > 50) at += ", ...";
+        return at;
+    };
+    if (!report.land_faces_at.empty()) a.emplace_back("faces_on_land_at", places(report.land_faces_at));
+    if (mo.land && mo.close_straits) {
+        std::string closed = std::to_string(report.straits_closed) + " (cutting off " +
+                             std::to_string(report.seas_cut_off.size()) + " basins";
+        for (std::size_t i = 0; i < report.seas_cut_off.size(); ++i)
+            closed += (i ? ", " : ": ") + number(report.seas_cut_off[i]) + " km2";
+        closed += "; " + number(report.straits_water_km2) + " km2 of water closed with them; " +
+                  std::to_string(report.nodes_split) + " nodes split)";
+        a.emplace_back("straits_closed", closed);
+        if (!report.straits_closed_at.empty()) a.emplace_back("straits_closed_at", places(report.straits_closed_at));
     }
     a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));

@@ -97,6 +97,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.min_island_area_km2, b.min_island_area_km2);
     EXPECT_EQ(a.min_island_triangles, b.min_island_triangles);
     EXPECT_EQ(a.keep_inland_seas, b.keep_inland_seas);
+    EXPECT_EQ(a.keep_straits, b.keep_straits);
     EXPECT_EQ(a.bathy, b.bathy);
     EXPECT_EQ(a.bathy_band, b.bathy_band);
     EXPECT_EQ(a.depth_positive, b.depth_positive);
@@ -135,7 +136,7 @@ void expect_same_cli(const globemesh::CliOptions& a, const globemesh::CliOptions
 std::vector<std::string> every_option(const std::string& out_dir) {
     return {"--coast", coast, "--coast-layer", "ne_110m_land", "--coast-where", "featurecla = 'Land'",
             "--coast-srs", "EPSG:4326", "--region", "-20.5,40,10.25,65", "--min-island-area", "2.5e7m2",
-            "--keep-inland-seas", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+            "--keep-inland-seas", "--keep-straits", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
             "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
             "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
@@ -304,6 +305,7 @@ TEST(Cli, print_config_round_trips_every_option) {
     EXPECT_DOUBLE_EQ(original.mesh.min_island_area_km2, 25.0);
     EXPECT_EQ(original.mesh.coast_rate, 0.123456789012345);
     EXPECT_NE(original.mesh.seed, globemesh::MeshOptions{}.seed);
+    EXPECT_TRUE(original.mesh.keep_straits);
     // And printing the re-read configuration gives the same text.
     const Result printed_again =
         run_refused({"mesh", "--config", (dir / "printed.toml").string(), "--print-config"});
