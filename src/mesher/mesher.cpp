@@ -903,9 +903,20 @@ std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherRep
 // the output splits it); nodes it puts on the boundary may lie up to strait_exposed_reach h
 // from the coast. The ocean faces beside each removal that cut the mesh go to `cut_sides`,
 // and each removal that closed a strait (cut, joined or pinched) to report.straits_closed.
+//
+// `loops`: the boundary loops, traced by the first call and kept up to date by its removals
+// (the nudge between the calls moves nodes but changes no boundary edge), so that the second
+// call takes them as they are.
+struct BoundaryLoops {
+    std::unordered_map<VertexId, std::uint32_t> of; // the loop of each boundary vertex (an id)
+    std::vector<std::uint32_t> parent;              // loops a removal joined share their root
+    std::uint32_t count = 0;
+    bool traced = false;
+};
 std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<TriangleId> island_faces,
                               double pocket_area, MesherReport& report, std::vector<TriangleId>& left_faces,
-                              bool straits = false, std::vector<TriangleId>* cut_sides = nullptr) {
+                              BoundaryLoops& loops_state, bool straits = false,
+                              std::vector<TriangleId>* cut_sides = nullptr) {
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     // The next half-edge leaving origin(h) clockwise around it (next_around_origin's reverse):
@@ -920,11 +931,12 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     // land is a segment: each loop is found from its first segment not yet seen and traced
     // around its vertices, so that the step costs what the coast has, not what the ocean has.
     std::unordered_map<VertexId, VertexId> next_on_boundary;
-    std::unordered_map<VertexId, std::uint32_t> loop_of;
-    std::vector<std::uint32_t> loop_parent;
-    std::uint32_t loops = 0;
+    auto& loop_of = loops_state.of;
+    auto& loop_parent = loops_state.parent;
+    std::uint32_t& loops = loops_state.count;
     std::vector<HalfEdge> boundary_edges; // ocean on the left
-    {
+    if (!loops_state.traced) {
+        loops_state.traced = true;
         // The boundary half-edge after h (ocean on the left of both): clockwise around h's
         // destination, through the ocean, from the edge of h's triangle that leaves it.
         auto next_on_loop = [&](HalfEdge h) {
@@ -936,34 +948,24 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
             auto it = next_on_boundary.find(a);
             return it != next_on_boundary.end() && it->second == b;
         };
-        auto trace = [&](HalfEdge start, std::size_t at_most) {
-            if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start)))) return;
-            if (seen(dt.origin(start), dt.destination(start))) return;
-            HalfEdge h = start;
-            do {
-                next_on_boundary.emplace(dt.origin(h), dt.destination(h));
-                loop_of.emplace(dt.origin(h), loops);
-                boundary_edges.push_back(h);
-                h = next_on_loop(h);
-            } while (h != start && boundary_edges.size() <= at_most);
-            loop_parent.push_back(loops++);
-        };
-        if (straits) {
-            // Earlier removals made boundary edges that are no segments: every edge between
-            // ocean and land starts a loop not traced yet.
-            for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-                if (is_ocean(t))
-                    for (int i = 0; i < 3; ++i) trace(half_edge(t, i), 3 * dt.triangle_slots());
-        } else {
-            TriangleId hint = no_triangle;
-            for (const auto& [segment, kind] : m.segments) {
-                const auto [a, b] = segment;
-                if (seen(a, b) || seen(b, a)) continue;
-                const HalfEdge from = dt.leaving(a, hint);
-                const HalfEdge e = from == no_half_edge ? no_half_edge : dt.find_edge(from, b);
-                if (e == no_half_edge) continue;
-                hint = triangle_of(e);
-                for (const HalfEdge start : {e, dt.twin(e)}) trace(start, m.segments.size());
+        TriangleId hint = no_triangle;
+        for (const auto& [segment, kind] : m.segments) {
+            const auto [a, b] = segment;
+            if (seen(a, b) || seen(b, a)) continue;
+            const HalfEdge from = dt.leaving(a, hint);
+            const HalfEdge e = from == no_half_edge ? no_half_edge : dt.find_edge(from, b);
+            if (e == no_half_edge) continue;
+            hint = triangle_of(e);
+            for (const HalfEdge start : {e, dt.twin(e)}) {
+                if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start)))) continue;
+                HalfEdge h = start;
+                do {
+                    next_on_boundary.emplace(dt.origin(h), dt.destination(h));
+                    loop_of.emplace(dt.origin(h), loops);
+                    boundary_edges.push_back(h);
+                    h = next_on_loop(h);
+                } while (h != start && boundary_edges.size() <= m.segments.size());
+                loop_parent.push_back(loops++);
             }
         }
     }
@@ -1339,11 +1341,11 @@ std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vect
 // and stay otherwise as basins of their own (report.seas_cut_off). Leaves in `faces` those
 // still on land.
 void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>& faces, const MesherOptions& options,
-                   MesherReport& report) {
+                   BoundaryLoops& loops, MesherReport& report) {
     SphericalDelaunay& dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     std::vector<TriangleId> sides, left;
-    remove_land_faces(m, land_test, faces, options.inlet_area, report, left, true, &sides);
+    remove_land_faces(m, land_test, faces, options.inlet_area, report, left, loops, true, &sides);
     // The pieces beside the cuts, each flooded until whole or over inlet_narrow_area h^2 (then
     // it stays whatever it is: the ocean, or a sea cut off). Floods that meet are one piece
     // (union-find over the floods).
@@ -2610,10 +2612,11 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     if (options.land) {
         t0 = Clock::now();
         std::vector<TriangleId> left;
-        remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left);
+        BoundaryLoops loops;
+        remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left, loops);
         report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
         if (options.close_straits && !left.empty()) {
-            close_straits(m, *options.land, left, options, report);
+            close_straits(m, *options.land, left, options, loops, report);
             report.land_faces_at.clear();
             if (!left.empty()) report.land_faces_nudged += nudge_off_land(m, *options.land, left, left, report.land_faces_at);
         }
