@@ -2663,9 +2663,30 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             int fans = 0;
             auto end_fan = [&] {
                 if (++fans > 1) {
-                    // Towards the centroid of the fan's middle face: inside the fan's angle.
+                    // Towards the centroid of the fan's middle face (inside the fan's angle),
+                    // pinch_apart or less: every face of the fan must stay counter-clockwise
+                    // (a sliver of the fan may be thinner than pinch_apart).
                     const Vec3 into = m.centroid(fan[fan.size() / 2]) - p;
-                    fan_point.push_back(normalized(p + pinch_apart * normalized(into - dot(into, p) * p)));
+                    const Vec3 dir = normalized(into - dot(into, p) * p);
+                    auto far_edge = [&](TriangleId t) {
+                        int k = 0;
+                        while (dt.vertex(t, k) != v) ++k;
+                        return std::pair{dt.point(dt.vertex(t, next3(k))), dt.point(dt.vertex(t, prev3(k)))};
+                    };
+                    Vec3 q = p;
+                    for (double d = pinch_apart; d > 1e-15; d *= 0.5) {
+                        const Vec3 moved = normalized(p + d * dir);
+                        bool ccw = true;
+                        for (const TriangleId t : fan) {
+                            const auto [a, b] = far_edge(t);
+                            ccw = ccw && predicates::orient(moved, a, b) > 0;
+                        }
+                        if (ccw) {
+                            q = moved;
+                            break;
+                        }
+                    }
+                    fan_point.push_back(q);
                     const auto node = static_cast<NodeIndex>(node_count + fan_point.size() - 1);
                     for (const TriangleId t : fan) corners.emplace_back(t, v, node);
                 }

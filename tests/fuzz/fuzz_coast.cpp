@@ -234,6 +234,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         mo.keep_inland_seas = options.keep_inland_seas;
         mo.smooth_iterations = 2;
         mo.lattice_km = h; // as the pipeline
+        mo.land = coast.land; // faces centred on land removed, straits closed (MesherOptions::close_straits)
         // Refinement reports progress every 16384 insertions; with at most 20000 nodes asked
         // for, a 5th report is a runaway (a known mesher bug, see known_mesher_bugs).
         std::size_t reports = 0;

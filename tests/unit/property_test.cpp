@@ -510,6 +510,7 @@ CoastCase coast_case(std::uint64_t seed) {
     c.options.min_island_triangles = g.pick(3);
     if (g.pick(5) == 0) c.options.region = std::array<double, 4>{g.uniform(-180, 0), -60, g.uniform(-180, 180), 60};
     c.h = g.uniform(800, 2000);
+    c.options.keep_straits = g.pick(4) == 0;
     return c;
 }
 
@@ -532,7 +533,8 @@ int run_case_isolated(const CoastCase& c, const std::string& path, int limit_s) 
             MeshOptions options = c.options;
             options.coast = path;
             const SizeFn size = [h = c.h](const Vec3&) { return h; };
-            const Boundary boundary = shape_boundary(load_coast(options), size, options);
+            const CoastData coast = load_coast(options);
+            const Boundary boundary = shape_boundary(coast, size, options);
             const auto issues = check_boundary(boundary);
             if (!issues.empty()) {
                 std::fprintf(stderr, "shaped boundary invalid: %s\n", issues.front().what.c_str());
@@ -540,6 +542,8 @@ int run_case_isolated(const CoastCase& c, const std::string& path, int limit_s) 
             }
             MesherOptions mo;
             mo.keep_inland_seas = options.keep_inland_seas;
+            mo.land = coast.land; // as the pipeline: faces centred on land removed, straits closed
+            mo.close_straits = !options.keep_straits;
             mo.max_nodes = 20000;
             mo.lattice_km = c.h; // as the pipeline: the lattice where the field is at its largest
             RunawayGuard guard;
@@ -991,6 +995,29 @@ TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
     mo.max_nodes = 20000;
     mo.lattice_km = c.h;
     const Mesh mesh = mesh_boundary(boundary, size, mo);
+    EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
+}
+
+// Found by CoastProperty.hundreds_of_hostile_small_coasts... once it closed straits (seed 192):
+// a strait closed at a node next to the south pole whose fan held a sliver 0.04 m2 in area;
+// moving the node's copy 0.64 m into its fan turned the sliver clockwise. The copy now moves
+// at most as far as keeps every face of its fan counter-clockwise.
+TEST(MesherProperty, a_node_split_at_a_closed_strait_keeps_its_fan_counter_clockwise) {
+    CoastCase c = coast_case(192);
+    MemFile file("seed192.geojson", c.json);
+    c.options.coast = file.path();
+    const SizeFn size = [h = c.h](const Vec3&) { return h; };
+    const CoastData coast = load_coast(c.options);
+    const Boundary boundary = shape_boundary(coast, size, c.options);
+    ASSERT_TRUE(check_boundary(boundary).empty());
+    MesherOptions mo;
+    mo.keep_inland_seas = c.options.keep_inland_seas;
+    mo.max_nodes = 20000;
+    mo.lattice_km = c.h;
+    mo.land = coast.land;
+    MesherReport report;
+    const Mesh mesh = mesh_boundary(boundary, size, mo, &report);
+    EXPECT_GE(report.nodes_split, 1u);
     EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
 }
 
