@@ -66,11 +66,12 @@
 //      boundary. The faces still on land lie across straits narrower than a face, or where a
 //      removal would leave a node too far from the coast. With MesherOptions::close_straits
 //      (the default) they go as above but may also cut the mesh in two, the sea behind
-//      becoming a basin of its own (the Black Sea behind the Dardanelles at 100 km; reported,
-//      and a piece under inlet_area * h^2 goes too), or close the strait at a node between two
-//      fans of water (the output gives each fan after the first a node of its own, 0.64 m into
-//      it, so the mesh stays a manifold), and the nodes they put on the boundary may lie up to
-//      0.75 h from the coast. The faces left on land are reported with their centroids.
+//      becoming a basin of its own (the Black Sea behind the Dardanelles at 100 km; reported;
+//      a piece that close_inlets' rule would close goes too), or close the strait at a node
+//      between two fans of water (the output gives each fan after the first a node of its
+//      own, 0.64 m into it or less, so the mesh stays a manifold), and the nodes they put on
+//      the boundary may lie up to 0.75 h from the coast. The faces left on land are reported
+//      with their centroids.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -144,7 +145,7 @@ struct MesherReport {
     std::size_t straits_closed = 0;     ///< of the faces removed, those that closed a strait (MesherOptions::close_straits)
     std::vector<Vec3> straits_closed_at; ///< their centroids
     std::vector<double> seas_cut_off;   ///< km2 of each basin those closings cut off (kept)
-    double straits_water_km2 = 0;       ///< water cut off with them and closed (MesherOptions::inlet_area)
+    double straits_water_km2 = 0;       ///< water cut off with them and closed (inlet_area, inlet_width)
     std::size_t nodes_split = 0;        ///< nodes added where a strait closed at a node between two fans of water
     std::vector<OceanComponent> components;
 };
