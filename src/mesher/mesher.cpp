@@ -432,6 +432,36 @@ struct Mesher {
         return true;
     }
 
+    // The fans of ocean triangles around the origin of `from`: the runs of ocean triangles
+    // between the others, counter-clockwise. visit(t, k) for each ocean triangle t of fan k
+    // (from 0, in order around the vertex). Returns how many: 1 for an interior vertex (all its
+    // triangles ocean), more where a removal left it between two fans of water.
+    template <class Visit>
+    int ocean_fans(HalfEdge from, Visit&& visit) const {
+        auto in_ocean = [&](HalfEdge h) { return dt.label(triangle_of(h)) == ocean; };
+        HalfEdge start = from;
+        while (in_ocean(start)) {
+            start = dt.next_around_origin(start);
+            if (start != from) continue;
+            do {
+                visit(triangle_of(start), 0);
+                start = dt.next_around_origin(start);
+            } while (start != from);
+            return 1;
+        }
+        int fans = 0;
+        bool before = false;
+        HalfEdge h = start;
+        do {
+            const bool in = in_ocean(h);
+            if (in && !before) ++fans;
+            if (in) visit(triangle_of(h), fans - 1);
+            before = in;
+            h = dt.next_around_origin(h);
+        } while (h != start);
+        return fans;
+    }
+
     // The ocean angle at u (the sum of its ocean triangles' angles), from a triangle near it.
     double ocean_angle(VertexId u, TriangleId hint) const {
         const HalfEdge from = dt.leaving(u, hint);
@@ -1014,23 +1044,7 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
         return l;
     };
     // The fans of ocean faces that meet at the origin of `from` (an interior vertex has one).
-    auto fans_at = [&](HalfEdge from) {
-        HalfEdge start = from;
-        while (is_ocean(triangle_of(start))) {
-            start = dt.next_around_origin(start);
-            if (start == from) return 1;
-        }
-        int runs = 0;
-        bool before = false;
-        HalfEdge h = start;
-        do {
-            const bool in = is_ocean(triangle_of(h));
-            if (in && !before) ++runs;
-            before = in;
-            h = dt.next_around_origin(h);
-        } while (h != start);
-        return runs;
-    };
+    auto fans_at = [&](HalfEdge from) { return m.ocean_fans(from, [](TriangleId, int) {}); };
     // Land under the face at the points halfway from its centroid to its corners and to its
     // sides' midpoints (of 6).
     auto land_points = [&](TriangleId t) {
@@ -1057,6 +1071,7 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
     std::vector<TriangleId> members;
     std::vector<std::pair<VertexId, HalfEdge>> corners; // each corner with a half-edge leaving it
     std::vector<VertexId> arc_parent;                     // union-find over corner indices
+    std::vector<VertexId> pinches;                        // corners left between two fans of water
     std::size_t holes = 0, joins = 0, removed_faces = 0;
     auto try_remove = [&](const std::vector<TriangleId>& group, TriangleId needed) {
         if (!is_ocean(needed)) return false;
@@ -1104,9 +1119,11 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
         for (TriangleId t : members) dt.set_label(t, land);
         bool ok = true;
         const double reach = straits ? strait_exposed_reach : land_exposed_reach;
+        pinches.clear();
         for (const auto& [v, from] : corners) {
             const int fans = fans_at(from);
             const bool was_on_boundary = loop_of.count(v) > 0;
+            if (fans > 1) pinches.push_back(v);
             if ((fans > 1 && !(straits && was_on_boundary)) || (!was_on_boundary && fans == 0)) ok = false;
             else if (!was_on_boundary && !land_test.coast_within(dt.point(v), reach * km_to_rad(m.size_km(dt.point(v)))))
                 ok = false;
@@ -1130,13 +1147,8 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
         if (straits) {
             // A strait closed: the removal cut the mesh, joined loops or pinched it at a node
             // (not an island coming back as a hole, or a bite into one coast).
-            bool pinched = false;
-            for (const auto& [v, from] : corners)
-                if (fans_at(from) > 1) {
-                    m.pinched.push_back(v);
-                    pinched = true;
-                }
-            if (cuts || pinched || arc_loops.size() > 1) {
+            m.pinched.insert(m.pinched.end(), pinches.begin(), pinches.end());
+            if (cuts || !pinches.empty() || arc_loops.size() > 1) {
                 ++report.straits_closed;
                 report.straits_closed_at.push_back(m.centroid(needed));
             }
@@ -2422,6 +2434,14 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             }
             return true;
         };
+        // A half-edge leaving v, found from `hint` (a triangle next to v when it was collected,
+        // updated to one next to it now), or no_half_edge.
+        auto leaving = [&](VertexId v, TriangleId& hint) {
+            const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
+            if (from == no_half_edge || dt.origin(from) != v) return no_half_edge;
+            hint = triangle_of(from);
+            return from;
+        };
         // The candidates for interior node v (p0, its star's far edges `far`) and the pattern
         // search's first step, 0.2 of its mean equilateral apex height.
         auto star_candidates = [&](const Vec3& p0) {
@@ -2443,9 +2463,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         // The quality rounds' move of interior node v: the candidates, then a pattern search,
         // for the best star_count_score.
         auto count_node = [&](VertexId v, TriangleId& hint, std::vector<char>* changed) {
-            const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
-            if (from == no_half_edge || dt.origin(from) != v) return;
-            hint = triangle_of(from);
+            const HalfEdge from = leaving(v, hint);
+            if (from == no_half_edge) return;
             if (!m.ocean_star(from, far)) return;
             const Vec3 p0 = dt.point(v);
             const double floor = std::min(star_worst_quality(p0, far), worst_goal);
@@ -2469,9 +2488,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         // sharp corner: its star's land triangles must stay counter-clockwise too, and it stays
         // within slide_reach h of the source coast; the candidates lie along its two segments.
         auto slide_node = [&](VertexId v, TriangleId& hint, std::vector<char>* changed) {
-            const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
-            if (from == no_half_edge || dt.origin(from) != v) return;
-            hint = triangle_of(from);
+            const HalfEdge from = leaving(v, hint);
+            if (from == no_half_edge) return;
             VertexId ends[2];
             if (!m.slide_star(from, far, land_far, ends)) return;
             const Vec3 p0 = dt.point(v);
@@ -2508,9 +2526,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         // The search rounds' move: to the candidate, then, when the star is still below
         // worst_goal, the point of a pattern search, that best raises the star's worst.
         auto improve_node = [&](VertexId v, TriangleId& hint) {
-            const HalfEdge from = dt.leaving(v, dt.is_live(hint) ? hint : no_triangle);
-            if (from == no_half_edge || dt.origin(from) != v) return;
-            hint = triangle_of(from);
+            const HalfEdge from = leaving(v, hint);
+            if (from == no_half_edge) return;
             if (!m.ocean_star(from, far)) return;
             const Vec3 p0 = dt.point(v);
             const double before = star_worst_quality(p0, far);
@@ -2649,60 +2666,43 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         std::sort(m.pinched.begin(), m.pinched.end());
         m.pinched.erase(std::unique(m.pinched.begin(), m.pinched.end()), m.pinched.end());
         std::vector<std::tuple<TriangleId, VertexId, NodeIndex>> corners;
-        std::vector<TriangleId> fan;
+        std::vector<std::vector<TriangleId>> fans;
         for (const VertexId v : m.pinched) {
-            // From a triangle outside the ocean, around v: each run of ocean triangles a fan.
-            const HalfEdge any = dt.leaving(v, no_triangle);
-            HalfEdge start = any;
-            while (dt.label(triangle_of(start)) == ocean) {
-                start = dt.next_around_origin(start);
-                if (start == any) break;
-            }
-            if (dt.label(triangle_of(start)) == ocean) continue; // one fan all round
+            fans.clear();
+            const int n = m.ocean_fans(dt.leaving(v, no_triangle), [&](TriangleId t, int k) {
+                if (k == int(fans.size())) fans.emplace_back();
+                fans[std::size_t(k)].push_back(t);
+            });
             const Vec3& p = dt.point(v);
-            int fans = 0;
-            auto end_fan = [&] {
-                if (++fans > 1) {
-                    // Towards the centroid of the fan's middle face (inside the fan's angle),
-                    // pinch_apart or less: every face of the fan must stay counter-clockwise
-                    // (a sliver of the fan may be thinner than pinch_apart).
-                    const Vec3 into = m.centroid(fan[fan.size() / 2]) - p;
-                    const Vec3 dir = normalized(into - dot(into, p) * p);
-                    auto far_edge = [&](TriangleId t) {
-                        int k = 0;
-                        while (dt.vertex(t, k) != v) ++k;
-                        return std::pair{dt.point(dt.vertex(t, next3(k))), dt.point(dt.vertex(t, prev3(k)))};
-                    };
-                    Vec3 q = p;
-                    for (double d = pinch_apart; d > 1e-15; d *= 0.5) {
-                        const Vec3 moved = normalized(p + d * dir);
-                        bool ccw = true;
-                        for (const TriangleId t : fan) {
-                            const auto [a, b] = far_edge(t);
-                            ccw = ccw && predicates::orient(moved, a, b) > 0;
-                        }
-                        if (ccw) {
-                            q = moved;
-                            break;
-                        }
+            for (int k = 1; k < n; ++k) {
+                const std::vector<TriangleId>& fan = fans[std::size_t(k)];
+                // Towards the centroid of the fan's middle face (inside the fan's angle),
+                // pinch_apart or less: every face of the fan must stay counter-clockwise (a
+                // sliver of the fan may be thinner than pinch_apart).
+                const Vec3 into = m.centroid(fan[fan.size() / 2]) - p;
+                const Vec3 dir = normalized(into - dot(into, p) * p);
+                auto far_edge = [&](TriangleId t) {
+                    int i = 0;
+                    while (dt.vertex(t, i) != v) ++i;
+                    return std::pair{dt.point(dt.vertex(t, next3(i))), dt.point(dt.vertex(t, prev3(i)))};
+                };
+                Vec3 q = p;
+                for (double d = pinch_apart; d > 1e-15; d *= 0.5) {
+                    const Vec3 moved = normalized(p + d * dir);
+                    bool ccw = true;
+                    for (const TriangleId t : fan) {
+                        const auto [a, b] = far_edge(t);
+                        ccw = ccw && predicates::orient(moved, a, b) > 0;
                     }
-                    fan_point.push_back(q);
-                    const auto node = static_cast<NodeIndex>(node_count + fan_point.size() - 1);
-                    for (const TriangleId t : fan) corners.emplace_back(t, v, node);
+                    if (ccw) {
+                        q = moved;
+                        break;
+                    }
                 }
-                fan.clear();
-            };
-            HalfEdge h = start;
-            do {
-                const TriangleId t = triangle_of(h);
-                if (dt.label(t) == ocean) {
-                    fan.push_back(t);
-                } else if (!fan.empty()) {
-                    end_fan();
-                }
-                h = dt.next_around_origin(h);
-            } while (h != start);
-            if (!fan.empty()) end_fan();
+                fan_point.push_back(q);
+                const auto node = static_cast<NodeIndex>(node_count + fan_point.size() - 1);
+                for (const TriangleId t : fan) corners.emplace_back(t, v, node);
+            }
         }
         std::sort(corners.begin(), corners.end());
         for (const auto& [t, v, node] : corners) {
