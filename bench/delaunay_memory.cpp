@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "allocation.hpp"
 #include "bench_points.hpp"
 #include "globemesh/delaunay.hpp"
 
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "usage: delaunay_memory N uniform|clustered\n");
         return 2;
     }
+    globemesh::configure_allocation(); // as the globemesh executable (src/cli/allocation.cpp)
     const std::size_t n = std::strtoull(argv[1], nullptr, 10);
     const std::string kind = argv[2];
     const long base = vm_kib("VmRSS:");

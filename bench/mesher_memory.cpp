@@ -18,10 +18,8 @@
 #include <string>
 #include <utility>
 #include <vector>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 
+#include "allocation.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/mesher.hpp"
 #include "globemesh/options.hpp"
@@ -55,9 +53,7 @@ int main(int argc, char** argv) {
     o.coast = argv[1];
     o.coast_layer = argv[2];
     o.hmax_km = std::atof(argv[3]);
-#ifdef __GLIBC__
-    mallopt(M_MMAP_THRESHOLD, 1 << 20); // as the globemesh executable (src/cli/main.cpp)
-#endif
+    globemesh::configure_allocation(); // as the globemesh executable (src/cli/allocation.cpp)
     const int repeats = argc > 4 ? std::atoi(argv[4]) : 1;
     const globemesh::SizeFn size = globemesh::uniform_size(o.hmax_km);
     globemesh::MesherOptions mo;
