@@ -6,8 +6,8 @@
 
 namespace globemesh {
 
-/// Sets glibc's allocator options for a whole run (a fixed 1 MiB mmap threshold); call first
-/// thing in main. Does nothing elsewhere.
+/// Sets glibc's allocator options for a whole run (a fixed 1 MiB mmap threshold, a 256 MiB trim
+/// threshold); call first thing in main. Does nothing elsewhere.
 void configure_allocation();
 
 } // namespace globemesh
