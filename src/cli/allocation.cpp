@@ -44,7 +44,7 @@ void configure_allocation() {
     mallopt(M_MMAP_THRESHOLD, 1 << 20);
     // The blocks under 1 MiB come from the heap, and glibc gives its top back to the system as
     // soon as 128 KiB there are free, so that a loop allocating and freeing a few hundred KiB
-    // (GEOS's monotone chains in load_coast, a star's scratch) faults the same pages in again
+    // (GEOS's monotone chains in load_coast above all) faults the same pages in again
     // and again. A top kept up to 256 MiB (never more than the small blocks held at once):
     // mesh_boundary at 20 km 181,000 -> 38,000 page faults in its process, mesh 2.06-2.17 ->
     // 1.91-1.93 s, its peak 116-117 -> 118 B/node.
