@@ -52,6 +52,14 @@ void configure_allocation() {
 #endif
 }
 
+bool replaces_operator_new() {
+#ifdef GLOBEMESH_HUGE_PAGES
+    return true;
+#else
+    return false;
+#endif
+}
+
 } // namespace globemesh
 
 #ifdef GLOBEMESH_HUGE_PAGES

@@ -10,4 +10,7 @@ namespace globemesh {
 /// threshold); call first thing in main. Does nothing elsewhere.
 void configure_allocation();
 
+/// True where linking this policy replaces operator new (Linux with glibc, not under AddressSanitizer).
+bool replaces_operator_new();
+
 } // namespace globemesh
