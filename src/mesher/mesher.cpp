@@ -1596,6 +1596,10 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
             }
         }
     std::vector<Vec3> rim, inside;
+    // Each to its size first: growing by doubling would copy and touch about twice the points.
+    const auto inner_count = static_cast<std::size_t>(std::count(inner.begin(), inner.end(), 1));
+    inside.reserve(inner_count);
+    rim.reserve(points.size() - inner_count);
     std::vector<VertexId> vertex_of(points.size(), no_vertex); // point -> vertex (inner: filled below)
     for (std::size_t q = 0; q < points.size(); ++q) (inner[q] ? inside : rim).push_back(points[q]);
     if (!rim.empty()) {
@@ -1814,6 +1818,9 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
         return &edge_node[static_cast<std::size_t>(edge_id[u][w]) * (rows + 1) + ww];
     };
     std::vector<Vec3> points;
+    // Room for every lattice point of the cap (those on land or too near the coast are never
+    // written, so never touched): growing by doubling would copy and touch about twice the points.
+    points.reserve(static_cast<std::size_t>((10 * n * n + 2) * 0.5 * (1 - cos_r)) + 1);
     TriangleId hint = no_triangle;
     for (int f = 0; f < 20; ++f) {
         const int ia = face[f][0], ib = face[f][1], ic = face[f][2];
