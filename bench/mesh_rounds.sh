@@ -28,13 +28,12 @@ for r in $(seq "$rounds"); do
     c=$("$core" 1000000 uniform | sed -n 's/.*points: \([0-9.]*\) s.*/\1/p')
     for h in $sizes; do
         "$exe" mesh --coast "$coast" --coast-layer land --hmax "${h}km" -o "$tmp/m.nc" --overwrite \
-            --quiet --timings "$tmp/t.json" --report "$tmp/r.json" >/dev/null
-        /usr/bin/python3 - "$r" "$c" "$h" "$tmp/t.json" "$tmp/r.json" >> "$tmp/rows" <<'PY'
+            --quiet --report "$tmp/r.json" >/dev/null
+        /usr/bin/python3 - "$r" "$c" "$h" "$tmp/r.json" >> "$tmp/rows" <<'PY'
 import json, sys
-r, core, h = sys.argv[1], float(sys.argv[2]), sys.argv[3]
-t, rep = json.load(open(sys.argv[4]))["stages"], json.load(open(sys.argv[5]))
-n = rep.get("nodes") or rep.get("mesh", {}).get("nodes")
-print(r, core, h, n, t["mesh"])
+r, core, h = sys.argv[1:4]
+rep = json.load(open(sys.argv[4]))
+print(r, core, h, rep["mesh"]["nodes"], rep["stages"]["mesh"])
 PY
     done
 done

@@ -18,8 +18,10 @@
 #include <cstdlib>
 #include <new>
 
+#ifdef __GLIBC__
+#include <malloc.h> // mallopt
+#endif
 #if defined(__GLIBC__) && defined(__linux__)
-#include <malloc.h>
 #include <sys/mman.h>
 #define GLOBEMESH_HUGE_PAGES 1
 #endif

@@ -1735,7 +1735,8 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
         const double r = std::acos(cos_r) + 2 * s; // a margin for the jitter
         cos_r = r < 1.5 ? std::cos(r) : -1;
     }
-    if ((10 * n * n + 2) * 0.5 * (1 - cos_r) > max_points) return 0;
+    const double cap_points = (10 * n * n + 2) * 0.5 * (1 - cos_r); // the lattice's points in the cap, about
+    if (cap_points > max_points) return 0;
     auto in_cap = [&](const Vec3& p) { return dot(p, centre) >= cos_r * norm(p); }; // p need not be unit
     const double g = 0.5 * (1.0 + std::sqrt(5.0));
     const std::array<Vec3, 12> corner = {
@@ -1820,7 +1821,7 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     std::vector<Vec3> points;
     // Room for every lattice point of the cap (those on land or too near the coast are never
     // written, so never touched): growing by doubling would copy and touch about twice the points.
-    points.reserve(static_cast<std::size_t>((10 * n * n + 2) * 0.5 * (1 - cos_r)) + 1);
+    points.reserve(static_cast<std::size_t>(cap_points) + 1);
     TriangleId hint = no_triangle;
     for (int f = 0; f < 20; ++f) {
         const int ia = face[f][0], ib = face[f][1], ic = face[f][2];
