@@ -2523,13 +2523,17 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 for (double f : {0.1, 0.2, 0.3}) consider(normalized((1 - f) * p0 + f * dt.point(e)));
             const double step = 0.5 * reach;
             if (best < star_count_best(far.size())) pattern_search(to, step, step / 8, consider);
-            if (chain.empty()) return;
-            const int land0 = star_faces_on_land(*options.land, p0, far);
-            for (auto it = chain.rbegin(); it != chain.rend(); ++it)
-                if (options.land->coast_within(*it, reach) && star_faces_on_land(*options.land, *it, far) <= land0) {
-                    move_checked(v, from, *it, floor, changed, ends);
-                    return;
-                }
+            // The star's faces centred on land where it is now are counted only when a point
+            // has some (rarely: most stars have none either way).
+            int land0 = -1;
+            for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+                if (!options.land->coast_within(*it, reach)) continue;
+                const int land = star_faces_on_land(*options.land, *it, far);
+                if (land > 0 && land0 < 0) land0 = star_faces_on_land(*options.land, p0, far);
+                if (land > 0 && land > land0) continue;
+                move_checked(v, from, *it, floor, changed, ends);
+                return;
+            }
         };
         // The search rounds' move: to the candidate, then, when the star is still below
         // worst_goal, the point of a pattern search, that best raises the star's worst.
