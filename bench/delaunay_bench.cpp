@@ -35,6 +35,28 @@ static void BM_globemesh_clustered(benchmark::State& s) { run_globemesh(s, "clus
 BENCHMARK(BM_globemesh_uniform)->Arg(10000)->Arg(100000)->Arg(1000000)->Arg(4000000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_globemesh_clustered)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 
+// A coast's insertion and recovery, as the mesher's steps 1 and 2 do them: the rings' nodes
+// inserted, then every segment recovered as a constraint (time per node).
+static void BM_globemesh_rings(benchmark::State& state) {
+    const auto rings = bench::coast_like_rings(static_cast<std::size_t>(state.range(0)));
+    std::vector<Vec3> points;
+    for (const auto& r : rings) points.insert(points.end(), r.begin(), r.end());
+    for (auto _ : state) {
+        SphericalDelaunay dt;
+        const auto ids = dt.insert_points(points);
+        std::size_t recovered = 0, offset = 0;
+        for (const auto& r : rings) {
+            for (std::size_t i = 0; i < r.size(); ++i)
+                recovered += dt.insert_constraint(ids[offset + i], ids[offset + (i + 1) % r.size()]);
+            offset += r.size();
+        }
+        if (recovered != points.size()) state.SkipWithError("a segment was not recovered");
+        state.counters["triangles"] = static_cast<double>(dt.triangle_count());
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(points.size()));
+}
+BENCHMARK(BM_globemesh_rings)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
 #ifdef GLOBEMESH_HAVE_CGAL
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Traits = CGAL::Delaunay_triangulation_on_sphere_traits_2<K>;

@@ -285,6 +285,7 @@ private:
     std::vector<std::pair<VertexId, VertexId>> dropped_; // (vertex left by a cavity, merged into)
     std::vector<VertexId> swallowed_, rim_vertices_;     // scratch of insert_in_cavity
     TriangleId last_ = no_triangle;
+    TriangleId recover_hint_ = no_triangle; // recover_segment's: where it last found or flipped an edge
     bool bounded_ = true; // every point ever stored is bounded(): the walk's static filter holds
     // scratch buffers reused across insertions (no allocation per insertion)
     struct Rim {

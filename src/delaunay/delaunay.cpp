@@ -1086,10 +1086,14 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
     const Vec3& pa = points_[a];
     const Vec3& pb = points_[b];
     for (int round = 0; round < 64; ++round) {
-        const HalfEdge from = leaving(a);
+        // From the last edge recovered or flipped: the previous segment of a ring ends at a,
+        // and the flips below go along the arc. (Without a hint, every lookup walked from the
+        // last insertion, across the mesh: 6 s for the 353,000 nodes of 1:110m land at 1 km.)
+        const HalfEdge from = leaving(a, recover_hint_);
         if (from == no_half_edge) return false;
         HalfEdge e = find_edge(from, b);
         if (e != no_half_edge) {
+            recover_hint_ = triangle_of(e);
             if (!is_constrained(e)) {
                 set_constrained(e, true);
                 constrained.emplace_back(a, b);
@@ -1152,9 +1156,10 @@ bool SphericalDelaunay::recover_segment(VertexId a, VertexId b, std::vector<Half
         while (head < queue.size()) {
             if (flips > max_flips) return false;
             auto [qu, qw] = queue[head++];
-            HalfEdge e2 = find_edge(leaving(qu), qw);
+            HalfEdge e2 = find_edge(leaving(qu, recover_hint_), qw);
             if (e2 == no_half_edge) continue; // already flipped away
             TriangleId s = triangle_of(e2);
+            recover_hint_ = s;
             int i = edge_of(e2);
             HalfEdge g = twin(e2);
             const Vec3& x = points_[vertex(s, i)];
