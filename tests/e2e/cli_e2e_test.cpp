@@ -292,6 +292,9 @@ INSTANTIATE_TEST_SUITE_P(
         ExeError{"region_without_ocean", {"mesh", "--coast", land110, "--coast-layer", "land", "--region", "0,20,10,25", "-o", "{dir}/o.nc", "-q"}, {1}, "region"},
         ExeError{"output_in_missing_folder", {"mesh", "--coast", land110, "-o", "{dir}/none/o.nc"}, {1}, "none"},
         ExeError{"existing_output", {"mesh", "--coast", land110, "-o", "{dir}/existing.nc"}, {1}, "--overwrite"},
+        // The ocean at 1 m would take some 4e14 nodes: refused at once from its area, not after
+        // minutes of shaping a coast of billions of nodes.
+        ExeError{"a_size_of_metres", {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "1m", "-o", "{dir}/o.nc", "-q"}, {1}, "--max-nodes"},
         ExeError{"unknown_subcommand", {"mesj"}, {2}, "mesj"},
         ExeError{"info_on_a_non_mesh", {"info", "{dir}/existing.nc"}, {1}, "existing.nc"}),
     [](const auto& info) { return info.param.name; });
