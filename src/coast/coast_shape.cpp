@@ -286,6 +286,21 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
             if (keep[i]) s.kept.push_back(i);
     }
     report(progress, 0.5, "resampling coast");
+    // The coast's nodes at the local size, at least (each arc over the larger size at its
+    // ends): a size of metres asks a global coast for billions, refused here as the mesher
+    // would refuse them, before the resampling spends the time and memory to make them.
+    {
+        double coast_nodes = 0;
+        for (const ShapedRing& s : shaped)
+            for (std::size_t k = 0; k < s.kept.size(); ++k) {
+                const std::uint32_t a = s.kept[k], b = s.kept[(k + 1) % s.kept.size()];
+                coast_nodes += arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
+            }
+        if (coast_nodes > static_cast<double>(options.max_nodes))
+            throw DataError("the coast alone asks for about " + std::to_string(std::llround(coast_nodes)) +
+                            " nodes at the target size, more than --max-nodes " + std::to_string(options.max_nodes) +
+                            ": raise --hmin/--hmax or --max-nodes");
+    }
 
     // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.

@@ -220,6 +220,30 @@ TEST(Coast, shaped_nodes_stay_near_the_source_and_segments_near_the_size) {
     EXPECT_GT(double(near_h), 0.8 * length.size());
 }
 
+// A size of metres asks the global coast for hundreds of millions of nodes: refused before the
+// resampling makes them, by --max-nodes (the coast alone is a lower bound of the mesh's nodes).
+// The 1:110m coast is about 2.6e5 km long (the sum of its arcs, measured below), so 1 m asks
+// for over 1e8 nodes and 100 km for a few thousand.
+TEST(Coast, a_coast_that_alone_exceeds_max_nodes_is_refused_before_it_is_resampled) {
+    double length_km = 0;
+    for (const auto& r : ne110().rings.rings)
+        for (std::size_t k = 0; k < r.nodes.size(); ++k) length_km += arc_km(r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]);
+    ASSERT_GT(length_km / 0.001, 1e8);
+    MeshOptions o;
+    o.max_nodes = 20'000'000;
+    try {
+        shape_boundary(ne110(), uniform(0.001), o);
+        ADD_FAILURE() << "a 1 m coast was shaped";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
+    }
+    // At 100 km the same bound lets it through, with nodes to spare.
+    o.max_nodes = static_cast<std::uint64_t>(length_km / 100 * 2);
+    CoastReport rep;
+    shape_boundary(ne110(), uniform(100), o, &rep);
+    EXPECT_GT(rep.nodes, 1000u);
+}
+
 TEST(Coast, shaping_follows_a_varying_size) {
     // h = 20 km north of the equator, 200 km south of it.
     auto size = [](const Vec3& v) { return v.z > 0 ? 20.0 : 200.0; };
