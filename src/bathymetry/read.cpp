@@ -201,7 +201,9 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     report(progress, 0.0, "read bathymetry");
 
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds) throw IoError("--bathy " + path + ": cannot open as a raster: " + gdal::last_error());
+    if (!ds)
+        throw IoError("--bathy " + path + ": cannot open as a raster: " +
+                      gdal::last_error("not a raster format GDAL reads"));
     GDALDatasetH h = ds.get();
     const int nbands = GDALGetRasterCount(h);
     if (band < 1 || band > nbands)

@@ -295,6 +295,8 @@ INSTANTIATE_TEST_SUITE_P(
         // The ocean at 1 m would take some 4e14 nodes: refused at once from its area, not after
         // minutes of shaping a coast of billions of nodes.
         ExeError{"a_size_of_metres", {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "1m", "-o", "{dir}/o.nc", "-q"}, {1}, "--max-nodes"},
+        // GDAL opens a vector file as no raster without a message of its own.
+        ExeError{"bathy_not_a_raster", {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "500km", "--bathy", land110, "-o", "{dir}/o.nc", "-q"}, {1}, "not a raster format GDAL reads"},
         ExeError{"unknown_subcommand", {"mesj"}, {2}, "mesj"},
         ExeError{"info_on_a_non_mesh", {"info", "{dir}/existing.nc"}, {1}, "existing.nc"}),
     [](const auto& info) { return info.param.name; });
