@@ -1,8 +1,10 @@
 // Time per point of the spherical Delaunay core (sort + triangulate, insert_points(vector&&)), against CGAL's
 // Delaunay_triangulation_on_sphere_2 on the same points in the same run when CGAL is found.
-// items_per_second is points per second; time per point = 1 / items_per_second.
+// items_per_second is points per second; time per point = 1 / items_per_second. Also a coast's
+// insertion and segment recovery (BM_globemesh_rings). Allocates as the globemesh executable.
 #include <benchmark/benchmark.h>
 
+#include "allocation.hpp"
 #include "bench_points.hpp"
 #include "globemesh/delaunay.hpp"
 
@@ -81,4 +83,11 @@ BENCHMARK(BM_cgal_uniform)->Arg(10000)->Arg(100000)->Arg(1000000)->Arg(4000000)-
 BENCHMARK(BM_cgal_clustered)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 #endif
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+    globemesh::configure_allocation(); // as the globemesh executable (src/cli/allocation.cpp)
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
