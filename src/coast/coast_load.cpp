@@ -607,17 +607,29 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
         auto collect = [](void* item, void* user) {
             static_cast<std::vector<std::size_t>*>(user)->push_back(reinterpret_cast<std::size_t>(item));
         };
+        // Of each pair, the polygon with more vertices is the prepared one, kept for its other
+        // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
+        // the geometry tested against a prepared one anew on every call. Intersection is
+        // symmetric: the groups are the same.
+        std::vector<int> vertices(n);
+        for (std::size_t i = 0; i < n; ++i) vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
+        std::vector<PreparedPtr> prepared;
+        for (std::size_t i = 0; i < n; ++i) prepared.emplace_back(nullptr, PreparedDeleter{geos.get()});
+        auto prepared_of = [&](std::size_t i) {
+            if (!prepared[i]) prepared[i].reset(GEOSPrepare_r(geos.get(), polys[i].get()));
+            return prepared[i].get();
+        };
         for (std::size_t i = 0; i < n; ++i) {
             hits.clear();
             GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
             std::sort(hits.begin(), hits.end());
-            PreparedPtr prepared(nullptr, PreparedDeleter{geos.get()});
             for (std::size_t j : hits) {
                 if (j <= i || find(i) == find(j)) continue;
-                if (!prepared) prepared.reset(GEOSPrepare_r(geos.get(), polys[i].get()));
-                if (GEOSPreparedIntersects_r(geos.get(), prepared.get(), polys[j].get()) == 1)
+                const auto [big, small] = vertices[j] > vertices[i] ? std::pair{j, i} : std::pair{i, j};
+                if (GEOSPreparedIntersects_r(geos.get(), prepared_of(big), polys[small].get()) == 1)
                     parent[find(j)] = find(i);
             }
+            prepared[i].reset(); // its pairs are all done: later ones have both indices above i
         }
     }
     std::vector<std::vector<std::size_t>> groups(n);
