@@ -1,6 +1,7 @@
 // read_raster / read_bathymetry: GDAL in, Raster out. The only file of bathymetry/ that sees GDAL.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -194,10 +195,38 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     return read_raster(path, band, depth_positive, progress, limits);
 }
 
+/// GDAL's block cache capped while a raster is read: every block is read once, so a larger cache
+/// only holds blocks that are never asked for again (by default 5% of the RAM, which --max-memory
+/// does not see). A GDAL_CACHEMAX the user set stays. Measured on a 40000 x 20000 Int16 GeoTIFF
+/// read to 15 km cells with --max-memory 1GB: default cache (900 MB here) read_bathy 6.3 s,
+/// process peak 1.31 GB; 64 MB 2.2 s, 137 MB; 16 MB 2.1 s, 88 MB.
+class BlockCacheCap {
+public:
+    explicit BlockCacheCap(std::uint64_t budget_bytes) : old_(GDALGetCacheMax64()) {
+        if (CPLGetConfigOption("GDAL_CACHEMAX", nullptr)) return;
+        GIntBig cap = GIntBig{64} << 20;
+        if (budget_bytes > 0) cap = std::min<GIntBig>(cap, std::max<GIntBig>(GIntBig{4} << 20, GIntBig(budget_bytes / 4)));
+        if (cap < old_) {
+            GDALSetCacheMax64(cap);
+            set_ = true;
+        }
+    }
+    ~BlockCacheCap() {
+        if (set_) GDALSetCacheMax64(old_);
+    }
+    BlockCacheCap(const BlockCacheCap&) = delete;
+    BlockCacheCap& operator=(const BlockCacheCap&) = delete;
+
+private:
+    GIntBig old_;
+    bool set_ = false;
+};
+
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
                    const RasterLimits& limits) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
+    const BlockCacheCap cache(limits.max_bytes);
     report(progress, 0.0, "read bathymetry");
 
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));

@@ -1,6 +1,7 @@
 // Tests of bathymetry/: synthetic rasters written here with GDAL whose values are known exactly,
 // and the real ETOPO5 fixtures checked against an independent read (netCDF-C coordinates and
 // values, GDALRasterIO of single pixels).
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <cpl_conv.h>
 #include <gdal.h>
 #include <netcdf.h>
 #include <ogr_srs_api.h>
@@ -349,6 +351,39 @@ TEST(Bathymetry, etopo5_global_netcdf_matches_its_own_coordinates_and_values) {
     EXPECT_GT(sea, land); // most of the Earth is ocean
     EXPECT_LT(r.elevation_m(-155, 0), -3000);  // central Pacific
     EXPECT_GT(r.elevation_m(86.9, 28.0), 3000); // Himalaya
+}
+
+// GDAL's block cache is capped while a raster is read (each block is read once; the default,
+// 5% of the RAM, is memory that --max-memory does not see: a 40000 x 20000 GeoTIFF read coarse
+// under --max-memory 1GB peaked at 1.31 GB) and restored after; a GDAL_CACHEMAX the user set
+// stays. Watched from the progress callback, which runs during the read.
+TEST(Bathymetry, gdal_block_cache_is_capped_while_a_raster_is_read_and_restored_after) {
+    const std::string path = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    const GIntBig before = GDALGetCacheMax64();
+    const GIntBig large = GIntBig{1} << 30; // 5% of a 20 GB machine
+    GDALSetCacheMax64(large);
+    GIntBig during = 0;
+    const Progress watch = [&](double, std::string_view) {
+        during = std::max(during, GDALGetCacheMax64());
+        return true;
+    };
+    read_raster(path, 1, false, watch);
+    EXPECT_GT(during, 0);
+    EXPECT_LE(during, GIntBig{64} << 20);
+    EXPECT_EQ(GDALGetCacheMax64(), large);
+    // Under a budget, a quarter of what the raster may take.
+    RasterLimits limits;
+    limits.max_bytes = std::uint64_t{40} << 20;
+    during = 0;
+    read_raster(path, 1, false, watch, limits);
+    EXPECT_LE(during, GIntBig{10} << 20);
+    EXPECT_EQ(GDALGetCacheMax64(), large);
+    CPLSetConfigOption("GDAL_CACHEMAX", "1024");
+    during = 0;
+    read_raster(path, 1, false, watch);
+    EXPECT_EQ(during, large);
+    CPLSetConfigOption("GDAL_CACHEMAX", nullptr);
+    GDALSetCacheMax64(before);
 }
 
 TEST(Bathymetry, etopo5_nwshelf_geotiff_nodes_sit_on_whole_5_minutes) {
