@@ -2087,8 +2087,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         }
     }
 
-    // Node estimate: an equilateral triangle of side h covers sqrt(3)/4 h^2, and a large mesh has
-    // two triangles per node.
+    // Node estimate (nodes_for_area), with each triangle at the smallest size at its centroid and
+    // corners.
     double estimate = 0;
     for (TriangleId t = 0; t < slots; ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
@@ -2096,7 +2096,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                                               dt.point(dt.vertex(t, 2)));
         double h = km_to_rad(size_km(m.centroid(t)));
         for (int i = 0; i < 3; ++i) h = std::min(h, km_to_rad(size_km(dt.point(dt.vertex(t, i)))));
-        estimate += area / (std::sqrt(3.0) / 4.0 * h * h) / 2.0;
+        estimate += nodes_for_area(area, h);
     }
     report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
     if (report.estimated_nodes > options.max_nodes)
@@ -2528,9 +2528,10 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             int land0 = -1;
             for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
                 if (!options.land->coast_within(*it, reach)) continue;
-                const int land = star_faces_on_land(*options.land, *it, far);
-                if (land > 0 && land0 < 0) land0 = star_faces_on_land(*options.land, p0, far);
-                if (land > 0 && land > land0) continue;
+                if (const int land = star_faces_on_land(*options.land, *it, far); land > 0) {
+                    if (land0 < 0) land0 = star_faces_on_land(*options.land, p0, far);
+                    if (land > land0) continue;
+                }
                 move_checked(v, from, *it, floor, changed, ends);
                 return;
             }
