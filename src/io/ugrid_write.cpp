@@ -9,15 +9,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <set>
 #include <string>
 #include <system_error>
-#include <thread>
 #include <vector>
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "face_area.hpp"
 #include "face_geometry.hpp"
 #include "mesh_topology.hpp"
 #include "netcdf_handle.hpp"
@@ -80,26 +81,77 @@ public:
                      std::string("writing attribute ") + name);
     }
     bool has_att(int v, const char* name) const { return nc_inq_attid(id_, v, name, nullptr) == NC_NOERR; }
+    /// Runs compute(first, count, buffers) and then write(first, count, buffers) for each block of
+    /// block_rows rows of n, in order. The next block is computed on another thread while this
+    /// one is written (netCDF-4's compression takes about as long as the computing); compute is
+    /// called for one block at a time, in order, so the file is the same as without.
+    template <class Buffers, class Compute, class Write>
+    static void in_blocks(std::size_t n, const Compute& compute, const Write& write) {
+        if (n == 0) return;
+        auto count_at = [n](std::size_t first) { return std::min(block_rows, n - first); };
+        Buffers current, next;
+        compute(std::size_t(0), count_at(0), current);
+        for (std::size_t first = 0; first < n; first += block_rows) {
+            const std::size_t after = first + block_rows;
+            std::future<void> ahead; // joined by its destructor should write throw
+            if (after < n) {
+                auto compute_next = [&] { compute(after, count_at(after), next); };
+                try {
+                    ahead = std::async(std::launch::async, compute_next);
+                } catch (const std::system_error&) {
+                    compute_next(); // no thread to be had (a process limit): in turn
+                }
+            }
+            write(first, count_at(first), current);
+            if (ahead.valid()) ahead.get();
+            std::swap(current, next);
+        }
+    }
     /// Writes the n rows of variable v in blocks of block_rows (one chunk each), N values of
     /// type T (double or int, as the variable) a row: row(i) returns row i as std::array<T, N>.
-    /// Rows are asked for in ascending order. Only one block is in memory at a time.
+    /// Rows are asked for in ascending order, from one thread at a time (in_blocks).
     template <class T, std::size_t N, class Row>
     void put_rows(int v, std::size_t n, const Row& row, const char* name) {
-        std::vector<T> block;
-        for (std::size_t first = 0; first < n; first += block_rows) {
-            const std::size_t count = std::min(block_rows, n - first);
-            block.resize(count * N);
-            for (std::size_t i = 0; i < count; ++i) {
-                const std::array<T, N> r = row(first + i);
-                std::copy(r.begin(), r.end(), block.begin() + std::ptrdiff_t(i * N));
-            }
-            put_block_rows(v, first, count, N, block.data(), name);
-        }
+        in_blocks<std::vector<T>>(
+            n,
+            [&](std::size_t first, std::size_t count, std::vector<T>& block) {
+                block.resize(count * N);
+                for (std::size_t i = 0; i < count; ++i) {
+                    const std::array<T, N> r = row(first + i);
+                    std::copy(r.begin(), r.end(), block.begin() + std::ptrdiff_t(i * N));
+                }
+            },
+            [&](std::size_t first, std::size_t count, const std::vector<T>& block) {
+                put_block_rows(v, first, count, N, block.data(), name);
+            });
     }
     /// put_rows for a variable of one value per row: value(i) returns row i's value.
     template <class T, class Value>
     void put_values(int v, std::size_t n, const Value& value, const char* name) {
         put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; }, name);
+    }
+
+    /// Writes the lon and lat of n points to variables v_lon and v_lat, point(i) giving point i
+    /// (a unit vector), each converted once.
+    template <class Point>
+    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point& point, const char* what) {
+        using LonLats = std::array<std::vector<double>, 2>;
+        const std::string lons = std::string(what) + " longitudes", lats = std::string(what) + " latitudes";
+        in_blocks<LonLats>(
+            n,
+            [&](std::size_t first, std::size_t count, LonLats& b) {
+                b[0].resize(count);
+                b[1].resize(count);
+                for (std::size_t i = 0; i < count; ++i) {
+                    const LonLat p = vec_to_lonlat(point(first + i));
+                    b[0][i] = p.lon;
+                    b[1][i] = p.lat;
+                }
+            },
+            [&](std::size_t first, std::size_t count, const LonLats& b) {
+                put_block_rows(v_lon, first, count, 1, b[0].data(), lons.c_str());
+                put_block_rows(v_lat, first, count, 1, b[1].data(), lats.c_str());
+            });
     }
 
     /// Writes rows first .. first + count - 1 of variable v (n_per_row values of type T, double or
@@ -110,32 +162,6 @@ public:
         const std::size_t start[2] = {first, 0}, counts[2] = {count, n_per_row};
         io::nc_check(put_block(v, start, counts, data), file_, std::string("writing ") + name);
     }
-    /// put_values with each block's values computed on every core, in contiguous slices:
-    /// value(i) must be safe to call from several threads at once. The file is the same.
-    template <class Value>
-    void put_values_parallel(int v, std::size_t n, const Value& value, const char* name) {
-        const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
-        std::vector<double> block;
-        for (std::size_t first = 0; first < n; first += block_rows) {
-            const std::size_t count = std::min(block_rows, n - first);
-            block.resize(count);
-            auto slice = [&](std::size_t k) {
-                for (std::size_t i = count * k / threads; i < count * (k + 1) / threads; ++i) block[i] = value(first + i);
-            };
-            std::vector<std::thread> pool;
-            std::size_t k = 1;
-            try {
-                for (; k < threads; ++k) pool.emplace_back(slice, k);
-            } catch (const std::system_error&) {
-                // No more threads (a process limit): this thread does the slices left.
-            }
-            for (; k < threads; ++k) slice(k);
-            slice(0);
-            for (auto& t : pool) t.join();
-            put_block_rows(v, first, count, 1, block.data(), name);
-        }
-    }
-
     static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
 
 private:
@@ -346,9 +372,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
 
     // Every variable is computed block by block while it is written (UgridWriter::put_rows):
     // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
-    // table: the node lon/lat (16 bytes a node).
-    auto lon = [&](const Vec3& p) { return vec_to_lonlat(p).lon; };
-    auto lat = [&](const Vec3& p) { return vec_to_lonlat(p).lat; };
+    // table: the edges' area terms (GeodesicFaceAreas, 24 bytes a node).
     auto centre = [&](std::size_t f) {
         return normalized(mesh.nodes[mesh.faces[f][0]] + mesh.nodes[mesh.faces[f][1]] + mesh.nodes[mesh.faces[f][2]]);
     };
@@ -361,39 +385,38 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
     }, "face nodes");
     if (options.after_partial_write) options.after_partial_write();
-    w.put_values<double>(coord_vars[2], nf, [&](std::size_t f) { return lon(centre(f)); }, "face longitudes");
-    w.put_values<double>(coord_vars[3], nf, [&](std::size_t f) { return lat(centre(f)); }, "face latitudes");
-    w.put_values<double>(coord_vars[4], ne, [&](std::size_t e) { return lon(midpoint(e)); }, "edge longitudes");
-    w.put_values<double>(coord_vars[5], ne, [&](std::size_t e) { return lat(midpoint(e)); }, "edge latitudes");
+    w.put_lonlat(coord_vars[2], coord_vars[3], nf, centre, "face");
+    w.put_lonlat(coord_vars[4], coord_vars[5], ne, midpoint, "edge");
     w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
     {
-        // Face edges and face neighbours a block of faces at a time, from one pass over the edges
-        // a block: no face-to-edge table of the whole mesh (12 bytes a face) at the writer's peak.
-        std::vector<std::int32_t> edges;
-        std::vector<int> links;
-        for (std::size_t first = 0; first < nf; first += UgridWriter::block_rows) {
-            const std::size_t count = std::min(UgridWriter::block_rows, nf - first);
-            io::face_edges(topo, first, count, edges);
-            w.put_block_rows(v_face_edges, first, count, 3, edges.data(), "face edges");
-            links.resize(3 * count);
-            for (std::size_t i = 0; i < count; ++i) {
-                const auto nb = io::face_faces(topo, &edges[3 * i], first + i);
-                std::copy(nb.begin(), nb.end(), links.begin() + std::ptrdiff_t(3 * i));
-            }
-            w.put_block_rows(v_face_links, first, count, 3, links.data(), "face neighbours");
-        }
-    }
-    {
-        // Node lon/lat converted once for the node coordinates and the face areas.
-        std::vector<LonLat> ll(nn);
-        for (std::size_t i = 0; i < nn; ++i) ll[i] = vec_to_lonlat(mesh.nodes[i]);
-        w.put_values<double>(coord_vars[0], nn, [&](std::size_t i) { return ll[i].lon; }, "node longitudes");
-        w.put_values<double>(coord_vars[1], nn, [&](std::size_t i) { return ll[i].lat; }, "node latitudes");
-        // Three geodesic problems a face: most of the writer's time, so on every core.
-        w.put_values_parallel(v_area, nf, [&](std::size_t f) {
-            const auto& t = mesh.faces[f];
-            return io::geodesic_triangle_area_m2(ll[t[0]], ll[t[1]], ll[t[2]]);
-        }, "area");
+        w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; }, "node");
+        // Most of the writer's time: each edge's geodesic problem, on every core.
+        const io::GeodesicFaceAreas areas(topo);
+        // Face edges, face neighbours and face areas a block of faces at a time, from one pass
+        // over the edges a block: no face-to-edge table of the whole mesh (12 bytes a face) at
+        // the writer's peak.
+        struct FaceRows {
+            std::vector<std::int32_t> edges;
+            std::vector<int> links;
+            std::vector<double> area;
+        };
+        UgridWriter::in_blocks<FaceRows>(
+            nf,
+            [&](std::size_t first, std::size_t count, FaceRows& b) {
+                io::face_edges(topo, first, count, b.edges);
+                b.links.resize(3 * count);
+                b.area.resize(count);
+                for (std::size_t i = 0; i < count; ++i) {
+                    const auto nb = io::face_faces(topo, &b.edges[3 * i], first + i);
+                    std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
+                    b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
+                }
+            },
+            [&](std::size_t first, std::size_t count, const FaceRows& b) {
+                w.put_block_rows(v_face_edges, first, count, 3, b.edges.data(), "face edges");
+                w.put_block_rows(v_face_links, first, count, 3, b.links.data(), "face neighbours");
+                w.put_block_rows(v_area, first, count, 1, b.area.data(), "area");
+            });
     }
     w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); }, "edge faces");
     if (nb)

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/PolygonArea.hpp>
 
 #include <fstream>
 #include <iterator>
@@ -323,6 +324,41 @@ TEST(Ugrid, face_areas_are_geodesic_and_tile_the_wgs84_ellipsoid) {
     double total = 0;
     for (double a : area) total += a;
     EXPECT_NEAR(total, GeographicLib::Geodesic::WGS84().EllipsoidArea(), 1e-8 * total);
+}
+
+// The writer solves each edge's geodesic problem once for its two faces; GeographicLib's
+// PolygonArea, face by face, is the independent reference. The meshes have faces with a corner at
+// a pole, faces across lon 0 and 180, and (without pole nodes) a face round each pole.
+TEST(Ugrid, each_face_area_is_polygonarea_of_its_corners) {
+    // Each mesh with the number of its faces that go round a pole without a corner on it.
+    const std::pair<Mesh, int> meshes[] = {{icosphere(3), 0}, {icosphere_without_pole_nodes(3), 2}};
+    for (const auto& [m, round_pole_expected] : meshes) {
+        TempDir dir;
+        write_ugrid(m, dir / "ico.nc");
+        int nc, v;
+        ASSERT_EQ(nc_open((dir / "ico.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+        ASSERT_EQ(nc_inq_varid(nc, "area", &v), NC_NOERR);
+        std::vector<double> area(m.faces.size());
+        ASSERT_EQ(nc_get_var_double(nc, v, area.data()), NC_NOERR);
+        nc_close(nc);
+        int round_pole = 0;
+        for (std::size_t f = 0; f < m.faces.size(); ++f) {
+            GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
+            for (NodeIndex k : m.faces[f]) {
+                const LonLat p = vec_to_lonlat(m.nodes[k]);
+                poly.AddPoint(p.lat, p.lon);
+            }
+            double perimeter, expected;
+            poly.Compute(false, true, perimeter, expected);
+            // Only the rounding of the edges' S12 terms (each up to a quarter of the ellipsoid,
+            // 1.3e14 m2, so a few 0.01 m2) may differ.
+            EXPECT_NEAR(area[f], std::fabs(expected), 0.1) << "face " << f;
+            const Vec3 &a = m.nodes[m.faces[f][0]], &b = m.nodes[m.faces[f][1]], &c = m.nodes[m.faces[f][2]];
+            for (const Vec3 pole : {Vec3{0, 0, 1}, Vec3{0, 0, -1}})
+                round_pole += dot(pole, cross(a, b)) > 0 && dot(pole, cross(b, c)) > 0 && dot(pole, cross(c, a)) > 0;
+        }
+        EXPECT_EQ(round_pole, round_pole_expected);
+    }
 }
 
 TEST(Ugrid, same_mesh_gives_identical_bytes) {
