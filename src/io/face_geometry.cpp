@@ -4,9 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <GeographicLib/Geodesic.hpp>
-#include <GeographicLib/PolygonArea.hpp>
-
 namespace globemesh::io {
 
 namespace {
@@ -120,14 +117,6 @@ std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes) {
         flush();
     }
     return parts;
-}
-
-double geodesic_triangle_area_m2(const LonLat& a, const LonLat& b, const LonLat& c) {
-    GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
-    for (const LonLat* p : {&a, &b, &c}) poly.AddPoint(p->lat, p->lon);
-    double perimeter = 0, area = 0;
-    poly.Compute(false, true, perimeter, area);
-    return std::fabs(area);
 }
 
 } // namespace globemesh::io

@@ -1,5 +1,5 @@
 // Internal to io/: faces and lines of the sphere as lon/lat geometry that GIS software draws
-// right, and the geodesic face areas both writers report.
+// right.
 //
 // GIS draws straight lines in lon/lat, so: a pole corner becomes two points at +-90 (at the
 // longitudes of the neighbouring corners) and the polar fan draws as quads; a face around a pole
@@ -22,9 +22,5 @@ std::vector<LonLatPart> face_polygons(const Vec3& a, const Vec3& b, const Vec3& 
 
 /// A polyline of unit vectors (straight in lon/lat between nodes) cut at +-180 into parts.
 std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes);
-
-/// Geodesic area of the triangle abc on the WGS84 ellipsoid, m2 (GeographicLib PolygonArea).
-/// One face at a time, so a writer needs no table of all the areas.
-double geodesic_triangle_area_m2(const LonLat& a, const LonLat& b, const LonLat& c);
 
 } // namespace globemesh::io

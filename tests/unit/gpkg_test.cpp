@@ -5,6 +5,8 @@
 
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
+#include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/PolygonArea.hpp>
 
 #include <fstream>
 
@@ -96,6 +98,16 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     const auto& depth = m.node_field("depth")->values;
     EXPECT_NEAR(f7->GetFieldAsDouble("depth"), (depth[t[0]] + depth[t[1]] + depth[t[2]]) / 3, 1e-9);
     EXPECT_NEAR(f7->GetFieldAsDouble("quality"), triangle_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]]), 1e-12);
+    // Every face's area_km2: GeographicLib's PolygonArea of its corners (the writer shares each
+    // edge's geodesic problem between its two faces).
+    for (auto& f : *faces) {
+        const auto& c = m.faces[std::size_t(f->GetFID() - 1)];
+        GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
+        for (NodeIndex k : c) poly.AddPoint(vec_to_lonlat(m.nodes[k]).lat, vec_to_lonlat(m.nodes[k]).lon);
+        double perimeter, area_m2;
+        poly.Compute(false, true, perimeter, area_m2);
+        EXPECT_NEAR(f->GetFieldAsDouble("area_km2"), std::fabs(area_m2) * 1e-6, 1e-7) << "face " << f->GetFID() - 1;
+    }
 
     // Boundary runs: every boundary edge once, tags coast and open both present.
     int edges = 0, coast = 0, open = 0;
