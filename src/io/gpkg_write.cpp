@@ -268,28 +268,31 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
             face_fields.push_back(&f);
         }
     w.begin();
-    // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
-    // every core), a block of faces at a time as face_edges gives their edges.
-    const io::GeodesicFaceAreas areas(topo);
-    constexpr std::size_t block = 65536;
-    std::vector<std::int32_t> edges;
-    for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
-        if (i % block == 0) io::face_edges(topo, i, std::min(block, mesh.faces.size() - i), edges);
-        const auto& t = mesh.faces[i];
-        OGRFeature feature(faces->GetLayerDefn());
-        feature.SetFID(GIntBig(i) + 1);
-        feature.SetField("face", int(i));
-        feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-        feature.SetField("area_km2", areas.face_m2(i, &edges[3 * (i % block)]) * 1e-6);
-        auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
-        if (depth) feature.SetField("depth", mean(depth));
-        if (size) feature.SetField("target_size", mean(size));
-        for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
-        auto* multi = new OGRMultiPolygon();
-        for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-            for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
-        feature.SetGeometryDirectly(multi);
-        w.add(faces, feature);
+    {
+        // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
+        // every core), a block of faces at a time as face_edges gives their edges. Freed before the
+        // nodes, whose RTree GDAL builds in memory.
+        const io::GeodesicFaceAreas areas(topo);
+        constexpr std::size_t block = 65536;
+        std::vector<std::int32_t> edges;
+        for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
+            if (i % block == 0) io::face_edges(topo, i, std::min(block, mesh.faces.size() - i), edges);
+            const auto& t = mesh.faces[i];
+            OGRFeature feature(faces->GetLayerDefn());
+            feature.SetFID(GIntBig(i) + 1);
+            feature.SetField("face", int(i));
+            feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
+            feature.SetField("area_km2", areas.face_m2(i, &edges[3 * (i % block)]) * 1e-6);
+            auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
+            if (depth) feature.SetField("depth", mean(depth));
+            if (size) feature.SetField("target_size", mean(size));
+            for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
+            auto* multi = new OGRMultiPolygon();
+            for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
+                for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
+            feature.SetGeometryDirectly(multi);
+            w.add(faces, feature);
+        }
     }
     w.commit();
     if (options.after_partial_write) options.after_partial_write();
