@@ -51,7 +51,8 @@ MeshTopology build_topology(const Mesh& mesh) {
     };
     for (std::size_t v = 0; v < nn; ++v) std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
 
-    // Calls edge(i, j) for each edge in order: its half-edges are bucket[i..j), one or two.
+    // Calls edge(i, j, v) for each edge in order: its half-edges are bucket[i..j), one or two,
+    // and v is its smaller node.
     auto for_each_edge = [&](const auto& edge) {
         for (std::size_t v = 0; v < nn; ++v) {
             for (std::size_t i = start[v], end = start[v + 1]; i < end;) {
@@ -61,20 +62,23 @@ MeshTopology build_topology(const Mesh& mesh) {
                 if (j - i > 2)
                     throw DataError("mesh: edge " + std::to_string(v) + "-" + std::to_string(larger) +
                                     " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
-                edge(i, j);
+                edge(i, j, v);
                 i = j;
             }
         }
     };
     std::size_t ne = 0;
-    for_each_edge([&](std::size_t, std::size_t) { ++ne; });
+    for_each_edge([&](std::size_t, std::size_t, std::size_t) { ++ne; });
     MeshTopology t;
     t.mesh = &mesh;
     t.edge_halves.reserve(ne); // exactly: growing by push_back would double it
-    for_each_edge([&](std::size_t i, std::size_t j) {
+    t.node_edges.assign(nn + 1, 0);
+    for_each_edge([&](std::size_t i, std::size_t j, std::size_t v) {
         if (j - i == 1) t.boundary_edges.push_back(std::int32_t(t.edge_halves.size()));
         t.edge_halves.push_back({bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge});
+        t.node_edges[v + 1] = std::uint32_t(t.edge_halves.size());
     });
+    for (std::size_t v = 0; v < nn; ++v) t.node_edges[v + 1] = std::max(t.node_edges[v + 1], t.node_edges[v]);
     std::vector<std::uint32_t>().swap(start);
     std::vector<std::uint32_t>().swap(bucket);
 
@@ -96,10 +100,20 @@ MeshTopology build_topology(const Mesh& mesh) {
 
 void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out) {
     out.assign(3 * count, -1);
-    const std::size_t lo = 3 * first, hi = 3 * (first + count);
-    for (std::size_t e = 0; e < topo.edge_count(); ++e)
-        for (std::uint32_t h : topo.edge_halves[e])
-            if (h != MeshTopology::no_half_edge && h >= lo && h < hi) out[h - lo] = std::int32_t(e);
+    const auto& faces = topo.mesh->faces;
+    for (std::size_t i = 0; i < count; ++i) {
+        const auto& face = faces[first + i];
+        for (std::size_t k = 0; k < 3; ++k) {
+            // Side k is a half-edge of one of the edges of its smaller node.
+            const auto h = std::uint32_t(3 * (first + i) + k);
+            const std::uint32_t v = std::min(face[k], face[(k + 1) % 3]);
+            for (std::uint32_t e = topo.node_edges[v]; e < topo.node_edges[v + 1]; ++e)
+                if (topo.edge_halves[e][0] == h || topo.edge_halves[e][1] == h) {
+                    out[3 * i + k] = std::int32_t(e);
+                    break;
+                }
+        }
+    }
 }
 
 std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::int32_t* edges_of_f, std::size_t f) {

@@ -6,10 +6,10 @@
 // left. Fill (-1) entries come last in a row.
 //
 // Memory: the edges are stored as their two half-edges, 8 bytes an edge (about 24 bytes per
-// node); edge nodes, edge faces and face neighbours are computed from them and the mesh when
-// asked for. The face-to-edge table is built a block of faces at a time (face_edges), by the
-// writer that needs it. Building the edges takes 28 to 32 bytes per node of scratch, freed
-// before it returns.
+// node), and where each node's edges start (4 bytes a node); edge nodes, edge faces and face
+// neighbours are computed from them and the mesh when asked for. The face-to-edge table is built
+// a block of faces at a time (face_edges), by the writer that needs it. Building the edges takes
+// 28 to 32 bytes per node of scratch, freed before it returns.
 #pragma once
 
 #include <array>
@@ -26,6 +26,8 @@ struct MeshTopology {
 
     const Mesh* mesh = nullptr; ///< the mesh it was built from, which must outlive it
     std::vector<std::array<std::uint32_t, 2>> edge_halves; ///< second is no_half_edge on the boundary
+    /// The edges whose smaller node is v are node_edges[v] .. node_edges[v + 1] - 1 (nodes + 1 entries).
+    std::vector<std::uint32_t> node_edges;
     std::vector<std::int32_t> boundary_edges;              ///< edge indices with one face, ascending
     std::vector<int> boundary_tags;                        ///< EdgeTag of each of boundary_edges
 
@@ -49,7 +51,7 @@ struct MeshTopology {
 MeshTopology build_topology(const Mesh& mesh);
 
 /// The edges of faces first .. first + count - 1: out[3 * i + k] is the edge joining nodes k and
-/// k+1 of face first + i. One pass over all the edges, so callers take large blocks.
+/// k+1 of face first + i, found among the edges of the side's smaller node.
 void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out);
 
 /// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from its three edges.
