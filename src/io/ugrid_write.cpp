@@ -380,6 +380,16 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         const auto ends = topo.edge_nodes(e);
         return arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]);
     };
+    // The edges' geodesic problems (GeodesicFaceAreas), the writer's largest computation, run in
+    // the background from here, while the variables before the face areas are computed and
+    // compressed (HDF5's deflate runs in this thread alone).
+    auto solve_edges = [&topo] { return io::GeodesicFaceAreas(topo); };
+    std::future<io::GeodesicFaceAreas> areas_ahead;
+    try {
+        areas_ahead = std::async(std::launch::async, solve_edges);
+    } catch (const std::system_error&) {
+        areas_ahead = std::async(std::launch::deferred, solve_edges); // no thread to be had: when needed
+    }
     w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
         const auto& t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
@@ -390,11 +400,9 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
     {
         w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; }, "node");
-        // Most of the writer's time: each edge's geodesic problem, on every core.
-        const io::GeodesicFaceAreas areas(topo);
-        // Face edges, face neighbours and face areas a block of faces at a time, from one pass
-        // over the edges a block: no face-to-edge table of the whole mesh (12 bytes a face) at
-        // the writer's peak.
+        const io::GeodesicFaceAreas areas = areas_ahead.get();
+        // Face edges, face neighbours and face areas a block of faces at a time (face_edges): no
+        // face-to-edge table of the whole mesh (12 bytes a face) at the writer's peak.
         struct FaceRows {
             std::vector<std::int32_t> edges;
             std::vector<int> links;
