@@ -5,6 +5,7 @@
 #include <cmath>
 #include <system_error>
 #include <thread>
+#include <vector>
 
 #include <GeographicLib/Accumulator.hpp>
 #include <GeographicLib/Geodesic.hpp>
@@ -30,9 +31,11 @@ int prime_meridian_transit(double lon1, double lon2) {
     return 0;
 }
 
-} // namespace
-
-void on_every_core(const std::function<void(std::size_t k, std::size_t threads)>& slice) {
+/// Runs slice(k, threads) for k = 0 .. threads - 1, one per core (at most 16), slice 0 on the
+/// calling thread; when the process may start no more threads, the caller runs the rest.
+/// slice must be safe to run concurrently with the others.
+template <class Slice>
+void on_every_core(const Slice& slice) {
     const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
     std::vector<std::thread> pool;
     std::size_t k = 1;
@@ -45,6 +48,8 @@ void on_every_core(const std::function<void(std::size_t k, std::size_t threads)>
     slice(0, threads);
     for (auto& t : pool) t.join();
 }
+
+} // namespace
 
 GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology& topo) : topo_(topo), s12_(topo.edge_count()) {
     const auto& wgs84 = GeographicLib::Geodesic::WGS84();
