@@ -270,19 +270,17 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.begin();
     {
         // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
-        // every core), a block of faces at a time as face_edges gives their edges. Freed before the
-        // nodes, whose RTree GDAL builds in memory.
+        // every core). Freed before the nodes, whose RTree GDAL builds in memory.
         const io::GeodesicFaceAreas areas(topo);
-        constexpr std::size_t block = 65536;
         std::vector<std::int32_t> edges;
         for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
-            if (i % block == 0) io::face_edges(topo, i, std::min(block, mesh.faces.size() - i), edges);
+            io::face_edges(topo, i, 1, edges);
             const auto& t = mesh.faces[i];
             OGRFeature feature(faces->GetLayerDefn());
             feature.SetFID(GIntBig(i) + 1);
             feature.SetField("face", int(i));
             feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-            feature.SetField("area_km2", areas.face_m2(i, &edges[3 * (i % block)]) * 1e-6);
+            feature.SetField("area_km2", areas.face_m2(i, edges.data()) * 1e-6);
             auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
             if (depth) feature.SetField("depth", mean(depth));
             if (size) feature.SetField("target_size", mean(size));

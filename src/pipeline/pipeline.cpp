@@ -113,11 +113,11 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
     clock.lap("read_coast");
     // The mesher's node estimate (nodes_for_area) with every size at --hmax (the field's
-    // largest). The mesher's own estimate, over the shaped
-    // ocean and the field's sizes, is larger but for the area the shaping closes (inlets, lakes;
-    // a few per mil of the global ocean), so only 90% of this one is held against --max-nodes:
-    // a size far too small is refused here, before the bathymetry, the size field and the
-    // coast's shaping spend minutes and gigabytes on it.
+    // largest). The mesher's own estimate, over the shaped ocean and the field's sizes, is larger
+    // but for the area the shaping closes (inlets, lakes; a few per mil of the global ocean), so
+    // only 90% of this one is held against --max-nodes: a size far too small is refused here,
+    // before the bathymetry, the size field and the coast's shaping spend minutes and gigabytes
+    // on it.
     if (const double estimate = nodes_for_area(coast.ocean_area_km2, o.hmax_km);
         0.9 * estimate > static_cast<double>(o.max_nodes))
         throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) + " km2) takes about " +
