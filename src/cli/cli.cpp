@@ -682,7 +682,10 @@ int report_error(std::ostream& err) {
         err << "globemesh: " << one_line(e.what()) << "\n";
         return 2;
     } catch (const Cancelled& e) {
-        err << "globemesh: cancelled, no output written\n";
+        // A signal other than Ctrl-C is named: it may come from a batch scheduler's time limit.
+        const int signal = InterruptGuard::signal();
+        const char* by = signal == SIGTERM ? " by SIGTERM" : signal == SIGHUP ? " by SIGHUP" : "";
+        err << "globemesh: cancelled" << by << ", no output written\n";
         return 1;
     } catch (const Error& e) {
         err << "globemesh: " << one_line(e.what()) << "\n";

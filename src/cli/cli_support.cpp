@@ -18,16 +18,16 @@ namespace globemesh::cli {
 
 namespace {
 
-volatile std::sig_atomic_t g_interrupted = 0;
+volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal that arrived, or 0
 
-/// The first Ctrl-C asks the run to stop at its next progress report; a second one, for a run
+/// The first signal asks the run to stop at its next progress report; a second one, for a run
 /// that does not report, ends the process the default way.
-extern "C" void on_sigint(int) {
+extern "C" void on_cancelling_signal(int signal) {
     if (g_interrupted) {
-        std::signal(SIGINT, SIG_DFL);
-        std::raise(SIGINT);
+        std::signal(signal, SIG_DFL);
+        std::raise(signal);
     }
-    g_interrupted = 1;
+    g_interrupted = signal;
 }
 
 } // namespace
@@ -35,17 +35,21 @@ extern "C" void on_sigint(int) {
 InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
     struct sigaction action {};
-    action.sa_handler = on_sigint;
+    action.sa_handler = on_cancelling_signal;
     sigemptyset(&action.sa_mask);
     action.sa_flags = 0;
-    installed_ = sigaction(SIGINT, &action, &previous_) == 0;
+    for (std::size_t k = 0; k < std::size(cancelling); ++k)
+        installed_[k] = sigaction(cancelling[k], &action, &previous_[k]) == 0;
 }
 
 InterruptGuard::~InterruptGuard() {
-    if (installed_) sigaction(SIGINT, &previous_, nullptr);
+    for (std::size_t k = 0; k < std::size(cancelling); ++k)
+        if (installed_[k]) sigaction(cancelling[k], &previous_[k], nullptr);
 }
 
 bool InterruptGuard::interrupted() { return g_interrupted != 0; }
+
+int InterruptGuard::signal() { return g_interrupted; }
 
 bool TerminalProgress::update(double fraction, std::string_view stage) {
     if (InterruptGuard::interrupted()) return false;

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
+#include <iterator>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -17,8 +18,9 @@
 
 namespace globemesh::cli {
 
-/// Installs a SIGINT handler for its lifetime (restoring the previous one after) that only
-/// sets a flag; interrupted() reads it. One guard at a time (run_cli is not re-entrant).
+/// Installs handlers for SIGINT, SIGTERM and SIGHUP for its lifetime (restoring the previous
+/// ones after) that only record the signal; interrupted() reads it. One guard at a time
+/// (run_cli is not re-entrant).
 class InterruptGuard {
 public:
     InterruptGuard();
@@ -26,16 +28,22 @@ public:
     InterruptGuard(const InterruptGuard&) = delete;
     InterruptGuard& operator=(const InterruptGuard&) = delete;
     static bool interrupted();
+    /// The signal that cancelled the last run (kept after the guard is gone), or 0.
+    static int signal();
+    /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
+    /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
+    /// and leave the temporary output files behind.
+    static constexpr int cancelling[3] = {SIGINT, SIGTERM, SIGHUP};
 
 private:
-    struct sigaction previous_ {};
-    bool installed_ = false;
+    struct sigaction previous_[std::size(cancelling)] {};
+    bool installed_[std::size(cancelling)] = {};
 };
 
 /// GDAL's terminal progress ("0...10...20...30...40...50...60...70...80...90...100 - done."),
 /// drawn on `err` rather than stdout (where GDALTermProgress writes) so that stdout carries
 /// results only. With `verbose`, each new stage starts a line "[stage] ". The callback returns
-/// false once SIGINT arrived, which cancels the run. run_cli owns one, so that an error line
+/// false once a cancelling signal arrived (InterruptGuard), which cancels the run. run_cli owns one, so that an error line
 /// never lands in the middle of a progress line.
 class TerminalProgress {
 public:

@@ -431,33 +431,40 @@ TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Ctrl-C
+// Signals
 
-TEST(Cli, sigint_cancels_the_run_leaves_no_output_and_restores_the_handler) {
-    TempDir dir;
-    struct sigaction before {};
-    sigaction(SIGINT, nullptr, &before);
-    RefusingLibrary refusing;
-    auto lib = refusing.lib();
-    bool handled_inside = false;
-    lib.mesh_ocean = [&](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                         globemesh::StageTimings*) -> globemesh::Mesh {
-        globemesh::report(progress, 0.1, "refine");
-        std::raise(SIGINT); // our handler only sets a flag, so the test process survives
-        handled_inside = true;
-        globemesh::report(progress, 0.2, "refine"); // throws Cancelled
-        ADD_FAILURE() << "the progress callback did not cancel the run";
-        return {};
-    };
-    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib);
-    EXPECT_TRUE(handled_inside);
-    EXPECT_EQ(r.status, 1);
-    EXPECT_NE(r.err.find("globemesh: cancelled"), std::string::npos) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_TRUE(fs::is_empty(dir.path()));
-    struct sigaction after {};
-    sigaction(SIGINT, nullptr, &after);
-    EXPECT_EQ(after.sa_handler, before.sa_handler);
+// Ctrl-C, `kill` (and a batch scheduler's time limit: SIGTERM) and a closed terminal (SIGHUP)
+// each cancel the run the same way; any but Ctrl-C is named in the message.
+TEST(Cli, each_cancelling_signal_stops_the_run_leaves_no_output_and_restores_the_handler) {
+    for (const auto& [signal, message] : {std::pair{SIGINT, "globemesh: cancelled, no output written\n"},
+                                          std::pair{SIGTERM, "globemesh: cancelled by SIGTERM, no output written\n"},
+                                          std::pair{SIGHUP, "globemesh: cancelled by SIGHUP, no output written\n"}}) {
+        SCOPED_TRACE(signal);
+        TempDir dir;
+        struct sigaction before {};
+        sigaction(signal, nullptr, &before);
+        RefusingLibrary refusing;
+        auto lib = refusing.lib();
+        bool handled_inside = false;
+        lib.mesh_ocean = [&, signal = signal](const globemesh::MeshOptions&, const globemesh::Progress& progress,
+                                              globemesh::StageTimings*) -> globemesh::Mesh {
+            globemesh::report(progress, 0.1, "refine");
+            std::raise(signal); // our handler only records it, so the test process survives
+            handled_inside = true;
+            globemesh::report(progress, 0.2, "refine"); // throws Cancelled
+            ADD_FAILURE() << "the progress callback did not cancel the run";
+            return {};
+        };
+        const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "-q"}, lib);
+        EXPECT_TRUE(handled_inside);
+        EXPECT_EQ(r.status, 1);
+        EXPECT_EQ(r.err, message);
+        EXPECT_EQ(r.out, "");
+        EXPECT_TRUE(fs::is_empty(dir.path()));
+        struct sigaction after {};
+        sigaction(signal, nullptr, &after);
+        EXPECT_EQ(after.sa_handler, before.sa_handler);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

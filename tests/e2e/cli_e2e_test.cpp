@@ -301,9 +301,13 @@ INSTANTIATE_TEST_SUITE_P(
         ExeError{"info_on_a_non_mesh", {"info", "{dir}/existing.nc"}, {1}, "existing.nc"}),
     [](const auto& info) { return info.param.name; });
 
-TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
+class CliE2eSignal : public ::testing::TestWithParam<int> {};
+
+// Ctrl-C, and `kill` or a batch scheduler's time limit (SIGTERM).
+TEST_P(CliE2eSignal, stops_a_run_and_leaves_no_output) {
     // A global 15 km mesh of the 1:50m land (about 3.7 M nodes) takes minutes: the signal lands
     // mid-run. The test sends it to the process it started, by its id.
+    const int signal = GetParam();
     TempDir dir;
     const std::string output = (dir / "big.nc").string();
     std::vector<std::string> args = {exe,      "mesh",  "--coast", land50, "--coast-layer", "land",
@@ -324,7 +328,7 @@ TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
     ASSERT_EQ(spawned, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));
     const auto sent = std::chrono::steady_clock::now();
-    kill(pid, SIGINT);
+    kill(pid, signal);
     int wstatus = 0;
     ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
     const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
@@ -334,10 +338,14 @@ TEST(CliE2e, sigint_stops_a_run_and_leaves_no_output) {
     fs::remove(err_path);
     ASSERT_NE(WEXITSTATUS(wstatus), 0) << "the run finished within 2.5 s: it is too short for this test";
     EXPECT_EQ(WEXITSTATUS(wstatus), 1); // cli.hpp: cancellation is status 1
-    EXPECT_EQ(err.str(), "globemesh: cancelled, no output written\n"); // one line, nothing else
+    EXPECT_EQ(err.str(), signal == SIGINT ? "globemesh: cancelled, no output written\n"
+                                         : "globemesh: cancelled by SIGTERM, no output written\n"); // one line, nothing else
     EXPECT_TRUE(fs::is_empty(dir.path())) << "output or temporary files left behind";
     EXPECT_LT(stop_s, 10.0) << "the run took " << stop_s << " s to stop after the signal";
 }
+
+INSTANTIATE_TEST_SUITE_P(Signals, CliE2eSignal, ::testing::Values(SIGINT, SIGTERM),
+                         [](const auto& info) { return info.param == SIGINT ? "sigint" : "sigterm"; });
 
 namespace {
 
