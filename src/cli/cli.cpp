@@ -269,6 +269,8 @@ void check_mesh_run(const CliOptions& o) {
     const std::vector<std::pair<std::string, std::string>> outputs = {
         {"--output", o.output}, {"--gpkg", o.gpkg}, {"--preview", o.preview},
         {"--timings", o.timings}, {"--report", o.report}};
+    for (const auto& [name, path] : outputs)
+        if (!path.empty()) check_output_kind(path, name);
     for (std::size_t i = 0; i < outputs.size(); ++i) {
         for (std::size_t j = i + 1; j < outputs.size(); ++j) {
             if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
@@ -502,6 +504,8 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     if (c.quiet && c.verbose) throw UsageError("--quiet and --verbose exclude each other");
     if (c.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o out.nc");
     check_input_path(c.t.points, "POINTS");
+    for (const auto& [name, path] : {std::pair{"--output", c.output}, {"--gpkg", c.gpkg}, {"--timings", c.timings}})
+        if (!path.empty()) check_output_kind(path, name);
     check_output_path(c.output, "--output", c.overwrite);
     if (!c.gpkg.empty()) check_output_path(c.gpkg, "--gpkg", c.overwrite);
     if (!c.timings.empty()) check_output_path(c.timings, "--timings", c.overwrite);

@@ -353,17 +353,20 @@ TEST_P(CliErrors, one_line_naming_the_culprit_and_no_output) {
         args.push_back(a);
     }
     write_text(dir / "existing.nc", "keep me");
+    write_text(dir / "existing.gpkg", "keep me too");
     const Result r = run_refused(args);
     EXPECT_EQ(r.status, c.status) << r.err;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
     EXPECT_EQ(r.err.rfind("globemesh: ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(c.named), std::string::npos) << "expected '" << c.named << "' in: " << r.err;
     EXPECT_EQ(r.out, "");
-    // Nothing but the file the test made is in the folder, and it is untouched.
+    // Nothing but the files the test made is in the folder, and they are untouched.
     std::vector<std::string> files;
     for (const auto& e : fs::directory_iterator(dir.path())) files.push_back(e.path().filename().string());
-    EXPECT_EQ(files, std::vector<std::string>{"existing.nc"});
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"existing.gpkg", "existing.nc"}));
     EXPECT_EQ(read_text(dir / "existing.nc"), "keep me");
+    EXPECT_EQ(read_text(dir / "existing.gpkg"), "keep me too");
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -389,7 +392,14 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"missing_bathy_file", {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"}, 1, "nodem.tif"},
         ErrorCase{"output_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"}, 1, "--output"},
         ErrorCase{"existing_output", {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"}, 1, "--overwrite"},
-        ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.nc"}, 1, "existing.nc"},
+        ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.gpkg"}, 1, "existing.gpkg"},
+        // An output named for another output's format: NetCDF under a GeoPackage's name would
+        // not open in QGIS as one.
+        ErrorCase{"output_named_gpkg", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg"}, 2, "use --gpkg "},
+        ErrorCase{"gpkg_named_nc", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/p.NC"}, 2, "--output"},
+        ErrorCase{"preview_named_json", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.json"}, 2, "--preview"},
+        ErrorCase{"report_named_png", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/r.png"}, 2, "--report"},
+        ErrorCase{"triangulate_output_named_gpkg", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/t.gpkg"}, 2, "--gpkg"},
         ErrorCase{"report_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/x/r.json"}, 1, "--report"},
         ErrorCase{"triangulate_missing_points", {"triangulate", "{dir}/none.csv", "-o", "{dir}/t.nc"}, 1, "none.csv"},
         ErrorCase{"triangulate_without_output", {"triangulate", fixture("points/stations.csv").string()}, 2, "--output"},
