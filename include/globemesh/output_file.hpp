@@ -34,6 +34,10 @@ public:
     /// overwrite, rename failed); the temporary file is then still removed by the destructor.
     void commit();
 
+    /// " (the disk is full)" when the folder of `file` has less than 1 MiB left, else "": for
+    /// write errors that do not say so themselves (HDF5's "HDF error", SQLite's missing tables).
+    static std::string full_disk_note(const std::filesystem::path& file);
+
     /// Writes `text` to the target safely in one go (for small reports such as JSON).
     static void write_text(const std::filesystem::path& target, const std::string& text, bool overwrite);
 

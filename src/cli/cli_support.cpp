@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
 
 namespace globemesh::cli {
 
@@ -100,7 +101,7 @@ void write_file_safely(const std::filesystem::path& path, const std::string& tex
             file.close();
             std::error_code ec;
             fs::remove(tmp, ec);
-            throw IoError("cannot write " + path.string() + " (disk full?)");
+            throw IoError("cannot write " + path.string() + OutputFile::full_disk_note(path));
         }
     }
     std::error_code ec;

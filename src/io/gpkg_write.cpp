@@ -81,7 +81,8 @@ public:
         srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     }
     [[noreturn]] void fail(const std::string& step) const {
-        throw IoError("GeoPackage output " + path_.string() + ": " + step + ": " + io::last_gdal_error());
+        throw IoError("GeoPackage output " + path_.string() + ": " + step + ": " + io::last_gdal_error() +
+                      OutputFile::full_disk_note(path_));
     }
     OGRLayer* layer(const char* name, OGRwkbGeometryType type, const char* description, const char* fid = "FID=fid") {
         const char* options[] = {fid, nullptr, nullptr};
@@ -103,7 +104,7 @@ public:
         if (ds_->StartTransaction() != OGRERR_NONE) fail("starting a transaction");
     }
     void commit() {
-        if (ds_->CommitTransaction() != OGRERR_NONE) fail("committing (disk full?)");
+        if (ds_->CommitTransaction() != OGRERR_NONE) fail("committing");
     }
 
 private:
@@ -248,7 +249,9 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
     if (!driver) throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
     io::GdalDatasetPtr ds(driver->Create(out.temp_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    if (!ds) throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")");
+    if (!ds)
+        throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")" +
+                      OutputFile::full_disk_note(path));
     GpkgWriter w(ds.get(), path);
 
     // faces
@@ -402,7 +405,8 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.add(styles, style);
 
     if (!io::close_dataset(ds))
-        throw IoError("GeoPackage output " + path.string() + ": closing failed (disk full?): " + io::last_gdal_error());
+        throw IoError("GeoPackage output " + path.string() + ": closing failed: " + io::last_gdal_error() +
+                      OutputFile::full_disk_note(path));
     out.commit();
 }
 

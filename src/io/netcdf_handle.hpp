@@ -11,33 +11,36 @@
 
 namespace globemesh::io {
 
-/// Throws IoError("<what> <file>: <step>: <nc_strerror>") when status is not NC_NOERR.
-inline void nc_check(int status, const std::filesystem::path& file, const std::string& step,
-                     const char* what = "UGRID file") {
-    if (status != NC_NOERR)
-        throw IoError(std::string(what) + " " + file.string() + ": " + step + ": " + nc_strerror(status));
-}
+/// Throws IoError("<what> <file>: <step>: <nc_strerror>") when status is not NC_NOERR, with a
+/// note when the file's disk is full (HDF5 reports that as a bare "HDF error").
+void nc_check(int status, const std::filesystem::path& file, const std::string& step,
+              const char* what = "UGRID file");
 
 /// Owns an open netCDF id; abandons (nc_abort) a file that was not closed explicitly.
+///
+/// HDF5 flushes a netCDF-4 file as it closes it, abandoned or not. When that flush fails (a full
+/// disk), HDF5 keeps the file open, netCDF-C 4.9.0 crashes listing its open objects, and HDF5
+/// 1.10.8 crashes closing it again at the process's exit. So a file this handle created is
+/// never closed on a failed flush: before it is abandoned, HDF5's descriptors of it are pointed
+/// at an empty memory file (it is a temporary file, deleted next), where the flush succeeds.
 class NcHandle {
 public:
     NcHandle() = default;
-    ~NcHandle() {
-        if (id_ >= 0) nc_abort(id_);
-    }
+    ~NcHandle();
     NcHandle(const NcHandle&) = delete;
     NcHandle& operator=(const NcHandle&) = delete;
     int* out() { return &id_; }
     int id() const { return id_; }
-    /// Closes the file, flushing it; throws IoError on failure (e.g. disk full).
-    void close(const std::filesystem::path& file, const char* what = "UGRID file") {
-        int id = id_;
-        id_ = -1;
-        nc_check(nc_close(id), file, "closing (disk full?)", what);
-    }
+    /// nc_create of `temp`, the temporary file through which `target` is written (messages
+    /// name target); throws IoError.
+    void create(const std::filesystem::path& temp, int mode, const std::filesystem::path& target, const char* what);
+    /// Closes the file, flushing it first on its own (when that fails, the file is still open and
+    /// the destructor abandons it as above); throws IoError on failure (e.g. a full disk).
+    void close(const std::filesystem::path& file, const char* what = "UGRID file");
 
 private:
     int id_ = -1;
+    std::filesystem::path created_;
 };
 
 } // namespace globemesh::io

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <system_error>
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "globemesh/error.hpp"
@@ -51,6 +52,13 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
     remove_quietly(temp_);
 }
 
+std::string OutputFile::full_disk_note(const fs::path& file) {
+    const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+    struct statvfs disk {};
+    if (::statvfs(folder.c_str(), &disk) != 0) return "";
+    return static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize) < 1048576.0 ? " (the disk is full)" : "";
+}
+
 OutputFile::~OutputFile() {
     if (committed_) return;
     remove_quietly(temp_);
@@ -85,7 +93,7 @@ void OutputFile::write_text(const fs::path& target, const std::string& text, boo
         std::ofstream f(out.temp_path(), std::ios::binary);
         f << text;
         f.flush();
-        if (!f) throw IoError("output " + target.string() + ": write failed (disk full?)");
+        if (!f) throw IoError("output " + target.string() + ": write failed" + full_disk_note(target));
     }
     out.commit();
 }

@@ -197,9 +197,12 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
     canvas->SetGeoTransform(identity);
     io::ScopedGdalConfig no_pam("GDAL_PAM_ENABLED", "NO");
     io::GdalDatasetPtr written(png->CreateCopy(out.temp_path().c_str(), canvas.get(), FALSE, nullptr, nullptr, nullptr));
-    if (!written) throw IoError("preview " + path.string() + ": writing the PNG failed: " + io::last_gdal_error());
+    if (!written)
+        throw IoError("preview " + path.string() + ": writing the PNG failed: " + io::last_gdal_error() +
+                      OutputFile::full_disk_note(path));
     if (!io::close_dataset(written))
-        throw IoError("preview " + path.string() + ": closing the PNG failed (disk full?): " + io::last_gdal_error());
+        throw IoError("preview " + path.string() + ": closing the PNG failed: " + io::last_gdal_error() +
+                      OutputFile::full_disk_note(path));
     out.commit();
 }
 

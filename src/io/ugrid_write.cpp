@@ -228,7 +228,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     // the temporary output, which OutputFile removes.
     io::NcHandle nc;
     const int mode = options.classic ? (NC_NOCLOBBER | NC_64BIT_OFFSET) : (NC_NOCLOBBER | NC_NETCDF4);
-    io::nc_check(nc_create(out.temp_path().c_str(), mode, nc.out()), path, "creating the file", "UGRID output");
+    nc.create(out.temp_path(), mode, path, "UGRID output");
     int old_fill;
     nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
     UgridWriter w(nc.id(), path, !options.classic);

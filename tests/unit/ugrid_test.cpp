@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <netcdf.h>
+#include <sched.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <GeographicLib/Geodesic.hpp>
@@ -12,6 +15,8 @@
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <sstream>
+#include <iostream>
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
@@ -472,6 +477,63 @@ TEST(Ugrid, run_cancelled_during_writing_leaves_no_partial_or_temporary_file) {
     o.classic = true;
     EXPECT_THROW(write_ugrid(icosphere(2), dir / "out.nc", o), Cancelled);
     EXPECT_TRUE(folder_listing(dir.path()).empty());
+}
+
+// A full disk, on a 1 MiB tmpfs mounted in a child process's own mount namespace (root only;
+// skipped elsewhere). netCDF-4 files of increasing size fail at different points: in a block's
+// write, or in the flush at the end, when the data of every variable of one chunk is still in
+// HDF5's cache. Each must give an IoError saying the disk is full and leave no file, and the
+// process must then exit normally: a flush that failed while closing left HDF5 holding the
+// file, and HDF5 crashed closing it again at exit (netcdf_handle.hpp).
+TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
+    TempDir dir;
+    const fs::path disk = dir / "disk", log = dir / "log.txt";
+    fs::create_directory(disk);
+    constexpr int cannot_mount = 77;
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        if (unshare(CLONE_NEWNS) != 0 || mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+            mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=1m") != 0)
+            _exit(cannot_mount);
+        std::ofstream out(log);
+        for (const bool classic : {false, true})
+            for (int level = 4; level <= 7; ++level) {
+                UgridOptions o;
+                o.classic = classic;
+                out << (classic ? "classic" : "netcdf4") << " level " << level << ": ";
+                try {
+                    write_ugrid(icosphere(level), disk / "o.nc", o);
+                    out << "written";
+                    fs::remove(disk / "o.nc");
+                } catch (const IoError& e) {
+                    out << "error " << e.what();
+                }
+                out << (fs::is_empty(disk) ? "" : " FILES LEFT") << "\n";
+            }
+        out.close();
+        umount(disk.c_str());
+        std::exit(0); // through the exit handlers, HDF5's among them
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == cannot_mount)
+        GTEST_SKIP() << "cannot mount a small tmpfs here (needs root and a mount namespace)";
+    const std::string text = file_bytes(log);
+    ASSERT_TRUE(WIFEXITED(status)) << "the process died of signal " << WTERMSIG(status) << " after:\n" << text;
+    EXPECT_EQ(WEXITSTATUS(status), 0) << text;
+    int full = 0, at_flush = 0;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+        EXPECT_EQ(line.find("FILES LEFT"), std::string::npos) << line;
+        if (line.find("error") == std::string::npos) continue;
+        ++full;
+        at_flush += line.rfind("netcdf4", 0) == 0 && line.find(": writing: ") != std::string::npos;
+        EXPECT_TRUE(line.find("(the disk is full)") != std::string::npos ||
+                    line.find("No space left on device") != std::string::npos) << line;
+    }
+    EXPECT_GE(full, 4) << "too few of the files filled the disk:\n" << text;
+    EXPECT_GE(at_flush, 1) << "no netCDF-4 file failed in the final flush (the crash's path):\n" << text;
 }
 
 TEST(OutputFile, write_text_is_atomic_and_refuses_existing_files) {
