@@ -250,7 +250,25 @@ struct MeshCommand {
 
     /// Parses; CLI11 errors (including help and version) propagate.
     void parse(std::span<const std::string> args) {
-        app.parse(reversed(args));
+        // A key of the config file that names no option is an error, not ignored: a typo
+        // (hmaxx) or a [section] would otherwise mesh at the defaults without a word.
+        app.allow_config_extras(CLI::config_extras_mode::error);
+        try {
+            app.parse(reversed(args));
+        } catch (const CLI::ConfigError& e) {
+            const std::string what = e.what(), prefix = "INI was not able to parse "; // CLI11's ConfigError::Extras
+            if (what.rfind(prefix, 0) != 0) throw;
+            const std::string key = what.substr(prefix.size()), file = app.get_config_ptr()->as<std::string>();
+            if (const auto dot = key.find('.'); dot != std::string::npos)
+                throw UsageError("--config " + file + ": [" + key.substr(0, dot) +
+                                 "]: the file takes no sections, only option = value lines");
+            std::string dashed = key;
+            std::replace(dashed.begin(), dashed.end(), '_', '-');
+            const std::string hint = dashed != key && app.get_option_no_throw("--" + dashed) != nullptr
+                                         ? "; did you mean " + dashed + "?"
+                                         : "; the keys are the long option names, as --print-config writes them";
+            throw UsageError("--config " + file + ": unknown key " + key + hint);
+        }
         if (region_opt->count() > 0 && region.size() == 4)
             o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
         if (bathy_fill_opt->count() > 0) o.mesh.bathy_fill_m = bathy_fill_m;

@@ -331,6 +331,25 @@ TEST(Cli, a_missing_config_file_is_an_error_naming_it) {
     EXPECT_NE(r.err.find("/nonexistent/run.toml"), std::string::npos) << r.err;
 }
 
+// A key that names no option would otherwise be dropped without a word: the run would mesh at
+// the default size for a misspelt hmax, or for any key under a [section].
+TEST(Cli, an_unknown_config_key_is_a_usage_error_naming_it) {
+    TempDir dir;
+    struct Case {
+        std::string text, named;
+    };
+    for (const Case& c : {Case{"hmax = \"50km\"\nhmaxx = \"20km\"\n", "unknown key hmaxx; the keys are the long option names"},
+                          Case{"coast_layer = \"land\"\n", "unknown key coast_layer; did you mean coast-layer?"},
+                          Case{"[mesh]\nhmax = \"50km\"\n", "[mesh]: the file takes no sections"}}) {
+        SCOPED_TRACE(c.text);
+        write_text(dir / "run.toml", c.text);
+        const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--config", (dir / "run.toml").string()});
+        EXPECT_EQ(r.status, 2);
+        EXPECT_EQ(count_lines(r.err), 1) << r.err;
+        EXPECT_NE(r.err.find("--config " + (dir / "run.toml").string() + ": " + c.named), std::string::npos) << r.err;
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors: status, one line naming the option or file, no output, no library call
 
