@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <type_traits>
 
 #include <cpl_conv.h>
@@ -12,6 +13,8 @@
 #include <gdal.h>
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
+
+#include "globemesh/progress.hpp"
 
 namespace globemesh::gdal {
 
@@ -70,5 +73,23 @@ using SrsPtr = HandlePtr<OGRSpatialReferenceH, OSRDestroySpatialReference>;
 /// Drops one reference (OSRRelease), deleting the spatial reference when it was the last.
 using SrsRefPtr = HandlePtr<OGRSpatialReferenceH, OSRRelease>;
 using TransformPtr = HandlePtr<OGRCoordinateTransformationH, OCTDestroyCoordinateTransformation>;
+
+/// A Progress as GDAL's GDALProgressFunc, on [lo, hi] of it under the name `stage`: pass
+/// &ProgressBridge::call and the bridge's address. When the callback asks to stop, GDAL's call
+/// fails and `cancelled` tells the caller to throw Cancelled rather than an error.
+struct ProgressBridge {
+    const Progress* progress;
+    double lo, hi;
+    std::string_view stage;
+    bool cancelled = false;
+    static int CPL_STDCALL call(double f, const char*, void* data) {
+        auto* b = static_cast<ProgressBridge*>(data);
+        if (*b->progress && !(*b->progress)(b->lo + (b->hi - b->lo) * f, b->stage)) {
+            b->cancelled = true;
+            return FALSE;
+        }
+        return TRUE;
+    }
+};
 
 } // namespace globemesh::gdal

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/progress.hpp"
 
 namespace globemesh {
 
@@ -22,6 +23,10 @@ struct GpkgOptions {
     /// compute_stats of this same mesh when the caller has it (mesh_info takes it as it is);
     /// null: the writer computes it.
     const MeshStats* stats = nullptr;
+    /// Reports the share written (stage "write_gpkg"); returning false cancels (Cancelled, no
+    /// file left). GDAL builds the spatial indexes as the file closes, the last third or so,
+    /// without reporting.
+    Progress progress;
     /// Test hook: called once after the faces are written, before the rename.
     std::function<void()> after_partial_write;
 };
@@ -35,6 +40,8 @@ struct PreviewOptions {
     int width_px = 1600;
     std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N; default the mesh extent or globe
     bool overwrite = false;
+    /// Reports the share drawn and written (stage "write_preview"); returning false cancels.
+    Progress progress;
     /// Test hook: called once after the picture is drawn, before it is written and renamed.
     std::function<void()> after_partial_write;
 };

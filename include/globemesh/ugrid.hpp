@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/progress.hpp"
 
 namespace globemesh {
 
@@ -28,6 +29,9 @@ struct UgridOptions {
     /// compute_stats of this same mesh when the caller has it (the global attributes take it
     /// as it is); null: the writer computes it.
     const MeshStats* stats = nullptr;
+    /// Reports the share of the rows written (stage "write_ugrid"); returning false cancels
+    /// (Cancelled, no file left).
+    Progress progress;
     /// Test hook: called once after the data is partly written, before the rename.
     std::function<void()> after_partial_write;
 };

@@ -159,21 +159,6 @@ Window window_of(const LonLatBounds& b, const double gt[6], std::size_t nx, std:
     return out;
 }
 
-struct ProgressBridge {
-    const Progress* progress;
-    double lo, hi;
-    bool cancelled = false;
-};
-
-int CPL_STDCALL gdal_progress(double f, const char*, void* data) {
-    auto* b = static_cast<ProgressBridge*>(data);
-    if (*b->progress && !(*b->progress)(b->lo + (b->hi - b->lo) * f, "read bathymetry")) {
-        b->cancelled = true;
-        return FALSE;
-    }
-    return TRUE;
-}
-
 std::string fmt_deg(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -319,10 +304,10 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         std::size_t s1 = std::min(by, s0 + strip);
         GDALRasterIOExtraArg extra;
         INIT_RASTERIO_EXTRA_ARG(extra);
-        ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
-                              0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by)};
+        gdal::ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
+                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), "read bathymetry"};
         if (progress) {
-            extra.pfnProgress = gdal_progress;
+            extra.pfnProgress = gdal::ProgressBridge::call;
             extra.pProgressData = &bridge;
         }
         double y0 = static_cast<double>(s0) * sy, y1 = static_cast<double>(s1) * sy;

@@ -369,9 +369,18 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     const auto t0 = std::chrono::steady_clock::now();
     StageTimings timings;
     terminal.configure(o.quiet, o.verbose);
-    Mesh mesh = lib.mesh_ocean(o.mesh, terminal.callback(), &timings);
+    // One progress line for the run: the mesh and each output get a share of it as their time
+    // compares. Measured at 20 km on 1:50m land (1.08e6 nodes), seconds for reading and meshing
+    // / the UGRID file / the GeoPackage / the PNG: 3.1 / 6 / 45 / 4.3.
+    const double w_mesh = 1, w_ugrid = 2, w_gpkg = o.gpkg.empty() ? 0 : 14, w_preview = o.preview.empty() ? 0 : 1.5;
+    const double w_total = w_mesh + w_ugrid + w_gpkg + w_preview;
+    auto share = [&, at = 0.0](double w) mutable {
+        const Progress p = sub_progress(terminal.callback(), at / w_total, (at + w) / w_total);
+        at += w;
+        return p;
+    };
+    Mesh mesh = lib.mesh_ocean(o.mesh, share(w_mesh), &timings);
     throw_if_interrupted();
-    terminal.finish(); // close the progress line if the pipeline stopped short of 1
     add_mesh_total(timings);
     // The effective configuration travels with the mesh, so the file itself says how to remake it.
     mesh.attributes.emplace_back("globemesh_configuration", command->app.config_to_str(true, false));
@@ -394,6 +403,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     ugrid.overwrite = o.overwrite;
     ugrid.history = history_text("mesh", args);
     ugrid.stats = &stats;
+    ugrid.progress = share(w_ugrid);
     lib.write_ugrid(mesh, o.output, ugrid);
     written.add(o.output);
     throw_if_interrupted();
@@ -401,6 +411,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         GpkgOptions gpkg;
         gpkg.overwrite = o.overwrite;
         gpkg.stats = &stats;
+        gpkg.progress = share(w_gpkg);
         lib.write_gpkg(mesh, o.gpkg, gpkg);
         written.add(o.gpkg);
         throw_if_interrupted();
@@ -411,11 +422,13 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         preview.colour_by = mesh.node_field("depth") ? "depth" : "quality";
         preview.extent_deg = o.mesh.region;
         preview.overwrite = o.overwrite;
+        preview.progress = share(w_preview);
         lib.write_preview_png(mesh, o.preview, preview);
         written.add(o.preview);
         throw_if_interrupted();
     }
     timings.add("write", seconds_since(tw));
+    terminal.finish(); // close the progress line if a stage stopped short of its share's end
 
     const double total_s = seconds_since(t0);
     const long long peak = peak_memory_bytes();

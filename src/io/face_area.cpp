@@ -51,12 +51,14 @@ void on_every_core(const Slice& slice) {
 
 } // namespace
 
-GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology& topo) : topo_(topo), s12_(topo.edge_count()) {
+GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology& topo, const std::atomic<bool>* stop)
+    : topo_(topo), s12_(topo.edge_count()) {
     const auto& wgs84 = GeographicLib::Geodesic::WGS84();
     const std::size_t n = s12_.size();
     on_every_core([&](std::size_t k, std::size_t threads) {
         double t;
         for (std::size_t e = n * k / threads; e < n * (k + 1) / threads; ++e) {
+            if (stop && e % 4096 == 0 && stop->load(std::memory_order_relaxed)) return;
             const auto ends = topo.edge_nodes(e);
             const LonLat a = vec_to_lonlat(topo.mesh->nodes[std::size_t(ends[0])]);
             const LonLat b = vec_to_lonlat(topo.mesh->nodes[std::size_t(ends[1])]);

@@ -14,6 +14,7 @@
 // the writer the process's peak at 20 km (204.3 MiB instead of the mesher's 194.5).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -24,8 +25,9 @@ namespace globemesh::io {
 
 class GeodesicFaceAreas {
 public:
-    /// Solves every edge's inverse problem, on every core.
-    explicit GeodesicFaceAreas(const MeshTopology& topo);
+    /// Solves every edge's inverse problem, on every core. When `stop` turns true meanwhile,
+    /// returns early with the areas unfinished (for a writer that failed or was cancelled).
+    explicit GeodesicFaceAreas(const MeshTopology& topo, const std::atomic<bool>* stop = nullptr);
 
     /// The area of face f (m2), whose edges edges_of_f are those face_edges gives.
     double face_m2(std::size_t f, const std::int32_t* edges_of_f) const;

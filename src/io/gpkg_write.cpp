@@ -253,6 +253,18 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")" +
                       OutputFile::full_disk_note(path));
     GpkgWriter w(ds.get(), path);
+    // Every layer is written in one transaction, rolled back when the write fails or is
+    // cancelled, before the dataset closes as it unwinds: GDAL would otherwise build the
+    // spatial indexes of the rows written so far, for a file about to be deleted (half a minute
+    // at 1e6 nodes). At 20 km one transaction writes as fast as one per layer (52.1/66.1 s
+    // against 53.7/61.3 s, alternated) and gives the same file.
+    struct RollBackOnFailure {
+        GDALDataset* ds;
+        bool done = false;
+        ~RollBackOnFailure() {
+            if (!done) ds->RollbackTransaction();
+        }
+    } roll_back_on_failure{ds.get()};
 
     // faces
     OGRLayer* faces = w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
@@ -270,6 +282,10 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
             w.field(faces, f.name.c_str(), OFTReal);
             face_fields.push_back(&f);
         }
+    // Shares of the progress, as measured at 20 km (45 s): the faces' features 20%, the nodes'
+    // 3%, and GDAL's close, which builds the spatial indexes (the faces' row by row) without
+    // reporting, the rest.
+    constexpr double face_share = 0.2, node_share = 0.03;
     w.begin();
     {
         // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
@@ -277,6 +293,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         const io::GeodesicFaceAreas areas(topo);
         std::vector<std::int32_t> edges;
         for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
+            if (i % 16384 == 0) report(options.progress, face_share * double(i) / double(mesh.faces.size()), "write_gpkg");
             io::face_edges(topo, i, 1, edges);
             const auto& t = mesh.faces[i];
             OGRFeature feature(faces->GetLayerDefn());
@@ -295,7 +312,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
             w.add(faces, feature);
         }
     }
-    w.commit();
     if (options.after_partial_write) options.after_partial_write();
 
     // nodes
@@ -303,8 +319,9 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.field(nodes, "node", OFTInteger);
     for (const auto& f : mesh.node_fields)
         if (f.name != "node") w.field(nodes, f.name.c_str(), OFTReal);
-    w.begin();
     for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+        if (i % 16384 == 0)
+            report(options.progress, face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
         OGRFeature feature(nodes->GetLayerDefn());
         feature.SetFID(GIntBig(i) + 1);
         feature.SetField("node", int(i));
@@ -314,7 +331,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         feature.SetGeometryDirectly(new OGRPoint(p.lon, p.lat));
         w.add(nodes, feature);
     }
-    w.commit();
 
     // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
     if (!topo.boundary_edges.empty()) {
@@ -324,7 +340,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.field(boundary, "loop", OFTInteger);
     w.field(boundary, "edges", OFTInteger);
     w.field(boundary, "length_km", OFTReal);
-    w.begin();
     for (const auto& run : boundary_runs(topo)) {
         OGRFeature feature(boundary->GetLayerDefn());
         feature.SetField("tag", run.tag == int(EdgeTag::open) ? "open" : "coast");
@@ -348,7 +363,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         feature.SetGeometryDirectly(multi);
         w.add(boundary, feature);
     }
-    w.commit();
     }
 
     // mesh_info
@@ -369,14 +383,12 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         {"edge_length_km_mean", std::to_string(stats.edge_km_mean)},
         {"edge_length_km_max", std::to_string(stats.edge_km_max)}};
     rows.insert(rows.end(), mesh.attributes.begin(), mesh.attributes.end());
-    w.begin();
     for (const auto& [key, value] : rows) {
         OGRFeature feature(info->GetLayerDefn());
         feature.SetField("key", key.c_str());
         feature.SetField("value", value.c_str());
         w.add(info, feature);
     }
-    w.commit();
 
     // layer_styles, in the schema QGIS creates and reads (QgsOgrProviderUtils / saveStyle).
     OGRLayer* styles = w.layer("layer_styles", wkbNone, "QGIS layer styles", "FID=id");
@@ -403,10 +415,14 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     style.SetField("owner", "");
     style.SetField("ui", "");
     w.add(styles, style);
+    w.commit();
 
+    report(options.progress, face_share + node_share, "write_gpkg");
+    roll_back_on_failure.done = true;
     if (!io::close_dataset(ds))
         throw IoError("GeoPackage output " + path.string() + ": closing failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));
+    report(options.progress, 1.0, "write_gpkg");
     out.commit();
 }
 

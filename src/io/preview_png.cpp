@@ -47,13 +47,18 @@ public:
         geoms_.push_back(OGRGeometry::ToHandle(g));
         values_.insert(values_.end(), c.begin(), c.end());
     }
-    void burn(GDALDataset* ds, const char* all_touched, const std::filesystem::path& path) {
+    /// Burns them into ds, reporting on [lo, hi] of `progress`.
+    void burn(GDALDataset* ds, const char* all_touched, const std::filesystem::path& path, const Progress& progress,
+              double lo, double hi) {
         if (geoms_.empty()) return;
         int bands[4] = {1, 2, 3, 4};
         char* opts[] = {const_cast<char*>(all_touched), nullptr};
-        if (GDALRasterizeGeometries(GDALDataset::ToHandle(ds), 4, bands, int(geoms_.size()), geoms_.data(), nullptr,
-                                    nullptr, values_.data(), opts, nullptr, nullptr) != CE_None)
-            throw IoError("preview " + path.string() + ": rasterizing failed: " + io::last_gdal_error());
+        gdal::ProgressBridge bridge{&progress, lo, hi, "write_preview"};
+        const CPLErr err = GDALRasterizeGeometries(GDALDataset::ToHandle(ds), 4, bands, int(geoms_.size()),
+                                                   geoms_.data(), nullptr, nullptr, values_.data(), opts,
+                                                   progress ? gdal::ProgressBridge::call : nullptr, &bridge);
+        if (bridge.cancelled) throw Cancelled();
+        if (err != CE_None) throw IoError("preview " + path.string() + ": rasterizing failed: " + io::last_gdal_error());
     }
 
 private:
@@ -150,10 +155,13 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
             for (const auto& g : land_geoms) burn.add(g->clone(), land_colour);
             double shifted[6] = {w - shift, gt[1], 0, n, 0, gt[5]};
             canvas->SetGeoTransform(shifted);
-            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, {}, 0, 0);
         }
         canvas->SetGeoTransform(gt);
     }
+    // Shares of the progress, as measured at 20 km (2.1e6 faces): the land 2%, the faces'
+    // polygons 80% (3.2 s), their burning 12%, the outlines and the PNG the rest.
+    report(options.progress, 0.02, "write_preview");
 
     // Faces, coloured by quality (red poor .. green good) or depth (light to dark blue).
     double depth_max = 1;
@@ -166,10 +174,16 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
     const std::vector<std::pair<double, Rgba>> depth_ramp = {
         {0.0, {222, 235, 247, 255}}, {0.5, {66, 146, 198, 255}}, {1.0, {8, 48, 107, 255}}};
     BurnList faces, outlines;
-    double mean_edge_deg = compute_stats(mesh).edge_km_mean / earth_radius_km * rad_to_deg;
+    // Outlines only where the mean side of a face is 6 pixels or more.
+    double sides_rad = 0;
+    for (const auto& t : mesh.faces)
+        for (int k = 0; k < 3; ++k) sides_rad += arc_angle(mesh.nodes[t[k]], mesh.nodes[t[(k + 1) % 3]]);
+    const double mean_edge_deg = sides_rad / double(3 * mesh.faces.size()) * rad_to_deg;
     const bool draw_outlines = mean_edge_deg / gt[1] >= 6.0;
     const Rgba outline = {40, 40, 40, 255};
-    for (const auto& t : mesh.faces) {
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        if (f % 65536 == 0) report(options.progress, 0.02 + 0.8 * double(f) / double(mesh.faces.size()), "write_preview");
+        const auto& t = mesh.faces[f];
         const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
         Rgba colour = options.colour_by == "depth"
                           ? ramp(depth_ramp, (depth->values[t[0]] + depth->values[t[1]] + depth->values[t[2]]) / 3.0 / depth_max)
@@ -188,8 +202,8 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
             }
         }
     }
-    faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
-    outlines.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+    faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, options.progress, 0.82, 0.94);
+    outlines.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, options.progress, 0.94, 0.97);
     if (options.after_partial_write) options.after_partial_write();
 
     // Written without georeferencing sidecars (no .aux.xml, no world file): a picture only.
@@ -203,6 +217,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
     if (!io::close_dataset(written))
         throw IoError("preview " + path.string() + ": closing the PNG failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));
+    report(options.progress, 1.0, "write_preview");
     out.commit();
 }
 

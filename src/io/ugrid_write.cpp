@@ -7,6 +7,7 @@
 // mesh_boundary_nodes, all 0-based with start_index written; "crs" for CF and MDAL. Nothing in
 // the file depends on the clock: the only date is the caller's history string.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <future>
@@ -41,8 +42,8 @@ constexpr const char* wgs84_wkt =
 /// Writes the variables of one file; every call checks its status.
 class UgridWriter {
 public:
-    UgridWriter(int id, const std::filesystem::path& file, bool compress)
-        : id_(id), file_(file), compress_(compress) {}
+    UgridWriter(int id, const std::filesystem::path& file, bool compress, const Progress& progress)
+        : id_(id), file_(file), compress_(compress), progress_(progress) {}
 
     int dim(const char* name, std::size_t len) {
         int d;
@@ -53,6 +54,11 @@ public:
         int v;
         io::nc_check(nc_def_var(id_, name, type, int(dims.size()), dims.data(), &v), file_,
                      std::string("defining variable ") + name);
+        if (!dims.empty()) {
+            std::size_t rows = 0;
+            io::nc_check(nc_inq_dimlen(id_, dims[0], &rows), file_, std::string("sizing ") + name);
+            rows_total_ += rows; // every variable with dimensions is written whole, once
+        }
         if (compress_ && !dims.empty()) {
             // Chunks of at most 65536 rows and a small chunk cache: netCDF's default chunking
             // makes one chunk of a whole variable, and HDF5 then keeps every variable written
@@ -161,6 +167,8 @@ public:
                         const char* name) {
         const std::size_t start[2] = {first, 0}, counts[2] = {count, n_per_row};
         io::nc_check(put_block(v, start, counts, data), file_, std::string("writing ") + name);
+        rows_done_ += count;
+        report(progress_, double(rows_done_) / double(std::max<std::size_t>(rows_total_, 1)), "write_ugrid");
     }
     static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
 
@@ -175,6 +183,8 @@ private:
     int id_;
     const std::filesystem::path& file_;
     bool compress_;
+    const Progress& progress_;
+    std::size_t rows_total_ = 0, rows_done_ = 0; ///< rows of all the variables, and written
 };
 
 /// A netCDF attribute name from a free-form key (letters, digits, underscore).
@@ -231,7 +241,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     nc.create(out.temp_path(), mode, path, "UGRID output");
     int old_fill;
     nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
-    UgridWriter w(nc.id(), path, !options.classic);
+    UgridWriter w(nc.id(), path, !options.classic, options.progress);
 
     const int d_node = w.dim("nMesh_node", nn), d_face = w.dim("nMesh_face", nf), d_edge = w.dim("nMesh_edge", ne);
     const int d_two = w.dim("Two", 2), d_three = w.dim("Three", 3);
@@ -383,13 +393,20 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     // The edges' geodesic problems (GeodesicFaceAreas), the writer's largest computation, run in
     // the background from here, while the variables before the face areas are computed and
     // compressed (HDF5's deflate runs in this thread alone).
-    auto solve_edges = [&topo] { return io::GeodesicFaceAreas(topo); };
+    std::atomic<bool> stop_solving{false};
+    auto solve_edges = [&topo, &stop_solving] { return io::GeodesicFaceAreas(topo, &stop_solving); };
     std::future<io::GeodesicFaceAreas> areas_ahead;
     try {
         areas_ahead = std::async(std::launch::async, solve_edges);
     } catch (const std::system_error&) {
         areas_ahead = std::async(std::launch::deferred, solve_edges); // no thread to be had: when needed
     }
+    // A failure or a cancel before the areas are taken stops their computation: the future's
+    // destructor waits for it (at 1e7 nodes, a minute).
+    struct StopOnExit {
+        std::atomic<bool>& stop;
+        ~StopOnExit() { stop = true; }
+    } stop_on_exit{stop_solving};
     w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
         const auto& t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};

@@ -511,14 +511,56 @@ TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
         return lib;
     };
     RefusingLibrary r1, r2, r3;
+    // The mesh has a share of the run's one progress line; the line ends before the error.
     const Result normal = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib_with_progress(r1));
-    EXPECT_EQ(normal.err, "0...10...20...30...40...50...60...70...80...90...100 - done.\nglobemesh: stop here\n");
+    EXPECT_TRUE(regex_search(normal.err, R"(^0(\.\.\.[1-9]0)+\.*\nglobemesh: stop here\n$)")) << normal.err;
+    EXPECT_EQ(normal.err.find("100"), std::string::npos) << normal.err;
     EXPECT_EQ(normal.out, "");
     const Result quiet = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--quiet"}, lib_with_progress(r2));
     EXPECT_EQ(quiet.err, "globemesh: stop here\n");
     const Result verbose = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--verbose"}, lib_with_progress(r3));
     EXPECT_NE(verbose.err.find("[size_field] 0"), std::string::npos) << verbose.err;
     EXPECT_NE(verbose.err.find("\n[refine] "), std::string::npos) << verbose.err;
+}
+
+// One progress line for the whole run: the mesh and each output report into their share of it,
+// and it reaches "100 - done." once, when the last output is written.
+TEST(Cli, the_mesh_and_its_outputs_share_one_progress_line) {
+    TempDir dir;
+    RefusingLibrary refusing;
+    auto lib = refusing.lib();
+    std::vector<std::string> order;
+    auto report_all = [&](const globemesh::Progress& p, const char* stage) {
+        order.push_back(stage);
+        for (int i = 0; i <= 20; ++i) globemesh::report(p, i / 20.0, stage);
+    };
+    lib.mesh_ocean = [&](const globemesh::MeshOptions&, const globemesh::Progress& p, globemesh::StageTimings*) {
+        report_all(p, "refine");
+        return globemesh::Mesh{};
+    };
+    lib.compute_stats = [](const globemesh::Mesh&) { return globemesh::MeshStats{}; };
+    lib.write_ugrid = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::UgridOptions& o) {
+        report_all(o.progress, "write_ugrid");
+        write_text(path, "ugrid");
+    };
+    lib.write_gpkg = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::GpkgOptions& o) {
+        report_all(o.progress, "write_gpkg");
+        write_text(path, "gpkg");
+    };
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg", (dir / "o.gpkg").string()}, lib);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(order, (std::vector<std::string>{"refine", "write_ugrid", "write_gpkg"}));
+    EXPECT_EQ(r.err, "0...10...20...30...40...50...60...70...80...90...100 - done.\n");
+    // Cancelled from the terminal while an output is written: no file left.
+    lib.write_ugrid = [&](const globemesh::Mesh&, const fs::path&, const globemesh::UgridOptions& o) {
+        globemesh::report(o.progress, 0.1, "write_ugrid");
+        std::raise(SIGINT);
+        globemesh::report(o.progress, 0.2, "write_ugrid"); // throws Cancelled
+    };
+    const Result cancelled = run({"mesh", "--coast", coast, "-o", (dir / "p.nc").string(), "-q"}, lib);
+    EXPECT_EQ(cancelled.status, 1);
+    EXPECT_EQ(cancelled.err, "globemesh: cancelled, no output written\n");
+    EXPECT_FALSE(fs::exists(dir / "p.nc"));
 }
 
 // ---------------------------------------------------------------------------------------------

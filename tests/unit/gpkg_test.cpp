@@ -284,6 +284,39 @@ TEST(Gpkg, existing_output_refused_and_failures_leave_no_file) {
     EXPECT_TRUE(folder_listing(dir.path()).empty());
 }
 
+// Both writers report their progress under their stage, from 0 up to 1, and stop when the
+// callback says so: Cancelled (also from inside GDAL's rasterizer), no file left.
+TEST(Gpkg, gpkg_and_preview_report_progress_and_stop_when_asked) {
+    TempDir dir;
+    const Mesh m = icosphere(5); // 20,480 faces: a few reports
+    struct Writer {
+        const char* stage;
+        std::function<void(const Progress&)> write;
+    };
+    const std::vector<Writer> writers = {
+        {"write_gpkg", [&](const Progress& p) { GpkgOptions o; o.progress = p; write_gpkg(m, dir / "o.gpkg", o); }},
+        {"write_preview", [&](const Progress& p) { PreviewOptions o; o.progress = p; write_preview_png(m, dir / "o.png", o); }}};
+    for (const Writer& w : writers) {
+        SCOPED_TRACE(w.stage);
+        std::vector<double> seen;
+        w.write([&](double f, std::string_view stage) {
+            EXPECT_EQ(stage, w.stage);
+            seen.push_back(f);
+            return true;
+        });
+        ASSERT_GE(seen.size(), 4u);
+        EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+        EXPECT_EQ(seen.back(), 1.0);
+        for (const auto& e : fs::directory_iterator(dir.path())) fs::remove(e.path());
+        // Stop at the first report, and at the first past 0.8 (the preview: inside GDAL's
+        // rasterizer, whose progress the writer passes on).
+        for (const double stop_at : {0.0, 0.8}) {
+            EXPECT_THROW(w.write([&](double f, std::string_view) { return f < stop_at; }), Cancelled) << stop_at;
+            EXPECT_TRUE(folder_listing(dir.path()).empty()) << stop_at;
+        }
+    }
+}
+
 TEST(Preview, draws_faces_over_land_without_smearing_across_the_map) {
     TempDir dir;
     Mesh m = icosphere_cap(4, 180, 0, 30);

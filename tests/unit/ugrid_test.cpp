@@ -536,6 +536,35 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
     EXPECT_GE(at_flush, 1) << "no netCDF-4 file failed in the final flush (the crash's path):\n" << text;
 }
 
+// The writer reports the share of its rows written, and a callback that returns false stops it
+// at once: nothing left behind, Cancelled rather than an error.
+TEST(Ugrid, reports_its_progress_and_stops_when_asked) {
+    TempDir dir;
+    const Mesh m = icosphere(7); // 163,842 nodes: several blocks of 65,536 rows a variable
+    for (const bool classic : {false, true}) {
+        SCOPED_TRACE(classic ? "classic" : "netcdf4");
+        UgridOptions o;
+        o.classic = classic;
+        std::vector<double> seen;
+        o.progress = [&](double f, std::string_view stage) {
+            EXPECT_EQ(stage, "write_ugrid");
+            seen.push_back(f);
+            return true;
+        };
+        write_ugrid(m, dir / "o.nc", o);
+        ASSERT_GE(seen.size(), 20u);
+        EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+        EXPECT_GT(seen.front(), 0.0);
+        EXPECT_EQ(seen.back(), 1.0); // every row counted once
+        fs::remove(dir / "o.nc");
+        int calls = 0;
+        o.progress = [&](double, std::string_view) { return ++calls < 3; };
+        EXPECT_THROW(write_ugrid(m, dir / "o.nc", o), Cancelled);
+        EXPECT_EQ(calls, 3);
+        EXPECT_TRUE(folder_listing(dir.path()).empty());
+    }
+}
+
 TEST(OutputFile, write_text_is_atomic_and_refuses_existing_files) {
     TempDir dir;
     OutputFile::write_text(dir / "r.json", "{}\n", false);
