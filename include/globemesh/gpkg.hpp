@@ -24,8 +24,8 @@ struct GpkgOptions {
     /// null: the writer computes it.
     const MeshStats* stats = nullptr;
     /// Reports the share written (stage "write_gpkg"); returning false cancels (Cancelled, no
-    /// file left). GDAL builds the spatial indexes as the file closes, the last third or so,
-    /// without reporting.
+    /// file left). GDAL builds the spatial indexes as the file closes, most of the time (35 of
+    /// 45 s at 1e6 nodes), without reporting.
     Progress progress;
     /// Test hook: called once after the faces are written, before the rename.
     std::function<void()> after_partial_write;

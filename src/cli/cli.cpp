@@ -550,11 +550,12 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     if (c.quiet && c.verbose) throw UsageError("--quiet and --verbose exclude each other");
     if (c.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o out.nc");
     check_input_path(c.t.points, "POINTS");
-    for (const auto& [name, path] : {std::pair{"--output", c.output}, {"--gpkg", c.gpkg}, {"--timings", c.timings}})
+    const std::pair<const char*, const std::string&> outputs[] = {
+        {"--output", c.output}, {"--gpkg", c.gpkg}, {"--timings", c.timings}};
+    for (const auto& [name, path] : outputs)
         if (!path.empty()) check_output_kind(path, name);
-    check_output_path(c.output, "--output", c.overwrite);
-    if (!c.gpkg.empty()) check_output_path(c.gpkg, "--gpkg", c.overwrite);
-    if (!c.timings.empty()) check_output_path(c.timings, "--timings", c.overwrite);
+    for (const auto& [name, path] : outputs)
+        if (!path.empty()) check_output_path(path, name, c.overwrite);
 
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, c.verbose);

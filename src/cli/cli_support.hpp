@@ -43,8 +43,8 @@ private:
 /// GDAL's terminal progress ("0...10...20...30...40...50...60...70...80...90...100 - done."),
 /// drawn on `err` rather than stdout (where GDALTermProgress writes) so that stdout carries
 /// results only. With `verbose`, each new stage starts a line "[stage] ". The callback returns
-/// false once a cancelling signal arrived (InterruptGuard), which cancels the run. run_cli owns one, so that an error line
-/// never lands in the middle of a progress line.
+/// false once a cancelling signal arrived (InterruptGuard), which cancels the run. run_cli owns
+/// one, so that an error line never lands in the middle of a progress line.
 class TerminalProgress {
 public:
     explicit TerminalProgress(std::ostream& err) : err_(err) {}

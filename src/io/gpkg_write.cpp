@@ -102,13 +102,24 @@ public:
     }
     void begin() {
         if (ds_->StartTransaction() != OGRERR_NONE) fail("starting a transaction");
+        in_transaction_ = true;
     }
     void commit() {
         if (ds_->CommitTransaction() != OGRERR_NONE) fail("committing");
+        in_transaction_ = false;
     }
+    /// A transaction still open (the write failed or was cancelled) is rolled back before the
+    /// dataset closes as it unwinds: GDAL would otherwise build the spatial indexes of the rows
+    /// written so far, for a file about to be deleted (half a minute at 1e6 nodes).
+    ~GpkgWriter() {
+        if (in_transaction_) ds_->RollbackTransaction();
+    }
+    GpkgWriter(const GpkgWriter&) = delete;
+    GpkgWriter& operator=(const GpkgWriter&) = delete;
 
 private:
     GDALDataset* ds_;
+    bool in_transaction_ = false;
     const std::filesystem::path& path_;
     OGRSpatialReference srs_;
 };
@@ -252,19 +263,8 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     if (!ds)
         throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")" +
                       OutputFile::full_disk_note(path));
+    // Declared after the dataset, so that it rolls back before the dataset closes.
     GpkgWriter w(ds.get(), path);
-    // Every layer is written in one transaction, rolled back when the write fails or is
-    // cancelled, before the dataset closes as it unwinds: GDAL would otherwise build the
-    // spatial indexes of the rows written so far, for a file about to be deleted (half a minute
-    // at 1e6 nodes). At 20 km one transaction writes as fast as one per layer (52.1/66.1 s
-    // against 53.7/61.3 s, alternated) and gives the same file.
-    struct RollBackOnFailure {
-        GDALDataset* ds;
-        bool done = false;
-        ~RollBackOnFailure() {
-            if (!done) ds->RollbackTransaction();
-        }
-    } roll_back_on_failure{ds.get()};
 
     // faces
     OGRLayer* faces = w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
@@ -286,6 +286,9 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     // 3%, and GDAL's close, which builds the spatial indexes (the faces' row by row) without
     // reporting, the rest.
     constexpr double face_share = 0.2, node_share = 0.03;
+    // Every layer in one transaction, so that a failure or a cancel anywhere before the end
+    // rolls all of it back (GpkgWriter). At 20 km one transaction writes as fast as one per
+    // layer (52.1/66.1 s against 53.7/61.3 s, alternated) and gives the same file.
     w.begin();
     {
         // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
@@ -418,7 +421,6 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.commit();
 
     report(options.progress, face_share + node_share, "write_gpkg");
-    roll_back_on_failure.done = true;
     if (!io::close_dataset(ds))
         throw IoError("GeoPackage output " + path.string() + ": closing failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));

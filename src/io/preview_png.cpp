@@ -48,8 +48,8 @@ public:
         values_.insert(values_.end(), c.begin(), c.end());
     }
     /// Burns them into ds, reporting on [lo, hi] of `progress`.
-    void burn(GDALDataset* ds, const char* all_touched, const std::filesystem::path& path, const Progress& progress,
-              double lo, double hi) {
+    void burn(GDALDataset* ds, const char* all_touched, const std::filesystem::path& path, const Progress& progress = {},
+              double lo = 0, double hi = 1) {
         if (geoms_.empty()) return;
         int bands[4] = {1, 2, 3, 4};
         char* opts[] = {const_cast<char*>(all_touched), nullptr};
@@ -155,7 +155,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
             for (const auto& g : land_geoms) burn.add(g->clone(), land_colour);
             double shifted[6] = {w - shift, gt[1], 0, n, 0, gt[5]};
             canvas->SetGeoTransform(shifted);
-            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, {}, 0, 0);
+            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
         }
         canvas->SetGeoTransform(gt);
     }
