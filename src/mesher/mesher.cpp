@@ -2667,7 +2667,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         }
     for (VertexId v = 0; v < dt.vertex_count(); ++v)
         if (node_of[v] == 0) node_of[v] = static_cast<NodeIndex>(node_count++);
-    if (node_count == 0) throw DataError("no ocean is left to mesh");
+    if (node_count == 0) throw DataError("no ocean is left to mesh at this size: the water was closed as inlets or straits, or removed as land; a smaller size keeps it");
     // A vertex between two or more fans of ocean (close_straits closed a strait there at a
     // point): each fan after the first gets a node of its own, pinch_apart into the fan, so
     // that the mesh is a manifold. (fan_corner, fan_node): the corners of those fans' faces and

@@ -153,6 +153,14 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     CoastReport coast_report;
     Boundary boundary = shape_boundary(coast, size, o, &coast_report, sub_progress(progress, 0.25, 0.3));
     clock.lap("boundary");
+    // A size wider than the region leaves too little of its outline for a triangle: say so, and
+    // which option to change, rather than the mesher's "fewer than 4 nodes".
+    if (std::size_t n = 0; !boundary.empty()) {
+        for (const Ring& r : boundary.rings) n += r.nodes.size();
+        if (n < 4)
+            throw DataError("no ocean to mesh: at --hmax " + number(o.hmax_km) + " km the coast and region keep only " +
+                            std::to_string(n) + " boundary nodes; lower --hmax");
+    }
     coast.rings = Boundary{}; // done with: the mesher reuses their memory (only coast.layer is used below)
 
     MesherOptions mo;

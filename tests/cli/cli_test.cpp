@@ -394,6 +394,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"unknown_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "20parsecs"}, 2, "--hmax"},
         ErrorCase{"not_a_number", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmin", "small"}, 2, "--hmin"},
         ErrorCase{"negative_size", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "-5km"}, 2, "--hmax"},
+        ErrorCase{"hmax_beyond_an_eighth_of_the_globe", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5001km"}, 2, "--hmax must be at most 5000km"},
         ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20km"}, 2, "--hmin"},
         ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
         ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},

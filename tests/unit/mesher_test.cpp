@@ -555,6 +555,25 @@ TEST(Mesher, regional_box_has_open_boundary_edges) {
     }
 }
 
+// A region of open sea 20 degrees square (about 1,100 by 2,200 km): at --hmax 2000 km its
+// outline still makes a mesh; at 3000 km, wider than the region, the outline keeps 3 nodes and
+// the error names --hmax.
+TEST(Mesher, a_size_wider_than_the_region_is_refused_naming_hmax) {
+    MeshOptions o = land_110m(2000);
+    o.region = std::array<double, 4>{170, -60, -170, -40};
+    const Mesh mesh = mesh_ocean(o);
+    EXPECT_GE(mesh.faces.size(), 2u);
+    expect_verified(mesh, "wide_region.nc", "0"); // (the region is about one edge across)
+    o.hmax_km = 3000;
+    try {
+        mesh_ocean(o);
+        ADD_FAILURE() << "a 3000 km size in a 2000 km region gave a mesh";
+    } catch (const DataError& e) {
+        EXPECT_TRUE(test::regex_match(e.what(), R"(no ocean to mesh: at --hmax 3000 km .* [0-3] boundary nodes; lower --hmax)"))
+            << e.what();
+    }
+}
+
 TEST(Mesher, same_input_gives_the_same_bytes) {
     test::TempDir dir;
     MeshOptions o = land_110m(300);
