@@ -1289,8 +1289,19 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
     if (!issues.empty()) {
         const auto& is = issues.front();
         LonLat at = vec_to_lonlat(out.rings.rings[is.ring].nodes[std::max(is.segment, 0L)]);
-        throw DataError(where + ": the cleaned coast has " + is.what + " near lon " + std::to_string(at.lon) +
-                        ", lat " + std::to_string(at.lat) + "; repair the data there");
+        const std::string near = " near lon " + std::to_string(at.lon) + ", lat " + std::to_string(at.lat);
+        // A region outline drawn along the coast (an ocean polygon as --region-file) leaves
+        // slivers between the two: the data is not at fault, the outline's course is.
+        auto open = [&](long ring, long segment) {
+            const auto& kinds = ring >= 0 && segment >= 0 ? out.rings.rings[ring].kinds : std::vector<SegmentKind>{};
+            return std::size_t(segment) < kinds.size() && kinds[segment] == SegmentKind::open;
+        };
+        if (open(is.ring, is.segment) || open(is.other_ring, is.other_segment))
+            throw DataError(std::string(options.region ? "--region" : "--region-file " + options.region_file) +
+                            ": its outline runs along the coast of " + where + near +
+                            ", leaving slivers of ocean between them (" + is.what +
+                            "); draw the outline across open water, clear of the coast");
+        throw DataError(where + ": in the cleaned coast " + is.what + near + "; repair the data there");
     }
     out.ocean_area_km2 = boundary_area_km2(out.rings);
     report(progress, 1.0, "coast loaded");

@@ -394,6 +394,22 @@ TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
     expect_valid(shape_boundary(d, uniform(30), o));
 }
 
+// The land itself, reprojected to Equal Earth and back, as the region: the region's outline runs
+// along the coast everywhere, a few micro-degrees off it, and the ocean between them is slivers.
+// The error blames the region's outline, not the coast data.
+TEST(Coast, a_region_outline_along_the_coast_is_refused_naming_the_region) {
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.region_file = fixture("coast/ne_110m_land_equal_earth.gpkg").string();
+    try {
+        load_coast(o);
+        ADD_FAILURE() << "the slivers between the region's outline and the coast were accepted";
+    } catch (const DataError& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind("--region-file " + o.region_file + ": its outline runs along the coast", 0), 0u) << m;
+        EXPECT_NE(m.find("clear of the coast"), std::string::npos) << m;
+    }
+}
+
 TEST(Coast, attribute_filter_selects_features) {
     MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
     o.coast_where = "scalerank = 0";
