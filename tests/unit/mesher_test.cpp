@@ -276,6 +276,9 @@ TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     // graded region and the icosahedron's edges, are inserted); mesh-verify checks that the
     // result is still constrained Delaunay.
     EXPECT_GT(report.lattice_patched, report.lattice_nodes / 2);
+    // The node estimate checked against --max-nodes before refining predicts the count.
+    EXPECT_GT(double(report.estimated_nodes), 0.9 * double(mesh.nodes.size()));
+    EXPECT_LT(double(report.estimated_nodes), 1.3 * double(mesh.nodes.size()));
     expect_verified(mesh, "gs.nc");
     // Edges near the centre are about 20 km, far away about 160 km.
     double near_sum = 0, far_sum = 0;
@@ -580,6 +583,25 @@ TEST(Mesher, same_input_gives_the_same_bytes) {
     write_ugrid(mesh_ocean(o), dir / "a.nc");
     write_ugrid(mesh_ocean(o), dir / "b.nc");
     EXPECT_EQ(slurp(dir / "a.nc"), slurp(dir / "b.nc"));
+}
+
+// A size of a few km at the coast, growing offshore: the node estimate follows the growth, so a
+// run is not refused by a --max-nodes half as large again as its count. (The smallest size over
+// each of the boundary's triangles, before, asked --hmax 100km --coast-size 2km on 1:50m land
+// for 80.7M nodes, and refused it, for a mesh of 2.6M.)
+TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
+    MeshOptions o = land_110m(400);
+    o.coast_size_km = 25;
+    const std::size_t nodes = mesh_ocean(o).nodes.size();
+    o.max_nodes = nodes * 3 / 2;
+    EXPECT_EQ(mesh_ocean(o).nodes.size(), nodes);
+    o.max_nodes = nodes / 2;
+    try {
+        mesh_ocean(o);
+        ADD_FAILURE() << "a run of " << nodes << " nodes passed --max-nodes " << o.max_nodes;
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Mesher, too_many_nodes_are_refused_before_refining) {
