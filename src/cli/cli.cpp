@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <chrono>
 #include <ctime>
 #include <filesystem>
@@ -57,6 +59,21 @@ CLI::Validator unit_transform(double (*parse)(std::string_view), const std::stri
             }
         },
         name);
+}
+
+/// A CLI11 transform for a count: a whole number, also written as 2e7 (CLI11 alone refuses that
+/// with "Could not convert").
+CLI::Validator count_transform() {
+    return CLI::Validator(
+        [](std::string& value) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(value.c_str(), &end);
+            if (value.empty() || *end != '\0' || !(v >= 0 && v <= 9.007199254740992e15) || v != std::floor(v))
+                return "'" + value + "' is not a whole number, e.g. 20000000 or 2e7";
+            value = std::to_string(static_cast<std::uint64_t>(v));
+            return {};
+        },
+        "");
 }
 
 /// CLI11 wants the arguments in reverse order.
@@ -196,7 +213,7 @@ struct MeshCommand {
             ->group(size)->type_name("G");
 
         app.add_option("--max-nodes", m.max_nodes, "Refuse runs estimated to give more nodes")
-            ->group(mesher)->type_name("N");
+            ->group(mesher)->type_name("N")->transform(count_transform());
         // Kept as text ("auto", "4GB") so that --print-config and the mesh's configuration say
         // what was asked, not this machine's memory; converted in parse(). "auto" is 3/4 of the
         // physical memory, read here: the library reads no system state.

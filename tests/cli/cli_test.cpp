@@ -236,6 +236,12 @@ TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
     EXPECT_EQ(a.mesh.hmax_km, b.mesh.hmax_km);
 }
 
+TEST(Cli, max_nodes_takes_a_whole_number_also_as_a_power_of_ten) {
+    EXPECT_EQ(globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "2e7"}).mesh.max_nodes, 20'000'000u);
+    EXPECT_EQ(globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "123456789"}).mesh.max_nodes,
+              123'456'789u);
+}
+
 TEST(Cli, defaults_are_those_of_mesh_options) {
     const auto a = globemesh::parse_mesh_args(std::vector<std::string>{});
     // All but --max-memory, which the library leaves off and the CLI sets from the machine.
@@ -395,6 +401,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"not_a_number", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmin", "small"}, 2, "--hmin"},
         ErrorCase{"negative_size", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "-5km"}, 2, "--hmax"},
         ErrorCase{"hmax_beyond_an_eighth_of_the_globe", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5001km"}, 2, "--hmax must be at most 5000km"},
+        ErrorCase{"max_nodes_not_whole", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--max-nodes", "2.5e-1"}, 2, "--max-nodes: '2.5e-1' is not a whole number"},
         ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20km"}, 2, "--hmin"},
         ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
         ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
