@@ -8,7 +8,8 @@
 // a temporary file. An existing target is refused (IoError) unless overwrite is set; without
 // overwrite the final step is link()+unlink(), which never replaces a file that appeared meanwhile.
 // A process killed by SIGKILL cannot clean up: then only the hidden temporary file remains, never
-// a partial target.
+// a partial target. A target that is a symbolic link is written through it (the link stays);
+// one that exists and is not a regular file (a device, a pipe) is refused, except by write_text.
 #pragma once
 
 #include <filesystem>
@@ -38,11 +39,16 @@ public:
     /// write errors that do not say so themselves (HDF5's "HDF error", SQLite's missing tables).
     static std::string full_disk_note(const std::filesystem::path& file);
 
-    /// Writes `text` to the target safely in one go (for small reports such as JSON).
-    static void write_text(const std::filesystem::path& target, const std::string& text, bool overwrite);
+    /// Writes `text` to the target safely in one go (for small reports such as JSON); to a
+    /// terminal or pipe (is_stream: /dev/stdout) directly.
+    static void write_text(const std::filesystem::path& target, const std::string& text, bool overwrite,
+                           const std::string& what = "output");
+
+    /// True when `target` (through symbolic links) is a character device or a named pipe.
+    static bool is_stream(const std::filesystem::path& target);
 
 private:
-    std::filesystem::path target_, temp_;
+    std::filesystem::path target_, real_, temp_; // real_: target_ through symbolic links
     bool overwrite_;
     std::string what_;
     bool committed_ = false;

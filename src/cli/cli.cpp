@@ -23,6 +23,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
 #include "globemesh/options.hpp"
+#include "globemesh/output_file.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/ugrid.hpp"
 
@@ -329,9 +330,12 @@ public:
     void add(const std::string& path) { paths_.push_back(path); }
     void commit() { paths_.clear(); }
     ~OutputsGuard() {
+        // The files written, through symbolic links as OutputFile wrote them; never a terminal or
+        // pipe (--report /dev/stdout).
         for (const auto& p : paths_) {
             std::error_code ec;
-            fs::remove(p, ec);
+            const fs::path file = fs::canonical(p, ec);
+            if (!ec && fs::is_regular_file(file, ec)) fs::remove(file, ec);
         }
     }
 
@@ -465,7 +469,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     const double total_s = seconds_since(t0);
     const long long peak = peak_memory_bytes();
     if (!o.timings.empty()) {
-        write_file_safely(o.timings, timings_json(timings));
+        OutputFile::write_text(o.timings, timings_json(timings), o.overwrite, "--timings");
         written.add(o.timings);
     }
     if (!o.report.empty()) {
@@ -484,7 +488,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
           << "  \"stages\": " << stages_json(timings) << ",\n"
           << "  \"total_seconds\": " << json_number(total_s) << ",\n"
           << "  \"peak_memory_bytes\": " << peak << "\n}\n";
-        write_file_safely(o.report, r.str());
+        OutputFile::write_text(o.report, r.str(), o.overwrite, "--report");
         written.add(o.report);
     }
     written.commit();
@@ -601,7 +605,7 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     timings.add("write", seconds_since(tw));
     terminal.finish();
     if (!c.timings.empty()) {
-        write_file_safely(c.timings, timings_json(timings));
+        OutputFile::write_text(c.timings, timings_json(timings), c.overwrite, "--timings");
         written.add(c.timings);
     }
     written.commit();

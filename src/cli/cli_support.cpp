@@ -88,30 +88,6 @@ void TerminalProgress::end_line() {
     mid_line_ = false;
 }
 
-void write_file_safely(const std::filesystem::path& path, const std::string& text) {
-    namespace fs = std::filesystem;
-    fs::path tmp = path;
-    tmp += ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
-        if (!file) throw IoError("cannot write " + path.string() + ": check the folder exists and is writable");
-        file << text;
-        file.flush();
-        if (!file) {
-            file.close();
-            std::error_code ec;
-            fs::remove(tmp, ec);
-            throw IoError("cannot write " + path.string() + OutputFile::full_disk_note(path));
-        }
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw IoError("cannot write " + path.string() + ": " + ec.message());
-    }
-}
-
 std::string json_number(double v) {
     if (!std::isfinite(v)) return "null";
     char buffer[32];
@@ -272,10 +248,17 @@ void check_output_path(const std::string& path, const std::string& what, bool ov
     if (!fs::is_directory(folder, ec))
         throw IoError(what + ": the folder " + folder.string() + " of " + path +
                       " does not exist; create it first");
+    // JSON goes to a terminal or pipe as it is (--report /dev/stdout); nothing else can.
+    if (OutputFile::is_stream(p)) {
+        if (what == "--report" || what == "--timings") return;
+        throw IoError(what + ": " + path + " is not a regular file (a device or pipe); give a file name");
+    }
     if (fs::exists(p, ec) && !overwrite)
         throw IoError(what + ": " + path + " exists; use --overwrite to replace it");
     if (fs::is_directory(p, ec))
         throw IoError(what + ": " + path + " is a folder; give a file name");
+    if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
+        throw IoError(what + ": " + path + " is not a regular file (a socket?); give a file name");
 }
 
 void check_output_kind(const std::string& path, const std::string& what) {

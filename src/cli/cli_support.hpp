@@ -65,10 +65,6 @@ private:
     std::string stage_;
 };
 
-/// Writes `text` to `path` through a temporary file in the same folder renamed at the end, so
-/// that a reader never sees half a file. Throws IoError naming the path.
-void write_file_safely(const std::filesystem::path& path, const std::string& text);
-
 /// A JSON number (shortest round-trip form) or null when not finite.
 std::string json_number(double v);
 /// A JSON string literal with escapes.

@@ -476,6 +476,26 @@ TEST(CliE2e, a_size_field_grid_or_a_mesh_beyond_the_budget_is_refused_before_it_
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
+// --report /dev/stdout (a pipe here) prints the JSON among the summary, with or without
+// --overwrite, and leaves /dev/stdout as it was (before, --overwrite renamed a regular file
+// over the system's /dev/stdout link).
+TEST(CliE2e, a_report_to_dev_stdout_is_printed_and_dev_stdout_is_kept) {
+    TempDir dir;
+    const auto before = fs::symlink_status("/dev/stdout").type();
+    for (const char* overwrite : {"--quiet", "--overwrite"}) {
+        std::string out, err;
+        ASSERT_EQ(run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "800km", "-o",
+                           (dir / "p.nc").string(), "--report", "/dev/stdout", "--overwrite", overwrite},
+                          out, err, dir.path()),
+                  0)
+            << err;
+        EXPECT_NE(out.find("\"peak_memory_bytes\": "), std::string::npos) << out;
+        EXPECT_NE(out.find("faces"), std::string::npos) << out; // and the summary
+        EXPECT_EQ(fs::symlink_status("/dev/stdout").type(), before);
+        EXPECT_EQ(files_in(dir.path()), std::set<std::string>{"p.nc"});
+    }
+}
+
 TEST(CliE2e, run_cli_in_process_prints_the_summary_on_out_only) {
     TempDir dir;
     std::ostringstream out, err;

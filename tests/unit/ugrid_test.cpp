@@ -565,6 +565,38 @@ TEST(Ugrid, reports_its_progress_and_stops_when_asked) {
     }
 }
 
+// A symbolic link as the target is written through (as the shell's > does): the link stays and
+// the file it names gets the content. Before, the rename replaced the link, and with --overwrite
+// "--report /dev/stdout" replaced the system's /dev/stdout link with a regular file.
+TEST(OutputFile, a_symbolic_link_is_written_through_and_kept) {
+    TempDir dir;
+    std::ofstream(dir / "real.json") << "old";
+    fs::create_symlink("real.json", dir / "link.json");
+    OutputFile::write_text(dir / "link.json", "new", true);
+    EXPECT_TRUE(fs::is_symlink(dir / "link.json"));
+    EXPECT_EQ(file_bytes(dir / "real.json"), "new");
+    EXPECT_THROW(OutputFile::write_text(dir / "link.json", "x", false), IoError); // exists
+    EXPECT_EQ(folder_listing(dir.path()), (std::vector<std::string>{"link.json", "real.json"}));
+}
+
+// A device or a pipe takes text as it is (--report /dev/stdout) and is refused as a file
+// output (a NetCDF or GeoPackage cannot be streamed), with or without overwrite; it is never
+// replaced.
+TEST(OutputFile, a_device_takes_text_and_is_refused_as_a_file) {
+    ASSERT_TRUE(OutputFile::is_stream("/dev/null"));
+    OutputFile::write_text("/dev/null", "{}\n", false);
+    for (bool overwrite : {false, true}) {
+        try {
+            OutputFile out("/dev/null", overwrite, "UGRID output");
+            ADD_FAILURE() << "a device was accepted as a file output";
+        } catch (const IoError& e) {
+            EXPECT_NE(std::string(e.what()).find("/dev/null is not a regular file"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_EQ(fs::status("/dev/null").type(), fs::file_type::character);
+    EXPECT_FALSE(OutputFile::is_stream(fs::temp_directory_path()));
+}
+
 TEST(OutputFile, write_text_is_atomic_and_refuses_existing_files) {
     TempDir dir;
     OutputFile::write_text(dir / "r.json", "{}\n", false);
