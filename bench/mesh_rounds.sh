@@ -3,7 +3,9 @@
 # drifts by tens of percent over minutes, so a figure taken alone says little):
 #   - `mesh` of the run nearest 1e6 nodes against the core's time to sort and triangulate 1e6
 #     random points (delaunay_memory, which allocates as the executable does), bound 4x;
-#   - the time per node of each run from 1e5 nodes up, as a percentage of their mean, bound +-30%.
+#   - the time per node of each run from 1e5 nodes up, as a percentage of their mean, bound +-30%;
+#   - a least-squares fit of each round's `mesh` to a*nodes + b*boundary edges (no constant), with
+#     each run's residual: the share of the time per node that the coast's length explains.
 # Each round runs the core once, then `globemesh mesh` on the 1:50m land at each uniform size;
 # the last lines give the median of the rounds.
 #
@@ -33,7 +35,7 @@ for r in $(seq "$rounds"); do
 import json, sys
 r, core, h = sys.argv[1:4]
 rep = json.load(open(sys.argv[4]))
-print(r, core, h, rep["mesh"]["nodes"], rep["stages"]["mesh"])
+print(r, core, h, rep["mesh"]["nodes"], rep["stages"]["mesh"], rep["mesh"]["boundary_edges"])
 PY
     done
 done
@@ -41,8 +43,10 @@ done
 import statistics, sys
 rows = [l.split() for l in open(sys.argv[1])]
 by_round = {}
-for r, core, h, n, mesh in rows:
+boundary = {}
+for r, core, h, n, mesh, b in rows:
     by_round.setdefault(int(r), []).append((h, int(n), float(mesh), float(core)))
+    boundary[h] = int(b)
 ratios, spreads = [], {}
 print(f"{'round':<6} {'core_s':>7}  " + "  ".join(f"{h + ' km':>22}" for h, *_ in by_round[1]) + f"  {'mesh/core':>9}  spread of us/node (from 1e5 nodes)")
 for r, runs in sorted(by_round.items()):
@@ -57,5 +61,17 @@ for r, runs in sorted(by_round.items()):
     cells = "  ".join(f"{mesh:7.3f} s {1e6 * mesh / n:5.2f} us/node" for h, n, mesh, _ in runs)
     print(f"{r:<6} {core:7.3f}  {cells}  {ratio:8.2f}x  " + " / ".join(f"{s:+.0f}%" for s in spread.values()))
 print(f"median mesh/core at {near[0]} km ({near[1]} nodes): {statistics.median(ratios):.2f}x (bound 4x)")
+# T = a N + b B by least squares on the relative residuals (each size weighted 1/T), over the
+# medians of each size: the 2x2 normal equations.
+med = {h: statistics.median(float(x[2]) for runs in by_round.values() for x in runs if x[0] == h) for h, *_ in by_round[1]}
+nodes = {h: n for h, n, *_ in by_round[1]}
+x = {h: (nodes[h] / med[h], boundary[h] / med[h]) for h in med}
+snn = sum(u * u for u, v in x.values()); snb = sum(u * v for u, v in x.values()); sbb = sum(v * v for u, v in x.values())
+sn = sum(u for u, v in x.values()); sb = sum(v for u, v in x.values())
+det = snn * sbb - snb * snb
+if len(med) >= 2 and det > 0:
+    a, b = (sn * sbb - sb * snb) / det, (snn * sb - snb * sn) / det
+    print(f"fit of the medians, mesh = a nodes + b boundary edges: a {1e6 * a:.2f} us, b {1e6 * b:.1f} us; residuals "
+          + " / ".join(f"{h} km {100 * (a * nodes[h] + b * boundary[h] - med[h]) / med[h]:+.0f}% (B/N {boundary[h] / nodes[h]:.4f})" for h in med))
 print("median spread: " + " / ".join(f"{h} km {statistics.median(v):+.0f}%" for h, v in spreads.items()) + " (bound +-30%)")
 PY
