@@ -167,7 +167,7 @@ struct MeshCommand {
             ->group(coast)->type_name("NAME");
         app.add_option("--coast-where", m.coast_where, "OGR SQL attribute filter on --coast; default none")
             ->group(coast)->type_name("SQL");
-        app.add_option("--coast-srs", m.coast_srs, "CRS of a --coast layer that declares none, e.g. EPSG:4326")
+        app.add_option("--coast-srs", m.coast_srs, "CRS of a --coast layer that declares none, e.g. EPSG:4326 (a declared one is not overridden)")
             ->group(coast)->type_name("SRS");
         region_opt = app.add_option("--region", region,
                                     "Region W,S,E,N in degrees (W > E crosses 180); default the whole globe")

@@ -336,6 +336,25 @@ Source read_source(const std::string& path, const std::string& layer_name, const
         source_srs.reset(OSRNewSpatialReference(nullptr));
         if (OSRSetFromUserInput(source_srs.get(), srs_override.c_str()) != OGRERR_NONE)
             throw UsageError("--coast-srs '" + srs_override + "' is not a CRS GDAL/PROJ understands");
+        // A layer's own CRS is not overridden: degrees read as EPSG:3857 metres put the whole
+        // coast within a kilometre of 0,0, and the mesh is silently an aqua-planet.
+        if (OGRSpatialReferenceH declared = OGR_L_GetSpatialRef(layer)) {
+            SrsPtr d(OSRClone(declared));
+            OSRSetAxisMappingStrategy(d.get(), OAMS_TRADITIONAL_GIS_ORDER);
+            OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
+            // Both read lon, lat (traditional order): only the CRS themselves are compared.
+            const char* same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
+            if (!OSRIsSameEx(d.get(), source_srs.get(), same_options)) {
+                const char* name = OSRGetName(d.get());
+                const char* auth = OSRGetAuthorityName(d.get(), nullptr);
+                const char* code = OSRGetAuthorityCode(d.get(), nullptr);
+                const std::string declared_name = std::string(name ? name : "a CRS") +
+                                                  (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
+                throw DataError(where_msg + " declares " + declared_name + ", not --coast-srs " + srs_override +
+                                "; --coast-srs is for a layer that declares none (leave it out, or replace a "
+                                "wrong CRS with ogr2ogr -a_srs)");
+            }
+        }
     } else if (OGRSpatialReferenceH s = OGR_L_GetSpatialRef(layer)) {
         source_srs.reset(OSRClone(s));
     } else {

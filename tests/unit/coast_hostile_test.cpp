@@ -347,6 +347,28 @@ TEST(CoastHostile, layer_without_crs_needs_coast_srs) {
     EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
 }
 
+TEST(CoastHostile, coast_srs_does_not_override_a_declared_crs) {
+    // Degrees read as EPSG:3857 metres put every island within 200 m of 0,0: all dropped as
+    // too small, and the mesh was a whole-sphere ocean with no word of why.
+    MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
+    o.coast_layer = "land";
+    o.coast_srs = "EPSG:3857";
+    auto m = message_of<DataError>(o);
+    EXPECT_NE(m.find("declares WGS 84 (EPSG:4326), not --coast-srs EPSG:3857"), std::string::npos) << m;
+    // The same CRS in another spelling is no contradiction (OGC:CRS84 is lon/lat WGS 84).
+    for (const char* same : {"EPSG:4326", "OGC:CRS84", "WGS84"}) {
+        o.coast_srs = same;
+        EXPECT_GT(load_coast(o).rings.rings.size(), 50u) << same;
+    }
+    // A projected layer and its own CRS.
+    o = options_for(globemesh::test::fixture("coast/ne_110m_land_equal_earth.gpkg").string());
+    o.coast_srs = "EPSG:4326";
+    m = message_of<DataError>(o);
+    EXPECT_NE(m.find("EPSG:8857"), std::string::npos) << m;
+    o.coast_srs = "EPSG:8857";
+    EXPECT_GT(load_coast(o).rings.rings.size(), 50u);
+}
+
 TEST(CoastHostile, bad_attribute_filter_is_a_usage_error) {
     MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
     o.coast_layer = "land";
