@@ -10,6 +10,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -34,7 +35,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace globemesh::cli;
 
-int report_error(std::ostream& err);
+int report_error(std::ostream& err, const std::string& command);
 
 std::string version_text() {
     return std::string("globemesh ") + GLOBEMESH_VERSION + " (GDAL " + GDALVersionInfo("RELEASE_NAME") + ")";
@@ -93,6 +94,42 @@ std::string one_line(std::string message) {
             r += c;
     }
     return r;
+}
+
+/// CLI11's parse errors in the words of the rest of globemesh's messages, for `command` (mesh,
+/// info, triangulate; empty at the top level): an option given twice, an option without its
+/// value, an unknown option, a stray argument.
+std::string usage_text(const CLI::ParseError& e, const std::string& command) {
+    const std::string what = one_line(e.what());
+    const std::string help = command.empty() ? "globemesh --help" : "globemesh " + command + " --help";
+    std::smatch m;
+    if (dynamic_cast<const CLI::ArgumentMismatch*>(&e)) {
+        static const std::regex at_most(R"(^(\S+): At Most (\d+) required but received (\d+)$)");
+        static const std::regex missing(R"(^(\S+): (\d+) required (\S+) missing$)");
+        if (std::regex_match(what, m, at_most))
+            return m[1].str() + " is given " + m[3].str() + " times; give it " +
+                   (m[2].str() == "1" ? std::string("once") : "at most " + m[2].str() + " times");
+        static const std::regex at_least(R"(^(\S+): At least (\d+) required but received (\d+)$)");
+        if (std::regex_match(what, m, at_least))
+            return m[1].str() + " needs " + m[2].str() + " values, got " + m[3].str();
+        if (std::regex_match(what, m, missing)) return m[1].str() + " needs a value (" + m[3].str() + ")";
+    }
+    if (dynamic_cast<const CLI::ExtrasError*>(&e)) {
+        // "The following argument(s) was/were not expected: A B": options first.
+        std::istringstream words(what.substr(what.find(": ") == std::string::npos ? what.size() : what.find(": ") + 2));
+        std::vector<std::string> options, others;
+        for (std::string w; words >> w;) (w.size() > 1 && w[0] == '-' ? options : others).push_back(w);
+        std::string list;
+        for (const auto& w : options.empty() ? others : options) list += (list.empty() ? "" : ", ") + w;
+        const std::string where = command.empty() ? "" : " for globemesh " + command;
+        if (!options.empty())
+            return std::string(options.size() > 1 ? "unknown options " : "unknown option ") + list + where +
+                   " (" + help + " lists them)";
+        return std::string(others.size() > 1 ? "unexpected arguments " : "unexpected argument ") + list + where +
+               " (a value goes after its option's name, e.g. --coast land.shp; " + help + ")";
+    }
+    if (dynamic_cast<const CLI::RequiredError*>(&e)) return what + " (" + help + ")";
+    return what;
 }
 
 /// The command line for the `history` attribute, with the date (UTC).
@@ -728,7 +765,7 @@ CliOptions parse_mesh_args(std::span<const std::string> args) {
     try {
         command->parse(args);
     } catch (const CLI::ParseError& e) {
-        throw UsageError(one_line(e.what()));
+        throw UsageError(usage_text(e, "mesh"));
     }
     return command->o;
 }
@@ -740,18 +777,19 @@ int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& 
         return dispatch(args, out, err, terminal, library);
     } catch (...) {
         terminal.end_line();
-        return report_error(err);
+        const bool sub = !args.empty() && (args[0] == "mesh" || args[0] == "info" || args[0] == "triangulate");
+        return report_error(err, sub ? args[0] : std::string());
     }
 }
 
 namespace {
 
 /// Maps the exception in flight to one line on err and the exit status.
-int report_error(std::ostream& err) {
+int report_error(std::ostream& err, const std::string& command) {
     try {
         throw;
     } catch (const CLI::ParseError& e) {
-        err << "globemesh: " << one_line(e.what()) << "\n";
+        err << "globemesh: " << usage_text(e, command) << "\n";
         return 2;
     } catch (const UsageError& e) {
         err << "globemesh: " << one_line(e.what()) << "\n";
