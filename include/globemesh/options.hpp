@@ -6,6 +6,7 @@
 // validate() checks the values alone (no file is opened) and throws UsageError naming the option.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -59,6 +60,12 @@ struct MeshOptions {
     double inlet_width = 0.5;
     std::uint64_t seed = 1;               ///< --seed: seed of every pseudo-random choice
 };
+
+/// The size field's floor hfloor (sizefield.hpp) for `options`: --hmin, or when it is 0 the sane
+/// floor max(hmax / 1000, 10 m).
+inline double size_floor_km(const MeshOptions& options) {
+    return options.hmin_km > 0 ? options.hmin_km : std::max(options.hmax_km / 1000, 0.01);
+}
 
 /// Checks option values alone (ranges, hmin <= hmax, region bounds); throws UsageError naming
 /// the option. Opens no file.

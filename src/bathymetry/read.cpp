@@ -352,7 +352,7 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
 RasterLimits bathymetry_limits(const MeshOptions& o) {
     // The mesh samples the raster at its nodes and on the size field's grid (spacing hfloor / 2):
     // finer cells only alias there, so they are averaged to that size.
-    const double hfloor_km = o.hmin_km > 0 ? o.hmin_km : std::max(o.hmax_km / 1000, 0.01);
+    const double hfloor_km = size_floor_km(o);
     RasterLimits limits;
     limits.min_cell_deg = 0.5 * hfloor_km / (earth_radius_km * deg_to_rad);
     limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh

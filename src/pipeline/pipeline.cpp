@@ -65,7 +65,7 @@ constexpr std::uint64_t land_bytes_per_vertex = 100;
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
 /// the region plus a cell of margin, at most size_grid_max_nodes).
 double size_grid_nodes(const MeshOptions& o) {
-    const double hfloor = o.hmin_km > 0 ? o.hmin_km : std::max(o.hmax_km / 1000, 0.01);
+    const double hfloor = size_floor_km(o);
     const double spacing = std::max(1e-6, 0.5 * hfloor / earth_radius_km * rad_to_deg);
     double lon_span = 360, lat_span = 180;
     if (o.region) {
@@ -123,6 +123,36 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
         throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) + " km2) takes about " +
                         std::to_string(std::llround(estimate)) + " nodes at --hmax " + number(o.hmax_km) +
                         " km, more than --max-nodes " + std::to_string(o.max_nodes) + ": raise --hmax or --max-nodes");
+    // The same for the water along the coast at --coast-size: the size grows from s there at
+    // rate g = min(--coast-rate, --grade) up to --hmax, and along a straight coast of length L
+    // the band takes L * integral of dd / (c (s + g d)^2) = L (1/s - 1/hmax) / (c g) nodes (c h^2
+    // the area of a node, nodes_for_area). The mesher counts them exactly, but only after the
+    // size field and the coast's shaping, which at a size of metres take seconds to minutes.
+    // Made / counted on 1:50m land at --hmax 100km: --coast-size 1km 5.22 / 6.75 million, 5km
+    // 1.12 / 1.30 million, 20km 217,000 / 273,000 (bays share their bands). The source coast
+    // is longer than the shaped one where the size is above its segments' mean length (the
+    // shaping simplifies it), so the count is held against --max-nodes only below that length,
+    // and at half its value.
+    if (o.coast_size_km > 0) {
+        double coast_km = 0;
+        std::size_t segments = 0;
+        for (const Ring& r : coast.rings.rings)
+            for (std::size_t i = 0; i < r.nodes.size(); ++i)
+                if (r.kinds[i] == SegmentKind::coast) {
+                    coast_km += arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]);
+                    ++segments;
+                }
+        const double floor = size_floor_km(o), s = std::clamp(o.coast_size_km, floor, o.hmax_km);
+        const double rate = std::min(o.coast_rate, o.grade);
+        const double estimate = rate > 0 ? nodes_for_area(coast_km * (1 / s - 1 / o.hmax_km) / rate, 1.0)
+                                         : nodes_for_area(coast_km * s, s); // a band one size wide
+        if (segments > 0 && s <= coast_km / double(segments) && 0.5 * estimate > static_cast<double>(o.max_nodes))
+            throw DataError("the water along the coast (" + std::to_string(std::llround(coast_km)) + " km) takes about " +
+                            std::to_string(std::llround(estimate)) + " nodes at --coast-size " + number(o.coast_size_km) + " km" +
+                            (s > o.coast_size_km ? " (" + number(s) + " km: sizes stop at --hmin, by default --hmax / 1000)" : "") +
+                            ", more than --max-nodes " + std::to_string(o.max_nodes) + ": raise --coast-size" +
+                            (s > o.coast_size_km ? " and --hmin" : "") + " or --max-nodes");
+    }
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {

@@ -152,7 +152,7 @@ SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boun
     if (o.coast_size_km > 0 && !coast)
         throw UsageError("--coast-size needs the coastline: give --coast");
     const double hmax = o.hmax_km;
-    const double hfloor = o.hmin_km > 0 ? o.hmin_km : std::max(hmax / 1000.0, 0.01);
+    const double hfloor = size_floor_km(o);
     if (o.coast_size_km > 0 && o.coast_size_km > hmax)
         throw UsageError("--coast-size (" + km(o.coast_size_km) + ") must not be larger than --hmax (" + km(hmax) + ")");
 

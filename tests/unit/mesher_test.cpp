@@ -602,6 +602,40 @@ TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
     } catch (const DataError& e) {
         EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
     }
+    // The pipeline's first count of the coast's band (before the size field): a straight coast's
+    // band, so no fewer than the mesher makes (bays share their bands), and under twice that,
+    // which its check relies on (it refuses at twice --max-nodes).
+    o.max_nodes = 3000; // above the ocean's count at --hmax alone (about 2,600)
+    try {
+        mesh_ocean(o);
+        ADD_FAILURE() << "a run of " << nodes << " nodes passed --max-nodes 3000";
+    } catch (const DataError& e) {
+        std::vector<std::string> g;
+        ASSERT_TRUE(test::regex_search(e.what(), R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at --coast-size 25 km)", &g))
+            << e.what();
+        const double estimate = std::stod(g[1]);
+        EXPECT_GE(estimate, double(nodes));
+        EXPECT_LT(estimate, 2.0 * double(nodes));
+    }
+}
+
+// A coast size of metres is refused from the coast's length, before the size field (whose grid
+// at such a size took 14 s, with the coast's shaping, on 1:50m land before the mesher refused).
+TEST(Mesher, a_coast_size_of_metres_is_refused_before_the_size_field) {
+    MeshOptions o = land_110m(100);
+    o.coast_size_km = 0.01;
+    std::vector<std::string> stages;
+    try {
+        mesh_ocean(o, [&](double, std::string_view stage) {
+            if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+            return true;
+        });
+        FAIL() << "a 10 m coast size on the 1:110m land passed --max-nodes 2e7";
+    } catch (const DataError& e) {
+        EXPECT_TRUE(test::regex_search(e.what(), R"(at --coast-size 0\.01 km \(0\.1 km: sizes stop at --hmin.*raise --coast-size and --hmin or --max-nodes$)"))
+            << e.what();
+    }
+    EXPECT_EQ(std::count(stages.begin(), stages.end(), "size field"), 0) << "reached the size field";
 }
 
 TEST(Mesher, too_many_nodes_are_refused_before_refining) {
