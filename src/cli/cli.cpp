@@ -357,6 +357,12 @@ void check_mesh_run(const CliOptions& o) {
     check_input_path(o.mesh.bathy, "--bathy");
     check_input_path(o.mesh.region_file, "--region-file");
     check_input_path(o.mesh.size_regions, "--size-regions");
+    const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
+                                                          {"--bathy", o.mesh.bathy},
+                                                          {"--region-file", o.mesh.region_file},
+                                                          {"--size-regions", o.mesh.size_regions}};
+    for (const auto& [name, path] : outputs)
+        if (!path.empty()) check_not_an_input(path, name, inputs);
     for (const auto& [name, path] : outputs)
         if (!path.empty()) check_output_path(path, name, o.overwrite);
 }
@@ -610,8 +616,11 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     check_input_path(c.t.points, "POINTS");
     const std::pair<const char*, const std::string&> outputs[] = {
         {"--output", c.output}, {"--gpkg", c.gpkg}, {"--timings", c.timings}};
+    const std::pair<std::string, std::string> inputs[] = {{"POINTS", c.t.points}};
     for (const auto& [name, path] : outputs)
         if (!path.empty()) check_output_kind(path, name);
+    for (const auto& [name, path] : outputs)
+        if (!path.empty()) check_not_an_input(path, name, inputs);
     for (const auto& [name, path] : outputs)
         if (!path.empty()) check_output_path(path, name, c.overwrite);
 

@@ -289,4 +289,13 @@ void check_input_path(const std::string& path, const std::string& what) {
         throw IoError(what + ": " + path + " does not exist");
 }
 
+void check_not_an_input(const std::string& path, const std::string& what,
+                        std::span<const std::pair<std::string, std::string>> inputs) {
+    std::error_code ec;
+    for (const auto& [option, input] : inputs)
+        if (!input.empty() && std::filesystem::equivalent(path, input, ec) && !ec)
+            throw UsageError(what + " " + path + " is the " + option +
+                             " file: the run would replace what it reads; write the output elsewhere");
+}
+
 } // namespace globemesh::cli

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iterator>
 #include <ostream>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -110,5 +111,11 @@ void check_output_kind(const std::string& path, const std::string& what);
 /// Throws IoError when a local input file is missing; GDAL virtual paths (/vsi...) and
 /// connection strings (PG:..., https://...) are left to GDAL.
 void check_input_path(const std::string& path, const std::string& what);
+
+/// Throws UsageError when output `path` (option `what`) is the very file of one of `inputs`
+/// (option, path; through links and other spellings): --overwrite would replace the data the run
+/// reads (gdal_translate refuses the same).
+void check_not_an_input(const std::string& path, const std::string& what,
+                        std::span<const std::pair<std::string, std::string>> inputs);
 
 } // namespace globemesh::cli

@@ -426,6 +426,11 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"missing_bathy_file", {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"}, 1, "nodem.tif"},
         ErrorCase{"output_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"}, 1, "--output"},
         ErrorCase{"existing_output", {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"}, 1, "--overwrite"},
+        // An output that is an input, even with --overwrite (and through another spelling):
+        // the run would replace the data it reads.
+        ErrorCase{"gpkg_is_the_coast", {"mesh", "--coast", "{dir}/existing.gpkg", "-o", "{dir}/o.nc", "--gpkg", "{dir}/./existing.gpkg", "--overwrite"}, 2, "existing.gpkg is the --coast file: the run would replace what it reads"},
+        ErrorCase{"output_is_the_bathy", {"mesh", "--coast", coast, "--bathy", "{dir}/existing.nc", "-o", "{dir}/existing.nc", "--overwrite"}, 2, "--output"},
+        ErrorCase{"triangulate_output_is_its_points", {"triangulate", "{dir}/existing.nc", "-o", "{dir}/existing.nc", "--overwrite"}, 2, "is the POINTS file"},
         ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.gpkg"}, 1, "existing.gpkg"},
         // An output named for another output's format: NetCDF under a GeoPackage's name would
         // not open in QGIS as one.
