@@ -1514,13 +1514,14 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
         ++defect[a], ++defect[b], ++defect[c];
         if (m.is_fixed(a) || m.is_fixed(b) || m.is_fixed(c)) coastal[a] = coastal[b] = coastal[c] = 1;
     }
-    // A flip needs a corner of positive defect at one end of its edge: only the triangles with
-    // one are tried (few where the lattice or smoothing left valence 6).
+    // A flip needs a corner of positive defect at one end of its edge, or one of valence 4
+    // opposite it: only the triangles with one are tried (few where the lattice or smoothing
+    // left valence 6).
     std::vector<TriangleId> tried;
+    auto wants = [&](VertexId v) { return !coastal[v] && (defect[v] > 0 || defect[v] <= -2); };
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-        const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
-        if ((defect[a] > 0 && !coastal[a]) || (defect[b] > 0 && !coastal[b]) || (defect[c] > 0 && !coastal[c])) tried.push_back(t);
+        if (wants(dt.vertex(t, 0)) || wants(dt.vertex(t, 1)) || wants(dt.vertex(t, 2))) tried.push_back(t);
     }
     std::vector<VertexId> move;
     std::size_t flips = 0;
@@ -1534,8 +1535,15 @@ std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std
                 if (dt.is_constrained(h) || dt.label(triangle_of(g)) != ocean) continue;
                 const VertexId a = dt.origin(h), b = dt.destination(h);
                 const VertexId c = dt.vertex(t, i), d = dt.vertex(triangle_of(g), edge_of(g));
-                // The sum of squares drops by 2 (gain - 2).
-                if (defect[a] + defect[b] - defect[c] - defect[d] < 3) continue;
+                // The sum of squares drops by 2 (gain - 2). At a gain of 2 it stays, and the flip
+                // is made when it brings every corner of valence 4 or 8 (or less, or more) among
+                // the four to 5, 6 or 7: a 4 among 6s is mended only so. (Each flip lowers the
+                // sum, or keeps it and lowers the count of such corners: the passes end.)
+                const int gain = defect[a] + defect[b] - defect[c] - defect[d];
+                if (gain < 2) continue;
+                if (gain == 2 && (std::max({std::abs(defect[a]), std::abs(defect[b]), std::abs(defect[c]), std::abs(defect[d])}) < 2 ||
+                                  std::max({std::abs(defect[a] - 1), std::abs(defect[b] - 1), std::abs(defect[c] + 1), std::abs(defect[d] + 1)}) >= 2))
+                    continue;
                 if (coastal[a] || coastal[b] || coastal[c] || coastal[d]) continue;
                 const Vec3 &pa = dt.point(a), &pb = dt.point(b), &pc = dt.point(c), &pd = dt.point(d);
                 if (predicates::orient(pa, pd, pc) <= 0 || predicates::orient(pd, pb, pc) <= 0) continue;
