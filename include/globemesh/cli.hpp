@@ -67,6 +67,7 @@ struct CliOptions {
     bool verbose = false;           ///< --verbose: stage names with the progress
     bool check = false;             ///< --check: verify the mesh invariants before writing
     bool print_config = false;      ///< --print-config: print the effective configuration, stop
+    std::string config;             ///< --config: the file read (kept to refuse it as an output)
 };
 
 /// Parses the arguments of `globemesh mesh` (after the word "mesh"), including any --config

@@ -324,6 +324,8 @@ struct MeshCommand {
                                          : "; the keys are the long option names, as --print-config writes them";
             throw UsageError("--config " + file + ": unknown key " + key + hint);
         }
+        if (const CLI::Option* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
+            o.config = config->as<std::string>();
         if (region_opt->count() > 0 && region.size() == 4)
             o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
         if (bathy_fill_opt->count() > 0) o.mesh.bathy_fill_m = bathy_fill_m;
@@ -360,7 +362,8 @@ void check_mesh_run(const CliOptions& o) {
     const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
                                                           {"--bathy", o.mesh.bathy},
                                                           {"--region-file", o.mesh.region_file},
-                                                          {"--size-regions", o.mesh.size_regions}};
+                                                          {"--size-regions", o.mesh.size_regions},
+                                                          {"--config", o.config}};
     for (const auto& [name, path] : outputs)
         if (!path.empty()) check_not_an_input(path, name, inputs);
     for (const auto& [name, path] : outputs)

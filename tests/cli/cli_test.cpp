@@ -447,6 +447,17 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"info_without_file", {"info"}, 2, "MESH"}),
     [](const auto& info) { return info.param.name; });
 
+TEST(Cli, the_config_file_is_not_an_output) {
+    TempDir dir;
+    write_text(dir / "run.toml", "hmax = \"500km\"\n");
+    const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--config",
+                                  (dir / "run.toml").string(), "--report", (dir / "run.toml").string(), "--overwrite"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("run.toml is the --config file"), std::string::npos) << r.err;
+    EXPECT_EQ(read_text(dir / "run.toml"), "hmax = \"500km\"\n");
+    EXPECT_FALSE(fs::exists(dir / "o.nc"));
+}
+
 TEST(Cli, the_folder_named_in_a_missing_folder_error_is_the_real_one) {
     TempDir dir;
     const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "no/such/o.nc").string()});
