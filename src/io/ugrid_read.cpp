@@ -6,6 +6,7 @@
 // from an edge variable "boundary_tag" when present. Nothing is trusted: every index is checked.
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -166,9 +167,17 @@ std::vector<std::string> split_words(const std::string& s) {
 Mesh read_ugrid(const std::filesystem::path& path) {
     io::NcHandle nc;
     int status = nc_open(path.c_str(), NC_NOWRITE, nc.out());
-    if (status != NC_NOERR)
+    if (status != NC_NOERR) {
+        // A GeoPackage (what --gpkg writes) starts with SQLite's header: say so rather than
+        // netCDF-C's "Unknown file format".
+        char head[16] = {};
+        std::ifstream(path, std::ios::binary).read(head, sizeof head);
+        if (status == NC_ENOTNC && std::string(head, sizeof head) == std::string("SQLite format 3\0", 16))
+            throw IoError("UGRID file " + path.string() + ": is a GeoPackage (SQLite), not NetCDF; give the UGRID "
+                          "file that -o wrote (ogrinfo reads the GeoPackage)");
         throw IoError("UGRID file " + path.string() + ": cannot open (" + nc_strerror(status) +
                       "); give an existing NetCDF file");
+    }
     Reader r(nc.id(), path);
 
     int nvars;

@@ -12,6 +12,7 @@
 
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
+#include "globemesh/ugrid.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
 
@@ -122,6 +123,19 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     bool found = false;
     for (auto& f : *info) found |= std::string(f->GetFieldAsString("key")) == "coast";
     EXPECT_TRUE(found);
+}
+
+// `globemesh info ocean.gpkg`: netCDF-C says "Unknown file format"; the reader names what
+// the file is instead.
+TEST(Gpkg, reading_a_geopackage_as_ugrid_says_it_is_one) {
+    TempDir dir;
+    write_gpkg(icosphere(1), dir / "m.gpkg");
+    try {
+        read_ugrid(dir / "m.gpkg");
+        FAIL() << "no IoError";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find("is a GeoPackage (SQLite), not NetCDF"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Gpkg, closed_mesh_faces_tile_the_lonlat_rectangle_with_no_part_wider_than_180) {
