@@ -105,11 +105,11 @@ std::string usage_text(const CLI::ParseError& e, const std::string& command) {
     std::smatch m;
     if (dynamic_cast<const CLI::ArgumentMismatch*>(&e)) {
         static const std::regex at_most(R"(^(\S+): At Most (\d+) required but received (\d+)$)");
+        static const std::regex at_least(R"(^(\S+): At least (\d+) required but received (\d+)$)");
         static const std::regex missing(R"(^(\S+): (\d+) required (\S+) missing$)");
         if (std::regex_match(what, m, at_most))
             return m[1].str() + " is given " + m[3].str() + " times; give it " +
                    (m[2].str() == "1" ? std::string("once") : "at most " + m[2].str() + " times");
-        static const std::regex at_least(R"(^(\S+): At least (\d+) required but received (\d+)$)");
         if (std::regex_match(what, m, at_least))
             return m[1].str() + " needs " + m[2].str() + " values, got " + m[3].str();
         if (std::regex_match(what, m, missing)) return m[1].str() + " needs a value (" + m[3].str() + ")";
