@@ -10,7 +10,6 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -102,17 +101,18 @@ std::string one_line(std::string message) {
 std::string usage_text(const CLI::ParseError& e, const std::string& command) {
     const std::string what = one_line(e.what());
     const std::string help = command.empty() ? "globemesh --help" : "globemesh " + command + " --help";
-    std::smatch m;
-    if (dynamic_cast<const CLI::ArgumentMismatch*>(&e)) {
-        static const std::regex at_most(R"(^(\S+): At Most (\d+) required but received (\d+)$)");
-        static const std::regex at_least(R"(^(\S+): At least (\d+) required but received (\d+)$)");
-        static const std::regex missing(R"(^(\S+): (\d+) required (\S+) missing$)");
-        if (std::regex_match(what, m, at_most))
-            return m[1].str() + " is given " + m[3].str() + " times; give it " +
-                   (m[2].str() == "1" ? std::string("once") : "at most " + m[2].str() + " times");
-        if (std::regex_match(what, m, at_least))
-            return m[1].str() + " needs " + m[2].str() + " values, got " + m[3].str();
-        if (std::regex_match(what, m, missing)) return m[1].str() + " needs a value (" + m[3].str() + ")";
+    if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) && what.find(": ") != std::string::npos) {
+        // "NAME: At Most N required but received M", "NAME: At least N required but received
+        // M", "NAME: N required TYPE missing" (CLI11 2.3's words).
+        const std::string name = what.substr(0, what.find(": "));
+        std::istringstream rest(what.substr(what.find(": ") + 2));
+        std::vector<std::string> w;
+        for (std::string x; rest >> x;) w.push_back(x);
+        if (w.size() == 7 && w[0] == "At" && w[1] == "Most" && w[3] == "required" && w[5] == "received")
+            return name + " is given " + w[6] + " times; give it " + (w[2] == "1" ? std::string("once") : "at most " + w[2] + " times");
+        if (w.size() == 7 && w[0] == "At" && w[1] == "least" && w[3] == "required" && w[5] == "received")
+            return name + " needs " + w[2] + " values, got " + w[6];
+        if (w.size() == 4 && w[1] == "required" && w[3] == "missing") return name + " needs a value (" + w[2] + ")";
     }
     if (dynamic_cast<const CLI::ExtrasError*>(&e)) {
         // "The following argument(s) was/were not expected: A B": options first.
