@@ -235,10 +235,13 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     double nodata = GDALGetRasterNoDataValue(src_band, &has_nodata);
 
     double gt[6];
-    if (GDALGetGeoTransform(h, gt) != CE_None || !GDALGetSpatialRef(h))
+    // A GeoTIFF whose CRS was unset reads back with a local (engineering) CRS of unknown
+    // units: no more georeferenced than one with none.
+    const OGRSpatialReferenceH crs = GDALGetSpatialRef(h);
+    if (GDALGetGeoTransform(h, gt) != CE_None || !crs || OSRIsLocal(crs))
         throw DataError("--bathy " + path +
-                        ": has no georeferencing (geotransform and CRS); assign them, e.g. "
-                        "gdal_translate -a_srs EPSG:4326 -a_ullr W N E S");
+                        ": has no georeferencing (a geotransform and a geographic or projected CRS); assign "
+                        "them, e.g. gdal_translate -a_srs EPSG:4326 -a_ullr W N E S");
 
     // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
     DatasetPtr band_vrt, warped;

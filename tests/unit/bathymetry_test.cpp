@@ -280,6 +280,26 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     }
     const std::string ok = (dir / "ok.tif").string();
     write_tiff(ok, {0, 10, 1, 1, 4, 4}, [](double, double) { return -1.0; });
+    // Its CRS unset on a pixel-is-point GeoTIFF (as the ETOPO5 fixture is; Python's
+    // SetProjection('') does the same): the raster-type geokey stays, and GDAL reads back a
+    // local CRS of unknown units that no transformation reaches (before: "cannot reproject
+    // ... ENGCRS[...]").
+    const std::string local = (dir / "local.tif").string();
+    write_tiff(local, {0, 10, 1, 1, 4, 4}, [](double, double) { return -1.0; });
+    {
+        GDALDatasetH ds = GDALOpen(local.c_str(), GA_Update);
+        ASSERT_NE(ds, nullptr);
+        GDALSetMetadataItem(ds, "AREA_OR_POINT", "Point", nullptr);
+        GDALSetProjection(ds, "");
+        GDALClose(ds);
+    }
+    try {
+        read_raster(local);
+        FAIL() << "a local CRS accepted";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("has no georeferencing"), std::string::npos) << e.what();
+        EXPECT_TRUE(one_line(e.what()));
+    }
     try {
         read_raster(ok, 2);
         FAIL() << "band 2 of 1 accepted";
