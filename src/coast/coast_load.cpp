@@ -330,7 +330,10 @@ Source read_source(const std::string& path, const std::string& layer_name, const
         throw UsageError("--coast-where '" + where + "' is not a valid filter for " + where_msg + ": " +
                          CPLGetLastErrorMsg());
 
-    // Coordinate reference system: the layer's, or the override; lon/lat WGS84 as target.
+    // Coordinate reference system: the layer's, or the override; lon/lat WGS84 as target. A
+    // local (engineering) CRS of unknown units, as a .prj with LOCAL_CS, counts as none.
+    OGRSpatialReferenceH declared = OGR_L_GetSpatialRef(layer);
+    if (declared && OSRIsLocal(declared)) declared = nullptr;
     SrsPtr source_srs;
     if (!srs_override.empty()) {
         source_srs.reset(OSRNewSpatialReference(nullptr));
@@ -338,7 +341,7 @@ Source read_source(const std::string& path, const std::string& layer_name, const
             throw UsageError("--coast-srs '" + srs_override + "' is not a CRS GDAL/PROJ understands");
         // A layer's own CRS is not overridden: degrees read as EPSG:3857 metres put the whole
         // coast within a kilometre of 0,0, and the mesh is silently an aqua-planet.
-        if (OGRSpatialReferenceH declared = OGR_L_GetSpatialRef(layer)) {
+        if (declared) {
             SrsPtr d(OSRClone(declared));
             OSRSetAxisMappingStrategy(d.get(), OAMS_TRADITIONAL_GIS_ORDER);
             OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
@@ -355,11 +358,13 @@ Source read_source(const std::string& path, const std::string& layer_name, const
                                 "wrong CRS with ogr2ogr -a_srs)");
             }
         }
-    } else if (OGRSpatialReferenceH s = OGR_L_GetSpatialRef(layer)) {
-        source_srs.reset(OSRClone(s));
+    } else if (declared) {
+        source_srs.reset(OSRClone(declared));
     } else {
-        throw DataError(where_msg + " declares no coordinate reference system; give it with "
-                        "--coast-srs (e.g. EPSG:4326)");
+        throw DataError(where_msg + " declares no coordinate reference system" +
+                        (OGR_L_GetSpatialRef(layer) ? " (only a local one, of unknown units)" : "") +
+                        (std::string(what) == "--coast" ? "; give it with --coast-srs (e.g. EPSG:4326)"
+                                                        : "; assign one, e.g. ogr2ogr -a_srs EPSG:4326"));
     }
     OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
     SrsPtr wgs84(OSRNewSpatialReference(nullptr));

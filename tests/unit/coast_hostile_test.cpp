@@ -2,6 +2,8 @@
 // repaired into valid rings (checked by an independent brute force and by area oracles) or
 // refused with a one-line UsageError / DataError / IoError, never a crash.
 #include <gtest/gtest.h>
+#include <gdal.h>
+#include <gdal_utils.h>
 
 #include <cmath>
 #include <fstream>
@@ -345,6 +347,39 @@ TEST(CoastHostile, layer_without_crs_needs_coast_srs) {
     o.coast_srs = "not a crs";
     m = message_of<UsageError>(o);
     EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+}
+
+TEST(CoastHostile, a_local_crs_counts_as_none) {
+    // A .prj of LOCAL_CS (unknown units): before, "no transformation from its CRS to WGS84 ...
+    // ENGCRS[...]"; now as a layer with no CRS, which --coast-srs then gives.
+    TempDir dir;
+    const std::string csv = write(dir, "local.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
+    const std::string shp = (dir / "local.shp").string();
+    {
+        GDALAllRegister();
+        GDALDatasetH src = GDALOpenEx(csv.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+        ASSERT_NE(src, nullptr);
+        const char* argv[] = {"-a_srs", "LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]", nullptr};
+        GDALVectorTranslateOptions* opts = GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+        GDALDatasetH out = GDALVectorTranslate(shp.c_str(), nullptr, 1, &src, opts, nullptr);
+        GDALVectorTranslateOptionsFree(opts);
+        ASSERT_NE(out, nullptr);
+        GDALClose(out);
+        GDALClose(src);
+    }
+    MeshOptions o = options_for(shp);
+    auto m = message_of<DataError>(o);
+    EXPECT_NE(m.find("declares no coordinate reference system (only a local one, of unknown units); give it with --coast-srs"),
+              std::string::npos) << m;
+    o.coast_srs = "EPSG:4326";
+    EXPECT_EQ(load_coast(o).rings.rings.size(), 1u);
+    // The same file as --region-file: the remedy is not --coast-srs, which is for --coast.
+    o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
+    o.coast_layer = "land";
+    o.region_file = shp;
+    m = message_of<DataError>(o);
+    EXPECT_NE(m.find("--region-file"), std::string::npos) << m;
+    EXPECT_NE(m.find("ogr2ogr -a_srs EPSG:4326"), std::string::npos) << m;
 }
 
 TEST(CoastHostile, coast_srs_does_not_override_a_declared_crs) {
