@@ -52,9 +52,10 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::v
         if (field < 0) continue;
         any_field = true;
         OGRSpatialReferenceH srs = OGR_L_GetSpatialRef(layer);
-        if (!srs)
-            throw DataError("--size-regions " + path + ": layer " + OGR_L_GetName(layer) +
-                            " has no CRS; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
+        if (!srs || OSRIsLocal(srs)) // a local CRS (LOCAL_CS, unknown units) is no more use
+            throw DataError("--size-regions " + path + ": layer " + OGR_L_GetName(layer) + " has no CRS" +
+                            (srs ? " (only a local one, of unknown units)" : "") +
+                            "; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
         TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, wgs84.get()));
         if (!to_lonlat)
             throw DataError("--size-regions " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");

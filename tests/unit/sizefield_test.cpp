@@ -240,32 +240,37 @@ TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles
     EXPECT_NEAR(f.size_km(0, 89.99), f.size_km(180, 89.99), 0.2);
 }
 
+/// A one-layer polygon file for --size-regions: one feature of WKT `polygon` (in `srs`, none
+/// when null) with size_km = `size`.
+void write_size_region(const std::string& path, const char* driver, OGRSpatialReferenceH srs, const char* polygon,
+                       double size) {
+    GDALAllRegister();
+    GDALDatasetH ds = GDALCreate(GDALGetDriverByName(driver), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    ASSERT_NE(ds, nullptr);
+    OGRLayerH layer = GDALDatasetCreateLayer(ds, "regions", srs, wkbPolygon, nullptr);
+    OGRFieldDefnH fd = OGR_Fld_Create("size_km", OFTReal);
+    OGR_L_CreateField(layer, fd, TRUE);
+    OGR_Fld_Destroy(fd);
+    OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+    OGR_F_SetFieldDouble(f, 0, size);
+    OGRGeometryH g = nullptr;
+    std::string wkt = polygon;
+    char* p = wkt.data();
+    OGR_G_CreateFromWkt(&p, nullptr, &g);
+    OGR_F_SetGeometryDirectly(f, g);
+    ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
+    OGR_F_Destroy(f);
+    GDALClose(ds);
+}
+
 TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     TempDir dir;
     const std::string path = (dir / "regions.gpkg").string();
-    {
-        GDALAllRegister();
-        GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
-        ASSERT_NE(ds, nullptr);
-        OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-        OSRImportFromEPSG(srs, 3857);
-        OGRLayerH layer = GDALDatasetCreateLayer(ds, "regions", srs, wkbPolygon, nullptr);
-        OSRRelease(srs);
-        OGRFieldDefnH fd = OGR_Fld_Create("size_km", OFTReal);
-        OGR_L_CreateField(layer, fd, TRUE);
-        OGR_Fld_Destroy(fd);
-        // A Mercator square from 0 to 2 degrees east, 0 to ~2 degrees north: 7 km inside.
-        OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
-        OGR_F_SetFieldDouble(f, 0, 7.0);
-        OGRGeometryH g = nullptr;
-        char wkt[] = "POLYGON ((0 0, 222639 0, 222639 222684, 0 222684, 0 0))";
-        char* p = wkt;
-        OGR_G_CreateFromWkt(&p, nullptr, &g);
-        OGR_F_SetGeometryDirectly(f, g);
-        ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
-        OGR_F_Destroy(f);
-        GDALClose(ds);
-    }
+    OGRSpatialReferenceH mercator = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(mercator, 3857);
+    // A Mercator square from 0 to 2 degrees east, 0 to ~2 degrees north: 7 km inside.
+    write_size_region(path, "GPKG", mercator, "POLYGON ((0 0, 222639 0, 222639 222684, 0 222684, 0 0))", 7.0);
+    OSRRelease(mercator);
     MeshOptions o = regional(-5, -5, 5, 5, 2, 100);
     o.size_regions = path;
     SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
@@ -281,6 +286,18 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     GDALClose(ds);
     o.size_regions = bare;
     EXPECT_THROW(build_size_field(o, nullptr, nullptr, {}, 1 << 16), DataError);
+    // A shapefile whose .prj is LOCAL_CS (unknown units) has no CRS to place it by.
+    const std::string local = (dir / "local.shp").string();
+    OGRSpatialReferenceH local_cs = OSRNewSpatialReference("LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]");
+    write_size_region(local, "ESRI Shapefile", local_cs, "POLYGON ((0 0, 2 0, 2 2, 0 2, 0 0))", 7.0);
+    OSRRelease(local_cs);
+    o.size_regions = local;
+    try {
+        build_size_field(o, nullptr, nullptr, {}, 1 << 16);
+        ADD_FAILURE() << "a LOCAL_CS layer placed";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("has no CRS (only a local one, of unknown units)"), std::string::npos) << e.what();
+    }
 }
 
 TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
