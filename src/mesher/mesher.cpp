@@ -362,28 +362,6 @@ struct Mesher {
         return normalized(dt.point(dt.vertex(t, 0)) + dt.point(dt.vertex(t, 1)) + dt.point(dt.vertex(t, 2)));
     }
 
-    // Per vertex, the size there (km; NaN: not asked yet), for the smoothing sweeps: a
-    // triangle's size is the mean of its corners' (the size at its centroid where the field is
-    // linear over it; the grid's cells are about hfloor / 2). One evaluation a vertex and one a
-    // move instead of one per star triangle visited: on 1:50m land at --hmax 100km
-    // --coast-size 5km, 5.1 instead of 20 million evaluations, the sweeps 3.1 -> 1.8 s, the
-    // quality the same (mean 0.9231, above 0.9 69.95 against 69.92%). (The refinement's
-    // badness from them too saved another 0.44 s, but cost the Gulf Stream field 0.0012 of its
-    // mean q: it keeps the size at the centroid.) Whoever moves a vertex while the table is in
-    // use updates its entry (set_vertex_size).
-    mutable std::vector<float> vertex_size;
-    double vertex_size_km(VertexId v) const {
-        if (v >= vertex_size.size()) vertex_size.resize(std::max<std::size_t>(dt.vertex_count(), v + 1), std::numeric_limits<float>::quiet_NaN());
-        if (std::isnan(vertex_size[v])) vertex_size[v] = static_cast<float>(size_km(dt.point(v)));
-        return vertex_size[v];
-    }
-    void set_vertex_size(VertexId v, const Vec3& p) {
-        if (v < vertex_size.size()) vertex_size[v] = static_cast<float>(size_km(p));
-    }
-    double corner_size_km(TriangleId t) const {
-        return (vertex_size_km(dt.vertex(t, 0)) + vertex_size_km(dt.vertex(t, 1)) + vertex_size_km(dt.vertex(t, 2))) / 3;
-    }
-
     // Recovers segment a->b, splitting it at its midpoint where flips cannot.
     void recover(VertexId a, VertexId b, SegmentKind kind, int depth) {
         if (a == b) return;
@@ -2399,6 +2377,24 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         for (VertexId v = lattice_first; v < lattice_end; ++v)
             if (as_made[v]) active[v] = 0;
     }
+    // Per vertex, the size there (km; NaN: not asked yet), for the sweeps: a triangle's size is
+    // the mean of its corners' (the size at its centroid where the field is linear over it; the
+    // grid's cells are about hfloor / 2), each evaluated when first asked and again when its
+    // node moves, instead of once per star triangle visited. On 1:50m land at --hmax 100km
+    // --coast-size 5km: 5.1 instead of 20 million evaluations, the sweeps 3.1 -> 1.8 s, the
+    // quality the same (mean 0.9231, above 0.9 69.95 against 69.92%). (The refinement's badness
+    // from them too saved another 0.44 s, but cost the Gulf Stream field 0.0012 of its mean q:
+    // it keeps the size at the centroid.) No node is added while it is in use.
+    std::vector<float> vertex_size(dt.vertex_count(), std::numeric_limits<float>::quiet_NaN());
+    auto corner_size_km = [&](TriangleId t) {
+        double sum = 0;
+        for (int i = 0; i < 3; ++i) {
+            float& h = vertex_size[dt.vertex(t, i)];
+            if (std::isnan(h)) h = static_cast<float>(size_km(dt.point(dt.vertex(t, i))));
+            sum += h;
+        }
+        return sum / 3;
+    };
     for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
         // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
         // (a triangle next to v) rather than an answer: the walk from it is a step or two.
@@ -2437,7 +2433,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
                 double area = 0.5 * norm(n);
                 // Optimal Delaunay triangulation update (Chen & Xu): weight the circumcentres by
                 // area / h^2 so that graded meshes keep their grading.
-                hk = m.corner_size_km(t);
+                hk = corner_size_km(t);
                 sum = sum + (area / (hk * hk)) * normalized(n);
                 h = dt.next_around_origin(h);
             } while (h != from && ++guard < 64);
@@ -2450,19 +2446,19 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             if (norm(target - dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
             if (lowers_worst_below(target, dt.point(v), far, 0.6)) continue;
             if (!dt.move_vertex_from(from, target)) continue;
-            m.set_vertex_size(v, target);
+            vertex_size[v] = static_cast<float>(size_km(target));
             active[v] |= 2;
             as_made[v] = 0;
             for (VertexId u : ring) active[u] |= 2;
         }
         for (auto& a : active) a >>= 1;
         if (sweep == options.smooth_iterations - 1) {
-            std::vector<float>().swap(m.vertex_size); // the relaxation moves nodes without it
+            std::vector<float>().swap(vertex_size); // the relaxation moves nodes without it
             report.valence_flips = relax_valence(m, as_made, active);
         }
         globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
     }
-    std::vector<float>().swap(m.vertex_size); // (with no sweeps)
+    std::vector<float>().swap(vertex_size); // (with no sweeps)
     // Then the nodes of the triangles still below q 0.9 (next to the coast, or at valence
     // defects), a few rounds: each interior node goes where its star has the most triangles
     // above count_quality (star_count_score), searched from the best of a few candidates (the
