@@ -101,11 +101,12 @@ std::string one_line(std::string message) {
 std::string usage_text(const CLI::ParseError& e, const std::string& command) {
     const std::string what = one_line(e.what());
     const std::string help = command.empty() ? "globemesh --help" : "globemesh " + command + " --help";
-    if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) && what.find(": ") != std::string::npos) {
+    const std::size_t colon = what.find(": ");
+    if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) && colon != std::string::npos) {
         // "NAME: At Most N required but received M", "NAME: At least N required but received
         // M", "NAME: N required TYPE missing" (CLI11 2.3's words).
-        const std::string name = what.substr(0, what.find(": "));
-        std::istringstream rest(what.substr(what.find(": ") + 2));
+        const std::string name = what.substr(0, colon);
+        std::istringstream rest(what.substr(colon + 2));
         std::vector<std::string> w;
         for (std::string x; rest >> x;) w.push_back(x);
         if (w.size() == 7 && w[0] == "At" && w[1] == "Most" && w[3] == "required" && w[5] == "received")
@@ -116,7 +117,7 @@ std::string usage_text(const CLI::ParseError& e, const std::string& command) {
     }
     if (dynamic_cast<const CLI::ExtrasError*>(&e)) {
         // "The following argument(s) was/were not expected: A B": options first.
-        std::istringstream words(what.substr(what.find(": ") == std::string::npos ? what.size() : what.find(": ") + 2));
+        std::istringstream words(colon == std::string::npos ? std::string() : what.substr(colon + 2));
         std::vector<std::string> options, others;
         for (std::string w; words >> w;) (w.size() > 1 && w[0] == '-' ? options : others).push_back(w);
         std::string list;

@@ -342,15 +342,13 @@ Source read_source(const std::string& path, const std::string& layer_name, const
         // A layer's own CRS is not overridden: degrees read as EPSG:3857 metres put the whole
         // coast within a kilometre of 0,0, and the mesh is silently an aqua-planet.
         if (declared) {
-            SrsPtr d(OSRClone(declared));
-            OSRSetAxisMappingStrategy(d.get(), OAMS_TRADITIONAL_GIS_ORDER);
-            OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
-            // Both read lon, lat (traditional order): only the CRS themselves are compared.
+            // Both are read lon, lat (traditional order, below): only the CRS themselves are
+            // compared, not their data axis mappings.
             const char* same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
-            if (!OSRIsSameEx(d.get(), source_srs.get(), same_options)) {
-                const char* name = OSRGetName(d.get());
-                const char* auth = OSRGetAuthorityName(d.get(), nullptr);
-                const char* code = OSRGetAuthorityCode(d.get(), nullptr);
+            if (!OSRIsSameEx(declared, source_srs.get(), same_options)) {
+                const char* name = OSRGetName(declared);
+                const char* auth = OSRGetAuthorityName(declared, nullptr);
+                const char* code = OSRGetAuthorityCode(declared, nullptr);
                 const std::string declared_name = std::string(name ? name : "a CRS") +
                                                   (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
                 throw DataError(where_msg + " declares " + declared_name + ", not --coast-srs " + srs_override +
