@@ -282,8 +282,9 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
     const long j_first = g.south_cap ? -1 : 0, j_last = g.north_cap ? nlat - 1 : nlat - 2;
     const double cap_dy_south = (g.lat(0) + 90.0) * deg_to_rad * earth_radius_km;
     const double cap_dy_north = (90.0 - g.lat(g.nlat - 1)) * deg_to_rad * earth_radius_km;
+    // Column i in [-1, nlon] (a cell's corners around a node), wrapped on global grids.
     auto node_id = [&](long i, long j) -> std::size_t {
-        return static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(((i % nlon) + nlon) % nlon);
+        return static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(i < 0 ? i + nlon : i >= nlon ? i - nlon : i);
     };
     // The two corner conditions of the cell with lower-left corner (i, j); 0 where there is none.
     auto corners = [&](long i, long j, Corner out[2]) -> int {
@@ -329,10 +330,19 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
     };
 
     const std::vector<float> initial(h); // the components' values, the ceiling of every node
-    MinHeap heap;
+    // The queue: the nodes' initial values, sorted once, merged with a heap of the values the
+    // solver lowers or raises them to (a band along the accepted front: small, where one heap of
+    // every node takes a cache miss at each of its levels on every pop). The two pop in the one
+    // order (value, node) a single heap of all the entries would: the same sizes. On 1:50m land
+    // at --hmax 100km --coast-size 5km (4.2 million grid nodes, 3.2 million seeds, the band at
+    // most 74,000): the size field 3.3 -> 2.5 s.
     // Nodes at the largest value never lower a neighbour: they enter only when lowered.
+    std::vector<HeapEntry> seeds;
     for (std::size_t n = 0; n < n_grid; ++n)
-        if (h[n] < top_value) heap.push({h[n], static_cast<std::uint32_t>(n)});
+        if (h[n] < top_value) seeds.push_back({h[n], static_cast<std::uint32_t>(n)});
+    std::sort(seeds.begin(), seeds.end(), [](const HeapEntry& a, const HeapEntry& b) { return b > a; });
+    std::size_t next_seed = 0;
+    MinHeap heap;
     std::vector<std::uint8_t> accepted(n_grid + 2, 0);
     std::size_t popped = 0;
     // A node's tentative value from scratch: its bounds can rise as well as fall when another
@@ -343,9 +353,14 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
         return t;
     };
     std::vector<std::size_t> around;
-    while (!heap.empty()) {
-        HeapEntry top = heap.top();
-        heap.pop();
+    while (!heap.empty() || next_seed < seeds.size()) {
+        HeapEntry top;
+        if (heap.empty() || (next_seed < seeds.size() && heap.top() > seeds[next_seed])) {
+            top = seeds[next_seed++];
+        } else {
+            top = heap.top();
+            heap.pop();
+        }
         if (accepted[top.node] || top.key != h[top.node]) continue;
         accepted[top.node] = 1;
         if (++popped % (1u << 20) == 0)
