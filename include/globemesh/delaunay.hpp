@@ -165,6 +165,12 @@ public:
     /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
     void flip(HalfEdge h);
 
+    /// Renumbers the vertices, vertex v becoming new_of_old[v] (a permutation of every vertex),
+    /// and the triangles in the order of their smallest new corner, free slots dropped: the same
+    /// triangulation, laid out in memory as new_of_old orders it (for locality, a space-filling
+    /// curve's order). Returns each old slot's new triangle (no_triangle for a free slot).
+    std::vector<TriangleId> renumber(std::span<const VertexId> new_of_old);
+
     /// Flips unconstrained non-Delaunay edges until none remains (Lawson). Returns the flips made.
     std::size_t make_delaunay();
     /// The same from the half-edges in `edges` only (consumed): enough after changes confined

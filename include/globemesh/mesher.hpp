@@ -161,6 +161,8 @@ struct MesherReport {
 /// or when the estimated node count exceeds options.max_nodes (or the estimated memory,
 /// estimated_nodes * mesher_bytes_per_node, exceeds options.max_memory); Cancelled through progress.
 /// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
+/// Neighbouring nodes are mostly close in the numbering, and so are neighbouring faces (the
+/// lattice's insertion order or, when the refinement made most nodes, a Hilbert curve's).
 Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
                    const MesherOptions& options = {}, MesherReport* report = nullptr,
                    const Progress& progress = {}, StageTimings* timings = nullptr);

@@ -1260,6 +1260,63 @@ bool SphericalDelaunay::place_vertex_from(HalfEdge from, const Vec3& p) {
 // Validation
 // ---------------------------------------------------------------------------------------------
 
+std::vector<TriangleId> SphericalDelaunay::renumber(std::span<const VertexId> new_of_old) {
+    // One array at a time, each old one freed before the next new one: the peak is the
+    // triangulation and one array more.
+    const std::size_t vertices = points_.size(), slots = triangle_slots();
+    {
+        std::vector<Vec3> points(vertices);
+        for (std::size_t v = 0; v < vertices; ++v) points[new_of_old[v]] = points_[v];
+        points_.swap(points);
+    }
+    // A counting sort of the live triangles by their smallest new corner.
+    auto smallest = [&](TriangleId t) {
+        return std::min({new_of_old[vertex(t, 0)], new_of_old[vertex(t, 1)], new_of_old[vertex(t, 2)]});
+    };
+    std::vector<TriangleId> new_of_slot(slots, no_triangle);
+    std::size_t live = 0;
+    {
+        std::vector<TriangleId> next(vertices + 1, 0);
+        for (TriangleId t = 0; t < slots; ++t)
+            if (is_live(t)) ++next[smallest(t) + 1];
+        for (std::size_t v = 0; v < vertices; ++v) next[v + 1] += next[v];
+        live = next[vertices];
+        for (TriangleId t = 0; t < slots; ++t)
+            if (is_live(t)) new_of_slot[t] = next[smallest(t)]++;
+    }
+    {
+        std::vector<std::uint8_t> labels(live);
+        for (TriangleId t = 0; t < slots; ++t)
+            if (new_of_slot[t] != no_triangle) labels[new_of_slot[t]] = labels_[t];
+        labels_.swap(labels);
+    }
+    {
+        std::vector<std::uint32_t> links(3 * live);
+        for (TriangleId t = 0; t < slots; ++t) {
+            if (new_of_slot[t] == no_triangle) continue;
+            for (int i = 0; i < 3; ++i) {
+                const std::uint32_t word = links_[half_edge(t, i)];
+                const HalfEdge twin = word & link_mask;
+                links[half_edge(new_of_slot[t], i)] = half_edge(new_of_slot[triangle_of(twin)], edge_of(twin)) | (word & ~link_mask);
+            }
+        }
+        links_.swap(links);
+    }
+    {
+        std::vector<VertexId> tri_vertices(3 * live);
+        for (TriangleId t = 0; t < slots; ++t)
+            if (new_of_slot[t] != no_triangle)
+                for (int i = 0; i < 3; ++i) tri_vertices[half_edge(new_of_slot[t], i)] = new_of_old[vertex(t, i)];
+        tri_vertices_.swap(tri_vertices);
+    }
+    free_.clear();
+    for (auto& [from, into] : dropped_) from = new_of_old[from], into = new_of_old[into];
+    auto moved = [&](TriangleId t) { return t < slots ? new_of_slot[t] : no_triangle; };
+    last_ = moved(last_);
+    recover_hint_ = moved(recover_hint_);
+    return new_of_slot;
+}
+
 std::vector<std::string> SphericalDelaunay::validate() const {
     std::vector<std::string> problems;
     auto fail = [&](const std::string& s) {

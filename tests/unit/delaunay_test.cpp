@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
@@ -283,6 +285,70 @@ TEST(Delaunay, constraints_are_recovered_by_flips_and_never_flipped_again) {
     ASSERT_TRUE(problems.empty()) << problems.front();
     star = dt.vertex_half_edges();
     for (int k = 0; k < 40; ++k) EXPECT_NE(dt.find_edge(star[ring[k]], ring[(k + 1) % 40]), no_half_edge);
+    (void)ids;
+}
+
+TEST(Delaunay, renumbering_keeps_every_triangle_constraint_and_label_and_lays_them_out_as_asked) {
+    // Insertions after the batch, constraints and labels.
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(random_points(3000, 31));
+    std::vector<VertexId> ring;
+    for (int k = 0; k < 30; ++k)
+        ring.push_back(dt.insert(lonlat_to_vec(-40 + 20 * std::cos(k * 2 * pi / 30), 10 + 20 * std::sin(k * 2 * pi / 30))));
+    for (int k = 0; k < 30; ++k) ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 30]));
+    for (const Vec3& q : random_points(1000, 32)) dt.insert(q);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        if (dt.is_live(t)) dt.set_label(t, static_cast<std::uint8_t>(t % 3));
+    // Each triangle as its corners' points, rotated to start at the smallest, with its label and
+    // which of its edges are constrained: the triangulation whatever the numbering.
+    using Described = std::tuple<Tri, std::uint8_t, std::array<bool, 3>>;
+    auto describe = [](const SphericalDelaunay& d) {
+        std::vector<Described> out;
+        for (TriangleId t = 0; t < d.triangle_slots(); ++t) {
+            if (!d.is_live(t)) continue;
+            Tri tri;
+            std::array<bool, 3> constrained;
+            for (int i = 0; i < 3; ++i) {
+                const Vec3& p = d.point(d.vertex(t, i));
+                tri[i] = {p.x, p.y, p.z};
+                constrained[i] = d.is_constrained(half_edge(t, i));
+            }
+            const auto m = std::min_element(tri.begin(), tri.end()) - tri.begin();
+            std::rotate(tri.begin(), tri.begin() + m, tri.end());
+            std::rotate(constrained.begin(), constrained.begin() + m, constrained.end());
+            out.emplace_back(tri, d.label(t), constrained);
+        }
+        std::sort(out.begin(), out.end());
+        return out;
+    };
+    const auto before = describe(dt);
+    const std::size_t live = dt.triangle_count(), slots = dt.triangle_slots();
+    // A random permutation of the vertices.
+    std::vector<VertexId> new_of_old(dt.vertex_count());
+    std::iota(new_of_old.begin(), new_of_old.end(), VertexId{0});
+    std::shuffle(new_of_old.begin(), new_of_old.end(), std::mt19937_64(33));
+    std::vector<Vec3> old_points(dt.points());
+    const auto new_of_slot = dt.renumber(new_of_old);
+    ASSERT_EQ(new_of_slot.size(), slots);
+    EXPECT_EQ(static_cast<std::size_t>(std::count(new_of_slot.begin(), new_of_slot.end(), no_triangle)), slots - live);
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    for (VertexId v = 0; v < old_points.size(); ++v) ASSERT_EQ(dt.point(new_of_old[v]), old_points[v]);
+    EXPECT_EQ(dt.triangle_slots(), live);
+    EXPECT_EQ(describe(dt), before);
+    // Laid out by their smallest corner, in increasing order.
+    auto smallest = [&](TriangleId t) { return std::min({dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)}); };
+    for (TriangleId t = 1; t < dt.triangle_slots(); ++t) ASSERT_LE(smallest(t - 1), smallest(t));
+    // The constraints are still found from their new ends, and insertion goes on from here.
+    auto star = dt.vertex_half_edges();
+    for (int k = 0; k < 30; ++k) {
+        const HalfEdge h = dt.find_edge(star[new_of_old[ring[k]]], new_of_old[ring[(k + 1) % 30]]);
+        ASSERT_NE(h, no_half_edge);
+        EXPECT_TRUE(dt.is_constrained(h));
+    }
+    for (const Vec3& q : random_points(500, 34)) dt.insert(q);
+    problems = dt.validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
     (void)ids;
 }
 
