@@ -1257,7 +1257,7 @@ bool SphericalDelaunay::place_vertex_from(HalfEdge from, const Vec3& p) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Validation
+// Renumbering
 // ---------------------------------------------------------------------------------------------
 
 std::vector<TriangleId> SphericalDelaunay::renumber(std::span<const VertexId> new_of_old) {
@@ -1316,6 +1316,10 @@ std::vector<TriangleId> SphericalDelaunay::renumber(std::span<const VertexId> ne
     recover_hint_ = moved(recover_hint_);
     return new_of_slot;
 }
+
+// ---------------------------------------------------------------------------------------------
+// Validation
+// ---------------------------------------------------------------------------------------------
 
 std::vector<std::string> SphericalDelaunay::validate() const {
     std::vector<std::string> problems;
