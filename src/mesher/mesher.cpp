@@ -327,6 +327,15 @@ double seconds_since(Clock::time_point t0) {
 using EdgeKey = std::pair<VertexId, VertexId>;
 EdgeKey key(VertexId a, VertexId b) { return a < b ? EdgeKey{a, b} : EdgeKey{b, a}; }
 
+// Moves per_vertex[v] to new_of_old[v] (SphericalDelaunay::renumber's numbering); vertices past
+// its end take `absent`.
+template <class T>
+void renumber_per_vertex(std::vector<T>& per_vertex, const std::vector<VertexId>& new_of_old, T absent) {
+    std::vector<T> out(new_of_old.size(), absent);
+    for (std::size_t v = 0; v < per_vertex.size(); ++v) out[new_of_old[v]] = per_vertex[v];
+    per_vertex.swap(out);
+}
+
 // The state shared by the steps: the triangulation, the boundary segments with their kinds,
 // the size field.
 struct Mesher {
@@ -362,14 +371,9 @@ struct Mesher {
     // its vertices or triangles; returns each old slot's new triangle.
     std::vector<TriangleId> renumber(const std::vector<VertexId>& new_of_old) {
         std::vector<TriangleId> new_of_slot = dt.renumber(new_of_old);
-        auto permute = [&](auto& per_vertex, auto absent) {
-            std::remove_reference_t<decltype(per_vertex)> out(new_of_old.size(), absent);
-            for (std::size_t v = 0; v < per_vertex.size(); ++v) out[new_of_old[v]] = per_vertex[v];
-            per_vertex.swap(out);
-        };
-        permute(sharp, char{0});
-        permute(fixed, char{0});
-        permute(ring_of, no_ring);
+        renumber_per_vertex(sharp, new_of_old, char{0});
+        renumber_per_vertex(fixed, new_of_old, char{0});
+        renumber_per_vertex(ring_of, new_of_old, no_ring);
         std::map<EdgeKey, SegmentKind> renamed;
         for (const auto& [e, kind] : segments) renamed.emplace(key(new_of_old[e.first], new_of_old[e.second]), kind);
         segments.swap(renamed);
@@ -2382,9 +2386,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             for (std::size_t k = 0; k < keyed.size(); ++k) new_of_old[keyed[k].second] = static_cast<VertexId>(k);
             for (std::size_t k = 0; k < keyed.size(); ++k) keyed[k].second = static_cast<VertexId>(k);
             m.renumber(new_of_old);
-            std::vector<char> renamed(lattice.size());
-            for (std::size_t v = 0; v < lattice.size(); ++v) renamed[new_of_old[v]] = lattice[v];
-            lattice.swap(renamed);
+            renumber_per_vertex(lattice, new_of_old, char{0});
         }
         for (const auto& kv : keyed)
             if (!m.is_fixed(kv.second)) visit.push_back(kv.second);
