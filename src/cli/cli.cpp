@@ -356,15 +356,12 @@ void check_mesh_run(const CliOptions& o) {
                                  outputs[i].second);
         }
     }
-    check_input_path(o.mesh.coast, "--coast");
-    check_input_path(o.mesh.bathy, "--bathy");
-    check_input_path(o.mesh.region_file, "--region-file");
-    check_input_path(o.mesh.size_regions, "--size-regions");
     const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
                                                           {"--bathy", o.mesh.bathy},
                                                           {"--region-file", o.mesh.region_file},
                                                           {"--size-regions", o.mesh.size_regions},
                                                           {"--config", o.config}};
+    for (const auto& [name, path] : inputs) check_input_path(path, name); // (--config was read)
     for (const auto& [name, path] : outputs)
         if (!path.empty()) check_not_an_input(path, name, inputs);
     for (const auto& [name, path] : outputs)
