@@ -94,7 +94,11 @@ std::string literal(const std::string& text) {
 class Database {
 public:
     Database(const std::filesystem::path& file, const std::filesystem::path& output) : output_(output) {
-        if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) fail("opening it with SQLite");
+        if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) == SQLITE_OK) return;
+        const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_); // the destructor does not run for a constructor that throws
+        db_ = nullptr;
+        fail("opening it with SQLite", why);
     }
     ~Database() {
         if (in_transaction_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
@@ -103,9 +107,11 @@ public:
     Database(const Database&) = delete;
     Database& operator=(const Database&) = delete;
 
-    [[noreturn]] void fail(const std::string& step) const {
-        throw IoError("GeoPackage output " + output_.string() + ": spatial index: " + step + ": " +
-                      (db_ ? sqlite3_errmsg(db_) : "out of memory") + OutputFile::full_disk_note(output_));
+    /// Throws the IoError of `step`, for SQLite's last error or `why`.
+    [[noreturn]] void fail(const std::string& step, std::string why = "") const {
+        if (why.empty()) why = sqlite3_errmsg(db_);
+        throw IoError("GeoPackage output " + output_.string() + ": spatial index: " + step + ": " + why +
+                      OutputFile::full_disk_note(output_));
     }
     void exec(const std::string& sql) {
         if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) fail(sql.substr(0, sql.find('(')));
