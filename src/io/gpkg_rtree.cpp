@@ -193,9 +193,23 @@ std::vector<std::string> triggers(const std::string& table, const std::string& c
     };
 }
 
+/// Progress over every layer's features, each counted twice (its leaf cell, its _rowid row).
+struct Steps {
+    const Progress& progress;
+    double total = 0;
+    double done = 0;
+    /// Adds n steps; reports every 65,536 of them, or every 1/32 of a smaller total.
+    void add(double n) {
+        const double every = std::max(1.0, std::min(65536.0, total / 32));
+        const bool due = std::floor(done / every) != std::floor((done + n) / every);
+        done += n;
+        if (due) report(progress, std::min(1.0, done / total), "write_gpkg");
+    }
+};
+
 /// One layer's index: the virtual table (SQLite creates its shadow tables and an empty root),
 /// then the packed tree written into them, then the triggers and the extension's row.
-void add_index(Database& db, const RtreeLayer& layer) {
+void add_index(Database& db, const RtreeLayer& layer, Steps& steps) {
     const std::string rtree = "rtree_" + layer.table + "_" + layer.column;
     db.exec("CREATE VIRTUAL TABLE " + quoted(rtree) + " USING rtree(id, minx, maxx, miny, maxy)");
     // The node size SQLite chose for this file's page size (its root is a node of that size).
@@ -264,9 +278,13 @@ void add_index(Database& db, const RtreeLayer& layer) {
                     else parent.insert(id, number);
                 }
                 node.insert(number, blob);
+                if (k == 0) steps.add(double(l.starts[j + 1] - l.starts[j]));
             }
         }
-        for (std::size_t i = 0; i < leaf_of.size(); ++i) rowid.insert(std::int64_t(i) + 1, leaf_of[i]);
+        for (std::size_t i = 0; i < leaf_of.size(); ++i) {
+            rowid.insert(std::int64_t(i) + 1, leaf_of[i]);
+            steps.add(1);
+        }
     }
     for (const std::string& sql : triggers(layer.table, layer.column)) db.exec(sql);
     db.exec("INSERT INTO gpkg_extensions (table_name, column_name, extension_name, definition, scope) VALUES (" +
@@ -277,14 +295,16 @@ void add_index(Database& db, const RtreeLayer& layer) {
 } // namespace
 
 void add_rtree_indexes(const std::filesystem::path& file, const std::vector<RtreeLayer>& layers,
-                       const std::filesystem::path& output) {
+                       const std::filesystem::path& output, const Progress& progress) {
+    Steps steps{progress};
+    for (const RtreeLayer& layer : layers) steps.total += 2.0 * double(layer.boxes.size());
     Database db(file, output);
     db.begin();
     // The GeoPackage's table of extensions, in the words of the standard (GDAL creates it only
     // for a file that uses one).
     db.exec("CREATE TABLE IF NOT EXISTS gpkg_extensions (table_name TEXT,column_name TEXT,extension_name TEXT NOT NULL,"
             "definition TEXT NOT NULL,scope TEXT NOT NULL,CONSTRAINT ge_tce UNIQUE (table_name, column_name, extension_name))");
-    for (const RtreeLayer& layer : layers) add_index(db, layer);
+    for (const RtreeLayer& layer : layers) add_index(db, layer, steps);
     db.commit();
 }
 

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "globemesh/progress.hpp"
+
 namespace globemesh::io {
 
 /// A feature's envelope as the RTree keeps it: min x, max x, min y, max y in 32-bit floats,
@@ -36,8 +38,10 @@ struct RtreeLayer {
 
 /// Adds the spatial index of each layer to the closed GeoPackage `file` (written by GDAL with
 /// SPATIAL_INDEX=NO), in one transaction: all of them, or none and an IoError that names
-/// `output` (the path the user gave; `file` is its temporary name) and SQLite's reason.
+/// `output` (the path the user gave; `file` is its temporary name) and SQLite's reason. Reports
+/// to `progress` under the stage "write_gpkg" (and stops with Cancelled, none written, when
+/// asked).
 void add_rtree_indexes(const std::filesystem::path& file, const std::vector<RtreeLayer>& layers,
-                       const std::filesystem::path& output);
+                       const std::filesystem::path& output, const Progress& progress = {});
 
 } // namespace globemesh::io

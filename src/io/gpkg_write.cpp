@@ -441,7 +441,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     if (!io::close_dataset(ds))
         throw IoError("GeoPackage output " + path.string() + ": closing failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));
-    io::add_rtree_indexes(out.temp_path(), indexes, path);
+    io::add_rtree_indexes(out.temp_path(), indexes, path, sub_progress(options.progress, face_share + node_share, 1.0));
     report(options.progress, 1.0, "write_gpkg");
     out.commit();
 }
