@@ -41,6 +41,19 @@ private:
     std::filesystem::path path_;
 };
 
+/// What the exception E that `f` throws says; a test failure (`what` names the call) and "" when
+/// f returns instead. An exception of another type goes on to gtest, which reports it.
+template <class E, class F>
+std::string thrown_message(F&& f, const std::string& what = "the call") {
+    try {
+        f();
+    } catch (const E& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << what << " threw nothing";
+    return "";
+}
+
 /// Runs a shell command, returns its exit status and puts stdout+stderr in `output`.
 inline int run_command(const std::string& command, std::string& output) {
     output.clear();

@@ -270,14 +270,10 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     GridSpec s{0, 10, 1, 1, 4, 4};
     s.georeferenced = false;
     write_tiff(bare, s, [](double, double) { return -1.0; });
-    try {
-        read_raster(bare);
-        FAIL() << "no georeferencing accepted";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find(bare), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("georeferencing"), std::string::npos) << e.what();
-        EXPECT_TRUE(one_line(e.what()));
-    }
+    std::string m = test::thrown_message<DataError>([&] { read_raster(bare); }, "a raster without georeferencing");
+    EXPECT_NE(m.find(bare), std::string::npos) << m;
+    EXPECT_NE(m.find("georeferencing"), std::string::npos) << m;
+    EXPECT_TRUE(one_line(m));
     const std::string ok = (dir / "ok.tif").string();
     write_tiff(ok, {0, 10, 1, 1, 4, 4}, [](double, double) { return -1.0; });
     // Its CRS unset on a pixel-is-point GeoTIFF (as the ETOPO5 fixture is; Python's
@@ -293,19 +289,11 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
         GDALSetProjection(ds, "");
         GDALClose(ds);
     }
-    try {
-        read_raster(local);
-        FAIL() << "a local CRS accepted";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("has no georeferencing"), std::string::npos) << e.what();
-        EXPECT_TRUE(one_line(e.what()));
-    }
-    try {
-        read_raster(ok, 2);
-        FAIL() << "band 2 of 1 accepted";
-    } catch (const UsageError& e) {
-        EXPECT_NE(std::string(e.what()).find("--bathy-band 2"), std::string::npos) << e.what();
-    }
+    m = test::thrown_message<DataError>([&] { read_raster(local); }, "a raster in a local CRS");
+    EXPECT_NE(m.find("has no georeferencing"), std::string::npos) << m;
+    EXPECT_TRUE(one_line(m));
+    m = test::thrown_message<UsageError>([&] { read_raster(ok, 2); }, "band 2 of 1");
+    EXPECT_NE(m.find("--bathy-band 2"), std::string::npos) << m;
     const std::string empty = (dir / "nodata.tif").string();
     GridSpec n{0, 10, 1, 1, 4, 4};
     n.nodata = -1.0;
@@ -314,13 +302,9 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     EXPECT_THROW(read_raster((dir / "missing.tif").string()), IoError);
     // A regional raster does not cover the globe, nor a region beyond it, unless filled.
     MeshOptions o = options_for(ok);
-    try {
-        read_bathymetry(o);
-        FAIL() << "partial coverage accepted";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("--bathy-fill"), std::string::npos) << e.what();
-        EXPECT_TRUE(one_line(e.what()));
-    }
+    m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a partial coverage");
+    EXPECT_NE(m.find("--bathy-fill"), std::string::npos) << m;
+    EXPECT_TRUE(one_line(m));
     o.region = std::array<double, 4>{1, 7, 3, 9};
     EXPECT_NO_THROW(read_bathymetry(o));
     o.region = std::array<double, 4>{1, 7, 5, 9};
@@ -509,15 +493,10 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     MeshOptions o = options_for(vrt);
     o.hmin_km = 1;                     // cells of 0.5 km asked: more than the 2^28-cell cap
     o.max_memory_bytes = 500'000'000;  // half of it for the raster: less than 2^28 floats
-    try {
-        read_bathymetry(o);
-        FAIL() << "a 1 GiB read within a 250 MB share";
-    } catch (const DataError& e) {
-        const std::string m = e.what();
-        EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
-        EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
-        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-    }
+    const std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a 1 GiB read within a 250 MB share");
+    EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
+    EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     // Coarser sizes fit: hmin 40 km asks for cells of 20 km (0.18 degree), rounded up in count.
     o.hmin_km = 40;
     o.hmax_km = 100;

@@ -505,24 +505,15 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
 
 TEST(Coast, missing_coast_option_is_a_usage_error) {
     MeshOptions o;
-    try {
-        load_coast(o);
-        FAIL() << "no exception";
-    } catch (const UsageError& e) {
-        EXPECT_NE(std::string(e.what()).find("--coast"), std::string::npos);
-    }
+    const std::string m = test::thrown_message<UsageError>([&] { load_coast(o); });
+    EXPECT_NE(m.find("--coast"), std::string::npos) << m;
 }
 
 TEST(Coast, two_polygon_layers_without_a_layer_name_list_the_layers) {
     MeshOptions o = coast_options("coast/ne_110m_land.gpkg", "");
-    try {
-        load_coast(o);
-        FAIL() << "no exception";
-    } catch (const DataError& e) {
-        std::string m = e.what();
-        EXPECT_NE(m.find("land"), std::string::npos);
-        EXPECT_NE(m.find("ocean"), std::string::npos);
-    }
+    const std::string m = test::thrown_message<DataError>([&] { load_coast(o); });
+    EXPECT_NE(m.find("land"), std::string::npos) << m;
+    EXPECT_NE(m.find("ocean"), std::string::npos) << m;
 }
 
 TEST(Coast, progress_reaches_one_and_cancel_stops) {

@@ -296,12 +296,8 @@ TEST(Gpkg, gdal_validator_accepts_the_file) {
 TEST(Gpkg, reading_a_geopackage_as_ugrid_says_it_is_one) {
     TempDir dir;
     write_gpkg(icosphere(1), dir / "m.gpkg");
-    try {
-        read_ugrid(dir / "m.gpkg");
-        FAIL() << "no IoError";
-    } catch (const IoError& e) {
-        EXPECT_NE(std::string(e.what()).find("is a GeoPackage (SQLite), not NetCDF"), std::string::npos) << e.what();
-    }
+    const std::string m = test::thrown_message<IoError>([&] { read_ugrid(dir / "m.gpkg"); });
+    EXPECT_NE(m.find("is a GeoPackage (SQLite), not NetCDF"), std::string::npos) << m;
 }
 
 TEST(Gpkg, closed_mesh_faces_tile_the_lonlat_rectangle_with_no_part_wider_than_180) {

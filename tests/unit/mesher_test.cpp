@@ -646,28 +646,24 @@ TEST(Mesher, a_coast_size_of_metres_is_refused_before_the_size_field) {
     MeshOptions o = land_110m(100);
     o.coast_size_km = 0.01;
     std::vector<std::string> stages;
-    try {
-        mesh_ocean(o, [&](double, std::string_view stage) {
-            if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
-            return true;
-        });
-        FAIL() << "a 10 m coast size on the 1:110m land passed --max-nodes 2e7";
-    } catch (const DataError& e) {
-        EXPECT_TRUE(test::regex_search(e.what(), R"(at --coast-size 0\.01 km \(0\.1 km: sizes stop at --hmin.*raise --coast-size and --hmin or --max-nodes$)"))
-            << e.what();
-    }
+    const std::string m = test::thrown_message<DataError>(
+        [&] {
+            mesh_ocean(o, [&](double, std::string_view stage) {
+                if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+                return true;
+            });
+        },
+        "a 10 m coast size on the 1:110m land (under --max-nodes 2e7)");
+    EXPECT_TRUE(test::regex_search(m, R"(at --coast-size 0\.01 km \(0\.1 km: sizes stop at --hmin.*raise --coast-size and --hmin or --max-nodes$)"))
+        << m;
     EXPECT_EQ(std::count(stages.begin(), stages.end(), "size field"), 0) << "reached the size field";
 }
 
 TEST(Mesher, too_many_nodes_are_refused_before_refining) {
     MeshOptions o = land_110m(5);
     o.max_nodes = 100000;
-    try {
-        mesh_ocean(o);
-        FAIL() << "expected a DataError";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
-    }
+    const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); });
+    EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
 }
 
 TEST(Mesher, without_the_source_land_every_ring_node_stays_in_place_and_sharp_corners_match_the_faces) {

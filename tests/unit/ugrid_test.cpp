@@ -420,12 +420,8 @@ TEST(Ugrid, out_of_range_index_and_non_ugrid_files_are_errors_not_read) {
     Mesh m = icosphere(1);
     m.nodes.pop_back(); // the faces now reference a node that is not in the file
     write_foreign(dir / "bad.nc", m, false, 1, false);
-    try {
-        read_ugrid(dir / "bad.nc");
-        FAIL() << "no DataError";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("outside [1, 41]"), std::string::npos) << e.what();
-    }
+    const std::string message = test::thrown_message<DataError>([&] { read_ugrid(dir / "bad.nc"); });
+    EXPECT_NE(message.find("outside [1, 41]"), std::string::npos) << message;
     std::ofstream(dir / "text.nc") << "not netcdf";
     EXPECT_THROW(read_ugrid(dir / "text.nc"), IoError);
     EXPECT_THROW(read_ugrid(dir / "missing.nc"), IoError);
