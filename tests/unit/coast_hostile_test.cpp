@@ -73,20 +73,12 @@ void expect_valid_both_stages(const CoastData& d, double h_km = 50) {
     EXPECT_EQ(count_violations(b), 0u);
 }
 
+/// What load_coast(o) throws as an E, checked to be one line.
 template <class E>
 std::string message_of(const MeshOptions& o) {
-    try {
-        load_coast(o);
-    } catch (const E& e) {
-        std::string m = e.what();
-        EXPECT_EQ(m.find('\n'), std::string::npos) << "not one line: " << m;
-        return m;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "wrong exception type: " << e.what();
-        return {};
-    }
-    ADD_FAILURE() << "no exception";
-    return {};
+    std::string m = test::thrown_message<E>([&] { load_coast(o); }, "load_coast");
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "not one line: " << m;
+    return m;
 }
 
 } // namespace

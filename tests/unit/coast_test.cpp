@@ -231,12 +231,8 @@ TEST(Coast, a_coast_that_alone_exceeds_max_nodes_is_refused_before_it_is_resampl
     ASSERT_GT(length_km / 0.001, 1e8);
     MeshOptions o;
     o.max_nodes = 20'000'000;
-    try {
-        shape_boundary(ne110(), uniform(0.001), o);
-        ADD_FAILURE() << "a 1 m coast was shaped";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
-    }
+    const std::string m = test::thrown_message<DataError>([&] { shape_boundary(ne110(), uniform(0.001), o); }, "a 1 m coast");
+    EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
     // At 100 km the same bound lets it through, with nodes to spare.
     o.max_nodes = static_cast<std::uint64_t>(length_km / 100 * 2);
     CoastReport rep;
@@ -400,14 +396,10 @@ TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
 TEST(Coast, a_region_outline_along_the_coast_is_refused_naming_the_region) {
     MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
     o.region_file = fixture("coast/ne_110m_land_equal_earth.gpkg").string();
-    try {
-        load_coast(o);
-        ADD_FAILURE() << "the slivers between the region's outline and the coast were accepted";
-    } catch (const DataError& e) {
-        const std::string m = e.what();
-        EXPECT_EQ(m.rfind("--region-file " + o.region_file + ": its outline runs along the coast", 0), 0u) << m;
-        EXPECT_NE(m.find("clear of the coast"), std::string::npos) << m;
-    }
+    const std::string m = test::thrown_message<DataError>([&] { load_coast(o); },
+                                                          "the slivers between the region's outline and the coast");
+    EXPECT_EQ(m.rfind("--region-file " + o.region_file + ": its outline runs along the coast", 0), 0u) << m;
+    EXPECT_NE(m.find("clear of the coast"), std::string::npos) << m;
 }
 
 TEST(Coast, attribute_filter_selects_features) {

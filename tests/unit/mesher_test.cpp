@@ -589,13 +589,8 @@ TEST(Mesher, a_size_wider_than_the_region_is_refused_naming_hmax) {
     EXPECT_GE(mesh.faces.size(), 2u);
     expect_verified(mesh, "wide_region.nc", "0"); // (the region is about one edge across)
     o.hmax_km = 3000;
-    try {
-        mesh_ocean(o);
-        ADD_FAILURE() << "a 3000 km size in a 2000 km region gave a mesh";
-    } catch (const DataError& e) {
-        EXPECT_TRUE(test::regex_match(e.what(), R"(no ocean to mesh: at --hmax 3000 km .* [0-3] boundary nodes; lower --hmax)"))
-            << e.what();
-    }
+    const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); }, "a 3000 km size in a 2000 km region");
+    EXPECT_TRUE(test::regex_match(m, R"(no ocean to mesh: at --hmax 3000 km .* [0-3] boundary nodes; lower --hmax)")) << m;
 }
 
 TEST(Mesher, same_input_gives_the_same_bytes) {
@@ -617,27 +612,21 @@ TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
     o.max_nodes = nodes * 3 / 2;
     EXPECT_EQ(mesh_ocean(o).nodes.size(), nodes);
     o.max_nodes = nodes / 2;
-    try {
-        mesh_ocean(o);
-        ADD_FAILURE() << "a run of " << nodes << " nodes passed --max-nodes " << o.max_nodes;
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("--max-nodes"), std::string::npos) << e.what();
-    }
+    std::string m = test::thrown_message<DataError>(
+        [&] { mesh_ocean(o); }, "a run of " + std::to_string(nodes) + " nodes under --max-nodes " + std::to_string(o.max_nodes));
+    EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
     // The pipeline's first count of the coast's band (before the size field): a straight coast's
     // band, so no fewer than the mesher makes (bays share their bands), and under twice that,
     // which its check relies on (it refuses at twice --max-nodes).
     o.max_nodes = 3000; // above the ocean's count at --hmax alone (about 2,600)
-    try {
-        mesh_ocean(o);
-        ADD_FAILURE() << "a run of " << nodes << " nodes passed --max-nodes 3000";
-    } catch (const DataError& e) {
-        std::vector<std::string> g;
-        ASSERT_TRUE(test::regex_search(e.what(), R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at --coast-size 25 km)", &g))
-            << e.what();
-        const double estimate = std::stod(g[1]);
-        EXPECT_GE(estimate, double(nodes));
-        EXPECT_LT(estimate, 2.0 * double(nodes));
-    }
+    m = test::thrown_message<DataError>([&] { mesh_ocean(o); },
+                                        "a run of " + std::to_string(nodes) + " nodes under --max-nodes 3000");
+    std::vector<std::string> g;
+    ASSERT_TRUE(test::regex_search(m, R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at --coast-size 25 km)", &g))
+        << m;
+    const double estimate = std::stod(g[1]);
+    EXPECT_GE(estimate, double(nodes));
+    EXPECT_LT(estimate, 2.0 * double(nodes));
 }
 
 // A coast size of metres is refused from the coast's length, before the size field (whose grid
@@ -846,11 +835,7 @@ TEST(Mesher, inlet_width_out_of_range_is_a_usage_error_naming_it) {
     for (double w : {-0.1, 2.5, std::nan("")}) {
         MeshOptions o = land_110m(300);
         o.inlet_width = w;
-        try {
-            mesh_ocean(o);
-            ADD_FAILURE() << "expected a UsageError for " << w;
-        } catch (const UsageError& e) {
-            EXPECT_NE(std::string(e.what()).find("--inlet-width"), std::string::npos) << e.what();
-        }
+        const std::string m = test::thrown_message<UsageError>([&] { mesh_ocean(o); }, "--inlet-width " + std::to_string(w));
+        EXPECT_NE(m.find("--inlet-width"), std::string::npos) << m;
     }
 }

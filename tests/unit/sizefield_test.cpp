@@ -292,12 +292,9 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     write_size_region(local, "ESRI Shapefile", local_cs, "POLYGON ((0 0, 2 0, 2 2, 0 2, 0 0))", 7.0);
     OSRRelease(local_cs);
     o.size_regions = local;
-    try {
-        build_size_field(o, nullptr, nullptr, {}, 1 << 16);
-        ADD_FAILURE() << "a LOCAL_CS layer placed";
-    } catch (const DataError& e) {
-        EXPECT_NE(std::string(e.what()).find("has no CRS (only a local one, of unknown units)"), std::string::npos) << e.what();
-    }
+    const std::string m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); },
+                                                          "a LOCAL_CS layer");
+    EXPECT_NE(m.find("has no CRS (only a local one, of unknown units)"), std::string::npos) << m;
 }
 
 TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
@@ -469,13 +466,8 @@ TEST(SizeField, analytic_fields_match_their_definitions) {
 }
 
 TEST(SizeField, bad_options_give_one_line_errors_naming_the_option) {
-    auto message = [](const MeshOptions& o, const Raster* bathy) -> std::string {
-        try {
-            build_size_field(o, bathy, nullptr, {}, 1 << 12);
-        } catch (const UsageError& e) {
-            return e.what();
-        }
-        return "";
+    auto message = [](const MeshOptions& o, const Raster* bathy) {
+        return test::thrown_message<UsageError>([&] { build_size_field(o, bathy, nullptr, {}, 1 << 12); });
     };
     MeshOptions o;
     o.hmin_km = 200;

@@ -582,12 +582,9 @@ TEST(OutputFile, a_device_takes_text_and_is_refused_as_a_file) {
     ASSERT_TRUE(OutputFile::is_stream("/dev/null"));
     OutputFile::write_text("/dev/null", "{}\n", false);
     for (bool overwrite : {false, true}) {
-        try {
-            OutputFile out("/dev/null", overwrite, "UGRID output");
-            ADD_FAILURE() << "a device was accepted as a file output";
-        } catch (const IoError& e) {
-            EXPECT_NE(std::string(e.what()).find("/dev/null is not a regular file"), std::string::npos) << e.what();
-        }
+        const std::string m = test::thrown_message<IoError>([&] { OutputFile out("/dev/null", overwrite, "UGRID output"); },
+                                                            "a device as a file output");
+        EXPECT_NE(m.find("/dev/null is not a regular file"), std::string::npos) << m;
     }
     EXPECT_EQ(fs::status("/dev/null").type(), fs::file_type::character);
     EXPECT_FALSE(OutputFile::is_stream(fs::temp_directory_path()));
