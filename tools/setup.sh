@@ -6,7 +6,7 @@ GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Build and run dependencies of globemesh itself.
 GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libsqlite3-dev libgeos-dev libproj-dev
-  libgeographiclib-dev libnetcdf-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
+  libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
 # its runtime (libFuzzer) for tools/fuzz.

@@ -13,10 +13,6 @@ namespace globemesh::io {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-/// Points every descriptor this process holds on `file` at one new empty memory file, so that
-/// whatever is written through them from now on lands in memory. Returns how many it moved.
 int divert_to_memory(const fs::path& file) {
     std::error_code ec;
     const fs::path target = fs::canonical(file, ec);
@@ -33,8 +29,6 @@ int divert_to_memory(const fs::path& file) {
     ::close(memory);
     return moved;
 }
-
-} // namespace
 
 void nc_check(int status, const fs::path& file, const std::string& step, const char* what) {
     if (status == NC_NOERR) return;

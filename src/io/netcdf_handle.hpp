@@ -16,6 +16,11 @@ namespace globemesh::io {
 void nc_check(int status, const std::filesystem::path& file, const std::string& step,
               const char* what = "UGRID file");
 
+/// Points every descriptor this process holds on `file` at one new empty memory file, so that
+/// whatever is written through them from now on lands in memory (a temporary file being
+/// abandoned, whose last flush must not fail). Returns how many it moved.
+int divert_to_memory(const std::filesystem::path& file);
+
 /// Owns an open netCDF id; abandons (nc_abort) a file that was not closed explicitly.
 ///
 /// HDF5 flushes a netCDF-4 file as it closes it, abandoned or not. When that flush fails (a full

@@ -9,11 +9,17 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <exception>
 #include <future>
+#include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <system_error>
+#include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "globemesh/error.hpp"
@@ -21,6 +27,7 @@
 #include "globemesh/ugrid.hpp"
 #include "face_area.hpp"
 #include "face_geometry.hpp"
+#include "hdf5_chunks.hpp"
 #include "mesh_topology.hpp"
 #include "netcdf_handle.hpp"
 
@@ -40,150 +47,278 @@ constexpr const char* wgs84_wkt =
     "ID[\"EPSG\",4326]]";
 
 /// Writes the variables of one file; every call checks its status.
+///
+/// The variables' data are computed and written a block of block_rows rows (one chunk) at a
+/// time (in_blocks), on every core. A netCDF-4 file is defined and closed in netCDF-C first
+/// (start_data), then each block's rows are shuffled and deflated on the thread that computed
+/// them and stored from this one as whole chunks (hdf5_chunks.hpp); a classic file's rows go
+/// through netCDF-C as they are.
 class UgridWriter {
 public:
-    UgridWriter(int id, const std::filesystem::path& file, bool compress, const Progress& progress)
-        : id_(id), file_(file), compress_(compress), progress_(progress) {}
+    UgridWriter(io::NcHandle& nc, const std::filesystem::path& temp, const std::filesystem::path& file, bool compress,
+                const Progress& progress)
+        : nc_(nc), temp_(temp), file_(file), compress_(compress), progress_(progress) {}
 
     int dim(const char* name, std::size_t len) {
         int d;
-        io::nc_check(nc_def_dim(id_, name, len, &d), file_, std::string("defining dimension ") + name);
+        io::nc_check(nc_def_dim(nc_.id(), name, len, &d), file_, std::string("defining dimension ") + name);
         return d;
     }
     int var(const char* name, nc_type type, std::vector<int> dims) {
         int v;
-        io::nc_check(nc_def_var(id_, name, type, int(dims.size()), dims.data(), &v), file_,
+        io::nc_check(nc_def_var(nc_.id(), name, type, int(dims.size()), dims.data(), &v), file_,
                      std::string("defining variable ") + name);
-        if (!dims.empty()) {
-            std::size_t rows = 0;
-            io::nc_check(nc_inq_dimlen(id_, dims[0], &rows), file_, std::string("sizing ") + name);
-            rows_total_ += rows; // every variable with dimensions is written whole, once
+        if (dims.empty()) return v;
+        Shape shape{name, 0, 1, 0};
+        std::vector<std::size_t> lengths(dims.size());
+        for (std::size_t k = 0; k < dims.size(); ++k) {
+            io::nc_check(nc_inq_dimlen(nc_.id(), dims[k], &lengths[k]), file_, std::string("sizing ") + name);
+            if (k > 0) shape.row_values *= lengths[k];
         }
-        if (compress_ && !dims.empty()) {
-            // Chunks of at most 65536 rows and a small chunk cache: netCDF's default chunking
-            // makes one chunk of a whole variable, and HDF5 then keeps every variable written
-            // in memory until the file closes (about half the process's peak at 1e6 nodes).
-            std::vector<std::size_t> chunk(dims.size());
-            for (std::size_t k = 0; k < dims.size(); ++k) {
-                io::nc_check(nc_inq_dimlen(id_, dims[k], &chunk[k]), file_, std::string("sizing ") + name);
-                chunk[k] = std::max<std::size_t>(1, k == 0 ? std::min(chunk[k], block_rows) : chunk[k]);
-            }
-            io::nc_check(nc_def_var_chunking(id_, v, NC_CHUNKED, chunk.data()), file_, std::string("chunking ") + name);
-            io::nc_check(nc_set_var_chunk_cache(id_, v, 1u << 20, 7, 1.0f), file_, std::string("caching ") + name);
-            io::nc_check(nc_def_var_deflate(id_, v, 1, 1, 1), file_, std::string("compressing ") + name);
+        shape.rows = lengths[0];
+        rows_total_ += shape.rows; // every variable with dimensions is written whole, once
+        if (compress_) {
+            // Chunks of at most block_rows rows, whole rows each: the blocks in_blocks computes.
+            // (netCDF's default chunking makes one chunk of a whole variable.)
+            shape.chunk_rows = std::max<std::size_t>(1, std::min(shape.rows, block_rows));
+            std::vector<std::size_t> chunk = lengths;
+            chunk[0] = shape.chunk_rows;
+            io::nc_check(nc_def_var_chunking(nc_.id(), v, NC_CHUNKED, chunk.data()), file_, std::string("chunking ") + name);
+            io::nc_check(nc_def_var_deflate(nc_.id(), v, 1, 1, 1), file_, std::string("compressing ") + name);
         }
+        if (shapes_.size() <= std::size_t(v)) shapes_.resize(std::size_t(v) + 1);
+        shapes_[std::size_t(v)] = shape;
         return v;
     }
     void text(int v, const char* name, const std::string& value) {
-        io::nc_check(nc_put_att_text(id_, v, name, value.size(), value.c_str()), file_,
+        io::nc_check(nc_put_att_text(nc_.id(), v, name, value.size(), value.c_str()), file_,
                      std::string("writing attribute ") + name);
     }
     void ints(int v, const char* name, std::vector<int> values) {
-        io::nc_check(nc_put_att_int(id_, v, name, NC_INT, values.size(), values.data()), file_,
+        io::nc_check(nc_put_att_int(nc_.id(), v, name, NC_INT, values.size(), values.data()), file_,
                      std::string("writing attribute ") + name);
     }
     void dbl(int v, const char* name, double value) {
-        io::nc_check(nc_put_att_double(id_, v, name, NC_DOUBLE, 1, &value), file_,
+        io::nc_check(nc_put_att_double(nc_.id(), v, name, NC_DOUBLE, 1, &value), file_,
                      std::string("writing attribute ") + name);
     }
-    bool has_att(int v, const char* name) const { return nc_inq_attid(id_, v, name, nullptr) == NC_NOERR; }
-    /// Runs compute(first, count, buffers) and then write(first, count, buffers) for each block of
-    /// block_rows rows of n, in order. The next block is computed on another thread while this
-    /// one is written (netCDF-4's compression takes about as long as the computing); compute is
-    /// called for one block at a time, in order, so the file is the same as without.
-    template <class Buffers, class Compute, class Write>
-    static void in_blocks(std::size_t n, const Compute& compute, const Write& write) {
-        if (n == 0) return;
-        auto count_at = [n](std::size_t first) { return std::min(block_rows, n - first); };
-        Buffers current, next;
-        compute(std::size_t(0), count_at(0), current);
-        for (std::size_t first = 0; first < n; first += block_rows) {
-            const std::size_t after = first + block_rows;
-            std::future<void> ahead; // joined by its destructor should write throw
-            if (after < n) {
-                auto compute_next = [&] { compute(after, count_at(after), next); };
-                try {
-                    ahead = std::async(std::launch::async, compute_next);
-                } catch (const std::system_error&) {
-                    compute_next(); // no thread to be had (a process limit): in turn
-                }
+    bool has_att(int v, const char* name) const { return nc_inq_attid(nc_.id(), v, name, nullptr) == NC_NOERR; }
+
+    /// After the definitions and the variables without dimensions: a netCDF-4 file is closed
+    /// and reopened for its chunks.
+    void start_data() {
+        if (!compress_) return;
+        nc_.close(file_, "UGRID output");
+        chunks_.emplace(temp_, file_, "UGRID output");
+    }
+    /// After the last block: closes the file (throws IoError).
+    void finish() {
+        if (chunks_) chunks_->close();
+        else nc_.close(file_, "UGRID output");
+    }
+
+    /// One block's rows of each variable it holds, as compute gives them (in_blocks).
+    class Block {
+    public:
+        /// Rows `first` .. `first + count - 1` (the block's) of variable v, row_values values of
+        /// type T (double or int, as the variable) a row; `data` must live until the block is
+        /// stored (it is the caller's Buffers).
+        template <class T>
+        void put(int v, const T* data, std::size_t count) {
+            static_assert(std::is_same_v<T, double> || std::is_same_v<T, int>);
+            if (used_ == pieces_.size()) pieces_.emplace_back();
+            Piece& p = pieces_[used_++];
+            p.var = v;
+            p.rows = count;
+            p.is_double = std::is_same_v<T, double>;
+            p.data = data;
+            if (encoder_) {
+                const Shape& s = writer_->shapes_[std::size_t(v)];
+                encoder_->encode(data, count, s.chunk_rows, s.row_values * sizeof(T), sizeof(T), p.chunk);
             }
-            write(first, count_at(first), current);
-            if (ahead.valid()) ahead.get();
-            std::swap(current, next);
+        }
+
+    private:
+        friend class UgridWriter;
+        struct Piece {
+            int var = -1;
+            std::size_t rows = 0;
+            bool is_double = false;
+            const void* data = nullptr;
+            std::vector<unsigned char> chunk; ///< encoded (netCDF-4)
+        };
+        const UgridWriter* writer_ = nullptr;
+        io::ChunkEncoder* encoder_ = nullptr;
+        std::vector<Piece> pieces_; ///< the first used_ are this block's (the rest: buffers to reuse)
+        std::size_t used_ = 0;
+    };
+
+    /// Computes and stores the blocks of block_rows rows of n. compute(first, count, buffers,
+    /// block) fills `buffers` (its scratch, a Buffers kept from block to block) and puts each
+    /// variable's rows into `block`. It runs on every core, for several blocks at once in any
+    /// order, so it must only read shared data. The blocks are stored from this thread in
+    /// ascending order (the file does not depend on the timing), at most `window` blocks
+    /// behind the computing; this thread computes too while the next block to store is not
+    /// ready, and alone when no thread can be started.
+    template <class Buffers, class Compute>
+    void in_blocks(std::size_t n, const Compute& compute) {
+        const std::size_t blocks = (n + block_rows - 1) / block_rows;
+        if (blocks == 0) return;
+        struct Slot {
+            Buffers buffers{};
+            Block block;
+            std::exception_ptr error;
+            bool ready = false;
+        };
+        const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
+        std::vector<Slot> slots(std::min(blocks, threads));
+        std::mutex mutex;
+        std::condition_variable changed;
+        std::size_t claimed = 0, stored = 0;
+        bool stop = false;
+        // Computes the next block when one is left and its slot is free (the lock held on entry
+        // and on return); false otherwise.
+        auto compute_next = [&](std::unique_lock<std::mutex>& lock, io::ChunkEncoder* encoder) {
+            if (stop || claimed == blocks || claimed == stored + slots.size()) return false;
+            const std::size_t k = claimed++;
+            Slot& slot = slots[k % slots.size()];
+            lock.unlock();
+            try {
+                slot.block.writer_ = this;
+                slot.block.encoder_ = encoder;
+                slot.block.used_ = 0;
+                const std::size_t first = k * block_rows;
+                compute(first, std::min(block_rows, n - first), slot.buffers, slot.block);
+            } catch (...) {
+                slot.error = std::current_exception();
+            }
+            lock.lock();
+            slot.ready = true;
+            changed.notify_all();
+            return true;
+        };
+        auto work = [&] {
+            std::optional<io::ChunkEncoder> encoder;
+            std::unique_lock lock(mutex);
+            try {
+                if (compress_) encoder.emplace();
+            } catch (...) {
+                return; // no memory for an encoder: the others do this one's share
+            }
+            while (!stop && claimed < blocks)
+                if (!compute_next(lock, encoder ? &*encoder : nullptr)) changed.wait(lock);
+        };
+        std::vector<std::thread> pool;
+        // Stops and joins the threads however this returns.
+        struct Join {
+            std::vector<std::thread>& pool;
+            std::mutex& mutex;
+            bool& stop;
+            std::condition_variable& changed;
+            ~Join() {
+                {
+                    std::lock_guard lock(mutex);
+                    stop = true;
+                }
+                changed.notify_all();
+                for (auto& t : pool) t.join();
+            }
+        } join{pool, mutex, stop, changed};
+        try {
+            for (std::size_t t = 1; t < threads && t < blocks; ++t) pool.emplace_back(work);
+        } catch (const std::system_error&) {
+            // No more threads (a process limit): fewer compute, this one among them.
+        }
+        std::optional<io::ChunkEncoder> encoder;
+        if (compress_) encoder.emplace();
+        for (std::size_t k = 0; k < blocks; ++k) {
+            Slot& slot = slots[k % slots.size()];
+            {
+                std::unique_lock lock(mutex);
+                while (!slot.ready)
+                    if (!compute_next(lock, encoder ? &*encoder : nullptr)) changed.wait(lock);
+            }
+            if (slot.error) std::rethrow_exception(slot.error);
+            store(k * block_rows, slot.block);
+            {
+                std::lock_guard lock(mutex);
+                slot.ready = false;
+                ++stored;
+            }
+            changed.notify_all();
         }
     }
-    /// Writes the n rows of variable v in blocks of block_rows (one chunk each), N values of
-    /// type T (double or int, as the variable) a row: row(i) returns row i as std::array<T, N>.
-    /// Rows are asked for in ascending order, from one thread at a time (in_blocks).
+
+    /// in_blocks for one variable of N values of type T (double or int, as the variable) a row:
+    /// row(i) returns row i as std::array<T, N>.
     template <class T, std::size_t N, class Row>
-    void put_rows(int v, std::size_t n, const Row& row, const char* name) {
-        in_blocks<std::vector<T>>(
-            n,
-            [&](std::size_t first, std::size_t count, std::vector<T>& block) {
-                block.resize(count * N);
-                for (std::size_t i = 0; i < count; ++i) {
-                    const std::array<T, N> r = row(first + i);
-                    std::copy(r.begin(), r.end(), block.begin() + std::ptrdiff_t(i * N));
-                }
-            },
-            [&](std::size_t first, std::size_t count, const std::vector<T>& block) {
-                put_block_rows(v, first, count, N, block.data(), name);
-            });
+    void put_rows(int v, std::size_t n, const Row& row) {
+        in_blocks<std::vector<T>>(n, [&](std::size_t first, std::size_t count, std::vector<T>& rows, Block& block) {
+            rows.resize(count * N);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::array<T, N> r = row(first + i);
+                std::copy(r.begin(), r.end(), rows.begin() + std::ptrdiff_t(i * N));
+            }
+            block.put(v, rows.data(), count);
+        });
     }
     /// put_rows for a variable of one value per row: value(i) returns row i's value.
     template <class T, class Value>
-    void put_values(int v, std::size_t n, const Value& value, const char* name) {
-        put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; }, name);
+    void put_values(int v, std::size_t n, const Value& value) {
+        put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; });
     }
 
     /// Writes the lon and lat of n points to variables v_lon and v_lat, point(i) giving point i
     /// (a unit vector), each converted once.
     template <class Point>
-    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point& point, const char* what) {
+    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point& point) {
         using LonLats = std::array<std::vector<double>, 2>;
-        const std::string lons = std::string(what) + " longitudes", lats = std::string(what) + " latitudes";
-        in_blocks<LonLats>(
-            n,
-            [&](std::size_t first, std::size_t count, LonLats& b) {
-                b[0].resize(count);
-                b[1].resize(count);
-                for (std::size_t i = 0; i < count; ++i) {
-                    const LonLat p = vec_to_lonlat(point(first + i));
-                    b[0][i] = p.lon;
-                    b[1][i] = p.lat;
-                }
-            },
-            [&](std::size_t first, std::size_t count, const LonLats& b) {
-                put_block_rows(v_lon, first, count, 1, b[0].data(), lons.c_str());
-                put_block_rows(v_lat, first, count, 1, b[1].data(), lats.c_str());
-            });
+        in_blocks<LonLats>(n, [&](std::size_t first, std::size_t count, LonLats& b, Block& block) {
+            b[0].resize(count);
+            b[1].resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const LonLat p = vec_to_lonlat(point(first + i));
+                b[0][i] = p.lon;
+                b[1][i] = p.lat;
+            }
+            block.put(v_lon, b[0].data(), count);
+            block.put(v_lat, b[1].data(), count);
+        });
     }
 
-    /// Writes rows first .. first + count - 1 of variable v (n_per_row values of type T, double or
-    /// int as the variable, a row) from data.
-    template <class T>
-    void put_block_rows(int v, std::size_t first, std::size_t count, std::size_t n_per_row, const T* data,
-                        const char* name) {
-        const std::size_t start[2] = {first, 0}, counts[2] = {count, n_per_row};
-        io::nc_check(put_block(v, start, counts, data), file_, std::string("writing ") + name);
-        rows_done_ += count;
-        report(progress_, double(rows_done_) / double(std::max<std::size_t>(rows_total_, 1)), "write_ugrid");
-    }
     static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
 
 private:
-    int put_block(int v, const std::size_t* start, const std::size_t* count, const double* data) {
-        return nc_put_vara_double(id_, v, start, count, data);
-    }
-    int put_block(int v, const std::size_t* start, const std::size_t* count, const int* data) {
-        return nc_put_vara_int(id_, v, start, count, data);
+    struct Shape {
+        std::string name;
+        std::size_t rows = 0, row_values = 1, chunk_rows = 0;
+    };
+
+    /// Stores a computed block whose rows start at `first`, and reports the progress.
+    void store(std::size_t first, const Block& block) {
+        for (std::size_t i = 0; i < block.used_; ++i) {
+            const Block::Piece& p = block.pieces_[i];
+            const Shape& s = shapes_[std::size_t(p.var)];
+            if (chunks_) {
+                chunks_->write(s.name, first, p.chunk);
+            } else {
+                const std::size_t start[2] = {first, 0}, count[2] = {p.rows, s.row_values};
+                const int status = p.is_double ? nc_put_vara_double(nc_.id(), p.var, start, count, static_cast<const double*>(p.data))
+                                               : nc_put_vara_int(nc_.id(), p.var, start, count, static_cast<const int*>(p.data));
+                io::nc_check(status, file_, "writing " + s.name);
+            }
+            rows_done_ += p.rows;
+            report(progress_, double(rows_done_) / double(std::max<std::size_t>(rows_total_, 1)), "write_ugrid");
+        }
     }
 
-    int id_;
+    io::NcHandle& nc_;
+    const std::filesystem::path& temp_;
     const std::filesystem::path& file_;
     bool compress_;
     const Progress& progress_;
+    std::vector<Shape> shapes_;          ///< by variable id (those with dimensions)
+    std::optional<io::Hdf5ChunkFile> chunks_; ///< a netCDF-4 file's, from start_data
     std::size_t rows_total_ = 0, rows_done_ = 0; ///< rows of all the variables, and written
 };
 
@@ -241,7 +376,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     nc.create(out.temp_path(), mode, path, "UGRID output");
     int old_fill;
     nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
-    UgridWriter w(nc.id(), path, !options.classic, options.progress);
+    UgridWriter w(nc, out.temp_path(), path, !options.classic, options.progress);
 
     const int d_node = w.dim("nMesh_node", nn), d_face = w.dim("nMesh_face", nf), d_edge = w.dim("nMesh_edge", ne);
     const int d_two = w.dim("Two", 2), d_three = w.dim("Three", 3);
@@ -313,11 +448,14 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     const char* node_coords = "mesh_node_lon mesh_node_lat";
     const char* face_coords = "mesh_face_lon mesh_face_lat";
     std::vector<int> node_vars, face_vars;
-    // Variable names in use; a field whose name is taken gets a "_node"/"_face" suffix.
+    // Variable and dimension names in use; a field whose name is taken gets a "_node"/"_face"
+    // suffix. (netCDF-4 stores a variable named as a dimension under another name in HDF5,
+    // where the chunks are written by name.)
     std::set<std::string> used = {"crs", "mesh", "quality", "area", "boundary_tag", "mesh_node_lon",
                                   "mesh_node_lat", "mesh_face_lon", "mesh_face_lat", "mesh_edge_lon",
                                   "mesh_edge_lat", "mesh_face_nodes", "mesh_edge_nodes", "mesh_face_edges",
-                                  "mesh_face_links", "mesh_edge_face_links", "mesh_boundary_nodes"};
+                                  "mesh_face_links", "mesh_edge_face_links", "mesh_boundary_nodes",
+                                  "nMesh_node", "nMesh_face", "nMesh_edge", "nMesh_boundary", "Two", "Three"};
     auto var_name = [&used](const std::string& name, const char* suffix) {
         std::string n = attribute_name(name);
         while (used.count(n)) n += suffix;
@@ -379,8 +517,9 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     const int zero = 0;
     io::nc_check(nc_put_var_int(nc.id(), crs, &zero), path, "writing crs", "UGRID output");
     io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
+    w.start_data();
 
-    // Every variable is computed block by block while it is written (UgridWriter::put_rows):
+    // Every variable is computed block by block while it is written (UgridWriter::in_blocks):
     // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
     // table: the edges' area terms (GeodesicFaceAreas, 24 bytes a node).
     auto centre = [&](std::size_t f) {
@@ -392,7 +531,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     };
     // The edges' geodesic problems (GeodesicFaceAreas), the writer's largest computation, run in
     // the background from here, while the variables before the face areas are computed and
-    // compressed (HDF5's deflate runs in this thread alone).
+    // compressed.
     std::atomic<bool> stop_solving{false};
     auto solve_edges = [&topo, &stop_solving] { return io::GeodesicFaceAreas(topo, &stop_solving); };
     std::future<io::GeodesicFaceAreas> areas_ahead;
@@ -410,13 +549,13 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
         const auto& t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
-    }, "face nodes");
+    });
     if (options.after_partial_write) options.after_partial_write();
-    w.put_lonlat(coord_vars[2], coord_vars[3], nf, centre, "face");
-    w.put_lonlat(coord_vars[4], coord_vars[5], ne, midpoint, "edge");
-    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); }, "edge nodes");
+    w.put_lonlat(coord_vars[2], coord_vars[3], nf, centre);
+    w.put_lonlat(coord_vars[4], coord_vars[5], ne, midpoint);
+    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
     {
-        w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; }, "node");
+        w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
         const io::GeodesicFaceAreas areas = areas_ahead.get();
         // Face edges, face neighbours and face areas a block of faces at a time (face_edges): no
         // face-to-edge table of the whole mesh (12 bytes a face) at the writer's peak.
@@ -425,47 +564,45 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
             std::vector<int> links;
             std::vector<double> area;
         };
-        UgridWriter::in_blocks<FaceRows>(
-            nf,
-            [&](std::size_t first, std::size_t count, FaceRows& b) {
-                io::face_edges(topo, first, count, b.edges);
-                b.links.resize(3 * count);
-                b.area.resize(count);
-                for (std::size_t i = 0; i < count; ++i) {
-                    const auto nb = io::face_faces(topo, &b.edges[3 * i], first + i);
-                    std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
-                    b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
-                }
-            },
-            [&](std::size_t first, std::size_t count, const FaceRows& b) {
-                w.put_block_rows(v_face_edges, first, count, 3, b.edges.data(), "face edges");
-                w.put_block_rows(v_face_links, first, count, 3, b.links.data(), "face neighbours");
-                w.put_block_rows(v_area, first, count, 1, b.area.data(), "area");
-            });
+        w.in_blocks<FaceRows>(nf, [&](std::size_t first, std::size_t count, FaceRows& b, UgridWriter::Block& block) {
+            io::face_edges(topo, first, count, b.edges);
+            b.links.resize(3 * count);
+            b.area.resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const auto nb = io::face_faces(topo, &b.edges[3 * i], first + i);
+                std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
+                b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
+            }
+            block.put(v_face_edges, b.edges.data(), count);
+            block.put(v_face_links, b.links.data(), count);
+            block.put(v_area, b.area.data(), count);
+        });
     }
-    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); }, "edge faces");
+    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); });
     if (nb)
-        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); },
-                           "boundary nodes");
+        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); });
     for (std::size_t i = 0; i < node_vars.size(); ++i) {
         const Field& f = mesh.node_fields[i];
-        w.put_values<double>(node_vars[i], nn, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());
+        w.put_values<double>(node_vars[i], nn, [&](std::size_t k) { return f.values[k]; });
     }
     w.put_values<double>(v_quality, nf, [&](std::size_t f) {
         const auto& t = mesh.faces[f];
         return triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
-    }, "quality");
+    });
     for (std::size_t i = 0; i < face_vars.size(); ++i) {
         const Field& f = *extra_face_fields[i];
-        w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; }, f.name.c_str());
+        w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; });
     }
-    std::size_t next_boundary = 0; // rows come in ascending order, as boundary_edges
-    w.put_values<int>(v_tag, ne, [&](std::size_t e) {
-        if (next_boundary < nb && std::size_t(topo.boundary_edges[next_boundary]) == e)
-            return topo.boundary_tags[next_boundary++];
-        return int(EdgeTag::interior);
-    }, "boundary tags");
-    nc.close(path, "UGRID output");
+    w.in_blocks<std::vector<int>>(ne, [&](std::size_t first, std::size_t count, std::vector<int>& tags,
+                                          UgridWriter::Block& block) {
+        tags.assign(count, int(EdgeTag::interior));
+        // boundary_edges ascend: those of this block follow the first at or after `first`.
+        auto b = std::lower_bound(topo.boundary_edges.begin(), topo.boundary_edges.end(), std::int32_t(first));
+        for (; b != topo.boundary_edges.end() && std::size_t(*b) < first + count; ++b)
+            tags[std::size_t(*b) - first] = topo.boundary_tags[std::size_t(b - topo.boundary_edges.begin())];
+        block.put(v_tag, tags.data(), count);
+    });
+    w.finish();
     out.commit();
 }
 

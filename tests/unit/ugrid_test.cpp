@@ -12,6 +12,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -379,6 +380,100 @@ TEST(Ugrid, same_mesh_gives_identical_bytes) {
     EXPECT_EQ(file_bytes(dir / "c.nc"), file_bytes(dir / "d.nc"));
 }
 
+// netCDF-4 variables are shuffled and deflated a chunk at a time on every core and stored as
+// whole chunks (hdf5_chunks.hpp); classic ones go through netCDF-C as they are. On a mesh of
+// several chunks a variable, with a partial last chunk, netCDF-C (HDF5's own filters) must read
+// every value of the first exactly as of the second, each variable must declare the filters
+// its chunks were made with, and two runs must give the same bytes, whatever the threads did.
+TEST(Ugrid, netcdf4_chunks_written_on_every_core_read_back_as_the_classic_file) {
+    TempDir dir;
+    const Mesh m = icosphere_with_holes(7); // over 65,536 rows in the node, face and edge variables
+    UgridOptions classic;
+    classic.classic = true;
+    write_ugrid(m, dir / "a.nc");
+    write_ugrid(m, dir / "b.nc");
+    write_ugrid(m, dir / "c.nc", classic);
+    EXPECT_EQ(file_bytes(dir / "a.nc"), file_bytes(dir / "b.nc"));
+    int a, c, nvars;
+    ASSERT_EQ(nc_open((dir / "a.nc").c_str(), NC_NOWRITE, &a), NC_NOERR);
+    ASSERT_EQ(nc_open((dir / "c.nc").c_str(), NC_NOWRITE, &c), NC_NOERR);
+    ASSERT_EQ(nc_inq_nvars(a, &nvars), NC_NOERR);
+    std::size_t multi_chunk = 0;
+    for (int v = 0; v < nvars; ++v) {
+        char name[NC_MAX_NAME + 1];
+        int ndims, dims[NC_MAX_VAR_DIMS], vc;
+        ASSERT_EQ(nc_inq_var(a, v, name, nullptr, &ndims, dims, nullptr), NC_NOERR);
+        SCOPED_TRACE(name);
+        ASSERT_EQ(nc_inq_varid(c, name, &vc), NC_NOERR);
+        std::size_t values = 1, rows = 1;
+        for (int k = 0; k < ndims; ++k) {
+            std::size_t len;
+            nc_inq_dimlen(a, dims[k], &len);
+            values *= len;
+            if (k == 0) rows = len;
+        }
+        std::vector<double> from_a(values), from_c(values);
+        ASSERT_EQ(nc_get_var_double(a, v, from_a.data()), NC_NOERR);
+        ASSERT_EQ(nc_get_var_double(c, vc, from_c.data()), NC_NOERR);
+        EXPECT_EQ(std::memcmp(from_a.data(), from_c.data(), values * sizeof(double)), 0);
+        if (ndims == 0) continue;
+        int shuffle, deflate, level, storage;
+        std::size_t chunk[NC_MAX_VAR_DIMS];
+        ASSERT_EQ(nc_inq_var_deflate(a, v, &shuffle, &deflate, &level), NC_NOERR);
+        ASSERT_EQ(nc_inq_var_chunking(a, v, &storage, chunk), NC_NOERR);
+        EXPECT_TRUE(shuffle && deflate && level == 1 && storage == NC_CHUNKED);
+        EXPECT_EQ(chunk[0], std::min<std::size_t>(rows, 65536));
+        multi_chunk += rows > 65536 && rows % 65536 != 0;
+    }
+    nc_close(a);
+    nc_close(c);
+    EXPECT_GE(multi_chunk, 10u); // coordinates, connectivities and fields of nodes, faces and edges
+    expect_mesh_verify(dir / "a.nc");
+}
+
+// A field named as a dimension or a fixed variable gets a suffix, in both formats: netCDF-4
+// would store a variable named as a dimension under another name in HDF5, and the chunks are
+// written by name (hdf5_chunks.hpp), so they would go to the dimension's own dataset.
+TEST(Ugrid, fields_named_as_dimensions_or_variables_are_written_under_suffixed_names) {
+    TempDir dir;
+    Mesh m = icosphere(2);
+    for (const char* name : {"Two", "nMesh_node", "quality"}) {
+        Field f{name, name, "1", "", {}};
+        for (const Vec3& p : m.nodes) f.values.push_back(p.x + 2 * p.y + 3 * p.z);
+        m.node_fields.push_back(f);
+    }
+    Field f{"nMesh_face", "faces", "1", "", {}};
+    for (std::size_t i = 0; i < m.faces.size(); ++i) f.values.push_back(double(i));
+    m.face_fields.push_back(f);
+    for (const bool classic : {false, true}) {
+        SCOPED_TRACE(classic ? "classic" : "netcdf4");
+        UgridOptions o;
+        o.classic = classic;
+        write_ugrid(m, dir / "o.nc", o);
+        int nc;
+        ASSERT_EQ(nc_open((dir / "o.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
+        auto values = [&](const char* name) {
+            int v;
+            std::size_t len = 0;
+            int dim;
+            std::vector<double> out;
+            if (nc_inq_varid(nc, name, &v) != NC_NOERR || nc_inq_vardimid(nc, v, &dim) != NC_NOERR) return out;
+            nc_inq_dimlen(nc, dim, &len);
+            out.resize(len);
+            EXPECT_EQ(nc_get_var_double(nc, v, out.data()), NC_NOERR);
+            return out;
+        };
+        EXPECT_EQ(values("Two_node"), m.node_fields[0].values);
+        EXPECT_EQ(values("nMesh_node_node"), m.node_fields[1].values);
+        EXPECT_EQ(values("quality_node"), m.node_fields[2].values);
+        EXPECT_EQ(values("nMesh_face_face"), m.face_fields[0].values);
+        EXPECT_EQ(values("Two"), std::vector<double>{}); // a dimension, no variable
+        EXPECT_EQ(values("quality").size(), m.faces.size());
+        nc_close(nc);
+        fs::remove(dir / "o.nc");
+    }
+}
+
 TEST(Ugrid, classic_format_is_netcdf3_and_reads_back_the_same) {
     TempDir dir;
     Mesh m = icosphere_with_holes(2);
@@ -476,11 +571,12 @@ TEST(Ugrid, run_cancelled_during_writing_leaves_no_partial_or_temporary_file) {
 }
 
 // A full disk, on a 1 MiB tmpfs mounted in a child process's own mount namespace (root only;
-// skipped elsewhere). netCDF-4 files of increasing size fail at different points: in a block's
-// write, or in the flush at the end, when the data of every variable of one chunk is still in
-// HDF5's cache. Each must give an IoError saying the disk is full and leave no file, and the
-// process must then exit normally: a flush that failed while closing left HDF5 holding the
-// file, and HDF5 crashed closing it again at exit (netcdf_handle.hpp).
+// skipped elsewhere). Files of increasing size fail in a block's write. Then one netCDF-4 file
+// that fits is written after fillers that leave it a little less room each time, down to none
+// for its data: some of those fail in the final flush, which writes HDF5's metadata (the chunk
+// indexes) after the data. Each must give an IoError saying the disk is full and leave no file,
+// and the process must then exit normally: a flush that failed while closing left HDF5 holding
+// the file, and HDF5 crashed closing it again at exit (netcdf_handle.hpp, hdf5_chunks.hpp).
 TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
     TempDir dir;
     const fs::path disk = dir / "disk", log = dir / "log.txt";
@@ -507,6 +603,26 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
                 }
                 out << (fs::is_empty(disk) ? "" : " FILES LEFT") << "\n";
             }
+        const Mesh m = icosphere(5);
+        write_ugrid(m, disk / "o.nc", {});
+        const auto size = std::uintmax_t(fs::file_size(disk / "o.nc"));
+        fs::remove(disk / "o.nc");
+        for (std::uintmax_t short_by = 0; short_by <= 64 * 1024; short_by += 4096) {
+            {
+                std::ofstream filler(disk / "filler", std::ios::binary);
+                filler << std::string(std::size_t((1u << 20) - size - 8192 + short_by), '\0');
+            }
+            out << "netcdf4 short by " << short_by << ": ";
+            try {
+                write_ugrid(m, disk / "o.nc", {});
+                out << "written";
+                fs::remove(disk / "o.nc");
+            } catch (const IoError& e) {
+                out << "error " << e.what();
+            }
+            fs::remove(disk / "filler");
+            out << (fs::is_empty(disk) ? "" : " FILES LEFT") << "\n";
+        }
         out.close();
         umount(disk.c_str());
         std::exit(0); // through the exit handlers, HDF5's among them
@@ -518,18 +634,24 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
     const std::string text = file_bytes(log);
     ASSERT_TRUE(WIFEXITED(status)) << "the process died of signal " << WTERMSIG(status) << " after:\n" << text;
     EXPECT_EQ(WEXITSTATUS(status), 0) << text;
-    int full = 0, at_flush = 0;
+    int full = 0, short_written = 0;
+    std::set<std::string> short_failed_at; // the steps where the one file failed
     std::istringstream lines(text);
     for (std::string line; std::getline(lines, line);) {
         EXPECT_EQ(line.find("FILES LEFT"), std::string::npos) << line;
-        if (line.find("error") == std::string::npos) continue;
+        const bool short_run = line.find("short by") != std::string::npos;
+        if (line.find("error") == std::string::npos) {
+            short_written += short_run;
+            continue;
+        }
         ++full;
-        at_flush += line.rfind("netcdf4", 0) == 0 && line.find(": writing: ") != std::string::npos;
         EXPECT_TRUE(line.find("(the disk is full)") != std::string::npos ||
                     line.find("No space left on device") != std::string::npos) << line;
+        if (short_run) short_failed_at.insert(line.substr(line.rfind(": ", line.find(": HDF error") - 1)));
     }
     EXPECT_GE(full, 4) << "too few of the files filled the disk:\n" << text;
-    EXPECT_GE(at_flush, 1) << "no netCDF-4 file failed in the final flush (the crash's path):\n" << text;
+    EXPECT_GE(short_written, 1) << "the file never fitted:\n" << text;
+    EXPECT_GE(short_failed_at.size(), 3u) << "the fillers did not stop the file at different steps:\n" << text;
 }
 
 // The writer reports the share of its rows written, and a callback that returns false stops it
