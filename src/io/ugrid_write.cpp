@@ -9,16 +9,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstring>
-#include <exception>
 #include <future>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
 #include <system_error>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -29,6 +25,7 @@
 #include "face_geometry.hpp"
 #include "hdf5_chunks.hpp"
 #include "mesh_topology.hpp"
+#include "ordered_blocks.hpp"
 #include "netcdf_handle.hpp"
 
 #ifndef GLOBEMESH_VERSION
@@ -49,7 +46,7 @@ constexpr const char* wgs84_wkt =
 /// Writes the variables of one file; every call checks its status.
 ///
 /// The variables' data are computed and written a block of block_rows rows (one chunk) at a
-/// time (in_blocks), on every core. A netCDF-4 file is defined and closed in netCDF-C first
+/// time (in_blocks), on every core (ordered_blocks.hpp). A netCDF-4 file is defined and closed in netCDF-C first
 /// (start_data), then each block's rows are shuffled and deflated on the thread that computed
 /// them and stored from this one as whole chunks (hdf5_chunks.hpp); a classic file's rows go
 /// through netCDF-C as they are.
@@ -153,100 +150,27 @@ public:
         std::size_t used_ = 0;
     };
 
-    /// Computes and stores the blocks of block_rows rows of n. compute(first, count, buffers,
-    /// block) fills `buffers` (its scratch, a Buffers kept from block to block) and puts each
-    /// variable's rows into `block`. It runs on every core, for several blocks at once in any
-    /// order, so it must only read shared data. The blocks are stored from this thread in
-    /// ascending order (the file does not depend on the timing), at most `window` blocks
-    /// behind the computing; this thread computes too while the next block to store is not
-    /// ready, and alone when no thread can be started.
+    /// Computes and stores the blocks of block_rows rows of n (compute_in_order). compute(first,
+    /// count, buffers, block) fills `buffers` (its scratch, a Buffers kept from block to block)
+    /// and puts each variable's rows into `block`; it runs on every core, for several blocks at
+    /// once in any order, so it must only read shared data. The blocks are stored in order.
     template <class Buffers, class Compute>
     void in_blocks(std::size_t n, const Compute& compute) {
-        const std::size_t blocks = (n + block_rows - 1) / block_rows;
-        if (blocks == 0) return;
         struct Slot {
             Buffers buffers{};
             Block block;
-            std::exception_ptr error;
-            bool ready = false;
         };
-        const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
-        std::vector<Slot> slots(std::min(blocks, threads));
-        std::mutex mutex;
-        std::condition_variable changed;
-        std::size_t claimed = 0, stored = 0;
-        bool stop = false;
-        // Computes the next block when one is left and its slot is free (the lock held on entry
-        // and on return); false otherwise.
-        auto compute_next = [&](std::unique_lock<std::mutex>& lock, io::ChunkEncoder* encoder) {
-            if (stop || claimed == blocks || claimed == stored + slots.size()) return false;
-            const std::size_t k = claimed++;
-            Slot& slot = slots[k % slots.size()];
-            lock.unlock();
-            try {
+        io::compute_in_order<Slot, std::optional<io::ChunkEncoder>>(
+            (n + block_rows - 1) / block_rows,
+            [&](std::size_t k, Slot& slot, std::optional<io::ChunkEncoder>& encoder) {
+                if (compress_ && !encoder) encoder.emplace();
                 slot.block.writer_ = this;
-                slot.block.encoder_ = encoder;
+                slot.block.encoder_ = encoder ? &*encoder : nullptr;
                 slot.block.used_ = 0;
                 const std::size_t first = k * block_rows;
                 compute(first, std::min(block_rows, n - first), slot.buffers, slot.block);
-            } catch (...) {
-                slot.error = std::current_exception();
-            }
-            lock.lock();
-            slot.ready = true;
-            changed.notify_all();
-            return true;
-        };
-        auto work = [&] {
-            std::optional<io::ChunkEncoder> encoder;
-            std::unique_lock lock(mutex);
-            try {
-                if (compress_) encoder.emplace();
-            } catch (...) {
-                return; // no memory for an encoder: the others do this one's share
-            }
-            while (!stop && claimed < blocks)
-                if (!compute_next(lock, encoder ? &*encoder : nullptr)) changed.wait(lock);
-        };
-        std::vector<std::thread> pool;
-        // Stops and joins the threads however this returns.
-        struct Join {
-            std::vector<std::thread>& pool;
-            std::mutex& mutex;
-            bool& stop;
-            std::condition_variable& changed;
-            ~Join() {
-                {
-                    std::lock_guard lock(mutex);
-                    stop = true;
-                }
-                changed.notify_all();
-                for (auto& t : pool) t.join();
-            }
-        } join{pool, mutex, stop, changed};
-        try {
-            for (std::size_t t = 1; t < threads && t < blocks; ++t) pool.emplace_back(work);
-        } catch (const std::system_error&) {
-            // No more threads (a process limit): fewer compute, this one among them.
-        }
-        std::optional<io::ChunkEncoder> encoder;
-        if (compress_) encoder.emplace();
-        for (std::size_t k = 0; k < blocks; ++k) {
-            Slot& slot = slots[k % slots.size()];
-            {
-                std::unique_lock lock(mutex);
-                while (!slot.ready)
-                    if (!compute_next(lock, encoder ? &*encoder : nullptr)) changed.wait(lock);
-            }
-            if (slot.error) std::rethrow_exception(slot.error);
-            store(k * block_rows, slot.block);
-            {
-                std::lock_guard lock(mutex);
-                slot.ready = false;
-                ++stored;
-            }
-            changed.notify_all();
-        }
+            },
+            [&](std::size_t k, const Slot& slot) { store(k * block_rows, slot.block); });
     }
 
     /// in_blocks for one variable of N values of type T (double or int, as the variable) a row:
