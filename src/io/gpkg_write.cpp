@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include <ogrsf_frmts.h>
@@ -23,6 +24,7 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
 #include "mesh_topology.hpp"
+#include "ordered_blocks.hpp"
 
 #ifndef GLOBEMESH_VERSION
 #define GLOBEMESH_VERSION "unknown"
@@ -302,29 +304,51 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
         // every core). Freed before the nodes.
         const io::GeodesicFaceAreas areas(topo);
-        std::vector<std::int32_t> edges;
         std::vector<io::RtreeBox>& boxes = indexes.emplace_back(io::RtreeLayer{"faces", "geom", {}}).boxes;
         boxes.reserve(mesh.faces.size());
-        for (std::size_t i = 0; i < mesh.faces.size(); ++i) {
-            if (i % 16384 == 0) report(options.progress, face_share * double(i) / double(mesh.faces.size()), "write_gpkg");
-            io::face_edges(topo, i, 1, edges);
-            const auto& t = mesh.faces[i];
-            OGRFeature feature(faces->GetLayerDefn());
-            feature.SetFID(GIntBig(i) + 1);
-            feature.SetField("face", int(i));
-            feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-            feature.SetField("area_km2", areas.face_m2(i, edges.data()) * 1e-6);
-            auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
-            if (depth) feature.SetField("depth", mean(depth));
-            if (size) feature.SetField("target_size", mean(size));
-            for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
-            auto* multi = new OGRMultiPolygon();
-            for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-                for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
-            boxes.push_back(box_of(*multi));
-            feature.SetGeometryDirectly(multi);
-            w.add(faces, feature);
-        }
+        // The features (fields, geometry cut at +-180, box) are made a block at a time on every
+        // core, and added in order from this thread, the one that calls GDAL
+        // (ordered_blocks.hpp): the same file, with GDAL's CreateFeature alone on this thread.
+        OGRFeatureDefn* defn = faces->GetLayerDefn();
+        struct FaceBlock {
+            std::vector<std::unique_ptr<OGRFeature>> features;
+            std::vector<io::RtreeBox> boxes;
+        };
+        struct Scratch {
+            std::vector<std::int32_t> edges;
+        };
+        constexpr std::size_t block_faces = 4096;
+        io::compute_in_order<FaceBlock, Scratch>(
+            (mesh.faces.size() + block_faces - 1) / block_faces,
+            [&](std::size_t k, FaceBlock& b, Scratch& scratch) {
+                const std::size_t first = k * block_faces, last = std::min(mesh.faces.size(), first + block_faces);
+                b.features.clear(); // the previous block's, freed on this thread rather than GDAL's
+                b.boxes.clear();
+                for (std::size_t i = first; i < last; ++i) {
+                    io::face_edges(topo, i, 1, scratch.edges);
+                    const auto& t = mesh.faces[i];
+                    auto& feature = *b.features.emplace_back(std::make_unique<OGRFeature>(defn));
+                    feature.SetFID(GIntBig(i) + 1);
+                    feature.SetField("face", int(i));
+                    feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
+                    feature.SetField("area_km2", areas.face_m2(i, scratch.edges.data()) * 1e-6);
+                    auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
+                    if (depth) feature.SetField("depth", mean(depth));
+                    if (size) feature.SetField("target_size", mean(size));
+                    for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
+                    auto* multi = new OGRMultiPolygon();
+                    for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
+                        for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
+                    b.boxes.push_back(box_of(*multi));
+                    feature.SetGeometryDirectly(multi);
+                }
+            },
+            [&](std::size_t k, FaceBlock& b) {
+                if (k % 4 == 0)
+                    report(options.progress, face_share * double(k * block_faces) / double(mesh.faces.size()), "write_gpkg");
+                for (auto& feature : b.features) w.add(faces, *feature);
+                boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
+            });
     }
     if (options.after_partial_write) options.after_partial_write();
 

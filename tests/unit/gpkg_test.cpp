@@ -128,7 +128,7 @@ std::map<GIntBig, OGREnvelope> envelopes(OGRLayer* layer) {
 
 TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     TempDir dir;
-    Mesh m = icosphere_with_holes(3);
+    Mesh m = icosphere_with_holes(5); // the faces' features are made in blocks of 4,096 on every core
     m.attributes = {{"coast", "land.gpkg"}};
     write_gpkg(m, dir / "m.gpkg");
     Dataset d(dir / "m.gpkg");
@@ -153,10 +153,14 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     const auto& depth = m.node_field("depth")->values;
     EXPECT_NEAR(f7->GetFieldAsDouble("depth"), (depth[t[0]] + depth[t[1]] + depth[t[2]]) / 3, 1e-9);
     EXPECT_NEAR(f7->GetFieldAsDouble("quality"), triangle_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]]), 1e-12);
-    // Every face's area_km2: GeographicLib's PolygonArea of its corners (the writer shares each
-    // edge's geodesic problem between its two faces).
+    // Every face's number, quality and area_km2, the area GeographicLib's PolygonArea of its
+    // corners (the writer shares each edge's geodesic problem between its two faces).
+    GIntBig fid = 0;
     for (auto& f : *faces) {
+        EXPECT_EQ(f->GetFID(), ++fid);
+        EXPECT_EQ(f->GetFieldAsInteger("face"), fid - 1);
         const auto& c = m.faces[std::size_t(f->GetFID() - 1)];
+        EXPECT_EQ(f->GetFieldAsDouble("quality"), triangle_quality(m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]]));
         GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
         for (NodeIndex k : c) poly.AddPoint(vec_to_lonlat(m.nodes[k]).lat, vec_to_lonlat(m.nodes[k]).lon);
         double perimeter, area_m2;
