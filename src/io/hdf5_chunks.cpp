@@ -1,12 +1,10 @@
 // Direct chunk writes of a netCDF-4 file's compressed variables: see hdf5_chunks.hpp.
 #include "hdf5_chunks.hpp"
 
-#include <cstring>
 #include <new>
 
 #include <libdeflate.h>
 
-#include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "netcdf_handle.hpp"
 
@@ -37,9 +35,12 @@ void ChunkEncoder::encode(const void* data, std::size_t rows, std::size_t chunk_
 Hdf5ChunkFile::Hdf5ChunkFile(const fs::path& temp, const fs::path& target, const char* what)
     : temp_(temp), target_(target), what_(what) {
     file_ = H5Fopen(temp.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    if (file_ < 0)
-        throw IoError(std::string(what) + " " + target.string() + ": reopening the file for its data: HDF error" +
-                      OutputFile::full_disk_note(target));
+    if (file_ < 0) throw failure("reopening the file for its data");
+}
+
+IoError Hdf5ChunkFile::failure(const std::string& step) const {
+    return IoError(std::string(what_) + " " + target_.string() + ": " + step + ": HDF error" +
+                   OutputFile::full_disk_note(target_));
 }
 
 Hdf5ChunkFile::~Hdf5ChunkFile() {
@@ -61,30 +62,22 @@ void Hdf5ChunkFile::close_datasets() {
 }
 
 void Hdf5ChunkFile::write(const std::string& name, std::size_t first_row, const std::vector<unsigned char>& chunk) {
-    auto fail = [&](const char* step) {
-        return IoError(std::string(what_) + " " + target_.string() + ": " + step + " " + name + ": HDF error" +
-                       OutputFile::full_disk_note(target_));
-    };
     auto it = datasets_.find(name);
     if (it == datasets_.end()) {
         const hid_t id = H5Dopen2(file_, name.c_str(), H5P_DEFAULT);
-        if (id < 0) throw fail("opening");
+        if (id < 0) throw failure("opening " + name);
         it = datasets_.emplace(name, id).first;
     }
     const hsize_t offset[2] = {hsize_t(first_row), 0}; // rank 1 or 2: only the rows are chunked
-    if (H5Dwrite_chunk(it->second, H5P_DEFAULT, 0, offset, chunk.size(), chunk.data()) < 0) throw fail("writing");
+    if (H5Dwrite_chunk(it->second, H5P_DEFAULT, 0, offset, chunk.size(), chunk.data()) < 0) throw failure("writing " + name);
 }
 
 void Hdf5ChunkFile::close() {
     close_datasets();
-    if (H5Fflush(file_, H5F_SCOPE_LOCAL) < 0)
-        throw IoError(std::string(what_) + " " + target_.string() + ": writing: HDF error" +
-                      OutputFile::full_disk_note(target_));
+    if (H5Fflush(file_, H5F_SCOPE_LOCAL) < 0) throw failure("writing");
     const hid_t id = file_;
     file_ = H5I_INVALID_HID;
-    if (H5Fclose(id) < 0)
-        throw IoError(std::string(what_) + " " + target_.string() + ": closing: HDF error" +
-                      OutputFile::full_disk_note(target_));
+    if (H5Fclose(id) < 0) throw failure("closing");
 }
 
 } // namespace globemesh::io

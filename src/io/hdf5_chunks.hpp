@@ -19,6 +19,8 @@
 
 #include <hdf5.h>
 
+#include "globemesh/error.hpp"
+
 struct libdeflate_compressor;
 
 namespace globemesh::io {
@@ -62,6 +64,8 @@ public:
 
 private:
     void close_datasets();
+    /// The IoError of a failed HDF5 call at `step`.
+    IoError failure(const std::string& step) const;
 
     std::filesystem::path temp_, target_;
     const char* what_;

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <cstdint>
 #include <future>
-#include <system_error>
 #include <utility>
 #include <vector>
 
 #include "globemesh/ugrid.hpp"
 #include "mesh_topology.hpp"
+#include "ordered_blocks.hpp"
 
 namespace globemesh {
 
@@ -93,15 +93,8 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
         s.quality_above_0_8 = double(above) / double(mesh.faces.size());
         s.area_km2 = area * earth_radius_km * earth_radius_km;
     };
-    auto start = [](const auto& task) {
-        try {
-            return std::async(std::launch::async, task);
-        } catch (const std::system_error&) {
-            return std::async(std::launch::deferred, task); // no thread to be had: in turn
-        }
-    };
     // Joined before `s` is returned, or by their destructors should the edges throw.
-    std::future<void> nodes_done = start(node_extent), faces_done = start(face_quality_and_area);
+    std::future<void> nodes_done = start_task(node_extent), faces_done = start_task(face_quality_and_area);
     const Field* size = mesh.node_field("target_size");
     s.has_size = size && size->values.size() == mesh.nodes.size();
     if (topo.edge_count() > 0) {

@@ -6,13 +6,14 @@
 // computed from the mesh alone. So block k is computed on any thread, into a slot of its own,
 // and stored by the calling thread once blocks 0 .. k - 1 are: the file does not depend on the
 // timing. The calling thread computes too while the next block to store is not ready, and alone
-// when no thread can be started.
+// when no thread can be started. start_task runs one computation beside the caller the same way.
 #pragma once
 
 #include <algorithm>
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
+#include <future>
 #include <mutex>
 #include <system_error>
 #include <thread>
@@ -22,6 +23,17 @@ namespace globemesh::io {
 
 /// Threads for the writers' blocks: one per core, at most 8.
 inline std::size_t block_threads() { return std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8); }
+
+/// std::async(task) on a thread of its own, or deferred (run in turn when its result is asked
+/// for) when the process may start no more threads.
+template <class Task>
+auto start_task(const Task& task) {
+    try {
+        return std::async(std::launch::async, task);
+    } catch (const std::system_error&) {
+        return std::async(std::launch::deferred, task);
+    }
+}
 
 /// Runs compute(k, slot, worker) for each block k in 0 .. blocks - 1 on up to block_threads()
 /// threads, then store(k, slot) on this thread in ascending k. A Slot holds a block's results
@@ -68,7 +80,6 @@ void compute_in_order(std::size_t blocks, const Compute& compute, const Store& s
                 if (!compute_next(lock, worker)) changed.wait(lock);
         } catch (...) {
             // No memory for the worker's scratch: the other threads do its share.
-            if (!lock.owns_lock()) lock.lock();
         }
     };
     std::vector<std::thread> pool;

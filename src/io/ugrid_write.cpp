@@ -14,7 +14,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <system_error>
 #include <type_traits>
 #include <vector>
 
@@ -46,10 +45,10 @@ constexpr const char* wgs84_wkt =
 /// Writes the variables of one file; every call checks its status.
 ///
 /// The variables' data are computed and written a block of block_rows rows (one chunk) at a
-/// time (in_blocks), on every core (ordered_blocks.hpp). A netCDF-4 file is defined and closed in netCDF-C first
-/// (start_data), then each block's rows are shuffled and deflated on the thread that computed
-/// them and stored from this one as whole chunks (hdf5_chunks.hpp); a classic file's rows go
-/// through netCDF-C as they are.
+/// time (in_blocks), on every core (ordered_blocks.hpp). A netCDF-4 file is defined and closed
+/// in netCDF-C first (start_data), then each block's rows are shuffled and deflated on the
+/// thread that computed them and stored from this one as whole chunks (hdf5_chunks.hpp); a
+/// classic file's rows go through netCDF-C as they are.
 class UgridWriter {
 public:
     UgridWriter(io::NcHandle& nc, const std::filesystem::path& temp, const std::filesystem::path& file, bool compress,
@@ -458,12 +457,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     // compressed.
     std::atomic<bool> stop_solving{false};
     auto solve_edges = [&topo, &stop_solving] { return io::GeodesicFaceAreas(topo, &stop_solving); };
-    std::future<io::GeodesicFaceAreas> areas_ahead;
-    try {
-        areas_ahead = std::async(std::launch::async, solve_edges);
-    } catch (const std::system_error&) {
-        areas_ahead = std::async(std::launch::deferred, solve_edges); // no thread to be had: when needed
-    }
+    std::future<io::GeodesicFaceAreas> areas_ahead = io::start_task(solve_edges);
     // A failure or a cancel before the areas are taken stops their computation: the future's
     // destructor waits for it (at 1e7 nodes, a minute).
     struct StopOnExit {
