@@ -18,6 +18,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/predicates.hpp"
 #include "../delaunay/hilbert.hpp"
+#include "star_search.hpp"
 
 namespace globemesh {
 
@@ -87,6 +88,7 @@ constexpr int improve_rounds = 6;
 constexpr double count_quality = 0.8;
 constexpr double count_cap = 0.82;
 constexpr double count_worst_weight = 1000; // the worst up to worst_goal comes first
+constexpr detail::CountRule count_rule{worst_goal, count_quality, count_cap, count_worst_weight};
 // In the same rounds a boundary node (not at a sharp corner, between two coast segments of one
 // ring) slides where its ocean star scores best, to points within slide_reach times h of the
 // source coast (LandTest::coast_within; the issue asks for h/4 at the 95th percentile), where
@@ -192,81 +194,20 @@ constexpr std::uint8_t ocean = 1;
 constexpr int next3(int i) { return i == 2 ? 0 : i + 1; }
 constexpr int prev3(int i) { return i == 0 ? 2 : i - 1; }
 
-/// A far edge b -> c of a star (its triangle v, b, c for the centre v), with what the tests of
-/// many candidate centres p share: the minors of orient(p, b, c) and |b - c|.
-struct FarEdge : predicates::OrientEdge {
-    double length;
-    FarEdge(const Vec3& b_, const Vec3& c_) : OrientEdge(b_, c_), length(norm(b_ - c_)) {}
-};
-
-/// The worst quality of the star triangles p, b, c for the star's far edges b -> c (counter-
-/// clockwise around the star's centre), or -1 when p would fold one of them (move_vertex's test).
-/// With `floor`, stops at the first triangle at or below it and returns that triangle's
-/// quality: a value at or below floor, no smaller than the worst (for callers that only ask
-/// whether the worst beats floor; the moves of the improve stage evaluate candidates so).
-double star_worst_quality(const Vec3& p, const std::vector<FarEdge>& far,
-                          double floor = -2.0) {
-    double worst = 1;
-    for (const FarEdge& e : far) {
-        if (predicates::orient(p, e) <= 0) return -1.0;
-        worst = std::min(worst, triangle_quality(p, e.b, e.c, e.length));
-        if (worst <= floor) return worst;
-    }
-    return worst;
-}
-
-/// The quality rounds' score of the star triangles p, b, c (far edges b -> c): count_worst_weight
-/// times the worst quality up to worst_goal, plus 1 for each triangle above count_quality and its quality
-/// capped at count_cap. A higher score first has a better worst below worst_goal, then more
-/// triangles above count_quality or, as many, closer to it. -1 when p would fold a triangle or
-/// bring one below `floor`. With `beat`, returns as soon as the score can no longer exceed it
-/// (a value at or below beat).
-double star_count_score(const Vec3& p, const std::vector<FarEdge>& far, double floor,
-                        double beat = -2.0) {
-    double score = 0, worst = worst_goal, left = static_cast<double>(far.size());
-    for (const FarEdge& e : far) {
-        if (predicates::orient(p, e) <= 0) return -1.0;
-        const double q = triangle_quality(p, e.b, e.c, e.length);
-        if (q < floor) return -1.0;
-        worst = std::min(worst, q);
-        score += (q > count_quality ? 1.0 : 0.0) + std::min(q, count_cap);
-        left -= 1;
-        // What the triangles left could add at most.
-        if (count_worst_weight * worst + score + left * (1 + count_cap) <= beat) return beat;
-    }
-    return count_worst_weight * worst + score;
-}
+using detail::FarEdge;
+using detail::pattern_search;
+using detail::Points8;
+using detail::star_count_accepts;
+using detail::star_count_best;
+using detail::star_count_score;
+using detail::star_worst_accepts;
+using detail::star_worst_quality;
 
 /// How many of the star triangles p, b, c (far edges b -> c) have their centroid on land.
 int star_faces_on_land(const LandTest& land, const Vec3& p, const std::vector<FarEdge>& far) {
     int n = 0;
     for (const FarEdge& e : far) n += land.contains(normalized(p + e.b + e.c));
     return n;
-}
-
-/// The highest star_count_score of a star of n triangles: all above count_cap.
-double star_count_best(std::size_t n) { return count_worst_weight * worst_goal + double(n) * (1 + count_cap); }
-
-/// A pattern search on the sphere from `to`: the eight directions at `step` around it, moving
-/// to the last that consider(p) accepts (consider keeps the best so far), the step halved when
-/// none is accepted, until it is no longer above `stop`. Returns where it ends.
-template <class Consider>
-Vec3 pattern_search(Vec3 to, double step, double stop, Consider&& consider) {
-    // cos and sin of k pi / 4.
-    constexpr double r = 0.70710678118654752440;
-    constexpr double cosines[8] = {1, r, 0, -r, -1, -r, 0, r}, sines[8] = {0, r, 1, r, 0, -r, -1, -r};
-    while (step > stop) {
-        const Vec3 e1 = normalized(cross(to, std::abs(to.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
-        const Vec3 e2 = cross(to, e1);
-        Vec3 next = to;
-        for (int k = 0; k < 8; ++k) {
-            const Vec3 p = normalized(to + step * (cosines[k] * e1 + sines[k] * e2));
-            if (consider(p)) next = p;
-        }
-        if (next == to) step *= 0.5;
-        else to = next;
-    }
-    return to;
 }
 
 /// True when moving the star's centre from `at` to `to` (far: its far edges) would bring the
@@ -2595,11 +2536,11 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             if (!m.ocean_star(from, far)) return;
             const Vec3 p0 = dt.point(v);
             const double floor = std::min(star_worst_quality(p0, far), worst_goal);
-            double best = star_count_score(p0, far, floor);
-            if (best >= star_count_best(far.size())) return; // every triangle above count_cap
+            double best = star_count_score(p0, far, count_rule, floor);
+            if (best >= star_count_best(far.size(), count_rule)) return; // every triangle above count_cap
             Vec3 to = p0;
             auto consider = [&](const Vec3& p) {
-                const double score = star_count_score(p, far, floor, best + 1e-12);
+                const double score = star_count_score(p, far, count_rule, floor, best + 1e-12);
                 if (score <= best + 1e-12) return false;
                 best = score;
                 to = p;
@@ -2608,7 +2549,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             // Half the search rounds' first step, and 4 halvings instead of 6.
             const double step = 0.5 * star_candidates(p0);
             for (const Vec3& p : candidates) consider(p);
-            if (best < star_count_best(far.size())) to = pattern_search(to, step, step / 16, consider);
+            if (best < star_count_best(far.size(), count_rule))
+                to = pattern_search(to, step, step / 16, [&](const Points8& p) { return star_count_accepts(p, far, count_rule, floor, best); });
             if (to != p0) move_checked(v, from, to, floor, changed);
         };
         // The same for boundary node v, between two coast segments of one ring, neither end a
@@ -2622,8 +2564,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             const Vec3 p0 = dt.point(v);
             const double reach = slide_reach * km_to_rad(size_km(p0));
             const double floor = std::min(star_worst_quality(p0, far), worst_goal);
-            double best = star_count_score(p0, far, floor);
-            if (best >= star_count_best(far.size())) return; // every triangle above count_cap
+            double best = star_count_score(p0, far, count_rule, floor);
+            if (best >= star_count_best(far.size(), count_rule)) return; // every triangle above count_cap
             // The search scores the star alone; the coast and land rules are checked on the points
             // it improved through, from the best back.
             chain.clear();
@@ -2631,7 +2573,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             auto consider = [&](const Vec3& p) {
                 for (const FarEdge& e : land_far)
                     if (predicates::orient(p, e) <= 0) return false;
-                const double score = star_count_score(p, far, floor, best + 1e-12);
+                const double score = star_count_score(p, far, count_rule, floor, best + 1e-12);
                 if (score <= best + 1e-12) return false;
                 best = score;
                 to = p;
@@ -2641,7 +2583,13 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             for (VertexId e : ends)
                 for (double f : {0.1, 0.2, 0.3}) consider(normalized((1 - f) * p0 + f * dt.point(e)));
             const double step = 0.5 * reach;
-            if (best < star_count_best(far.size())) pattern_search(to, step, step / 8, consider);
+            if (best < star_count_best(far.size(), count_rule))
+                pattern_search(to, step, step / 8, [&](const Points8& p) {
+                    const unsigned accepted = star_count_accepts(p, far, count_rule, floor, best, &land_far);
+                    for (int k = 0; k < 8; ++k)
+                        if (accepted >> k & 1u) chain.push_back(p[k]);
+                    return accepted;
+                });
             // The star's faces centred on land where it is now are counted only when a point
             // has some (rarely: most stars have none either way).
             int land0 = -1;
@@ -2674,7 +2622,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
             };
             const double step = star_candidates(p0);
             for (const Vec3& p : candidates) consider(p);
-            if (best < worst_goal) to = pattern_search(to, step, step / 64, consider);
+            if (best < worst_goal)
+                to = pattern_search(to, step, step / 64, [&](const Points8& p) { return star_worst_accepts(p, far, best); });
             if (to != p0) move_checked(v, from, to, std::min(before, worst_goal), nullptr);
         };
         collect(0.9, false, options.land ? &slide_todo : nullptr);
