@@ -22,6 +22,13 @@ bool positive(double v) { return std::isfinite(v) && v > 0; }
 /// leave mesh-verify's boundary crossing test to rounding (it then reports crossings).
 constexpr double max_hmax_km = 5000;
 
+/// A length as the options take it back: "2.5km".
+std::string km(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%gkm", v);
+    return buf;
+}
+
 /// Below this no run fits: the smallest meshes and GDAL's own buffers take more.
 constexpr std::uint64_t min_memory_budget_bytes = 1'000'000;
 
@@ -32,9 +39,8 @@ void validate(const MeshOptions& o) {
     require(o.hmax_km <= max_hmax_km, "--hmax must be at most " + std::to_string(int(max_hmax_km)) +
                                           "km (an eighth of the Earth's circumference)");
     require(std::isfinite(o.hmin_km) && o.hmin_km >= 0, "--hmin must be a positive length, e.g. 10km");
-    require(o.hmin_km <= o.hmax_km, "--hmin (" + std::to_string(o.hmin_km) +
-                                        " km) must not be larger than --hmax (" +
-                                        std::to_string(o.hmax_km) + " km)");
+    require(o.hmin_km <= o.hmax_km,
+            "--hmin (" + km(o.hmin_km) + ") must not be larger than --hmax (" + km(o.hmax_km) + ")");
     require(std::isfinite(o.coast_size_km) && o.coast_size_km >= 0,
             "--coast-size must be a positive length, e.g. 20km");
     require(std::isfinite(o.coast_rate) && o.coast_rate >= 0, "--coast-rate must be >= 0");

@@ -403,7 +403,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"hmax_beyond_an_eighth_of_the_globe", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5001km"}, 2, "--hmax must be at most 5000km"},
         ErrorCase{"max_nodes_not_whole", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--max-nodes", "2.5e-1"}, 2, "--max-nodes: '2.5e-1' is not a whole number"},
         ErrorCase{"gpkg_to_a_device", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "/dev/null", "--overwrite"}, 1, "/dev/null is not a regular file"},
-        ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20km"}, 2, "--hmin"},
+        ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20.5km"}, 2, "--hmin (20.5km) must not be larger than --hmax (10km)"},
         ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
         ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
         ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
