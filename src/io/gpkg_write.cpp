@@ -204,6 +204,31 @@ OGRPolygon* polygon_of(const io::LonLatPart& ring) {
     return p;
 }
 
+/// Sets the feature's geometry to a multipolygon of one ring per part: in place when it holds one
+/// of as many polygons with rings of as many points, else a new one.
+void set_polygons(OGRFeature& feature, const std::vector<io::LonLatPart>& parts) {
+    if (OGRGeometry* g = feature.GetGeometryRef(); g && wkbFlatten(g->getGeometryType()) == wkbMultiPolygon) {
+        OGRMultiPolygon* multi = g->toMultiPolygon();
+        bool same = multi->getNumGeometries() == int(parts.size());
+        for (int p = 0; same && p < int(parts.size()); ++p) {
+            const OGRPolygon* polygon = multi->getGeometryRef(p);
+            same = polygon->getNumInteriorRings() == 0 && polygon->getExteriorRing() &&
+                   polygon->getExteriorRing()->getNumPoints() == int(parts[std::size_t(p)].size() + 1);
+        }
+        if (same) {
+            for (int p = 0; p < int(parts.size()); ++p) {
+                const io::LonLatPart& ring = parts[std::size_t(p)];
+                OGRLinearRing* r = multi->getGeometryRef(p)->getExteriorRing();
+                for (std::size_t i = 0; i <= ring.size(); ++i) r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
+            }
+            return;
+        }
+    }
+    auto* multi = new OGRMultiPolygon();
+    for (const auto& part : parts) multi->addGeometryDirectly(polygon_of(part));
+    feature.SetGeometryDirectly(multi);
+}
+
 /// Boundary edges chained into loops, each loop split into runs of one tag.
 struct BoundaryRun {
     std::vector<NodeIndex> nodes;
@@ -310,8 +335,19 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         // core, and added in order from this thread, the one that calls GDAL
         // (ordered_blocks.hpp): the same file, with GDAL's CreateFeature alone on this thread.
         OGRFeatureDefn* defn = faces->GetLayerDefn();
+        const int face_field = defn->GetFieldIndex("face"), quality_field = defn->GetFieldIndex("quality"),
+                  area_field = defn->GetFieldIndex("area_km2");
+        const int depth_field = depth ? defn->GetFieldIndex("depth") : -1;
+        const int size_field = size ? defn->GetFieldIndex("target_size") : -1;
+        std::vector<int> face_field_index;
+        for (const Field* f : face_fields) face_field_index.push_back(defn->GetFieldIndex(f->name.c_str()));
+        // A slot's features are made once and refilled for each block it holds (every field
+        // is set again; a face's polygon takes the new corners in place when it has as many
+        // parts and points as before): a feature made and freed per face cost as much as the
+        // rest of the face (allocations, and the layer definition's reference count).
         struct FaceBlock {
             std::vector<std::unique_ptr<OGRFeature>> features;
+            std::size_t count = 0; // the features of this block: the first count
             std::vector<io::RtreeBox> boxes;
         };
         struct Scratch {
@@ -322,31 +358,32 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
             (mesh.faces.size() + block_faces - 1) / block_faces,
             [&](std::size_t k, FaceBlock& b, Scratch& scratch) {
                 const std::size_t first = k * block_faces, last = std::min(mesh.faces.size(), first + block_faces);
-                b.features.clear(); // the previous block's, freed on this thread rather than GDAL's
+                b.count = last - first;
+                while (b.features.size() < b.count) b.features.push_back(std::make_unique<OGRFeature>(defn));
                 b.boxes.clear();
                 for (std::size_t i = first; i < last; ++i) {
                     io::face_edges(topo, i, 1, scratch.edges);
                     const auto& t = mesh.faces[i];
-                    auto& feature = *b.features.emplace_back(std::make_unique<OGRFeature>(defn));
+                    OGRFeature& feature = *b.features[i - first];
                     feature.SetFID(GIntBig(i) + 1);
-                    feature.SetField("face", int(i));
-                    feature.SetField("quality", triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-                    feature.SetField("area_km2", areas.face_m2(i, scratch.edges.data()) * 1e-6);
+                    feature.SetField(face_field, int(i));
+                    feature.SetField(quality_field, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
+                    feature.SetField(area_field, areas.face_m2(i, scratch.edges.data()) * 1e-6);
                     auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
-                    if (depth) feature.SetField("depth", mean(depth));
-                    if (size) feature.SetField("target_size", mean(size));
-                    for (const Field* f : face_fields) feature.SetField(f->name.c_str(), f->values[i]);
-                    auto* multi = new OGRMultiPolygon();
+                    if (depth) feature.SetField(depth_field, mean(depth));
+                    if (size) feature.SetField(size_field, mean(size));
+                    for (std::size_t f = 0; f < face_fields.size(); ++f) feature.SetField(face_field_index[f], face_fields[f]->values[i]);
+                    std::vector<io::LonLatPart> parts;
                     for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-                        for (const auto& part : narrow_rings(std::move(ring))) multi->addGeometryDirectly(polygon_of(part));
-                    b.boxes.push_back(box_of(*multi));
-                    feature.SetGeometryDirectly(multi);
+                        for (auto& part : narrow_rings(std::move(ring))) parts.push_back(std::move(part));
+                    set_polygons(feature, parts);
+                    b.boxes.push_back(box_of(*feature.GetGeometryRef()));
                 }
             },
             [&](std::size_t k, FaceBlock& b) {
                 if (k % 4 == 0)
                     report(options.progress, face_share * double(k * block_faces) / double(mesh.faces.size()), "write_gpkg");
-                for (auto& feature : b.features) w.add(faces, *feature);
+                for (std::size_t f = 0; f < b.count; ++f) w.add(faces, *b.features[f]);
                 boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
             });
     }

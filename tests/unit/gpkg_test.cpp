@@ -156,6 +156,7 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     // Every face's number, quality and area_km2, the area GeographicLib's PolygonArea of its
     // corners (the writer shares each edge's geodesic problem between its two faces).
     GIntBig fid = 0;
+    std::size_t parts = 0;
     for (auto& f : *faces) {
         EXPECT_EQ(f->GetFID(), ++fid);
         EXPECT_EQ(f->GetFieldAsInteger("face"), fid - 1);
@@ -166,7 +167,23 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
         double perimeter, area_m2;
         poly.Compute(false, true, perimeter, area_m2);
         EXPECT_NEAR(f->GetFieldAsDouble("area_km2"), std::fabs(area_m2) * 1e-6, 1e-7) << "face " << f->GetFID() - 1;
+        // Its polygon holds each of its corners away from the cuts (the writer refills the
+        // features and polygons of a block for later blocks: none keeps another face's). The
+        // longitudes are unwrapped from the previous corner's, to rounding.
+        const OGRMultiPolygon* multi = f->GetGeometryRef()->toMultiPolygon();
+        parts += multi->getNumGeometries();
+        for (NodeIndex k : c) {
+            const LonLat ll = vec_to_lonlat(m.nodes[k]);
+            if (std::fabs(ll.lon) > 179.9 || std::fabs(ll.lat) > 89.9) continue;
+            bool found = false;
+            for (const OGRPolygon* polygon : *multi)
+                for (const OGRPoint& point : *polygon->getExteriorRing())
+                    found = found || (std::fabs(point.getX() - ll.lon) < 1e-9 && point.getY() == ll.lat);
+            EXPECT_TRUE(found) << "face " << f->GetFID() - 1 << " lacks its corner " << ll.lon << " " << ll.lat;
+        }
     }
+    // Faces cut at +-180 (two parts) among the others: both kinds follow each other in a slot.
+    EXPECT_GT(parts, m.faces.size());
 
     // Boundary runs: every boundary edge once, tags coast and open both present.
     int edges = 0, coast = 0, open = 0;
