@@ -396,18 +396,27 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
         if (f.name != "node") w.field(nodes, f.name.c_str(), OFTReal);
     std::vector<io::RtreeBox>& node_boxes = indexes.emplace_back(io::RtreeLayer{"nodes", "geom", {}}).boxes;
     node_boxes.reserve(mesh.nodes.size());
-    for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
-        if (i % 16384 == 0)
-            report(options.progress, face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
+    {
+        // One feature and one point, refilled for each node (as the faces' features are).
         OGRFeature feature(nodes->GetLayerDefn());
-        feature.SetFID(GIntBig(i) + 1);
-        feature.SetField("node", int(i));
+        const int node_field = feature.GetFieldIndex("node");
+        std::vector<std::pair<int, const Field*>> fields;
         for (const auto& f : mesh.node_fields)
-            if (f.name != "node" && f.values.size() == mesh.nodes.size()) feature.SetField(f.name.c_str(), f.values[i]);
-        LonLat p = vec_to_lonlat(mesh.nodes[i]);
-        node_boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
-        feature.SetGeometryDirectly(new OGRPoint(p.lon, p.lat));
-        w.add(nodes, feature);
+            if (f.name != "node" && f.values.size() == mesh.nodes.size()) fields.emplace_back(feature.GetFieldIndex(f.name.c_str()), &f);
+        auto* point = new OGRPoint(0, 0);
+        feature.SetGeometryDirectly(point);
+        for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+            if (i % 16384 == 0)
+                report(options.progress, face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
+            feature.SetFID(GIntBig(i) + 1);
+            feature.SetField(node_field, int(i));
+            for (const auto& [index, f] : fields) feature.SetField(index, f->values[i]);
+            LonLat p = vec_to_lonlat(mesh.nodes[i]);
+            node_boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
+            point->setX(p.lon);
+            point->setY(p.lat);
+            w.add(nodes, feature);
+        }
     }
 
     // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)

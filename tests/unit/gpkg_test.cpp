@@ -184,6 +184,19 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     }
     // Faces cut at +-180 (two parts) among the others: both kinds follow each other in a slot.
     EXPECT_GT(parts, m.faces.size());
+    // Every node: its number, its fields and its point (one feature refilled for each).
+    fid = 0;
+    for (auto& f : *nodes) {
+        EXPECT_EQ(f->GetFID(), ++fid);
+        const auto i = std::size_t(fid - 1);
+        EXPECT_EQ(f->GetFieldAsInteger("node"), int(i));
+        EXPECT_EQ(f->GetFieldAsDouble("depth"), m.node_field("depth")->values[i]);
+        EXPECT_EQ(f->GetFieldAsDouble("target_size"), m.node_field("target_size")->values[i]);
+        const OGRPoint* point = f->GetGeometryRef()->toPoint();
+        EXPECT_EQ(point->getX(), vec_to_lonlat(m.nodes[i]).lon);
+        EXPECT_EQ(point->getY(), vec_to_lonlat(m.nodes[i]).lat);
+    }
+    EXPECT_EQ(std::size_t(fid), m.nodes.size());
 
     // Boundary runs: every boundary edge once, tags coast and open both present.
     int edges = 0, coast = 0, open = 0;
