@@ -29,6 +29,10 @@ struct UgridOptions {
     /// compute_stats of this same mesh when the caller has it (the global attributes take it
     /// as it is); null: the writer computes it.
     const MeshStats* stats = nullptr;
+    /// When given, receives each face's geodesic area (m2), as the file's face area variable
+    /// holds it: write_gpkg takes it (GpkgOptions::face_areas_m2) instead of solving every
+    /// edge's geodesic problem again.
+    std::vector<double>* face_areas_m2 = nullptr;
     /// Reports the share of the rows written (stage "write_ugrid"); returning false cancels
     /// (Cancelled, no file left).
     Progress progress;

@@ -9,6 +9,7 @@
 // would pass 180 (the pieces share the cut vertex).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -326,9 +327,12 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     // layer (52.1/66.1 s against 53.7/61.3 s, alternated) and gives the same file.
     w.begin();
     {
-        // The face areas as the UGRID file has them (each edge's geodesic problem solved once, on
-        // every core). Freed before the nodes.
-        const io::GeodesicFaceAreas areas(topo);
+        // The face areas as the UGRID file has them: those write_ugrid gave, else each edge's
+        // geodesic problem solved once here, on every core (freed before the nodes).
+        const std::vector<double>* given = options.face_areas_m2;
+        if (given && given->size() != mesh.faces.size()) given = nullptr;
+        std::optional<io::GeodesicFaceAreas> areas;
+        if (!given) areas.emplace(topo);
         std::vector<io::RtreeBox>& boxes = indexes.emplace_back(io::RtreeLayer{"faces", "geom", {}}).boxes;
         boxes.reserve(mesh.faces.size());
         // The features (fields, geometry cut at +-180, box) are made a block at a time on every
@@ -362,13 +366,19 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
                 while (b.features.size() < b.count) b.features.push_back(std::make_unique<OGRFeature>(defn));
                 b.boxes.clear();
                 for (std::size_t i = first; i < last; ++i) {
-                    io::face_edges(topo, i, 1, scratch.edges);
                     const auto& t = mesh.faces[i];
                     OGRFeature& feature = *b.features[i - first];
                     feature.SetFID(GIntBig(i) + 1);
                     feature.SetField(face_field, int(i));
                     feature.SetField(quality_field, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-                    feature.SetField(area_field, areas.face_m2(i, scratch.edges.data()) * 1e-6);
+                    double area_m2;
+                    if (given) {
+                        area_m2 = (*given)[i];
+                    } else {
+                        io::face_edges(topo, i, 1, scratch.edges);
+                        area_m2 = areas->face_m2(i, scratch.edges.data());
+                    }
+                    feature.SetField(area_field, area_m2 * 1e-6);
                     auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
                     if (depth) feature.SetField(depth_field, mean(depth));
                     if (size) feature.SetField(size_field, mean(size));
@@ -387,6 +397,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
                 boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
             });
     }
+    if (options.face_areas_m2) std::vector<double>().swap(*options.face_areas_m2); // not needed any more
     if (options.after_partial_write) options.after_partial_write();
 
     // nodes

@@ -475,6 +475,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     {
         w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
         const io::GeodesicFaceAreas areas = areas_ahead.get();
+        if (options.face_areas_m2) options.face_areas_m2->assign(nf, 0.0);
         // Face edges, face neighbours and face areas a block of faces at a time (face_edges): no
         // face-to-edge table of the whole mesh (12 bytes a face) at the writer's peak.
         struct FaceRows {
@@ -494,6 +495,8 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
             block.put(v_face_edges, b.edges.data(), count);
             block.put(v_face_links, b.links.data(), count);
             block.put(v_area, b.area.data(), count);
+            if (options.face_areas_m2)
+                std::copy(b.area.begin(), b.area.end(), options.face_areas_m2->begin() + std::ptrdiff_t(first));
         });
     }
     w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); });

@@ -213,6 +213,45 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     EXPECT_TRUE(found);
 }
 
+TEST(Gpkg, face_areas_from_the_ugrid_writer_are_taken_as_given_and_freed_after_the_faces) {
+    TempDir dir;
+    const Mesh m = icosphere_with_holes(4);
+    std::vector<double> areas;
+    UgridOptions u;
+    u.face_areas_m2 = &areas;
+    write_ugrid(m, dir / "m.nc", u);
+    ASSERT_EQ(areas.size(), m.faces.size());
+    write_gpkg(m, dir / "own.gpkg"); // computed by the writer
+    // Doubled, so that the file shows they were taken as given, not computed again.
+    std::vector<double> doubled = areas;
+    for (double& a : doubled) a *= 2;
+    GpkgOptions g;
+    g.face_areas_m2 = &doubled;
+    write_gpkg(m, dir / "given.gpkg", g);
+    EXPECT_TRUE(doubled.empty() && doubled.capacity() == 0);
+    // One area too few: computed by the writer, as without.
+    std::vector<double> short_by_one(areas.begin(), areas.end() - 1);
+    g.face_areas_m2 = &short_by_one;
+    write_gpkg(m, dir / "short.gpkg", g);
+    Dataset own(dir / "own.gpkg"), given(dir / "given.gpkg"), fallback(dir / "short.gpkg");
+    ASSERT_TRUE(own.ds && given.ds && fallback.ds);
+    OGRLayer* a = own.ds->GetLayerByName("faces");
+    OGRLayer* b = given.ds->GetLayerByName("faces");
+    OGRLayer* c = fallback.ds->GetLayerByName("faces");
+    ASSERT_TRUE(a && b && c);
+    std::size_t n = 0;
+    for (auto& fa : *a) {
+        std::unique_ptr<OGRFeature> fb(b->GetNextFeature()), fc(c->GetNextFeature());
+        ASSERT_TRUE(fb && fc);
+        const double km2 = fa->GetFieldAsDouble("area_km2");
+        EXPECT_EQ(km2, areas[n] * 1e-6) << "face " << n; // the UGRID file's areas
+        EXPECT_EQ(fb->GetFieldAsDouble("area_km2"), 2 * areas[n] * 1e-6) << "face " << n;
+        EXPECT_EQ(fc->GetFieldAsDouble("area_km2"), km2) << "face " << n;
+        ++n;
+    }
+    EXPECT_EQ(n, m.faces.size());
+}
+
 // The spatial indexes are written in bulk into SQLite's RTree tables (gpkg_rtree.hpp). Oracles:
 // SQLite's own rtreecheck() of the tree's structure, OGR's envelope of each feature read back
 // (the float box must hold it and be the tightest that does), and brute force over those

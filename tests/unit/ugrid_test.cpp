@@ -31,6 +31,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The face areas of a UGRID file (its variable "area"), n of them.
+std::vector<double> file_areas(const fs::path& file, std::size_t n) {
+    std::vector<double> area(n);
+    int nc, v;
+    EXPECT_EQ(nc_open(file.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    EXPECT_EQ(nc_inq_varid(nc, "area", &v), NC_NOERR);
+    EXPECT_EQ(nc_get_var_double(nc, v, area.data()), NC_NOERR);
+    nc_close(nc);
+    return area;
+}
+
 std::vector<std::string> folder_listing(const fs::path& dir) {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
@@ -341,12 +352,7 @@ TEST(Ugrid, each_face_area_is_polygonarea_of_its_corners) {
     for (const auto& [m, round_pole_expected] : meshes) {
         TempDir dir;
         write_ugrid(m, dir / "ico.nc");
-        int nc, v;
-        ASSERT_EQ(nc_open((dir / "ico.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
-        ASSERT_EQ(nc_inq_varid(nc, "area", &v), NC_NOERR);
-        std::vector<double> area(m.faces.size());
-        ASSERT_EQ(nc_get_var_double(nc, v, area.data()), NC_NOERR);
-        nc_close(nc);
+        const std::vector<double> area = file_areas(dir / "ico.nc", m.faces.size());
         int round_pole = 0;
         for (std::size_t f = 0; f < m.faces.size(); ++f) {
             GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
@@ -364,6 +370,20 @@ TEST(Ugrid, each_face_area_is_polygonarea_of_its_corners) {
                 round_pole += dot(pole, cross(a, b)) > 0 && dot(pole, cross(b, c)) > 0 && dot(pole, cross(c, a)) > 0;
         }
         EXPECT_EQ(round_pole, round_pole_expected);
+    }
+}
+
+TEST(Ugrid, face_areas_asked_for_are_the_files_own) {
+    // Several blocks of faces (written on every core), the classic and the netCDF-4 writer.
+    const Mesh m = icosphere(6);
+    for (const bool classic : {false, true}) {
+        TempDir dir;
+        std::vector<double> given = {1, 2, 3}; // replaced
+        UgridOptions o;
+        o.classic = classic;
+        o.face_areas_m2 = &given;
+        write_ugrid(m, dir / "ico.nc", o);
+        EXPECT_EQ(given, file_areas(dir / "ico.nc", m.faces.size()));
     }
 }
 
