@@ -281,8 +281,12 @@ std::vector<BoundaryRun> boundary_runs(const io::MeshTopology& topo) {
 void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options) {
     if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
     OutputFile out(path, options.overwrite, "GeoPackage output");
-    const io::MeshTopology topo = io::build_topology(mesh);
+    // The topology (about 50 bytes a node) serves the statistics, the boundary's runs and the
+    // faces' areas and edges, and goes once the faces are written: held to the end, it made the
+    // spatial indexes' step the process's peak at 20 km (242.7 MiB, 218.5 without).
+    io::MeshTopology topo = io::build_topology(mesh);
     const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
+    const std::vector<BoundaryRun> runs = boundary_runs(topo);
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;
@@ -398,6 +402,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
             });
     }
     if (options.face_areas_m2) std::vector<double>().swap(*options.face_areas_m2); // not needed any more
+    topo = io::MeshTopology{};
     if (options.after_partial_write) options.after_partial_write();
 
     // nodes
@@ -431,7 +436,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     }
 
     // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
-    if (!topo.boundary_edges.empty()) {
+    if (!runs.empty()) {
     OGRLayer* boundary = w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
     w.field(boundary, "tag", OFTString);
     w.field(boundary, "tag_code", OFTInteger);
@@ -439,7 +444,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     w.field(boundary, "edges", OFTInteger);
     w.field(boundary, "length_km", OFTReal);
     std::vector<io::RtreeBox>& run_boxes = indexes.emplace_back(io::RtreeLayer{"boundary", "geom", {}}).boxes;
-    for (const auto& run : boundary_runs(topo)) {
+    for (const auto& run : runs) {
         OGRFeature feature(boundary->GetLayerDefn());
         feature.SetFID(GIntBig(run_boxes.size()) + 1);
         feature.SetField("tag", run.tag == int(EdgeTag::open) ? "open" : "coast");
