@@ -9,9 +9,9 @@
 // would pass 180 (the pieces share the cut vertex).
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <ogrsf_frmts.h>
