@@ -605,25 +605,29 @@ TEST(Preview, draws_faces_over_land_without_smearing_across_the_map) {
 }
 
 TEST(Preview, faces_smaller_than_a_pixel_leave_no_pixel_of_a_closed_sphere_unpainted) {
-    // 81,920 faces about half a pixel wide: the writer skips those whose box holds no pixel centre
-    // (they burn nothing); a face skipped wrongly would leave its pixel the background's.
-    TempDir dir;
-    const Mesh m = icosphere(6);
-    PreviewOptions o;
-    o.width_px = 200;
-    o.extent_deg = std::array<double, 4>{-180, -90, 180, 90};
-    write_preview_png(m, dir / "sphere.png", o);
-    Dataset d(dir / "sphere.png", GDAL_OF_RASTER);
-    ASSERT_TRUE(d.ds);
-    const int nx = d.ds->GetRasterXSize(), ny = d.ds->GetRasterYSize();
-    ASSERT_EQ(nx, 200);
-    std::vector<std::uint8_t> rgb(3 * std::size_t(nx) * std::size_t(ny));
-    int bands[3] = {1, 2, 3};
-    ASSERT_EQ(d.ds->RasterIO(GF_Read, 0, 0, nx, ny, rgb.data(), nx, ny, GDT_Byte, 3, bands, 3, 3 * nx, 1, nullptr), CE_None);
-    std::size_t background = 0;
-    for (std::size_t i = 0; i < rgb.size(); i += 3)
-        background += rgb[i] == 236 && rgb[i + 1] == 242 && rgb[i + 2] == 248;
-    EXPECT_EQ(background, 0u);
+    // 327,680 faces, at 200 pixels about a quarter of a pixel wide: the writer skips those whose
+    // box holds no pixel centre (they burn nothing); at 1,600 pixels about two pixels wide, and
+    // burnt in batches of 262,144 as they are made. A face skipped wrongly, or a batch left out,
+    // would leave pixels the background's.
+    const Mesh m = icosphere(7);
+    for (const int width : {200, 1600}) {
+        TempDir dir;
+        PreviewOptions o;
+        o.width_px = width;
+        o.extent_deg = std::array<double, 4>{-180, -90, 180, 90};
+        write_preview_png(m, dir / "sphere.png", o);
+        Dataset d(dir / "sphere.png", GDAL_OF_RASTER);
+        ASSERT_TRUE(d.ds);
+        const int nx = d.ds->GetRasterXSize(), ny = d.ds->GetRasterYSize();
+        ASSERT_EQ(nx, width);
+        std::vector<std::uint8_t> rgb(3 * std::size_t(nx) * std::size_t(ny));
+        int bands[3] = {1, 2, 3};
+        ASSERT_EQ(d.ds->RasterIO(GF_Read, 0, 0, nx, ny, rgb.data(), nx, ny, GDT_Byte, 3, bands, 3, 3 * nx, 1, nullptr), CE_None);
+        std::size_t background = 0;
+        for (std::size_t i = 0; i < rgb.size(); i += 3)
+            background += rgb[i] == 236 && rgb[i + 1] == 242 && rgb[i + 2] == 248;
+        EXPECT_EQ(background, 0u) << width << " pixels";
+    }
 }
 
 TEST(Preview, default_extent_of_a_pacific_mesh_is_continuous_across_180_and_colours_by_depth) {
