@@ -208,6 +208,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
         std::vector<Rgba> colours;
     };
     constexpr std::size_t block_faces = 16384, burn_batch = 262144;
+    const double west = w, east = e; // (a lambda may not capture a structured binding before C++20's clang 16)
     io::compute_in_order<Shapes, char>(
         (mesh.faces.size() + block_faces - 1) / block_faces,
         [&](std::size_t k, Shapes& shapes, char&) {
@@ -226,7 +227,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
                         lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
                         south = std::min(south, p[1]), north = std::max(north, p[1]);
                     }
-                    for (double shift : shifts_for(lo, hi, w, e)) {
+                    for (double shift : shifts_for(lo, hi, west, east)) {
                         if (!draw_outlines && !holds_a_centre(gt, lo + shift, hi + shift, south, north)) continue;
                         auto r = std::make_unique<OGRLinearRing>();
                         for (const auto& p : ring) r->addPoint(p[0] + shift, p[1]);
