@@ -220,6 +220,11 @@ public:
     }
     /// A half-edge leaving v (origin(h) == v) for every vertex; no_half_edge for merged-away ones.
     std::vector<HalfEdge> vertex_half_edges() const;
+    /// Room for `points` vertices in all and their triangles (2n - 4 on the sphere), so that a
+    /// caller that knows how many it will add spares the arrays their growth by doubling: each
+    /// doubling copies the arrays into new ones and touches their pages again. Untouched room
+    /// costs address space only. Never shrinks.
+    void reserve(std::size_t points);
     /// The half-edge from a to b, searching the star of a from `from` (a half-edge leaving a);
     /// no_half_edge when a-b is not an edge.
     HalfEdge find_edge(HalfEdge from, VertexId b) const;

@@ -172,6 +172,11 @@ void SphericalDelaunay::make_tetrahedron(VertexId v[4]) {
         }
 }
 
+void SphericalDelaunay::reserve(std::size_t points) {
+    points_.reserve(points);
+    reserve_for(points);
+}
+
 void SphericalDelaunay::reserve_for(std::size_t points) {
     // A closed triangulation of n points has 2n - 4 triangles; reserve once.
     tri_vertices_.reserve(3 * (2 * points + 4));

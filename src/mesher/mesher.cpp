@@ -2135,6 +2135,12 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         throw DataError("the size field asks for " + nodes + ", which need more than --max-memory " +
                         std::to_string(options.max_memory >> 20) + " MiB: raise --hmin/--hmax or --max-memory");
     }
+    // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
+    // per cent of the nodes made on 1:50m land at 64, 20 and 10 km), instead of doubling through
+    // the lattice and the refinement: each doubling copied them into new blocks and touched
+    // their pages again. Measured (alternated runs): refine at 64 km 0.113 -> 0.094 s, at 20 km
+    // 0.622 -> 0.565 s; the peak at 20 km 193.9 -> 190.9 MiB.
+    dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
     if (timings) timings->add("classify", seconds_since(t0));
 
     // ---- 4. refine ---------------------------------------------------------------------------

@@ -164,6 +164,27 @@ TEST(Delaunay, shuffled_input_gives_the_same_triangulation) {
     EXPECT_EQ(canonical(a, false), canonical(b, false));
 }
 
+TEST(Delaunay, reserved_room_holds_the_points_added_one_by_one_without_moving_them) {
+    // The mesher reserves for the nodes it expects before the refinement adds them one at a
+    // time: the points must stay where they are (no regrowth) and the triangulation be the one
+    // made without the reservation.
+    const auto p = random_points(5000, 11);
+    const std::span<const Vec3> first(p.data(), 100);
+    SphericalDelaunay plain, reserved;
+    plain.insert_points(first);
+    reserved.insert_points(first);
+    reserved.reserve(p.size());
+    const Vec3* storage = reserved.points().data();
+    for (std::size_t i = first.size(); i < p.size(); ++i) {
+        plain.insert(p[i], plain.last_triangle());
+        reserved.insert(p[i], reserved.last_triangle());
+    }
+    EXPECT_EQ(reserved.points().data(), storage);
+    EXPECT_EQ(reserved.vertex_count(), p.size());
+    expect_valid_closed(reserved);
+    EXPECT_EQ(canonical(plain, false), canonical(reserved, false));
+}
+
 TEST(Delaunay, one_degree_grid_with_both_poles_is_valid_and_order_independent) {
     auto p = grid_points(1.0);
     SphericalDelaunay dt;
