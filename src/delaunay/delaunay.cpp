@@ -259,8 +259,7 @@ std::vector<VertexId> SphericalDelaunay::insert_points(std::span<const Vec3> poi
     std::vector<VertexId> vertex_of(points.size(), no_vertex);
     std::vector<std::uint32_t> order = detail::brio_order(points, options_.seed);
     const std::size_t expected = points_.size() + points.size();
-    points_.reserve(expected);
-    reserve_for(expected);
+    reserve(expected);
     if (triangle_count() == 0) initial_tetrahedron(points, order, vertex_of);
     TriangleId hint = last_;
     for (std::uint32_t i : order) {
