@@ -40,6 +40,11 @@
 #endif
 
 namespace globemesh {
+namespace {
+// glibc's mmap threshold (configure_allocation), and the size from which operator new below maps
+// a block itself: one size, so that every large block is a mapping of its own either way.
+constexpr std::size_t own_mapping_bytes = std::size_t{1} << 20;
+} // namespace
 
 void configure_allocation() {
 #ifdef __GLIBC__
@@ -48,7 +53,7 @@ void configure_allocation() {
     // stage's. A fixed 1 MiB threshold gives every large array back when it is freed: the peak
     // at 1e6 nodes goes from about 199 to 187 bytes a node, the write about 5% slower. (The
     // blocks C++ allocates from 1 MiB up are mappings of operator new's below.)
-    mallopt(M_MMAP_THRESHOLD, 1 << 20);
+    mallopt(M_MMAP_THRESHOLD, int(own_mapping_bytes));
     // The blocks under 1 MiB come from the heap, and glibc gives its top back to the system as
     // soon as 128 KiB there are free, so that a loop allocating and freeing a few hundred KiB
     // (GEOS's monotone chains in load_coast above all) faults the same pages in again
@@ -74,8 +79,6 @@ namespace {
 
 constexpr std::size_t huge_page_bytes = std::size_t{2} << 20;
 constexpr std::uintptr_t page_bytes = 4096;
-// Blocks from this size up (glibc's mmap threshold above) get a mapping of their own.
-constexpr std::size_t own_mapping_bytes = std::size_t{1} << 20;
 
 // The live blocks of map_block, for operator delete. Large blocks are few (tens at a time), so a
 // fixed table scanned under a lock is enough, and it allocates nothing itself; when it is full,
@@ -137,7 +140,7 @@ bool unmap_block(void* p) {
 // replace; the over-aligned forms keep their own (aligned_alloc and free).
 void* operator new(std::size_t n) {
     if (n == 0) n = 1;
-    if (n >= own_mapping_bytes)
+    if (n >= globemesh::own_mapping_bytes)
         if (void* p = map_block(n)) return p;
     void* p;
     while ((p = std::malloc(n)) == nullptr) {
