@@ -208,7 +208,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
         std::vector<Rgba> colours;
     };
     constexpr std::size_t block_faces = 16384, burn_batch = 262144;
-    const double west = w, east = e; // (a lambda may not capture a structured binding before C++20's clang 16)
+    const double west = w, east = e; // (clang before 16 lets no lambda capture a structured binding)
     io::compute_in_order<Shapes, char>(
         (mesh.faces.size() + block_faces - 1) / block_faces,
         [&](std::size_t k, Shapes& shapes, char&) {
