@@ -9,8 +9,12 @@
 # Each round runs the core once, then `globemesh mesh` on the 1:50m land at each uniform size;
 # the last lines give the median of the rounds.
 #
-# Usage: bench/mesh_rounds.sh [BUILD_DIR] [ROUNDS] [sizes in km...]
+# Usage: bench/mesh_rounds.sh [BUILD_DIR] [ROUNDS] [SIZE[:SCALE]...]
 #        (default build/release, 3 rounds, sizes 64 20 10: about 1e5, 1e6 and 4e6 nodes)
+# A size is in km; with :SCALE (110m, 50m or 10m) it meshes Natural Earth's land at that scale
+# instead of 1:50m (bench/natural_earth.sh: 1:10m is read from ../shared/data).
+# `64:110m 20:50m 10:10m` gives each size the finest scale drawn no finer than it (1 mm of a
+# 1:110m map is 110 km): the coast a user would take for that mesh.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build/release}
@@ -22,16 +26,20 @@ core=$build/bench/delaunay_memory
 for f in "$exe" "$core"; do
     [[ -x $f ]] || { echo "mesh_rounds.sh: $f not built (cmake --build $build)" >&2; exit 2; }
 done
-coast=$root/fixtures/coast/ne_50m_land.gpkg
+source "$root/bench/natural_earth.sh"
+for s in $sizes; do [[ $s == *:* ]] && natural_earth_land "${s#*:}" >/dev/null; done
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 : > "$tmp/rows"
 for r in $(seq "$rounds"); do
     c=$("$core" 1000000 uniform | sed -n 's/.*points: \([0-9.]*\) s.*/\1/p')
-    for h in $sizes; do
+    for s in $sizes; do
+        h=${s%%:*}
+        [[ $s == *:* ]] && scale=${s#*:} || scale=50m
+        coast=$(natural_earth_land "$scale")
         "$exe" mesh --coast "$coast" --coast-layer land --hmax "${h}km" -o "$tmp/m.nc" --overwrite \
             --quiet --report "$tmp/r.json" >/dev/null
-        /usr/bin/python3 - "$r" "$c" "$h" "$tmp/r.json" >> "$tmp/rows" <<'PY'
+        /usr/bin/python3 - "$r" "$c" "$s" "$tmp/r.json" >> "$tmp/rows" <<'PY'
 import json, sys
 r, core, h = sys.argv[1:4]
 rep = json.load(open(sys.argv[4]))
@@ -42,25 +50,27 @@ done
 /usr/bin/python3 - "$tmp/rows" <<'PY'
 import statistics, sys
 rows = [l.split() for l in open(sys.argv[1])]
+# A size's label: "64 km", or "64 km 1:110m" with its coast's scale.
+def lab(s): return s.split(":")[0] + " km" + (" 1:" + s.split(":")[1] if ":" in s else "")
 by_round = {}
 boundary = {}
 for r, core, h, n, mesh, b in rows:
     by_round.setdefault(int(r), []).append((h, int(n), float(mesh), float(core)))
     boundary[h] = int(b)
 ratios, spreads = [], {}
-print(f"{'round':<6} {'core_s':>7}  " + "  ".join(f"{h + ' km':>22}" for h, *_ in by_round[1]) + f"  {'mesh/core':>9}  spread of us/node (from 1e5 nodes)")
+print(f"{'round':<6} {'core_s':>7}  " + "  ".join(f"{lab(h):>22}" for h, *_ in by_round[1]) + f"  {'mesh/core':>9}  spread of us/node (from 1e5 nodes)")
 for r, runs in sorted(by_round.items()):
     core = runs[0][3]
     near = min(runs, key=lambda x: abs(x[1] - 1e6))
     ratio = near[2] / core
     ratios.append(ratio)
     per_node = {h: 1e6 * mesh / n for h, n, mesh, _ in runs if n >= 0.9e5}
-    mean = statistics.mean(per_node.values())
+    mean = statistics.mean(per_node.values()) if per_node else 0
     spread = {h: 100 * (v / mean - 1) for h, v in per_node.items()}
     for h, s in spread.items(): spreads.setdefault(h, []).append(s)
     cells = "  ".join(f"{mesh:7.3f} s {1e6 * mesh / n:5.2f} us/node" for h, n, mesh, _ in runs)
     print(f"{r:<6} {core:7.3f}  {cells}  {ratio:8.2f}x  " + " / ".join(f"{s:+.0f}%" for s in spread.values()))
-print(f"median mesh/core at {near[0]} km ({near[1]} nodes): {statistics.median(ratios):.2f}x (bound 4x)")
+print(f"median mesh/core at {lab(near[0])} ({near[1]} nodes): {statistics.median(ratios):.2f}x (bound 4x)")
 # T = a N + b B by least squares on the relative residuals (each size weighted 1/T), over the
 # medians of each size: the 2x2 normal equations.
 med = {h: statistics.median(float(x[2]) for runs in by_round.values() for x in runs if x[0] == h) for h, *_ in by_round[1]}
@@ -72,6 +82,6 @@ det = snn * sbb - snb * snb
 if len(med) >= 2 and det > 0:
     a, b = (sn * sbb - sb * snb) / det, (snn * sb - snb * sn) / det
     print(f"fit of the medians, mesh = a nodes + b boundary edges: a {1e6 * a:.2f} us, b {1e6 * b:.1f} us; residuals "
-          + " / ".join(f"{h} km {100 * (a * nodes[h] + b * boundary[h] - med[h]) / med[h]:+.0f}% (B/N {boundary[h] / nodes[h]:.4f})" for h in med))
-print("median spread: " + " / ".join(f"{h} km {statistics.median(v):+.0f}%" for h, v in spreads.items()) + " (bound +-30%)")
+          + " / ".join(f"{lab(h)} {100 * (a * nodes[h] + b * boundary[h] - med[h]) / med[h]:+.0f}% (B/N {boundary[h] / nodes[h]:.4f})" for h in med))
+print("median spread: " + " / ".join(f"{lab(h)} {statistics.median(v):+.0f}%" for h, v in spreads.items()) + " (bound +-30%)")
 PY

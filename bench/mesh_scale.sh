@@ -10,8 +10,11 @@
 # the peak bytes per node of that call alone (VmHWM reset before it; the writer not counted);
 # then the process's peak in each step (read_coast, boundary, each mesher stage, write).
 #
-# Usage: bench/mesh_scale.sh [BUILD_DIR | globemesh binary] [sizes in km...]
+# Usage: bench/mesh_scale.sh [BUILD_DIR | globemesh binary] [SIZE[:SCALE]...]
 #        (default build/release; sizes 200 64 20 10)
+# A size is in km; with :SCALE (110m, 50m or 10m) Natural Earth's land at that scale instead of
+# 1:50m (bench/natural_earth.sh), e.g. `200:110m 64:110m 20:50m 10:10m`: each size with the
+# finest scale drawn no finer than it.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 arg=${1:-$root/build/release}
@@ -24,15 +27,19 @@ else
     mem=$(dirname "$exe")/../bench/mesher_memory
 fi
 sizes=${*:-"200 64 20 10"}
-coast=$root/fixtures/coast/ne_50m_land.gpkg
+source "$root/bench/natural_earth.sh"
+for s in $sizes; do [[ $s == *:* ]] && natural_earth_land "${s#*:}" >/dev/null; done
+# The coast of size $1 (SIZE[:SCALE]).
+coast_of() { if [[ $1 == *:* ]]; then natural_earth_land "${1#*:}"; else natural_earth_land 50m; fi; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "globemesh mesh (whole process)"
 printf '%-8s %10s %10s %10s %12s %12s %14s\n' h_km nodes mesh_s us/node refine_us improve_us peak_B/node
-for h in $sizes; do
-    "$exe" mesh --coast "$coast" --coast-layer land --hmax "${h}km" \
+for s in $sizes; do
+    h=${s%%:*}
+    "$exe" mesh --coast "$(coast_of "$s")" --coast-layer land --hmax "${h}km" \
         -o "$tmp/m.nc" --overwrite --quiet --timings "$tmp/t.json" --report "$tmp/r.json" >/dev/null
-    /usr/bin/python3 - "$h" "$tmp/t.json" "$tmp/r.json" <<'PY'
+    /usr/bin/python3 - "$s" "$tmp/t.json" "$tmp/r.json" <<'PY'
 import json, sys
 h, t, r = sys.argv[1], json.load(open(sys.argv[2]))["stages"], json.load(open(sys.argv[3]))
 n = r.get("nodes") or r.get("mesh", {}).get("nodes")
@@ -43,7 +50,7 @@ PY
 done
 if [[ -x $mem ]]; then
     echo "mesh_boundary alone (bench/mesher_memory)"
-    for h in $sizes; do "$mem" "$coast" land "$h" 1 "$tmp/mm.nc"; done
+    for s in $sizes; do "$mem" "$(coast_of "$s")" land "${s%%:*}" 1 "$tmp/mm.nc"; done
 else
     echo "($mem not built: cmake --build BUILD --target mesher_memory for the mesher's own peak)"
 fi
