@@ -164,7 +164,8 @@ inline unsigned folds_exactly(const Points8& p, const std::vector<FarEdge>& far,
 /// and (with `left_of`: slide_node's land edges) orient(p[k], e) > 0 for each e there. Bit k set
 /// for each accepted. The eight scores are computed to the end, with the least of the bounds
 /// star_count_score stops at on the way: the same decisions as eight calls.
-GLOBEMESH_LANES_CLONED inline unsigned star_count_accepts(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule, double floor,
+GLOBEMESH_LANES_CLONED
+inline unsigned star_count_accepts(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule, double floor,
                                    double& best, const std::vector<FarEdge>* left_of = nullptr) {
     const double worst_goal = rule.worst_goal, count_quality = rule.count_quality, count_cap = rule.count_cap,
                  count_worst_weight = rule.worst_weight;
@@ -205,7 +206,8 @@ GLOBEMESH_LANES_CLONED inline unsigned star_count_accepts(const Points8& p, cons
 }
 
 /// The same for the search rounds: star_worst_quality(p[k], far, best + 1e-9) above best + 1e-9.
-GLOBEMESH_LANES_CLONED inline unsigned star_worst_accepts(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+GLOBEMESH_LANES_CLONED
+inline unsigned star_worst_accepts(const Points8& p, const std::vector<FarEdge>& far, double& best) {
     double worst[8], q[8];
     for (double& w : worst) w = 1;
     unsigned out = 0, undecided = 0;
