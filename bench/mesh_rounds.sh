@@ -27,7 +27,7 @@ for f in "$exe" "$core"; do
     [[ -x $f ]] || { echo "mesh_rounds.sh: $f not built (cmake --build $build)" >&2; exit 2; }
 done
 source "$root/bench/natural_earth.sh"
-for s in $sizes; do [[ $s == *:* ]] && natural_earth_land "${s#*:}" >/dev/null; done
+check_sizes_coasts $sizes
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 : > "$tmp/rows"
@@ -35,9 +35,7 @@ for r in $(seq "$rounds"); do
     c=$("$core" 1000000 uniform | sed -n 's/.*points: \([0-9.]*\) s.*/\1/p')
     for s in $sizes; do
         h=${s%%:*}
-        [[ $s == *:* ]] && scale=${s#*:} || scale=50m
-        coast=$(natural_earth_land "$scale")
-        "$exe" mesh --coast "$coast" --coast-layer land --hmax "${h}km" -o "$tmp/m.nc" --overwrite \
+        "$exe" mesh --coast "$(coast_of_size "$s")" --coast-layer land --hmax "${h}km" -o "$tmp/m.nc" --overwrite \
             --quiet --report "$tmp/r.json" >/dev/null
         /usr/bin/python3 - "$r" "$c" "$s" "$tmp/r.json" >> "$tmp/rows" <<'PY'
 import json, sys

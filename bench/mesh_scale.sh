@@ -28,16 +28,14 @@ else
 fi
 sizes=${*:-"200 64 20 10"}
 source "$root/bench/natural_earth.sh"
-for s in $sizes; do [[ $s == *:* ]] && natural_earth_land "${s#*:}" >/dev/null; done
-# The coast of size $1 (SIZE[:SCALE]).
-coast_of() { if [[ $1 == *:* ]]; then natural_earth_land "${1#*:}"; else natural_earth_land 50m; fi; }
+check_sizes_coasts $sizes
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 echo "globemesh mesh (whole process)"
 printf '%-8s %10s %10s %10s %12s %12s %14s\n' h_km nodes mesh_s us/node refine_us improve_us peak_B/node
 for s in $sizes; do
     h=${s%%:*}
-    "$exe" mesh --coast "$(coast_of "$s")" --coast-layer land --hmax "${h}km" \
+    "$exe" mesh --coast "$(coast_of_size "$s")" --coast-layer land --hmax "${h}km" \
         -o "$tmp/m.nc" --overwrite --quiet --timings "$tmp/t.json" --report "$tmp/r.json" >/dev/null
     /usr/bin/python3 - "$s" "$tmp/t.json" "$tmp/r.json" <<'PY'
 import json, sys
@@ -50,7 +48,7 @@ PY
 done
 if [[ -x $mem ]]; then
     echo "mesh_boundary alone (bench/mesher_memory)"
-    for s in $sizes; do "$mem" "$(coast_of "$s")" land "${s%%:*}" 1 "$tmp/mm.nc"; done
+    for s in $sizes; do "$mem" "$(coast_of_size "$s")" land "${s%%:*}" 1 "$tmp/mm.nc"; done
 else
     echo "($mem not built: cmake --build BUILD --target mesher_memory for the mesher's own peak)"
 fi

@@ -10,3 +10,15 @@ natural_earth_land() {
     echo "$(basename "$0"): no ne_$1_land.gpkg in fixtures/coast or ../shared/data" >&2
     exit 2
 }
+
+# The land of a benchmark size SIZE[:SCALE] (km, then 110m, 50m or 10m; 1:50m without a scale).
+coast_of_size() {
+    if [[ $1 == *:* ]]; then natural_earth_land "${1#*:}"; else natural_earth_land 50m; fi
+}
+
+# Every size's land there, or the script stops before its first run (a command substitution's
+# exit would not stop it).
+check_sizes_coasts() {
+    local s
+    for s in "$@"; do coast_of_size "$s" >/dev/null; done
+}
