@@ -69,8 +69,9 @@ namespace globemesh {
 /// The land of the cleaned coast at full resolution, as GIS software (and mesh-verify) sees it:
 /// polygons in planar lon/lat, after validation, dissolving, --min-island-area and the region
 /// clip. The mesher asks it which face centroids lie on land and how near the coast a node is
-/// (MesherOptions::land). GEOS prepared polygons under an STR tree of their envelopes, and the
-/// outlines as unit vectors in short pieces under a second one; one GEOS context of its own.
+/// (MesherOptions::land). GEOS prepared polygons under an STR tree of their envelopes, with lon/lat
+/// cells in front, and the outlines as unit vectors in short pieces under a second tree; one
+/// GEOS context of its own.
 class LandMask final : public LandTest {
 public:
     /// Each polygon is its shell, then its holes (lon/lat rings, first == last).
@@ -79,12 +80,16 @@ public:
     LandMask(const LandMask&) = delete;
     LandMask& operator=(const LandMask&) = delete;
     /// True when p lies strictly inside a land polygon (not in one of its holes, not on its
-    /// outline). Not thread-safe (one GEOS context).
+    /// outline): GEOS's answer, asked once per component of the lon/lat cells (1/32 degree)
+    /// that no outline segment's box touches, and at every point of a cell one touches. Not
+    /// thread-safe (one GEOS context, and the components' answers kept as they are asked).
     bool contains(const Vec3& p) const override;
     /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
     bool coast_within(const Vec3& p, double angle) const override;
     std::size_t vertices() const { return vertices_; }
+    /// The bytes of the cells in front of `contains` (about 8 MB for the world's land).
+    std::size_t cell_bytes() const;
 
 private:
     struct Impl;

@@ -2,6 +2,8 @@
 // planar lon/lat, the way GIS software and mesh-verify read land polygons, and the distance to
 // the outlines on the sphere.
 #include <cmath>
+#include <cstdint>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,28 @@ namespace globemesh {
 /// meets few of them, long enough that the tree stays small.
 constexpr std::size_t piece_vertices = 16;
 
+// The cells in front of the point-in-polygon test: lon/lat cells of 1/cells_per_degree degree
+// (3.5 km at the equator), in blocks of block_side x block_side. A cell that no segment's box
+// touches holds no outline, and neither does the side two such cells share: the cells of one
+// component (such cells joined through their sides) lie all on land or all in the water, and
+// GEOS is asked once per component, at the first point that falls in it. The cell of a
+// coordinate is floor((x + 180 or 90) * cells_per_degree), clamped to the grid: monotone in x in
+// floating point too, so a segment lies in the cells between its ends' cells. A block's cells
+// are numbered by the piece of it they belong to (a flood fill within the block), and the pieces
+// joined across the blocks' sides into components (union-find). 1:50m land: 16,573 blocks with
+// coast, 273,740 pieces in 2,138 components, about 8 MB; of the 70,036 land tests of a 64 km
+// mesh, 11,033 reach GEOS (all of them before).
+constexpr int cells_per_degree = 32;
+constexpr int block_side = 16; // a block's row is 16 bits of one 64-bit word of `touched`
+constexpr int cells_x = 360 * cells_per_degree, cells_y = 180 * cells_per_degree;
+constexpr int blocks_x = cells_x / block_side, blocks_y = cells_y / block_side;
+constexpr int block_cells = block_side * block_side;
+
+int cell_of(double x, double origin, int cells) {
+    const double c = std::floor((x + origin) * cells_per_degree);
+    return c <= 0 ? 0 : c >= cells - 1 ? cells - 1 : static_cast<int>(c);
+}
+
 struct LandMask::Impl {
     GEOSContextHandle_t ctx = GEOS_init_r();
     std::vector<GEOSGeometry*> polygons;
@@ -28,6 +52,17 @@ struct LandMask::Impl {
     std::vector<std::size_t> piece_start; // piece i is outline[piece_start[i], piece_start[i + 1])
     std::vector<GEOSGeometry*> envelopes;
     GEOSSTRtree* pieces = nullptr;
+    // The cells (see cells_per_degree): per cell, set when a segment's box touches it (built by
+    // add_segments, then read by label_pieces); per block, the offset of its cells' piece
+    // numbers in `piece` (0: a segment touches the cell, else 1 + the piece within the block)
+    // or -1 when no segment touches the block (one piece); and the offset of its pieces'
+    // answers in `answer` (-1 not asked yet, 0 water, 1 land).
+    std::vector<std::uint64_t> touched = std::vector<std::uint64_t>((std::size_t(cells_x) * cells_y + 63) / 64, 0);
+    std::vector<std::int32_t> block_piece;
+    std::vector<std::uint8_t> piece;
+    std::vector<std::uint32_t> block_first; // the number of the block's first piece among all
+    std::vector<std::uint32_t> component;   // per piece, the component's first piece
+    mutable std::vector<std::int8_t> answer; // per component, at its first piece
 
     ~Impl() {
         if (tree) GEOSSTRtree_destroy_r(ctx, tree);
@@ -53,6 +88,115 @@ struct LandMask::Impl {
             if (!box) throw DataError("coast: GEOS failed to build an envelope for the land test");
             envelopes.push_back(box);
         }
+    }
+
+    // Marks the cells of each segment's lon/lat box.
+    void add_segments(const std::vector<LonLat>& pts) {
+        for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
+            const int x0 = cell_of(std::min(pts[k].lon, pts[k + 1].lon), 180, cells_x);
+            const int x1 = cell_of(std::max(pts[k].lon, pts[k + 1].lon), 180, cells_x);
+            const int y0 = cell_of(std::min(pts[k].lat, pts[k + 1].lat), 90, cells_y);
+            const int y1 = cell_of(std::max(pts[k].lat, pts[k + 1].lat), 90, cells_y);
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    const std::size_t i = std::size_t(y) * cells_x + std::size_t(x);
+                    touched[i / 64] |= std::uint64_t{1} << (i % 64);
+                }
+        }
+    }
+
+    // Numbers the pieces of every block that a segment touches (a flood fill over its cells),
+    // joins them across the blocks' sides into components, then lets the per-cell marks go.
+    void label_pieces() {
+        block_piece.assign(std::size_t(blocks_x) * blocks_y, -1);
+        block_first.resize(block_piece.size());
+        std::uint32_t pieces_in_all = 0;
+        std::vector<int> stack;
+        auto row_bits = [&](int bx, int y) {
+            const std::size_t i = std::size_t(y) * cells_x + std::size_t(bx) * block_side;
+            return static_cast<std::uint16_t>(touched[i / 64] >> (i % 64));
+        };
+        for (int by = 0; by < blocks_y; ++by)
+            for (int bx = 0; bx < blocks_x; ++bx) {
+                const std::size_t b = std::size_t(by) * blocks_x + bx;
+                block_first[b] = pieces_in_all;
+                bool any = false;
+                for (int y = 0; y < block_side && !any; ++y) any = row_bits(bx, by * block_side + y) != 0;
+                if (!any) {
+                    ++pieces_in_all;
+                    continue;
+                }
+                const std::size_t first = piece.size();
+                block_piece[b] = static_cast<std::int32_t>(first);
+                piece.resize(first + block_cells, 0);
+                std::uint8_t pieces = 0;
+                auto free_cell = [&](int c) {
+                    return piece[first + c] == 0 && !(row_bits(bx, by * block_side + c / block_side) >> (c % block_side) & 1u);
+                };
+                for (int c = 0; c < block_cells; ++c) {
+                    if (!free_cell(c)) continue;
+                    piece[first + c] = ++pieces; // at most block_cells / 2 pieces: they fit
+                    stack.assign(1, c);
+                    while (!stack.empty()) {
+                        const int u = stack.back(), ux = u % block_side, uy = u / block_side;
+                        stack.pop_back();
+                        for (const int v : {ux + 1 < block_side ? u + 1 : -1, ux > 0 ? u - 1 : -1,
+                                            uy + 1 < block_side ? u + block_side : -1, uy > 0 ? u - block_side : -1})
+                            if (v >= 0 && free_cell(v)) {
+                                piece[first + v] = pieces;
+                                stack.push_back(v);
+                            }
+                    }
+                }
+                pieces_in_all += pieces;
+            }
+        // The components: pieces on both sides of a block side, each in a free cell, are one.
+        component.resize(pieces_in_all);
+        for (std::uint32_t k = 0; k < pieces_in_all; ++k) component[k] = k;
+        auto root = [&](std::uint32_t k) {
+            while (component[k] != k) k = component[k] = component[component[k]];
+            return k;
+        };
+        auto piece_at = [&](int x, int y) -> std::int64_t { // -1: a touched cell
+            const std::size_t b = std::size_t(y / block_side) * blocks_x + std::size_t(x / block_side);
+            if (block_piece[b] < 0) return block_first[b];
+            const std::uint8_t k = piece[std::size_t(block_piece[b]) + std::size_t(y % block_side) * block_side + std::size_t(x % block_side)];
+            return k == 0 ? -1 : std::int64_t(block_first[b]) + k - 1;
+        };
+        auto join = [&](int x0, int y0, int x1, int y1) {
+            const std::int64_t a = piece_at(x0, y0), b = piece_at(x1, y1);
+            if (a >= 0 && b >= 0) component[root(std::uint32_t(a))] = root(std::uint32_t(b));
+        };
+        for (int x = block_side; x < cells_x; x += block_side)
+            for (int y = 0; y < cells_y; ++y) join(x - 1, y, x, y);
+        for (int y = block_side; y < cells_y; y += block_side)
+            for (int x = 0; x < cells_x; ++x) join(x, y - 1, x, y);
+        for (std::uint32_t k = 0; k < pieces_in_all; ++k) component[k] = root(k);
+        answer.assign(pieces_in_all, -1);
+        piece.shrink_to_fit();
+        std::vector<std::uint64_t>().swap(touched);
+    }
+
+    // GEOS's answer: inside one of the polygons whose envelope holds the point.
+    bool geos_contains(const LonLat& ll) const {
+        GEOSGeometry* point = GEOSGeom_createPointFromXY_r(ctx, ll.lon, ll.lat);
+        if (!point) throw DataError("coast: GEOS failed to build a point for the land test");
+        struct Query {
+            const Impl* m;
+            const GEOSGeometry* point;
+            bool inside = false;
+        } q{this, point};
+        GEOSSTRtree_query_r(
+            ctx, tree, point,
+            [](void* item, void* data) {
+                auto& q = *static_cast<Query*>(data);
+                if (q.inside) return;
+                const auto i = reinterpret_cast<std::size_t>(item);
+                q.inside = GEOSPreparedContains_r(q.m->ctx, q.m->prepared[i], q.point) == 1;
+            },
+            &q);
+        GEOSGeom_destroy_r(ctx, point);
+        return q.inside;
     }
 
     GEOSGeometry* ring(const std::vector<LonLat>& pts) const {
@@ -83,11 +227,15 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons
         m.polygons.push_back(poly);
         probes.push_back(rings[0][0]);
         for (const auto& r : rings) {
-            if (r.size() >= 4) m.add_outline(r);
+            if (r.size() >= 4) {
+                m.add_outline(r);
+                m.add_segments(r);
+            }
             vertices_ += r.size();
         }
     }
     m.piece_start.push_back(m.outline.size());
+    m.label_pieces();
     // Every polygon prepared now, its point locator built by a first test (GEOS builds it
     // lazily): the index belongs to loading the coast, not to the meshing that asks it.
     m.prepared.assign(m.polygons.size(), nullptr);
@@ -110,28 +258,28 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons
 
 LandMask::~LandMask() = default;
 
+std::size_t LandMask::cell_bytes() const {
+    const Impl& m = *impl_;
+    return m.block_piece.capacity() * sizeof(std::int32_t) + m.piece.capacity() + m.block_first.capacity() * sizeof(std::uint32_t) +
+           m.component.capacity() * sizeof(std::uint32_t) + m.answer.capacity();
+}
+
 bool LandMask::contains(const Vec3& p) const {
     const Impl& m = *impl_;
     if (m.polygons.empty()) return false;
     const LonLat ll = vec_to_lonlat(p);
-    GEOSGeometry* point = GEOSGeom_createPointFromXY_r(m.ctx, ll.lon, ll.lat);
-    if (!point) throw DataError("coast: GEOS failed to build a point for the land test");
-    struct Query {
-        const Impl* m;
-        const GEOSGeometry* point;
-        bool inside = false;
-    } q{&m, point};
-    GEOSSTRtree_query_r(
-        m.ctx, m.tree, point,
-        [](void* item, void* data) {
-            auto& q = *static_cast<Query*>(data);
-            if (q.inside) return;
-            const auto i = reinterpret_cast<std::size_t>(item);
-            q.inside = GEOSPreparedContains_r(q.m->ctx, q.m->prepared[i], q.point) == 1;
-        },
-        &q);
-    GEOSGeom_destroy_r(m.ctx, point);
-    return q.inside;
+    if (!std::isfinite(ll.lon) || !std::isfinite(ll.lat)) return m.geos_contains(ll);
+    const int x = cell_of(ll.lon, 180, cells_x), y = cell_of(ll.lat, 90, cells_y);
+    const std::size_t b = std::size_t(y / block_side) * blocks_x + std::size_t(x / block_side);
+    std::uint32_t k = m.block_first[b];
+    if (const std::int32_t first = m.block_piece[b]; first >= 0) {
+        const std::uint8_t in_block = m.piece[std::size_t(first) + std::size_t(y % block_side) * block_side + std::size_t(x % block_side)];
+        if (in_block == 0) return m.geos_contains(ll); // a cell the outline may cross
+        k += in_block - 1u;
+    }
+    std::int8_t& a = m.answer[m.component[k]];
+    if (a < 0) a = m.geos_contains(ll) ? 1 : 0;
+    return a == 1;
 }
 
 bool LandMask::coast_within(const Vec3& p, double angle) const {

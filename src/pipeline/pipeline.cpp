@@ -59,7 +59,7 @@ constexpr std::uint64_t ring_bytes_per_node = 40;
 
 /// Bytes per vertex of the land test (LandMask) while meshing: GEOS coordinates (24), the
 /// prepared polygons' segment index, the outline as unit vectors (24) and its pieces' envelopes,
-/// rounded up.
+/// rounded up; its cells come on top (LandMask::cell_bytes).
 constexpr std::uint64_t land_bytes_per_vertex = 100;
 
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
@@ -208,7 +208,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     mo.seed = o.seed;
     if (coast.land) {
         // The land test holds the land polygons (GEOS coordinates and their prepared index).
-        budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex));
+        budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex + coast.land->cell_bytes()));
         mo.land = coast.land;
     }
     MesherReport report;

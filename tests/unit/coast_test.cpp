@@ -4,6 +4,7 @@
 // regions across +-180 and at a pole.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -473,6 +474,28 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
         outlines.push_back(std::move(ring));
     };
     for (auto g : source) collect(g);
+
+    // Near the coast too, where the land test's cells (a cell no segment's box touches answers
+    // from the first point asked in its component) meet the outline: points within a few cells
+    // of the source's vertices, a third of them on cell sides and corners (multiples of 1/32
+    // degree), each asked twice.
+    std::uniform_int_distribution<std::size_t> pick(0, outlines.size() - 1);
+    std::uniform_real_distribution<double> offset(-0.15, 0.15);
+    std::size_t near_land = 0, near_disagree = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const auto& r = outlines[pick(rng)];
+        const LonLat v = vec_to_lonlat(r[std::uniform_int_distribution<std::size_t>(0, r.size() - 1)(rng)]);
+        LonLat q{v.lon + offset(rng), std::clamp(v.lat + offset(rng), -90.0, 90.0)};
+        if (i % 3 == 0) q = {std::round(q.lon * 32) / 32, std::round(q.lat * 32) / 32};
+        const Vec3 p = lonlat_to_vec(q.lon, q.lat);
+        const bool in = d.land->contains(p);
+        EXPECT_EQ(d.land->contains(p), in);
+        near_land += in;
+        near_disagree += in != ogr_land(vec_to_lonlat(p));
+    }
+    EXPECT_EQ(near_disagree, 0u);
+    EXPECT_GT(near_land, 600u);
+    EXPECT_LT(near_land, 2400u);
     for (auto g : source) OGR_G_DestroyGeometry(g);
 
     // coast_within agrees with the brute-force distance on the sphere, at every latitude and
