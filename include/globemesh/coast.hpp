@@ -80,7 +80,7 @@ public:
     LandMask(const LandMask&) = delete;
     LandMask& operator=(const LandMask&) = delete;
     /// True when p lies strictly inside a land polygon (not in one of its holes, not on its
-    /// outline): GEOS's answer, asked once per component of the lon/lat cells (1/32 degree)
+    /// outline): GEOS's answer, asked once per component of the lon/lat cells (1/16 degree)
     /// that no outline segment's box touches, and at every point of a cell one touches. Not
     /// thread-safe (one GEOS context, and the components' answers kept as they are asked).
     bool contains(const Vec3& p) const override;
@@ -88,7 +88,7 @@ public:
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
     bool coast_within(const Vec3& p, double angle) const override;
     std::size_t vertices() const { return vertices_; }
-    /// The bytes of the cells in front of `contains` (about 8 MB for the world's land).
+    /// The bytes of the cells in front of `contains` (about 2.7 MB for the world's land).
     std::size_t cell_bytes() const;
 
 private:

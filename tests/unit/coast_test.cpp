@@ -477,7 +477,7 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
 
     // Near the coast too, where the land test's cells (a cell no segment's box touches answers
     // from the first point asked in its component) meet the outline: points within a few cells
-    // of the source's vertices, a third of them on cell sides and corners (multiples of 1/32
+    // of the source's vertices, a third of them on cell sides and corners (multiples of 1/16
     // degree), each asked twice.
     std::uniform_int_distribution<std::size_t> pick(0, outlines.size() - 1);
     std::uniform_real_distribution<double> offset(-0.15, 0.15);
@@ -486,7 +486,7 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
         const auto& r = outlines[pick(rng)];
         const LonLat v = vec_to_lonlat(r[std::uniform_int_distribution<std::size_t>(0, r.size() - 1)(rng)]);
         LonLat q{v.lon + offset(rng), std::clamp(v.lat + offset(rng), -90.0, 90.0)};
-        if (i % 3 == 0) q = {std::round(q.lon * 32) / 32, std::round(q.lat * 32) / 32};
+        if (i % 3 == 0) q = {std::round(q.lon * 16) / 16, std::round(q.lat * 16) / 16};
         const Vec3 p = lonlat_to_vec(q.lon, q.lat);
         const bool in = d.land->contains(p);
         EXPECT_EQ(d.land->contains(p), in);
