@@ -57,113 +57,158 @@ bool arcs_conflict(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
     return (s1 > 0) == (s2 > 0);
 }
 
-std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>& rings,
-                                    std::size_t max_pairs) {
-    struct Seg {
-        std::uint32_t ring, index;
-    };
-    std::vector<Seg> segs;
+ArcGrid::ArcGrid(const std::vector<const std::vector<Vec3>*>& rings) : rings_(rings) {
     double total = 0;
     std::size_t count = 0;
-    for (std::uint32_t r = 0; r < rings.size(); ++r) {
-        const auto& nodes = *rings[r];
-        for (std::uint32_t i = 0; i < nodes.size(); ++i) {
-            segs.push_back({r, i});
-            total += norm(nodes[i] - nodes[(i + 1) % nodes.size()]);
-            ++count;
-        }
-    }
-    std::vector<ArcPair> out;
-    if (count == 0) return out;
+    for (const auto* ring : rings)
+        for (std::size_t i = 0; i < ring->size(); ++i, ++count) total += norm((*ring)[i] - (*ring)[(i + 1) % ring->size()]);
     // Cell size: a few mean chords, bounded so the grid stays small.
-    double cell = std::clamp(4.0 * total / static_cast<double>(count), 2e-5, 0.05);
-    auto cell_of = [cell](double v) { return static_cast<std::uint64_t>(std::floor((v + 1.5) / cell)); };
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
-    entries.reserve(count * 2);
-    struct Box {
-        double lo[3], hi[3];
-    };
-    std::vector<Box> boxes(segs.size());
-    for (std::uint32_t s = 0; s < segs.size(); ++s) {
-        const auto& nodes = *rings[segs[s].ring];
-        const Vec3& a = nodes[segs[s].index];
-        const Vec3& b = nodes[(segs[s].index + 1) % nodes.size()];
-        double chord = norm(a - b);
-        // The arc bulges out of the chord's box by at most chord^2 / 8 (plus rounding).
-        double bulge = 1e-12 + 0.125 * chord * chord;
-        boxes[s] = {{std::min(a.x, b.x) - bulge, std::min(a.y, b.y) - bulge, std::min(a.z, b.z) - bulge},
-                    {std::max(a.x, b.x) + bulge, std::max(a.y, b.y) + bulge, std::max(a.z, b.z) + bulge}};
-        int pieces = std::max(1, static_cast<int>(std::ceil(chord / (0.5 * cell))));
-        Vec3 prev = a;
-        for (int k = 1; k <= pieces; ++k) {
-            Vec3 next = k == pieces ? b : arc_interpolate(a, b, double(k) / pieces);
-            double piece = norm(next - prev);
-            double pad = 1e-12 + 0.125 * piece * piece;
-            double lo[3] = {std::min(prev.x, next.x) - pad, std::min(prev.y, next.y) - pad,
-                            std::min(prev.z, next.z) - pad};
-            double hi[3] = {std::max(prev.x, next.x) + pad, std::max(prev.y, next.y) + pad,
-                            std::max(prev.z, next.z) + pad};
-            for (std::uint64_t ix = cell_of(lo[0]); ix <= cell_of(hi[0]); ++ix)
-                for (std::uint64_t iy = cell_of(lo[1]); iy <= cell_of(hi[1]); ++iy)
-                    for (std::uint64_t iz = cell_of(lo[2]); iz <= cell_of(hi[2]); ++iz)
-                        entries.push_back({(ix << 42) | (iy << 21) | iz, s});
-            prev = next;
-        }
-    }
-    std::sort(entries.begin(), entries.end());
-    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
-    auto overlap = [&](std::uint32_t s, std::uint32_t t) {
-        const Box& p = boxes[s];
-        const Box& q = boxes[t];
-        return p.lo[0] <= q.hi[0] && q.lo[0] <= p.hi[0] && p.lo[1] <= q.hi[1] && q.lo[1] <= p.hi[1] &&
-               p.lo[2] <= q.hi[2] && q.lo[2] <= p.hi[2];
-    };
-    for (std::size_t i = 0; i < entries.size();) {
+    cell_ = count == 0 ? 0.05 : std::clamp(4.0 * total / static_cast<double>(count), 2e-5, 0.05);
+    ids_of_.resize(rings.size());
+    for (std::uint32_t r = 0; r < rings.size(); ++r)
+        for (std::uint32_t i = 0; i < rings[r]->size(); ++i) ids_of_[r].push_back(add_arc(r, i, entries_));
+    std::sort(entries_.begin(), entries_.end());
+    entries_.erase(std::unique(entries_.begin(), entries_.end()), entries_.end());
+    for (std::size_t i = 0; i < entries_.size();) {
         std::size_t j = i;
-        while (j < entries.size() && entries[j].first == entries[i].first) ++j;
-        for (std::size_t p = i; p < j; ++p) {
-            for (std::size_t q = p + 1; q < j; ++q) {
-                std::uint32_t s = std::min(entries[p].second, entries[q].second);
-                std::uint32_t t = std::max(entries[p].second, entries[q].second);
-                if (!overlap(s, t)) continue;
-                const Seg& u = segs[s];
-                const Seg& v = segs[t];
-                const auto& ru = *rings[u.ring];
-                const auto& rv = *rings[v.ring];
-                const Vec3& a = ru[u.index];
-                const Vec3& b = ru[(u.index + 1) % ru.size()];
-                const Vec3& c = rv[v.index];
-                const Vec3& d = rv[(v.index + 1) % rv.size()];
-                bool conflict;
-                if (u.ring == v.ring && ru.size() > 2 &&
-                    ((u.index + 1) % ru.size() == v.index || (v.index + 1) % ru.size() == u.index)) {
-                    // Consecutive arcs share one node: they conflict only when one folds back on
-                    // the other (a zero-width spike).
-                    bool u_first = (u.index + 1) % ru.size() == v.index;
-                    const Vec3& pp = u_first ? a : c;
-                    const Vec3& m = u_first ? b : d;
-                    const Vec3& qq = u_first ? d : b;
-                    Vec3 n = robust_cross(pp, m);
-                    double ln = norm(n);
-                    conflict = ln == 0 || (std::abs(dot((1.0 / ln) * n, qq)) < touch_eps && dot(m - pp, qq - m) < 0);
-                } else {
-                    conflict = arcs_conflict(a, b, c, d);
-                }
-                if (conflict) out.push_back({u.ring, u.index, v.ring, v.index});
-            }
-        }
+        while (j < entries_.size() && entries_[j].first == entries_[i].first) ++j;
+        for (std::size_t p = i; p < j; ++p)
+            for (std::size_t q = p + 1; q < j; ++q) test(entries_[p].second, entries_[q].second);
         i = j;
     }
-    auto order = [](const ArcPair& x, const ArcPair& y) {
+    settle();
+}
+
+std::uint32_t ArcGrid::add_arc(std::uint32_t r, std::uint32_t i, std::vector<std::pair<std::uint64_t, std::uint32_t>>& entries) {
+    const auto id = static_cast<std::uint32_t>(ring_.size());
+    ring_.push_back(r);
+    index_.push_back(i);
+    alive_.push_back(1);
+    const auto& nodes = *rings_[r];
+    const Vec3& a = nodes[i];
+    const Vec3& b = nodes[(i + 1) % nodes.size()];
+    const double chord = norm(a - b);
+    // The arc bulges out of the chord's box by at most chord^2 / 8 (plus rounding).
+    const double bulge = 1e-12 + 0.125 * chord * chord;
+    boxes_.push_back({{std::min(a.x, b.x) - bulge, std::min(a.y, b.y) - bulge, std::min(a.z, b.z) - bulge},
+                      {std::max(a.x, b.x) + bulge, std::max(a.y, b.y) + bulge, std::max(a.z, b.z) + bulge}});
+    auto cell_of = [this](double v) { return static_cast<std::uint64_t>(std::floor((v + 1.5) / cell_)); };
+    const int pieces = std::max(1, static_cast<int>(std::ceil(chord / (0.5 * cell_))));
+    Vec3 prev = a;
+    for (int k = 1; k <= pieces; ++k) {
+        const Vec3 next = k == pieces ? b : arc_interpolate(a, b, double(k) / pieces);
+        const double piece = norm(next - prev);
+        const double pad = 1e-12 + 0.125 * piece * piece;
+        const double lo[3] = {std::min(prev.x, next.x) - pad, std::min(prev.y, next.y) - pad, std::min(prev.z, next.z) - pad};
+        const double hi[3] = {std::max(prev.x, next.x) + pad, std::max(prev.y, next.y) + pad, std::max(prev.z, next.z) + pad};
+        for (std::uint64_t ix = cell_of(lo[0]); ix <= cell_of(hi[0]); ++ix)
+            for (std::uint64_t iy = cell_of(lo[1]); iy <= cell_of(hi[1]); ++iy)
+                for (std::uint64_t iz = cell_of(lo[2]); iz <= cell_of(hi[2]); ++iz)
+                    entries.push_back({(ix << 42) | (iy << 21) | iz, id});
+        prev = next;
+    }
+    return id;
+}
+
+void ArcGrid::test(std::uint32_t s, std::uint32_t t) {
+    if (s == t) return;
+    const Box& p = boxes_[s];
+    const Box& q = boxes_[t];
+    if (!(p.lo[0] <= q.hi[0] && q.lo[0] <= p.hi[0] && p.lo[1] <= q.hi[1] && q.lo[1] <= p.hi[1] && p.lo[2] <= q.hi[2] &&
+          q.lo[2] <= p.hi[2]))
+        return;
+    const auto& ru = *rings_[ring_[s]];
+    const auto& rv = *rings_[ring_[t]];
+    const std::uint32_t ui = index_[s], vi = index_[t];
+    const Vec3& a = ru[ui];
+    const Vec3& b = ru[(ui + 1) % ru.size()];
+    const Vec3& c = rv[vi];
+    const Vec3& d = rv[(vi + 1) % rv.size()];
+    bool conflict;
+    if (ring_[s] == ring_[t] && ru.size() > 2 && ((ui + 1) % ru.size() == vi || (vi + 1) % ru.size() == ui)) {
+        // Consecutive arcs share one node: they conflict only when one folds back on the
+        // other (a zero-width spike).
+        const bool u_first = (ui + 1) % ru.size() == vi;
+        const Vec3& pp = u_first ? a : c;
+        const Vec3& m = u_first ? b : d;
+        const Vec3& qq = u_first ? d : b;
+        const Vec3 n = robust_cross(pp, m);
+        const double ln = norm(n);
+        conflict = ln == 0 || (std::abs(dot((1.0 / ln) * n, qq)) < touch_eps && dot(m - pp, qq - m) < 0);
+    } else {
+        conflict = arcs_conflict(a, b, c, d);
+    }
+    if (conflict) pairs_.emplace_back(std::min(s, t), std::max(s, t));
+}
+
+void ArcGrid::settle() {
+    std::sort(pairs_.begin(), pairs_.end());
+    pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+}
+
+void ArcGrid::replace(std::uint32_t r, const std::vector<std::uint32_t>& old_of) {
+    std::vector<std::uint32_t>& ids = ids_of_[r];
+    for (const std::uint32_t id : ids) alive_[id] = 0;
+    std::vector<std::uint32_t> now(old_of.size());
+    for (std::uint32_t i = 0; i < old_of.size(); ++i) {
+        if (old_of[i] == none) {
+            now[i] = add_arc(r, i, fresh_);
+            continue;
+        }
+        now[i] = ids[old_of[i]];
+        alive_[now[i]] = 1;
+        index_[now[i]] = i;
+    }
+    ids = std::move(now);
+}
+
+void ArcGrid::update() {
+    // The pairs found before whose arcs both stay still conflict (the same arcs, and two arcs of
+    // one ring consecutive before are consecutive now); every other pair has a new arc.
+    std::erase_if(pairs_, [&](const auto& st) { return !alive_[st.first] || !alive_[st.second]; });
+    std::sort(fresh_.begin(), fresh_.end());
+    fresh_.erase(std::unique(fresh_.begin(), fresh_.end()), fresh_.end());
+    for (std::size_t i = 0; i < fresh_.size();) {
+        std::size_t j = i;
+        while (j < fresh_.size() && fresh_[j].first == fresh_[i].first) ++j;
+        // New against new in the cell, then against the arcs indexed before that stay.
+        for (std::size_t p = i; p < j; ++p)
+            for (std::size_t q = p + 1; q < j; ++q) test(fresh_[p].second, fresh_[q].second);
+        const auto lo = std::lower_bound(entries_.begin(), entries_.end(), std::pair{fresh_[i].first, std::uint32_t{0}});
+        for (auto e = lo; e != entries_.end() && e->first == fresh_[i].first; ++e)
+            if (alive_[e->second])
+                for (std::size_t p = i; p < j; ++p) test(fresh_[p].second, e->second);
+        i = j;
+    }
+    settle();
+    // The new arcs join the index; the entries of arcs gone are dropped once they are half.
+    const std::size_t middle = entries_.size();
+    entries_.insert(entries_.end(), fresh_.begin(), fresh_.end());
+    std::inplace_merge(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(middle), entries_.end());
+    fresh_.clear();
+    std::size_t alive = 0;
+    for (const auto& e : entries_) alive += alive_[e.second];
+    if (2 * alive < entries_.size())
+        std::erase_if(entries_, [&](const auto& e) { return !alive_[e.second]; });
+}
+
+std::vector<ArcPair> ArcGrid::conflicts(std::size_t max_pairs) const {
+    std::vector<ArcPair> out;
+    out.reserve(pairs_.size());
+    for (const auto& [s, t] : pairs_) {
+        ArcPair x{ring_[s], index_[s], ring_[t], index_[t]};
+        if (std::tie(x.ring_b, x.seg_b) < std::tie(x.ring_a, x.seg_a)) x = {x.ring_b, x.seg_b, x.ring_a, x.seg_a};
+        out.push_back(x);
+    }
+    std::sort(out.begin(), out.end(), [](const ArcPair& x, const ArcPair& y) {
         return std::tie(x.ring_a, x.seg_a, x.ring_b, x.seg_b) < std::tie(y.ring_a, y.seg_a, y.ring_b, y.seg_b);
-    };
-    auto same = [](const ArcPair& x, const ArcPair& y) {
-        return x.ring_a == y.ring_a && x.seg_a == y.seg_a && x.ring_b == y.ring_b && x.seg_b == y.seg_b;
-    };
-    std::sort(out.begin(), out.end(), order);
-    out.erase(std::unique(out.begin(), out.end(), same), out.end());
+    });
     if (out.size() > max_pairs) out.resize(max_pairs);
     return out;
+}
+
+std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>& rings, std::size_t max_pairs) {
+    return ArcGrid(rings).conflicts(max_pairs);
 }
 
 double rings_area_km2(const std::vector<std::vector<LonLat>>& rings) {

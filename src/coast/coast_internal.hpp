@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "globemesh/boundary.hpp"
@@ -22,6 +23,43 @@ bool arcs_conflict(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 /// when they fold back), found through a uniform 3-D grid; sorted, at most max_pairs.
 std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>& rings,
                                     std::size_t max_pairs = static_cast<std::size_t>(-1));
+
+/// find_conflicts for rings that change a few arcs at a time: the grid and the conflicting
+/// pairs are kept, and after a change only the new arcs are tested (against the new and the
+/// kept ones). The rings are read through the pointers given, so a ring's vector is changed
+/// in place and then named in replace().
+class ArcGrid {
+public:
+    static constexpr std::uint32_t none = 0xffffffffu;
+    /// Indexes every arc of the rings and finds the conflicts.
+    explicit ArcGrid(const std::vector<const std::vector<Vec3>*>& rings);
+    /// Ring r has changed: its arc i (from node i to the next) is its former arc old_of[i], the
+    /// same two points, or `none` (a new arc). Two arcs kept must stay in their order, and two
+    /// that followed each other must still.
+    void replace(std::uint32_t r, const std::vector<std::uint32_t>& old_of);
+    /// After the rings' replace() calls: the conflicts again.
+    void update();
+    /// The conflicts, as find_conflicts gives them.
+    std::vector<ArcPair> conflicts(std::size_t max_pairs = static_cast<std::size_t>(-1)) const;
+
+private:
+    struct Box {
+        double lo[3], hi[3];
+    };
+    std::uint32_t add_arc(std::uint32_t r, std::uint32_t i, std::vector<std::pair<std::uint64_t, std::uint32_t>>& entries);
+    void test(std::uint32_t s, std::uint32_t t); // adds (s, t) to pairs_ when they conflict
+    void settle();                               // sorts pairs_, each once
+
+    const std::vector<const std::vector<Vec3>*>& rings_;
+    double cell_ = 0.05;
+    std::vector<std::uint32_t> ring_, index_; // per arc id: its ring and its index there now
+    std::vector<char> alive_;                  // per arc id: still in its ring
+    std::vector<Box> boxes_;
+    std::vector<std::vector<std::uint32_t>> ids_of_;               // per ring, its arcs' ids in order
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries_; // (cell, arc id), sorted
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> fresh_;   // the new arcs', until update()
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;   // conflicting arc ids, smaller first
+};
 
 /// Geodesic area (WGS84) to the left of all the closed lon/lat rings, km2 (sum of signed
 /// GeographicLib areas modulo the Earth's area); the whole Earth when there is no ring.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -48,10 +49,21 @@ struct ShapedRing {
     std::vector<bool> corner;         // nodes the resampled ring must pass through
 };
 
-/// A node of a resampled ring: on the kept arc kept[arc] -> kept[arc + 1].
+/// A node of a resampled ring: on the kept arc from source node `node` to the next kept one.
 struct Sample {
     Vec3 p;
-    std::uint32_t arc;
+    std::uint32_t node;
+};
+
+/// A ring as last resampled: its samples, and per run (from corner `from` to corner `to`, as
+/// source node indices) where its samples are.
+struct Resampled {
+    struct Run {
+        std::uint32_t from, to;
+        std::size_t offset, count;
+    };
+    std::vector<Sample> samples;
+    std::vector<Run> runs;
 };
 
 /// Douglas-Peucker between kept nodes i < j (indices modulo n): keeps the node farthest from the
@@ -89,8 +101,12 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, double
 /// two corners is cut into pieces of equal length in units of the local size (the integral of
 /// ds / h along the line), as many as round that length, so that coast segments are about h long
 /// and neighbours differ little. A ring without corners is one closed run from its first node.
+/// `last` holds the ring as resampled before and gets it as now: a run between the same two
+/// corners as then (no corner came between) is taken from it as it was, since nothing it is
+/// made from has changed. `old_of` gets, per arc of the new ring, its arc in `last` with the
+/// same two points, or ArcGrid::none.
 template <class H>
-std::vector<Sample> resample(const ShapedRing& s, const H& h_at) {
+void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<std::uint32_t>& old_of) {
     const auto& nodes = s.ring->nodes;
     const std::uint32_t m = static_cast<std::uint32_t>(s.kept.size());
     auto at = [&](std::uint32_t k) -> const Vec3& { return nodes[s.kept[k % m]]; };
@@ -106,13 +122,17 @@ std::vector<Sample> resample(const ShapedRing& s, const H& h_at) {
     };
     std::vector<std::vector<Point>> runs(corners.size());
     std::vector<long> pieces(corners.size());
-    for (std::size_t c = 0; c < corners.size(); ++c) {
-        std::uint32_t first = corners[c];
-        std::uint32_t last = c + 1 < corners.size() ? corners[c + 1] : corners[0] + m;
+    std::vector<const Resampled::Run*> same(corners.size(), nullptr); // the run of `last` to copy
+    std::vector<const Resampled::Run*> by_from;
+    for (const auto& r : last.runs) by_from.push_back(&r);
+    std::sort(by_from.begin(), by_from.end(), [](const auto* x, const auto* y) { return x->from < y->from; });
+    auto end_of = [&](std::size_t c) { return c + 1 < corners.size() ? corners[c + 1] : corners[0] + m; };
+    auto measure = [&](std::size_t c) {
+        const std::uint32_t first = corners[c], end = end_of(c);
         auto& run = runs[c];
         double along = 0;
         run.push_back({0, first % m, 0});
-        for (std::uint32_t k = first; k < last; ++k) {
+        for (std::uint32_t k = first; k < end; ++k) {
             const Vec3& a = at(k);
             const Vec3& b = at(k + 1);
             const double len = arc_angle(a, b);
@@ -128,18 +148,44 @@ std::vector<Sample> resample(const ShapedRing& s, const H& h_at) {
             }
         }
         pieces[c] = std::max(1L, std::lround(along));
+    };
+    for (std::size_t c = 0; c < corners.size(); ++c) {
+        const std::uint32_t from = s.kept[corners[c] % m], to = s.kept[end_of(c) % m];
+        const auto it = std::lower_bound(by_from.begin(), by_from.end(), from, [](const auto* r, std::uint32_t x) { return r->from < x; });
+        if (it != by_from.end() && (*it)->from == from && (*it)->to == to) {
+            same[c] = *it;
+            pieces[c] = static_cast<long>((*it)->count);
+        } else {
+            measure(c);
+        }
     }
-    // A ring needs three nodes: add pieces where they are longest.
+    // A ring needs three nodes: add pieces where they are longest (every run measured then).
+    if (std::accumulate(pieces.begin(), pieces.end(), 0L) < 3)
+        for (std::size_t c = 0; c < corners.size(); ++c)
+            if (same[c]) {
+                same[c] = nullptr;
+                measure(c);
+            }
     for (long total = 0; (total = std::accumulate(pieces.begin(), pieces.end(), 0L)) < 3;) {
         std::size_t best = 0;
         for (std::size_t c = 1; c < runs.size(); ++c)
             if (runs[c].back().along / pieces[c] > runs[best].back().along / pieces[best]) best = c;
         ++pieces[best];
     }
-    std::vector<Sample> out;
+    Resampled now;
+    std::vector<Sample>& out = now.samples;
+    old_of.clear();
     for (std::size_t c = 0; c < runs.size(); ++c) {
+        const std::size_t offset = out.size();
+        if (const Resampled::Run* r = same[c]) {
+            out.insert(out.end(), last.samples.begin() + static_cast<std::ptrdiff_t>(r->offset),
+                       last.samples.begin() + static_cast<std::ptrdiff_t>(r->offset + r->count));
+            for (std::size_t j = 0; j < r->count; ++j) old_of.push_back(static_cast<std::uint32_t>(r->offset + j));
+            now.runs.push_back({r->from, r->to, offset, r->count});
+            continue;
+        }
         const auto& run = runs[c];
-        out.push_back({at(corners[c]), corners[c] % m});
+        out.push_back({at(corners[c]), s.kept[corners[c] % m]});
         std::size_t i = 1;
         for (long p = 1; p < pieces[c]; ++p) {
             const double want = run.back().along * double(p) / double(pieces[c]);
@@ -149,10 +195,12 @@ std::vector<Sample> resample(const ShapedRing& s, const H& h_at) {
             const double f = hi.along > lo.along ? (want - lo.along) / (hi.along - lo.along) : 0.0;
             const double t0 = lo.arc == hi.arc ? lo.t : 0.0;
             const double t = t0 + f * (hi.t - t0);
-            out.push_back({arc_interpolate(at(hi.arc), at(hi.arc + 1), t), hi.arc});
+            out.push_back({arc_interpolate(at(hi.arc), at(hi.arc + 1), t), s.kept[hi.arc]});
         }
+        old_of.resize(out.size(), coast_detail::ArcGrid::none);
+        now.runs.push_back({s.kept[corners[c] % m], s.kept[end_of(c) % m], offset, out.size() - offset});
     }
-    return out;
+    last = std::move(now);
 }
 
 } // namespace
@@ -307,31 +355,41 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
     //    not conflict.
     //    Only the rings that got a corner are resampled again.
-    std::vector<std::vector<Sample>> samples(shaped.size());
+    //    Each round after the first resamples only the runs that got a corner (resample) and
+    //    tests only their new arcs (ArcGrid): the same rings and conflicts as doing it all again
+    //    (the boundary stage on 1:50m land at 64 km, 11 rounds: 0.033 -> 0.019 s; on 1:10m at
+    //    100 km, 116 rounds: 0.155 -> 0.058 s; at 10 km, 24 rounds: 0.83 -> 0.23 s).
+    std::vector<Resampled> resampled(shaped.size());
     std::vector<std::vector<Vec3>> rings(shaped.size());
+    std::vector<const std::vector<Vec3>*> ptrs;
+    for (const auto& r : rings) ptrs.push_back(&r);
     std::vector<char> changed(shaped.size(), 1);
+    std::optional<coast_detail::ArcGrid> grid;
+    std::vector<std::uint32_t> old_of;
     for (int round = 0;; ++round) {
         for (std::size_t r = 0; r < shaped.size(); ++r) {
             if (!changed[r]) continue;
-            samples[r] = resample(shaped[r], h_at);
+            resample(shaped[r], h_at, resampled[r], old_of);
             rings[r].clear();
-            rings[r].reserve(samples[r].size());
-            for (const auto& x : samples[r]) rings[r].push_back(x.p);
+            rings[r].reserve(resampled[r].samples.size());
+            for (const auto& x : resampled[r].samples) rings[r].push_back(x.p);
+            if (grid) grid->replace(static_cast<std::uint32_t>(r), old_of);
         }
-        std::vector<const std::vector<Vec3>*> ptrs;
-        for (const auto& r : rings) ptrs.push_back(&r);
-        auto conflicts = coast_detail::find_conflicts(ptrs);
+        if (grid) grid->update();
+        else grid.emplace(ptrs);
+        const auto conflicts = grid->conflicts();
         if (conflicts.empty()) break;
         std::vector<std::vector<std::uint32_t>> insert(shaped.size());
         auto refine = [&](std::uint32_t r, std::uint32_t seg) {
             const auto& s = shaped[r];
-            const auto& x = samples[r];
+            const auto& x = resampled[r].samples;
             const std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
-            const std::uint32_t m = static_cast<std::uint32_t>(s.kept.size());
             const Sample& p = x[seg];
             const Sample& q = x[(seg + 1) % x.size()];
-            std::uint32_t a = s.kept[p.arc];
-            std::uint32_t b = s.kept[(q.arc + 1) % m];
+            // From p's arc's start to q's arc's end (the kept node after q's).
+            std::uint32_t a = p.node;
+            const auto after = std::upper_bound(s.kept.begin(), s.kept.end(), q.node);
+            std::uint32_t b = after == s.kept.end() ? s.kept.front() : *after;
             if (b <= a) b += n;
             double worst = -1;
             std::uint32_t at = n;
@@ -378,11 +436,12 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     for (std::size_t r = 0; r < shaped.size(); ++r) {
         const auto& s = shaped[r];
         Ring ring;
-        ring.nodes.reserve(samples[r].size());
-        ring.kinds.reserve(samples[r].size());
-        for (const auto& x : samples[r]) {
+        const auto& samples = resampled[r].samples;
+        ring.nodes.reserve(samples.size());
+        ring.kinds.reserve(samples.size());
+        for (const auto& x : samples) {
             ring.nodes.push_back(x.p);
-            ring.kinds.push_back(s.ring->kinds[s.kept[x.arc]]);
+            ring.kinds.push_back(s.ring->kinds[x.node]);
         }
         out.rings.push_back(std::move(ring));
     }
