@@ -354,7 +354,6 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
     //    not conflict.
-    //    Only the rings that got a corner are resampled again.
     //    Each round after the first resamples only the runs that got a corner (resample) and
     //    tests only their new arcs (ArcGrid): the same rings and conflicts as doing it all again
     //    (the boundary stage on 1:50m land at 64 km, 11 rounds: 0.033 -> 0.019 s; on 1:10m at
