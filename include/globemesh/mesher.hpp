@@ -28,7 +28,7 @@
 //      corners are away from the boundary (not on it nor next to it) are flipped where that
 //      lowers the corners' sum of squared valence defects, the nodes around move to the mean of
 //      their neighbours without flips, and Lawson flips make the mesh Delaunay again there.
-//      Then six rounds over the nodes of triangles below q 0.9: each interior node moves where
+//      Then six rounds over the nodes of triangles below q 0.82: each interior node moves where
 //      its star has the best worst triangle up to 0.6, then the most triangles above q 0.8,
 //      then the highest sum of qualities capped at 0.82 (a pattern search from the best of a
 //      few candidates: the mean of the apexes that would make each star triangle equilateral,

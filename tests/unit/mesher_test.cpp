@@ -231,7 +231,10 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
 
 // The Dardanelles and the Bosphorus (1-6 km wide) at 100 km: the faces across them are centred
 // on land. By default they close, and the Black Sea becomes a basin of its own; with
-// keep_straits they stay, centred on land, and the mesh is one piece.
+// keep_straits they stay, centred on land, and the mesh is one piece. (Other water behind
+// passages narrower than a face may close too, depending on where the nodes lie: since
+// session 28, 15 faces of the Ionian Sea between Kefalonia and the mainland, open to the
+// region's western edge, closed at 20.4E 38.3N.)
 TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
     MeshOptions o = land_110m(100);
     o.coast = fixture("coast/ne_50m_land.gpkg").string();
@@ -241,10 +244,13 @@ TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
     const Closed closed = straits_closed(closed_mesh);
     EXPECT_GE(closed.count, 1u);
     EXPECT_TRUE(closed.near(26.5, 40.2) || closed.near(29.0, 41.1)) << "the Dardanelles or the Bosphorus";
-    ASSERT_EQ(closed.basins_km2.size(), 1u);
-    EXPECT_GT(closed.basins_km2[0], 3.5e5); // the Black Sea: 436,000 km2, and the Sea of Azov
+    // The largest basin cut off is the Black Sea (436,000 km2, and the Sea of Azov), each basin
+    // a piece of its own beside the main one.
+    ASSERT_GE(closed.basins_km2.size(), 1u);
+    EXPECT_GT(closed.basins_km2[0], 3.5e5);
     EXPECT_LT(closed.basins_km2[0], 5.0e5);
-    EXPECT_EQ(pieces(closed_mesh), 2u);
+    for (std::size_t i = 1; i < closed.basins_km2.size(); ++i) EXPECT_LT(closed.basins_km2[i], 5e4);
+    EXPECT_EQ(pieces(closed_mesh), closed.basins_km2.size() + 1);
     // (About 200 nodes, most on the coast: the size fit is not this test's point.)
     expect_verified(closed_mesh, "straits.nc", "0.5", "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
 
