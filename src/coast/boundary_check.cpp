@@ -67,19 +67,27 @@ ArcGrid::ArcGrid(const std::vector<const std::vector<Vec3>*>& rings) : rings_(ri
     ids_of_.resize(rings.size());
     for (std::uint32_t r = 0; r < rings.size(); ++r)
         for (std::uint32_t i = 0; i < rings[r]->size(); ++i) ids_of_[r].push_back(add_arc(r, i, entries_));
-    std::sort(entries_.begin(), entries_.end());
-    entries_.erase(std::unique(entries_.begin(), entries_.end()), entries_.end());
-    for (std::size_t i = 0; i < entries_.size();) {
-        std::size_t j = i;
-        while (j < entries_.size() && entries_[j].first == entries_[i].first) ++j;
-        for (std::size_t p = i; p < j; ++p)
-            for (std::size_t q = p + 1; q < j; ++q) test(entries_[p].second, entries_[q].second);
-        i = j;
-    }
+    test_cells(entries_, [](std::size_t, std::size_t) {});
     settle();
 }
 
-std::uint32_t ArcGrid::add_arc(std::uint32_t r, std::uint32_t i, std::vector<std::pair<std::uint64_t, std::uint32_t>>& entries) {
+// Sorts `entries` (each once), tests every two arcs that share a cell, and calls also(i, j)
+// with each cell's run entries[i, j).
+template <class Also>
+void ArcGrid::test_cells(std::vector<Entry>& entries, Also&& also) {
+    std::sort(entries.begin(), entries.end());
+    entries.erase(std::unique(entries.begin(), entries.end()), entries.end());
+    for (std::size_t i = 0; i < entries.size();) {
+        std::size_t j = i;
+        while (j < entries.size() && entries[j].first == entries[i].first) ++j;
+        for (std::size_t p = i; p < j; ++p)
+            for (std::size_t q = p + 1; q < j; ++q) test(entries[p].second, entries[q].second);
+        also(i, j);
+        i = j;
+    }
+}
+
+std::uint32_t ArcGrid::add_arc(std::uint32_t r, std::uint32_t i, std::vector<Entry>& entries) {
     const auto id = static_cast<std::uint32_t>(ring_.size());
     ring_.push_back(r);
     index_.push_back(i);
@@ -166,20 +174,13 @@ void ArcGrid::update() {
     // The pairs found before whose arcs both stay still conflict (the same arcs, and two arcs of
     // one ring consecutive before are consecutive now); every other pair has a new arc.
     std::erase_if(pairs_, [&](const auto& st) { return !alive_[st.first] || !alive_[st.second]; });
-    std::sort(fresh_.begin(), fresh_.end());
-    fresh_.erase(std::unique(fresh_.begin(), fresh_.end()), fresh_.end());
-    for (std::size_t i = 0; i < fresh_.size();) {
-        std::size_t j = i;
-        while (j < fresh_.size() && fresh_[j].first == fresh_[i].first) ++j;
-        // New against new in the cell, then against the arcs indexed before that stay.
-        for (std::size_t p = i; p < j; ++p)
-            for (std::size_t q = p + 1; q < j; ++q) test(fresh_[p].second, fresh_[q].second);
-        const auto lo = std::lower_bound(entries_.begin(), entries_.end(), std::pair{fresh_[i].first, std::uint32_t{0}});
+    // New against new in each cell, then against the arcs indexed before that stay.
+    test_cells(fresh_, [&](std::size_t i, std::size_t j) {
+        const auto lo = std::lower_bound(entries_.begin(), entries_.end(), Entry{fresh_[i].first, 0});
         for (auto e = lo; e != entries_.end() && e->first == fresh_[i].first; ++e)
             if (alive_[e->second])
                 for (std::size_t p = i; p < j; ++p) test(fresh_[p].second, e->second);
-        i = j;
-    }
+    });
     settle();
     // The new arcs join the index; the entries of arcs gone are dropped once they are half.
     const std::size_t middle = entries_.size();

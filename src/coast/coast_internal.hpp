@@ -46,9 +46,12 @@ private:
     struct Box {
         double lo[3], hi[3];
     };
-    std::uint32_t add_arc(std::uint32_t r, std::uint32_t i, std::vector<std::pair<std::uint64_t, std::uint32_t>>& entries);
+    using Entry = std::pair<std::uint64_t, std::uint32_t>; // (cell, arc id)
+    std::uint32_t add_arc(std::uint32_t r, std::uint32_t i, std::vector<Entry>& entries);
     void test(std::uint32_t s, std::uint32_t t); // adds (s, t) to pairs_ when they conflict
-    void settle();                               // sorts pairs_, each once
+    template <class Also>
+    void test_cells(std::vector<Entry>& entries, Also&& also); // see boundary_check.cpp
+    void settle();                                             // sorts pairs_, each once
 
     const std::vector<const std::vector<Vec3>*>& rings_;
     double cell_ = 0.05;
@@ -56,8 +59,8 @@ private:
     std::vector<char> alive_;                  // per arc id: still in its ring
     std::vector<Box> boxes_;
     std::vector<std::vector<std::uint32_t>> ids_of_;               // per ring, its arcs' ids in order
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries_; // (cell, arc id), sorted
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> fresh_;   // the new arcs', until update()
+    std::vector<Entry> entries_;                                   // sorted
+    std::vector<Entry> fresh_;                                     // the new arcs', until update()
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;   // conflicting arc ids, smaller first
 };
 
