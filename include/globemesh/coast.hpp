@@ -44,7 +44,14 @@
 // datasets close Antarctica there; rings enclosing less than 1e-14 square degree (zero-area
 // slivers, collapsed holes) are dropped; where two rings (or one ring) meet at a single point
 // (valid in GEOS, not for a mesher) each copy of that node is moved 1e-7 rad (0.64 m) into the
-// land. Ocean left on one side only of the +-180 seam (halves of an island that do not match,
+// land. The land is snap-rounded to a lon/lat grid of 2^-20 degree (0.11 m; GEOS's snap-rounding
+// noder): near-touches closer than about half a cell become touches, spikes narrower collapse,
+// and polygons whose outlines come within 2 cells are snap-rounded together (CoastData counts
+// them). A great-circle arc that strays across a neighbour its lon/lat edge keeps clear of is
+// split at the edge's midpoint until none does (CoastData::arcs_split). A region's outline takes
+// the land's vertices within 2^-16 degree (1.7 m), so that land clipped to the region (or the
+// region drawn from the same coast in another CRS) leaves no sliver of water along it; the
+// region's box sides lie on the snap grid. Ocean left on one side only of the +-180 seam (halves of an island that do not match,
 // as Fiji at 1:50m) keeps that stretch of meridian as coast.
 //
 // Units: areas km2 (GeographicLib on WGS84), lengths km (mean radius, sphere.hpp).
@@ -105,6 +112,11 @@ struct CoastData {
     std::size_t lakes_removed = 0;   ///< holes and inland water bodies dropped (area or inland seas)
     double area_gained_km2 = 0;      ///< ocean added by dropping islands
     double area_lost_km2 = 0;        ///< ocean lost by dropping lakes and inland seas
+    std::size_t polygons_joined = 0; ///< land polygons joined to another they came within the snap grid of
+    /// rings gained or lost by dissolving and snap rounding (overlapping polygons merged, a ring
+    /// split where it touched itself, a sliver collapsed), summed over GEOS's batches
+    std::size_t rings_changed = 0;
+    std::size_t arcs_split = 0;      ///< nodes added where a great-circle arc strayed across the lon/lat edge's neighbour
     std::string layer;               ///< name of the layer that was read
     std::shared_ptr<const LandMask> land; ///< the land those rings leave out, for the mesher
 };

@@ -64,6 +64,17 @@ private:
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;   // conflicting arc ids, smaller first
 };
 
+/// Pairs (i < j) of polygons (each its closed lon/lat rings) whose outlines come within
+/// `distance` degrees of each other in the lon/lat plane, touching or crossing included
+/// (near_pairs.cpp). Sorted, each once.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> near_pairs(const std::vector<std::vector<std::vector<LonLat>>>& polygons,
+                                                                double distance);
+
+/// Splits every arc that touches or crosses another at the midpoint of its lon/lat edge, and
+/// again for the halves that still do, for at most max_rounds rounds (arc_split.cpp). Returns
+/// the nodes added; conflicts that remain are the data's own (check_boundary reports them).
+std::size_t split_conflicting_arcs(Boundary& boundary, int max_rounds);
+
 /// Geodesic area (WGS84) to the left of all the closed lon/lat rings, km2 (sum of signed
 /// GeographicLib areas modulo the Earth's area); the whole Earth when there is no ring.
 double rings_area_km2(const std::vector<std::vector<LonLat>>& rings);

@@ -109,6 +109,14 @@ constexpr double line_end_snap_deg = 1e-3;
 constexpr double max_line_gap_deg = 0.5;
 /// Rings enclosing less than this (planar lon/lat, 1e-14 deg2, about 1e-4 m2) are slivers.
 constexpr double min_ring_area_deg2 = 1e-14;
+/// The land is snap-rounded to a lon/lat grid of 2^-20 degree (0.11 m at the equator): near-
+/// touches closer than about half a cell (an islet's vertex 5 cm from the mainland's edge)
+/// become touches, spikes narrower collapse, and what stays apart is at least half a cell
+/// apart. A power of two, so that +-180, +-90 and grid multiples are exact in binary.
+constexpr double snap_grid_deg = 1.0 / (1 << 20);
+/// A region's outline takes the land's vertices within 2^-16 degree (1.7 m), so that the same
+/// coast reprojected or clipped in another CRS (a few micro-degrees off) leaves no slivers.
+constexpr double outline_snap_deg = 1.0 / (1 << 16);
 
 /// Moves onto the seam each vertex within seam_notch_deg of it whose neighbour along the ring
 /// lies on it, on the same side (neighbours judged as they were before this pass).
@@ -603,11 +611,21 @@ struct TreeDeleter {
     }
 };
 
-/// Dissolves valid polygonal parts into non-overlapping polygons, in input order. Only groups
-/// of polygons that really intersect go through GEOS union (an STR-tree finds candidates and a
-/// prepared-geometry test confirms them): most coastline polygons are disjoint, and a union of
-/// all of them would cost seconds at 1:10m.
-std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
+/// What snap rounding did to the land (CoastData reports it).
+struct SnapCount {
+    std::size_t joined = 0;  ///< polygons joined to another that they only came within the grid of
+    std::size_t changed = 0; ///< rings gained or lost by dissolving and snap rounding, per batch
+};
+
+/// Dissolves valid polygonal parts into non-overlapping polygons, in input order, snap-rounded
+/// to a lon/lat grid of `grid` degrees (GEOS's snap-rounding noder, OverlayNG): every vertex on
+/// the grid, and every edge that passes through a vertex's grid cell noded at that vertex, so
+/// two rings that came within about half a cell of each other touch there, and no vertex lies
+/// closer than half a cell to an edge it is not on. Polygons closer than `grid` to each other
+/// are snap-rounded together (one union), every other one alone: most coastline polygons are
+/// disjoint, and a union of all of them costs seconds at 1:10m. Candidates come from an STR
+/// tree; GEOS's prepared distance test confirms them.
+std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts, double grid, SnapCount& count) {
     std::vector<GeomPtr> polys;
     for (const auto& part : parts) {
         std::vector<const GEOSGeometry*> ps;
@@ -621,6 +639,9 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
         while (parent[i] != i) i = parent[i] = parent[parent[i]];
         return i;
     };
+    std::vector<char> near_only(n, 0); // joined by distance alone, not by intersection
+    std::vector<int> vertices(n);
+    for (std::size_t i = 0; i < n; ++i) vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
     {
         std::unique_ptr<GEOSSTRtree, TreeDeleter> tree(GEOSSTRtree_create_r(geos.get(), 10), TreeDeleter{geos.get()});
         for (std::size_t i = 0; i < n; ++i)
@@ -633,8 +654,6 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
         // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
         // the geometry tested against a prepared one anew on every call. Intersection is
         // symmetric: the groups are the same.
-        std::vector<int> vertices(n);
-        for (std::size_t i = 0; i < n; ++i) vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
         std::vector<PreparedPtr> prepared;
         for (std::size_t i = 0; i < n; ++i) prepared.emplace_back(nullptr, PreparedDeleter{geos.get()});
         auto prepared_of = [&](std::size_t i) {
@@ -654,23 +673,71 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts) {
             prepared[i].reset(); // its pairs are all done: later ones have both indices above i
         }
     }
+    // Outlines within a grid cell of each other (near-touches) are snap-rounded together too.
+    {
+        std::vector<PolygonRings> outlines(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            outlines[i].push_back(ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polys[i].get())));
+            for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polys[i].get()); ++h)
+                outlines[i].push_back(ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polys[i].get(), h)));
+        }
+        for (auto [i, j] : coast_detail::near_pairs(outlines, 2 * grid)) {
+            if (find(i) == find(j)) continue;
+            near_only[j] = 1;
+            parent[find(j)] = find(i);
+        }
+    }
+    // Each group goes to GEOS as one collection: a polygon alone through GEOS's precision
+    // reducer, several through a snap-rounding union. Lone polygons go in batches of about
+    // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap
+    // rounding seeds a random generator through CPUID, which a virtual machine traps. Groups are
+    // far enough apart (2 cells: rounding moves a vertex at most 0.71 cell) that rounding them
+    // apart cannot make them meet.
+    constexpr std::size_t batch_vertices = 100'000;
     std::vector<std::vector<std::size_t>> groups(n);
     for (std::size_t i = 0; i < n; ++i) groups[find(i)].push_back(i);
     std::vector<GeomPtr> out;
+    auto rings_of = [&](const GEOSGeometry* p) { return std::size_t(1 + GEOSGetNumInteriorRings_r(geos.get(), p)); };
+    auto add_snapped = [&](GeomPtr snapped, std::size_t rings_in) {
+        std::vector<const GEOSGeometry*> ps;
+        polygons_of(geos, snapped.get(), ps);
+        std::size_t rings_out = 0;
+        for (const auto* p : ps) {
+            rings_out += rings_of(p);
+            out.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
+        }
+        count.changed += rings_out > rings_in ? rings_out - rings_in : rings_in - rings_out;
+    };
+    std::vector<GEOSGeometry*> lone;
+    std::size_t lone_vertices = 0, lone_rings = 0;
+    auto flush_lone = [&] {
+        if (lone.empty()) return;
+        GeomPtr multi = own(geos, GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, lone.data(),
+                                                               static_cast<unsigned>(lone.size())), "collect polygons");
+        add_snapped(own(geos, GEOSGeom_setPrecision_r(geos.get(), multi.get(), grid, 0), "snap-round the land"), lone_rings);
+        lone.clear();
+        lone_vertices = lone_rings = 0;
+    };
     for (std::size_t i = 0; i < n; ++i) {
         if (groups[i].empty()) continue;
         if (groups[i].size() == 1) {
-            out.push_back(std::move(polys[i]));
+            lone_rings += rings_of(polys[i].get());
+            lone_vertices += static_cast<std::size_t>(vertices[i]);
+            lone.push_back(polys[i].release());
+            if (lone_vertices >= batch_vertices) flush_lone();
             continue;
         }
         std::vector<GeomPtr> members;
-        for (std::size_t j : groups[i]) members.push_back(std::move(polys[j]));
+        std::size_t rings_in = 0;
+        for (std::size_t j : groups[i]) {
+            count.joined += near_only[j];
+            rings_in += rings_of(polys[j].get());
+            members.push_back(std::move(polys[j]));
+        }
         GeomPtr all = make_collection(geos, members);
-        GeomPtr merged = own(geos, GEOSUnaryUnion_r(geos.get(), all.get()), "dissolve the land polygons");
-        std::vector<const GEOSGeometry*> ps;
-        polygons_of(geos, merged.get(), ps);
-        for (const auto* p : ps) out.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
+        add_snapped(own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid), "dissolve the land polygons"), rings_in);
     }
+    flush_lone();
     return out;
 }
 
@@ -787,7 +854,7 @@ public:
                 GeomPtr pt = own(geos_, GEOSGeom_createPoint_r(geos_.get(), seq), "build a point");
                 double d = 1;
                 GEOSPreparedDistance_r(geos_.get(), clip_.boundary, pt.get(), &d);
-                if (d > 1e-9) return EdgeKind::coast;
+                if (d > snap_grid_deg) return EdgeKind::coast; // noded at a hot pixel: still the outline
             }
             return EdgeKind::open;
         }
@@ -1136,6 +1203,10 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         auto [w, s, e, n] = *options.region;
         if (!(s < n) || s < -90 || n > 90 || w < -180 || w > 180 || e < -180 || e > 180 || w == e)
             throw UsageError("--region W,S,E,N: need -180 <= W, E <= 180, W != E, -90 <= S < N <= 90");
+        // The box's sides on the land's snap grid, so that land clipped to the same box (data
+        // downloaded for the area) meets them exactly instead of leaving slivers of ocean.
+        auto on_grid = [](double v) { return std::nearbyint(v / snap_grid_deg) * snap_grid_deg; };
+        w = on_grid(w), s = on_grid(s), e = on_grid(e), n = on_grid(n);
         clip.box = true;
         clip.w = w, clip.s = s, clip.e = e, clip.n = n;
         clip.seam_glued = w > e || (w == -180 && e == 180);
@@ -1154,9 +1225,9 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         for (const auto& poly : region.polygons) rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
         if (rparts.empty()) throw DataError("--region-file " + options.region_file + " holds no polygons");
         GeomPtr all = make_collection(geos, rparts);
-        domain = own(geos, GEOSUnaryUnion_r(geos.get(), all.get()), "dissolve the region");
+        domain = own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), snap_grid_deg), "dissolve the region");
         GeomPtr world = own(geos, GEOSGeom_createRectangle_r(geos.get(), -180, -90, 180, 90), "build");
-        domain = own(geos, GEOSIntersection_r(geos.get(), domain.get(), world.get()), "clip the region");
+        domain = own(geos, GEOSIntersectionPrec_r(geos.get(), domain.get(), world.get(), snap_grid_deg), "clip the region");
         outline = own(geos, GEOSBoundary_r(geos.get(), domain.get()), "take the region outline");
         prepared_outline.reset(GEOSPrepare_r(geos.get(), outline.get()));
         clip.boundary = prepared_outline.get();
@@ -1173,8 +1244,16 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         near.push_back(clip_to_box(geos, g.get(), x0, y0, x1, y1, "clip the land"));
     }
     GeomPtr land_near = make_collection(geos, near);
-    land_near = own(geos, GEOSUnaryUnion_r(geos.get(), land_near.get()), "dissolve the land");
-    GeomPtr ocean = own(geos, GEOSDifference_r(geos.get(), domain.get(), land_near.get()), "subtract the land");
+    land_near = own(geos, GEOSUnaryUnionPrec_r(geos.get(), land_near.get(), snap_grid_deg), "dissolve the land");
+    // An outline that runs along the coast (land clipped to the region, or the region drawn
+    // from the same data in another CRS) follows the land there: it takes the land's vertices
+    // within outline_snap_deg, so no sliver of water is left between the two.
+    domain = own(geos, GEOSSnap_r(geos.get(), domain.get(), land_near.get(), outline_snap_deg), "snap the region to the coast");
+    if (GEOSisValid_r(geos.get(), domain.get()) != 1) domain = make_valid(geos, domain.get());
+    // On the land's snap grid: where the land runs along the outline (clipped to the same box or
+    // polygon), the two meet exactly, and slivers narrower than half a cell collapse.
+    GeomPtr ocean = own(geos, GEOSDifferencePrec_r(geos.get(), domain.get(), land_near.get(), snap_grid_deg),
+                        "subtract the land");
 
     std::vector<const GEOSGeometry*> ocean_polys;
     polygons_of(geos, ocean.get(), ocean_polys);
@@ -1249,7 +1328,10 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
         add_wrapped(geos, std::move(g), parts);
     }
     if (!src.lines.empty()) add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
-    std::vector<GeomPtr> land = dissolve(geos, parts);
+    SnapCount snapped;
+    std::vector<GeomPtr> land = dissolve(geos, parts, snap_grid_deg, snapped);
+    out.polygons_joined = snapped.joined;
+    out.rings_changed = snapped.changed;
     parts.clear();
     report(progress, 0.5, "cleaning coast");
 
@@ -1307,6 +1389,8 @@ CoastData load_coast(const MeshOptions& options, const Progress& progress) {
         if (r.nodes.size() >= 3) out.rings.rings.push_back(std::move(r));
     }
     separate_pinches(out.rings);
+    // 30 rounds shorten an arc 2^30 times: far past any bulge that snap rounding leaves room for.
+    out.arcs_split = coast_detail::split_conflicting_arcs(out.rings, 30);
     auto issues = check_boundary(out.rings, 5);
     if (!issues.empty()) {
         const auto& is = issues.front();

@@ -224,16 +224,27 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     };
 
     // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
-    //    water bodies (ocean on the left that small); rings with an open segment always stay.
+    //    water bodies (ocean on the left that small, also a pocket of water that land cuts off
+    //    at a region's edge); the land outside a region's outline is never an island.
     std::vector<ShapedRing> shaped;
     std::vector<std::vector<Vec3>> dropped_islands;
     bool dropped_water = false;
+    // The largest water ring on a region's outline stays whatever its size (a size wider than
+    // the region is refused later, naming it).
+    const Ring* largest_open = nullptr;
+    double largest_open_area = -1;
+    for (const Ring& ring : coast.rings.rings) {
+        if (std::none_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; }))
+            continue;
+        const double left = left_area_sr(ring.nodes);
+        if (left < 2 * pi && left > largest_open_area) largest_open_area = left, largest_open = &ring;
+    }
     for (const Ring& ring : coast.rings.rings) {
         ShapedRing s{&ring, {}, {}, {}, {}};
         s.h_rad.reserve(ring.nodes.size());
         for (const auto& v : ring.nodes) s.h_rad.push_back(h_at(v));
         bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; });
-        if (!has_open && options.min_island_triangles > 0) {
+        if (options.min_island_triangles > 0 && &ring != largest_open) {
             double left = left_area_sr(ring.nodes);
             Vec3 sum{};
             for (const auto& v : ring.nodes) sum = sum + v;
@@ -246,7 +257,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
                     dropped_water = true;
                     continue;
                 }
-            } else if (4 * pi - left < threshold) {
+            } else if (!has_open && 4 * pi - left < threshold) {
                 ++rep.islands_removed;
                 rep.area_gained_km2 += (4 * pi - left) * r2;
                 dropped_islands.push_back(ring.nodes);

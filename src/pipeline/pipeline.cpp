@@ -238,6 +238,9 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("boundary_nodes", std::to_string(coast_report.nodes));
     a.emplace_back("islands_removed", std::to_string(coast_report.islands_removed));
     a.emplace_back("lakes_removed", std::to_string(coast_report.lakes_removed));
+    a.emplace_back("coast_repairs", std::to_string(coast.polygons_joined) + " polygons joined at near-touches, " +
+                                        std::to_string(coast.rings_changed) + " rings changed by snap rounding, " +
+                                        std::to_string(coast.arcs_split) + " nodes added to straying arcs");
     a.emplace_back("faces_on_removed_islands", std::to_string(report.island_centroids_left) + " (" +
                                                    std::to_string(report.island_centroids_moved) + " moved off)");
     a.emplace_back("faces_on_land", std::to_string(report.land_faces_left) + " (" +
