@@ -104,6 +104,23 @@ TEST(CoastHostile, spike_is_removed) {
     EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
 }
 
+// A spike 1e-7 degree wide (1 cm) and 3 degrees long: valid to GEOS, it meshed with node pairs
+// 6 mm apart (issue 37). On the snap grid (2^-20 degree) its two sides are one line, and the
+// spike collapses: no two nodes of the cleaned coast are closer than a kilometre.
+TEST(CoastHostile, a_spike_narrower_than_the_snap_grid_collapses) {
+    TempDir dir;
+    auto path = write(dir, "thin.geojson",
+                      geojson({polygon("[[0,0],[10,0],[10,10],[5.0000001,10],[5.0000001,13],[5,13],[5,10],[0,10],[0,0]]")}));
+    CoastData d = load_coast(options_for(path));
+    ASSERT_EQ(d.rings.rings.size(), 1u);
+    const auto& nodes = d.rings.rings[0].nodes;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        EXPECT_LE(vec_to_lonlat(nodes[i]).lat, 10.0 + 1e-6);
+        for (std::size_t j = i + 1; j < nodes.size(); ++j) EXPECT_GT(norm(nodes[i] - nodes[j]), 1.0 / 6371.0);
+    }
+    expect_valid_both_stages(d);
+}
+
 TEST(CoastHostile, duplicate_consecutive_vertices_are_merged) {
     TempDir dir;
     auto path = write(dir, "dups.geojson",
