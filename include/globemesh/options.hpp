@@ -36,6 +36,9 @@ struct MeshOptions {
     int bathy_band = 1;            ///< --bathy-band: 1-based band number
     bool depth_positive = false;   ///< --depth-positive: the raster stores depth positive down
     std::optional<double> bathy_fill_m; ///< --bathy-fill: depth (m) where the raster has no data
+    /// --min-depth: depth (m, positive down) that every node shallower than it is raised to
+    /// after sampling (depth := max(depth, min_depth)); nullopt keeps the sampled depths.
+    std::optional<double> min_depth_m;
 
     // --- size field (sizefield/), km ---
     double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh

@@ -67,6 +67,11 @@ void validate(const MeshOptions& o) {
         require(r[0] != r[2], "--region W and E must differ (W > E crosses +-180)");
     }
     require(!(o.region && !o.region_file.empty()), "--region and --region-file cannot be used together");
+    // A layer without its file, or a depth floor without depths, would be ignored without a word.
+    if (o.min_depth_m) {
+        require(std::isfinite(*o.min_depth_m), "--min-depth must be a depth in metres, e.g. 5m");
+        require(!o.bathy.empty(), "--min-depth needs --bathy: it raises the sampled depths");
+    }
 }
 
 std::string memory_text(double bytes) {
