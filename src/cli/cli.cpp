@@ -217,6 +217,8 @@ struct MeshCommand {
         region_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // no region: the globe
         app.add_option("--region-file", m.region_file, "Polygons (any OGR source, any CRS) bounding the ocean")
             ->group(coast)->type_name("SOURCE");
+        app.add_option("--region-layer", m.region_layer, "Layer of --region-file; default the only polygon or line layer")
+            ->group(coast)->type_name("NAME");
         app.add_option("--min-island-area", m.min_island_area_km2,
                        "Drop islands and lakes smaller than AREA (km2 or m2; bare number: km2)")
             ->group(coast)->type_name("AREA")->transform(unit_transform(parse_area_km2, ""));
@@ -256,6 +258,9 @@ struct MeshCommand {
             ->group(size)->type_name("N");
         app.add_option("--size-regions", m.size_regions, "Polygons with a size_km attribute: edge length inside")
             ->group(size)->type_name("SOURCE");
+        app.add_option("--size-regions-layer", m.size_regions_layer,
+                       "Layer of --size-regions; default every layer with a size_km field")
+            ->group(size)->type_name("NAME");
         app.add_option("--grade", m.grade, "Largest |grad h|, the gradation of edge lengths (km/km)")
             ->group(size)->type_name("G");
 

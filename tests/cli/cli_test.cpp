@@ -103,6 +103,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.coast_srs, b.coast_srs);
     EXPECT_EQ(a.region, b.region);
     EXPECT_EQ(a.region_file, b.region_file);
+    EXPECT_EQ(a.region_layer, b.region_layer);
     EXPECT_EQ(a.min_island_area_km2, b.min_island_area_km2);
     EXPECT_EQ(a.min_island_triangles, b.min_island_triangles);
     EXPECT_EQ(a.keep_inland_seas, b.keep_inland_seas);
@@ -120,6 +121,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.wave_period_h, b.wave_period_h);
     EXPECT_EQ(a.slope, b.slope);
     EXPECT_EQ(a.size_regions, b.size_regions);
+    EXPECT_EQ(a.size_regions_layer, b.size_regions_layer);
     EXPECT_EQ(a.grade, b.grade);
     EXPECT_EQ(a.max_nodes, b.max_nodes);
     EXPECT_EQ(a.max_memory_bytes, b.max_memory_bytes);
@@ -149,7 +151,7 @@ std::vector<std::string> every_option(const std::string& out_dir) {
             "--keep-inland-seas", "--keep-straits", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
             "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--min-depth", "-2.5m", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
-            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
+            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--size-regions", out_dir + "/sizes.gpkg", "--size-regions-layer", "fine", "--grade", "0.2",
             "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--inlet-width", "0.25", "--seed", "42",
             "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
             "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
@@ -326,10 +328,27 @@ TEST(Cli, print_config_round_trips_every_option) {
     EXPECT_NE(original.mesh.seed, globemesh::MeshOptions{}.seed);
     EXPECT_TRUE(original.mesh.keep_straits);
     EXPECT_EQ(original.mesh.min_depth_m, -2.5);
+    EXPECT_EQ(original.mesh.size_regions_layer, "fine");
     // And printing the re-read configuration gives the same text.
     const Result printed_again =
         run_refused({"mesh", "--config", (dir / "printed.toml").string(), "--print-config"});
     EXPECT_EQ(printed_again.out, printed.out);
+}
+
+// --region-layer goes with --region-file, which every_option leaves out (it has --region).
+TEST(Cli, print_config_round_trips_the_region_layer) {
+    TempDir dir;
+    const std::vector<std::string> args = {"--coast", coast, "--region-file", (dir / "r.gpkg").string(),
+                                           "--region-layer", "north sea", "-o", (dir / "o.nc").string()};
+    std::vector<std::string> print_args = args;
+    print_args.insert(print_args.begin(), "mesh");
+    print_args.push_back("--print-config");
+    const Result printed = run_refused(print_args);
+    ASSERT_EQ(printed.status, 0) << printed.err;
+    write_text(dir / "printed.toml", printed.out);
+    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "printed.toml").string()});
+    EXPECT_EQ(again.mesh.region_layer, "north sea");
+    expect_same_cli(again, globemesh::parse_mesh_args(args));
 }
 
 TEST(Cli, print_config_of_defaults_reads_back_as_the_defaults) {
@@ -420,6 +439,8 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20.5km"}, 2, "--hmin (20.5km) must not be larger than --hmax (10km)"},
         ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
         ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
+        ErrorCase{"region_layer_without_region_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region-layer", "a"}, 2, "--region-layer names a layer of --region-file, which is not given"},
+        ErrorCase{"size_regions_layer_without_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--size-regions-layer", "a"}, 2, "--size-regions-layer"},
         ErrorCase{"min_depth_without_bathy", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5"}, 2, "--min-depth needs --bathy"},
         ErrorCase{"min_depth_with_area_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5m2"}, 2, "--min-depth"},
         ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
@@ -978,4 +999,75 @@ TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
                                               std::to_string(shallower) + " raised to --min-depth 5 m\n"))
         << floored.out;
     globemesh::test::expect_mesh_verify(dir / "d5.nc");
+}
+
+namespace {
+
+/// Adds a layer `name` (EPSG:4326) holding the box W,S,E,N (degrees) to the GeoPackage `path`,
+/// created when missing.
+void add_box_layer(const std::string& path, const char* name, double w, double s, double e, double n) {
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+    if (!ds) ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    ASSERT_NE(ds, nullptr) << path;
+    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(wgs84, 4326);
+    OGRLayerH layer = GDALDatasetCreateLayer(ds, name, wgs84, wkbPolygon, nullptr);
+    OSRRelease(wgs84);
+    ASSERT_NE(layer, nullptr);
+    OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing), polygon = OGR_G_CreateGeometry(wkbPolygon);
+    for (auto [x, y] : {std::pair{w, s}, {e, s}, {e, n}, {w, n}, {w, s}}) OGR_G_AddPoint_2D(ring, x, y);
+    OGR_G_AddGeometryDirectly(polygon, ring);
+    OGR_F_SetGeometryDirectly(f, polygon);
+    EXPECT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
+    OGR_F_Destroy(f);
+    GDALClose(ds);
+}
+
+} // namespace
+
+TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
+    TempDir dir;
+    const std::string regions = (dir / "regions.gpkg").string();
+    add_box_layer(regions, "north_sea", -4, 51, 9, 59);
+    add_box_layer(regions, "biscay", -10, 43.5, -1, 48);
+    auto mesh = [&](const std::string& out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"mesh", "--coast", coast, "--coast-layer", "land", "--region-file", regions,
+                                         "--hmax", "40km", "-q", "-o", (dir / out).string()};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result both = mesh("both.nc", {});
+    EXPECT_EQ(both.status, 1);
+    EXPECT_EQ(both.err, "globemesh: --region-file " + regions +
+                            ": several polygon or line layers, choose one with --region-layer; layers: "
+                            "north_sea (Polygon), biscay (Polygon)\n");
+    EXPECT_FALSE(fs::exists(dir / "both.nc"));
+    const Result missing = mesh("missing.nc", {"--region-layer", "baltic"});
+    EXPECT_EQ(missing.status, 1);
+    EXPECT_NE(missing.err.find("no layer named 'baltic'"), std::string::npos) << missing.err;
+
+    // Each layer alone: the nodes lie in its box and reach across it.
+    for (const auto& [layer, box] : {std::pair{"biscay", std::array<double, 4>{-10, 43.5, -1, 48}},
+                                     std::pair{"north_sea", std::array<double, 4>{-4, 51, 9, 59}}}) {
+        SCOPED_TRACE(layer);
+        const std::string out = std::string(layer) + ".nc";
+        const Result r = mesh(out, {"--region-layer", layer});
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto lon = nc_doubles(dir / out, "mesh_node_lon"), lat = nc_doubles(dir / out, "mesh_node_lat");
+        ASSERT_FALSE(lon.empty());
+        const auto [lon_min, lon_max] = std::minmax_element(lon.begin(), lon.end());
+        const auto [lat_min, lat_max] = std::minmax_element(lat.begin(), lat.end());
+        EXPECT_GE(*lon_min, box[0] - 1e-9);
+        EXPECT_LE(*lon_max, box[2] + 1e-9);
+        EXPECT_GE(*lat_min, box[1] - 1e-9);
+        // The outline's edges are great circles: the northern one bulges north of its parallel
+        // to atan(tan(N) / cos(half its longitude span)) at its middle.
+        const double half_span = 0.5 * (box[2] - box[0]) * M_PI / 180;
+        EXPECT_LE(*lat_max, std::atan(std::tan(box[3] * M_PI / 180) / std::cos(half_span)) * 180 / M_PI + 1e-9);
+        EXPECT_GT(*lon_max - *lon_min, 0.8 * (box[2] - box[0]));
+        EXPECT_GT(*lat_max - *lat_min, 0.8 * (box[3] - box[1]));
+        globemesh::test::expect_mesh_verify(dir / out);
+    }
 }
