@@ -308,7 +308,7 @@ struct MeshCommand {
         app.add_flag("--print-config", o.print_config, "Print the effective configuration (for --config) and stop")
             ->group(run)->configurable(false);
         // Not CLI11's excludes(): --print-config writes both as false, and must read back.
-        app.add_flag("-q,--quiet", o.quiet, "No progress on stderr (not with --verbose)")->group(run);
+        app.add_flag("-q,--quiet", o.quiet, "No progress or warnings on stderr (not with --verbose)")->group(run);
         app.add_flag("-v,--verbose", o.verbose, "Show stage names with the progress, and GDAL warnings")
             ->group(run);
         app.add_flag("--check", o.check, "Check the mesh invariants before writing (exit 1 if one fails)")
@@ -474,9 +474,9 @@ std::string depth_json(const Mesh& mesh) {
            "}";
 }
 
-/// The summary's depth line, and the warning on `err` when nodes above sea level are written
-/// with negative depth (no --min-depth).
-void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh) {
+/// The summary's depth line, and unless `quiet` the warning on `err` when nodes above sea level
+/// are written with negative depth (no --min-depth).
+void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh, bool quiet) {
     const auto above = find_attribute(mesh, "nodes_above_sea_level");
     if (!above) return;
     const long long count = std::stoll(*above);
@@ -489,7 +489,7 @@ void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh) {
         out << ", " << find_attribute(mesh, "nodes_raised_to_min_depth").value_or("0") << " raised to --min-depth "
             << *floor << " m";
     out << "\n";
-    if (count > 0 && !floor)
+    if (count > 0 && !floor && !quiet)
         err << "globemesh: warning: " << grouped(count) << (count == 1 ? " node lies" : " nodes lie")
             << " above sea level" << down_to << (count == 1 ? " and is" : " and are")
             << " written with negative depth; --min-depth 5 would raise them to 5 m\n";
@@ -634,7 +634,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         places("straits_closed_at");
     }
     out << "ocean components  " << attribute("ocean_components") << "\n";
-    print_depth(out, err, mesh);
+    print_depth(out, err, mesh, o.quiet);
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"
