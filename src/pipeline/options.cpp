@@ -68,7 +68,8 @@ void validate(const MeshOptions& o) {
     }
     require(!(o.region && !o.region_file.empty()), "--region and --region-file cannot be used together");
     // A layer without its file, or a depth floor without depths, would be ignored without a word.
-    require(o.region_layer.empty() || !o.region_file.empty(), "--region-layer names a layer of --region-file, which is not given");
+    require(o.region_layer.empty() || !o.region_file.empty(),
+            "--region-layer names a layer of --region-file, which is not given");
     require(o.size_regions_layer.empty() || !o.size_regions.empty(),
             "--size-regions-layer names a layer of --size-regions, which is not given");
     if (o.min_depth_m) {
