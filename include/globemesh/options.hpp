@@ -23,6 +23,7 @@ struct MeshOptions {
     /// --region W,S,E,N in degrees; W > E crosses +-180. Default: the whole globe.
     std::optional<std::array<double, 4>> region;
     std::string region_file; ///< --region-file: polygons (any OGR source, any CRS) bounding the ocean
+    std::string region_layer; ///< --region-layer: layer of --region-file; default the only polygon/line layer
     double min_island_area_km2 = 0; ///< --min-island-area: drop islands and lakes smaller (km2)
     /// Islands whose area is below this many equilateral triangles of the local size are dropped.
     double min_island_triangles = 4;
@@ -36,6 +37,9 @@ struct MeshOptions {
     int bathy_band = 1;            ///< --bathy-band: 1-based band number
     bool depth_positive = false;   ///< --depth-positive: the raster stores depth positive down
     std::optional<double> bathy_fill_m; ///< --bathy-fill: depth (m) where the raster has no data
+    /// --min-depth: depth (m, positive down) that every node shallower than it is raised to
+    /// after sampling (depth := max(depth, min_depth)); nullopt keeps the sampled depths.
+    std::optional<double> min_depth_m;
 
     // --- size field (sizefield/), km ---
     double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh
@@ -46,6 +50,9 @@ struct MeshOptions {
     double wave_period_h = 12.42; ///< --wave-period: period of that wave (hours; M2 by default)
     double slope = 0.0;         ///< --slope: points per topographic length scale; 0 = off
     std::string size_regions;   ///< --size-regions: polygons with a "size_km" attribute
+    /// --size-regions-layer: the layer of --size-regions to read; default every layer with a
+    /// size_km field
+    std::string size_regions_layer;
     double grade = 0.15;        ///< --grade: largest |grad h| (km/km)
 
     // --- mesher (mesher/) ---

@@ -10,8 +10,10 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -184,10 +186,12 @@ struct MeshCommand {
     CliOptions o;
     std::vector<double> region;
     double bathy_fill_m = 0;
+    double min_depth_m = 0;
     std::string max_memory_text = "auto";
     CLI::App app{"Mesh the ocean between the coastlines, graded by the size options.", "globemesh mesh"};
     CLI::Option* region_opt = nullptr;
     CLI::Option* bathy_fill_opt = nullptr;
+    CLI::Option* min_depth_opt = nullptr;
 
     MeshCommand() {
         app.option_defaults()->always_capture_default();
@@ -213,6 +217,8 @@ struct MeshCommand {
         region_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // no region: the globe
         app.add_option("--region-file", m.region_file, "Polygons (any OGR source, any CRS) bounding the ocean")
             ->group(coast)->type_name("SOURCE");
+        app.add_option("--region-layer", m.region_layer, "Layer of --region-file; default the only polygon or line layer")
+            ->group(coast)->type_name("NAME");
         app.add_option("--min-island-area", m.min_island_area_km2,
                        "Drop islands and lakes smaller than AREA (km2 or m2; bare number: km2)")
             ->group(coast)->type_name("AREA")->transform(unit_transform(parse_area_km2, ""));
@@ -231,6 +237,10 @@ struct MeshCommand {
                                         "Depth where the raster has no data (m or km; bare number: m); default none")
                              ->group(bathy)->type_name("DEPTH")->transform(unit_transform(parse_depth_m, ""));
         bathy_fill_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // unset: no fill
+        min_depth_opt = app.add_option("--min-depth", min_depth_m,
+                                       "Raise nodes shallower than DEPTH to DEPTH (m or km, positive down); default none")
+                            ->group(bathy)->type_name("DEPTH")->transform(unit_transform(parse_depth_m, ""));
+        min_depth_opt->always_capture_default(false)->default_str("")->run_callback_for_default(false); // unset: as sampled
 
         app.add_option("--hmax", m.hmax_km, "Largest edge length (km or m; bare number: km); alone gives a uniform mesh")
             ->group(size)->type_name("LENGTH")->transform(unit_transform(parse_length_km, ""));
@@ -248,6 +258,9 @@ struct MeshCommand {
             ->group(size)->type_name("N");
         app.add_option("--size-regions", m.size_regions, "Polygons with a size_km attribute: edge length inside")
             ->group(size)->type_name("SOURCE");
+        app.add_option("--size-regions-layer", m.size_regions_layer,
+                       "Layer of --size-regions; default every layer with a size_km field")
+            ->group(size)->type_name("NAME");
         app.add_option("--grade", m.grade, "Largest |grad h|, the gradation of edge lengths (km/km)")
             ->group(size)->type_name("G");
 
@@ -295,7 +308,7 @@ struct MeshCommand {
         app.add_flag("--print-config", o.print_config, "Print the effective configuration (for --config) and stop")
             ->group(run)->configurable(false);
         // Not CLI11's excludes(): --print-config writes both as false, and must read back.
-        app.add_flag("-q,--quiet", o.quiet, "No progress on stderr (not with --verbose)")->group(run);
+        app.add_flag("-q,--quiet", o.quiet, "No progress or warnings on stderr (not with --verbose)")->group(run);
         app.add_flag("-v,--verbose", o.verbose, "Show stage names with the progress, and GDAL warnings")
             ->group(run);
         app.add_flag("--check", o.check, "Check the mesh invariants before writing (exit 1 if one fails)")
@@ -330,6 +343,7 @@ struct MeshCommand {
         if (region_opt->count() > 0 && region.size() == 4)
             o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
         if (bathy_fill_opt->count() > 0) o.mesh.bathy_fill_m = bathy_fill_m;
+        if (min_depth_opt->count() > 0) o.mesh.min_depth_m = min_depth_m;
         o.mesh.max_memory_bytes =
             max_memory_text == "auto" ? default_memory_budget_bytes() : parse_memory_bytes(max_memory_text);
         if (o.quiet && o.verbose) throw UsageError("--quiet and --verbose exclude each other");
@@ -428,6 +442,57 @@ void add_mesh_total(StageTimings& timings) {
     for (const auto& [name, s] : timings.stages)
         if (name.rfind("read", 0) != 0) total += s;
     timings.add("mesh", total);
+}
+
+/// The value of the mesh's attribute `key`, or nullopt.
+std::optional<std::string> find_attribute(const Mesh& mesh, std::string_view key) {
+    for (const auto& [k, v] : mesh.attributes)
+        if (k == key) return v;
+    return std::nullopt;
+}
+
+/// A whole number with thousands separators: 33251 -> "33,251", -2505 -> "-2,505".
+std::string grouped(long long v) {
+    std::string digits = std::to_string(v < 0 ? -v : v), r;
+    for (std::size_t i = 0; i < digits.size(); ++i) {
+        if (i > 0 && (digits.size() - i) % 3 == 0) r += ',';
+        r += digits[i];
+    }
+    return (v < 0 ? "-" : "") + r;
+}
+
+/// The depth counts of the pipeline's attributes (nodes above sea level as sampled, those
+/// --min-depth raised) as a JSON object, or "" when the mesh has no depth.
+std::string depth_json(const Mesh& mesh) {
+    const auto above = find_attribute(mesh, "nodes_above_sea_level");
+    if (!above) return "";
+    const auto shallowest = find_attribute(mesh, "min_sampled_depth_m");
+    const auto floor = find_attribute(mesh, "min_depth_m");
+    const auto raised = find_attribute(mesh, "nodes_raised_to_min_depth");
+    return "{\"nodes_above_sea_level\": " + *above + ", \"min_sampled_depth_m\": " + shallowest.value_or("null") +
+           ", \"min_depth_m\": " + floor.value_or("null") + ", \"nodes_raised_to_min_depth\": " + raised.value_or("0") +
+           "}";
+}
+
+/// The summary's depth line, and unless `quiet` the warning on `err` when nodes above sea level
+/// are written with negative depth (no --min-depth).
+void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh, bool quiet) {
+    const auto above = find_attribute(mesh, "nodes_above_sea_level");
+    if (!above) return;
+    const long long count = std::stoll(*above);
+    const auto floor = find_attribute(mesh, "min_depth_m");
+    std::string down_to;
+    if (const auto shallowest = find_attribute(mesh, "min_sampled_depth_m"))
+        down_to = " (down to " + grouped(std::llround(std::stod(*shallowest))) + " m)";
+    out << "depth             " << count << " nodes above sea level" << down_to;
+    if (floor)
+        out << ", " << find_attribute(mesh, "nodes_raised_to_min_depth").value_or("0") << " raised to --min-depth "
+            << *floor << " m";
+    out << "\n";
+    if (count > 0 && !floor && !quiet)
+        err << "globemesh: warning: " << grouped(count) << (count == 1 ? " node lies" : " nodes lie")
+            << " above sea level" << down_to << (count == 1 ? " and is" : " and are")
+            << " written with negative depth; --min-depth 5 would raise them to 5 m\n";
 }
 
 int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream& err,
@@ -529,6 +594,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
         if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
         r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n";
+        if (const std::string depth = depth_json(mesh); !depth.empty()) r << "  \"depth\": " << depth << ",\n";
         // What the run did to the coast and the land, as the NetCDF file's global attributes say.
         r << "  \"attributes\": {";
         for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
@@ -569,6 +635,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         places("straits_closed_at");
     }
     out << "ocean components  " << attribute("ocean_components") << "\n";
+    print_depth(out, err, mesh, o.quiet);
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"

@@ -326,8 +326,9 @@ Source read_source(const std::string& path, const std::string& layer_name, const
         if (candidates.size() != 1)
             throw DataError(std::string(what) + " " + path + ": " +
                             (candidates.empty() ? "no polygon or line layer"
-                                                : "several polygon or line layers, choose one with "
-                                                  "--coast-layer") +
+                                                : std::string("several polygon or line layers, choose one with ") +
+                                                      (std::string(what) == "--region-file" ? "--region-layer"
+                                                                                            : "--coast-layer")) +
                             "; layers: " + layer_list(h));
         layer = candidates.front();
     }
@@ -1220,7 +1221,8 @@ std::vector<Chain> region_rings(Geos& geos, std::vector<GeomPtr>& land, const Me
         domain = make_collection(geos, boxes);
         domain = own(geos, GEOSUnaryUnion_r(geos.get(), domain.get()), "build the region");
     } else {
-        Source region = read_source(options.region_file, "", "", "", "--region-file", options.max_memory_bytes);
+        Source region = read_source(options.region_file, options.region_layer, "", "", "--region-file",
+                                    options.max_memory_bytes);
         std::vector<GeomPtr> rparts;
         for (const auto& poly : region.polygons) rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
         if (rparts.empty()) throw DataError("--region-file " + options.region_file + " holds no polygons");

@@ -67,6 +67,15 @@ void validate(const MeshOptions& o) {
         require(r[0] != r[2], "--region W and E must differ (W > E crosses +-180)");
     }
     require(!(o.region && !o.region_file.empty()), "--region and --region-file cannot be used together");
+    // A layer without its file, or a depth floor without depths, would be ignored without a word.
+    require(o.region_layer.empty() || !o.region_file.empty(),
+            "--region-layer names a layer of --region-file, which is not given");
+    require(o.size_regions_layer.empty() || !o.size_regions.empty(),
+            "--size-regions-layer names a layer of --size-regions, which is not given");
+    if (o.min_depth_m) {
+        require(std::isfinite(*o.min_depth_m), "--min-depth must be a depth in metres, e.g. 5m");
+        require(!o.bathy.empty(), "--min-depth needs --bathy: it raises the sampled depths");
+    }
 }
 
 std::string memory_text(double bytes) {

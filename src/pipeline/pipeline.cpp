@@ -8,6 +8,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/coast.hpp"
@@ -98,6 +99,30 @@ private:
     std::uint64_t total_;
     double held_ = 0;
 };
+
+/// What --min-depth found and changed in the sampled depths.
+struct DepthFloor {
+    std::size_t above_sea_level = 0; ///< nodes with depth < 0 as sampled
+    double shallowest_m = 0;         ///< the smallest sampled depth when some are < 0 (m)
+    std::size_t raised = 0;          ///< nodes set to min_depth_m
+};
+
+/// Counts the depths (m, positive down) above sea level and raises those below `min_depth_m`
+/// (when set) to it; no-data values (NaN) stay as they are.
+DepthFloor apply_min_depth(std::vector<double>& depths, std::optional<double> min_depth_m) {
+    DepthFloor f;
+    for (double& d : depths) {
+        if (d < 0) {
+            f.shallowest_m = f.above_sea_level == 0 ? d : std::min(f.shallowest_m, d);
+            ++f.above_sea_level;
+        }
+        if (min_depth_m && d < *min_depth_m) {
+            d = *min_depth_m;
+            ++f.raised;
+        }
+    }
+    return f;
+}
 
 } // namespace
 
@@ -222,11 +247,13 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
         timings->add("mesh", mesh_seconds);
     }
 
+    std::optional<DepthFloor> depth_floor;
     if (bathy) {
         Field depth{"depth", "sea floor depth below mean sea level", "m",
                     "sea_floor_depth_below_mean_sea_level", {}};
         depth.values.reserve(mesh.nodes.size());
         for (const Vec3& p : mesh.nodes) depth.values.push_back(bathy->depth_m(p));
+        depth_floor = apply_min_depth(depth.values, o.min_depth_m);
         mesh.node_fields.insert(mesh.node_fields.begin(), std::move(depth));
     }
 
@@ -234,6 +261,15 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
     a.emplace_back("coast_file", o.coast);
     a.emplace_back("coast_layer", coast.layer);
     if (!o.bathy.empty()) a.emplace_back("bathymetry_file", o.bathy);
+    if (depth_floor) {
+        // As sampled, before --min-depth (the CLI warns from them when it is not given).
+        a.emplace_back("nodes_above_sea_level", std::to_string(depth_floor->above_sea_level));
+        if (depth_floor->above_sea_level > 0) a.emplace_back("min_sampled_depth_m", number(depth_floor->shallowest_m));
+        if (o.min_depth_m) {
+            a.emplace_back("min_depth_m", number(*o.min_depth_m));
+            a.emplace_back("nodes_raised_to_min_depth", std::to_string(depth_floor->raised));
+        }
+    }
     a.emplace_back("boundary_rings", std::to_string(coast_report.rings));
     a.emplace_back("boundary_nodes", std::to_string(coast_report.nodes));
     a.emplace_back("islands_removed", std::to_string(coast_report.islands_removed));

@@ -68,7 +68,9 @@ struct PoleSizes {
 PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade,
                          const Progress& progress);
 
-/// min(h, size_km) over the nodes inside each polygon of an OGR source with a size_km field.
-void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h);
+/// min(h, size_km) over the nodes inside each polygon of an OGR source with a size_km field:
+/// of its layer `layer_name`, or of every layer with that field when it is empty.
+void apply_size_regions(const BackgroundGrid& g, const std::string& path, const std::string& layer_name,
+                        std::vector<float>& h);
 
 } // namespace globemesh::detail

@@ -30,9 +30,36 @@ using gdal::TransformPtr;
 
 std::string last_message() { return gdal::last_error("unknown error"); }
 
+/// "a, b, c": the layer names of `ds`, for messages.
+std::string layer_names(GDALDatasetH ds) {
+    std::string list;
+    for (int l = 0; l < GDALDatasetGetLayerCount(ds); ++l)
+        list += (l ? ", " : "") + std::string(OGR_L_GetName(GDALDatasetGetLayer(ds, l)));
+    return list.empty() ? "none" : list;
+}
+
+/// The layers to read: `name` alone when given (DataError when the file has no such layer or
+/// it has no size_km field), else every layer of `ds`.
+std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string& path, const std::string& name) {
+    std::vector<OGRLayerH> layers;
+    if (name.empty()) {
+        for (int l = 0; l < GDALDatasetGetLayerCount(ds); ++l) layers.push_back(GDALDatasetGetLayer(ds, l));
+        return layers;
+    }
+    OGRLayerH layer = GDALDatasetGetLayerByName(ds, name.c_str());
+    if (!layer)
+        throw DataError("--size-regions " + path + ": no layer named '" + name + "' (--size-regions-layer); layers: " +
+                        layer_names(ds));
+    if (OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), "size_km") < 0)
+        throw DataError("--size-regions " + path + " layer '" + name + "' has no size_km field (edge length in km)");
+    layers.push_back(layer);
+    return layers;
+}
+
 } // namespace
 
-void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::vector<float>& h) {
+void apply_size_regions(const BackgroundGrid& g, const std::string& path, const std::string& layer_name,
+                        std::vector<float>& h) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
@@ -45,8 +72,7 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, std::v
     // Polygons in lon/lat with their sizes.
     std::vector<std::pair<double, GeometryPtr>> regions;
     bool any_field = false;
-    for (int l = 0; l < GDALDatasetGetLayerCount(ds.get()); ++l) {
-        OGRLayerH layer = GDALDatasetGetLayer(ds.get(), l);
+    for (OGRLayerH layer : size_layers(ds.get(), path, layer_name)) {
         OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
         int field = OGR_FD_GetFieldIndex(defn, "size_km");
         if (field < 0) continue;

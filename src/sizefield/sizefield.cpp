@@ -213,7 +213,7 @@ SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boun
     }
     report(progress, 0.55, "size field");
 
-    if (!o.size_regions.empty()) detail::apply_size_regions(g, o.size_regions, h);
+    if (!o.size_regions.empty()) detail::apply_size_regions(g, o.size_regions, o.size_regions_layer, h);
     report(progress, 0.6, "size field");
 
     for (float& v : h) v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));

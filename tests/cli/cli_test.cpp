@@ -5,6 +5,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <fstream>
@@ -13,6 +15,11 @@
 #include <string>
 #include <vector>
 
+#include <gdal.h>
+#include <netcdf.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
 #include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
 #include "support.hpp"
@@ -20,6 +27,8 @@
 namespace fs = std::filesystem;
 using globemesh::test::fixture;
 using globemesh::test::TempDir;
+using globemesh::test::regex_match;
+using globemesh::test::regex_replace;
 using globemesh::test::regex_search;
 
 namespace {
@@ -94,6 +103,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.coast_srs, b.coast_srs);
     EXPECT_EQ(a.region, b.region);
     EXPECT_EQ(a.region_file, b.region_file);
+    EXPECT_EQ(a.region_layer, b.region_layer);
     EXPECT_EQ(a.min_island_area_km2, b.min_island_area_km2);
     EXPECT_EQ(a.min_island_triangles, b.min_island_triangles);
     EXPECT_EQ(a.keep_inland_seas, b.keep_inland_seas);
@@ -102,6 +112,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.bathy_band, b.bathy_band);
     EXPECT_EQ(a.depth_positive, b.depth_positive);
     EXPECT_EQ(a.bathy_fill_m, b.bathy_fill_m);
+    EXPECT_EQ(a.min_depth_m, b.min_depth_m);
     EXPECT_EQ(a.hmax_km, b.hmax_km);
     EXPECT_EQ(a.hmin_km, b.hmin_km);
     EXPECT_EQ(a.coast_size_km, b.coast_size_km);
@@ -110,6 +121,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.wave_period_h, b.wave_period_h);
     EXPECT_EQ(a.slope, b.slope);
     EXPECT_EQ(a.size_regions, b.size_regions);
+    EXPECT_EQ(a.size_regions_layer, b.size_regions_layer);
     EXPECT_EQ(a.grade, b.grade);
     EXPECT_EQ(a.max_nodes, b.max_nodes);
     EXPECT_EQ(a.max_memory_bytes, b.max_memory_bytes);
@@ -137,9 +149,10 @@ std::vector<std::string> every_option(const std::string& out_dir) {
     return {"--coast", coast, "--coast-layer", "ne_110m_land", "--coast-where", "featurecla = 'Land'",
             "--coast-srs", "EPSG:4326", "--region", "-20.5,40,10.25,65", "--min-island-area", "2.5e7m2",
             "--keep-inland-seas", "--keep-straits", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
-            "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--hmax", "45000m",
+            "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--min-depth", "-2.5m", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
-            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12", "--grade", "0.2",
+            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12",
+            "--size-regions", out_dir + "/sizes.gpkg", "--size-regions-layer", "fine", "--grade", "0.2",
             "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--inlet-width", "0.25", "--seed", "42",
             "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
             "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
@@ -224,7 +237,7 @@ TEST(Cli, memory_sizes_take_si_and_binary_units_and_auto) {
 TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
     const auto a = globemesh::parse_mesh_args(std::vector<std::string>{
         "--hmax", "5000m", "--hmin", "0.5", "--min-island-area", "1e6m2", "--coast-size", "2km",
-        "--wave-period", "30min", "--bathy-fill", "1km"});
+        "--wave-period", "30min", "--bathy-fill", "1km", "--min-depth", "0.005km"});
     EXPECT_DOUBLE_EQ(a.mesh.hmax_km, 5.0);
     EXPECT_DOUBLE_EQ(a.mesh.hmin_km, 0.5);
     EXPECT_DOUBLE_EQ(a.mesh.min_island_area_km2, 1.0);
@@ -232,6 +245,8 @@ TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
     EXPECT_DOUBLE_EQ(a.mesh.wave_period_h, 0.5);
     ASSERT_TRUE(a.mesh.bathy_fill_m.has_value());
     EXPECT_DOUBLE_EQ(*a.mesh.bathy_fill_m, 1000.0);
+    ASSERT_TRUE(a.mesh.min_depth_m.has_value());
+    EXPECT_DOUBLE_EQ(*a.mesh.min_depth_m, 5.0);
     const auto b = globemesh::parse_mesh_args(std::vector<std::string>{"--hmax", "5"});
     EXPECT_EQ(a.mesh.hmax_km, b.mesh.hmax_km);
 }
@@ -250,6 +265,7 @@ TEST(Cli, defaults_are_those_of_mesh_options) {
     EXPECT_GT(a.mesh.max_memory_bytes, 0u);
     EXPECT_FALSE(a.mesh.region.has_value());
     EXPECT_FALSE(a.mesh.bathy_fill_m.has_value());
+    EXPECT_FALSE(a.mesh.min_depth_m.has_value());
     EXPECT_EQ(a.format, "netcdf4");
 }
 
@@ -312,10 +328,28 @@ TEST(Cli, print_config_round_trips_every_option) {
     EXPECT_EQ(original.mesh.coast_rate, 0.123456789012345);
     EXPECT_NE(original.mesh.seed, globemesh::MeshOptions{}.seed);
     EXPECT_TRUE(original.mesh.keep_straits);
+    EXPECT_EQ(original.mesh.min_depth_m, -2.5);
+    EXPECT_EQ(original.mesh.size_regions_layer, "fine");
     // And printing the re-read configuration gives the same text.
     const Result printed_again =
         run_refused({"mesh", "--config", (dir / "printed.toml").string(), "--print-config"});
     EXPECT_EQ(printed_again.out, printed.out);
+}
+
+// --region-layer goes with --region-file, which every_option leaves out (it has --region).
+TEST(Cli, print_config_round_trips_the_region_layer) {
+    TempDir dir;
+    const std::vector<std::string> args = {"--coast", coast, "--region-file", (dir / "r.gpkg").string(),
+                                           "--region-layer", "north sea", "-o", (dir / "o.nc").string()};
+    std::vector<std::string> print_args = args;
+    print_args.insert(print_args.begin(), "mesh");
+    print_args.push_back("--print-config");
+    const Result printed = run_refused(print_args);
+    ASSERT_EQ(printed.status, 0) << printed.err;
+    write_text(dir / "printed.toml", printed.out);
+    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "printed.toml").string()});
+    EXPECT_EQ(again.mesh.region_layer, "north sea");
+    expect_same_cli(again, globemesh::parse_mesh_args(args));
 }
 
 TEST(Cli, print_config_of_defaults_reads_back_as_the_defaults) {
@@ -406,6 +440,10 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20.5km"}, 2, "--hmin (20.5km) must not be larger than --hmax (10km)"},
         ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
         ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
+        ErrorCase{"region_layer_without_region_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region-layer", "a"}, 2, "--region-layer names a layer of --region-file, which is not given"},
+        ErrorCase{"size_regions_layer_without_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--size-regions-layer", "a"}, 2, "--size-regions-layer"},
+        ErrorCase{"min_depth_without_bathy", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5"}, 2, "--min-depth needs --bathy"},
+        ErrorCase{"min_depth_with_area_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5m2"}, 2, "--min-depth"},
         ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
         ErrorCase{"unknown_option", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmaxx", "3"}, 2, "unknown option --hmaxx for globemesh mesh"},
         // CLI11's own words ("At Most 1 required but received 2") in globemesh's.
@@ -649,7 +687,7 @@ std::set<std::string> long_options(const std::string& text) {
 
 std::string man_text_plain() {
     // man(7) writes a minus as "\-": turn it back into "-" before looking for options.
-    return globemesh::test::regex_replace(read_text(man_page), R"(\\-)", "-");
+    return regex_replace(read_text(man_page), R"(\\-)", "-");
 }
 
 } // namespace
@@ -835,4 +873,204 @@ TEST(Cli, info_reads_back_a_written_octahedron) {
     ASSERT_EQ(text.status, 0) << text.err;
     EXPECT_TRUE(regex_search(text.out, R"(faces\s+8\n)")) << text.out;
     EXPECT_TRUE(regex_search(text.out, R"(\[0\.9, 1\.0\]\s+8 100\.0% #+\n)")) << text.out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Options whose effect only the data shows, through the real library on real data (ETOPO5 and
+// Natural Earth), each run in well under a second; the files are read back with netCDF-C, not
+// with globemesh's reader.
+
+namespace {
+
+/// A variable of a NetCDF file as doubles, read with netCDF-C; empty (and a test failure) when
+/// it is not there.
+std::vector<double> nc_doubles(const fs::path& file, const char* name) {
+    int nc = -1, var = -1, ndims = 0, dim = -1;
+    std::size_t n = 0;
+    if (nc_open(file.c_str(), NC_NOWRITE, &nc) != NC_NOERR) {
+        ADD_FAILURE() << "netCDF cannot open " << file;
+        return {};
+    }
+    std::vector<double> values;
+    if (nc_inq_varid(nc, name, &var) == NC_NOERR && nc_inq_varndims(nc, var, &ndims) == NC_NOERR && ndims == 1 &&
+        nc_inq_vardimid(nc, var, &dim) == NC_NOERR && nc_inq_dimlen(nc, dim, &n) == NC_NOERR) {
+        values.resize(n);
+        if (nc_get_var_double(nc, var, values.data()) != NC_NOERR) values.clear();
+    }
+    if (values.empty()) ADD_FAILURE() << "no 1-D variable " << name << " in " << file;
+    nc_close(nc);
+    return values;
+}
+
+/// A text attribute of a variable, read with netCDF-C ("" when missing).
+std::string nc_text(const fs::path& file, const char* var_name, const char* attribute) {
+    int nc = -1, var = -1;
+    std::size_t n = 0;
+    std::string text;
+    if (nc_open(file.c_str(), NC_NOWRITE, &nc) != NC_NOERR) return text;
+    if (nc_inq_varid(nc, var_name, &var) == NC_NOERR && nc_inq_attlen(nc, var, attribute, &n) == NC_NOERR) {
+        text.resize(n);
+        if (nc_get_att_text(nc, var, attribute, text.data()) != NC_NOERR) text.clear();
+    }
+    nc_close(nc);
+    return text;
+}
+
+/// The --report's "depth" object: above sea level, shallowest, --min-depth (text), raised.
+struct ReportedDepth {
+    long long above = -1, raised = -1;
+    double shallowest = NAN;
+    std::string floor;
+};
+
+ReportedDepth reported_depth(const std::string& report) {
+    std::vector<std::string> g;
+    ReportedDepth d;
+    if (!regex_search(report,
+                      R"re("depth": \{"nodes_above_sea_level": ([0-9]+), "min_sampled_depth_m": ([-0-9.e+]+|null), )re"
+                      R"re("min_depth_m": ([-0-9.e+]+|null), "nodes_raised_to_min_depth": ([0-9]+)\})re",
+                      &g)) {
+        ADD_FAILURE() << "no depth object in the report:\n" << report;
+        return d;
+    }
+    d.above = std::stoll(g[1]);
+    d.shallowest = g[2] == "null" ? NAN : std::stod(g[2]);
+    d.floor = g[3];
+    d.raised = std::stoll(g[4]);
+    return d;
+}
+
+} // namespace
+
+// The nodes of the coast sample the land side of the raster: the run counts them as written,
+// warns without --min-depth, and with it raises exactly the nodes shallower than DEPTH.
+TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
+    TempDir dir;
+    const std::vector<std::string> common = {
+        "mesh", "--coast", coast, "--coast-layer", "land", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+        "--region", "-10,48,10,60", "--hmax", "30km"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = common;
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result plain = with({"-o", (dir / "d0.nc").string(), "--report", (dir / "r0.json").string()});
+    ASSERT_EQ(plain.status, 0) << plain.err;
+    const Result floored = with({"-o", (dir / "d5.nc").string(), "--report", (dir / "r5.json").string(),
+                                 "--min-depth", "5m", "-q"});
+    ASSERT_EQ(floored.status, 0) << floored.err;
+
+    const std::vector<double> d0 = nc_doubles(dir / "d0.nc", "depth"), d5 = nc_doubles(dir / "d5.nc", "depth");
+    EXPECT_EQ(nc_text(dir / "d0.nc", "depth", "positive"), "down");
+    ASSERT_EQ(d0.size(), d5.size());
+    // The same mesh: --min-depth changes the depths only.
+    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lon"), nc_doubles(dir / "d5.nc", "mesh_node_lon"));
+    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lat"), nc_doubles(dir / "d5.nc", "mesh_node_lat"));
+    const long long above = std::count_if(d0.begin(), d0.end(), [](double d) { return d < 0; });
+    const long long shallower = std::count_if(d0.begin(), d0.end(), [](double d) { return d < 5; });
+    const double shallowest = *std::min_element(d0.begin(), d0.end());
+    ASSERT_GT(above, 10); // not vacuous: coast nodes on land cells
+    EXPECT_GT(shallower, above);
+    EXPECT_GE(*std::min_element(d5.begin(), d5.end()), 5.0);
+    for (std::size_t i = 0; i < d0.size(); ++i) ASSERT_EQ(d5[i], std::max(d0[i], 5.0)) << "node " << i;
+
+    const ReportedDepth r0 = reported_depth(read_text(dir / "r0.json"));
+    EXPECT_EQ(r0.above, above);
+    EXPECT_NEAR(r0.shallowest, shallowest, 1e-5 * std::abs(shallowest));
+    EXPECT_EQ(r0.floor, "null");
+    EXPECT_EQ(r0.raised, 0);
+    const ReportedDepth r5 = reported_depth(read_text(dir / "r5.json"));
+    EXPECT_EQ(r5.above, above); // as sampled, before --min-depth
+    EXPECT_EQ(r5.floor, "5");
+    EXPECT_EQ(r5.raised, shallower);
+
+    // The warning (one line after the progress, counts grouped by thousands) comes only without
+    // --min-depth, and not with --quiet.
+    std::vector<std::string> g;
+    ASSERT_TRUE(regex_search(plain.err, R"(done\.\nglobemesh: warning: ([0-9,]+) nodes lie above sea level \(down to )"
+                                        R"((-?[0-9,]+) m\) and are written with negative depth; --min-depth 5 would )"
+                                        R"(raise them to 5 m\n$)",
+                             &g))
+        << plain.err;
+    EXPECT_EQ(with({"-o", (dir / "quiet.nc").string(), "-q"}).err, "");
+    auto plain_number = [](std::string t) { return std::stoll(regex_replace(t, ",", "")); };
+    EXPECT_EQ(plain_number(g[1]), above);
+    EXPECT_EQ(plain_number(g[2]), std::llround(shallowest));
+    EXPECT_EQ(floored.err, "");
+    const std::string depth_line = "\ndepth +" + std::to_string(above) + " nodes above sea level \\(down to -[0-9,]+ m\\)";
+    EXPECT_TRUE(regex_search(plain.out, depth_line + "\n")) << plain.out;
+    EXPECT_TRUE(regex_search(floored.out, depth_line + ", " + std::to_string(shallower) + " raised to --min-depth 5 m\n"))
+        << floored.out;
+    globemesh::test::expect_mesh_verify(dir / "d5.nc");
+}
+
+namespace {
+
+/// Adds a layer `name` (EPSG:4326) holding the box W,S,E,N (degrees) to the GeoPackage `path`,
+/// created when missing.
+void add_box_layer(const std::string& path, const char* name, double w, double s, double e, double n) {
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+    if (!ds) ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    ASSERT_NE(ds, nullptr) << path;
+    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(wgs84, 4326);
+    OGRLayerH layer = GDALDatasetCreateLayer(ds, name, wgs84, wkbPolygon, nullptr);
+    OSRRelease(wgs84);
+    ASSERT_NE(layer, nullptr);
+    OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing), polygon = OGR_G_CreateGeometry(wkbPolygon);
+    for (auto [x, y] : {std::pair{w, s}, {e, s}, {e, n}, {w, n}, {w, s}}) OGR_G_AddPoint_2D(ring, x, y);
+    OGR_G_AddGeometryDirectly(polygon, ring);
+    OGR_F_SetGeometryDirectly(f, polygon);
+    EXPECT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
+    OGR_F_Destroy(f);
+    GDALClose(ds);
+}
+
+} // namespace
+
+TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
+    TempDir dir;
+    const std::string regions = (dir / "regions.gpkg").string();
+    add_box_layer(regions, "north_sea", -4, 51, 9, 59);
+    add_box_layer(regions, "biscay", -10, 43.5, -1, 48);
+    auto mesh = [&](const std::string& out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"mesh", "--coast", coast, "--coast-layer", "land", "--region-file", regions,
+                                         "--hmax", "40km", "-q", "-o", (dir / out).string()};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result both = mesh("both.nc", {});
+    EXPECT_EQ(both.status, 1);
+    EXPECT_EQ(both.err, "globemesh: --region-file " + regions +
+                            ": several polygon or line layers, choose one with --region-layer; layers: "
+                            "north_sea (Polygon), biscay (Polygon)\n");
+    EXPECT_FALSE(fs::exists(dir / "both.nc"));
+    const Result missing = mesh("missing.nc", {"--region-layer", "baltic"});
+    EXPECT_EQ(missing.status, 1);
+    EXPECT_NE(missing.err.find("no layer named 'baltic'"), std::string::npos) << missing.err;
+
+    // Each layer alone: the nodes lie in its box and reach across it.
+    for (const auto& [layer, box] : {std::pair{"biscay", std::array<double, 4>{-10, 43.5, -1, 48}},
+                                     std::pair{"north_sea", std::array<double, 4>{-4, 51, 9, 59}}}) {
+        SCOPED_TRACE(layer);
+        const std::string out = std::string(layer) + ".nc";
+        const Result r = mesh(out, {"--region-layer", layer});
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto lon = nc_doubles(dir / out, "mesh_node_lon"), lat = nc_doubles(dir / out, "mesh_node_lat");
+        ASSERT_FALSE(lon.empty());
+        const auto [lon_min, lon_max] = std::minmax_element(lon.begin(), lon.end());
+        const auto [lat_min, lat_max] = std::minmax_element(lat.begin(), lat.end());
+        EXPECT_GE(*lon_min, box[0] - 1e-9);
+        EXPECT_LE(*lon_max, box[2] + 1e-9);
+        EXPECT_GE(*lat_min, box[1] - 1e-9);
+        // The outline's edges are great circles: the northern one bulges north of its parallel
+        // to atan(tan(N) / cos(half its longitude span)) at its middle.
+        const double half_span = 0.5 * (box[2] - box[0]) * M_PI / 180;
+        EXPECT_LE(*lat_max, std::atan(std::tan(box[3] * M_PI / 180) / std::cos(half_span)) * 180 / M_PI + 1e-9);
+        EXPECT_GT(*lon_max - *lon_min, 0.8 * (box[2] - box[0]));
+        EXPECT_GT(*lat_max - *lat_min, 0.8 * (box[3] - box[1]));
+        globemesh::test::expect_mesh_verify(dir / out);
+    }
 }

@@ -297,6 +297,63 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     EXPECT_NE(m.find("has no CRS (only a local one, of unknown units)"), std::string::npos) << m;
 }
 
+/// Adds a layer `name` (EPSG:4326, with a size_km field when `size` > 0) holding the square
+/// [x0, x0 + 2] x [y0, y0 + 2] degrees to the GeoPackage `path` (created when missing).
+void add_square_layer(const std::string& path, const char* name, double x0, double y0, double size) {
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+    if (!ds) ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    ASSERT_NE(ds, nullptr);
+    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(wgs84, 4326);
+    OGRLayerH layer = GDALDatasetCreateLayer(ds, name, wgs84, wkbPolygon, nullptr);
+    OSRRelease(wgs84);
+    ASSERT_NE(layer, nullptr);
+    OGRFieldDefnH fd = OGR_Fld_Create(size > 0 ? "size_km" : "label", OFTReal);
+    OGR_L_CreateField(layer, fd, TRUE);
+    OGR_Fld_Destroy(fd);
+    OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+    OGR_F_SetFieldDouble(f, 0, size);
+    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing), polygon = OGR_G_CreateGeometry(wkbPolygon);
+    for (auto [dx, dy] : {std::pair{0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}}) OGR_G_AddPoint_2D(ring, x0 + dx, y0 + dy);
+    OGR_G_AddGeometryDirectly(polygon, ring);
+    OGR_F_SetGeometryDirectly(f, polygon);
+    ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
+    OGR_F_Destroy(f);
+    GDALClose(ds);
+}
+
+TEST(SizeField, size_regions_layer_reads_that_layer_alone) {
+    TempDir dir;
+    const std::string path = (dir / "two_layers.gpkg").string();
+    // Squares far apart beside the grading (9.9 km/km: 100 km within 10 km of each).
+    add_square_layer(path, "fine", 2, 2, 7);       // 7 km over [2, 4] x [2, 4]
+    add_square_layer(path, "medium", -4, -4, 30);  // 30 km over [-4, -2] x [-4, -2]
+    add_square_layer(path, "unsized", -4, 2, 0);   // no size_km field
+    MeshOptions o = regional(-5, -5, 5, 5, 2, 100);
+    o.size_regions = path;
+    // Without a layer: every layer with a size_km field.
+    SizeField both = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    EXPECT_NEAR(both.size_km(3, 3), 7, 1e-5);
+    EXPECT_NEAR(both.size_km(-3, -3), 30, 1e-5);
+    o.size_regions_layer = "medium";
+    SizeField medium = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    EXPECT_NEAR(medium.size_km(-3, -3), 30, 1e-5);
+    EXPECT_NEAR(medium.size_km(3, 3), 100, 1e-5); // the fine square is not read
+    o.size_regions_layer = "fine";
+    SizeField fine = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    EXPECT_NEAR(fine.size_km(3, 3), 7, 1e-5);
+    EXPECT_NEAR(fine.size_km(-3, -3), 100, 1e-5);
+    // A layer that is not there is named with the layers there are; one without size_km is refused.
+    o.size_regions_layer = "coarse";
+    std::string m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
+    EXPECT_NE(m.find("no layer named 'coarse' (--size-regions-layer); layers: fine, medium, unsized"),
+              std::string::npos) << m;
+    o.size_regions_layer = "unsized";
+    m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
+    EXPECT_NE(m.find("layer 'unsized' has no size_km field"), std::string::npos) << m;
+}
+
 TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
     Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
     MeshOptions o;
