@@ -36,6 +36,7 @@ struct MeshOptions {
     int bathy_band = 1;            ///< --bathy-band: 1-based band number
     bool depth_positive = false;   ///< --depth-positive: the raster stores depth positive down
     std::optional<double> bathy_fill_m; ///< --bathy-fill: depth (m) where the raster has no data
+    std::string bathy_srs;         ///< --bathy-srs: CRS of the raster, replacing the file's (e.g. EPSG:4326)
 
     // --- size field (sizefield/), km ---
     double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh
