@@ -102,11 +102,16 @@ DatasetPtr with_srs(GDALDatasetH ds, const std::string& srs, const std::string& 
     return out;
 }
 
-/// --bathy-srs as a CRS; UsageError when it is none (or a local CRS of unknown units).
+/// --bathy-srs as a CRS; UsageError when it is none (or a local CRS of unknown units, or one
+/// with no WKT).
 gdal::SrsRefPtr parse_bathy_srs(const std::string& srs) {
     gdal::QuietErrors quiet;
     gdal::SrsRefPtr parsed(OSRNewSpatialReference(nullptr));
-    if (OSRSetFromUserInput(parsed.get(), srs.c_str()) != OGRERR_NONE || OSRIsLocal(parsed.get()))
+    char* wkt = nullptr;
+    const bool ok = OSRSetFromUserInput(parsed.get(), srs.c_str()) == OGRERR_NONE && !OSRIsLocal(parsed.get()) &&
+                    OSRExportToWkt(parsed.get(), &wkt) == OGRERR_NONE;
+    CPLFree(wkt);
+    if (!ok)
         throw UsageError("--bathy-srs '" + srs + "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
     return parsed;
 }
@@ -134,11 +139,13 @@ AssignedCrs assign_crs(GDALDatasetH ds, const std::string& srs, const std::strin
     if (!srs.empty()) {
         const gdal::SrsRefPtr parsed = parse_bathy_srs(srs);
         char* wkt = nullptr;
-        if (OSRExportToWkt(parsed.get(), &wkt) != OGRERR_NONE) wkt = CPLStrdup("");
-        const std::string text = wkt;
+        OSRExportToWkt(parsed.get(), &wkt);
+        const std::string text = wkt ? wkt : "";
         CPLFree(wkt);
+        const char* same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
+        const bool replaced = own && !OSRIsSameEx(own, parsed.get(), same_options);
         return {with_srs(ds, text, path), "CRS " + srs_name(parsed.get()) + " from --bathy-srs" +
-                                              (own ? ", not the file's " + srs_name(own) : "")};
+                                              (replaced ? ", not the file's " + srs_name(own) : "")};
     }
     if (own || GDALGetGeoTransform(ds, gt) != CE_None || !has_cf_lonlat_axes(ds) ||
         !lonlat_extent(gt, GDALGetRasterXSize(ds), GDALGetRasterYSize(ds)))
@@ -517,11 +524,11 @@ double outside_deg(const LonLatBounds& b, double lon, double lat) {
     return std::max(dlat, dlon);
 }
 
-/// The point of the ocean's outline (its rings' nodes, and points a quarter of a raster cell
-/// apart along longer segments, as the great-circle arcs go) or a pole inside it that r does
-/// not cover, farthest outside r; nullopt when r covers them all.
+/// The point of the ocean's outline (its rings' nodes, and on segments longer than a raster
+/// cell points a quarter of a cell apart, as the great-circle arcs bulge) or a pole inside it
+/// that r does not cover, farthest outside r; nullopt when r covers them all.
 std::optional<LonLat> uncovered_point(const Raster& r, const Boundary& ocean) {
-    const double step = 0.25 * std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad;
+    const double cell = std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad, step = 0.25 * cell;
     const LonLatBounds b = r.bounds();
     std::optional<LonLat> worst;
     double worst_deg = -1;
@@ -532,7 +539,8 @@ std::optional<LonLat> uncovered_point(const Raster& r, const Boundary& ocean) {
     for (const Ring& ring : ocean.rings) {
         for (std::size_t i = 0; i < ring.nodes.size(); ++i) {
             const Vec3 &a = ring.nodes[i], &c = ring.nodes[(i + 1) % ring.nodes.size()];
-            const int parts = static_cast<int>(std::min(1e4, std::ceil(arc_angle(a, c) / step)));
+            const double arc = arc_angle(a, c);
+            const int parts = arc > cell ? static_cast<int>(std::min(1e4, std::ceil(arc / step))) : 1;
             check(vec_to_lonlat(a));
             for (int k = 1; k < parts; ++k) check(vec_to_lonlat(arc_interpolate(a, c, double(k) / parts)));
         }

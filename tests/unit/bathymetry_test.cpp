@@ -736,6 +736,10 @@ TEST(Bathymetry, bathy_srs_replaces_a_wrong_declared_crs) {
     EXPECT_NEAR(r.bounds().west, 100, 1e-9);
     EXPECT_NEAR(r.bounds().north, 30, 1e-9);
     for (double lon : {100.3, 105.1, 119.7}) EXPECT_NEAR(r.elevation_m(lon, 25.2), plane(lon, 25.2), 1e-3) << lon;
+    // The file's own CRS given again: nothing replaced, nothing said of it.
+    Stages same;
+    read_raster(path, 1, false, same.callback(), RasterLimits{}, "EPSG:3857");
+    EXPECT_TRUE(same.any_contains("(EPSG:3857) from --bathy-srs)")) << same.names.front();
 }
 
 // Global grids whose last column repeats the first meridian (node registered), from 20 1/6 E
