@@ -567,7 +567,7 @@ Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Bou
                                ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north);
     const std::string remedy = "; pass --bathy-fill DEPTH for the rest, or a --region or --region-file inside the raster";
     // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
-    if (ocean && (o.region || !o.region_file.empty())) {
+    if (ocean && !ocean->rings.empty() && (o.region || !o.region_file.empty())) {
         if (const auto p = uncovered_point(r, *ocean))
             throw DataError(covers + " but the ocean of " + (o.region ? "--region" : "--region-file " + o.region_file) +
                             " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
