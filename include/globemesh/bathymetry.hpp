@@ -9,9 +9,15 @@
 // Georeferencing: a raster in a geographic CRS with a north-up (or south-up) geotransform is read
 // as is, longitudes in 0..360 or -180..180 alike. Any other raster (projected, rotated) is read
 // through an in-memory warped VRT to EPSG:4326 (GDALWarp, bilinear, exact transformer -et 0,
-// NaN outside the source footprint). A grid whose columns span 360 degrees is global and wraps
-// across +-180; a node-registered global grid (first and last column on the same meridian) drops
-// its duplicate last column.
+// NaN outside the source footprint). --bathy-srs replaces the file's CRS (or gives one). A file
+// without a CRS whose coordinates are CF longitude and latitude (GDAL metadata such as
+// lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles, classic global relief
+// NetCDF grids), with a geotransform whose extent can be degrees, is read as WGS 84 lon/lat
+// (the progress stage says so, which the CLI shows with --verbose).
+// A grid whose columns span 360 degrees (within a tenth of a cell: coordinates written with few
+// digits or as float32) is global, its spacing taken as exactly 360 / columns, and wraps across
+// its seam; a node-registered global grid (the last column repeats the first meridian, e.g.
+// longitudes 20 .. 380 or -180 .. 180) drops that last column and interpolates across the seam.
 //
 // Sampling (Raster::sample, elevation_m): bilinear in lon/lat between the four surrounding cell
 // centres, exact at the cell centres (error below 1e-9 m there, the values being stored as float)
@@ -29,8 +35,9 @@
 // average resampling through RasterIO, which uses the raster's overviews when it has some and
 // only the source window a VRT maps otherwise) applies to rasters with more than max_cells
 // cells (default 2^28, 1 GiB: a 1-arc-minute global grid fits) and, through RasterLimits, to
-// cells finer than the mesh can use. With --region, only the cells that cover the region (and
-// a margin: 1% of its larger side and three cells) are read: a regional run reads a small window of a global raster,
+// cells finer than the mesh can use. With --region (or --region-file, the extent of its ocean),
+// only the cells that cover the region (and a margin: 1% of its larger side and three cells) are
+// read: a regional run reads a small window of a global raster,
 // at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half the
 // smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and refuses
 // (DataError naming --max-memory) when the values would take more than half of
@@ -38,7 +45,7 @@
 // top while reading.
 //
 // Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
-// exist; DataError for a raster without georeferencing, with no valid cell, or that does not
+// exist or a --bathy-srs that is no CRS; DataError for a raster without georeferencing, with no valid cell, or that does not
 // cover the region (unless --bathy-fill gives a value for the uncovered part).
 #pragma once
 
@@ -48,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/progress.hpp"
 #include "globemesh/sphere.hpp"
@@ -140,20 +148,42 @@ Raster read_raster(const std::string& path, int band = 1, bool depth_positive = 
 
 /// read_raster within `limits`: decimated as they say, and a DataError naming the raster's size,
 /// the bytes needed and --max-memory, before anything large is allocated, when it does not fit.
+/// srs: the raster's CRS (--bathy-srs: any string OGRSpatialReference::SetFromUserInput takes)
+/// in place of the file's; empty: the file's, or lon/lat for CF lon/lat axes (file comment).
+/// Throws UsageError naming --bathy-srs when srs is not a CRS.
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
-                   const RasterLimits& limits);
+                   const RasterLimits& limits, const std::string& srs = {});
+
+/// Throws UsageError (one line naming --bathy-srs) when srs is neither empty nor a CRS that
+/// OGRSpatialReference::SetFromUserInput takes. Opens no file.
+void validate_bathy_srs(const std::string& srs);
+
+/// The lon/lat box of the ocean left of `ocean`'s rings: longitudes the shortest arc of the
+/// circle that holds every segment (to 1/8 degree, outward), latitudes those of the nodes,
+/// reaching a pole that lies in the ocean (then every longitude). nullopt without rings (the
+/// whole sphere).
+std::optional<LonLatBounds> ocean_extent(const Boundary& ocean);
+
+/// in(north pole) - in(south pole) for the ocean left of the rings: 1 when the ocean holds the
+/// north pole but not the south one, -1 the reverse, 0 for neither (or both). Rings through a
+/// pole are left out (that pole is on the outline).
+int ocean_pole_winding(const Boundary& ocean);
 
 /// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
-/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory, and with
-/// --region the window of the region widened by 1% of its larger side (the size field's grid
-/// reaches a cell beyond the region).
-RasterLimits bathymetry_limits(const MeshOptions& options);
+/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory, and a
+/// window widened by 1% of its larger side (the size field's grid reaches a cell beyond the
+/// region): --region's box, or with --region-file the ocean_extent of `ocean` (the coast stage's
+/// rings) when given.
+RasterLimits bathymetry_limits(const MeshOptions& options, const Boundary* ocean = nullptr);
 
-/// Reads options.bathy (band options.bathy_band, options.depth_positive), sets the fill to
-/// -options.bathy_fill_m when given, and checks that the raster covers options.region (the whole
-/// globe without --region; --region-file is not checked here), within bathymetry_limits(options).
-/// Throws as read_raster, and
-/// DataError when the raster covers only part of the region and no --bathy-fill is set.
-Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {});
+/// Reads options.bathy (band options.bathy_band, options.depth_positive, options.bathy_srs), sets
+/// the fill to -options.bathy_fill_m when given, and checks the raster covers the region, within
+/// bathymetry_limits(options, ocean). With `ocean` (the rings the coast stage cut for --region
+/// or --region-file) the region is that ocean: the raster must hold every point of its outline
+/// (a point a quarter of a cell apart along the great-circle segments) and a pole inside it;
+/// land in the region needs no raster. Without: --region's box, or the whole globe.
+/// Throws as read_raster, and DataError (naming a point not covered) when the raster covers
+/// only part of the region and no --bathy-fill is set.
+Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {}, const Boundary* ocean = nullptr);
 
 } // namespace globemesh

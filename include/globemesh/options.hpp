@@ -40,6 +40,7 @@ struct MeshOptions {
     /// --min-depth: depth (m, positive down) that every node shallower than it is raised to
     /// after sampling (depth := max(depth, min_depth)); nullopt keeps the sampled depths.
     std::optional<double> min_depth_m;
+    std::string bathy_srs;         ///< --bathy-srs: CRS of the raster, replacing the file's (e.g. EPSG:4326)
 
     // --- size field (sizefield/), km ---
     double hmax_km = 100.0;     ///< --hmax: largest edge length (km); alone gives a uniform mesh

@@ -1,5 +1,6 @@
 // read_raster / read_bathymetry: GDAL in, Raster out. The only file of bathymetry/ that sees GDAL.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -7,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <cpl_conv.h>
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal.h>
@@ -46,6 +48,120 @@ bool is_plain_lonlat(GDALDatasetH ds, const double gt[6]) {
     double unit = OSRGetAngularUnits(srs, nullptr);
     if (std::abs(unit - deg_to_rad) > 1e-12) return false;
     return gt[2] == 0 && gt[4] == 0 && gt[1] > 0 && gt[5] != 0;
+}
+
+/// True when GDAL's metadata of ds ("variable#attribute" items, as the netCDF driver gives a
+/// file's attributes) names a longitude and a latitude coordinate the CF way: standard_name
+/// longitude / latitude, or units degrees_east / degrees_north (or CF's other spellings). Not
+/// when the file has 2-D coordinates (GDAL's GEOLOCATION arrays): its grid is not lon/lat.
+bool has_cf_lonlat_axes(GDALDatasetH ds) {
+    if (GDALGetMetadata(ds, "GEOLOCATION") != nullptr) return false;
+    static const char* const east[] = {"degrees_east", "degree_east", "degrees_e", "degree_e", "degreese", "degreee"};
+    static const char* const north[] = {"degrees_north", "degree_north", "degrees_n", "degree_n", "degreesn", "degreen"};
+    auto one_of = [](const std::string& v, const auto& list) {
+        return std::any_of(std::begin(list), std::end(list), [&](const char* u) { return v == u; });
+    };
+    bool lon = false, lat = false;
+    for (char** item = GDALGetMetadata(ds, nullptr); item && *item; ++item) {
+        const std::string s = *item;
+        const std::size_t eq = s.find('='), hash = s.rfind('#', eq);
+        if (eq == std::string::npos || hash == std::string::npos) continue;
+        const std::string attribute = s.substr(hash + 1, eq - hash - 1);
+        std::string value = s.substr(eq + 1);
+        std::transform(value.begin(), value.end(), value.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (attribute == "standard_name") {
+            lon = lon || value == "longitude";
+            lat = lat || value == "latitude";
+        } else if (attribute == "units") {
+            lon = lon || one_of(value, east);
+            lat = lat || one_of(value, north);
+        }
+    }
+    return lon && lat;
+}
+
+/// True when the geotransform of an nx x ny raster is north- or south-up and its extent can be
+/// degrees: latitudes within a cell of +-90, longitudes in -360..720 and at most 360 degrees
+/// and a cell wide.
+bool lonlat_extent(const double gt[6], int nx, int ny) {
+    if (gt[2] != 0 || gt[4] != 0 || !(gt[1] > 0) || gt[5] == 0) return false;
+    const double west = gt[0], east = gt[0] + nx * gt[1];
+    const double lat_a = gt[3], lat_b = gt[3] + ny * gt[5], cell = std::abs(gt[5]);
+    return west >= -360 && east <= 720 && east - west <= 360 + 1.01 * gt[1] &&
+           std::min(lat_a, lat_b) >= -90 - 1.01 * cell && std::max(lat_a, lat_b) <= 90 + 1.01 * cell;
+}
+
+/// ds with the CRS `srs` (WKT) in place of its own, as a lazy in-memory VRT (gdal_translate -a_srs).
+DatasetPtr with_srs(GDALDatasetH ds, const std::string& srs, const std::string& path) {
+    StringList argv{"-of", "VRT", "-a_srs", srs.c_str()};
+    GDALTranslateOptions* opts = GDALTranslateOptionsNew(argv.get(), nullptr);
+    int usage_error = 0;
+    DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
+    GDALTranslateOptionsFree(opts);
+    if (!out) throw IoError("--bathy " + path + ": cannot assign its CRS: " + gdal::last_error());
+    return out;
+}
+
+/// --bathy-srs as a CRS; UsageError when it is none (or a local CRS of unknown units, or one
+/// with no WKT).
+gdal::SrsRefPtr parse_bathy_srs(const std::string& srs) {
+    gdal::QuietErrors quiet;
+    gdal::SrsRefPtr parsed(OSRNewSpatialReference(nullptr));
+    char* wkt = nullptr;
+    const bool ok = OSRSetFromUserInput(parsed.get(), srs.c_str()) == OGRERR_NONE && !OSRIsLocal(parsed.get()) &&
+                    OSRExportToWkt(parsed.get(), &wkt) == OGRERR_NONE;
+    CPLFree(wkt);
+    if (!ok)
+        throw UsageError("--bathy-srs '" + srs + "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
+    return parsed;
+}
+
+/// The name of a CRS and its authority code when it has one: "WGS 84 (EPSG:4326)".
+std::string srs_name(OGRSpatialReferenceH srs) {
+    const char* name = OSRGetName(srs);
+    const char* auth = OSRGetAuthorityName(srs, nullptr);
+    const char* code = OSRGetAuthorityCode(srs, nullptr);
+    return std::string(name ? name : "a CRS") + (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
+}
+
+/// The CRS read_raster gives a raster in place of its own: --bathy-srs when set (`srs`), WGS 84
+/// lon/lat for a grid without a CRS whose axes are CF longitude and latitude (see
+/// has_cf_lonlat_axes), none otherwise. `note` says which, for the progress line.
+struct AssignedCrs {
+    DatasetPtr dataset; ///< the raster with that CRS (a VRT), or null: its own CRS stands
+    std::string note;
+};
+
+AssignedCrs assign_crs(GDALDatasetH ds, const std::string& srs, const std::string& path) {
+    OGRSpatialReferenceH own = GDALGetSpatialRef(ds);
+    if (own && OSRIsLocal(own)) own = nullptr; // a local CRS of unknown units is none
+    double gt[6];
+    if (!srs.empty()) {
+        const gdal::SrsRefPtr parsed = parse_bathy_srs(srs);
+        char* wkt = nullptr;
+        OSRExportToWkt(parsed.get(), &wkt);
+        const std::string text = wkt ? wkt : "";
+        CPLFree(wkt);
+        const char* same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
+        const bool replaced = own && !OSRIsSameEx(own, parsed.get(), same_options);
+        return {with_srs(ds, text, path), "CRS " + srs_name(parsed.get()) + " from --bathy-srs" +
+                                              (replaced ? ", not the file's " + srs_name(own) : "")};
+    }
+    if (own || GDALGetGeoTransform(ds, gt) != CE_None || !has_cf_lonlat_axes(ds) ||
+        !lonlat_extent(gt, GDALGetRasterXSize(ds), GDALGetRasterYSize(ds)))
+        return {};
+    return {with_srs(ds, SRS_WKT_WGS84_LAT_LONG, path),
+            "no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84 lon/lat, EPSG:4326"};
+}
+
+/// Columns of a lon/lat grid of pixel width dx degrees that go once round the globe: nx when
+/// nx * dx is 360, nx - 1 when the last column repeats the first meridian ((nx - 1) * dx is
+/// 360), 0 when neither. Within a tenth of a cell: coordinates written with few digits (0.333)
+/// or as float32 miss 360 by a fraction of a cell, and no regional grid comes that close.
+std::size_t global_columns(std::size_t nx, double dx) {
+    for (std::size_t n : {nx, nx - 1})
+        if (n > 0 && std::abs(static_cast<double>(n) * dx - 360.0) <= 0.1 * dx) return n;
+    return 0;
 }
 
 /// A VRT holding band `band` of ds alone (the warper takes every band otherwise).
@@ -161,7 +277,7 @@ Window window_of(const LonLatBounds& b, const double gt[6], std::size_t nx, std:
 
 std::string fmt_deg(double v) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.4g", v);
+    std::snprintf(buf, sizeof buf, "%.7g", v);
     return buf;
 }
 
@@ -208,11 +324,10 @@ private:
 };
 
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
-                   const RasterLimits& limits) {
+                   const RasterLimits& limits, const std::string& srs) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
     const BlockCacheCap cache(limits.max_bytes);
-    report(progress, 0.0, "read bathymetry");
 
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds)
@@ -224,6 +339,13 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         throw UsageError("--bathy-band " + std::to_string(band) + ": " + path + " has " +
                          std::to_string(nbands) + " band" + (nbands == 1 ? "" : "s"));
     GDALRasterBandH src_band = GDALGetRasterBand(h, band);
+
+    // The CRS given in place of the file's (--bathy-srs, or lon/lat for CF lon/lat axes) is
+    // said on the progress line, which --verbose shows.
+    const AssignedCrs assigned = assign_crs(h, srs, path);
+    const std::string stage = assigned.dataset ? "read bathymetry (" + assigned.note + ")" : "read bathymetry";
+    report(progress, 0.0, stage);
+    GDALDatasetH geo = assigned.dataset ? assigned.dataset.get() : h; // the source with its CRS
 
     // Scale, offset and nodata belong to the original band; the warper keeps raw values.
     int has = 0;
@@ -237,18 +359,19 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     double gt[6];
     // A GeoTIFF whose CRS was unset reads back with a local (engineering) CRS of unknown
     // units: no more georeferenced than one with none.
-    const OGRSpatialReferenceH crs = GDALGetSpatialRef(h);
-    if (GDALGetGeoTransform(h, gt) != CE_None || !crs || OSRIsLocal(crs))
+    const OGRSpatialReferenceH crs = GDALGetSpatialRef(geo);
+    if (GDALGetGeoTransform(geo, gt) != CE_None || !crs || OSRIsLocal(crs))
         throw DataError("--bathy " + path +
-                        ": has no georeferencing (a geotransform and a geographic or projected CRS); assign "
-                        "them, e.g. gdal_translate -a_srs EPSG:4326 -a_ullr W N E S");
+                        ": has no georeferencing (a geotransform and a geographic or projected CRS); give its "
+                        "CRS with --bathy-srs (e.g. EPSG:4326), or assign both, e.g. gdal_translate -a_srs "
+                        "EPSG:4326 -a_ullr W N E S");
 
     // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
     DatasetPtr band_vrt, warped;
     GDALRasterBandH read_band = src_band;
-    bool warp = !is_plain_lonlat(h, gt);
+    bool warp = !is_plain_lonlat(geo, gt);
     if (warp) {
-        band_vrt = single_band_vrt(h, band, path);
+        band_vrt = single_band_vrt(geo, band, path);
         warped = warped_to_lonlat(band_vrt.get(), path);
         read_band = GDALGetRasterBand(warped.get(), 1);
         if (GDALGetGeoTransform(warped.get(), gt) != CE_None)
@@ -259,8 +382,14 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     std::size_t nx = static_cast<std::size_t>(GDALGetRasterXSize(read_ds));
     std::size_t ny = static_cast<std::size_t>(GDALGetRasterYSize(read_ds));
 
-    // A node-registered global grid repeats its first meridian as the last column: drop it.
-    if (nx > 1 && std::abs(static_cast<double>(nx - 1) * gt[1] - 360.0) <= 1e-6 * gt[1]) --nx;
+    // A global grid: its columns exactly 360 / n apart (the seam closes), and a last column
+    // that repeats the first meridian dropped.
+    if (const std::size_t n = global_columns(nx, gt[1]); n > 0) {
+        const double first_centre = gt[0] + 0.5 * gt[1];
+        gt[1] = 360.0 / static_cast<double>(n);
+        gt[0] = first_centre - 0.5 * gt[1];
+        nx = n;
+    }
 
     // The window of limits.window: columns c0 .. c0 + nx - 1 and rows r0 .. r0 + ny - 1.
     std::size_t c0 = 0, r0 = 0;
@@ -308,7 +437,7 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         GDALRasterIOExtraArg extra;
         INIT_RASTERIO_EXTRA_ARG(extra);
         gdal::ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
-                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), "read bathymetry"};
+                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
         if (progress) {
             extra.pfnProgress = gdal::ProgressBridge::call;
             extra.pProgressData = &bridge;
@@ -348,34 +477,100 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     if (raster.valid_count() == 0)
         throw DataError("--bathy " + path + ": band " + std::to_string(band) +
                         " holds no valid value (all nodata)");
-    report(progress, 1.0, "read bathymetry");
+    report(progress, 1.0, stage);
     return raster;
 }
 
-RasterLimits bathymetry_limits(const MeshOptions& o) {
+void validate_bathy_srs(const std::string& srs) {
+    if (!srs.empty()) parse_bathy_srs(srs);
+}
+
+RasterLimits bathymetry_limits(const MeshOptions& o, const Boundary* ocean) {
     // The mesh samples the raster at its nodes and on the size field's grid (spacing hfloor / 2):
     // finer cells only alias there, so they are averaged to that size.
     const double hfloor_km = size_floor_km(o);
     RasterLimits limits;
     limits.min_cell_deg = 0.5 * hfloor_km / (earth_radius_km * deg_to_rad);
     limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh
+    std::optional<LonLatBounds> box;
     if (o.region) {
+        const auto& r = *o.region;
+        box = LonLatBounds{r[0], r[1], r[2] > r[0] ? r[2] : r[2] + 360, r[3]};
+    } else if (!o.region_file.empty() && ocean) {
+        box = ocean_extent(*ocean);
+        if (box && box->east - box->west >= 360 && box->south <= -90 && box->north >= 90) box.reset();
+    }
+    if (box) {
         // The region and 1% of its larger side: the size field's grid over it reaches a cell
         // beyond, and its cells are at most 1/2048 of that side (pipeline.cpp, 2^22 nodes).
-        const auto& r = *o.region;
-        const double east = r[2] > r[0] ? r[2] : r[2] + 360, pad = 0.01 * std::max(east - r[0], r[3] - r[1]);
-        limits.window = LonLatBounds{r[0] - pad, std::max(-90.0, r[1] - pad), east + pad, std::min(90.0, r[3] + pad)};
+        const double pad = 0.01 * std::max(box->east - box->west, box->north - box->south);
+        limits.window = LonLatBounds{box->west - pad, std::max(-90.0, box->south - pad), box->east + pad,
+                                     std::min(90.0, box->north + pad)};
     }
     return limits;
 }
 
-Raster read_bathymetry(const MeshOptions& o, const Progress& progress) {
+namespace {
+
+/// How far (degrees, the larger of the two axes) a point lies outside the box b, 0 inside it;
+/// longitudes taken modulo 360.
+double outside_deg(const LonLatBounds& b, double lon, double lat) {
+    const double dlat = std::max({0.0, b.south - lat, lat - b.north});
+    double dlon = 0;
+    if (b.east - b.west < 360) {
+        const double x = b.west + std::fmod(std::fmod(lon - b.west, 360.0) + 360.0, 360.0); // in [west, west + 360)
+        dlon = x <= b.east ? 0.0 : std::min(x - b.east, b.west + 360 - x);
+    }
+    return std::max(dlat, dlon);
+}
+
+/// The point of the ocean's outline (its rings' nodes, and on segments longer than a raster
+/// cell points a quarter of a cell apart, as the great-circle arcs bulge) or a pole inside it
+/// that r does not cover, farthest outside r; nullopt when r covers them all.
+std::optional<LonLat> uncovered_point(const Raster& r, const Boundary& ocean) {
+    const double cell = std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad, step = 0.25 * cell;
+    const LonLatBounds b = r.bounds();
+    std::optional<LonLat> worst;
+    double worst_deg = -1;
+    auto check = [&](const LonLat& p) {
+        if (r.contains(p.lon, p.lat)) return;
+        if (const double d = outside_deg(b, p.lon, p.lat); d > worst_deg) worst_deg = d, worst = p;
+    };
+    for (const Ring& ring : ocean.rings) {
+        for (std::size_t i = 0; i < ring.nodes.size(); ++i) {
+            const Vec3 &a = ring.nodes[i], &c = ring.nodes[(i + 1) % ring.nodes.size()];
+            const double arc = arc_angle(a, c);
+            const int parts = arc > cell ? static_cast<int>(std::min(1e4, std::ceil(arc / step))) : 1;
+            check(vec_to_lonlat(a));
+            for (int k = 1; k < parts; ++k) check(vec_to_lonlat(arc_interpolate(a, c, double(k) / parts)));
+        }
+    }
+    const int winding = ocean_pole_winding(ocean);
+    if (winding > 0) check(LonLat{0, 90});
+    if (winding < 0) check(LonLat{0, -90});
+    return worst;
+}
+
+} // namespace
+
+Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Boundary* ocean) {
     if (o.bathy.empty()) throw UsageError("--bathy: no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
         throw UsageError("--bathy-fill must be a depth in metres");
-    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress, bathymetry_limits(o));
+    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress, bathymetry_limits(o, ocean), o.bathy_srs);
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
+        return r;
+    }
+    const LonLatBounds b = r.bounds();
+    const std::string covers = "--bathy " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." + fmt_deg(b.east) +
+                               ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north);
+    const std::string remedy = "; pass --bathy-fill DEPTH for the rest, or a --region or --region-file inside the raster";
+    // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
+    if (ocean && !ocean->rings.empty() && (o.region || !o.region_file.empty())) {
+        if (const auto p = uncovered_point(r, *ocean))
+            throw DataError(covers + " but the ocean of " + (o.region ? "--region" : "--region-file " + o.region_file) +
+                            " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
         return r;
     }
     // Coverage of the region (the whole globe without --region), on a dense set of points.
@@ -395,13 +590,8 @@ Raster read_bathymetry(const MeshOptions& o, const Progress& progress) {
         covered = r.contains(lon, 0.5 * (s + n)) && r.contains(0.5 * (w + e), lat) &&
                   r.contains(lon, s) && r.contains(lon, n);
     }
-    if (!covered) {
-        LonLatBounds b = r.bounds();
-        throw DataError("--bathy " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." +
-                        fmt_deg(b.east) + ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north) +
-                        (o.region ? " but not all of --region" : " but the region is the whole globe") +
-                        "; pass --bathy-fill DEPTH for the rest or a --region inside the raster");
-    }
+    if (!covered)
+        throw DataError(covers + (o.region ? " but not all of --region" : " but the region is the whole globe") + remedy);
     return r;
 }
 

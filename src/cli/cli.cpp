@@ -21,6 +21,7 @@
 #include <gdal.h>
 
 #include "cli_support.hpp"
+#include "globemesh/bathymetry.hpp"
 #include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
@@ -231,6 +232,19 @@ struct MeshCommand {
         app.add_option("--bathy", m.bathy, "Elevation (or depth) raster: any GDAL raster; default none")
             ->group(bathy)->type_name("RASTER");
         app.add_option("--bathy-band", m.bathy_band, "1-based band of --bathy")->group(bathy)->type_name("N");
+        app.add_option("--bathy-srs", m.bathy_srs, "CRS of --bathy, replacing the file's (e.g. EPSG:4326); default the file's")
+            ->group(bathy)->type_name("SRS")
+            ->check(CLI::Validator(
+                [](std::string& value) -> std::string {
+                    try {
+                        validate_bathy_srs(value);
+                        return {};
+                    } catch (const UsageError& e) { // CLI11 puts the option's name in front
+                        const std::string what = e.what(), name = "--bathy-srs ";
+                        return what.rfind(name, 0) == 0 ? what.substr(name.size()) : what;
+                    }
+                },
+                ""));
         app.add_flag("--depth-positive", m.depth_positive, "The raster stores depth, positive down")
             ->group(bathy);
         bathy_fill_opt = app.add_option("--bathy-fill", bathy_fill_m,

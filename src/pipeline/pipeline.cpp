@@ -181,7 +181,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* ti
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
-        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15));
+        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15), &coast.rings); // covering the ocean cut
         budget.hold(static_cast<double>(bathy->values().size() * sizeof(float)));
     }
     clock.lap("read_bathy");

@@ -113,6 +113,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.depth_positive, b.depth_positive);
     EXPECT_EQ(a.bathy_fill_m, b.bathy_fill_m);
     EXPECT_EQ(a.min_depth_m, b.min_depth_m);
+    EXPECT_EQ(a.bathy_srs, b.bathy_srs);
     EXPECT_EQ(a.hmax_km, b.hmax_km);
     EXPECT_EQ(a.hmin_km, b.hmin_km);
     EXPECT_EQ(a.coast_size_km, b.coast_size_km);
@@ -149,7 +150,8 @@ std::vector<std::string> every_option(const std::string& out_dir) {
     return {"--coast", coast, "--coast-layer", "ne_110m_land", "--coast-where", "featurecla = 'Land'",
             "--coast-srs", "EPSG:4326", "--region", "-20.5,40,10.25,65", "--min-island-area", "2.5e7m2",
             "--keep-inland-seas", "--keep-straits", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
-            "--bathy-band", "1", "--depth-positive", "--bathy-fill", "0.05km", "--min-depth", "-2.5m", "--hmax", "45000m",
+            "--bathy-band", "1", "--bathy-srs", "EPSG:4326", "--depth-positive", "--bathy-fill", "0.05km",
+            "--min-depth", "-2.5m", "--hmax", "45000m",
             "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
             "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12",
             "--size-regions", out_dir + "/sizes.gpkg", "--size-regions-layer", "fine", "--grade", "0.2",
@@ -445,6 +447,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"min_depth_without_bathy", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5"}, 2, "--min-depth needs --bathy"},
         ErrorCase{"min_depth_with_area_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5m2"}, 2, "--min-depth"},
         ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
+        ErrorCase{"bad_bathy_srs", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--bathy-srs", "EPSG:99999"}, 2, "--bathy-srs: 'EPSG:99999' is not a CRS"},
         ErrorCase{"unknown_option", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmaxx", "3"}, 2, "unknown option --hmaxx for globemesh mesh"},
         // CLI11's own words ("At Most 1 required but received 2") in globemesh's.
         ErrorCase{"option_given_twice", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5km", "--hmax", "6km"}, 2, "--hmax is given 2 times; give it once"},

@@ -506,3 +506,60 @@ TEST(CliE2e, run_cli_in_process_prints_the_summary_on_out_only) {
     EXPECT_NE(out.str().find("faces"), std::string::npos);
     expect_mesh_verify(dir / "p.nc");
 }
+
+// A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
+// UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
+// and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
+// reaching south of the tile into the water is refused, one line, no output.
+TEST(CliE2e, a_cf_tile_without_a_crs_meshes_a_region_file_in_utm) {
+    TempDir dir;
+    const std::string tile = fixture("bathy/cudem_sabine_unequal_48x40.nc").string();
+    python(R"(
+from osgeo import ogr, osr
+wgs, utm = osr.SpatialReference(), osr.SpatialReference()
+wgs.ImportFromEPSG(4326); utm.ImportFromEPSG(32615)
+wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+for name, south in (('inside', 29.7530), ('beyond', 29.7450)):
+    ring = ogr.Geometry(ogr.wkbLinearRing)
+    for x, y in ((-93.8905, south), (-93.8775, south), (-93.8775, 29.7628), (-93.8905, 29.7628), (-93.8905, south)):
+        ring.AddPoint_2D(x, y)
+    poly = ogr.Geometry(ogr.wkbPolygon); poly.AddGeometry(ring)
+    poly.Transform(osr.CoordinateTransformation(wgs, utm))
+    ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" + dir.path().string() + R"(/' + name + '.gpkg')
+    layer = ds.CreateLayer('region', utm, ogr.wkbPolygon)
+    f = ogr.Feature(layer.GetLayerDefn()); f.SetGeometry(poly); layer.CreateFeature(f)
+    ds = None
+)",
+           dir.path());
+    std::string out, err;
+    int status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile, "--region-file",
+                          (dir / "inside.gpkg").string(), "--hmax", "100m", "--wavelength", "40", "-o",
+                          (dir / "m.nc").string(), "--verbose"},
+                         out, err, dir.path());
+    ASSERT_EQ(status, 0) << err;
+    EXPECT_NE(err.find("its axes are CF longitude/latitude: read as WGS 84 lon/lat"), std::string::npos) << err;
+    expect_mesh_verify(dir / "m.nc");
+    const std::string verdict = python(R"(
+import netCDF4, numpy as np
+t = netCDF4.Dataset(')" + tile + R"(')
+x, y, z = t['lon'][:], t['lat'][:], t['Band1'][:].astype(float)
+m = netCDF4.Dataset(')" + (dir / "m.nc").string() + R"(')
+lon, lat, depth = m['mesh_node_lon'][:], m['mesh_node_lat'][:], m['depth'][:]
+assert len(lon) > 100 and not np.isnan(depth).any(), len(lon)
+i = np.clip(np.searchsorted(x, lon) - 1, 0, len(x) - 2); j = np.clip(np.searchsorted(y, lat) - 1, 0, len(y) - 2)
+u = np.clip((lon - x[i]) / (x[i + 1] - x[i]), 0, 1); v = np.clip((lat - y[j]) / (y[j + 1] - y[j]), 0, 1)
+expect = -((1-u)*(1-v)*z[j, i] + u*(1-v)*z[j, i+1] + (1-u)*v*z[j+1, i] + u*v*z[j+1, i+1])
+assert np.abs(expect - depth).max() < 1e-4, np.abs(expect - depth).max()
+print('OK')
+)",
+                                       dir.path());
+    EXPECT_EQ(verdict, "OK\n");
+    status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile, "--region-file",
+                      (dir / "beyond.gpkg").string(), "--hmax", "100m", "-o", (dir / "b.nc").string(), "--quiet"},
+                     out, err, dir.path());
+    EXPECT_EQ(status, 1) << err;
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_NE(err.find("but the ocean of --region-file " + (dir / "beyond.gpkg").string() + " reaches lon"),
+              std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir / "b.nc"));
+}

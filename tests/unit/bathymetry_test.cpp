@@ -585,3 +585,335 @@ TEST(Bathymetry, without_a_budget_or_a_floor_the_raster_is_read_at_full_resoluti
     EXPECT_EQ(r.nlat(), static_cast<std::size_t>(GDALGetRasterYSize(ds)));
     GDALClose(ds);
 }
+
+// ---------------------------------------------------------------------------------------------
+// CF lon/lat grids without a CRS, --bathy-srs, wrap columns, the coverage of a region's ocean
+
+namespace {
+
+/// A CF grid written with netCDF-C: z(lat, lon) float, coordinate variables lon and lat of the
+/// given type with the given attributes (name, value) each, and no CRS (no grid_mapping).
+struct CfGrid {
+    std::vector<double> lon, lat;
+    std::vector<float> z; // row j (lat[j]) after row
+    nc_type lon_type = NC_DOUBLE;
+    std::vector<std::pair<std::string, std::string>> lon_attributes{{"standard_name", "longitude"}, {"units", "degrees_east"}};
+    std::vector<std::pair<std::string, std::string>> lat_attributes{{"standard_name", "latitude"}, {"units", "degrees_north"}};
+};
+
+void write_cf(const std::string& path, const CfGrid& g) {
+    int nc = -1, dims[2], lon_id, lat_id, z_id;
+    ASSERT_EQ(nc_create(path.c_str(), NC_CLOBBER | NC_64BIT_OFFSET, &nc), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "lat", g.lat.size(), &dims[0]), NC_NOERR);
+    ASSERT_EQ(nc_def_dim(nc, "lon", g.lon.size(), &dims[1]), NC_NOERR);
+    ASSERT_EQ(nc_def_var(nc, "lat", NC_DOUBLE, 1, &dims[0], &lat_id), NC_NOERR);
+    ASSERT_EQ(nc_def_var(nc, "lon", g.lon_type, 1, &dims[1], &lon_id), NC_NOERR);
+    ASSERT_EQ(nc_def_var(nc, "z", NC_FLOAT, 2, dims, &z_id), NC_NOERR);
+    for (const auto& [k, v] : g.lon_attributes) nc_put_att_text(nc, lon_id, k.c_str(), v.size(), v.c_str());
+    for (const auto& [k, v] : g.lat_attributes) nc_put_att_text(nc, lat_id, k.c_str(), v.size(), v.c_str());
+    ASSERT_EQ(nc_enddef(nc), NC_NOERR);
+    ASSERT_EQ(nc_put_var_double(nc, lat_id, g.lat.data()), NC_NOERR);
+    ASSERT_EQ(nc_put_var_double(nc, lon_id, g.lon.data()), NC_NOERR); // netCDF converts to lon_type
+    ASSERT_EQ(nc_put_var_float(nc, z_id, g.z.data()), NC_NOERR);
+    ASSERT_EQ(nc_close(nc), NC_NOERR);
+}
+
+/// The stage names a read reports, in order, each once.
+struct Stages {
+    std::vector<std::string> names;
+    Progress callback() {
+        return [this](double, std::string_view s) {
+            if (names.empty() || names.back() != s) names.emplace_back(s);
+            return true;
+        };
+    }
+    bool any_contains(const std::string& text) const {
+        return std::any_of(names.begin(), names.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+    }
+};
+
+/// A closed ring of unit vectors through the lon/lat points, all segments tagged open.
+Ring ring_of(const std::vector<std::pair<double, double>>& points) {
+    Ring r;
+    for (const auto& [lon, lat] : points) {
+        r.nodes.push_back(lonlat_to_vec(lon, lat));
+        r.kinds.push_back(SegmentKind::open);
+    }
+    return r;
+}
+
+} // namespace
+
+// A CUDEM tile (NOAA, Sabine Pass; 48 x 40 of its non-square cells, as published: CF lon/lat
+// axes, no CRS) is read as WGS 84 lon/lat, and the progress line says so; values and
+// coordinates checked against netCDF-C.
+TEST(Bathymetry, cf_lonlat_grid_without_a_crs_is_read_as_wgs84_and_says_so) {
+    const std::string path = fixture("bathy/cudem_sabine_unequal_48x40.nc").string();
+    Stages stages;
+    Raster r = read_raster(path, 1, false, stages.callback(), RasterLimits{});
+    EXPECT_TRUE(stages.any_contains("no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84"))
+        << stages.names.front();
+    ASSERT_EQ(r.nlon(), 48u);
+    ASSERT_EQ(r.nlat(), 40u);
+    int nc = -1, lon_id, lat_id, z_id;
+    ASSERT_EQ(nc_open(path.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lon", &lon_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lat", &lat_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "Band1", &z_id), NC_NOERR);
+    std::vector<double> lon(48), lat(40), z(48 * 40);
+    ASSERT_EQ(nc_get_var_double(nc, lon_id, lon.data()), NC_NOERR);
+    ASSERT_EQ(nc_get_var_double(nc, lat_id, lat.data()), NC_NOERR);
+    ASSERT_EQ(nc_get_var_double(nc, z_id, z.data()), NC_NOERR);
+    nc_close(nc);
+    int sea = 0;
+    for (std::size_t j = 0; j < 40; ++j)
+        for (std::size_t i = 0; i < 48; ++i) {
+            EXPECT_NEAR(r.elevation_m(lon[i], lat[j]), z[j * 48 + i], 1e-6) << i << " " << j;
+            sea += z[j * 48 + i] < 0;
+        }
+    EXPECT_GT(sea, 300); // water and marsh both
+    // Inside a cell: bilinear between the file's four values, at the file's coordinates.
+    const double fu = 0.3, fv = 0.8, x = lon[10] + fu * (lon[11] - lon[10]), y = lat[20] + fv * (lat[21] - lat[20]);
+    const double expect = (1 - fu) * (1 - fv) * z[20 * 48 + 10] + fu * (1 - fv) * z[20 * 48 + 11] +
+                          (1 - fu) * fv * z[21 * 48 + 10] + fu * fv * z[21 * 48 + 11];
+    EXPECT_NEAR(r.elevation_m(x, y), expect, 1e-5);
+}
+
+TEST(Bathymetry, a_grid_without_crs_or_lonlat_axes_is_refused_and_bathy_srs_gives_its_crs) {
+    TempDir dir;
+    auto z = [](double x, double y) { return -100.0 - 2.0 * x - 3.0 * y; };
+    CfGrid g;
+    for (int i = 0; i < 12; ++i) g.lon.push_back(0.25 + 0.5 * i);
+    for (int j = 0; j < 10; ++j) g.lat.push_back(40.25 + 0.5 * j);
+    for (double y : g.lat)
+        for (double x : g.lon) g.z.push_back(static_cast<float>(z(x, y)));
+    // The same grid with axes that do not say they are degrees: refused, naming --bathy-srs.
+    CfGrid bare = g;
+    bare.lon_attributes = {{"long_name", "x"}};
+    bare.lat_attributes = {{"long_name", "y"}};
+    const std::string bare_path = (dir / "bare.nc").string();
+    write_cf(bare_path, bare);
+    std::string m = test::thrown_message<DataError>([&] { read_raster(bare_path); }, "no CRS, no CF axes");
+    EXPECT_NE(m.find("has no georeferencing"), std::string::npos) << m;
+    EXPECT_NE(m.find("--bathy-srs"), std::string::npos) << m;
+    // Degrees by its units but an extent no lon/lat grid has (latitudes in the thousands): refused.
+    CfGrid far = g;
+    for (double& y : far.lat) y *= 100;
+    const std::string far_path = (dir / "far.nc").string();
+    write_cf(far_path, far);
+    EXPECT_THROW(read_raster(far_path), DataError);
+    // --bathy-srs gives the CRS: values as written.
+    Stages stages;
+    Raster r = read_raster(bare_path, 1, false, stages.callback(), RasterLimits{}, "EPSG:4326");
+    EXPECT_TRUE(stages.any_contains("CRS WGS 84 (EPSG:4326) from --bathy-srs")) << stages.names.front();
+    for (double y : {40.3, 42.0, 44.7})
+        for (double x : {0.3, 2.2, 5.7}) EXPECT_NEAR(r.elevation_m(x, y), z(x, y), 1e-4) << x << " " << y;
+    // A string that is no CRS: one line naming the option, before any file is opened.
+    for (const std::string bad : {"EPSG:99999", "not a crs", "LOCAL_CS[\"x\"]"}) {
+        m = test::thrown_message<UsageError>([&] { validate_bathy_srs(bad); }, bad);
+        EXPECT_EQ(m.rfind("--bathy-srs '" + bad + "' is not a CRS", 0), 0u) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        EXPECT_THROW(read_raster(bare_path, 1, false, {}, RasterLimits{}, bad), UsageError) << bad;
+    }
+    EXPECT_NO_THROW(validate_bathy_srs(""));
+    EXPECT_NO_THROW(validate_bathy_srs("+proj=longlat +datum=WGS84"));
+}
+
+// A GeoTIFF whose coordinates are lon/lat but whose CRS says Web Mercator (metres): read as
+// declared it lies within metres of 0,0; --bathy-srs replaces the CRS and the progress line
+// names both.
+TEST(Bathymetry, bathy_srs_replaces_a_wrong_declared_crs) {
+    TempDir dir;
+    const std::string path = (dir / "mislabelled.tif").string();
+    auto plane = [](double lon, double lat) { return -3000.0 + 10.0 * lon + 4.0 * lat; };
+    write_tiff(path, {100, 30, 0.5, 0.5, 40, 20, 3857}, plane);
+    Raster declared = read_raster(path);
+    EXPECT_LT(declared.bounds().east, 0.01);
+    Stages stages;
+    Raster r = read_raster(path, 1, false, stages.callback(), RasterLimits{}, "EPSG:4326");
+    EXPECT_TRUE(stages.any_contains("from --bathy-srs, not the file's WGS 84 / Pseudo-Mercator (EPSG:3857)"))
+        << stages.names.front();
+    EXPECT_NEAR(r.bounds().west, 100, 1e-9);
+    EXPECT_NEAR(r.bounds().north, 30, 1e-9);
+    for (double lon : {100.3, 105.1, 119.7}) EXPECT_NEAR(r.elevation_m(lon, 25.2), plane(lon, 25.2), 1e-3) << lon;
+    // The file's own CRS given again: nothing replaced, nothing said of it.
+    Stages same;
+    read_raster(path, 1, false, same.callback(), RasterLimits{}, "EPSG:3857");
+    EXPECT_TRUE(same.any_contains("(EPSG:3857) from --bathy-srs)")) << same.names.front();
+}
+
+// Global grids whose last column repeats the first meridian (node registered), from 20 1/6 E
+// (longitudes as float32: GDAL's spacing then misses 1/3 by 1e-8, 360 degrees by 1e-5), from
+// 20 E (doubles) and from -180 to 180 (float32): global, and interpolated across the seam. The
+// field is smooth and periodic, steepest across the seam, so holding the last column instead
+// (the old clamp) is off by about half the step between the two columns there (1.5 m).
+TEST(Bathymetry, a_repeated_wrap_column_is_recognised_and_interpolated_across) {
+    TempDir dir;
+    struct Case {
+        double west;
+        nc_type type;
+    };
+    const double step = 1.0 / 3.0;
+    for (const Case c : {Case{20 + 1.0 / 6, NC_FLOAT}, Case{20, NC_DOUBLE}, Case{-180, NC_FLOAT}}) {
+        auto f = [&](double lon, double lat) {
+            return -1000.0 - 500.0 * std::sin((lon - c.west) * deg_to_rad) * std::cos(lat * deg_to_rad);
+        };
+        CfGrid g;
+        g.lon_type = c.type;
+        for (int i = 0; i <= 1080; ++i) {
+            const double lon = c.west + i * step;
+            g.lon.push_back(c.type == NC_FLOAT ? static_cast<double>(static_cast<float>(lon)) : lon);
+        }
+        for (int j = 0; j <= 36; ++j) g.lat.push_back(-90.0 + 5.0 * j);
+        for (double lat : g.lat)
+            for (int i = 0; i <= 1080; ++i) g.z.push_back(static_cast<float>(f(c.west + i * step, lat)));
+        const std::string path = (dir / "wrap.nc").string();
+        write_cf(path, g);
+        const std::string what = std::to_string(c.west) + (c.type == NC_FLOAT ? " float" : " double");
+        MeshOptions o = options_for(path);
+        Raster r = read_bathymetry(o); // covers the globe: no DataError
+        ASSERT_TRUE(r.global()) << what;
+        EXPECT_EQ(r.nlon(), 1080u) << what;
+        EXPECT_NEAR(r.dlon_deg(), step, 1e-12) << what;
+        // Across the seam: between the last column that is not a repeat and the first, at the
+        // grid's latitudes, from the two stored values by hand.
+        for (double lat : {-45.0, 0.0, 30.0, 85.0})
+            for (double t : {0.1, 0.5, 0.9}) {
+                const double lon = c.west - step + t * step;
+                const double expect = (1 - t) * f32(f(c.west - step, lat)) + t * f32(f(c.west, lat));
+                EXPECT_NEAR(r.elevation_m(lon, lat), expect, 2e-3) << what << " " << lon << " " << lat;
+                EXPECT_NEAR(r.elevation_m(lon + 360, lat), expect, 2e-3) << what;
+                EXPECT_NEAR(r.elevation_m(lon - 360, lat), expect, 2e-3) << what;
+                // Bilinear within h^2/8 |f''| = 0.0085 m of the field itself.
+                EXPECT_NEAR(r.elevation_m(lon, lat), f(lon, lat), 0.01) << what;
+            }
+        // Across 180, and at the repeated column itself.
+        for (double lon : {179.9, -179.9, 180.0, -180.0, c.west, c.west + 360})
+            EXPECT_NEAR(r.elevation_m(lon, 10.0), f(lon, 10.0), 0.01) << what << " " << lon;
+    }
+}
+
+// ETOPO5 (the fixture) cut into a node-registered grid from 20 E round to 20 E again, its
+// longitudes float32 and no CRS (as a CF file from another tool comes): read, it equals the
+// fixture everywhere, the seam at 20 E included. Every third row, to keep the file small.
+TEST(Bathymetry, etopo5_with_a_repeated_wrap_column_reads_as_etopo5) {
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    int nc = -1, lon_id, lat_id, z_id;
+    ASSERT_EQ(nc_open(source.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lon", &lon_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "lat", &lat_id), NC_NOERR);
+    ASSERT_EQ(nc_inq_varid(nc, "elevation", &z_id), NC_NOERR);
+    std::vector<double> lon(2160), lat(1080);
+    std::vector<float> z(2160 * 1080);
+    ASSERT_EQ(nc_get_var_double(nc, lon_id, lon.data()), NC_NOERR);
+    ASSERT_EQ(nc_get_var_double(nc, lat_id, lat.data()), NC_NOERR);
+    ASSERT_EQ(nc_get_var_float(nc, z_id, z.data()), NC_NOERR);
+    nc_close(nc);
+    const std::size_t k0 = 1200; // the column centred at 20 1/12 E
+    ASSERT_NEAR(lon[k0], 20 + 1.0 / 12, 1e-9);
+    CfGrid g;
+    g.lon_type = NC_FLOAT;
+    for (std::size_t i = 0; i <= 2160; ++i) g.lon.push_back(lon[(k0 + i) % 2160] + (k0 + i >= 2160 ? 360 : 0));
+    for (std::size_t j = 1; j < 1080; j += 3) {
+        g.lat.push_back(lat[j]);
+        for (std::size_t i = 0; i <= 2160; ++i) g.z.push_back(z[j * 2160 + (k0 + i) % 2160]);
+    }
+    TempDir dir;
+    const std::string path = (dir / "etopo5_wrap20.nc").string();
+    write_cf(path, g);
+    Raster r = read_bathymetry(options_for(path));
+    ASSERT_TRUE(r.global());
+    ASSERT_EQ(r.nlon(), 2160u);
+    Raster truth = read_bathymetry(options_for(source));
+    // float32 longitudes sit up to 1e-6 degrees off: 3e-3 m on the steepest ETOPO5 slopes.
+    std::mt19937 rng(37);
+    std::uniform_real_distribution<double> ulon(-180, 180);
+    std::uniform_int_distribution<std::size_t> urow(0, g.lat.size() - 1);
+    for (int k = 0; k < 2000; ++k) {
+        const double x = ulon(rng), y = g.lat[urow(rng)];
+        EXPECT_NEAR(r.elevation_m(x, y), truth.elevation_m(x, y), 0.01) << x << " " << y;
+    }
+    // The seam, from the file's two values by hand (20 1/12 E is column k0, 19 11/12 E k0 - 1).
+    for (std::size_t row : {std::size_t{100}, std::size_t{200}, std::size_t{300}}) {
+        const std::size_t j = 1 + 3 * row;
+        for (double t : {0.25, 0.5, 0.75}) {
+            const double x = lon[k0 - 1] + t / 6;
+            const double expect = (1 - t) * z[j * 2160 + k0 - 1] + t * z[j * 2160 + k0];
+            EXPECT_NEAR(r.elevation_m(x, lat[j]), expect, 0.01) << x << " " << lat[j];
+        }
+    }
+}
+
+TEST(Bathymetry, ocean_extent_takes_the_short_way_round_and_the_pole_an_ocean_holds) {
+    // A box across 180, ocean inside (counter-clockwise seen from outside).
+    Boundary box;
+    box.rings.push_back(ring_of({{170, -10}, {-170, -10}, {-170, 10}, {170, 10}}));
+    EXPECT_EQ(ocean_pole_winding(box), 0);
+    auto e = ocean_extent(box);
+    ASSERT_TRUE(e);
+    EXPECT_NEAR(e->west, 170, 0.125);
+    EXPECT_NEAR(e->east, 190, 0.125);
+    EXPECT_LE(e->west, 170);
+    EXPECT_GE(e->east, 190);
+    EXPECT_NEAR(e->south, -10, 1e-9);
+    EXPECT_NEAR(e->north, 10, 1e-9);
+    // A parallel at 60 N walked east: the ocean on its left is the cap round the north pole.
+    std::vector<std::pair<double, double>> parallel;
+    for (int k = 0; k < 36; ++k) parallel.emplace_back(-180 + 10 * k, 60);
+    Boundary cap;
+    cap.rings.push_back(ring_of(parallel));
+    EXPECT_EQ(ocean_pole_winding(cap), 1);
+    e = ocean_extent(cap);
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->north, 90);
+    EXPECT_NEAR(e->south, 60, 1e-9);
+    EXPECT_EQ(e->east - e->west, 360);
+    // Walked west: the ocean is everything south of it, the south pole too.
+    std::reverse(cap.rings[0].nodes.begin(), cap.rings[0].nodes.end());
+    EXPECT_EQ(ocean_pole_winding(cap), -1);
+    e = ocean_extent(cap);
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->south, -90);
+    EXPECT_NEAR(e->north, 60, 1e-9);
+    EXPECT_FALSE(ocean_extent(Boundary{})); // no rings: the whole sphere
+}
+
+// The region a raster must cover is the ocean the coast stage cut (--region box or
+// --region-file): its land needs no raster; an ocean reaching beyond is refused naming where.
+// The window read is the ocean's extent for --region-file.
+TEST(Bathymetry, coverage_is_that_of_the_ocean_of_the_region_file_or_box) {
+    TempDir dir;
+    const std::string path = (dir / "regional.tif").string();
+    write_tiff(path, {0, 10, 0.05, 0.05, 200, 200}, [](double lon, double lat) { return -50.0 - lon - lat; });
+    MeshOptions o = options_for(path);
+    o.region_file = (dir / "region.gpkg").string(); // not opened here: the coast stage read it
+    Boundary ocean;
+    ocean.rings.push_back(ring_of({{2, 2}, {4, 2}, {4, 3}, {2, 3}}));
+    Raster r = read_bathymetry(o, {}, &ocean);
+    // The window: the ocean's extent (to 1/8 degree), 1% of its side and three cells beyond.
+    EXPECT_LT(r.nlon(), 60u);
+    EXPECT_LT(r.nlat(), 40u);
+    EXPECT_NEAR(r.elevation_m(3.0, 2.5), -55.5, 1e-4);
+    // Without the ocean, --region-file leaves the whole globe to cover, as before.
+    EXPECT_THROW(read_bathymetry(o), DataError);
+    // An ocean reaching east of the raster (10 E): refused, naming the file and the place
+    // farthest out.
+    ocean.rings[0] = ring_of({{2, 2}, {11, 2}, {11, 3}, {2, 3}});
+    std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "ocean beyond");
+    EXPECT_NE(m.find("the ocean of --region-file " + o.region_file + " reaches lon 11, lat 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("--bathy-fill"), std::string::npos) << m;
+    // A --region box running west of the raster over land: its ocean is inside, so it is covered.
+    o.region_file.clear();
+    o.region = std::array<double, 4>{-5, 1, 9, 9};
+    ocean.rings[0] = ring_of({{1, 1}, {9, 1}, {9, 9}, {1, 9}});
+    EXPECT_NO_THROW(read_bathymetry(o, {}, &ocean));
+    EXPECT_THROW(read_bathymetry(o), DataError); // the box alone is not
+    // A segment bulging past the raster between two covered nodes: the great circle from
+    // (9.5, 9.99) to (0.5, 9.99) reaches 10.02 N, past the raster's edge at 10 N.
+    o.region = std::array<double, 4>{-5, 1, 9.5, 9.99};
+    ocean.rings[0] = ring_of({{0.5, 1}, {9.5, 1}, {9.5, 9.99}, {0.5, 9.99}});
+    m = test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "bulge");
+    EXPECT_NE(m.find("reaches lon"), std::string::npos) << m;
+    o.bathy_fill_m = 20.0; // the fill answers for the rest
+    EXPECT_NO_THROW(read_bathymetry(o, {}, &ocean));
+}
