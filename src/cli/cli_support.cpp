@@ -1,5 +1,6 @@
 #include "cli_support.hpp"
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <memory>
@@ -22,21 +24,43 @@ namespace globemesh::cli {
 namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal that arrived, or 0
+volatile std::sig_atomic_t g_mid_line = 0;    // a progress line on stderr is open
+pthread_t g_main_thread;                      // the thread of the guard, which handles the signals
 
-/// The first signal asks the run to stop at its next progress report; a second one, for a run
-/// that does not report, ends the process the default way.
-extern "C" void on_cancelling_signal(int signal) {
-    if (g_interrupted) {
-        std::signal(signal, SIG_DFL);
-        std::raise(signal);
+void write_stderr(const char* text) {
+    for (std::size_t left = std::strlen(text); left > 0;) {
+        const ssize_t n = ::write(STDERR_FILENO, text, left);
+        if (n <= 0) return;
+        text += n, left -= static_cast<std::size_t>(n);
     }
-    g_interrupted = signal;
+}
+
+/// The first signal asks the run to stop at its next progress report, which then unwinds and
+/// removes its files. A second one ends the process at once (Ctrl-C twice, or a run stuck in a
+/// call that does not report), after removing the temporary files itself; unless the outputs
+/// are being moved in place, which takes a few system calls and leaves them all complete.
+/// Handled on the guard's thread, so that no other thread of the run writes meanwhile.
+extern "C" void on_cancelling_signal(int signal) {
+    if (!pthread_equal(pthread_self(), g_main_thread)) {
+        pthread_kill(g_main_thread, signal);
+        return;
+    }
+    if (!g_interrupted) {
+        g_interrupted = signal;
+        return;
+    }
+    if (OutputFile::committing()) return;
+    OutputFile::remove_temporaries();
+    write_stderr(g_mid_line ? "\nglobemesh: cancelled, no output written\n" : "globemesh: cancelled, no output written\n");
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
 }
 
 } // namespace
 
 InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
+    g_main_thread = pthread_self();
     struct sigaction action {};
     action.sa_handler = on_cancelling_signal;
     sigemptyset(&action.sa_mask);
@@ -54,6 +78,8 @@ bool InterruptGuard::interrupted() { return g_interrupted != 0; }
 
 int InterruptGuard::signal() { return g_interrupted; }
 
+void InterruptGuard::forget() { g_interrupted = 0; }
+
 bool TerminalProgress::update(double fraction, std::string_view stage) {
     if (InterruptGuard::interrupted()) return false;
     if (quiet_) return true;
@@ -62,11 +88,14 @@ bool TerminalProgress::update(double fraction, std::string_view stage) {
         err_ << '[' << stage << "] ";
         stage_ = std::string(stage);
         mid_line_ = true;
+        g_mid_line = 1;
     }
     // GDALTermProgress's arithmetic: 40 ticks, a number every fourth, " - done." at 100.
     const int tick = std::clamp(static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 40.0), 0, 40);
     if (tick < last_tick_ && last_tick_ >= 39) last_tick_ = -1; // a new run of 0..100
-    if (tick <= last_tick_) return true;
+    // Without --verbose the line starts at the first tick after 0, so that an error found while
+    // the inputs are opened stands alone, without a "0" before it.
+    if (tick <= last_tick_ || (tick == 0 && !verbose_)) return true;
     while (tick > last_tick_) {
         ++last_tick_;
         if (last_tick_ % 4 == 0)
@@ -80,12 +109,14 @@ bool TerminalProgress::update(double fraction, std::string_view stage) {
         mid_line_ = false;
     }
     err_.flush();
+    g_mid_line = mid_line_;
     return true;
 }
 
 void TerminalProgress::end_line() {
     if (mid_line_) err_ << '\n';
     mid_line_ = false;
+    g_mid_line = 0;
 }
 
 std::string json_number(double v) {
@@ -253,10 +284,10 @@ void check_output_path(const std::string& path, const std::string& what, bool ov
         if (what == "--report" || what == "--timings") return;
         throw IoError(what + ": " + path + " is not a regular file (a device or pipe); give a file name");
     }
+    if (fs::is_directory(p, ec)) // before "exists": --overwrite would not help
+        throw IoError(what + ": " + path + " is a folder; give a file name");
     if (fs::exists(p, ec) && !overwrite)
         throw IoError(what + ": " + path + " exists; use --overwrite to replace it");
-    if (fs::is_directory(p, ec))
-        throw IoError(what + ": " + path + " is a folder; give a file name");
     if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
         throw IoError(what + ": " + path + " is not a regular file (a socket?); give a file name");
 }

@@ -20,8 +20,11 @@
 namespace globemesh::cli {
 
 /// Installs handlers for SIGINT, SIGTERM and SIGHUP for its lifetime (restoring the previous
-/// ones after) that only record the signal; interrupted() reads it. One guard at a time
-/// (run_cli is not re-entrant).
+/// ones after). The first signal is only recorded (interrupted() reads it; the run stops at its
+/// next progress report and removes its files). A second one removes the temporary output files
+/// (OutputFile::remove_temporaries), says "cancelled" on stderr and ends the process by that
+/// signal, unless the outputs are being moved in place. One guard at a time, on the thread that
+/// runs (run_cli is not re-entrant); a signal delivered to another thread is passed to it.
 class InterruptGuard {
 public:
     InterruptGuard();
@@ -31,6 +34,8 @@ public:
     static bool interrupted();
     /// The signal that cancelled the last run (kept after the guard is gone), or 0.
     static int signal();
+    /// Clears signal() before a new run.
+    static void forget();
     /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
     /// and leave the temporary output files behind.
@@ -45,7 +50,8 @@ private:
 /// drawn on `err` rather than stdout (where GDALTermProgress writes) so that stdout carries
 /// results only. With `verbose`, each new stage starts a line "[stage] ". The callback returns
 /// false once a cancelling signal arrived (InterruptGuard), which cancels the run. run_cli owns
-/// one, so that an error line never lands in the middle of a progress line.
+/// one, so that an error line never lands in the middle of a progress line. Without `verbose`
+/// the line starts at the first tick after 0, so an early error is not preceded by a lone "0".
 class TerminalProgress {
 public:
     explicit TerminalProgress(std::ostream& err) : err_(err) {}

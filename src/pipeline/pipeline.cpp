@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "coast/geos_interrupt.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -101,7 +102,10 @@ private:
 
 } // namespace
 
-Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* timings) {
+Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
+    // A long GEOS operation of the coast stages stops too when the run is cancelled.
+    const coast::GeosInterrupt geos_interrupt(run_progress);
+    const Progress& progress = geos_interrupt.progress();
     validate(o);
     if (o.coast.empty()) throw UsageError("--coast is required: a land polygon or coastline file (any OGR source)");
     StageClock clock(timings);
