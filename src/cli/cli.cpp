@@ -518,6 +518,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         OutputFile::write_text(o.report, r.str(), o.overwrite, "--report");
     }
     batch.commit(InterruptGuard::interrupted);
+    InterruptGuard::finished();
 
     print_stats(out, stats, false);
     // What the run changed of the coast, from the pipeline's attributes.
@@ -639,6 +640,7 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
         OutputFile::write_text(c.timings, timings_json(timings), c.overwrite, "--timings");
     }
     batch.commit(InterruptGuard::interrupted);
+    InterruptGuard::finished();
     out << "nodes             " << mesh.nodes.size() << "\n"
         << "faces             " << mesh.faces.size() << "\n";
     print_timings(out, timings);

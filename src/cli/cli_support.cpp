@@ -25,6 +25,7 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal that arrived, or 0
 volatile std::sig_atomic_t g_mid_line = 0;    // a progress line on stderr is open
+volatile std::sig_atomic_t g_finished = 0;    // the outputs are in place: nothing to cancel
 pthread_t g_main_thread;                      // the thread of the guard, which handles the signals
 
 void write_stderr(const char* text) {
@@ -50,6 +51,11 @@ extern "C" void on_cancelling_signal(int signal) {
         return;
     }
     if (OutputFile::committing()) return;
+    if (g_finished) {
+        std::signal(signal, SIG_DFL);
+        std::raise(signal);
+        return;
+    }
     OutputFile::remove_temporaries();
     write_stderr(g_mid_line ? "\nglobemesh: cancelled, no output written\n" : "globemesh: cancelled, no output written\n");
     std::signal(signal, SIG_DFL);
@@ -60,6 +66,7 @@ extern "C" void on_cancelling_signal(int signal) {
 
 InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
+    g_finished = 0;
     g_main_thread = pthread_self();
     struct sigaction action {};
     action.sa_handler = on_cancelling_signal;
@@ -79,6 +86,8 @@ bool InterruptGuard::interrupted() { return g_interrupted != 0; }
 int InterruptGuard::signal() { return g_interrupted; }
 
 void InterruptGuard::forget() { g_interrupted = 0; }
+
+void InterruptGuard::finished() { g_finished = 1; }
 
 bool TerminalProgress::update(double fraction, std::string_view stage) {
     if (InterruptGuard::interrupted()) return false;

@@ -36,6 +36,9 @@ public:
     static int signal();
     /// Clears signal() before a new run.
     static void forget();
+    /// The outputs are in place: a second signal now ends the process without a word (the run
+    /// is complete), a first one changes nothing.
+    static void finished();
     /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
     /// and leave the temporary output files behind.
