@@ -1,11 +1,16 @@
 #include "cli_support.hpp"
 
 #include <pthread.h>
+#include <semaphore.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <ctime>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -27,6 +32,8 @@ volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal tha
 volatile std::sig_atomic_t g_mid_line = 0;    // a progress line on stderr is open
 volatile std::sig_atomic_t g_finished = 0;    // the outputs are in place: nothing to cancel
 pthread_t g_main_thread;                      // the thread of the guard, which handles the signals
+sem_t g_wake;                                 // posted by the first signal and by the guard's end
+std::atomic<bool> g_guard_ending{false};
 
 void write_stderr(const char* text) {
     for (std::size_t left = std::strlen(text); left > 0;) {
@@ -48,6 +55,7 @@ extern "C" void on_cancelling_signal(int signal) {
     }
     if (!g_interrupted) {
         g_interrupted = signal;
+        sem_post(&g_wake); // the watchdog's clock starts
         return;
     }
     if (OutputFile::committing()) return;
@@ -57,9 +65,30 @@ extern "C" void on_cancelling_signal(int signal) {
         return;
     }
     OutputFile::remove_temporaries();
-    write_stderr(g_mid_line ? "\nglobemesh: cancelled, no output written\n" : "globemesh: cancelled, no output written\n");
+    if (g_mid_line) write_stderr("\n");
+    write_stderr(signal == SIGTERM  ? "globemesh: cancelled by SIGTERM, no output written\n"
+                 : signal == SIGHUP ? "globemesh: cancelled by SIGHUP, no output written\n"
+                                    : "globemesh: cancelled, no output written\n");
     std::signal(signal, SIG_DFL);
     std::raise(signal);
+}
+
+/// Waits for a first signal; when the run has not ended stop_grace after it (a long call that
+/// does not report: a GEOS validity test of a continent, a library's write), sends the signal
+/// again, which ends the process as a second one does.
+void watchdog() {
+    while (sem_wait(&g_wake) != 0 && errno == EINTR) {
+    }
+    if (g_guard_ending.load()) return;
+    timespec deadline {};
+    clock_gettime(CLOCK_REALTIME, &deadline);
+    const long grace_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(InterruptGuard::stop_grace).count();
+    deadline.tv_sec += (deadline.tv_nsec + grace_ns) / 1000000000L;
+    deadline.tv_nsec = (deadline.tv_nsec + grace_ns) % 1000000000L;
+    int waited = 0;
+    while ((waited = sem_timedwait(&g_wake, &deadline)) != 0 && errno == EINTR) {
+    }
+    if (waited != 0 && !g_guard_ending.load()) pthread_kill(g_main_thread, g_interrupted);
 }
 
 } // namespace
@@ -68,6 +97,9 @@ InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
     g_finished = 0;
     g_main_thread = pthread_self();
+    g_guard_ending = false;
+    sem_init(&g_wake, 0, 0);
+    watchdog_ = std::thread(watchdog);
     struct sigaction action {};
     action.sa_handler = on_cancelling_signal;
     sigemptyset(&action.sa_mask);
@@ -77,8 +109,12 @@ InterruptGuard::InterruptGuard() {
 }
 
 InterruptGuard::~InterruptGuard() {
+    g_guard_ending = true;
+    sem_post(&g_wake);
+    watchdog_.join();
     for (std::size_t k = 0; k < std::size(cancelling); ++k)
         if (installed_[k]) sigaction(cancelling[k], &previous_[k], nullptr);
+    sem_destroy(&g_wake);
 }
 
 bool InterruptGuard::interrupted() { return g_interrupted != 0; }

@@ -2,6 +2,7 @@
 // run summary shared by `mesh`, `triangulate` and `info`.
 #pragma once
 
+#include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -23,8 +25,10 @@ namespace globemesh::cli {
 /// ones after). The first signal is only recorded (interrupted() reads it; the run stops at its
 /// next progress report and removes its files). A second one removes the temporary output files
 /// (OutputFile::remove_temporaries), says "cancelled" on stderr and ends the process by that
-/// signal, unless the outputs are being moved in place. One guard at a time, on the thread that
-/// runs (run_cli is not re-entrant); a signal delivered to another thread is passed to it.
+/// signal, unless the outputs are being moved in place. A run still going stop_grace after the
+/// first signal (in a long call that does not report) gets it again from a watchdog thread, and
+/// so ends as on a second one. One guard at a time, on the thread that runs (run_cli is not
+/// re-entrant); a signal delivered to another thread is passed to it.
 class InterruptGuard {
 public:
     InterruptGuard();
@@ -43,10 +47,13 @@ public:
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
     /// and leave the temporary output files behind.
     static constexpr int cancelling[3] = {SIGINT, SIGTERM, SIGHUP};
+    /// How long a run has to stop cleanly (status 1) after a signal before it is ended by it.
+    static constexpr std::chrono::milliseconds stop_grace{1000};
 
 private:
     struct sigaction previous_[std::size(cancelling)] {};
     bool installed_[std::size(cancelling)] = {};
+    std::thread watchdog_;
 };
 
 /// GDAL's terminal progress ("0...10...20...30...40...50...60...70...80...90...100 - done."),
