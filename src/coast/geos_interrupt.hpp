@@ -9,8 +9,10 @@
 
 namespace globemesh::coast {
 
-/// While alive, GEOS operations on this thread stop within about 0.1 s once `parent` asks to stop.
-/// GEOS calls its interrupt callback (one for the process in GEOS 3.11) as it works; ours
+/// While alive, GEOS operations on this thread stop within about 0.1 s once `parent` asks to stop,
+/// those that check for interrupts (overlay and union do; validity tests may not, and a loop
+/// of short calls should call poll()). GEOS calls its interrupt callback (one for the process in
+/// GEOS 3.11) as it works; ours
 /// repeats the run's last report to `parent` at most every 50 ms, and when it returns false
 /// requests GEOS's interrupt: the GEOS call in progress then fails (a null geometry, an error
 /// code) and interrupted() or poll() tell the caller to throw Cancelled instead of an error. Pass
