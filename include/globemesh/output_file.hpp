@@ -1,4 +1,4 @@
-// globemesh/output_file.hpp: safe writing of one output file (temporary name, rename at the end).
+// globemesh/output_file.hpp: safe writing of output files (temporary names, renamed at the end).
 //
 // An OutputFile reserves a hidden temporary name beside the target (same folder, so the final
 // rename is atomic on POSIX file systems). The writer writes to temp_path() and calls commit(),
@@ -10,10 +10,17 @@
 // A process killed by SIGKILL cannot clean up: then only the hidden temporary file remains, never
 // a partial target. A target that is a symbolic link is written through it (the link stays);
 // one that exists and is not a regular file (a device, a pipe) is refused, except by write_text.
+//
+// The outputs of one run appear together through an OutputBatch: while one is alive on the
+// thread, commit() leaves the finished file under its temporary name, and OutputBatch::commit()
+// moves them all at the end. remove_temporaries() is for a signal handler that ends the process.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <vector>
 
 namespace globemesh {
 
@@ -31,8 +38,9 @@ public:
     const std::filesystem::path& temp_path() const { return temp_; }
     const std::filesystem::path& target() const { return target_; }
 
-    /// Moves the finished temporary file to the target. Throws IoError (target appeared without
-    /// overwrite, rename failed); the temporary file is then still removed by the destructor.
+    /// Moves the finished temporary file to the target, or hands it to the thread's OutputBatch.
+    /// Throws IoError (target appeared without overwrite, rename failed); the temporary file is
+    /// then still removed by the destructor.
     void commit();
 
     /// " (the disk is full)" when the folder of `file` has less than 1 MiB left, else "": for
@@ -47,10 +55,51 @@ public:
     /// True when `target` (through symbolic links) is a character device or a named pipe.
     static bool is_stream(const std::filesystem::path& target);
 
+    /// Unlinks every temporary file (and sidecar) of the OutputFiles and OutputBatches alive in
+    /// the process. Async-signal-safe: for a handler that then ends the process. Does nothing
+    /// while an OutputBatch moves its files in place (committing()), so that all of them arrive.
+    static void remove_temporaries() noexcept;
+    /// True while an OutputBatch::commit() moves files to their targets (async-signal-safe).
+    static bool committing() noexcept;
+
 private:
+    friend class OutputBatch;
+    /// Target, temporary name and choices of one finished file, for the final step.
+    struct Finished {
+        std::filesystem::path target, real, temp;
+        bool overwrite;
+        std::string what;
+        int slot; ///< its entry in the table remove_temporaries() reads, or -1
+    };
+    static void place(const Finished& f); // the final link or rename; throws IoError
+
     std::filesystem::path target_, real_, temp_; // real_: target_ through symbolic links
     bool overwrite_;
     std::string what_;
+    bool committed_ = false;
+    int slot_ = -1;
+};
+
+/// The outputs of one run, made to appear together or not at all. While a batch is alive (one
+/// per thread), OutputFile::commit() keeps the finished file under its temporary name and hands
+/// it to the batch; commit() then moves every file to its target, after checking them all. A
+/// batch destroyed before commit() (an error, a cancelled run) removes all the files handed to it.
+class OutputBatch {
+public:
+    OutputBatch();
+    ~OutputBatch();
+    OutputBatch(const OutputBatch&) = delete;
+    OutputBatch& operator=(const OutputBatch&) = delete;
+
+    /// Throws Cancelled, moving nothing, when `cancelled` (when set) says so once the batch holds
+    /// off remove_temporaries(); else moves each file in place. Throws IoError when a target
+    /// cannot be written (one appeared without overwrite): the files placed are then removed.
+    void commit(const std::function<bool()>& cancelled = {});
+
+private:
+    friend class OutputFile;
+    std::vector<OutputFile::Finished> files_;
+    OutputBatch* outer_ = nullptr;
     bool committed_ = false;
 };
 

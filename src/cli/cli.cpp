@@ -396,25 +396,6 @@ void check_mesh_run(const CliOptions& o) {
         if (!path.empty()) check_output_path(path, name, o.overwrite);
 }
 
-/// Removes the files of this run if it fails part-way, so no run leaves some outputs only.
-class OutputsGuard {
-public:
-    void add(const std::string& path) { paths_.push_back(path); }
-    void commit() { paths_.clear(); }
-    ~OutputsGuard() {
-        // The files written, through symbolic links as OutputFile wrote them; never a terminal or
-        // pipe (--report /dev/stdout).
-        for (const auto& p : paths_) {
-            std::error_code ec;
-            const fs::path file = fs::canonical(p, ec);
-            if (!ec && fs::is_regular_file(file, ec)) fs::remove(file, ec);
-        }
-    }
-
-private:
-    std::vector<std::string> paths_;
-};
-
 /// One progress line for a run: the mesh (or triangulation) and each output get a share of it
 /// as their times compare, asked for in the order they run. Measured at 20 km on 1:50m land
 /// (1.08e6 nodes), seconds for reading and meshing / the UGRID file / the GeoPackage / the PNG:
@@ -555,7 +536,8 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     // Computed once for the report and both writers (each would otherwise build the topology
     // again for it).
     const MeshStats stats = lib.compute_stats(mesh);
-    OutputsGuard written;
+    // Every output of the run waits under its temporary name until all are complete.
+    OutputBatch batch;
     const auto tw = std::chrono::steady_clock::now();
     UgridOptions ugrid;
     ugrid.classic = o.format == "classic";
@@ -568,7 +550,6 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     std::vector<double> face_areas;
     if (!o.gpkg.empty()) ugrid.face_areas_m2 = &face_areas;
     lib.write_ugrid(mesh, o.output, ugrid);
-    written.add(o.output);
     throw_if_interrupted();
     if (!o.gpkg.empty()) {
         GpkgOptions gpkg;
@@ -577,7 +558,6 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         gpkg.face_areas_m2 = &face_areas;
         gpkg.progress = share.gpkg();
         lib.write_gpkg(mesh, o.gpkg, gpkg);
-        written.add(o.gpkg);
         throw_if_interrupted();
     }
     if (!o.preview.empty()) {
@@ -588,7 +568,6 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         preview.overwrite = o.overwrite;
         preview.progress = share.preview();
         lib.write_preview_png(mesh, o.preview, preview);
-        written.add(o.preview);
         throw_if_interrupted();
     }
     timings.add("write", seconds_since(tw));
@@ -598,7 +577,6 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     const long long peak = peak_memory_bytes();
     if (!o.timings.empty()) {
         OutputFile::write_text(o.timings, timings_json(timings), o.overwrite, "--timings");
-        written.add(o.timings);
     }
     if (!o.report.empty()) {
         std::ostringstream r;
@@ -618,9 +596,9 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
           << "  \"total_seconds\": " << json_number(total_s) << ",\n"
           << "  \"peak_memory_bytes\": " << peak << "\n}\n";
         OutputFile::write_text(o.report, r.str(), o.overwrite, "--report");
-        written.add(o.report);
     }
-    written.commit();
+    batch.commit(InterruptGuard::interrupted);
+    InterruptGuard::finished();
 
     print_stats(out, stats, false);
     // What the run changed of the coast, from the pipeline's attributes.
@@ -719,7 +697,7 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     RunShares share(terminal, !c.gpkg.empty(), false);
     Mesh mesh = lib.triangulate_file(c.t, share.mesh(), &timings);
     throw_if_interrupted();
-    OutputsGuard written;
+    OutputBatch batch; // every output waits under its temporary name until all are complete
     const auto tw = std::chrono::steady_clock::now();
     UgridOptions ugrid;
     ugrid.overwrite = c.overwrite;
@@ -729,23 +707,22 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     std::vector<double> face_areas;
     if (!c.gpkg.empty()) ugrid.face_areas_m2 = &face_areas;
     lib.write_ugrid(mesh, c.output, ugrid);
-    written.add(c.output);
+    throw_if_interrupted();
     if (!c.gpkg.empty()) {
         GpkgOptions gpkg;
         gpkg.overwrite = c.overwrite;
         gpkg.face_areas_m2 = &face_areas;
         gpkg.progress = share.gpkg();
         lib.write_gpkg(mesh, c.gpkg, gpkg);
-        written.add(c.gpkg);
     }
     throw_if_interrupted();
     timings.add("write", seconds_since(tw));
     terminal.finish();
     if (!c.timings.empty()) {
         OutputFile::write_text(c.timings, timings_json(timings), c.overwrite, "--timings");
-        written.add(c.timings);
     }
-    written.commit();
+    batch.commit(InterruptGuard::interrupted);
+    InterruptGuard::finished();
     out << "nodes             " << mesh.nodes.size() << "\n"
         << "faces             " << mesh.faces.size() << "\n";
     print_timings(out, timings);
@@ -873,6 +850,7 @@ CliOptions parse_mesh_args(std::span<const std::string> args) {
 int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err,
             const CliLibrary& library) {
     TerminalProgress terminal(err);
+    InterruptGuard::forget(); // a signal of an earlier run in this process
     try {
         return dispatch(args, out, err, terminal, library);
     } catch (...) {
@@ -886,6 +864,24 @@ namespace {
 
 /// Maps the exception in flight to one line on err and the exit status.
 int report_error(std::ostream& err, const std::string& command) {
+    bool usage = false;
+    try {
+        throw;
+    } catch (const CLI::ParseError&) {
+        usage = true;
+    } catch (const UsageError&) {
+        usage = true;
+    } catch (...) {
+    }
+    // After a cancelling signal any other failure is the run stopping: a GEOS or GDAL call
+    // interrupted fails in its own words.
+    if (InterruptGuard::signal() != 0 && !usage) {
+        // A signal other than Ctrl-C is named: it may come from a batch scheduler's time limit.
+        const int signal = InterruptGuard::signal();
+        const char* by = signal == SIGTERM ? " by SIGTERM" : signal == SIGHUP ? " by SIGHUP" : "";
+        err << "globemesh: cancelled" << by << ", no output written\n";
+        return 1;
+    }
     try {
         throw;
     } catch (const CLI::ParseError& e) {
@@ -895,10 +891,7 @@ int report_error(std::ostream& err, const std::string& command) {
         err << "globemesh: " << one_line(e.what()) << "\n";
         return 2;
     } catch (const Cancelled& e) {
-        // A signal other than Ctrl-C is named: it may come from a batch scheduler's time limit.
-        const int signal = InterruptGuard::signal();
-        const char* by = signal == SIGTERM ? " by SIGTERM" : signal == SIGHUP ? " by SIGHUP" : "";
-        err << "globemesh: cancelled" << by << ", no output written\n";
+        err << "globemesh: cancelled, no output written\n"; // by the library's caller, not a signal
         return 1;
     } catch (const Error& e) {
         err << "globemesh: " << one_line(e.what()) << "\n";

@@ -1,14 +1,21 @@
 #include "cli_support.hpp"
 
+#include <pthread.h>
+#include <semaphore.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <ctime>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <memory>
@@ -22,21 +29,77 @@ namespace globemesh::cli {
 namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal that arrived, or 0
+volatile std::sig_atomic_t g_mid_line = 0;    // a progress line on stderr is open
+volatile std::sig_atomic_t g_finished = 0;    // the outputs are in place: nothing to cancel
+pthread_t g_main_thread;                      // the thread of the guard, which handles the signals
+sem_t g_wake;                                 // posted by the first signal and by the guard's end
+std::atomic<bool> g_guard_ending{false};
 
-/// The first signal asks the run to stop at its next progress report; a second one, for a run
-/// that does not report, ends the process the default way.
+void write_stderr(const char* text) {
+    for (std::size_t left = std::strlen(text); left > 0;) {
+        const ssize_t n = ::write(STDERR_FILENO, text, left);
+        if (n <= 0) return;
+        text += n, left -= static_cast<std::size_t>(n);
+    }
+}
+
+/// The first signal asks the run to stop at its next progress report, which then unwinds and
+/// removes its files. A second one ends the process at once (Ctrl-C twice, or a run stuck in a
+/// call that does not report), after removing the temporary files itself; unless the outputs
+/// are being moved in place, which takes a few system calls and leaves them all complete.
+/// Handled on the guard's thread, so that no other thread of the run writes meanwhile.
 extern "C" void on_cancelling_signal(int signal) {
-    if (g_interrupted) {
+    if (!pthread_equal(pthread_self(), g_main_thread)) {
+        pthread_kill(g_main_thread, signal);
+        return;
+    }
+    if (!g_interrupted) {
+        g_interrupted = signal;
+        sem_post(&g_wake); // the watchdog's clock starts
+        return;
+    }
+    if (OutputFile::committing()) return;
+    if (g_finished) {
         std::signal(signal, SIG_DFL);
         std::raise(signal);
+        return;
     }
-    g_interrupted = signal;
+    OutputFile::remove_temporaries();
+    if (g_mid_line) write_stderr("\n");
+    write_stderr(signal == SIGTERM  ? "globemesh: cancelled by SIGTERM, no output written\n"
+                 : signal == SIGHUP ? "globemesh: cancelled by SIGHUP, no output written\n"
+                                    : "globemesh: cancelled, no output written\n");
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+}
+
+/// Waits for a first signal; when the run has not ended stop_grace after it (a long call that
+/// does not report: a GEOS validity test of a continent, a library's write), sends the signal
+/// again, which ends the process as a second one does.
+void watchdog() {
+    while (sem_wait(&g_wake) != 0 && errno == EINTR) {
+    }
+    if (g_guard_ending.load()) return;
+    timespec deadline {};
+    clock_gettime(CLOCK_REALTIME, &deadline);
+    const long grace_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(InterruptGuard::stop_grace).count();
+    deadline.tv_sec += (deadline.tv_nsec + grace_ns) / 1000000000L;
+    deadline.tv_nsec = (deadline.tv_nsec + grace_ns) % 1000000000L;
+    int waited = 0;
+    while ((waited = sem_timedwait(&g_wake, &deadline)) != 0 && errno == EINTR) {
+    }
+    if (waited != 0 && !g_guard_ending.load()) pthread_kill(g_main_thread, g_interrupted);
 }
 
 } // namespace
 
 InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
+    g_finished = 0;
+    g_main_thread = pthread_self();
+    g_guard_ending = false;
+    sem_init(&g_wake, 0, 0);
+    watchdog_ = std::thread(watchdog);
     struct sigaction action {};
     action.sa_handler = on_cancelling_signal;
     sigemptyset(&action.sa_mask);
@@ -46,13 +109,21 @@ InterruptGuard::InterruptGuard() {
 }
 
 InterruptGuard::~InterruptGuard() {
+    g_guard_ending = true;
+    sem_post(&g_wake);
+    watchdog_.join();
     for (std::size_t k = 0; k < std::size(cancelling); ++k)
         if (installed_[k]) sigaction(cancelling[k], &previous_[k], nullptr);
+    sem_destroy(&g_wake);
 }
 
 bool InterruptGuard::interrupted() { return g_interrupted != 0; }
 
 int InterruptGuard::signal() { return g_interrupted; }
+
+void InterruptGuard::forget() { g_interrupted = 0; }
+
+void InterruptGuard::finished() { g_finished = 1; }
 
 bool TerminalProgress::update(double fraction, std::string_view stage) {
     if (InterruptGuard::interrupted()) return false;
@@ -62,11 +133,14 @@ bool TerminalProgress::update(double fraction, std::string_view stage) {
         err_ << '[' << stage << "] ";
         stage_ = std::string(stage);
         mid_line_ = true;
+        g_mid_line = 1;
     }
     // GDALTermProgress's arithmetic: 40 ticks, a number every fourth, " - done." at 100.
     const int tick = std::clamp(static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 40.0), 0, 40);
     if (tick < last_tick_ && last_tick_ >= 39) last_tick_ = -1; // a new run of 0..100
-    if (tick <= last_tick_) return true;
+    // Without --verbose the line starts at the first tick after 0, so that an error found while
+    // the inputs are opened stands alone, without a "0" before it.
+    if (tick <= last_tick_ || (tick == 0 && !verbose_)) return true;
     while (tick > last_tick_) {
         ++last_tick_;
         if (last_tick_ % 4 == 0)
@@ -80,12 +154,14 @@ bool TerminalProgress::update(double fraction, std::string_view stage) {
         mid_line_ = false;
     }
     err_.flush();
+    g_mid_line = mid_line_;
     return true;
 }
 
 void TerminalProgress::end_line() {
     if (mid_line_) err_ << '\n';
     mid_line_ = false;
+    g_mid_line = 0;
 }
 
 std::string json_number(double v) {
@@ -253,10 +329,10 @@ void check_output_path(const std::string& path, const std::string& what, bool ov
         if (what == "--report" || what == "--timings") return;
         throw IoError(what + ": " + path + " is not a regular file (a device or pipe); give a file name");
     }
+    if (fs::is_directory(p, ec)) // before "exists": --overwrite would not help
+        throw IoError(what + ": " + path + " is a folder; give a file name");
     if (fs::exists(p, ec) && !overwrite)
         throw IoError(what + ": " + path + " exists; use --overwrite to replace it");
-    if (fs::is_directory(p, ec))
-        throw IoError(what + ": " + path + " is a folder; give a file name");
     if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
         throw IoError(what + ": " + path + " is not a regular file (a socket?); give a file name");
 }

@@ -2,6 +2,7 @@
 // run summary shared by `mesh`, `triangulate` and `info`.
 #pragma once
 
+#include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -20,8 +22,13 @@
 namespace globemesh::cli {
 
 /// Installs handlers for SIGINT, SIGTERM and SIGHUP for its lifetime (restoring the previous
-/// ones after) that only record the signal; interrupted() reads it. One guard at a time
-/// (run_cli is not re-entrant).
+/// ones after). The first signal is only recorded (interrupted() reads it; the run stops at its
+/// next progress report and removes its files). A second one removes the temporary output files
+/// (OutputFile::remove_temporaries), says "cancelled" on stderr and ends the process by that
+/// signal, unless the outputs are being moved in place. A run still going stop_grace after the
+/// first signal (in a long call that does not report) gets it again from a watchdog thread, and
+/// so ends as on a second one. One guard at a time, on the thread that runs (run_cli is not
+/// re-entrant); a signal delivered to another thread is passed to it.
 class InterruptGuard {
 public:
     InterruptGuard();
@@ -31,21 +38,30 @@ public:
     static bool interrupted();
     /// The signal that cancelled the last run (kept after the guard is gone), or 0.
     static int signal();
+    /// Clears signal() before a new run.
+    static void forget();
+    /// The outputs are in place: a second signal now ends the process without a word (the run
+    /// is complete), a first one changes nothing.
+    static void finished();
     /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
     /// and leave the temporary output files behind.
     static constexpr int cancelling[3] = {SIGINT, SIGTERM, SIGHUP};
+    /// How long a run has to stop cleanly (status 1) after a signal before it is ended by it.
+    static constexpr std::chrono::milliseconds stop_grace{1000};
 
 private:
     struct sigaction previous_[std::size(cancelling)] {};
     bool installed_[std::size(cancelling)] = {};
+    std::thread watchdog_;
 };
 
 /// GDAL's terminal progress ("0...10...20...30...40...50...60...70...80...90...100 - done."),
 /// drawn on `err` rather than stdout (where GDALTermProgress writes) so that stdout carries
 /// results only. With `verbose`, each new stage starts a line "[stage] ". The callback returns
 /// false once a cancelling signal arrived (InterruptGuard), which cancels the run. run_cli owns
-/// one, so that an error line never lands in the middle of a progress line.
+/// one, so that an error line never lands in the middle of a progress line. Without `verbose`
+/// the line starts at the first tick after 0, so an early error is not preceded by a lone "0".
 class TerminalProgress {
 public:
     explicit TerminalProgress(std::ostream& err) : err_(err) {}

@@ -25,6 +25,7 @@
 
 #include "coast_internal.hpp"
 #include "gdal_handles.hpp"
+#include "geos_interrupt.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 
@@ -78,8 +79,10 @@ struct PreparedDeleter {
 using PreparedPtr = std::unique_ptr<const GEOSPreparedGeometry, PreparedDeleter>;
 
 GeomPtr own(Geos& geos, GEOSGeometry* g, const char* what) {
+    GeomPtr owned(g, GeomDeleter{geos.get()});
+    coast::GeosInterrupt::poll(); // Cancelled once the run is (then g may be null: GEOS was interrupted)
     if (!g) throw DataError(std::string("coast: GEOS failed to ") + what + ": " + geos.message());
-    return GeomPtr(g, GeomDeleter{geos.get()});
+    return owned;
 }
 
 // ----------------------------------------------------------------------------- reading

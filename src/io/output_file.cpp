@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <fstream>
 #include <system_error>
@@ -19,12 +20,76 @@ namespace {
 
 std::atomic<unsigned> temp_counter{0};
 
+constexpr const char* sidecars[] = {".aux.xml", "-journal", "-wal", "-shm"};
+
 void remove_quietly(const fs::path& p) {
     std::error_code ec;
     fs::remove(p, ec);
 }
 
+/// The temporary file and its sidecars (GDAL's .aux.xml, SQLite's journals).
+void remove_with_sidecars(const fs::path& temp) {
+    remove_quietly(temp);
+    for (const char* suffix : sidecars) remove_quietly(fs::path(temp.string() + suffix));
+}
+
+// The temporary names alive, in a fixed table a signal handler can read without allocating:
+// a slot is free (0), being changed (1) or holds a name (2); `generation` changes with each
+// name, so a reader that raced a change skips the slot.
+struct TempSlot {
+    std::atomic<int> state{0};
+    std::atomic<unsigned> generation{0};
+    char path[PATH_MAX];
+};
+constexpr int slot_count = 64;
+TempSlot temp_slots[slot_count];
+std::atomic<bool> g_committing{false};
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
+
+/// Enters `path` in the table; -1 when it is full or the path too long (then only the
+/// destructors remove the file).
+int register_temp(const fs::path& path) {
+    const std::string& text = path.native();
+    if (text.size() + 16 >= PATH_MAX) return -1; // room for the longest sidecar suffix
+    for (int i = 0; i < slot_count; ++i) {
+        int expected = 0;
+        if (!temp_slots[i].state.compare_exchange_strong(expected, 1)) continue;
+        std::memcpy(temp_slots[i].path, text.c_str(), text.size() + 1);
+        temp_slots[i].generation.fetch_add(1);
+        temp_slots[i].state.store(2);
+        return i;
+    }
+    return -1;
+}
+
+void unregister_temp(int slot) {
+    if (slot < 0) return;
+    temp_slots[slot].state.store(1);
+    temp_slots[slot].generation.fetch_add(1);
+    temp_slots[slot].state.store(0);
+}
+
 } // namespace
+
+void OutputFile::remove_temporaries() noexcept {
+    if (g_committing.load()) return;
+    for (TempSlot& slot : temp_slots) {
+        if (slot.state.load() != 2) continue;
+        const unsigned generation = slot.generation.load();
+        char name[PATH_MAX];
+        std::memcpy(name, slot.path, sizeof name);
+        name[PATH_MAX - 1] = '\0';
+        if (slot.state.load() != 2 || slot.generation.load() != generation) continue;
+        ::unlink(name);
+        const std::size_t length = std::strlen(name);
+        for (const char* suffix : sidecars) {
+            std::memcpy(name + length, suffix, std::strlen(suffix) + 1);
+            ::unlink(name);
+        }
+    }
+}
+
+bool OutputFile::committing() noexcept { return g_committing.load(); }
 
 bool OutputFile::is_stream(const fs::path& target) {
     std::error_code ec;
@@ -67,6 +132,7 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
     name += real_.extension().string();
     temp_ = folder / name;
     remove_quietly(temp_);
+    slot_ = register_temp(temp_);
 }
 
 std::string OutputFile::full_disk_note(const fs::path& file) {
@@ -78,29 +144,77 @@ std::string OutputFile::full_disk_note(const fs::path& file) {
 
 OutputFile::~OutputFile() {
     if (committed_) return;
-    remove_quietly(temp_);
-    for (const char* suffix : {".aux.xml", "-journal", "-wal", "-shm"})
-        remove_quietly(fs::path(temp_.string() + suffix));
+    remove_with_sidecars(temp_);
+    unregister_temp(slot_);
 }
+
+namespace {
+thread_local OutputBatch* active_batch = nullptr;
+} // namespace
 
 void OutputFile::commit() {
     std::error_code ec;
     if (!fs::is_regular_file(temp_, ec))
         throw IoError(what_ + " " + target_.string() + ": the writer produced no file");
-    if (!overwrite_) {
-        if (::link(temp_.c_str(), real_.c_str()) == 0) {
-            remove_quietly(temp_);
-            committed_ = true;
+    Finished f{target_, real_, temp_, overwrite_, what_, slot_};
+    if (active_batch != nullptr) {
+        active_batch->files_.push_back(std::move(f)); // the batch now removes or places it
+    } else {
+        place(f);
+        unregister_temp(slot_);
+    }
+    committed_ = true;
+}
+
+void OutputFile::place(const Finished& f) {
+    std::error_code ec;
+    if (!f.overwrite) {
+        if (::link(f.temp.c_str(), f.real.c_str()) == 0) {
+            remove_quietly(f.temp);
             return;
         }
         if (errno == EEXIST)
-            throw IoError(what_ + " " + target_.string() + " already exists; use --overwrite to replace it");
+            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
         // File systems without hard links: check, then rename.
-        if (fs::exists(real_, ec))
-            throw IoError(what_ + " " + target_.string() + " already exists; use --overwrite to replace it");
+        if (fs::exists(f.real, ec))
+            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
     }
-    fs::rename(temp_, real_, ec);
-    if (ec) throw IoError(what_ + " " + target_.string() + ": cannot move the finished file in place (" + ec.message() + ")");
+    fs::rename(f.temp, f.real, ec);
+    if (ec)
+        throw IoError(f.what + " " + f.target.string() + ": cannot move the finished file in place (" + ec.message() + ")");
+}
+
+OutputBatch::OutputBatch() : outer_(active_batch) { active_batch = this; }
+
+OutputBatch::~OutputBatch() {
+    active_batch = outer_;
+    if (committed_) return;
+    for (const auto& f : files_) {
+        remove_with_sidecars(f.temp);
+        unregister_temp(f.slot);
+    }
+}
+
+void OutputBatch::commit(const std::function<bool()>& cancelled) {
+    // Held from here to the last file: a signal ending the process now would leave some
+    // targets only; SIGKILL still can, in these few system calls.
+    struct Committing {
+        Committing() { g_committing.store(true); }
+        ~Committing() { g_committing.store(false); }
+    } committing;
+    if (cancelled && cancelled()) throw Cancelled();
+    std::error_code ec;
+    for (const auto& f : files_)
+        if (!f.overwrite && fs::exists(f.real, ec))
+            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
+    std::size_t placed = 0;
+    try {
+        for (; placed < files_.size(); ++placed) OutputFile::place(files_[placed]);
+    } catch (...) {
+        for (std::size_t i = 0; i < placed; ++i) remove_quietly(files_[i].real);
+        throw;
+    }
+    for (const auto& f : files_) unregister_temp(f.slot);
     committed_ = true;
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "coast/geos_interrupt.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -126,7 +127,10 @@ DepthFloor apply_min_depth(std::vector<double>& depths, std::optional<double> mi
 
 } // namespace
 
-Mesh mesh_ocean(const MeshOptions& o, const Progress& progress, StageTimings* timings) {
+Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
+    // A long GEOS operation of the coast stages stops too when the run is cancelled.
+    const coast::GeosInterrupt geos_interrupt(run_progress);
+    const Progress& progress = geos_interrupt.progress();
     validate(o);
     if (o.coast.empty()) throw UsageError("--coast is required: a land polygon or coastline file (any OGR source)");
     StageClock clock(timings);

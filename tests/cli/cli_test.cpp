@@ -22,6 +22,7 @@
 
 #include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
 #include "support.hpp"
 
 namespace fs = std::filesystem;
@@ -467,6 +468,9 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"missing_bathy_file", {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"}, 1, "nodem.tif"},
         ErrorCase{"output_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"}, 1, "--output"},
         ErrorCase{"existing_output", {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"}, 1, "--overwrite"},
+        // Said at once, not "exists; use --overwrite" first (which would not help).
+        ErrorCase{"output_is_a_folder", {"mesh", "--coast", coast, "-o", "{dir}"}, 1, "is a folder; give a file name"},
+        ErrorCase{"gpkg_is_a_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/"}, 1, "/ is a folder; give a file name"},
         // An output that is an input, even with --overwrite (and through another spelling):
         // the run would replace the data it reads.
         ErrorCase{"gpkg_is_the_coast", {"mesh", "--coast", "{dir}/existing.gpkg", "-o", "{dir}/o.nc", "--gpkg", "{dir}/./existing.gpkg", "--overwrite"}, 2, "existing.gpkg is the --coast file: the run would replace what it reads"},
@@ -588,6 +592,17 @@ TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
     EXPECT_TRUE(regex_search(normal.err, R"(^0(\.\.\.[1-9]0)+\.*\nglobemesh: stop here\n$)")) << normal.err;
     EXPECT_EQ(normal.err.find("100"), std::string::npos) << normal.err;
     EXPECT_EQ(normal.out, "");
+    // An error before the run made any progress stands alone: no "0" before it.
+    RefusingLibrary r0;
+    auto early = r0.lib();
+    early.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
+                          globemesh::StageTimings*) -> globemesh::Mesh {
+        globemesh::report(progress, 0.0, "reading coast");
+        globemesh::report(progress, 0.001, "reading coast");
+        throw globemesh::DataError("--coast x.gpkg: several layers");
+    };
+    EXPECT_EQ(run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, early).err,
+              "globemesh: --coast x.gpkg: several layers\n");
     const Result quiet = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--quiet"}, lib_with_progress(r2));
     EXPECT_EQ(quiet.err, "globemesh: stop here\n");
     const Result verbose = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--verbose"}, lib_with_progress(r3));
@@ -767,16 +782,16 @@ struct FakeRun {
             EXPECT_NE(o.history.find("globemesh mesh --coast"), std::string::npos) << o.history;
             for (const auto& [key, value] : m.attributes)
                 if (key == "globemesh_configuration") configuration = value;
-            write_text(p, "nc");
+            globemesh::OutputFile::write_text(p, "nc", o.overwrite); // as the real writers do
             written.push_back(p.string());
         };
-        l.write_gpkg = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::GpkgOptions&) {
+        l.write_gpkg = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::GpkgOptions& o) {
             if (fail_gpkg) throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
-            write_text(p, "gpkg");
+            globemesh::OutputFile::write_text(p, "gpkg", o.overwrite);
             written.push_back(p.string());
         };
-        l.write_preview_png = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::PreviewOptions&) {
-            write_text(p, "png");
+        l.write_preview_png = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::PreviewOptions& o) {
+            globemesh::OutputFile::write_text(p, "png", o.overwrite);
             written.push_back(p.string());
         };
         l.read_ugrid = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
@@ -829,6 +844,75 @@ TEST(Cli, a_failing_writer_leaves_none_of_the_run_outputs) {
     EXPECT_EQ(fake.written, std::vector<std::string>{(dir / "o.nc").string()}); // it was written...
     EXPECT_TRUE(fs::is_empty(dir.path()));                                       // ...and removed
     EXPECT_EQ(r.out, "");
+}
+
+// The outputs appear together: none under its own name while another is still being written,
+// all of them once the run succeeds, and a stale file of one kept out by the final check.
+TEST(Cli, the_outputs_appear_together_at_the_end_of_the_run) {
+    TempDir dir;
+    FakeRun fake;
+    std::vector<std::set<std::string>> seen; // the folder as each later writer starts
+    auto lib = fake.lib();
+    const auto gpkg = lib.write_gpkg;
+    const auto preview = lib.write_preview_png;
+    auto names = [&] {
+        std::set<std::string> n;
+        for (const auto& e : fs::directory_iterator(dir.path())) n.insert(e.path().filename().string());
+        return n;
+    };
+    lib.write_gpkg = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::GpkgOptions& o) {
+        seen.push_back(names());
+        gpkg(m, p, o);
+    };
+    lib.write_preview_png = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::PreviewOptions& o) {
+        seen.push_back(names());
+        preview(m, p, o);
+    };
+    const std::vector<std::string> args = {"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg",
+                                           (dir / "o.gpkg").string(), "--preview", (dir / "o.png").string(),
+                                           "--report", (dir / "r.json").string(), "-q"};
+    const Result r = run(args, lib);
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_EQ(seen.size(), 2u);
+    for (const auto& before : seen) {
+        EXPECT_EQ(before.count("o.nc"), 0u); // waiting under a hidden temporary name
+        EXPECT_EQ(before.size(), &before == &seen[0] ? 1u : 2u);
+        for (const auto& name : before) EXPECT_EQ(name[0], '.') << name;
+    }
+    EXPECT_EQ(names(), (std::set<std::string>{"o.nc", "o.gpkg", "o.png", "r.json"}));
+    EXPECT_EQ(read_text(dir / "o.png"), "png");
+    // A file that appears under one of the names during the run stops it before any is placed.
+    for (const char* name : {"o.nc", "o.gpkg", "o.png", "r.json"}) fs::remove(dir / name);
+    lib.write_preview_png = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::PreviewOptions& o) {
+        write_text(dir / "o.gpkg", "someone else's");
+        preview(m, p, o);
+    };
+    const Result clash = run(args, lib);
+    EXPECT_EQ(clash.status, 1);
+    EXPECT_NE(clash.err.find("o.gpkg already exists"), std::string::npos) << clash.err;
+    EXPECT_EQ(names(), (std::set<std::string>{"o.gpkg"}));
+    EXPECT_EQ(read_text(dir / "o.gpkg"), "someone else's");
+}
+
+// A failure of the library after a cancelling signal is the run stopping (an interrupted GEOS or
+// GDAL call fails in its own words): reported as the cancellation.
+TEST(Cli, an_error_after_a_signal_is_reported_as_the_cancellation) {
+    TempDir dir;
+    FakeRun fake;
+    auto lib = fake.lib();
+    lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress&,
+                        globemesh::StageTimings*) -> globemesh::Mesh {
+        std::raise(SIGTERM);
+        throw globemesh::DataError("coast: GEOS failed to dissolve the land polygons: Interrupted!");
+    };
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "-q"}, lib);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "globemesh: cancelled by SIGTERM, no output written\n");
+    // The next run in the process starts afresh: its own error is its own.
+    const Result next = run({"mesh", "--coast", coast, "-o", (dir / "x" / "o.nc").string(), "-q"}, lib);
+    EXPECT_EQ(next.status, 1);
+    EXPECT_NE(next.err.find("does not exist"), std::string::npos) << next.err;
+    EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 TEST(Cli, the_mesh_carries_a_configuration_that_remakes_the_run) {
