@@ -665,6 +665,7 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts, dou
             return prepared[i].get();
         };
         for (std::size_t i = 0; i < n; ++i) {
+            coast::GeosInterrupt::poll(); // a long run of short GEOS calls, none of which reports
             hits.clear();
             GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
             std::sort(hits.begin(), hits.end());
