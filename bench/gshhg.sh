@@ -20,7 +20,7 @@ for r in $resolutions; do
             -o "$out" --timings "$cache/t.json" --overwrite --quiet 2> "$cache/time.txt" >/dev/null || {
             echo "gshhg $r ${h} km: FAILED: $(tail -1 "$cache/time.txt")"; continue; }
         coast=$(sed -nE 's/.*"read_coast": ([0-9.]+).*/\1/p' "$cache/t.json")
-        quality=$("$build/src/globemesh" info "$out" | sed -nE 's/^quality +//p')
+        quality=$("$build/src/globemesh" info "$out" | sed -nE "s/^quality +//p" | head -1)
         verdict="mesh-verify SKIPPED"
         [ -x "$verify" ] && verdict=$("$verify" "$out" --coast "$land" 2>&1 | grep -m1 -oE "RESULT: [A-Z]+")
         echo "gshhg $r ${h} km: read_coast ${coast} s, run $(tail -1 "$cache/time.txt"), quality ${quality}, ${verdict}"
