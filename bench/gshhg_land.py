@@ -9,12 +9,13 @@ Only level 1, the land/ocean shoreline, is kept: lakes (level 2) are land to an 
 Writes a GeoPackage with one polygon per island or continent (layer 'land', EPSG:4326).
 Usage: bench/gshhg_land.py {c,l,i,h,f} OUT.gpkg   (needs Debian's gmt and gmt-gshhg-*)
 """
-import argparse, re, subprocess, sys
+import argparse, re, subprocess, sys, tempfile
 from osgeo import ogr, osr
 
 def pieces(res):
-    out = subprocess.run(["gmt", "coast", "-Rd", "-D" + res, "-W", "-M"], check=True,
-                         capture_output=True, text=True).stdout
+    with tempfile.TemporaryDirectory() as tmp:  # GMT leaves its gmt.history in the working folder
+        out = subprocess.run(["gmt", "coast", "-Rd", "-D" + res, "-W", "-M"], check=True,
+                             capture_output=True, text=True, cwd=tmp).stdout
     cur, lev = None, None
     for line in out.splitlines():
         if line.startswith(">"):
