@@ -72,13 +72,6 @@
 //      own, 0.64 m into it or less, so the mesh stays a manifold), and the nodes they put on
 //      the boundary may lie up to 0.75 h from the coast. The faces left on land are reported
 //      with their centroids.
-//   8. blunts the coast's corners too sharp for a face above q 0.3 (the floor of OceanMesh2D):
-//      an ocean face below it with two boundary sides (an ear: a closed inlet's short mouth
-//      beside a segment of length h, a spike of water) goes when its corner lies within h of its
-//      third side, which becomes coast; a longer ear first gets its longer side split at the
-//      midpoint. Repeated on the face behind, so a spike goes from its tip. With close_straits,
-//      a face below the floor with one boundary side whose opposite corner is on the boundary
-//      within h closes there (the water is narrower than the face), as a strait closes at a node.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -148,7 +141,6 @@ struct MesherReport {
     std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
     std::size_t valence_flips = 0;      ///< flips towards valence 6 before the last restoration
     std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
-    std::size_t corners_blunted = 0;    ///< ears of the coast below q 0.3 removed last (step 8)
     std::size_t land_faces_removed = 0; ///< faces removed because their centroid lies on land
     std::size_t land_faces_left = 0;    ///< faces centred on land that could not go (MesherOptions::land)
     std::size_t land_faces_nudged = 0;  ///< faces that a corner's move took off land instead

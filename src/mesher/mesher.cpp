@@ -193,15 +193,6 @@ constexpr double inlet_narrow_area = 25;
 // centroid of each whole triangle, before: 80.7M for 2.6M nodes at --coast-size 2km, refused.
 // A reach of 32 instead of 8 changes the estimates on bathymetry fields by under 0.5% (--slope
 // 20: 6.17M for 5.52M nodes in 0.9 s) and costs a uniform 20 km field 3 ms instead of 16.
-// The last step (blunt_ears): an ocean face below blunt_floor (the floor, OceanMesh2D's)
-// with two boundary sides is an ear of the coast at a corner too sharp for the faces its
-// segments allow (a narrow inlet's mouth closed beside a long segment, a spike of water thinner
-// than a face); it goes, and its third side becomes coast, when its corner lies within
-// blunt_reach times h of that side. The face behind is looked at again, so a spike goes from
-// its tip while its faces are below the floor.
-constexpr double blunt_floor = 0.3;
-constexpr double blunt_reach = 1.0;
-
 constexpr double estimate_area = 8;
 constexpr double estimate_ratio = 1.25;
 constexpr double estimate_reach = 32;
@@ -1477,101 +1468,6 @@ void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>
         if (is_ocean(t)) faces.push_back(t);
 }
 
-// Removes the ears of the coast below blunt_floor (see blunt_floor); returns how many went. A
-// face alone (three boundary sides) below the floor goes too. With `straits`, so does a face
-// below the floor with one boundary side whose opposite corner is on the boundary within
-// blunt_reach h of it: water narrower than the face (a strait, or a spike of land whose tip
-// nearly touches the coast across) closes at that corner, which the output splits between the
-// fans of water left (as close_straits' closings at a node; counted and placed with them).
-// Removing a face keeps every other face and edge, so the mesh stays constrained Delaunay.
-std::size_t blunt_ears(Mesher& m, bool straits) {
-    SphericalDelaunay& dt = m.dt;
-    auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
-    auto quality = [&](TriangleId t) {
-        return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)), dt.point(dt.vertex(t, 2)));
-    };
-    auto on_boundary = [&](VertexId v, TriangleId t) {
-        const HalfEdge from = dt.leaving(v, t);
-        HalfEdge h = from;
-        do {
-            if (dt.label(triangle_of(h)) != ocean) return true;
-            h = dt.next_around_origin(h);
-        } while (h != from);
-        return false;
-    };
-    auto kind_of = [&](VertexId u, VertexId v) {
-        const auto it = m.segments.find(key(u, v));
-        return it != m.segments.end() ? it->second : SegmentKind::coast;
-    };
-    std::vector<TriangleId> todo;
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (is_ocean(t) && quality(t) < blunt_floor) todo.push_back(t);
-    std::reverse(todo.begin(), todo.end()); // taken from the back: in slot order
-    std::size_t blunted = 0;
-    while (!todo.empty()) {
-        const TriangleId t = todo.back();
-        todo.pop_back();
-        if (!is_ocean(t) || quality(t) >= blunt_floor) continue;
-        int inner = -1, outer = -1, sides = 0; // a side with ocean behind it, one without; the latter's count
-        for (int i = 0; i < 3; ++i) {
-            if (is_ocean(triangle_of(dt.twin(half_edge(t, i))))) inner = i;
-            else outer = i, ++sides;
-        }
-        if (sides == 3) {
-            dt.set_label(t, land);
-            ++blunted;
-            continue;
-        }
-        // The corner: where the two boundary sides meet, or opposite the one.
-        const int corner = sides == 2 ? inner : outer;
-        const VertexId apex = dt.vertex(t, corner);
-        const HalfEdge across = half_edge(t, corner);
-        const Vec3& p = dt.point(apex);
-        if (sides == 1 && !(straits && on_boundary(apex, t))) continue;
-        if (arc_distance(dt.point(dt.origin(across)), dt.point(dt.destination(across)), p) >
-            blunt_reach * km_to_rad(m.size_km(p))) {
-            // An ear reaching farther: its longer boundary side is split at its midpoint (as the
-            // refinement does) and the faces at the new node are looked at again, so the tip
-            // comes within reach, unless the side is too short to split.
-            if (sides == 1) continue;
-            const HalfEdge s1 = half_edge(t, next3(corner)), s2 = half_edge(t, prev3(corner));
-            auto length = [&](HalfEdge e) { return arc_angle(dt.point(dt.origin(e)), dt.point(dt.destination(e))); };
-            const VertexId v = m.split_segment(length(s1) >= length(s2) ? s1 : s2);
-            if (v == no_vertex) continue;
-            ++m.report.encroached_splits;
-            const HalfEdge from = dt.leaving(v, dt.last_triangle());
-            HalfEdge e = from;
-            do {
-                if (is_ocean(triangle_of(e))) todo.push_back(triangle_of(e));
-                e = dt.next_around_origin(e);
-            } while (e != from);
-            continue;
-        }
-        dt.set_label(t, land);
-        for (int i = 0; i < 3; ++i) {
-            const HalfEdge h = half_edge(t, i);
-            const TriangleId behind = triangle_of(dt.twin(h));
-            if (!is_ocean(behind)) continue;
-            // A new segment, ocean on its left (the face behind); open only where the two
-            // sides it replaces both were.
-            const VertexId a = dt.origin(h), b = dt.destination(h);
-            const bool open = sides == 2 && kind_of(a, apex) == SegmentKind::open && kind_of(apex, b) == SegmentKind::open;
-            dt.set_constrained(h, true);
-            m.add_segment(b, a, open ? SegmentKind::open : SegmentKind::coast);
-            todo.push_back(behind);
-            if (sides == 1) m.cut_sides.push_back(behind);
-        }
-        if (sides == 2) {
-            ++blunted;
-        } else {
-            m.pinched.push_back(apex);
-            ++m.report.straits_closed;
-            m.report.straits_closed_at.push_back(m.centroid(t));
-        }
-    }
-    return blunted;
-}
-
 // Relaxation by flips towards valence 6 (Frey & Field): an unconstrained edge between two ocean
 // triangles with four free corners is flipped when that lowers the sum of squared valence
 // defects (valence - 6) of those corners. The flipped corners and their free neighbours then
@@ -2838,7 +2734,6 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         report.land_faces_left = report.land_faces_at.size();
         if (timings) timings->add("land", seconds_since(t0));
     }
-    report.corners_blunted = blunt_ears(m, options.close_straits);
 
     // ---- output ------------------------------------------------------------------------------
     // The faces first, then the triangulation goes and its points become the nodes in place: the
