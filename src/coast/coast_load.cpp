@@ -617,18 +617,19 @@ struct TreeDeleter {
 
 /// What snap rounding did to the land (CoastData reports it).
 struct SnapCount {
-    std::size_t joined = 0;  ///< polygons joined to another that they only came within the grid of
+    std::size_t joined = 0;  ///< polygons joined to another that they only came within 2 cells of
     std::size_t changed = 0; ///< rings gained or lost by dissolving and snap rounding, per batch
 };
 
-/// Dissolves valid polygonal parts into non-overlapping polygons, in input order, snap-rounded
-/// to a lon/lat grid of `grid` degrees (GEOS's snap-rounding noder, OverlayNG): every vertex on
-/// the grid, and every edge that passes through a vertex's grid cell noded at that vertex, so
-/// two rings that came within about half a cell of each other touch there, and no vertex lies
-/// closer than half a cell to an edge it is not on. Polygons closer than `grid` to each other
-/// are snap-rounded together (one union), every other one alone: most coastline polygons are
-/// disjoint, and a union of all of them costs seconds at 1:10m. Candidates come from an STR
-/// tree; GEOS's prepared distance test confirms them.
+/// Dissolves valid polygonal parts into non-overlapping polygons, snap-rounded to a lon/lat
+/// grid of `grid` degrees (GEOS's snap-rounding noder, OverlayNG): every vertex on the grid, and
+/// every edge that passes through a vertex's grid cell noded at that vertex, so two rings that
+/// came within about half a cell of each other touch there, and no vertex lies closer than half
+/// a cell to an edge it is not on. Polygons that intersect (an STR tree's candidates confirmed by
+/// GEOS's prepared test) or come within 2 cells of each other (near_pairs) are snap-rounded
+/// together (one union), every other one alone: most coastline polygons are disjoint, and a
+/// union of all of them costs seconds at 1:10m. Output order: each group where its first polygon
+/// stands, the lone polygons with the batch they were rounded in (deterministic).
 std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts, double grid, SnapCount& count) {
     std::vector<GeomPtr> polys;
     for (const auto& part : parts) {
@@ -678,7 +679,7 @@ std::vector<GeomPtr> dissolve(Geos& geos, const std::vector<GeomPtr>& parts, dou
             prepared[i].reset(); // its pairs are all done: later ones have both indices above i
         }
     }
-    // Outlines within a grid cell of each other (near-touches) are snap-rounded together too.
+    // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
     {
         std::vector<PolygonRings> outlines(n);
         for (std::size_t i = 0; i < n; ++i) {
