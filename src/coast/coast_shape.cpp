@@ -231,21 +231,24 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     bool dropped_water = false;
     // The largest water ring on a region's outline stays whatever its size (a size wider than
     // the region is refused later, naming it).
-    const Ring* largest_open = nullptr;
-    double largest_open_area = -1;
-    for (const Ring& ring : coast.rings.rings) {
-        if (std::none_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; }))
-            continue;
-        const double left = left_area_sr(ring.nodes);
-        if (left < 2 * pi && left > largest_open_area) largest_open_area = left, largest_open = &ring;
+    const auto& source = coast.rings.rings;
+    std::vector<double> left_of(source.size()); // each ring's area on its left (sr)
+    std::size_t largest_open = source.size();
+    for (std::size_t r = 0; r < source.size(); ++r) {
+        left_of[r] = left_area_sr(source[r].nodes);
+        const auto& kinds = source[r].kinds;
+        if (left_of[r] < 2 * pi && std::find(kinds.begin(), kinds.end(), SegmentKind::open) != kinds.end() &&
+            (largest_open == source.size() || left_of[r] > left_of[largest_open]))
+            largest_open = r;
     }
-    for (const Ring& ring : coast.rings.rings) {
+    for (std::size_t r = 0; r < source.size(); ++r) {
+        const Ring& ring = source[r];
         ShapedRing s{&ring, {}, {}, {}, {}};
         s.h_rad.reserve(ring.nodes.size());
         for (const auto& v : ring.nodes) s.h_rad.push_back(h_at(v));
         bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; });
-        if (options.min_island_triangles > 0 && &ring != largest_open) {
-            double left = left_area_sr(ring.nodes);
+        if (options.min_island_triangles > 0 && r != largest_open) {
+            const double left = left_of[r];
             Vec3 sum{};
             for (const auto& v : ring.nodes) sum = sum + v;
             double hc = norm(sum) > 1e-9 ? h_at(normalized(sum)) : s.h_rad[0];
