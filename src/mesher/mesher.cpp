@@ -24,14 +24,14 @@ namespace globemesh {
 
 namespace {
 
+// The tuned constants, each with its reason; the measurements behind them are in
+// bench/RESULTS-mesher.md.
+
 // Refinement stops when every circumradius is below this factor times that of an equilateral
-// triangle of side h: Delaunay refinement leaves most triangles well inside the bound, so a
-// factor above 1 centres the edge lengths on h after smoothing (measured: see tests).
+// triangle of side h: above 1, so that the edge lengths centre on h after smoothing.
 constexpr double circumradius_factor = 1.35;
-// Frontal points make triangles of circumradius this factor times the refinement bound. It sets
-// the median edge against h: on 1:50m land at 100 km, 0.8 gave 1.073 (edges 7% long), 0.75
-// gives 1.012 (10% more nodes; q > 0.8 97.27 -> 97.58%), 0.7 gives 0.945. At an equal node
-// count the quality is the same (circumradius_factor 1.5 with 0.7: 97.08%).
+// Frontal points make triangles of circumradius this factor times the refinement bound: it
+// puts the median edge within about 1% of h.
 constexpr double frontal_radius_factor = 0.75;
 // Largest circumradius of a frontal triangle relative to its front edge's length.
 constexpr double front_growth = 1.0;
@@ -39,12 +39,9 @@ constexpr double front_growth = 1.0;
 // (sqrt(2): smallest angle 20.7 degrees, the bound for which Ruppert's algorithm terminates).
 constexpr double shape_bound = 1.4142135623730951;
 // Triangles with a boundary corner are split above this ratio instead (smallest angle 25.8
-// degrees): smoothing moves at most two of their corners, and the coast's crowded places
-// (straits, island groups) leave it little room. Measured on 1:50m land, faces below q 0.6
-// away from sharp corners at 100 km / Gulf Stream field: sqrt(2) 9 / 12, 1.3 6 / 13, 1.2 2 / 2,
-// 1.15 1 / 2, 1.1 4 / 2, 1.0 1 / 6 (with 2% more centroids on land and size fit 97.2%); q > 0.8
-// 97.61 / 97.28% -> 97.62 / 97.34% at 1.15, 0.1% more nodes. (Below Ruppert's sqrt(2) the
-// refinement still ends: shape stops counting below refine_floor.)
+// degrees): smoothing moves at most two of their corners, and the coast's crowded places leave
+// it little room. (Below sqrt(2) the refinement still ends: shape stops counting below
+// refine_floor.)
 constexpr double coast_shape_bound = 1.15;
 // Triangles with two or three boundary corners, which smoothing cannot move, are refined until
 // their quality q (sphere.hpp) reaches this.
@@ -52,46 +49,29 @@ constexpr double quality_goal = 0.6;
 // Shape stops counting below this fraction of the target circumradius, and boundary segments
 // shorter than twice this fraction of h are not split: narrow rivers and the pinch points of
 // the coast (rings moved 0.64 m apart where they touched) would otherwise be refined down to
-// their own width. Measured on 1:50m land at 100 km: 0.5 leaves 247 faces below q 0.6 away
-// from sharp corners, 0.05 leaves 84 for 1.8% more nodes.
+// their own width.
 constexpr double refine_floor = 0.05;
 // The refinement pops the worst triangles first, their badness coarsened to this many levels per
 // doubling; within a level, along the Hilbert curve. Consecutive insertions are then neighbours
 // on the sphere and so are the new vertices' numbers, which keeps the refinement and the
-// smoothing in cache. Measured on 1:50m land (mesh_boundary, bench/mesher_memory), exact order
-// -> this: 20 km 8.0 -> 6.1 s, 10 km 37.3 -> 26.6 s (us/node x1.65 -> x1.20 from 64 to 10 km);
-// at 100 km q > 0.8 97.29% -> 97.36%, mean q 0.9534 -> 0.9541 (4 levels: 0.9517, 16: 0.9536).
+// smoothing in cache.
 constexpr double badness_levels_per_doubling = 8;
 // A smoothing move shorter than this fraction of h is not made, and the node is left out of the
-// next sweep unless a neighbour moves. Measured on 1:50m land: at 20 km improve 2.93 -> 1.92 s
-// (bench/mesher_memory); at 100 km q > 0.8 97.36 -> 97.34%, mean q 0.9541 -> 0.9538; Gulf
-// Stream field 96.93 -> 96.93%, mean 0.9535 -> 0.9533 (0.02: improve 1.73 s, q > 0.8 97.33%).
+// next sweep unless a neighbour moves: most of the sweeps' time saved, the quality the same.
 constexpr double settle_fraction = 0.01;
 // Then the nodes of triangles below this quality (away from sharp corners) get a pattern search
-// for their star's best worst triangle, for this many rounds. Measured on 1:50m land at 100 km:
-// faces below 0.6 away from sharp corners 38 -> 9, the worst 0.445 -> 0.535, faces below 0.8
-// 2,070 -> 2,086; Gulf Stream field 46 -> 15, 0.469 -> 0.525 (4 rounds: the same).
+// for their star's best worst triangle, for this many rounds (more rounds change nothing).
 constexpr double worst_goal = 0.6;
 constexpr int search_rounds = 2;
 constexpr int mend_passes = 3;
-// Rounds of the last, quality-driven smoothing of the nodes of triangles below q count_cap.
-// Measured on 1:50m land at 100 km, q > 0.8 with the count and the slides below: 99.61% after
-// 4 rounds, 99.63% after 6 (with the star's worst as the goal and no slides, 3 rounds took the
-// faces below q 0.8 away from the coast from 0.89% to 0.12%; 6 gained 0.02%).
+// Rounds of the last, quality-driven smoothing of the nodes of triangles below q count_cap:
+// past 6, a round gains under 0.02% of faces above q 0.8.
 constexpr int improve_rounds = 6;
 // Those rounds move each node where its star has the most triangles above count_quality (the
 // issue's q 0.8), ties broken by the sum of the qualities capped at count_cap, with no triangle
-// below min(the star's worst, worst_goal) (star_count_score). Measured on 1:50m land at 100 km,
-// q > 0.8 after 3 rounds without slides: the star's worst as the goal (before) 97.93%; the
-// capped sum alone, cap 0.8 98.41%, 0.82 98.71%, 0.85 98.50%; the count and the capped sum,
-// cap 0.82 98.85%, 0.85 98.81%, 0.9 98.71%.
-// The nodes are those of the triangles below count_cap: a node whose triangles are all above it
-// has the best score already and stays. Collected below q 0.9 before (session 28), 12,988 of
-// the 22,111 visits at 64 km on 1:50m ended at once; below count_cap the improve stage took
-// 0.95 -> 0.82 us per node there, and on 1:50m land at 100 km / the Gulf Stream field q > 0.8
-// 99.54 / 99.53 -> 99.52 / 99.50%, mean q 0.9558 / 0.9590 -> 0.9559 / 0.9591, the worst away
-// from sharp corners 0.600 both (collected below 0.8: 99.50 / 99.48%; below 0.7: 98.41 /
-// 98.24%, with two faces below 0.6; no rounds at all: 97.24 / 97.11%).
+// below min(the star's worst, worst_goal) (star_count_score): the count and the capped sum at
+// 0.82 gave the most faces above 0.8. The nodes are those of the triangles below count_cap: a
+// node whose triangles are all above it has the best score already and stays.
 constexpr double count_quality = 0.8;
 constexpr double count_cap = 0.82;
 constexpr double count_worst_weight = 1000; // the worst up to worst_goal comes first
@@ -100,20 +80,15 @@ constexpr detail::CountRule count_rule{worst_goal, count_quality, count_cap, cou
 // ring) slides where its ocean star scores best, to points within slide_reach times h of the
 // source coast (LandTest::coast_within; the issue asks for h/4 at the 95th percentile), where
 // no corner of the coast becomes sharper than 60 degrees and no more of its star's faces have
-// their centroid on land. Measured on 1:50m land, 100 km / Gulf Stream field: q > 0.8
-// 98.90 / 98.87% without slides, 99.61 / 99.57% with; boundary node to coast p95 0.233 / 0.223 h
-// -> 0.227 / 0.212 h; face centroids on land 52 / 47 -> 48 / 39 (66 / 45 when slides may put
-// more centroids on land). The coast and land rules checked only on the points the search
-// improved through, from the best back, instead of on each: mesh_boundary at 64 km 2,339 ->
-// 2,204 million instructions; after the nudge below, faces on land 19 / 14 -> 18 / 15, p95
-// 0.227 / 0.212 -> 0.228 / 0.218 h, q > 0.8 99.54 / 99.49 -> 99.54 / 99.50%.
+// their centroid on land. The coast and land rules are checked only on the points the search
+// improved through, from the best back, instead of on each (fewer evaluations, the same
+// quality).
 constexpr double slide_reach = 0.2;
 // Relaxation towards valence 6 (relax_valence): passes of flips over the candidate triangles, a
 // flip refused where either new triangle would be below q relax_floor; then rounds of moves to
 // the mean of the neighbours, a move refused where the star's worst triangle would fall below
-// min(relax_move_floor, where it was). Measured on 1:50m land at 100 km, the floor 0.6 instead
-// of 0.8 for the moves: faces below 0.6 away from sharp corners 11 instead of 6 (the moves
-// then still reached the coast's neighbours).
+// min(relax_move_floor, where it was): a lower floor let the moves flatten the coast's
+// neighbours.
 constexpr int relax_passes = 4;
 constexpr int relax_rounds = 6;
 constexpr double relax_floor = 0.3;
@@ -128,37 +103,22 @@ constexpr double lattice_level = 0.99;
 constexpr double lattice_clearance = 1.5;
 constexpr double lattice_jitter = 1e-6;
 // Moving a free node to take a face's centroid off a dropped island (clear_dropped_islands):
-// no face of its star may fall below min(its quality, this); the ways out tried are towards
-// the nearest points of this many sides of the outline. Measured on 1:50m land at 100 km, faces
-// moved / left on dropped islands: floor 0.8 with 1 way 110 / 251, 4 ways 116 / 244, 16 the
-// same; floor 0.6 226 / 135 (q > 0.8 97.62 -> 97.40%), none 297 / 60 (97.13%, worst 0.04).
+// no face of its star may fall below min(its quality, this), which keeps q > 0.8 where a lower
+// floor trades it for fewer faces left; the ways out tried are towards the nearest points of
+// this many sides of the outline (more change nothing).
 constexpr double island_quality_floor = 0.8;
 constexpr std::size_t island_exits = 4;
 // Removing the faces centred on land (remove_land_faces): a face that would pinch the mesh at
 // a corner may take along at most this many water faces of that corner's fan (or the water it
-// cuts off, up to inlet_area h^2); no removal leaves on the boundary a node farther than
-// land_exposed_reach times h from the source coast. Measured on 1:50m land (faces centred on
-// land / boundary node to coast p95 over h), 100 km, Gulf Stream field, 50 km: no removal
-// 577 / 0.175, 521 / 0.181, 1,149 / 0.186; one face at a time, the loops kept apart and the
-// coast distance from the nearest lon/lat point: reach 0.25: 263 / 0.183, 273 / 0.183,
-// 592 / 0.191; 0.35: 191 / 0.200, 227 / 0.197, 457 / 0.206; 0.5: 129 / 0.221, 171 / 0.219,
-// 275 / 0.232; no bound: 93 / 0.239, 145 / 0.229, 173 / 0.252 (over the issue's h/4). Fans of 1
-// face instead of 2 (no bound): 98 and 146 left; of 3: the same as 2. With groups removed
-// whole, loops joined and the coast distance on the sphere, reach 0.5: 50 / 0.228,
-// 109 / 0.223, 124 / 0.240; a last round at 0.6: 35 / 0.237, 95 / 0.232, 72 / 0.250; at
-// 0.75: 30 / 0.239, 91 / 0.234, 56 / 0.254.
+// cuts off, up to inlet_area h^2; 3 removes no more than 2); no removal leaves on the boundary
+// a node farther than land_exposed_reach times h from the source coast (0.5: the 95th
+// percentile stays under the issue's h/4).
 constexpr std::size_t land_fan_faces = 2;
 // The faces left on land then get a corner moved (nudge_off_land) towards the water nearest
 // the centroid (the nudge_water nearest points of a grid of nudge_grid rows on the face), each
 // of nudge_reaches times the way from the centroid (the centroid moves a third as far), where
-// no triangle falls below min(its star's worst, nudge_floor). Measured on 1:50m land, faces
-// left on land at 100 km / Gulf Stream field: no nudge 48 / 39; interior corners only, the 3
-// nearest points at 3.3: 26 / 24 (q > 0.8 99.61 -> 99.53%), floor 0.7 35 / 32, 4 times 31 / 27,
-// 5 times 34 / 29; boundary corners sliding too (slide_reach), 3.1: 21 / 15; the 8 nearest at
-// 2, 3.1 and 4: 19 / 14 (q > 0.8 99.54 / 99.49%); a second pass: the same. (18 / 15 with the
-// slides' lazy checks.) Nodes that the removals put on the boundary sliding too, within the
-// land_exposed_reach that admitted them: 12 / 13 (99.52 / 99.50%); a grid of 24 rows or a
-// reach of 1.5 as well: 12 / 12-13.
+// no triangle falls below min(its star's worst, nudge_floor): the fewest faces left on land
+// for the quality kept (a finer grid, a longer reach or a second pass leave as many).
 constexpr double nudge_reaches[3] = {2.0, 3.1, 4.0};
 constexpr int nudge_grid = 12;
 constexpr double nudge_floor = 0.6;
@@ -170,11 +130,7 @@ constexpr double land_exposed_reach = 0.5;
 // too: the rest of the strait, or a narrow sound behind it) or leave a node between two fans
 // of water (the strait closed at a point: the output splits the node, pinch_apart radians
 // into each fan); a node it puts on the boundary may lie up to strait_exposed_reach h from the
-// coast. Measured on 1:50m land, faces left centred on land at 100 km: 12 before; cuts allowed
-// 6; nodes between two fans too 2; the last two (Roosevelt Island and Kolguyev, dropped by the
-// shaping, where a corner would come onto the boundary 0.5-0.75 h from their coast) with the
-// reach 0.75: 0. Gulf Stream field 13 -> 0, 20 km 29 -> 0; boundary node to coast p95 at 100 km
-// 0.228 -> 0.230 h.
+// coast, which lets the last straits of islands the shaping dropped close too.
 constexpr double strait_exposed_reach = 0.75;
 constexpr double pinch_apart = 1e-7; // 0.64 m
 // A face centred on land whose removal would join two boundary loops goes only when at least
@@ -185,14 +141,9 @@ constexpr int join_land_points = 3;
 constexpr double inlet_narrow_area = 25;
 // The node estimate (add_node_estimate) splits a triangle larger than estimate_area times the
 // square of the smallest size at its corners and centroid while those sizes differ by more than
-// estimate_ratio or a side exceeds estimate_reach times the smallest. Measured on 1:50m land at
-// --hmax 100km, estimate / nodes and the estimate's seconds: --coast-size 5km 1.113M / 0.958M,
-// 0.2 s (area 2: 1.048M, 0.35 s; 16 with ratio 1.5: 1.174M, 0.16 s), 20km 217k / 193k; a
-// refusal (10m) after 3.7 s (area 2: 8.1 s). Without the area bound the boundary's slivers split
-// into ever more slivers (8.8M pieces for 1M nodes). The smallest size at the corners and
-// centroid of each whole triangle, before: 80.7M for 2.6M nodes at --coast-size 2km, refused.
-// A reach of 32 instead of 8 changes the estimates on bathymetry fields by under 0.5% (--slope
-// 20: 6.17M for 5.52M nodes in 0.9 s) and costs a uniform 20 km field 3 ms instead of 16.
+// estimate_ratio or a side exceeds estimate_reach times the smallest: within about 15% of the
+// nodes made, in a fraction of a second (without the area bound the boundary's slivers split
+// into ever more slivers).
 constexpr double estimate_area = 8;
 constexpr double estimate_ratio = 1.25;
 constexpr double estimate_reach = 32;
@@ -710,10 +661,7 @@ private:
 // behind a narrow mouth closes when it is small (a lagoon) or narrow on average too (twice its
 // area over its perimeter under inlet_width * h: a river with lakes along it, up to
 // inlet_narrow_area h^2), and stays when it is large and wide (the Black Sea behind the
-// Bosphorus). Measured on 1:50m land, faces centred on land / q > 0.8, area alone -> with the
-// mean width: 100 km 50 / 97.91% -> 48 / 97.92% (Maracaibo, Chesapeake Bay, the Gulf of Ob and
-// the Lagoa dos Patos close); Gulf Stream field 109 / 97.79% -> 44 / 97.94% (the St. Lawrence
-// above Quebec, 7.3 h^2, the White Sea, the Gulf of Finland, the Sea of Azov, Lake Melville).
+// Bosphorus).
 void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report) {
     SphericalDelaunay& dt = m.dt;
     struct Chord {
@@ -2145,8 +2093,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
     // per cent of the nodes made on 1:50m land at 64, 20 and 10 km), instead of doubling through
     // the lattice and the refinement: each doubling copied them into new blocks and touched
-    // their pages again. Measured (alternated runs): refine at 64 km 0.113 -> 0.094 s, at 20 km
-    // 0.622 -> 0.565 s; the peak at 20 km 193.9 -> 190.9 MiB.
+    // their pages again.
     dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
     if (timings) timings->add("classify", seconds_since(t0));
 
@@ -2321,11 +2268,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // refinement made most of them, they are renumbered in that order first, and the triangles
     // after them (SphericalDelaunay::renumber), so that neighbours lie near each other in memory:
     // the refinement numbers nodes in the order it makes them, all over the sphere level after
-    // level (1:50m land at --hmax 100km --coast-size 5km: 88% of the triangles joined vertices
-    // over 4,096 ids apart), where the lattice's come in Hilbert order already (20 km: 9%). The
-    // stages below and the output's numbering follow. Measured there: improve 5.0 -> 3.6 s, land
-    // 0.7 -> 0.4 s, UGRID write 5.0 -> 3.6 s; renumbering a uniform 20 km mesh would take 0.17 s
-    // (its new arrays' first touch, mostly) for nothing.
+    // level, where the lattice's come in Hilbert order already. The stages below and the
+    // output's numbering follow.
     std::vector<char> lattice(dt.vertex_count(), 0); // the lattice's nodes
     std::fill_n(lattice.begin() + lattice_first, report.lattice_nodes, 1);
     std::vector<VertexId> visit;
@@ -2371,11 +2315,9 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     // Per vertex, the size there (km; NaN: not asked yet), for the sweeps: a triangle's size is
     // the mean of its corners' (the size at its centroid where the field is linear over it; the
     // grid's cells are about hfloor / 2), each evaluated when first asked and again when its
-    // node moves, instead of once per star triangle visited. On 1:50m land at --hmax 100km
-    // --coast-size 5km: 5.1 instead of 20 million evaluations, the sweeps 3.1 -> 1.8 s, the
-    // quality the same (mean 0.9231, above 0.9 69.95 against 69.92%). (The refinement's badness
-    // from them too saved another 0.44 s, but cost the Gulf Stream field 0.0012 of its mean q:
-    // it keeps the size at the centroid.) No node is added while it is in use.
+    // node moves, instead of once per star triangle visited (the refinement's badness keeps
+    // the size at the centroid: from the corners it cost graded fields quality). No node is
+    // added while it is in use.
     std::vector<float> vertex_size(dt.vertex_count(), std::numeric_limits<float>::quiet_NaN());
     auto corner_size_km = [&](TriangleId t) {
         double sum = 0;
@@ -2674,9 +2616,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         // their corner). It gets its circumcentre when that lies in the ocean without
         // encroaching on a segment, else the segment in the way is split at its midpoint (as the
         // refinement does), and the new node and its free neighbours get their search, twice; a
-        // few passes, as a search may leave another such triangle. (The split mends the last
-        // face below 0.6 away from sharp corners on the Gulf Stream field, 0.5996 at the tip of
-        // Sakhalin, and changes nothing at 100 km.)
+        // few passes, as a search may leave another such triangle.
         std::vector<TriangleId> mend;
         std::vector<std::pair<VertexId, TriangleId>> around;
         for (int pass = 0; pass < mend_passes; ++pass) {
