@@ -156,4 +156,135 @@ void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report)
     }
 }
 
+namespace {
+
+// Flood fills from triangle `seed` across unconstrained edges, marking component[t] = id;
+// returns the area (steradians) of the triangles reached.
+double flood_component(const SphericalDelaunay& dt, TriangleId seed, std::uint32_t id,
+                       std::vector<std::uint32_t>& component, std::vector<TriangleId>& stack) {
+    double area = 0;
+    stack.assign(1, seed);
+    component[seed] = id;
+    while (!stack.empty()) {
+        TriangleId t = stack.back();
+        stack.pop_back();
+        area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                        dt.point(dt.vertex(t, 2)));
+        for (int i = 0; i < 3; ++i) {
+            HalfEdge h = half_edge(t, i);
+            if (dt.is_constrained(h)) continue;
+            TriangleId nb = triangle_of(dt.twin(h));
+            if (component[nb] != 0xffffffffu) continue;
+            component[nb] = id;
+            stack.push_back(nb);
+        }
+    }
+    return area;
+}
+
+// Floods the components on the left of the boundary segments (their areas into
+// component_area), then checks that every segment has land (or the outside of the region) on
+// its right.
+void flood_left_of_segments(const Mesher& m, std::vector<std::uint32_t>& component,
+                            std::vector<double>& component_area, std::vector<TriangleId>& stack) {
+    const SphericalDelaunay& dt = m.dt;
+    // Consecutive segments of a ring share a node: each edge's triangle is the next one's
+    // hint, which saves a walk from the last triangle across the whole triangulation.
+    TriangleId hint = no_triangle;
+    for (auto [a, b] : m.directed) {
+        HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
+        if (h == no_half_edge) throw DataError("internal: a recovered boundary segment is missing");
+        hint = triangle_of(h);
+        TriangleId left = triangle_of(h);
+        if (component[left] == 0xffffffffu)
+            component_area.push_back(flood_component(dt, left, static_cast<std::uint32_t>(component_area.size()),
+                                                     component, stack));
+    }
+    hint = no_triangle;
+    for (auto [a, b] : m.directed) {
+        HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
+        hint = triangle_of(h);
+        TriangleId right = triangle_of(dt.twin(h));
+        if (component[right] != 0xffffffffu && component[right] == component[triangle_of(h)])
+            throw DataError("the boundary rings do not close the ocean: ocean on both sides of the "
+                            "boundary near " + Mesher::describe(dt.point(a)));
+        if (component[right] != 0xffffffffu) {
+            // Ocean on the right of a segment: two rings of opposite orientation face each other
+            // (e.g. an island drawn the wrong way round).
+            throw DataError("a boundary ring has the ocean on its right near " +
+                            Mesher::describe(dt.point(a)) + ": rings must keep the ocean on their left");
+        }
+    }
+}
+
+} // namespace
+
+void classify_ocean(Mesher& m, const Boundary& boundary, const MesherOptions& options) {
+    SphericalDelaunay& dt = m.dt;
+    const std::size_t slots = dt.triangle_slots();
+    std::vector<std::uint32_t> component(slots, 0xffffffffu);
+    std::vector<double> component_area;
+    std::vector<TriangleId> stack;
+    if (boundary.empty())
+        component_area.push_back(flood_component(dt, dt.last_triangle(), 0, component, stack));
+    else
+        flood_left_of_segments(m, component, component_area, stack);
+    std::size_t largest = 0;
+    for (std::size_t c = 0; c < component_area.size(); ++c)
+        if (component_area[c] > component_area[largest]) largest = c;
+    std::vector<char> kept(component_area.size(), 0);
+    for (std::size_t c = 0; c < component_area.size(); ++c) {
+        kept[c] = c == largest || options.keep_inland_seas;
+        m.report.components.push_back({component_area[c] * earth_radius_km * earth_radius_km, kept[c] != 0});
+    }
+    if (component_area.empty()) throw DataError("no ocean is left inside the boundary");
+    for (TriangleId t = 0; t < slots; ++t)
+        if (dt.is_live(t))
+            dt.set_label(t, component[t] != 0xffffffffu && kept[component[t]] ? ocean : land);
+}
+
+void mark_sharp_corners(Mesher& m) {
+    const SphericalDelaunay& dt = m.dt;
+    std::vector<double> angle(dt.vertex_count(), 0.0);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean) continue;
+        for (int i = 0; i < 3; ++i) {
+            const Vec3& p = dt.point(dt.vertex(t, i));
+            const Vec3 u = dt.point(dt.vertex(t, next3(i))) - p;
+            const Vec3 w = dt.point(dt.vertex(t, prev3(i))) - p;
+            angle[dt.vertex(t, i)] += std::atan2(norm(cross(u, w)), dot(u, w));
+        }
+    }
+    m.sharp.assign(dt.vertex_count(), 0);
+    for (auto [a, b] : m.directed) {
+        if (angle[a] > 0 && angle[a] < 60.0 * deg_to_rad) m.sharp[a] = 1;
+        if (angle[b] > 0 && angle[b] < 60.0 * deg_to_rad) m.sharp[b] = 1;
+    }
+}
+
+void estimate_nodes(Mesher& m, const MesherOptions& options) {
+    SphericalDelaunay& dt = m.dt;
+    MesherReport& report = m.report;
+    std::size_t limit = options.max_nodes;
+    if (options.max_memory != 0) limit = std::min<std::size_t>(limit, options.max_memory / mesher_bytes_per_node);
+    const double stop = double(limit) - double(dt.vertex_count());
+    double estimate = 0;
+    for (TriangleId t = 0; t < dt.triangle_slots() && estimate <= stop; ++t)
+        if (dt.is_live(t) && dt.label(t) == ocean)
+            add_node_estimate(m.size_km, dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                              dt.point(dt.vertex(t, 2)), stop, estimate);
+    report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
+    if (estimate > stop) {
+        const std::string nodes = "more than " + std::to_string(limit) + " nodes";
+        if (limit == options.max_nodes)
+            throw DataError("the size field asks for " + nodes + " (--max-nodes): raise --hmin/--hmax or --max-nodes");
+        throw DataError("the size field asks for " + nodes + ", which need more than --max-memory " +
+                        std::to_string(options.max_memory >> 20) + " MiB: raise --hmin/--hmax or --max-memory");
+    }
+    // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
+    // per cent of the nodes made), instead of doubling through the lattice and the refinement:
+    // each doubling copied them into new blocks and touched their pages again.
+    dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
+}
+
 } // namespace globemesh::mesher_internal

@@ -29,27 +29,6 @@ namespace mesher_internal {
 namespace {
 
 // The tuned constants of the stages still here (bench/RESULTS-mesher.md has the measurements).
-// Refinement stops when every circumradius is below this factor times that of an equilateral
-// triangle of side h: above 1, so that the edge lengths centre on h after smoothing.
-constexpr double circumradius_factor = 1.35;
-// Frontal points make triangles of circumradius this factor times the refinement bound: it
-// puts the median edge within about 1% of h.
-constexpr double frontal_radius_factor = 0.75;
-// Largest circumradius of a frontal triangle relative to its front edge's length.
-constexpr double front_growth = 1.0;
-// Refinement splits triangles whose circumradius exceeds this factor times their shortest edge
-// (sqrt(2): smallest angle 20.7 degrees, the bound for which Ruppert's algorithm terminates).
-constexpr double shape_bound = 1.4142135623730951;
-// Triangles with a boundary corner are split above this ratio instead (smallest angle 25.8
-// degrees): smoothing moves at most two of their corners, and the coast's crowded places leave
-// it little room. (Below sqrt(2) the refinement still ends: shape stops counting below
-// refine_floor.)
-constexpr double coast_shape_bound = 1.15;
-// The refinement pops the worst triangles first, their badness coarsened to this many levels per
-// doubling; within a level, along the Hilbert curve. Consecutive insertions are then neighbours
-// on the sphere and so are the new vertices' numbers, which keeps the refinement and the
-// smoothing in cache.
-constexpr double badness_levels_per_doubling = 8;
 // A smoothing move shorter than this fraction of h is not made, and the node is left out of the
 // next sweep unless a neighbour moves: most of the sweeps' time saved, the quality the same.
 constexpr double settle_fraction = 0.01;
@@ -73,123 +52,6 @@ constexpr detail::CountRule count_rule{worst_goal, count_quality, count_cap, cou
 // The output splits a node between two fans of ocean (close_straits) this far into each fan.
 constexpr double pinch_apart = 1e-7; // 0.64 m
 
-// How much triangle t wants refining: > 1 means too large for the size field or too
-// skinny (radius-edge ratio above sqrt(2), i.e. a smallest angle below about 20.7 degrees).
-// Lengths are chords, not arcs: below 0.1 rad (637 km) they differ by under 0.05%, and a
-// chord needs no atan2 (this runs for every triangle the refinement creates).
-double badness(const Mesher& m, TriangleId t) {
-    const SphericalDelaunay& dt = m.dt;
-    const Vec3& a = dt.point(dt.vertex(t, 0));
-    const Vec3& b = dt.point(dt.vertex(t, 1));
-    const Vec3& d = dt.point(dt.vertex(t, 2));
-    const double r = norm(m.circumcentre(t) - a);
-    double h = km_to_rad(m.size_km(m.centroid(t)));
-    double size_ratio = r / (circumradius_factor * h / std::sqrt(3.0));
-    // A triangle at a sharp coast corner keeps the corner's small angle whatever is inserted:
-    // only its size counts (Ruppert's algorithm needs input angles of 60 degrees or more).
-    if (m.is_sharp(dt.vertex(t, 0)) || m.is_sharp(dt.vertex(t, 1)) || m.is_sharp(dt.vertex(t, 2)))
-        return size_ratio;
-    const Vec3 ab = b - a, bd = d - b, da = a - d;
-    const double shortest = std::sqrt(std::min({dot(ab, ab), dot(bd, bd), dot(da, da)}));
-    // Below a floor, shape does not count: pinch points of the coast (rings moved 0.64 m
-    // apart where they touched) would otherwise be refined down to their own scale.
-    // A triangle with a boundary corner is held to a tighter shape; one with two or three,
-    // which smoothing cannot mend, is refined until its quality reaches quality_goal.
-    const int corners = m.is_fixed(dt.vertex(t, 0)) + m.is_fixed(dt.vertex(t, 1)) + m.is_fixed(dt.vertex(t, 2));
-    double shape_ratio = r / shortest / (corners > 0 ? coast_shape_bound : shape_bound);
-    if (corners >= 2) shape_ratio = std::max(shape_ratio, quality_goal / std::max(1e-3, triangle_quality(a, b, d)));
-    if (size_ratio < refine_floor) shape_ratio = 0;
-    return std::max(size_ratio, shape_ratio);
-}
-
-// A refinement candidate: 16 bytes. `order` is the badness level (badness_levels_per_doubling)
-// above the Hilbert key of the triangle's centroid. `stamp` is the generation of slot t when it
-// was queued (twice, plus 1 when the triangle was on the front); a slot's generation (24 bits)
-// grows each time the core puts a new triangle in it, so an entry whose stamp no longer matches
-// is stale.
-struct Candidate {
-    std::uint64_t order;
-    TriangleId t;
-    std::uint32_t stamp;
-    bool active() const { return (stamp & 1u) != 0; } // next to an accepted triangle or the boundary
-    bool operator<(const Candidate& o) const {
-        if (active() != o.active()) return !active();
-        if (order != o.order) return order < o.order;
-        return t > o.t; // deterministic ties
-    }
-};
-
-// Cache-line aligned storage for the heap below.
-template <class T>
-struct LineAllocator {
-    using value_type = T;
-    LineAllocator() = default;
-    template <class U>
-    LineAllocator(const LineAllocator<U>&) {}
-    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
-    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
-    template <class U>
-    bool operator==(const LineAllocator<U>&) const { return true; }
-};
-
-// A max-heap of candidates with four children per node: half the depth of a binary heap, and
-// the four children of a node (16 bytes each) fill one 64-byte cache line, so a sift-down
-// touches one line per level. Node i lives at index i + 3, which puts the children 4i+1..4i+4
-// at indices 4(i+1)..4(i+1)+3 of a 64-byte aligned array. Pops come in the order of
-// Candidate::operator< (entries that compare equal are interchangeable: the same triangle,
-// badness and front flag, so either identical or stale).
-class CandidateHeap {
-public:
-    bool empty() const { return size() == 0; }
-    std::size_t size() const { return a_.size() - pad; }
-    void push(const Candidate& c) {
-        a_.push_back(c);
-        std::size_t i = size() - 1;
-        while (i > 0) {
-            const std::size_t parent = (i - 1) / 4;
-            if (!(at(parent) < c)) break;
-            at(i) = at(parent);
-            i = parent;
-        }
-        at(i) = c;
-    }
-    Candidate pop() {
-        const Candidate top = at(0);
-        const Candidate last = a_.back();
-        a_.pop_back();
-        if (!empty()) sift_down(0, last);
-        return top;
-    }
-    /// Drops the entries for which `drop` holds and restores the heap.
-    template <class F>
-    void remove_if(F drop) {
-        std::erase_if(a_, [&](const Candidate& c) { return &c >= a_.data() + pad && drop(c); });
-        for (std::size_t i = size() / 4 + 1; i-- > 0;)
-            if (i < size()) sift_down(i, at(i));
-    }
-    void release() { std::vector<Candidate, LineAllocator<Candidate>>().swap(a_); }
-
-private:
-    static constexpr std::size_t pad = 3;
-    Candidate& at(std::size_t i) { return a_[i + pad]; }
-    void sift_down(std::size_t i, const Candidate c) { // c by value: it may be at(i)
-        const std::size_t n = size();
-        for (;;) {
-            const std::size_t first = 4 * i + 1;
-            if (first >= n) break;
-            std::size_t best = first;
-            const std::size_t end = std::min(first + 4, n);
-            for (std::size_t k = first + 1; k < end; ++k)
-                if (at(best) < at(k)) best = k;
-            if (!(c < at(best))) break;
-            at(i) = at(best);
-            i = best;
-        }
-        at(i) = c;
-    }
-    std::vector<Candidate, LineAllocator<Candidate>> a_ = std::vector<Candidate, LineAllocator<Candidate>>(pad);
-};
-
 } // namespace
 } // namespace mesher_internal
 
@@ -204,356 +66,37 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
     Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, report);
     SphericalDelaunay& dt = m.dt;
 
-    // ---- 1. boundary nodes -------------------------------------------------------------------
+    // ---- 1. boundary nodes and segments --------------------------------------------------------
     auto t0 = Clock::now();
-    std::vector<Vec3> nodes;
-    std::vector<std::size_t> offsets;
-    for (const Ring& r : boundary.rings) {
-        offsets.push_back(nodes.size());
-        nodes.insert(nodes.end(), r.nodes.begin(), r.nodes.end());
-    }
-    report.boundary_nodes = nodes.size();
-    std::vector<VertexId> ids;
-    if (boundary.empty()) {
-        // An aqua-planet: start from the octahedron and let refinement do the rest.
-        std::vector<Vec3> seed = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-        dt.insert_points(seed);
-    } else {
-        if (nodes.size() < 4) throw DataError("the boundary has fewer than 4 nodes: no ocean to mesh");
-        ids = dt.insert_points(nodes);
-        // When every boundary node lies in one hemisphere, ghost triangles (delaunay.hpp) close
-        // the far side, and the far side may be ocean: add fixed far points until every triangle
-        // is solid. A candidate closer than 1e-4 rad to a boundary arc is skipped, so none lies
-        // on a segment; the flood fill below classifies them like any vertex.
-        auto has_ghost = [&] {
-            for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-                if (dt.is_live(t) && !dt.is_solid(t)) return true;
-            return false;
-        };
-        if (has_ghost()) {
-            std::vector<Vec3> far;
-            for (double x : {-1.0, 1.0}) {
-                far.push_back({x, 0, 0});
-                far.push_back({0, x, 0});
-                far.push_back({0, 0, x});
-            }
-            for (double x : {-1.0, 1.0})
-                for (double y : {-1.0, 1.0})
-                    for (double z : {-1.0, 1.0}) far.push_back(normalized(Vec3{x, y, z}));
-            for (const Vec3& p : far) {
-                bool clear = true;
-                for (std::size_t r = 0; r < boundary.rings.size() && clear; ++r) {
-                    const auto& rn = boundary.rings[r].nodes;
-                    for (std::size_t i = 0; i < rn.size() && clear; ++i)
-                        clear = arc_distance(rn[i], rn[(i + 1) % rn.size()], p) > 1e-4;
-                }
-                if (clear) dt.insert(p);
-                if (!has_ghost()) break;
-            }
-        }
-    }
+    const std::vector<VertexId> ids = insert_boundary(m, boundary);
     globemesh::report(progress, 0.05, "insert_boundary");
     if (timings) timings->add("insert_boundary", seconds_since(t0));
-
-    // ---- 2. recover segments -----------------------------------------------------------------
     t0 = Clock::now();
-    for (std::size_t r = 0; r < boundary.rings.size(); ++r) {
-        const Ring& ring = boundary.rings[r];
-        const std::size_t n = ring.nodes.size();
-        m.current_ring = static_cast<std::uint32_t>(r);
-        for (std::size_t i = 0; i < n; ++i) {
-            VertexId a = ids[offsets[r] + i], b = ids[offsets[r] + (i + 1) % n];
-            SegmentKind kind = i < ring.kinds.size() ? ring.kinds[i] : SegmentKind::coast;
-            m.recover(a, b, kind, 0);
-        }
-    }
+    recover_segments(m, boundary, ids);
     globemesh::report(progress, 0.1, "recover");
     if (timings) timings->add("recover", seconds_since(t0));
 
-    // ---- 3. classify -------------------------------------------------------------------------
+    // ---- 2. classify -------------------------------------------------------------------------
     t0 = Clock::now();
-    const std::size_t slots = dt.triangle_slots();
-    std::vector<std::uint32_t> component(slots, 0xffffffffu);
-    std::vector<double> component_area;
-    std::vector<TriangleId> stack;
-    auto flood = [&](TriangleId seed, std::uint32_t id) {
-        double area = 0;
-        stack.assign(1, seed);
-        component[seed] = id;
-        while (!stack.empty()) {
-            TriangleId t = stack.back();
-            stack.pop_back();
-            area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
-                                            dt.point(dt.vertex(t, 2)));
-            for (int i = 0; i < 3; ++i) {
-                HalfEdge h = half_edge(t, i);
-                if (dt.is_constrained(h)) continue;
-                TriangleId nb = triangle_of(dt.twin(h));
-                if (component[nb] != 0xffffffffu) continue;
-                component[nb] = id;
-                stack.push_back(nb);
-            }
-        }
-        return area;
-    };
-    if (boundary.empty()) {
-        component_area.push_back(flood(dt.last_triangle(), 0));
-    } else {
-        // Consecutive segments of a ring share a node: each edge's triangle is the next one's
-        // hint, which saves a walk from the last triangle across the whole triangulation.
-        TriangleId hint = no_triangle;
-        for (auto [a, b] : m.directed) {
-            HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
-            if (h == no_half_edge) throw DataError("internal: a recovered boundary segment is missing");
-            hint = triangle_of(h);
-            TriangleId left = triangle_of(h);
-            if (component[left] == 0xffffffffu)
-                component_area.push_back(flood(left, static_cast<std::uint32_t>(component_area.size())));
-        }
-        // Every segment must have land (or the outside of the region) on its right.
-        hint = no_triangle;
-        for (auto [a, b] : m.directed) {
-            HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
-            hint = triangle_of(h);
-            TriangleId right = triangle_of(dt.twin(h));
-            if (component[right] != 0xffffffffu && component[right] == component[triangle_of(h)])
-                throw DataError("the boundary rings do not close the ocean: ocean on both sides of the "
-                                "boundary near " + Mesher::describe(dt.point(a)));
-            if (component[right] != 0xffffffffu) {
-                // Ocean on the right of a segment: two rings of opposite orientation face each other
-                // (e.g. an island drawn the wrong way round).
-                throw DataError("a boundary ring has the ocean on its right near " +
-                                Mesher::describe(dt.point(a)) + ": rings must keep the ocean on their left");
-            }
-        }
-    }
-    std::size_t largest = 0;
-    for (std::size_t c = 0; c < component_area.size(); ++c)
-        if (component_area[c] > component_area[largest]) largest = c;
-    std::vector<char> kept(component_area.size(), 0);
-    for (std::size_t c = 0; c < component_area.size(); ++c) {
-        kept[c] = c == largest || options.keep_inland_seas;
-        report.components.push_back({component_area[c] * earth_radius_km * earth_radius_km, kept[c] != 0});
-    }
-    if (component_area.empty()) throw DataError("no ocean is left inside the boundary");
-    for (TriangleId t = 0; t < slots; ++t)
-        if (dt.is_live(t))
-            dt.set_label(t, component[t] != 0xffffffffu && kept[component[t]] ? ocean : land);
+    classify_ocean(m, boundary, options);
     if (options.inlet_width > 0 && !boundary.empty()) close_inlets(m, options, report);
     globemesh::report(progress, 0.15, "classify");
-
-    // Sharp corners: boundary vertices whose ocean angle (the sum of their ocean triangles'
-    // angles) is below 60 degrees. Later splits never change it: segments stay on their arcs.
-    {
-        std::vector<double> angle(dt.vertex_count(), 0.0);
-        for (TriangleId t = 0; t < slots; ++t) {
-            if (!dt.is_live(t) || dt.label(t) != ocean) continue;
-            for (int i = 0; i < 3; ++i) {
-                const Vec3& p = dt.point(dt.vertex(t, i));
-                const Vec3 u = dt.point(dt.vertex(t, next3(i))) - p;
-                const Vec3 w = dt.point(dt.vertex(t, prev3(i))) - p;
-                angle[dt.vertex(t, i)] += std::atan2(norm(cross(u, w)), dot(u, w));
-            }
-        }
-        m.sharp.assign(dt.vertex_count(), 0);
-        for (auto [a, b] : m.directed) {
-            if (angle[a] > 0 && angle[a] < 60.0 * deg_to_rad) m.sharp[a] = 1;
-            if (angle[b] > 0 && angle[b] < 60.0 * deg_to_rad) m.sharp[b] = 1;
-        }
-    }
-
-    // Node estimate over the ocean's triangles (add_node_estimate), which stops once past the
-    // limits: the refusal then says "more than".
-    std::size_t limit = options.max_nodes;
-    if (options.max_memory != 0) limit = std::min<std::size_t>(limit, options.max_memory / mesher_bytes_per_node);
-    const double stop = double(limit) - double(dt.vertex_count());
-    double estimate = 0;
-    for (TriangleId t = 0; t < slots && estimate <= stop; ++t)
-        if (dt.is_live(t) && dt.label(t) == ocean)
-            add_node_estimate(size_km, dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)), dt.point(dt.vertex(t, 2)),
-                              stop, estimate);
-    report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
-    if (estimate > stop) {
-        const std::string nodes = "more than " + std::to_string(limit) + " nodes";
-        if (limit == options.max_nodes)
-            throw DataError("the size field asks for " + nodes + " (--max-nodes): raise --hmin/--hmax or --max-nodes");
-        throw DataError("the size field asks for " + nodes + ", which need more than --max-memory " +
-                        std::to_string(options.max_memory >> 20) + " MiB: raise --hmin/--hmax or --max-memory");
-    }
-    // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
-    // per cent of the nodes made on 1:50m land at 64, 20 and 10 km), instead of doubling through
-    // the lattice and the refinement: each doubling copied them into new blocks and touched
-    // their pages again.
-    dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
+    mark_sharp_corners(m);
+    estimate_nodes(m, options);
     if (timings) timings->add("classify", seconds_since(t0));
 
-    // ---- 4. refine ---------------------------------------------------------------------------
+    // ---- 3. lattice and refinement -----------------------------------------------------------
     t0 = Clock::now();
     const auto lattice_first = static_cast<VertexId>(dt.vertex_count()); // the lattice nodes follow
     // The lattice's points over the whole sphere may be a few times the nodes asked for (the
     // global ocean: 1.5 times), not more.
     if (options.lattice_km > 0)
         report.lattice_nodes = fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000);
-    // Badness per triangle slot, computed once when the core creates the triangle: a triangle
-    // never changes while it lives (its corners, their fixed/sharp flags and the size field are
-    // all fixed), and every triangle an insertion creates has the new vertex as a corner.
-    std::vector<double> bad(dt.triangle_slots(), 0.0);
-    // Per slot: the generation of its triangle (bits 8-31, grows each time the core puts a new
-    // triangle in the slot) and how many copies of its candidate, off the front (bits 0-3) and
-    // on it (bits 4-7), are queued. Copies of one candidate are identical, so the heap holds one
-    // entry for them and puts it back after each pop while copies remain: the same pops as one
-    // entry per copy, with a smaller heap and fewer stale pops.
-    std::vector<std::uint32_t> slot_state(dt.triangle_slots(), 0);
-    CandidateHeap queue;
-    auto refresh = [&](TriangleId t) {
-        if (t >= bad.size()) {
-            bad.resize(dt.triangle_slots(), 0.0);
-            slot_state.resize(dt.triangle_slots(), 0);
-        }
-        slot_state[t] = ((slot_state[t] >> 8) + 1) << 8;
-        bad[t] = dt.label(t) == ocean ? badness(m, t) : 0.0;
-    };
-    auto order_of = [&](double b, TriangleId t) -> std::uint64_t {
-        const auto level = static_cast<std::uint64_t>(std::log2(b) * badness_levels_per_doubling); // b > 1
-        return level << 32 | detail::hilbert_key(m.centroid(t));
-    };
-    auto push = [&](double b, TriangleId t, bool active) {
-        const int shift = active ? 4 : 0;
-        const std::uint32_t copies = (slot_state[t] >> shift) & 15u;
-        if (copies == 0) queue.push({order_of(b, t), t, (slot_state[t] >> 8) << 1 | (active ? 1u : 0u)});
-        if (copies < 15) slot_state[t] += 1u << shift; // (more than 15 copies: counted as 15)
-    };
-    auto stale = [&](const Candidate& c) {
-        return !dt.is_live(c.t) || slot_state[c.t] >> 8 != c.stamp >> 1 || dt.label(c.t) != ocean;
-    };
-    // Frontal order (Rebay 1993): a bad triangle whose edge borders an accepted triangle or the
-    // boundary is on the front and goes first; its new node is placed off that edge.
-    auto front_edge = [&](TriangleId t) -> int {
-        int best = -1;
-        double best_len = 0;
-        for (int i = 0; i < 3; ++i) {
-            HalfEdge h = half_edge(t, i);
-            TriangleId nb = triangle_of(dt.twin(h));
-            bool accepted = dt.is_constrained(h) || dt.label(nb) != ocean || bad[nb] <= 1.0;
-            if (!accepted) continue;
-            const Vec3 d = dt.point(dt.destination(h)) - dt.point(dt.origin(h));
-            const double len = dot(d, d); // the shortest chord is the shortest arc
-            if (best < 0 || len < best_len) {
-                best = i;
-                best_len = len;
-            }
-        }
-        return best;
-    };
-    auto consider = [&](TriangleId t) {
-        if (!dt.is_live(t) || dt.label(t) != ocean) return;
-        double b = bad[t];
-        if (b > 1.0) {
-            push(b, t, front_edge(t) >= 0);
-        } else {
-            // An accepted triangle puts its bad neighbours on the front.
-            for (int i = 0; i < 3; ++i) {
-                TriangleId nb = triangle_of(dt.twin(half_edge(t, i)));
-                if (dt.label(nb) == ocean && !dt.is_constrained(half_edge(t, i))) {
-                    double bn = bad[nb];
-                    if (bn > 1.0) push(bn, nb, true);
-                }
-            }
-        }
-    };
-    std::vector<TriangleId> star_triangles;
-    auto consider_star = [&](VertexId v) {
-        // Every triangle created by the last insertion has v as a corner: rotate around v, give
-        // each its badness first (front_edge reads the neighbours'), then consider each.
-        TriangleId last = dt.last_triangle();
-        int k = 0;
-        while (k < 3 && dt.vertex(last, k) != v) ++k;
-        if (k == 3) return;
-        HalfEdge from = half_edge(last, prev3(k)); // leaves v
-        HalfEdge h = from;
-        star_triangles.clear();
-        do {
-            star_triangles.push_back(triangle_of(h));
-            refresh(triangle_of(h));
-            h = dt.next_around_origin(h);
-        } while (h != from);
-        for (TriangleId t : star_triangles) consider(t);
-    };
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (dt.is_live(t) && dt.label(t) == ocean) bad[t] = badness(m, t);
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) consider(t);
-    const std::size_t node_limit = 4 * report.estimated_nodes + 1000;
-    std::size_t inserted = 0;
-    // Stale entries are dropped whenever the heap doubles since the last sweep (this keeps the
-    // pop order: only entries that would be skipped go).
-    std::size_t compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
-    while (!queue.empty()) {
-        if (queue.size() >= compact_at) {
-            queue.remove_if(stale);
-            compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
-        }
-        const Candidate c = queue.pop();
-        const TriangleId t = c.t;
-        if (stale(c)) continue;
-        const int shift = c.active() ? 4 : 0;
-        slot_state[t] -= 1u << shift;
-        if ((slot_state[t] >> shift & 15u) != 0) queue.push(c); // the next copy
-        if (dt.vertex_count() > node_limit)
-            throw DataError("refinement does not converge (over " + std::to_string(node_limit) +
-                            " nodes): the size field may be too small for the boundary");
-        Vec3 centre = m.circumcentre(t);
-        if (int e = front_edge(t); e >= 0) {
-            // Off the front edge u->w (t on its left): the apex of an isosceles triangle whose
-            // circumradius is the target's, kept inside t's circumcircle (Rebay's point).
-            const Vec3& u = dt.point(dt.vertex(t, next3(e)));
-            const Vec3& w = dt.point(dt.vertex(t, prev3(e)));
-            Vec3 mid = arc_midpoint(u, w);
-            Vec3 left = normalized(cross(u, w));
-            double half = 0.5 * arc_angle(u, w);
-            // Grow from short front edges (e.g. short coast segments) at most by the edge's own
-            // length, so the mesh grades away from them instead of leaving slivers.
-            double target = circumradius_factor * km_to_rad(size_km(mid)) / std::sqrt(3.0) * frontal_radius_factor;
-            double rho = std::max(half, std::min(target, 2.0 * half * front_growth));
-            double height = rho + std::sqrt(std::max(0.0, rho * rho - half * half));
-            double to_centre = std::atan2(dot(centre, left), dot(centre, mid)); // signed, along the bisector
-            if (to_centre > 0) {
-                double d = std::min(height, to_centre);
-                centre = normalized(std::cos(d) * mid + std::sin(d) * left);
-            }
-        }
-        // Walk from t to the circumcentre; stop at the first constrained edge in the way, or at
-        // one whose diametral circle it lands in (Ruppert's rule): split that segment instead.
-        HalfEdge blocked = no_half_edge;
-        const TriangleId cur = m.walk_towards(t, centre, blocked);
-        VertexId v;
-        if (blocked != no_half_edge) {
-            // The circumcentre lies beyond a boundary segment: split the segment, if it is
-            // not already short against the size field.
-            v = m.split_segment(blocked);
-            if (v == no_vertex) continue;
-            ++report.encroached_splits;
-            consider_star(v);
-            // The triangle itself may survive the split: look at it again.
-            consider(t);
-        } else {
-            if (dt.label(cur) != ocean) continue;
-            std::size_t before = dt.vertex_count();
-            v = dt.insert_in_triangle(centre, cur);
-            if (dt.vertex_count() == before) continue; // merged with a close vertex
-            consider_star(v);
-        }
-        if ((++inserted & 0x3fff) == 0)
-            globemesh::report(progress, 0.15 + 0.6 * std::min(1.0, double(dt.vertex_count()) / double(report.estimated_nodes + 1)),
-                   "refine");
-    }
+    refine(m, progress);
     if (timings) timings->add("refine", seconds_since(t0));
 
     // ---- 5. improve --------------------------------------------------------------------------
     t0 = Clock::now();
-    // The refinement's memory goes before the smoothing's: the heap and the per-slot arrays.
-    queue.release();
-    std::vector<double>().swap(bad);
-    std::vector<std::uint32_t>().swap(slot_state);
     // Nodes are visited along the Hilbert curve, boundary nodes (fixed) left out. When the
     // refinement made most of them, they are renumbered in that order first, and the triangles
     // after them (SphericalDelaunay::renumber), so that neighbours lie near each other in memory:

@@ -397,28 +397,48 @@ struct BoundaryLoops {
     bool traced = false;
 };
 
-// The stages' entry points, each in the file named.
+// The stages' entry points, in the order mesh_boundary (mesher.cpp) runs them, each in the file
+// named.
 
-// classify.cpp
+// insert.cpp: the boundary rings' nodes triangulated (returns their vertices, ring after ring;
+// none for an empty boundary, which starts from an octahedron), then each segment made an edge.
+std::vector<VertexId> insert_boundary(Mesher& m, const Boundary& boundary);
+void recover_segments(Mesher& m, const Boundary& boundary, const std::vector<VertexId>& ids);
+
+// classify.cpp: the triangles labelled ocean (the largest component left of the segments, or
+// all with keep_inland_seas) or land; narrow inlets closed; corners below 60 degrees marked
+// sharp; the nodes estimated (refused past max_nodes or max_memory) and the triangulation
+// reserved for them.
+void classify_ocean(Mesher& m, const Boundary& boundary, const MesherOptions& options);
+void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report);
+void mark_sharp_corners(Mesher& m);
+void estimate_nodes(Mesher& m, const MesherOptions& options);
 void add_node_estimate(const std::function<double(const Vec3&)>& size_km, const Vec3& a, const Vec3& b,
                        const Vec3& c, double stop, double& sum);
-void close_inlets(Mesher& m, const MesherOptions& options, MesherReport& report);
-// islands.cpp
+
+// lattice.cpp: the open ocean filled with an icosahedral lattice; returns the nodes added.
+std::size_t fill_lattice(Mesher& m, double s_km, double max_points);
+
+// refine.cpp: refinement until every ocean triangle fits the size field and the shape bounds.
+void refine(Mesher& m, const Progress& progress);
+
+// smooth.cpp: the smoothing sweeps and the relaxation towards valence 6.
+std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std::uint8_t>& active);
+
+// islands.cpp: face centroids moved off the islands the coast shaping dropped.
 std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherReport& report,
                                   std::vector<TriangleId>& nearby);
-// land.cpp
+
+// land.cpp: faces centred on land removed, or nudged off it.
 std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<TriangleId> island_faces,
                               double pocket_area, MesherReport& report, std::vector<TriangleId>& left_faces,
                               BoundaryLoops& loops_state, bool straits = false,
                               std::vector<TriangleId>* cut_sides = nullptr);
 std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces,
                            std::vector<TriangleId>& left, std::vector<Vec3>& left_at);
-// straits.cpp
+
+// straits.cpp: straits narrower than a face closed.
 void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>& faces, const MesherOptions& options,
                    BoundaryLoops& loops, MesherReport& report);
-// smooth.cpp
-std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std::uint8_t>& active);
-// lattice.cpp
-std::size_t fill_lattice(Mesher& m, double s_km, double max_points);
 
 } // namespace globemesh::mesher_internal
