@@ -29,9 +29,6 @@ namespace mesher_internal {
 namespace {
 
 // The tuned constants of the stages still here (bench/RESULTS-mesher.md has the measurements).
-// A smoothing move shorter than this fraction of h is not made, and the node is left out of the
-// next sweep unless a neighbour moves: most of the sweeps' time saved, the quality the same.
-constexpr double settle_fraction = 0.01;
 // Then the nodes of triangles below this quality (away from sharp corners) get a pattern search
 // for their star's best worst triangle, for this many rounds (more rounds change nothing).
 constexpr double worst_goal = 0.6;
@@ -97,134 +94,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // ---- 5. improve --------------------------------------------------------------------------
     t0 = Clock::now();
-    // Nodes are visited along the Hilbert curve, boundary nodes (fixed) left out. When the
-    // refinement made most of them, they are renumbered in that order first, and the triangles
-    // after them (SphericalDelaunay::renumber), so that neighbours lie near each other in memory:
-    // the refinement numbers nodes in the order it makes them, all over the sphere level after
-    // level, where the lattice's come in Hilbert order already. The stages below and the
-    // output's numbering follow.
-    std::vector<char> lattice(dt.vertex_count(), 0); // the lattice's nodes
-    std::fill_n(lattice.begin() + lattice_first, report.lattice_nodes, 1);
-    std::vector<VertexId> visit;
-    {
-        using Key = decltype(detail::hilbert_key(Vec3{}));
-        std::vector<std::pair<Key, VertexId>> keyed;
-        keyed.reserve(dt.vertex_count());
-        for (VertexId v = 0; v < dt.vertex_count(); ++v) keyed.emplace_back(detail::hilbert_key(dt.point(v)), v);
-        std::sort(keyed.begin(), keyed.end());
-        if (2 * report.lattice_nodes < dt.vertex_count()) {
-            std::vector<VertexId> new_of_old(keyed.size());
-            for (std::size_t k = 0; k < keyed.size(); ++k) new_of_old[keyed[k].second] = static_cast<VertexId>(k);
-            for (std::size_t k = 0; k < keyed.size(); ++k) keyed[k].second = static_cast<VertexId>(k);
-            m.renumber(new_of_old);
-            renumber_per_vertex(lattice, new_of_old, char{0});
-        }
-        for (const auto& kv : keyed)
-            if (!m.is_fixed(kv.second)) visit.push_back(kv.second);
-    }
-    std::vector<FarEdge> far; // a star's far edges b -> c (triangles v, b, c)
-    std::vector<VertexId> ring;             // the star's outer vertices
-    // Per vertex, bit 0: visit in this sweep, bit 1: in the next. A node whose move would be
-    // shorter than settle_fraction of h stays and stays off the next sweep, unless a neighbour
-    // moves.
-    std::vector<std::uint8_t> active(dt.vertex_count(), 1);
-    // Per vertex: a lattice node among lattice nodes only that has not moved. Such a node is
-    // about where smoothing would leave it (inside a face of the icosahedron, the move is under
-    // 0.3% of the spacing, below settle_fraction), so it starts settled and moves only when a
-    // neighbour does; and a triangle of three is the lattice's own (q above 0.88), which the
-    // quality rounds below leave as it is.
-    std::vector<char> as_made(dt.vertex_count(), 0);
-    if (report.lattice_nodes > 0) {
-        as_made = lattice; // then those with every neighbour a lattice node too
-        for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-            if (!dt.is_live(t)) continue;
-            const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
-            if (!lattice[a] || !lattice[b] || !lattice[c]) as_made[a] = as_made[b] = as_made[c] = 0;
-        }
-        for (VertexId v = 0; v < dt.vertex_count(); ++v)
-            if (as_made[v]) active[v] = 0;
-    }
-    std::vector<char>().swap(lattice);
-    // Per vertex, the size there (km; NaN: not asked yet), for the sweeps: a triangle's size is
-    // the mean of its corners' (the size at its centroid where the field is linear over it; the
-    // grid's cells are about hfloor / 2), each evaluated when first asked and again when its
-    // node moves, instead of once per star triangle visited (the refinement's badness keeps
-    // the size at the centroid: from the corners it cost graded fields quality). No node is
-    // added while it is in use.
-    std::vector<float> vertex_size(dt.vertex_count(), std::numeric_limits<float>::quiet_NaN());
-    auto corner_size_km = [&](TriangleId t) {
-        double sum = 0;
-        for (int i = 0; i < 3; ++i) {
-            float& h = vertex_size[dt.vertex(t, i)];
-            if (std::isnan(h)) h = static_cast<float>(size_km(dt.point(dt.vertex(t, i))));
-            sum += h;
-        }
-        return sum / 3;
-    };
-    for (int sweep = 0; sweep < options.smooth_iterations; ++sweep) {
-        // One vertex map per sweep; flips make entries stale, so each serves as a walk hint
-        // (a triangle next to v) rather than an answer: the walk from it is a step or two.
-        const std::vector<HalfEdge> star = dt.vertex_half_edges();
-        for (std::size_t k = 0; k < visit.size(); ++k) {
-            const VertexId v = visit[k];
-            if (!(active[v] & 1)) continue;
-            // The next stars' entries are far apart in memory: ask for them ahead.
-            if (k + 16 < visit.size()) __builtin_prefetch(&star[visit[k + 16]]);
-            if (k + 8 < visit.size() && star[visit[k + 8]] != no_half_edge)
-                __builtin_prefetch(&dt.point(dt.destination(star[visit[k + 8]])));
-            if (star[v] == no_half_edge) continue;
-            HalfEdge from = star[v];
-            if (dt.origin(from) != v || !dt.is_live(triangle_of(from))) from = dt.leaving(v, triangle_of(from));
-            if (from == no_half_edge || dt.origin(from) != v) continue;
-            // Only nodes inside the kept ocean move.
-            Vec3 sum{0, 0, 0};
-            bool inside = true;
-            HalfEdge h = from;
-            std::size_t guard = 0;
-            far.clear();
-            ring.clear();
-            double hk = 0;
-            do {
-                TriangleId t = triangle_of(h);
-                if (dt.label(t) != ocean) {
-                    inside = false;
-                    break;
-                }
-                far.emplace_back(dt.point(dt.destination(h)), dt.point(dt.vertex(t, edge_of(h))));
-                ring.push_back(dt.destination(h));
-                const Vec3& a = dt.point(dt.vertex(t, 0));
-                const Vec3& b = dt.point(dt.vertex(t, 1));
-                const Vec3& c = dt.point(dt.vertex(t, 2));
-                Vec3 n = cross(b - a, c - a); // |n| = twice the chordal area
-                double area = 0.5 * norm(n);
-                // Optimal Delaunay triangulation update (Chen & Xu): weight the circumcentres by
-                // area / h^2 so that graded meshes keep their grading.
-                hk = corner_size_km(t);
-                sum = sum + (area / (hk * hk)) * normalized(n);
-                h = dt.next_around_origin(h);
-            } while (h != from && ++guard < 64);
-            if (!inside || norm(sum) == 0) continue;
-            // Refuse a move that would bring the worst triangle of the star below 0.6 and
-            // below where it was (smoothing must not flatten triangles against the coast).
-            const Vec3 target = normalized(sum);
-            // The quality before the move is needed only when the move would go below 0.6. (A
-            // move that would fold the star counts as -1: move_vertex_from refuses it anyway.)
-            if (norm(target - dt.point(v)) < settle_fraction * km_to_rad(hk)) continue;
-            if (lowers_worst_below(target, dt.point(v), far, 0.6)) continue;
-            if (!dt.move_vertex_from(from, target)) continue;
-            vertex_size[v] = static_cast<float>(size_km(target));
-            active[v] |= 2;
-            as_made[v] = 0;
-            for (VertexId u : ring) active[u] |= 2;
-        }
-        for (auto& a : active) a >>= 1;
-        if (sweep == options.smooth_iterations - 1) {
-            std::vector<float>().swap(vertex_size); // the relaxation moves nodes without it
-            report.valence_flips = relax_valence(m, as_made, active);
-        }
-        globemesh::report(progress, 0.75 + 0.2 * (sweep + 1) / std::max(1, options.smooth_iterations), "improve");
-    }
-    std::vector<float>().swap(vertex_size); // (with no sweeps)
+    std::vector<char> as_made = smooth(m, options, lattice_first, progress);
     // Then the nodes of the triangles still below q count_cap (next to the coast, or at valence
     // defects), a few rounds: each interior node goes where its star has the most triangles
     // above count_quality (star_count_score), searched from the best of a few candidates (the
@@ -265,6 +135,7 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         };
         std::vector<Vec3> candidates;
         std::vector<VertexId> touched;                 // move_checked's scratch
+        std::vector<FarEdge> far;        // a star's far edges b -> c (triangles v, b, c)
         std::vector<FarEdge> land_far;   // slide_node's: the star's far edges on land
         std::vector<Vec3> chain;                       // slide_node's: the points its search improved through
         // Moves v (`from` leaves it) to `to` (Mesher::move_if) when the ocean triangles the move

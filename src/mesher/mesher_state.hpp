@@ -422,7 +422,10 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points);
 // refine.cpp: refinement until every ocean triangle fits the size field and the shape bounds.
 void refine(Mesher& m, const Progress& progress);
 
-// smooth.cpp: the smoothing sweeps and the relaxation towards valence 6.
+// smooth.cpp: the smoothing sweeps and the relaxation towards valence 6 (report.valence_flips);
+// returns per vertex whether it is a lattice node that has not moved (the quality rounds leave
+// triangles of three such alone). lattice_first: the first of the report.lattice_nodes.
+std::vector<char> smooth(Mesher& m, const MesherOptions& options, VertexId lattice_first, const Progress& progress);
 std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std::uint8_t>& active);
 
 // islands.cpp: face centroids moved off the islands the coast shaping dropped.
