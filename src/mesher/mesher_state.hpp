@@ -428,6 +428,12 @@ void refine(Mesher& m, const Progress& progress);
 std::vector<char> smooth(Mesher& m, const MesherOptions& options, VertexId lattice_first, const Progress& progress);
 std::size_t relax_valence(Mesher& m, std::vector<char>& as_made, std::vector<std::uint8_t>& active);
 
+// quality.cpp: the quality rounds after the smoothing: the nodes of the triangles below q 0.82
+// move where their star has the most triangles above q 0.8 (boundary nodes slide near the coast
+// when options.land is given), pattern searches raise the worst triangles, and triangles with
+// two or three boundary corners are mended.
+void improve_quality(Mesher& m, const MesherOptions& options, std::vector<char>& as_made);
+
 // islands.cpp: face centroids moved off the islands the coast shaping dropped.
 std::size_t clear_dropped_islands(Mesher& m, const Boundary& boundary, MesherReport& report,
                                   std::vector<TriangleId>& nearby);
