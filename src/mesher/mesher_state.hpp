@@ -446,8 +446,14 @@ std::size_t remove_land_faces(Mesher& m, const LandTest& land_test, std::vector<
 std::size_t nudge_off_land(Mesher& m, const LandTest& land_test, const std::vector<TriangleId>& faces,
                            std::vector<TriangleId>& left, std::vector<Vec3>& left_at);
 
-// straits.cpp: straits narrower than a face closed.
+// straits.cpp: straits narrower than a face closed; clear_land runs the land clean-up (with
+// options.land): remove_land_faces, nudge_off_land, then close_straits and a second nudge.
+void clear_land(Mesher& m, const MesherOptions& options, std::vector<TriangleId> island_faces);
 void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>& faces, const MesherOptions& options,
                    BoundaryLoops& loops, MesherReport& report);
+
+// output.cpp: the ocean triangles as a Mesh (nodes a closed strait pinched split, the seas it cut
+// off, sharp corners and the target size per node in the report and the mesh).
+Mesh to_mesh(Mesher& m);
 
 } // namespace globemesh::mesher_internal

@@ -97,4 +97,18 @@ void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>
         if (is_ocean(t)) faces.push_back(t);
 }
 
+void clear_land(Mesher& m, const MesherOptions& options, std::vector<TriangleId> island_faces) {
+    MesherReport& report = m.report;
+    std::vector<TriangleId> left;
+    BoundaryLoops loops;
+    remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left, loops);
+    report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+    if (options.close_straits && !left.empty()) {
+        close_straits(m, *options.land, left, options, loops, report);
+        report.land_faces_at.clear();
+        if (!left.empty()) report.land_faces_nudged += nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+    }
+    report.land_faces_left = report.land_faces_at.size();
+}
+
 } // namespace globemesh::mesher_internal
