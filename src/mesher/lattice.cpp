@@ -30,15 +30,18 @@ struct LatticeCells {
     std::vector<Row> row_of; // 20 * (rows + 1)
     std::vector<std::uint32_t> cell;
 
-    const Row& row(int f, int i) const { return row_of[static_cast<std::size_t>(f) * (rows + 1) + i]; }
+    const Row &row(int f, int i) const {
+        return row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
+    }
     /// The cell of (i, j) in face f, or SIZE_MAX outside the face or the rows walked.
     std::size_t index(int f, int i, int j) const {
-        if (i < 0 || i > rows || j < 0 || j > rows - i) return SIZE_MAX;
-        const Row& r = row(f, i);
+        if (i < 0 || i > rows || j < 0 || j > rows - i)
+            return SIZE_MAX;
+        const Row &r = row(f, i);
         return j < r.lo || j > r.hi ? SIZE_MAX : r.start + static_cast<std::size_t>(j - r.lo);
     }
     /// The entry of (i, j) of face f in `of` (an array over the cells), or none outside.
-    std::uint32_t at(const std::vector<std::uint32_t>& of, int f, int i, int j) const {
+    std::uint32_t at(const std::vector<std::uint32_t> &of, int f, int i, int j) const {
         const std::size_t c = index(f, i, j);
         return c == SIZE_MAX ? none : of[c];
     }
@@ -57,22 +60,24 @@ struct LatticeCells {
 // lattice edge the rounding or the icosahedron's distortion left non-Delaunay: the result is
 // the triangulation point insertion would give, without locating each point and testing its
 // cavity. Returns the number of nodes added.
-std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& points) {
-    SphericalDelaunay& dt = m.dt;
+std::size_t place_lattice(Mesher &m, LatticeCells &grid, std::vector<Vec3> &points) {
+    SphericalDelaunay &dt = m.dt;
     constexpr std::uint32_t none = LatticeCells::none;
     const int rows = grid.rows;
-    const std::vector<std::uint32_t>& cell = grid.cell;
+    const std::vector<std::uint32_t> &cell = grid.cell;
     auto kept = [&](int f, int i, int j) { return grid.kept(f, i, j); };
     const std::size_t before = dt.vertex_count();
     std::vector<char> inner(points.size(), 0);
     for (int f = 0; f < 20; ++f)
         for (int i = 1; i < rows; ++i) {
-            const LatticeCells::Row& row = grid.row(f, i);
+            const LatticeCells::Row &row = grid.row(f, i);
             for (int j = std::max(row.lo, 1); j <= std::min(row.hi, rows - i - 1); ++j) {
                 const std::uint32_t id = cell[row.start + static_cast<std::size_t>(j - row.lo)];
-                if (id == none) continue;
-                inner[id] = kept(f, i + 1, j) != none && kept(f, i - 1, j) != none && kept(f, i, j + 1) != none &&
-                            kept(f, i, j - 1) != none && kept(f, i + 1, j - 1) != none && kept(f, i - 1, j + 1) != none;
+                if (id == none)
+                    continue;
+                inner[id] = kept(f, i + 1, j) != none && kept(f, i - 1, j) != none &&
+                            kept(f, i, j + 1) != none && kept(f, i, j - 1) != none &&
+                            kept(f, i + 1, j - 1) != none && kept(f, i - 1, j + 1) != none;
             }
         }
     std::vector<Vec3> rim, inside;
@@ -80,17 +85,21 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
     const auto inner_count = static_cast<std::size_t>(std::count(inner.begin(), inner.end(), 1));
     inside.reserve(inner_count);
     rim.reserve(points.size() - inner_count);
-    std::vector<VertexId> vertex_of(points.size(), no_vertex); // point -> vertex (inner: filled below)
-    for (std::size_t q = 0; q < points.size(); ++q) (inner[q] ? inside : rim).push_back(points[q]);
+    std::vector<VertexId> vertex_of(points.size(),
+                                    no_vertex); // point -> vertex (inner: filled below)
+    for (std::size_t q = 0; q < points.size(); ++q)
+        (inner[q] ? inside : rim).push_back(points[q]);
     if (!rim.empty()) {
         const std::vector<VertexId> ids = dt.insert_points(rim);
         for (std::size_t q = 0, r = 0; q < points.size(); ++q)
-            if (!inner[q]) vertex_of[q] = ids[r++];
+            if (!inner[q])
+                vertex_of[q] = ids[r++];
     }
     points.clear();
     points.shrink_to_fit();
     for (std::size_t q = 0, r = 0; q < vertex_of.size(); ++q)
-        if (inner[q]) vertex_of[q] = static_cast<VertexId>(dt.vertex_count() + r++);
+        if (inner[q])
+            vertex_of[q] = static_cast<VertexId>(dt.vertex_count() + r++);
     inner.clear();
     inner.shrink_to_fit();
     // The lattice triangles whose corners are all kept: up (i, j), (i + 1, j), (i, j + 1) at
@@ -101,12 +110,15 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
     std::uint32_t count = 0;
     for (int f = 0; f < 20; ++f)
         for (int i = 0; i < rows; ++i) {
-            const LatticeCells::Row& row = grid.row(f, i);
+            const LatticeCells::Row &row = grid.row(f, i);
             for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
                 const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
-                if (cell[c] == none || kept(f, i + 1, j) == none) continue;
-                if (kept(f, i, j + 1) != none) up[c] = count++;
-                if (kept(f, i + 1, j - 1) != none) down[c] = count++;
+                if (cell[c] == none || kept(f, i + 1, j) == none)
+                    continue;
+                if (kept(f, i, j + 1) != none)
+                    up[c] = count++;
+                if (kept(f, i + 1, j - 1) != none)
+                    down[c] = count++;
             }
         }
     std::vector<VertexId> triangles(3 * static_cast<std::size_t>(count));
@@ -117,7 +129,7 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
     // Links half-edge e of new triangle r (corners v) to edge e2 of new triangle t on its other
     // side or, when t is none, to the edge of the rim nodes' triangulation that it replaces
     // (a border edge; `fits` turns false when that edge is missing).
-    auto set_edge = [&](std::uint32_t r, int e, const VertexId* v, std::uint32_t t, int e2) {
+    auto set_edge = [&](std::uint32_t r, int e, const VertexId *v, std::uint32_t t, int e2) {
         if (t != none) {
             adjacent[3 * r + e] = 3 * t + e2;
             return;
@@ -125,17 +137,19 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
         const VertexId from = v[next3(e)], to = v[prev3(e)];
         const HalfEdge h = from < star.size() ? dt.find_edge(star[from], to) : no_half_edge;
         fits = fits && h != no_half_edge;
-        adjacent[3 * r + e] = SphericalDelaunay::patch_border | static_cast<std::uint32_t>(border.size());
+        adjacent[3 * r + e] =
+            SphericalDelaunay::patch_border | static_cast<std::uint32_t>(border.size());
         border.push_back(h);
     };
     for (int f = 0; f < 20 && fits; ++f)
         for (int i = 0; i < rows && fits; ++i) {
-            const LatticeCells::Row& row = grid.row(f, i);
+            const LatticeCells::Row &row = grid.row(f, i);
             for (int j = row.lo; j <= std::min(row.hi, rows - i - 1); ++j) {
                 const std::size_t c = row.start + static_cast<std::size_t>(j - row.lo);
                 if (const std::uint32_t r = up[c]; r != none) {
-                    VertexId* v = &triangles[3 * r];
-                    v[0] = vertex_of[cell[c]], v[1] = vertex_of[kept(f, i + 1, j)], v[2] = vertex_of[kept(f, i, j + 1)];
+                    VertexId *v = &triangles[3 * r];
+                    v[0] = vertex_of[cell[c]], v[1] = vertex_of[kept(f, i + 1, j)],
+                    v[2] = vertex_of[kept(f, i, j + 1)];
                     // Edge 0, (i + 1, j) -> (i, j + 1), is the down triangle's at (i, j + 1)
                     // edge 1; edge 1, (i, j + 1) -> (i, j), that at (i - 1, j + 1) edge 2;
                     // edge 2, (i, j) -> (i + 1, j), that at (i, j) edge 0.
@@ -144,8 +158,9 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
                     set_edge(r, 2, v, down[c], 0);
                 }
                 if (const std::uint32_t r = down[c]; r != none) {
-                    VertexId* w = &triangles[3 * r];
-                    w[0] = vertex_of[kept(f, i + 1, j - 1)], w[1] = vertex_of[kept(f, i + 1, j)], w[2] = vertex_of[cell[c]];
+                    VertexId *w = &triangles[3 * r];
+                    w[0] = vertex_of[kept(f, i + 1, j - 1)], w[1] = vertex_of[kept(f, i + 1, j)],
+                    w[2] = vertex_of[cell[c]];
                     // Edge 0, (i + 1, j) -> (i, j), is the up triangle's at (i, j) edge 2; edge
                     // 1, (i, j) -> (i + 1, j - 1), that at (i, j - 1) edge 0; edge 2,
                     // (i + 1, j - 1) -> (i + 1, j), that at (i + 1, j - 1) edge 1.
@@ -169,13 +184,15 @@ std::size_t place_lattice(Mesher& m, LatticeCells& grid, std::vector<Vec3>& poin
     }
     // Every new edge once (an edge between two new triangles from its smaller half-edge).
     std::vector<char> is_new(dt.triangle_slots(), 0);
-    for (TriangleId t : slots) is_new[t] = 1;
+    for (TriangleId t : slots)
+        is_new[t] = 1;
     std::vector<HalfEdge> to_check;
     to_check.reserve(3 * slots.size() / 2 + border.size());
     for (TriangleId t : slots)
         for (int e = 0; e < 3; ++e) {
             const HalfEdge h = half_edge(t, e), o = dt.twin(h);
-            if (h < o || !is_new[triangle_of(o)]) to_check.push_back(h);
+            if (h < o || !is_new[triangle_of(o)])
+                to_check.push_back(h);
         }
     dt.make_delaunay(to_check);
     m.report.lattice_patched = n_inside;
@@ -201,10 +218,11 @@ std::array<Vec3, 12> ico_corners() {
 // an edge or a corner) is made by the first face that has it.
 int owner(int a, int b) {
     for (int f = 0; f < 20; ++f) {
-        const int* v = ico_face[f];
+        const int *v = ico_face[f];
         const bool has_a = v[0] == a || v[1] == a || v[2] == a;
         const bool has_b = b < 0 || v[0] == b || v[1] == b || v[2] == b;
-        if (has_a && has_b) return f;
+        if (has_a && has_b)
+            return f;
     }
     return -1;
 }
@@ -214,8 +232,10 @@ int owner(int a, int b) {
 bool owns_node(int f, int i, int j, int k) {
     const int ia = ico_face[f][0], ib = ico_face[f][1], ic = ico_face[f][2];
     const int zeros = (i == 0) + (j == 0) + (k == 0);
-    if (zeros == 2) return owner(i > 0 ? ia : j > 0 ? ib : ic, -1) == f;
-    if (zeros == 1) return owner(i == 0 ? ib : ia, k == 0 ? ib : ic) == f;
+    if (zeros == 2)
+        return owner(i > 0 ? ia : j > 0 ? ib : ic, -1) == f;
+    if (zeros == 1)
+        return owner(i == 0 ? ib : ia, k == 0 ? ib : ic) == f;
     return true;
 }
 
@@ -225,21 +245,25 @@ bool owns_node(int f, int i, int j, int k) {
 struct Cap {
     Vec3 centre{0, 0, 0};
     double cos_r = -1;
-    bool contains(const Vec3& p) const { return dot(p, centre) >= cos_r * norm(p); } // p need not be unit
+    bool contains(const Vec3 &p) const {
+        return dot(p, centre) >= cos_r * norm(p);
+    } // p need not be unit
 };
 
 // The ocean's cap, with a margin of twice the spacing s for the jitter.
-Cap ocean_cap(const SphericalDelaunay& dt, double s) {
+Cap ocean_cap(const SphericalDelaunay &dt, double s) {
     Cap cap;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
         if (dt.is_live(t) && dt.label(t) == ocean)
-            for (int i = 0; i < 3; ++i) cap.centre = cap.centre + dt.point(dt.vertex(t, i));
+            for (int i = 0; i < 3; ++i)
+                cap.centre = cap.centre + dt.point(dt.vertex(t, i));
     if (norm(cap.centre) > 0) {
         cap.centre = normalized(cap.centre);
         cap.cos_r = 1;
         for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
             if (dt.is_live(t) && dt.label(t) == ocean)
-                for (int i = 0; i < 3; ++i) cap.cos_r = std::min(cap.cos_r, dot(dt.point(dt.vertex(t, i)), cap.centre));
+                for (int i = 0; i < 3; ++i)
+                    cap.cos_r = std::min(cap.cos_r, dot(dt.point(dt.vertex(t, i)), cap.centre));
         const double r = std::acos(cap.cos_r) + 2 * s; // a margin for the jitter
         cap.cos_r = r < 1.5 ? std::cos(r) : -1;
     }
@@ -250,7 +274,8 @@ Cap ocean_cap(const SphericalDelaunay& dt, double s) {
 // points in the cap are an interval [lo, hi] of j around the point nearest the cap's centre,
 // found by a ternary search (the cosine to the centre is unimodal along an arc under pi), and
 // its ends by bisection. False when no point of the row is in the cap.
-bool row_in_cap(const Cap& cap, const Vec3& a, const Vec3& b, const Vec3& c, int i, int len, int& lo, int& hi) {
+bool row_in_cap(const Cap &cap, const Vec3 &a, const Vec3 &b, const Vec3 &c, int i, int len,
+                int &lo, int &hi) {
     auto at = [&](int j) { return double(i) * a + double(j) * b + double(len - j) * c; };
     auto closeness = [&](int j) {
         const Vec3 q = at(j);
@@ -259,25 +284,33 @@ bool row_in_cap(const Cap& cap, const Vec3& a, const Vec3& b, const Vec3& c, int
     int x0 = 0, x1 = len;
     while (x1 - x0 > 2) {
         const int m1 = x0 + (x1 - x0) / 3, m2 = x1 - (x1 - x0) / 3;
-        if (closeness(m1) < closeness(m2)) x0 = m1 + 1;
-        else x1 = m2;
+        if (closeness(m1) < closeness(m2))
+            x0 = m1 + 1;
+        else
+            x1 = m2;
     }
     int best = x0;
     for (int j = x0 + 1; j <= x1; ++j)
-        if (closeness(j) > closeness(best)) best = j;
-    if (!cap.contains(at(best))) return false;
+        if (closeness(j) > closeness(best))
+            best = j;
+    if (!cap.contains(at(best)))
+        return false;
     int l = 0, r = best; // the first j in the cap
     while (l < r) {
         const int mid = l + (r - l) / 2;
-        if (cap.contains(at(mid))) r = mid;
-        else l = mid + 1;
+        if (cap.contains(at(mid)))
+            r = mid;
+        else
+            l = mid + 1;
     }
     lo = l;
     l = best, r = len; // the last
     while (l < r) {
         const int mid = l + (r - l + 1) / 2;
-        if (cap.contains(at(mid))) l = mid;
-        else r = mid - 1;
+        if (cap.contains(at(mid)))
+            l = mid;
+        else
+            r = mid - 1;
     }
     hi = l;
     return true;
@@ -287,10 +320,10 @@ bool row_in_cap(const Cap& cap, const Vec3& a, const Vec3& b, const Vec3& c, int
 // hashed, splitmix64): the lattice's mirror symmetries make many four points exactly
 // cocircular, each an in-circle test that only exact arithmetic decides.
 Vec3 lattice_shift(int f, int i, int j) {
-    std::uint64_t x =
-        (static_cast<std::uint64_t>(f) << 42) ^ (static_cast<std::uint64_t>(i) << 21) ^ static_cast<std::uint64_t>(j);
+    std::uint64_t x = (static_cast<std::uint64_t>(f) << 42) ^
+                      (static_cast<std::uint64_t>(i) << 21) ^ static_cast<std::uint64_t>(j);
     Vec3 shift;
-    for (double* e : {&shift.x, &shift.y, &shift.z}) {
+    for (double *e : {&shift.x, &shift.y, &shift.z}) {
         x += 0x9e3779b97f4a7c15ull;
         std::uint64_t z = x;
         z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -304,27 +337,35 @@ Vec3 lattice_shift(int f, int i, int j) {
 // its 12 corners, shared by the faces that have them.
 class SharedNodes {
 public:
-    explicit SharedNodes(int rows) : rows(rows), edge_node(30 * static_cast<std::size_t>(rows + 1), LatticeCells::none) {
-        for (auto& e : edge_id) e.fill(-1);
+    explicit SharedNodes(int rows)
+        : rows(rows), edge_node(30 * static_cast<std::size_t>(rows + 1), LatticeCells::none) {
+        for (auto &e : edge_id)
+            e.fill(-1);
         int edges = 0;
-        for (const auto& v : ico_face)
+        for (const auto &v : ico_face)
             for (int q = 0; q < 3; ++q) {
                 const int u = std::min(v[q], v[(q + 1) % 3]), w = std::max(v[q], v[(q + 1) % 3]);
-                if (edge_id[u][w] < 0) edge_id[u][w] = edges++;
+                if (edge_id[u][w] < 0)
+                    edge_id[u][w] = edges++;
             }
         corner_node.fill(LatticeCells::none);
     }
     // The shared entry of node (i, j, k) of face f (weights on its corners a, b, c), or null
     // inside the face.
-    std::uint32_t* at(int f, int i, int j, int k) {
+    std::uint32_t *at(int f, int i, int j, int k) {
         const int zeros = (i == 0) + (j == 0) + (k == 0);
-        if (zeros == 0) return nullptr;
-        const int* v = ico_face[f];
-        if (zeros == 2) return &corner_node[i > 0 ? v[0] : j > 0 ? v[1] : v[2]];
+        if (zeros == 0)
+            return nullptr;
+        const int *v = ico_face[f];
+        if (zeros == 2)
+            return &corner_node[i > 0 ? v[0] : j > 0 ? v[1] : v[2]];
         int u = v[0], w = v[1], wu = i, ww = j; // k == 0: the edge a-b
-        if (i == 0) u = v[1], w = v[2], wu = j, ww = k;
-        else if (j == 0) u = v[0], w = v[2], wu = i, ww = k;
-        if (u > w) std::swap(u, w), std::swap(wu, ww);
+        if (i == 0)
+            u = v[1], w = v[2], wu = j, ww = k;
+        else if (j == 0)
+            u = v[0], w = v[2], wu = i, ww = k;
+        if (u > w)
+            std::swap(u, w), std::swap(wu, ww);
         return &edge_node[static_cast<std::size_t>(edge_id[u][w]) * (rows + 1) + ww];
     }
     void release() { edge_node.clear(), edge_node.shrink_to_fit(); }
@@ -340,24 +381,29 @@ private:
 // clearance: the triangles whose edges come that close, from t.
 class Clearance {
 public:
-    Clearance(const SphericalDelaunay& dt, double clearance)
+    Clearance(const SphericalDelaunay &dt, double clearance)
         : dt(dt), clearance(clearance), sin2(std::pow(std::sin(clearance), 2)),
           chord2(std::pow(2.0 * std::sin(0.5 * clearance), 2)) {}
-    bool clear(const Vec3& p, TriangleId t) {
+    bool clear(const Vec3 &p, TriangleId t) {
         seen.assign(1, t);
         for (std::size_t k = 0; k < seen.size(); ++k) {
             for (int i = 0; i < 3; ++i) {
                 const HalfEdge e = half_edge(seen[k], i);
-                const Vec3& u = dt.point(dt.origin(e));
-                const Vec3& w = dt.point(dt.destination(e));
-                if (dot(u - p, u - p) < chord2) return false;
+                const Vec3 &u = dt.point(dt.origin(e));
+                const Vec3 &w = dt.point(dt.destination(e));
+                if (dot(u - p, u - p) < chord2)
+                    return false;
                 const Vec3 c = cross(u, w);
                 const double d = dot(p, c);
-                if (d * d >= sin2 * dot(c, c) || arc_distance(u, w, p) >= clearance) continue; // far from the arc's circle, or its ends
-                if (dt.is_constrained(e)) return false;
+                if (d * d >= sin2 * dot(c, c) || arc_distance(u, w, p) >= clearance)
+                    continue; // far from the arc's circle, or its ends
+                if (dt.is_constrained(e))
+                    return false;
                 const TriangleId nb = triangle_of(dt.twin(e));
-                if (std::find(seen.begin(), seen.end(), nb) != seen.end()) continue;
-                if (seen.size() == 64) return false; // a fan of long edges: leave it to the refinement
+                if (std::find(seen.begin(), seen.end(), nb) != seen.end())
+                    continue;
+                if (seen.size() == 64)
+                    return false; // a fan of long edges: leave it to the refinement
                 seen.push_back(nb);
             }
         }
@@ -365,7 +411,7 @@ public:
     }
 
 private:
-    const SphericalDelaunay& dt;
+    const SphericalDelaunay &dt;
     const double clearance, sin2, chord2;
     std::vector<TriangleId> seen;
 };
@@ -384,13 +430,15 @@ private:
 // Only the lattice's points in a cap around the ocean are walked (a region's), and none when
 // those are more than `max_points` (about 10 n^2 times the cap's share of the sphere). Returns
 // the number of nodes added.
-std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
-    SphericalDelaunay& dt = m.dt;
+std::size_t fill_lattice(Mesher &m, double s_km, double max_points) {
+    SphericalDelaunay &dt = m.dt;
     const double s = km_to_rad(s_km);
     const double n = std::max(1.0, std::round(lattice_edge_scale / s));
     const Cap cap = ocean_cap(dt, s);
-    const double cap_points = (10 * n * n + 2) * 0.5 * (1 - cap.cos_r); // the lattice's points in the cap, about
-    if (cap_points > max_points) return 0;
+    const double cap_points =
+        (10 * n * n + 2) * 0.5 * (1 - cap.cos_r); // the lattice's points in the cap, about
+    if (cap_points > max_points)
+        return 0;
     const std::array<Vec3, 12> corner = ico_corners();
     Clearance clearance(dt, lattice_clearance * s);
     // The points walked (a node of an edge or corner that another face owns is filled in
@@ -400,7 +448,7 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     LatticeCells grid;
     grid.rows = rows;
     grid.row_of.resize(20 * static_cast<std::size_t>(rows + 1));
-    std::vector<std::uint32_t>& cell = grid.cell;
+    std::vector<std::uint32_t> &cell = grid.cell;
     SharedNodes shared_nodes(rows);
     std::vector<Vec3> points;
     // Room for every lattice point of the cap (those on land or too near the coast are never
@@ -408,42 +456,51 @@ std::size_t fill_lattice(Mesher& m, double s_km, double max_points) {
     points.reserve(static_cast<std::size_t>(cap_points) + 1);
     TriangleId hint = no_triangle;
     for (int f = 0; f < 20; ++f) {
-        const Vec3 &a = corner[ico_face[f][0]], &b = corner[ico_face[f][1]], &c = corner[ico_face[f][2]];
+        const Vec3 &a = corner[ico_face[f][0]], &b = corner[ico_face[f][1]],
+                   &c = corner[ico_face[f][2]];
         // Skip a face whose cap (from its centre out to its corners) misses the ocean's.
         const Vec3 face_centre = normalized(a + b + c);
-        if (cap.cos_r > -1 && arc_angle(face_centre, cap.centre) > arc_angle(face_centre, a) + std::acos(cap.cos_r))
+        if (cap.cos_r > -1 &&
+            arc_angle(face_centre, cap.centre) > arc_angle(face_centre, a) + std::acos(cap.cos_r))
             continue;
         for (int i = 0; i <= rows; ++i) {
             const int len = rows - i;
             int lo = 0, hi = len;
-            if (cap.cos_r > -1 && !row_in_cap(cap, a, b, c, i, len, lo, hi)) continue;
-            LatticeCells::Row& row = grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
+            if (cap.cos_r > -1 && !row_in_cap(cap, a, b, c, i, len, lo, hi))
+                continue;
+            LatticeCells::Row &row = grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
             row = {lo, hi, cell.size()};
             cell.resize(cell.size() + static_cast<std::size_t>(hi - lo + 1), none);
             for (int step = 0; step <= hi - lo; ++step) {
                 const int j = i % 2 == 0 ? lo + step : hi - step;
                 const int k = rows - i - j;
-                if (!owns_node(f, i, j, k)) continue;
+                if (!owns_node(f, i, j, k))
+                    continue;
                 // Each point moved by a pseudo-random 1e-6 of the spacing.
-                const Vec3 p = normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
-                                          (lattice_jitter * s) * lattice_shift(f, i, j));
-                if (m.size_km(p) < lattice_level * s_km) continue;
+                const Vec3 p =
+                    normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
+                               (lattice_jitter * s) * lattice_shift(f, i, j));
+                if (m.size_km(p) < lattice_level * s_km)
+                    continue;
                 hint = dt.locate(p, hint);
-                if (dt.label(hint) != ocean || !clearance.clear(p, hint)) continue;
+                if (dt.label(hint) != ocean || !clearance.clear(p, hint))
+                    continue;
                 const auto id = static_cast<std::uint32_t>(points.size());
                 cell[row.start + static_cast<std::size_t>(j - lo)] = id;
-                if (std::uint32_t* shared = shared_nodes.at(f, i, j, k)) *shared = id;
+                if (std::uint32_t *shared = shared_nodes.at(f, i, j, k))
+                    *shared = id;
                 points.push_back(p);
             }
         }
     }
-    if (points.empty()) return 0;
+    if (points.empty())
+        return 0;
     // Every face's edge and corner cells from their owners.
     for (int f = 0; f < 20; ++f)
         for (int i = 0; i <= rows; ++i) {
-            const LatticeCells::Row& row = grid.row(f, i);
+            const LatticeCells::Row &row = grid.row(f, i);
             for (int j = row.lo; j <= row.hi; ++j)
-                if (const std::uint32_t* shared = shared_nodes.at(f, i, j, rows - i - j))
+                if (const std::uint32_t *shared = shared_nodes.at(f, i, j, rows - i - j))
                     cell[row.start + static_cast<std::size_t>(j - row.lo)] = *shared;
         }
     shared_nodes.release();

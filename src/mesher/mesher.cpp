@@ -8,17 +8,18 @@ namespace globemesh {
 
 using namespace mesher_internal;
 
-Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
-                   const MesherOptions& options, MesherReport* report_out, const Progress& progress,
-                   StageTimings* timings) {
+Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Vec3 &)> &size_km,
+                   const MesherOptions &options, MesherReport *report_out, const Progress &progress,
+                   StageTimings *timings) {
     MesherReport local_report;
-    MesherReport& report = report_out ? *report_out : local_report;
+    MesherReport &report = report_out ? *report_out : local_report;
     report = MesherReport{};
     Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, report);
     // Each timed() adds the seconds since the last to `timings` under the stage's name.
     auto t0 = Clock::now();
-    auto timed = [&](const char* stage) {
-        if (timings) timings->add(stage, seconds_since(t0));
+    auto timed = [&](const char *stage) {
+        if (timings)
+            timings->add(stage, seconds_since(t0));
         t0 = Clock::now();
     };
 
@@ -32,7 +33,8 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // Classification, inlets, sharp corners and the node estimate (classify.cpp).
     classify_ocean(m, boundary, options);
-    if (options.inlet_width > 0 && !boundary.empty()) close_inlets(m, options, report);
+    if (options.inlet_width > 0 && !boundary.empty())
+        close_inlets(m, options, report);
     globemesh::report(progress, 0.15, "classify");
     mark_sharp_corners(m);
     estimate_nodes(m, options);
@@ -40,9 +42,11 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
 
     // The lattice (lattice.cpp), whose points over the whole sphere may be a few times the nodes
     // asked for (the global ocean: 1.5 times), not more; then the refinement (refine.cpp).
-    const auto lattice_first = static_cast<VertexId>(m.dt.vertex_count()); // the lattice nodes follow
+    const auto lattice_first =
+        static_cast<VertexId>(m.dt.vertex_count()); // the lattice nodes follow
     if (options.lattice_km > 0)
-        report.lattice_nodes = fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000);
+        report.lattice_nodes =
+            fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000);
     refine(m, progress);
     timed("refine");
 

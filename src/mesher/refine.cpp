@@ -36,11 +36,11 @@ constexpr double badness_levels_per_doubling = 8;
 // skinny (radius-edge ratio above sqrt(2), i.e. a smallest angle below about 20.7 degrees).
 // Lengths are chords, not arcs: below 0.1 rad (637 km) they differ by under 0.05%, and a
 // chord needs no atan2 (this runs for every triangle the refinement creates).
-double badness(const Mesher& m, TriangleId t) {
-    const SphericalDelaunay& dt = m.dt;
-    const Vec3& a = dt.point(dt.vertex(t, 0));
-    const Vec3& b = dt.point(dt.vertex(t, 1));
-    const Vec3& d = dt.point(dt.vertex(t, 2));
+double badness(const Mesher &m, TriangleId t) {
+    const SphericalDelaunay &dt = m.dt;
+    const Vec3 &a = dt.point(dt.vertex(t, 0));
+    const Vec3 &b = dt.point(dt.vertex(t, 1));
+    const Vec3 &d = dt.point(dt.vertex(t, 2));
     const double r = norm(m.circumcentre(t) - a);
     double h = km_to_rad(m.size_km(m.centroid(t)));
     double size_ratio = r / (circumradius_factor * h / std::sqrt(3.0));
@@ -54,10 +54,14 @@ double badness(const Mesher& m, TriangleId t) {
     // apart where they touched) would otherwise be refined down to their own scale.
     // A triangle with a boundary corner is held to a tighter shape; one with two or three,
     // which smoothing cannot mend, is refined until its quality reaches quality_goal.
-    const int corners = m.is_fixed(dt.vertex(t, 0)) + m.is_fixed(dt.vertex(t, 1)) + m.is_fixed(dt.vertex(t, 2));
+    const int corners =
+        m.is_fixed(dt.vertex(t, 0)) + m.is_fixed(dt.vertex(t, 1)) + m.is_fixed(dt.vertex(t, 2));
     double shape_ratio = r / shortest / (corners > 0 ? coast_shape_bound : shape_bound);
-    if (corners >= 2) shape_ratio = std::max(shape_ratio, quality_goal / std::max(1e-3, triangle_quality(a, b, d)));
-    if (size_ratio < refine_floor) shape_ratio = 0;
+    if (corners >= 2)
+        shape_ratio =
+            std::max(shape_ratio, quality_goal / std::max(1e-3, triangle_quality(a, b, d)));
+    if (size_ratio < refine_floor)
+        shape_ratio = 0;
     return std::max(size_ratio, shape_ratio);
 }
 
@@ -70,25 +74,28 @@ struct Candidate {
     std::uint64_t order;
     TriangleId t;
     std::uint32_t stamp;
-    bool active() const { return (stamp & 1u) != 0; } // next to an accepted triangle or the boundary
-    bool operator<(const Candidate& o) const {
-        if (active() != o.active()) return !active();
-        if (order != o.order) return order < o.order;
+    bool active() const {
+        return (stamp & 1u) != 0;
+    } // next to an accepted triangle or the boundary
+    bool operator<(const Candidate &o) const {
+        if (active() != o.active())
+            return !active();
+        if (order != o.order)
+            return order < o.order;
         return t > o.t; // deterministic ties
     }
 };
 
 // Cache-line aligned storage for the heap below.
-template <class T>
-struct LineAllocator {
+template <class T> struct LineAllocator {
     using value_type = T;
     LineAllocator() = default;
-    template <class U>
-    LineAllocator(const LineAllocator<U>&) {}
-    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
-    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
-    template <class U>
-    bool operator==(const LineAllocator<U>&) const { return true; }
+    template <class U> LineAllocator(const LineAllocator<U> &) {}
+    T *allocate(std::size_t n) {
+        return static_cast<T *>(::operator new (n * sizeof(T), std::align_val_t{64}));
+    }
+    void deallocate(T *p, std::size_t) { ::operator delete (p, std::align_val_t{64}); }
+    template <class U> bool operator==(const LineAllocator<U> &) const { return true; }
 };
 
 // A max-heap of candidates with four children per node: half the depth of a binary heap, and
@@ -101,12 +108,13 @@ class CandidateHeap {
 public:
     bool empty() const { return size() == 0; }
     std::size_t size() const { return a_.size() - pad; }
-    void push(const Candidate& c) {
+    void push(const Candidate &c) {
         a_.push_back(c);
         std::size_t i = size() - 1;
         while (i > 0) {
             const std::size_t parent = (i - 1) / 4;
-            if (!(at(parent) < c)) break;
+            if (!(at(parent) < c))
+                break;
             at(i) = at(parent);
             i = parent;
         }
@@ -116,49 +124,53 @@ public:
         const Candidate top = at(0);
         const Candidate last = a_.back();
         a_.pop_back();
-        if (!empty()) sift_down(0, last);
+        if (!empty())
+            sift_down(0, last);
         return top;
     }
     /// Drops the entries for which `drop` holds and restores the heap.
-    template <class F>
-    void remove_if(F drop) {
-        std::erase_if(a_, [&](const Candidate& c) { return &c >= a_.data() + pad && drop(c); });
+    template <class F> void remove_if(F drop) {
+        std::erase_if(a_, [&](const Candidate &c) { return &c >= a_.data() + pad && drop(c); });
         for (std::size_t i = size() / 4 + 1; i-- > 0;)
-            if (i < size()) sift_down(i, at(i));
+            if (i < size())
+                sift_down(i, at(i));
     }
     void release() { std::vector<Candidate, LineAllocator<Candidate>>().swap(a_); }
 
 private:
     static constexpr std::size_t pad = 3;
-    Candidate& at(std::size_t i) { return a_[i + pad]; }
+    Candidate &at(std::size_t i) { return a_[i + pad]; }
     void sift_down(std::size_t i, const Candidate c) { // c by value: it may be at(i)
         const std::size_t n = size();
         for (;;) {
             const std::size_t first = 4 * i + 1;
-            if (first >= n) break;
+            if (first >= n)
+                break;
             std::size_t best = first;
             const std::size_t end = std::min(first + 4, n);
             for (std::size_t k = first + 1; k < end; ++k)
-                if (at(best) < at(k)) best = k;
-            if (!(c < at(best))) break;
+                if (at(best) < at(k))
+                    best = k;
+            if (!(c < at(best)))
+                break;
             at(i) = at(best);
             i = best;
         }
         at(i) = c;
     }
-    std::vector<Candidate, LineAllocator<Candidate>> a_ = std::vector<Candidate, LineAllocator<Candidate>>(pad);
+    std::vector<Candidate, LineAllocator<Candidate>> a_ =
+        std::vector<Candidate, LineAllocator<Candidate>>(pad);
 };
-
 
 // The refinement's queue and per-slot state (the lambdas of one loop, as members).
 class Refinement {
 public:
-    explicit Refinement(Mesher& m) : m(m), dt(m.dt) {}
-    void run(const Progress& progress);
+    explicit Refinement(Mesher &m) : m(m), dt(m.dt) {}
+    void run(const Progress &progress);
 
 private:
-    Mesher& m;
-    SphericalDelaunay& dt;
+    Mesher &m;
+    SphericalDelaunay &dt;
     // Badness per triangle slot, computed once when the core creates the triangle: a triangle
     // never changes while it lives (its corners, their fixed/sharp flags and the size field are
     // all fixed), and every triangle an insertion creates has the new vertex as a corner.
@@ -181,16 +193,19 @@ private:
         bad[t] = dt.label(t) == ocean ? badness(m, t) : 0.0;
     }
     std::uint64_t order_of(double b, TriangleId t) const {
-        const auto level = static_cast<std::uint64_t>(std::log2(b) * badness_levels_per_doubling); // b > 1
+        const auto level =
+            static_cast<std::uint64_t>(std::log2(b) * badness_levels_per_doubling); // b > 1
         return level << 32 | detail::hilbert_key(m.centroid(t));
     }
     void push(double b, TriangleId t, bool active) {
         const int shift = active ? 4 : 0;
         const std::uint32_t copies = (slot_state[t] >> shift) & 15u;
-        if (copies == 0) queue.push({order_of(b, t), t, (slot_state[t] >> 8) << 1 | (active ? 1u : 0u)});
-        if (copies < 15) slot_state[t] += 1u << shift; // (more than 15 copies: counted as 15)
+        if (copies == 0)
+            queue.push({order_of(b, t), t, (slot_state[t] >> 8) << 1 | (active ? 1u : 0u)});
+        if (copies < 15)
+            slot_state[t] += 1u << shift; // (more than 15 copies: counted as 15)
     }
-    bool stale(const Candidate& c) const {
+    bool stale(const Candidate &c) const {
         return !dt.is_live(c.t) || slot_state[c.t] >> 8 != c.stamp >> 1 || dt.label(c.t) != ocean;
     }
     int front_edge(TriangleId t) const;
@@ -210,7 +225,8 @@ int Refinement::front_edge(TriangleId t) const {
         HalfEdge h = half_edge(t, i);
         TriangleId nb = triangle_of(dt.twin(h));
         bool accepted = dt.is_constrained(h) || dt.label(nb) != ocean || bad[nb] <= 1.0;
-        if (!accepted) continue;
+        if (!accepted)
+            continue;
         const Vec3 d = dt.point(dt.destination(h)) - dt.point(dt.origin(h));
         const double len = dot(d, d); // the shortest chord is the shortest arc
         if (best < 0 || len < best_len) {
@@ -222,7 +238,8 @@ int Refinement::front_edge(TriangleId t) const {
 }
 
 void Refinement::consider(TriangleId t) {
-    if (!dt.is_live(t) || dt.label(t) != ocean) return;
+    if (!dt.is_live(t) || dt.label(t) != ocean)
+        return;
     double b = bad[t];
     if (b > 1.0) {
         push(b, t, front_edge(t) >= 0);
@@ -232,7 +249,8 @@ void Refinement::consider(TriangleId t) {
             TriangleId nb = triangle_of(dt.twin(half_edge(t, i)));
             if (dt.label(nb) == ocean && !dt.is_constrained(half_edge(t, i))) {
                 double bn = bad[nb];
-                if (bn > 1.0) push(bn, nb, true);
+                if (bn > 1.0)
+                    push(bn, nb, true);
             }
         }
     }
@@ -243,8 +261,10 @@ void Refinement::consider_star(VertexId v) {
     // each its badness first (front_edge reads the neighbours'), then consider each.
     TriangleId last = dt.last_triangle();
     int k = 0;
-    while (k < 3 && dt.vertex(last, k) != v) ++k;
-    if (k == 3) return;
+    while (k < 3 && dt.vertex(last, k) != v)
+        ++k;
+    if (k == 3)
+        return;
     HalfEdge from = half_edge(last, prev3(k)); // leaves v
     HalfEdge h = from;
     star_triangles.clear();
@@ -253,7 +273,8 @@ void Refinement::consider_star(VertexId v) {
         refresh(triangle_of(h));
         h = dt.next_around_origin(h);
     } while (h != from);
-    for (TriangleId t : star_triangles) consider(t);
+    for (TriangleId t : star_triangles)
+        consider(t);
 }
 
 // The point inserted for bad triangle t: its circumcentre or, on the front, the apex off the
@@ -263,17 +284,19 @@ Vec3 Refinement::insertion_point(TriangleId t) const {
     if (int e = front_edge(t); e >= 0) {
         // Off the front edge u->w (t on its left): the apex of an isosceles triangle whose
         // circumradius is the target's, kept inside t's circumcircle (Rebay's point).
-        const Vec3& u = dt.point(dt.vertex(t, next3(e)));
-        const Vec3& w = dt.point(dt.vertex(t, prev3(e)));
+        const Vec3 &u = dt.point(dt.vertex(t, next3(e)));
+        const Vec3 &w = dt.point(dt.vertex(t, prev3(e)));
         Vec3 mid = arc_midpoint(u, w);
         Vec3 left = normalized(cross(u, w));
         double half = 0.5 * arc_angle(u, w);
         // Grow from short front edges (e.g. short coast segments) at most by the edge's own
         // length, so the mesh grades away from them instead of leaving slivers.
-        double target = circumradius_factor * km_to_rad(m.size_km(mid)) / std::sqrt(3.0) * frontal_radius_factor;
+        double target = circumradius_factor * km_to_rad(m.size_km(mid)) / std::sqrt(3.0) *
+                        frontal_radius_factor;
         double rho = std::max(half, std::min(target, 2.0 * half * front_growth));
         double height = rho + std::sqrt(std::max(0.0, rho * rho - half * half));
-        double to_centre = std::atan2(dot(centre, left), dot(centre, mid)); // signed, along the bisector
+        double to_centre =
+            std::atan2(dot(centre, left), dot(centre, mid)); // signed, along the bisector
         if (to_centre > 0) {
             double d = std::min(height, to_centre);
             centre = normalized(std::cos(d) * mid + std::sin(d) * left);
@@ -295,26 +318,31 @@ bool Refinement::insert_for(TriangleId t) {
         // The circumcentre lies beyond a boundary segment: split the segment, if it is
         // not already short against the size field.
         v = m.split_segment(blocked);
-        if (v == no_vertex) return false;
+        if (v == no_vertex)
+            return false;
         ++m.report.encroached_splits;
         consider_star(v);
         // The triangle itself may survive the split: look at it again.
         consider(t);
     } else {
-        if (dt.label(cur) != ocean) return false;
+        if (dt.label(cur) != ocean)
+            return false;
         std::size_t before = dt.vertex_count();
         v = dt.insert_in_triangle(centre, cur);
-        if (dt.vertex_count() == before) return false; // merged with a close vertex
+        if (dt.vertex_count() == before)
+            return false; // merged with a close vertex
         consider_star(v);
     }
     return true;
 }
 
-void Refinement::run(const Progress& progress) {
-    const MesherReport& report = m.report;
+void Refinement::run(const Progress &progress) {
+    const MesherReport &report = m.report;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (dt.is_live(t) && dt.label(t) == ocean) bad[t] = badness(m, t);
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) consider(t);
+        if (dt.is_live(t) && dt.label(t) == ocean)
+            bad[t] = badness(m, t);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        consider(t);
     const std::size_t node_limit = 4 * report.estimated_nodes + 1000;
     std::size_t inserted = 0;
     // Stale entries are dropped whenever the heap doubles since the last sweep (this keeps the
@@ -322,28 +350,34 @@ void Refinement::run(const Progress& progress) {
     std::size_t compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
     while (!queue.empty()) {
         if (queue.size() >= compact_at) {
-            queue.remove_if([&](const Candidate& c) { return stale(c); });
+            queue.remove_if([&](const Candidate &c) { return stale(c); });
             compact_at = std::max<std::size_t>(2 * queue.size(), 1 << 16);
         }
         const Candidate c = queue.pop();
         const TriangleId t = c.t;
-        if (stale(c)) continue;
+        if (stale(c))
+            continue;
         const int shift = c.active() ? 4 : 0;
         slot_state[t] -= 1u << shift;
-        if ((slot_state[t] >> shift & 15u) != 0) queue.push(c); // the next copy
+        if ((slot_state[t] >> shift & 15u) != 0)
+            queue.push(c); // the next copy
         if (dt.vertex_count() > node_limit)
             throw DataError("refinement does not converge (over " + std::to_string(node_limit) +
                             " nodes): the size field may be too small for the boundary");
-        if (!insert_for(t)) continue;
+        if (!insert_for(t))
+            continue;
         if ((++inserted & 0x3fff) == 0)
             globemesh::report(progress,
-                              0.15 + 0.6 * std::min(1.0, double(dt.vertex_count()) / double(report.estimated_nodes + 1)),
+                              0.15 + 0.6 * std::min(1.0, double(dt.vertex_count()) /
+                                                             double(report.estimated_nodes + 1)),
                               "refine");
     }
 }
 
 } // namespace
 
-void refine(Mesher& m, const Progress& progress) { Refinement(m).run(progress); }
+void refine(Mesher &m, const Progress &progress) {
+    Refinement(m).run(progress);
+}
 
 } // namespace globemesh::mesher_internal

@@ -10,9 +10,9 @@ namespace globemesh::mesher_internal {
 // h^2: the rest of the strait, a narrow sound behind it) unless they touch an open boundary,
 // and stay otherwise as basins of their own (report.seas_cut_off). Leaves in `faces` those
 // still on land.
-void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>& faces, const MesherOptions& options,
-                   BoundaryLoops& loops, MesherReport& report) {
-    SphericalDelaunay& dt = m.dt;
+void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId> &faces,
+                   const MesherOptions &options, BoundaryLoops &loops, MesherReport &report) {
+    SphericalDelaunay &dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     std::vector<TriangleId> sides, left;
     remove_land_faces(m, land_test, faces, options.inlet_area, report, left, loops, true, &sides);
@@ -29,7 +29,8 @@ void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>
     std::vector<Flood> floods;
     std::unordered_map<TriangleId, std::uint32_t> piece;
     auto root = [&](std::uint32_t f) {
-        while (floods[f].parent != f) f = floods[f].parent = floods[floods[f].parent].parent;
+        while (floods[f].parent != f)
+            f = floods[f].parent = floods[floods[f].parent].parent;
         return f;
     };
     for (const TriangleId t : sides)
@@ -40,8 +41,9 @@ void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>
         const double cap = inlet_narrow_area * h * h;
         while (floods[f].next < floods[f].faces.size() && floods[root(f)].area <= cap) {
             const TriangleId t = floods[f].faces[floods[f].next++];
-            Flood& r = floods[root(f)];
-            r.area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)), dt.point(dt.vertex(t, 2)));
+            Flood &r = floods[root(f)];
+            r.area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                              dt.point(dt.vertex(t, 2)));
             for (int i = 0; i < 3; ++i) {
                 const TriangleId n = dt.neighbour(t, i);
                 if (!is_ocean(n)) {
@@ -69,44 +71,56 @@ void close_straits(Mesher& m, const LandTest& land_test, std::vector<TriangleId>
     std::vector<std::uint32_t> whole;
     std::vector<char> growing(floods.size(), 0);
     for (std::uint32_t f = 0; f < floods.size(); ++f)
-        if (floods[f].next < floods[f].faces.size()) growing[root(f)] = 1;
+        if (floods[f].next < floods[f].faces.size())
+            growing[root(f)] = 1;
     for (std::uint32_t f = 0; f < floods.size(); ++f)
-        if (root(f) == f && !growing[f]) whole.push_back(f);
+        if (root(f) == f && !growing[f])
+            whole.push_back(f);
     if (std::find(growing.begin(), growing.end(), 1) == growing.end() && !whole.empty())
-        whole.erase(std::max_element(whole.begin(), whole.end(),
-                                     [&](std::uint32_t x, std::uint32_t y) { return floods[x].area < floods[y].area; }));
+        whole.erase(
+            std::max_element(whole.begin(), whole.end(), [&](std::uint32_t x, std::uint32_t y) {
+                return floods[x].area < floods[y].area;
+            }));
     for (const std::uint32_t k : whole) {
-        const Flood& p = floods[k];
+        const Flood &p = floods[k];
         const double h = km_to_rad(m.size_km(m.centroid(p.faces[0])));
         const bool small = p.area <= options.inlet_area * h * h ||
-                           (p.area <= inlet_narrow_area * h * h && 2 * p.area < options.inlet_width * h * p.perimeter);
-        if (p.open || !small) continue;
+                           (p.area <= inlet_narrow_area * h * h &&
+                            2 * p.area < options.inlet_width * h * p.perimeter);
+        if (p.open || !small)
+            continue;
         report.straits_water_km2 += p.area * earth_radius_km * earth_radius_km;
         for (std::uint32_t f = 0; f < floods.size(); ++f)
             if (root(f) == k)
                 for (const TriangleId t : floods[f].faces) {
                     dt.set_label(t, land);
-                    ++(land_test.contains(m.centroid(t)) ? report.land_faces_removed : report.water_faces_removed);
+                    ++(land_test.contains(m.centroid(t)) ? report.land_faces_removed
+                                                         : report.water_faces_removed);
                 }
     }
     // Where the cuts are, for the count of basins they made (mesh_boundary's output).
     for (const TriangleId t : sides)
-        if (is_ocean(t)) m.cut_sides.push_back(t);
+        if (is_ocean(t))
+            m.cut_sides.push_back(t);
     faces.clear();
     for (const TriangleId t : left)
-        if (is_ocean(t)) faces.push_back(t);
+        if (is_ocean(t))
+            faces.push_back(t);
 }
 
-void clear_land(Mesher& m, const MesherOptions& options, std::vector<TriangleId> island_faces) {
-    MesherReport& report = m.report;
+void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces) {
+    MesherReport &report = m.report;
     std::vector<TriangleId> left;
     BoundaryLoops loops;
-    remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left, loops);
+    remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left,
+                      loops);
     report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
     if (options.close_straits && !left.empty()) {
         close_straits(m, *options.land, left, options, loops, report);
         report.land_faces_at.clear();
-        if (!left.empty()) report.land_faces_nudged += nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+        if (!left.empty())
+            report.land_faces_nudged +=
+                nudge_off_land(m, *options.land, left, left, report.land_faces_at);
     }
     report.land_faces_left = report.land_faces_at.size();
 }
