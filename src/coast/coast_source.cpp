@@ -210,9 +210,8 @@ std::uint64_t vertex_count(OGRGeometryH g) {
 
 /// Peak bytes per input vertex of load_coast: the lon/lat copy (16), GEOS's coordinate
 /// sequences of the polygon, its valid and dissolved copies (3 x 24), the rings on the sphere
-/// (24 + tags) and the containers' slack. Measured on ne_10m_land (0.41 M vertices): peak RSS
-/// 129 MB for a whole 100 km run against 60 MB for a run refused before reading, 170 B/vertex
-/// with the mesh included; rounded up.
+/// (24 + tags) and the containers' slack: 170 B/vertex measured, rounded up
+/// (bench/RESULTS-core-coast.md).
 constexpr std::uint64_t coast_bytes_per_vertex = 200;
 
 bool is_polygon_type(OGRwkbGeometryType t) {
