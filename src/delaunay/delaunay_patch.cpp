@@ -22,6 +22,48 @@ using predicates::orient;
 // Replacing a region by a known patch
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+// The patch alone (see replace_region): corners (new, or on the border), orientation, symmetric
+// links, each border edge taken once with its own ends. taker[k] gets the new half-edge in
+// border[k]'s place.
+template <class At>
+bool patch_fits(const SphericalDelaunay &d, std::span<const HalfEdge> border,
+                const std::vector<VertexId> &triangles, const std::vector<std::uint32_t> &adjacent,
+                std::size_t first, std::size_t end, const std::vector<char> &on_border, At at,
+                std::vector<std::uint32_t> &taker) {
+    const std::size_t nt = triangles.size() / 3;
+    for (std::size_t r = 0; r < nt; ++r) {
+        const VertexId *v = &triangles[3 * r];
+        if (v[0] >= end || v[1] >= end || v[2] >= end || v[0] == v[1] || v[1] == v[2] ||
+            v[2] == v[0])
+            return false;
+        for (int i = 0; i < 3; ++i)
+            if (v[i] < first && !on_border[v[i]])
+                return false;
+        if (predicates::orient(at(v[0]), at(v[1]), at(v[2])) <= 0)
+            return false;
+        for (int i = 0; i < 3; ++i) {
+            const std::uint32_t a = adjacent[3 * r + i];
+            if (a & SphericalDelaunay::patch_border) {
+                const std::uint32_t k = a & ~SphericalDelaunay::patch_border;
+                if (k >= border.size() || taker[k] != no_half_edge)
+                    return false;
+                taker[k] = static_cast<std::uint32_t>(3 * r + i);
+                if (d.origin(border[k]) != v[next3(i)] || d.destination(border[k]) != v[prev3(i)])
+                    return false;
+            } else if (a >= 3 * nt || adjacent[a] != 3 * r + i || a / 3 == r ||
+                       triangles[a - a % 3 + next3(a % 3)] != v[prev3(i)] ||
+                       triangles[a - a % 3 + prev3(a % 3)] != v[next3(i)]) {
+                return false;
+            }
+        }
+    }
+    return std::find(taker.begin(), taker.end(), no_half_edge) == taker.end();
+}
+
+} // namespace
+
 bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::vector<Vec3> &points,
                                        std::vector<VertexId> &triangles,
                                        std::vector<std::uint32_t> &adjacent, std::uint8_t label,
@@ -58,36 +100,9 @@ bool SphericalDelaunay::replace_region(std::span<const HalfEdge> border, std::ve
         return std::lower_bound(by_edge.begin(), by_edge.end(), std::make_pair(h, std::uint32_t{0}))
             ->second;
     };
-    // The patch alone: corners (new, or on the border), orientation, symmetric links, each
-    // border edge taken once with its own ends. taker[k]: the new half-edge in border[k]'s place.
+    // The patch alone; taker[k]: the new half-edge in border[k]'s place.
     std::vector<std::uint32_t> taker(border.size(), no_half_edge);
-    for (std::size_t r = 0; r < nt; ++r) {
-        const VertexId *v = &triangles[3 * r];
-        if (v[0] >= end || v[1] >= end || v[2] >= end || v[0] == v[1] || v[1] == v[2] ||
-            v[2] == v[0])
-            return false;
-        for (int i = 0; i < 3; ++i)
-            if (v[i] < first && !on_border[v[i]])
-                return false;
-        if (predicates::orient(at(v[0]), at(v[1]), at(v[2])) <= 0)
-            return false;
-        for (int i = 0; i < 3; ++i) {
-            const std::uint32_t a = adjacent[3 * r + i];
-            if (a & patch_border) {
-                const std::uint32_t k = a & ~patch_border;
-                if (k >= border.size() || taker[k] != no_half_edge)
-                    return false;
-                taker[k] = static_cast<std::uint32_t>(3 * r + i);
-                if (origin(border[k]) != v[next3(i)] || destination(border[k]) != v[prev3(i)])
-                    return false;
-            } else if (a >= 3 * nt || adjacent[a] != 3 * r + i || a / 3 == r ||
-                       triangles[a - a % 3 + next3(a % 3)] != v[prev3(i)] ||
-                       triangles[a - a % 3 + prev3(a % 3)] != v[next3(i)]) {
-                return false;
-            }
-        }
-    }
-    if (std::find(taker.begin(), taker.end(), no_half_edge) != taker.end())
+    if (!patch_fits(*this, border, triangles, adjacent, first, end, on_border, at, taker))
         return false;
     // Each border edge's other side (twin and constrained flag), read before any change.
     std::vector<std::uint32_t> outside(border.size());
