@@ -38,6 +38,81 @@ GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
     return std::move(parts.front());
 }
 
+/// Union-find over polygon indices (path halving).
+struct Groups {
+    std::vector<std::size_t> parent;
+    explicit Groups(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+    std::size_t find(std::size_t i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    }
+};
+
+/// Joins the polygons that intersect: an STR tree's candidates confirmed by GEOS's prepared test.
+void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
+                       const std::vector<int> &vertices, Groups &groups) {
+    const std::size_t n = polys.size();
+    auto find = [&](std::size_t i) { return groups.find(i); };
+    std::vector<std::size_t> &parent = groups.parent;
+    TreePtr tree(GEOSSTRtree_create_r(geos.get(), 10), GeosDeleter{geos.get()});
+    for (std::size_t i = 0; i < n; ++i)
+        GEOSSTRtree_insert_r(geos.get(), tree.get(), polys[i].get(), reinterpret_cast<void *>(i));
+    std::vector<std::size_t> hits;
+    auto collect = [](void *item, void *user) {
+        static_cast<std::vector<std::size_t> *>(user)->push_back(
+            reinterpret_cast<std::size_t>(item));
+    };
+    // Of each pair, the polygon with more vertices is the prepared one, kept for its other
+    // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
+    // the geometry tested against a prepared one anew on every call. Intersection is
+    // symmetric: the groups are the same.
+    std::vector<PreparedPtr> prepared;
+    for (std::size_t i = 0; i < n; ++i)
+        prepared.emplace_back(nullptr, GeosDeleter{geos.get()});
+    auto prepared_of = [&](std::size_t i) {
+        if (!prepared[i])
+            prepared[i].reset(GEOSPrepare_r(geos.get(), polys[i].get()));
+        return prepared[i].get();
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        coast::GeosInterrupt::poll(); // a long run of short GEOS calls, none of which reports
+        hits.clear();
+        GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
+        std::sort(hits.begin(), hits.end());
+        for (std::size_t j : hits) {
+            if (j <= i || find(i) == find(j))
+                continue;
+            const auto [big, small] = vertices[j] > vertices[i] ? std::pair{j, i} : std::pair{i, j};
+            if (GEOSPreparedIntersects_r(geos.get(), prepared_of(big), polys[small].get()) == 1)
+                parent[find(j)] = find(i);
+        }
+        prepared[i].reset(); // its pairs are all done: later ones have both indices above i
+    }
+}
+
+/// Joins the polygons whose outlines come within 2 cells of each other (near-touches), marking
+/// in near_only those joined by distance alone.
+void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Groups &groups,
+               std::vector<char> &near_only) {
+    const std::size_t n = polys.size();
+    auto find = [&](std::size_t i) { return groups.find(i); };
+    std::vector<std::size_t> &parent = groups.parent;
+    std::vector<PolygonRings> outlines(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        outlines[i].push_back(ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polys[i].get())));
+        for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polys[i].get()); ++h)
+            outlines[i].push_back(
+                ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polys[i].get(), h)));
+    }
+    for (auto [i, j] : coast_detail::near_pairs(outlines, 2 * grid)) {
+        if (find(i) == find(j))
+            continue;
+        near_only[j] = 1;
+        parent[find(j)] = find(i);
+    }
+}
+
 } // namespace
 
 GeomPtr make_ring(Geos &geos, const PointList &pts) {
@@ -191,72 +266,15 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
             polys.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
     }
     std::size_t n = polys.size();
-    std::vector<std::size_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0);
-    auto find = [&](std::size_t i) {
-        while (parent[i] != i)
-            i = parent[i] = parent[parent[i]];
-        return i;
-    };
+    Groups joined(n);
+    auto find = [&](std::size_t i) { return joined.find(i); };
     std::vector<char> near_only(n, 0); // joined by distance alone, not by intersection
     std::vector<int> vertices(n);
     for (std::size_t i = 0; i < n; ++i)
         vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
-    {
-        TreePtr tree(GEOSSTRtree_create_r(geos.get(), 10), GeosDeleter{geos.get()});
-        for (std::size_t i = 0; i < n; ++i)
-            GEOSSTRtree_insert_r(geos.get(), tree.get(), polys[i].get(),
-                                 reinterpret_cast<void *>(i));
-        std::vector<std::size_t> hits;
-        auto collect = [](void *item, void *user) {
-            static_cast<std::vector<std::size_t> *>(user)->push_back(
-                reinterpret_cast<std::size_t>(item));
-        };
-        // Of each pair, the polygon with more vertices is the prepared one, kept for its other
-        // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
-        // the geometry tested against a prepared one anew on every call. Intersection is
-        // symmetric: the groups are the same.
-        std::vector<PreparedPtr> prepared;
-        for (std::size_t i = 0; i < n; ++i)
-            prepared.emplace_back(nullptr, GeosDeleter{geos.get()});
-        auto prepared_of = [&](std::size_t i) {
-            if (!prepared[i])
-                prepared[i].reset(GEOSPrepare_r(geos.get(), polys[i].get()));
-            return prepared[i].get();
-        };
-        for (std::size_t i = 0; i < n; ++i) {
-            coast::GeosInterrupt::poll(); // a long run of short GEOS calls, none of which reports
-            hits.clear();
-            GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
-            std::sort(hits.begin(), hits.end());
-            for (std::size_t j : hits) {
-                if (j <= i || find(i) == find(j))
-                    continue;
-                const auto [big, small] =
-                    vertices[j] > vertices[i] ? std::pair{j, i} : std::pair{i, j};
-                if (GEOSPreparedIntersects_r(geos.get(), prepared_of(big), polys[small].get()) == 1)
-                    parent[find(j)] = find(i);
-            }
-            prepared[i].reset(); // its pairs are all done: later ones have both indices above i
-        }
-    }
+    join_intersecting(geos, polys, vertices, joined);
     // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
-    {
-        std::vector<PolygonRings> outlines(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            outlines[i].push_back(
-                ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polys[i].get())));
-            for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polys[i].get()); ++h)
-                outlines[i].push_back(
-                    ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polys[i].get(), h)));
-        }
-        for (auto [i, j] : coast_detail::near_pairs(outlines, 2 * grid)) {
-            if (find(i) == find(j))
-                continue;
-            near_only[j] = 1;
-            parent[find(j)] = find(i);
-        }
-    }
+    join_near(geos, polys, grid, joined, near_only);
     // Each group goes to GEOS as one collection: a polygon alone through GEOS's precision
     // reducer, several through a snap-rounding union. Lone polygons go in batches of about
     // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap

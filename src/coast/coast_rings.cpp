@@ -2,6 +2,7 @@
 // cut at the +-180 seam and the poles and stitched into closed rings with their segment kinds
 // (coast or open), inland water dropped or kept, pinched nodes separated.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -300,6 +301,56 @@ struct Bbox {
     }
 };
 
+/// The --region box (two boxes when it crosses +-180), its sides on the snap grid; `clip` says so.
+GeomPtr box_domain(Geos &geos, const std::array<double, 4> &region, Clip &clip) {
+    auto [w, s, e, n] = region;
+    if (!(s < n) || s < -90 || n > 90 || w < -180 || w > 180 || e < -180 || e > 180 || w == e)
+        throw UsageError("--region W,S,E,N: need -180 <= W, E <= 180, W != E, -90 <= S < N <= 90");
+    // The box's sides on the land's snap grid, so that land clipped to the same box (data
+    // downloaded for the area) meets them exactly instead of leaving slivers of ocean.
+    auto on_grid = [](double v) { return std::nearbyint(v / snap_grid_deg) * snap_grid_deg; };
+    w = on_grid(w), s = on_grid(s), e = on_grid(e), n = on_grid(n);
+    clip.box = true;
+    clip.w = w, clip.s = s, clip.e = e, clip.n = n;
+    clip.seam_glued = w > e || (w == -180 && e == 180);
+    std::vector<GeomPtr> boxes;
+    if (w < e) {
+        boxes.push_back(
+            own(geos, GEOSGeom_createRectangle_r(geos.get(), w, s, e, n), "build the region"));
+    } else {
+        boxes.push_back(
+            own(geos, GEOSGeom_createRectangle_r(geos.get(), w, s, 180, n), "build the region"));
+        boxes.push_back(
+            own(geos, GEOSGeom_createRectangle_r(geos.get(), -180, s, e, n), "build the region"));
+    }
+    GeomPtr domain = make_collection(geos, boxes);
+    return own(geos, GEOSUnaryUnion_r(geos.get(), domain.get()), "build the region");
+}
+
+/// The --region-file polygons, valid, dissolved and clipped to the globe; `clip` gets their
+/// prepared outline (held in `outline` and `prepared_outline`).
+GeomPtr file_domain(Geos &geos, const MeshOptions &options, Clip &clip, GeomPtr &outline,
+                    PreparedPtr &prepared_outline) {
+    Source region = read_source(options.region_file, options.region_layer, "", "", "--region-file",
+                                options.max_memory_bytes);
+    std::vector<GeomPtr> rparts;
+    for (const auto &poly : region.polygons)
+        rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
+    if (rparts.empty())
+        throw DataError("--region-file " + options.region_file + " holds no polygons");
+    GeomPtr all = make_collection(geos, rparts);
+    GeomPtr domain = own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), snap_grid_deg),
+                         "dissolve the region");
+    GeomPtr world = own(geos, GEOSGeom_createRectangle_r(geos.get(), -180, -90, 180, 90), "build");
+    domain = own(geos, GEOSIntersectionPrec_r(geos.get(), domain.get(), world.get(), snap_grid_deg),
+                 "clip the region");
+    outline = own(geos, GEOSBoundary_r(geos.get(), domain.get()), "take the region outline");
+    prepared_outline.reset(GEOSPrepare_r(geos.get(), outline.get()));
+    clip.boundary = prepared_outline.get();
+    clip.seam_glued = false; // the outline along +-180 is the user's region edge
+    return domain;
+}
+
 } // namespace
 
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
@@ -484,49 +535,9 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Me
     if (options.region && !options.region_file.empty())
         throw UsageError("--region and --region-file exclude each other: give one");
     if (options.region) {
-        auto [w, s, e, n] = *options.region;
-        if (!(s < n) || s < -90 || n > 90 || w < -180 || w > 180 || e < -180 || e > 180 || w == e)
-            throw UsageError(
-                "--region W,S,E,N: need -180 <= W, E <= 180, W != E, -90 <= S < N <= 90");
-        // The box's sides on the land's snap grid, so that land clipped to the same box (data
-        // downloaded for the area) meets them exactly instead of leaving slivers of ocean.
-        auto on_grid = [](double v) { return std::nearbyint(v / snap_grid_deg) * snap_grid_deg; };
-        w = on_grid(w), s = on_grid(s), e = on_grid(e), n = on_grid(n);
-        clip.box = true;
-        clip.w = w, clip.s = s, clip.e = e, clip.n = n;
-        clip.seam_glued = w > e || (w == -180 && e == 180);
-        std::vector<GeomPtr> boxes;
-        if (w < e) {
-            boxes.push_back(
-                own(geos, GEOSGeom_createRectangle_r(geos.get(), w, s, e, n), "build the region"));
-        } else {
-            boxes.push_back(own(geos, GEOSGeom_createRectangle_r(geos.get(), w, s, 180, n),
-                                "build the region"));
-            boxes.push_back(own(geos, GEOSGeom_createRectangle_r(geos.get(), -180, s, e, n),
-                                "build the region"));
-        }
-        domain = make_collection(geos, boxes);
-        domain = own(geos, GEOSUnaryUnion_r(geos.get(), domain.get()), "build the region");
+        domain = box_domain(geos, *options.region, clip);
     } else {
-        Source region = read_source(options.region_file, options.region_layer, "", "",
-                                    "--region-file", options.max_memory_bytes);
-        std::vector<GeomPtr> rparts;
-        for (const auto &poly : region.polygons)
-            rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
-        if (rparts.empty())
-            throw DataError("--region-file " + options.region_file + " holds no polygons");
-        GeomPtr all = make_collection(geos, rparts);
-        domain = own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), snap_grid_deg),
-                     "dissolve the region");
-        GeomPtr world =
-            own(geos, GEOSGeom_createRectangle_r(geos.get(), -180, -90, 180, 90), "build");
-        domain =
-            own(geos, GEOSIntersectionPrec_r(geos.get(), domain.get(), world.get(), snap_grid_deg),
-                "clip the region");
-        outline = own(geos, GEOSBoundary_r(geos.get(), domain.get()), "take the region outline");
-        prepared_outline.reset(GEOSPrepare_r(geos.get(), outline.get()));
-        clip.boundary = prepared_outline.get();
-        clip.seam_glued = false; // the outline along +-180 is the user's region edge
+        domain = file_domain(geos, options, clip, outline, prepared_outline);
     }
     // Only the land near the region matters: cut it to the region's extent first (fast).
     double x0, y0, x1, y1;
