@@ -48,8 +48,7 @@ using TreePtr = GeosPtr<GEOSSTRtree>;
 /// was interrupted, and g may be null), else DataError naming `what` when g is null.
 inline GeomPtr own(Geos &geos, GEOSGeometry *g, const char *what) {
     GeomPtr owned(g, GeosDeleter{geos.get()});
-    coast::GeosInterrupt::poll(); // Cancelled once the run is (then g may be null: GEOS was
-                                  // interrupted)
+    coast::GeosInterrupt::poll();
     if (!g)
         throw DataError(std::string("coast: GEOS failed to ") + what + ": " + geos.message());
     return owned;
