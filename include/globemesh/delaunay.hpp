@@ -264,6 +264,10 @@ private:
     bool visible(TriangleId t, const Vec3& p) const;
     // id: the vertex p becomes (an adopted point's slot), or no_vertex to append p.
     VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id = no_vertex);
+    // insert_in_cavity's steps: the cavity (marked, in cavity_, its rim in cavity_boundary_), and
+    // the vertex it swallows that p merges into, or no_vertex with the others' drops listed.
+    void grow_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
+    VertexId swallowed_vertex(const Vec3& p, VertexId split_a, VertexId split_b, std::size_t& drops);
     // Both triangles of a flip as they were (vertices and link words), to undo it exactly.
     struct FlipRecord {
         TriangleId t, s;

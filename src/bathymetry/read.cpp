@@ -287,6 +287,60 @@ std::string fmt_count(double v) {
     return buf;
 }
 
+/// Reads the window (columns c0 .. c0 + nx - 1, rows r0 .. r0 + ny - 1) of the band into
+/// `values`, bx x by cells (GDAL's average when that is coarser), as float.
+void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std::size_t nx, std::size_t ny,
+                 std::size_t bx, std::size_t by, std::vector<float>& values, const Progress& progress,
+                 const std::string& stage, const std::string& path) {
+    const double sy = static_cast<double>(ny) / static_cast<double>(by);
+    // Strips of rows, so that progress and cancellation are reported while GDAL reads its blocks.
+    int block_x = 0, block_y = 0;
+    GDALGetBlockSize(read_band, &block_x, &block_y);
+    std::size_t strip = std::max<std::size_t>(1, std::min<std::size_t>(by, std::max(block_y, 64)));
+    for (std::size_t s0 = 0; s0 < by; s0 += strip) {
+        std::size_t s1 = std::min(by, s0 + strip);
+        GDALRasterIOExtraArg extra;
+        INIT_RASTERIO_EXTRA_ARG(extra);
+        gdal::ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
+                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
+        if (progress) {
+            extra.pfnProgress = gdal::ProgressBridge::call;
+            extra.pProgressData = &bridge;
+        }
+        double y0 = static_cast<double>(s0) * sy, y1 = static_cast<double>(s1) * sy;
+        int iy0 = static_cast<int>(std::floor(y0));
+        int iy1 = std::min(static_cast<int>(ny), static_cast<int>(std::ceil(y1 - 1e-9)));
+        if (bx != nx || by != ny) {
+            extra.eResampleAlg = GRIORA_Average;
+            extra.bFloatingPointWindowValidity = TRUE;
+            extra.dfXOff = static_cast<double>(c0);
+            extra.dfXSize = static_cast<double>(nx);
+            extra.dfYOff = static_cast<double>(r0) + y0;
+            extra.dfYSize = y1 - y0;
+        }
+        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0), static_cast<int>(r0) + iy0,
+                                    static_cast<int>(nx), iy1 - iy0, values.data() + s0 * bx, static_cast<int>(bx),
+                                    static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
+        if (bridge.cancelled) throw Cancelled();
+        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal::last_error());
+    }
+}
+
+/// Raw values -> metres, elevation positive up; nodata and NaN -> NaN.
+void to_elevation(std::vector<float>& values, double scale, double offset, int has_nodata, double nodata,
+                  bool depth_positive) {
+    const float nodata_f = static_cast<float>(nodata);
+    const bool nodata_nan = has_nodata && std::isnan(nodata);
+    for (float& v : values) {
+        if (!std::isfinite(v) || (has_nodata && !nodata_nan && v == nodata_f)) {
+            v = std::numeric_limits<float>::quiet_NaN();
+            continue;
+        }
+        double z = static_cast<double>(v) * scale + offset;
+        v = static_cast<float>(depth_positive ? -z : z);
+    }
+}
+
 } // namespace
 
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
@@ -298,9 +352,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
 
 /// GDAL's block cache capped while a raster is read: every block is read once, so a larger cache
 /// only holds blocks that are never asked for again (by default 5% of the RAM, which --max-memory
-/// does not see). A GDAL_CACHEMAX the user set stays. Measured on a 40000 x 20000 Int16 GeoTIFF
-/// read to 15 km cells with --max-memory 1GB: default cache (900 MB here) read_bathy 6.3 s,
-/// process peak 1.31 GB; 64 MB 2.2 s, 137 MB; 16 MB 2.1 s, 88 MB.
+/// does not see). A GDAL_CACHEMAX the user set stays. 64 MB at most: no slower than a larger
+/// cache, a tenth of its peak (bench/RESULTS-core-coast.md).
 class BlockCacheCap {
 public:
     explicit BlockCacheCap(std::uint64_t budget_bytes) : old_(GDALGetCacheMax64()) {
@@ -428,49 +481,9 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     const double dlon = gt[1] * sx, dlat = gt[5] * sy;
 
     std::vector<float> values(bx * by);
-    // Strips of rows, so that progress and cancellation are reported while GDAL reads its blocks.
-    int block_x = 0, block_y = 0;
-    GDALGetBlockSize(read_band, &block_x, &block_y);
-    std::size_t strip = std::max<std::size_t>(1, std::min<std::size_t>(by, std::max(block_y, 64)));
-    for (std::size_t s0 = 0; s0 < by; s0 += strip) {
-        std::size_t s1 = std::min(by, s0 + strip);
-        GDALRasterIOExtraArg extra;
-        INIT_RASTERIO_EXTRA_ARG(extra);
-        gdal::ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
-                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
-        if (progress) {
-            extra.pfnProgress = gdal::ProgressBridge::call;
-            extra.pProgressData = &bridge;
-        }
-        double y0 = static_cast<double>(s0) * sy, y1 = static_cast<double>(s1) * sy;
-        int iy0 = static_cast<int>(std::floor(y0));
-        int iy1 = std::min(static_cast<int>(ny), static_cast<int>(std::ceil(y1 - 1e-9)));
-        if (bx != nx || by != ny) {
-            extra.eResampleAlg = GRIORA_Average;
-            extra.bFloatingPointWindowValidity = TRUE;
-            extra.dfXOff = static_cast<double>(c0);
-            extra.dfXSize = static_cast<double>(nx);
-            extra.dfYOff = static_cast<double>(r0) + y0;
-            extra.dfYSize = y1 - y0;
-        }
-        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0), static_cast<int>(r0) + iy0,
-                                    static_cast<int>(nx), iy1 - iy0, values.data() + s0 * bx, static_cast<int>(bx),
-                                    static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
-        if (bridge.cancelled) throw Cancelled();
-        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal::last_error());
-    }
+    read_window(read_band, c0, r0, nx, ny, bx, by, values, progress, stage, path);
 
-    // Raw values -> metres, elevation positive up; nodata and NaN -> NaN.
-    const float nodata_f = static_cast<float>(nodata);
-    const bool nodata_nan = has_nodata && std::isnan(nodata);
-    for (float& v : values) {
-        if (!std::isfinite(v) || (has_nodata && !nodata_nan && v == nodata_f)) {
-            v = std::numeric_limits<float>::quiet_NaN();
-            continue;
-        }
-        double z = static_cast<double>(v) * scale + offset;
-        v = static_cast<float>(depth_positive ? -z : z);
-    }
+    to_elevation(values, scale, offset, has_nodata, nodata, depth_positive);
 
     const double west = gt[0] + static_cast<double>(c0) * gt[1], top = gt[3] + static_cast<double>(r0) * gt[5];
     Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));

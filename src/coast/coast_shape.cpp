@@ -203,31 +203,17 @@ void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<s
     last = std::move(now);
 }
 
-} // namespace
 
-Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
-                        CoastReport* report_out, const Progress& progress) {
-    if (!size_km) throw UsageError("shape_boundary: no size function given");
-    CoastReport rep;
-    rep.islands_removed = coast.islands_removed;
-    rep.lakes_removed = coast.lakes_removed;
-    rep.area_gained_km2 = coast.area_gained_km2;
-    rep.area_lost_km2 = coast.area_lost_km2;
-    report(progress, 0.0, "shaping coast");
-
-    const double r2 = earth_radius_km * earth_radius_km;
-    auto h_at = [&](const Vec3& v) {
-        double h = size_km(v);
-        if (!(h > 0) || !std::isfinite(h))
-            throw UsageError("the target size must be positive (got " + std::to_string(h) + " km)");
-        return km_to_rad(h);
-    };
-
+/// Step 1 of shape_boundary: the rings kept, each with its size at every node; the small ones
+/// dropped are counted in `rep` and the islands among them added to `dropped_islands`.
+template <class H>
+std::vector<ShapedRing> drop_small_rings(const CoastData& coast, const H& h_at, const MeshOptions& options,
+                                         CoastReport& rep, std::vector<std::vector<Vec3>>& dropped_islands) {
     // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
     //    water bodies (ocean on the left that small, also a pocket of water that land cuts off
     //    at a region's edge); the land outside a region's outline is never an island.
+    const double r2 = earth_radius_km * earth_radius_km;
     std::vector<ShapedRing> shaped;
-    std::vector<std::vector<Vec3>> dropped_islands;
     bool dropped_water = false;
     // The largest water ring on a region's outline stays whatever its size (a size wider than
     // the region is refused later, naming it).
@@ -273,105 +259,115 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
         throw DataError("the ocean of --coast " + options.coast +
                         " is smaller than a few triangles of the target size: lower the size or "
                         "--min-island-triangles");
-    report(progress, 0.2, "simplifying coast");
+    return shaped;
+}
 
-    // 2. Douglas-Peucker on the sphere between anchors (kind changes, plus three spread nodes).
-    for (auto& s : shaped) {
-        const Ring& ring = *s.ring;
-        std::uint32_t n = static_cast<std::uint32_t>(ring.nodes.size());
-        std::vector<bool> keep(n, false);
-        for (std::uint32_t i = 0; i < n; ++i)
-            if (ring.kinds[i] != ring.kinds[(i + n - 1) % n]) keep[i] = true;
-        keep[0] = keep[n / 3] = keep[(2 * n) / 3] = true;
-        s.anchor = keep;
-        // The shape at the scale of h (tolerance h/2, nodes at least h/2 apart) gives the corners.
-        auto simplify = [&](double tolerance) {
-            std::vector<std::uint32_t> from;
-            for (std::uint32_t i = 0; i < n; ++i)
-                if (keep[i]) from.push_back(i);
-            for (std::size_t a = 0; a < from.size(); ++a)
-                simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance, keep);
-        };
-        simplify(0.5);
-        // Thin nodes closer than half the local size to the previous kept node.
-        std::uint32_t last = 0;
-        for (std::uint32_t i = 1; i < n; ++i) {
-            if (!keep[i]) continue;
-            if (!s.anchor[i] && arc_angle(ring.nodes[last], ring.nodes[i]) < 0.5 * std::min(s.h_rad[last], s.h_rad[i])) {
-                std::uint32_t next = i + 1;
-                while (next < n && !keep[next]) ++next;
-                std::uint32_t nn = next % n;
-                // Only when the merged arc stays short and close to the dropped node.
-                if (arc_angle(ring.nodes[last], ring.nodes[nn]) < max_simplified_arc &&
-                    arc_distance(ring.nodes[last], ring.nodes[nn], ring.nodes[i]) < 0.5 * s.h_rad[i]) {
-                    keep[i] = false;
-                    continue;
-                }
-            }
-            last = i;
-        }
-        // Corners: where the kind changes, and where the line turns sharply at the scale of h;
-        // of two corners less than h/2 apart along the line, the one that turns less goes.
-        s.corner.assign(n, false);
-        {
-            std::vector<std::uint32_t> coarse;
-            for (std::uint32_t i = 0; i < n; ++i)
-                if (keep[i]) coarse.push_back(i);
-            const std::size_t m = coarse.size();
-            std::vector<double> turn(m, 0.0);
-            std::vector<char> must(m, 0);
-            for (std::size_t k = 0; k < m; ++k) {
-                const std::uint32_t i = coarse[k];
-                must[k] = ring.kinds[i] != ring.kinds[(i + n - 1) % n];
-                turn[k] = turn_angle(ring.nodes[coarse[(k + m - 1) % m]], ring.nodes[i], ring.nodes[coarse[(k + 1) % m]]);
-            }
-            std::size_t prev = m; // the last corner kept, m: none yet
-            double since = 0;     // line length from it, in units of h
-            for (std::size_t k = 0; k < m; ++k) {
-                if (k > 0) {
-                    const std::uint32_t a = coarse[k - 1], b = coarse[k];
-                    since += arc_angle(ring.nodes[a], ring.nodes[b]) / std::min(s.h_rad[a], s.h_rad[b]);
-                }
-                if (!must[k] && !(turn[k] > corner_turn)) continue;
-                if (prev < m && since < 0.5) {
-                    if (must[prev] || (!must[k] && turn[prev] >= turn[k])) continue; // k goes
-                    s.corner[coarse[prev]] = false;                                // prev goes
-                }
-                s.corner[coarse[k]] = true;
-                prev = k;
-                since = 0;
-            }
-        }
-        // The line the nodes are placed on: within simplify_tolerance * h of the source.
-        simplify(simplify_tolerance);
-        for (std::uint32_t i = 0; i < n; ++i)
-            if (keep[i]) s.kept.push_back(i);
+/// Corners: where the kind changes, and where the line turns sharply at the scale of h;
+/// of two corners less than h/2 apart along the line, the one that turns less goes.
+/// Marks them in s.corner among the nodes `keep` holds.
+void mark_corners(ShapedRing& s, const std::vector<bool>& keep) {
+    const Ring& ring = *s.ring;
+    const std::uint32_t n = static_cast<std::uint32_t>(ring.nodes.size());
+    s.corner.assign(n, false);
+    std::vector<std::uint32_t> coarse;
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (keep[i]) coarse.push_back(i);
+    const std::size_t m = coarse.size();
+    std::vector<double> turn(m, 0.0);
+    std::vector<char> must(m, 0);
+    for (std::size_t k = 0; k < m; ++k) {
+        const std::uint32_t i = coarse[k];
+        must[k] = ring.kinds[i] != ring.kinds[(i + n - 1) % n];
+        turn[k] = turn_angle(ring.nodes[coarse[(k + m - 1) % m]], ring.nodes[i], ring.nodes[coarse[(k + 1) % m]]);
     }
-    report(progress, 0.5, "resampling coast");
-    // The coast's nodes at the local size, at least (each arc over the larger size at its
-    // ends): a size of metres asks a global coast for billions, refused here as the mesher
-    // would refuse them, before the resampling spends the time and memory to make them.
-    {
-        double coast_nodes = 0;
-        for (const ShapedRing& s : shaped)
-            for (std::size_t k = 0; k < s.kept.size(); ++k) {
-                const std::uint32_t a = s.kept[k], b = s.kept[(k + 1) % s.kept.size()];
-                coast_nodes += arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
-            }
-        if (coast_nodes > static_cast<double>(options.max_nodes))
-            throw DataError("the coast alone asks for about " + std::to_string(std::llround(coast_nodes)) +
-                            " nodes at the target size, more than --max-nodes " + std::to_string(options.max_nodes) +
-                            ": raise --hmin/--hmax or --max-nodes");
+    std::size_t prev = m; // the last corner kept, m: none yet
+    double since = 0;     // line length from it, in units of h
+    for (std::size_t k = 0; k < m; ++k) {
+        if (k > 0) {
+            const std::uint32_t a = coarse[k - 1], b = coarse[k];
+            since += arc_angle(ring.nodes[a], ring.nodes[b]) / std::min(s.h_rad[a], s.h_rad[b]);
+        }
+        if (!must[k] && !(turn[k] > corner_turn)) continue;
+        if (prev < m && since < 0.5) {
+            if (must[prev] || (!must[k] && turn[prev] >= turn[k])) continue; // k goes
+            s.corner[coarse[prev]] = false;                                // prev goes
+        }
+        s.corner[coarse[k]] = true;
+        prev = k;
+        since = 0;
     }
+}
 
+/// Step 2 of shape_boundary, for one ring: Douglas-Peucker on the sphere between anchors (kind
+/// changes, plus three spread nodes); s gets its anchors, corners and kept nodes.
+void simplify_ring(ShapedRing& s) {
+    const Ring& ring = *s.ring;
+    std::uint32_t n = static_cast<std::uint32_t>(ring.nodes.size());
+    std::vector<bool> keep(n, false);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (ring.kinds[i] != ring.kinds[(i + n - 1) % n]) keep[i] = true;
+    keep[0] = keep[n / 3] = keep[(2 * n) / 3] = true;
+    s.anchor = keep;
+    // The shape at the scale of h (tolerance h/2, nodes at least h/2 apart) gives the corners.
+    auto simplify = [&](double tolerance) {
+        std::vector<std::uint32_t> from;
+        for (std::uint32_t i = 0; i < n; ++i)
+            if (keep[i]) from.push_back(i);
+        for (std::size_t a = 0; a < from.size(); ++a)
+            simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance, keep);
+    };
+    simplify(0.5);
+    // Thin nodes closer than half the local size to the previous kept node.
+    std::uint32_t last = 0;
+    for (std::uint32_t i = 1; i < n; ++i) {
+        if (!keep[i]) continue;
+        if (!s.anchor[i] && arc_angle(ring.nodes[last], ring.nodes[i]) < 0.5 * std::min(s.h_rad[last], s.h_rad[i])) {
+            std::uint32_t next = i + 1;
+            while (next < n && !keep[next]) ++next;
+            std::uint32_t nn = next % n;
+            // Only when the merged arc stays short and close to the dropped node.
+            if (arc_angle(ring.nodes[last], ring.nodes[nn]) < max_simplified_arc &&
+                arc_distance(ring.nodes[last], ring.nodes[nn], ring.nodes[i]) < 0.5 * s.h_rad[i]) {
+                keep[i] = false;
+                continue;
+            }
+        }
+        last = i;
+    }
+    mark_corners(s, keep);
+    // The line the nodes are placed on: within simplify_tolerance * h of the source.
+    simplify(simplify_tolerance);
+    for (std::uint32_t i = 0; i < n; ++i)
+        if (keep[i]) s.kept.push_back(i);
+}
+
+/// The coast's nodes at the local size, at least (each arc over the larger size at its
+/// ends): a size of metres asks a global coast for billions, refused here as the mesher
+/// would refuse them, before the resampling spends the time and memory to make them.
+void check_node_count(const std::vector<ShapedRing>& shaped, const MeshOptions& options) {
+    double coast_nodes = 0;
+    for (const ShapedRing& s : shaped)
+        for (std::size_t k = 0; k < s.kept.size(); ++k) {
+            const std::uint32_t a = s.kept[k], b = s.kept[(k + 1) % s.kept.size()];
+            coast_nodes += arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
+        }
+    if (coast_nodes > static_cast<double>(options.max_nodes))
+        throw DataError("the coast alone asks for about " + std::to_string(std::llround(coast_nodes)) +
+                        " nodes at the target size, more than --max-nodes " + std::to_string(options.max_nodes) +
+                        ": raise --hmin/--hmax or --max-nodes");
+}
+
+/// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
+template <class H>
+std::vector<Resampled> resample_clear(std::vector<ShapedRing>& shaped, const H& h_at, CoastReport& rep,
+                                      const Progress& progress) {
     // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
     //    not conflict.
     //    Each round after the first resamples only the runs that got a corner (resample) and
-    //    tests only their new arcs (ArcGrid): the same rings and conflicts as doing it all again
-    //    (the boundary stage on 1:50m land at 64 km, 11 rounds: 0.033 -> 0.019 s; on 1:10m at
-    //    100 km, 116 rounds: 0.155 -> 0.058 s; at 10 km, 24 rounds: 0.83 -> 0.23 s).
+    //    tests only their new arcs (ArcGrid): the same rings and conflicts as doing it all again,
+    //    in a fraction of the time (bench/RESULTS-core-coast.md).
     std::vector<Resampled> resampled(shaped.size());
     std::vector<std::vector<Vec3>> rings(shaped.size());
     std::vector<const std::vector<Vec3>*> ptrs;
@@ -444,6 +440,37 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
         }
         report(progress, 0.5 + 0.4 * (1.0 - 1.0 / (round + 2)), "checking coast topology");
     }
+    return resampled;
+}
+
+} // namespace
+
+Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
+                        CoastReport* report_out, const Progress& progress) {
+    if (!size_km) throw UsageError("shape_boundary: no size function given");
+    CoastReport rep;
+    rep.islands_removed = coast.islands_removed;
+    rep.lakes_removed = coast.lakes_removed;
+    rep.area_gained_km2 = coast.area_gained_km2;
+    rep.area_lost_km2 = coast.area_lost_km2;
+    report(progress, 0.0, "shaping coast");
+
+    auto h_at = [&](const Vec3& v) {
+        double h = size_km(v);
+        if (!(h > 0) || !std::isfinite(h))
+            throw UsageError("the target size must be positive (got " + std::to_string(h) + " km)");
+        return km_to_rad(h);
+    };
+
+    std::vector<std::vector<Vec3>> dropped_islands;
+    std::vector<ShapedRing> shaped = drop_small_rings(coast, h_at, options, rep, dropped_islands);
+    report(progress, 0.2, "simplifying coast");
+
+    for (auto& s : shaped) simplify_ring(s);
+    report(progress, 0.5, "resampling coast");
+    check_node_count(shaped, options);
+
+    const std::vector<Resampled> resampled = resample_clear(shaped, h_at, rep, progress);
 
     Boundary out;
     for (std::size_t r = 0; r < shaped.size(); ++r) {

@@ -10,6 +10,7 @@
 
 #include <geos_c.h>
 
+#include "geos_handles.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 
@@ -28,10 +29,8 @@ constexpr std::size_t piece_vertices = 16;
 // cells_per_degree), clamped to the grid: monotone in x in floating point too, so a segment lies
 // in the cells between its ends' cells. A block's cells are numbered by the piece of the block
 // they lie in (runs of each row joined with the row below), and the pieces joined across the
-// blocks' sides into components (union-find). 1:50m land: 6,949 blocks with coast, 72,125
-// pieces in 1,456 components, about 2.7 MB, built in 15 ms; of the 70,036 land tests of a 64 km
-// mesh, 14,615 reach GEOS (all of them before), of the 218,589 of a 20 km mesh 69,708. Cells
-// of 1/32 degree sent 11,033 and 51,424 to GEOS but took 40 ms to build.
+// blocks' sides into components (union-find). 1/16 degree: finer cells send few fewer tests to
+// GEOS and take longer to build (bench/RESULTS-core-coast.md).
 constexpr int cells_per_degree = 16;
 constexpr int block_side = 16; // a block's row is 16 bits of a 64-bit word of `touched`
 constexpr int cells_x = 360 * cells_per_degree, cells_y = 180 * cells_per_degree;
@@ -43,18 +42,26 @@ int cell_of(double x, double origin, int cells) {
     return c <= 0 ? 0 : c >= cells - 1 ? cells - 1 : static_cast<int>(c);
 }
 
+using coast_detail::GeomPtr;
+using coast_detail::GeosDeleter;
+using coast_detail::PreparedPtr;
+using coast_detail::TreePtr;
+
+// Members are destroyed in reverse order: each tree before the geometries it indexes, the
+// prepared polygons before the polygons, the context last.
 struct LandMask::Impl {
-    GEOSContextHandle_t ctx = GEOS_init_r();
-    std::vector<GEOSGeometry*> polygons;
-    std::vector<const GEOSPreparedGeometry*> prepared;
-    GEOSSTRtree* tree = nullptr;
+    coast_detail::Geos geos;
+    GEOSContextHandle_t ctx = geos.get();
+    std::vector<GeomPtr> polygons;
+    std::vector<PreparedPtr> prepared;
+    TreePtr tree;
     // The outlines (shells and holes) as unit vectors, cut into pieces of piece_vertices
     // vertices (the last one shared with the next piece), under an STR tree of their lon/lat
     // envelopes: the coast distance is measured on the sphere, segment by segment.
     std::vector<Vec3> outline;            // every piece's vertices, one piece after another
     std::vector<std::size_t> piece_start; // piece i is outline[piece_start[i], piece_start[i + 1])
-    std::vector<GEOSGeometry*> envelopes;
-    GEOSSTRtree* pieces = nullptr;
+    std::vector<GeomPtr> envelopes;
+    TreePtr pieces;
     // The cells (see cells_per_degree): per cell, set when a segment's box touches it (built by
     // add_segments, then read by label_pieces); per block, the offset of its cells' piece
     // numbers in `piece` (0: a segment touches the cell, else 1 + the piece within the block)
@@ -68,16 +75,6 @@ struct LandMask::Impl {
     std::vector<std::uint32_t> component;   // per piece, the component's first piece
     mutable std::vector<std::int8_t> answer; // per piece: used at the components' first pieces
 
-    ~Impl() {
-        if (tree) GEOSSTRtree_destroy_r(ctx, tree);
-        if (pieces) GEOSSTRtree_destroy_r(ctx, pieces);
-        for (const auto* p : prepared)
-            if (p) GEOSPreparedGeom_destroy_r(ctx, p);
-        for (auto* g : envelopes) GEOSGeom_destroy_r(ctx, g);
-        for (auto* g : polygons) GEOSGeom_destroy_r(ctx, g);
-        GEOS_finish_r(ctx);
-    }
-
     void add_outline(const std::vector<LonLat>& pts) {
         for (std::size_t first = 0; first + 1 < pts.size(); first += piece_vertices - 1) {
             const std::size_t last = std::min(first + piece_vertices, pts.size());
@@ -88,9 +85,9 @@ struct LandMask::Impl {
                 y0 = std::min(y0, pts[k].lat), y1 = std::max(y1, pts[k].lat);
                 outline.push_back(lonlat_to_vec(pts[k].lon, pts[k].lat));
             }
-            GEOSGeometry* box = GEOSGeom_createRectangle_r(ctx, x0, y0, x1, y1);
+            GeomPtr box(GEOSGeom_createRectangle_r(ctx, x0, y0, x1, y1), GeosDeleter{ctx});
             if (!box) throw DataError("coast: GEOS failed to build an envelope for the land test");
-            envelopes.push_back(box);
+            envelopes.push_back(std::move(box));
         }
     }
 
@@ -214,23 +211,22 @@ struct LandMask::Impl {
 
     // GEOS's answer: inside one of the polygons whose envelope holds the point.
     bool geos_contains(const LonLat& ll) const {
-        GEOSGeometry* point = GEOSGeom_createPointFromXY_r(ctx, ll.lon, ll.lat);
+        const GeomPtr point(GEOSGeom_createPointFromXY_r(ctx, ll.lon, ll.lat), GeosDeleter{ctx});
         if (!point) throw DataError("coast: GEOS failed to build a point for the land test");
         struct Query {
             const Impl* m;
             const GEOSGeometry* point;
             bool inside = false;
-        } q{this, point};
+        } q{this, point.get()};
         GEOSSTRtree_query_r(
-            ctx, tree, point,
+            ctx, tree.get(), point.get(),
             [](void* item, void* data) {
                 auto& q = *static_cast<Query*>(data);
                 if (q.inside) return;
                 const auto i = reinterpret_cast<std::size_t>(item);
-                q.inside = GEOSPreparedContains_r(q.m->ctx, q.m->prepared[i], q.point) == 1;
+                q.inside = GEOSPreparedContains_r(q.m->ctx, q.m->prepared[i].get(), q.point) == 1;
             },
             &q);
-        GEOSGeom_destroy_r(ctx, point);
         return q.inside;
     }
 
@@ -259,7 +255,7 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons
             if (rings[i].size() >= 4) holes.push_back(m.ring(rings[i]));
         GEOSGeometry* poly = GEOSGeom_createPolygon_r(m.ctx, shell, holes.data(), static_cast<unsigned>(holes.size()));
         if (!poly) throw DataError("coast: GEOS failed to build a land polygon for the land test");
-        m.polygons.push_back(poly);
+        m.polygons.emplace_back(poly, GeosDeleter{m.ctx});
         probes.push_back(rings[0][0]);
         for (const auto& r : rings) {
             if (r.size() >= 4) {
@@ -273,22 +269,19 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons
     m.label_pieces();
     // Every polygon prepared now, its point locator built by a first test (GEOS builds it
     // lazily): the index belongs to loading the coast, not to the meshing that asks it.
-    m.prepared.assign(m.polygons.size(), nullptr);
+    m.prepared.reserve(m.polygons.size());
     for (std::size_t i = 0; i < m.polygons.size(); ++i) {
-        m.prepared[i] = GEOSPrepare_r(m.ctx, m.polygons[i]);
+        m.prepared.emplace_back(GEOSPrepare_r(m.ctx, m.polygons[i].get()), GeosDeleter{m.ctx});
         if (!m.prepared[i]) throw DataError("coast: GEOS failed to prepare a land polygon for the land test");
-        GEOSGeometry* probe = GEOSGeom_createPointFromXY_r(m.ctx, probes[i].lon, probes[i].lat);
-        if (probe) {
-            GEOSPreparedContains_r(m.ctx, m.prepared[i], probe);
-            GEOSGeom_destroy_r(m.ctx, probe);
-        }
+        const GeomPtr probe(GEOSGeom_createPointFromXY_r(m.ctx, probes[i].lon, probes[i].lat), GeosDeleter{m.ctx});
+        if (probe) GEOSPreparedContains_r(m.ctx, m.prepared[i].get(), probe.get());
     }
-    m.tree = GEOSSTRtree_create_r(m.ctx, 10);
+    m.tree = TreePtr(GEOSSTRtree_create_r(m.ctx, 10), GeosDeleter{m.ctx});
     for (std::size_t i = 0; i < m.polygons.size(); ++i)
-        GEOSSTRtree_insert_r(m.ctx, m.tree, m.polygons[i], reinterpret_cast<void*>(i));
-    m.pieces = GEOSSTRtree_create_r(m.ctx, 10);
+        GEOSSTRtree_insert_r(m.ctx, m.tree.get(), m.polygons[i].get(), reinterpret_cast<void*>(i));
+    m.pieces = TreePtr(GEOSSTRtree_create_r(m.ctx, 10), GeosDeleter{m.ctx});
     for (std::size_t i = 0; i < m.envelopes.size(); ++i)
-        GEOSSTRtree_insert_r(m.ctx, m.pieces, m.envelopes[i], reinterpret_cast<void*>(i));
+        GEOSSTRtree_insert_r(m.ctx, m.pieces.get(), m.envelopes[i].get(), reinterpret_cast<void*>(i));
 }
 
 LandMask::~LandMask() = default;
@@ -335,10 +328,10 @@ bool LandMask::coast_within(const Vec3& p, double angle) const {
         bool near = false;
     } q{&m, p, angle};
     for (const auto& [x0, x1] : spans) {
-        GEOSGeometry* box = GEOSGeom_createRectangle_r(m.ctx, x0, y0, x1, y1);
+        const GeomPtr box(GEOSGeom_createRectangle_r(m.ctx, x0, y0, x1, y1), GeosDeleter{m.ctx});
         if (!box) throw DataError("coast: GEOS failed to build a query for the coast distance");
         GEOSSTRtree_query_r(
-            m.ctx, m.pieces, box,
+            m.ctx, m.pieces.get(), box.get(),
             [](void* item, void* data) {
                 auto& q = *static_cast<Query*>(data);
                 if (q.near) return;
@@ -348,7 +341,6 @@ bool LandMask::coast_within(const Vec3& p, double angle) const {
                     q.near = arc_distance(o[k], o[k + 1], q.p) <= q.angle;
             },
             &q);
-        GEOSGeom_destroy_r(m.ctx, box);
         if (q.near) break;
     }
     return q.near;

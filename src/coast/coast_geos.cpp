@@ -1,0 +1,392 @@
+// The GEOS operations of the coast: building GEOS geometries from lon/lat rings and reading them
+// back, making them valid, polygonizing coastline lines, dissolving and snap-rounding the land,
+// clipping to a box and wrapping across +-180.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <geos_c.h>
+
+#include "coast_internal.hpp"
+#include "coast_load_internal.hpp"
+#include "globemesh/error.hpp"
+
+namespace globemesh::coast_detail {
+namespace {
+
+constexpr double line_end_snap_deg = 1e-3;
+constexpr double max_line_gap_deg = 0.5;
+
+/// XOR of many polygonal geometries by pairwise reduction (even-odd fill of nested rings).
+GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
+    if (parts.empty())
+        return own(geos, GEOSGeom_createEmptyPolygon_r(geos.get()), "build");
+    while (parts.size() > 1) {
+        std::vector<GeomPtr> next;
+        for (std::size_t i = 0; i + 1 < parts.size(); i += 2)
+            next.push_back(own(geos,
+                               GEOSSymDifference_r(geos.get(), parts[i].get(), parts[i + 1].get()),
+                               "combine coastline rings"));
+        if (parts.size() % 2)
+            next.push_back(std::move(parts.back()));
+        parts = std::move(next);
+    }
+    return std::move(parts.front());
+}
+
+/// Union-find over polygon indices (path halving).
+struct Groups {
+    std::vector<std::size_t> parent;
+    explicit Groups(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+    std::size_t find(std::size_t i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    }
+};
+
+/// Joins the polygons that intersect: an STR tree's candidates confirmed by GEOS's prepared test.
+void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
+                       const std::vector<int> &vertices, Groups &groups) {
+    const std::size_t n = polys.size();
+    auto find = [&](std::size_t i) { return groups.find(i); };
+    std::vector<std::size_t> &parent = groups.parent;
+    TreePtr tree(GEOSSTRtree_create_r(geos.get(), 10), GeosDeleter{geos.get()});
+    for (std::size_t i = 0; i < n; ++i)
+        GEOSSTRtree_insert_r(geos.get(), tree.get(), polys[i].get(), reinterpret_cast<void *>(i));
+    std::vector<std::size_t> hits;
+    auto collect = [](void *item, void *user) {
+        static_cast<std::vector<std::size_t> *>(user)->push_back(
+            reinterpret_cast<std::size_t>(item));
+    };
+    // Of each pair, the polygon with more vertices is the prepared one, kept for its other
+    // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
+    // the geometry tested against a prepared one anew on every call. Intersection is
+    // symmetric: the groups are the same.
+    std::vector<PreparedPtr> prepared;
+    for (std::size_t i = 0; i < n; ++i)
+        prepared.emplace_back(nullptr, GeosDeleter{geos.get()});
+    auto prepared_of = [&](std::size_t i) {
+        if (!prepared[i])
+            prepared[i].reset(GEOSPrepare_r(geos.get(), polys[i].get()));
+        return prepared[i].get();
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        coast::GeosInterrupt::poll(); // a long run of short GEOS calls, none of which reports
+        hits.clear();
+        GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
+        std::sort(hits.begin(), hits.end());
+        for (std::size_t j : hits) {
+            if (j <= i || find(i) == find(j))
+                continue;
+            const auto [big, small] = vertices[j] > vertices[i] ? std::pair{j, i} : std::pair{i, j};
+            if (GEOSPreparedIntersects_r(geos.get(), prepared_of(big), polys[small].get()) == 1)
+                parent[find(j)] = find(i);
+        }
+        prepared[i].reset(); // its pairs are all done: later ones have both indices above i
+    }
+}
+
+/// Joins the polygons whose outlines come within 2 cells of each other (near-touches), marking
+/// in near_only those joined by distance alone.
+void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Groups &groups,
+               std::vector<char> &near_only) {
+    const std::size_t n = polys.size();
+    auto find = [&](std::size_t i) { return groups.find(i); };
+    std::vector<std::size_t> &parent = groups.parent;
+    std::vector<PolygonRings> outlines(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        outlines[i].push_back(ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polys[i].get())));
+        for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polys[i].get()); ++h)
+            outlines[i].push_back(
+                ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polys[i].get(), h)));
+    }
+    for (auto [i, j] : coast_detail::near_pairs(outlines, 2 * grid)) {
+        if (find(i) == find(j))
+            continue;
+        near_only[j] = 1;
+        parent[find(j)] = find(i);
+    }
+}
+
+} // namespace
+
+GeomPtr make_ring(Geos &geos, const PointList &pts) {
+    std::vector<double> xy;
+    xy.reserve(pts.size() * 2);
+    for (const auto &p : pts) {
+        xy.push_back(p.lon);
+        xy.push_back(p.lat);
+    }
+    GEOSCoordSequence *seq = GEOSCoordSeq_copyFromBuffer_r(geos.get(), xy.data(), pts.size(), 0, 0);
+    if (!seq)
+        throw DataError("coast: GEOS cannot build a coordinate sequence: " + geos.message());
+    return own(geos, GEOSGeom_createLinearRing_r(geos.get(), seq), "build a ring");
+}
+
+GeomPtr make_polygon(Geos &geos, const PolygonRings &rings) {
+    GeomPtr shell = make_ring(geos, rings[0]);
+    std::vector<GEOSGeometry *> holes;
+    for (std::size_t i = 1; i < rings.size(); ++i)
+        holes.push_back(make_ring(geos, rings[i]).release());
+    return own(geos,
+               GEOSGeom_createPolygon_r(geos.get(), shell.release(), holes.data(),
+                                        static_cast<unsigned>(holes.size())),
+               "build a polygon");
+}
+
+GeomPtr make_collection(Geos &geos, std::vector<GeomPtr> &parts) {
+    std::vector<GEOSGeometry *> raw;
+    for (auto &p : parts)
+        raw.push_back(p.release());
+    parts.clear();
+    return own(geos,
+               GEOSGeom_createCollection_r(geos.get(), GEOS_GEOMETRYCOLLECTION, raw.data(),
+                                           static_cast<unsigned>(raw.size())),
+               "build a collection");
+}
+
+/// MakeValid (STRUCTURE method, collapsed parts dropped): polygonal output only.
+GeomPtr make_valid(Geos &geos, const GEOSGeometry *g) {
+    GEOSMakeValidParams *params = GEOSMakeValidParams_create_r(geos.get());
+    GEOSMakeValidParams_setMethod_r(geos.get(), params, GEOS_MAKE_VALID_STRUCTURE);
+    GEOSMakeValidParams_setKeepCollapsed_r(geos.get(), params, 0);
+    GEOSGeometry *out = GEOSMakeValidWithParams_r(geos.get(), g, params);
+    GEOSMakeValidParams_destroy_r(geos.get(), params);
+    return own(geos, out, "make a polygon valid");
+}
+
+void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeometry *> &out) {
+    int type = GEOSGeomTypeId_r(geos.get(), g);
+    if (type == GEOS_POLYGON) {
+        if (!GEOSisEmpty_r(geos.get(), g))
+            out.push_back(g);
+    } else if (type == GEOS_MULTIPOLYGON || type == GEOS_GEOMETRYCOLLECTION) {
+        for (int i = 0; i < GEOSGetNumGeometries_r(geos.get(), g); ++i)
+            polygons_of(geos, GEOSGetGeometryN_r(geos.get(), g, i), out);
+    }
+}
+
+PointList ring_points(Geos &geos, const GEOSGeometry *ring) {
+    const GEOSCoordSequence *seq = GEOSGeom_getCoordSeq_r(geos.get(), ring);
+    unsigned n = 0;
+    GEOSCoordSeq_getSize_r(geos.get(), seq, &n);
+    std::vector<double> xy(2 * n);
+    if (n)
+        GEOSCoordSeq_copyToBuffer_r(geos.get(), seq, xy.data(), 0, 0);
+    PointList pts(n);
+    for (unsigned i = 0; i < n; ++i)
+        pts[i] = {xy[2 * i], xy[2 * i + 1]};
+    return pts;
+}
+
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines,
+                         const std::string &where) {
+    std::vector<GeomPtr> linestrings;
+    for (const auto &l : lines) {
+        std::vector<double> xy;
+        for (const auto &p : l) {
+            xy.push_back(p.lon);
+            xy.push_back(p.lat);
+        }
+        GEOSCoordSequence *seq =
+            GEOSCoordSeq_copyFromBuffer_r(geos.get(), xy.data(), l.size(), 0, 0);
+        linestrings.push_back(
+            own(geos, GEOSGeom_createLineString_r(geos.get(), seq), "build a line"));
+    }
+    GeomPtr all = make_collection(geos, linestrings);
+    GeomPtr merged = own(geos, GEOSLineMerge_r(geos.get(), all.get()), "merge coastline lines");
+    std::vector<GeomPtr> faces;
+    int n = GEOSGetNumGeometries_r(geos.get(), merged.get());
+    for (int i = 0; i < n; ++i) {
+        PointList pts = ring_points(geos, GEOSGetGeometryN_r(geos.get(), merged.get(), i));
+        if (pts.size() < 2)
+            continue;
+        LonLat a = pts.front(), b = pts.back();
+        if (a.lon != b.lon || a.lat != b.lat) {
+            // Open ends within 0.001 degree (110 m) of the seam, on either side, were cut there
+            // (an end far beyond it, lon 199 of a line drawn in [0, 360), is not).
+            for (LonLat *e : {&pts.front(), &pts.back()})
+                if (std::abs(std::abs(e->lon) - 180.0) <= line_end_snap_deg)
+                    e->lon = e->lon > 0 ? 180.0 : -180.0;
+            a = pts.front(), b = pts.back();
+            bool a_seam = std::abs(a.lon) == 180.0, b_seam = std::abs(b.lon) == 180.0;
+            double gap = std::hypot(a.lon - b.lon, a.lat - b.lat);
+            if ((!a_seam || !b_seam) && gap <= max_line_gap_deg) {
+                // a small gap in the data: close it straight
+                a_seam = b_seam = true;
+                b = a;
+            }
+            if (!a_seam || !b_seam)
+                throw DataError(where + ": a coastline line from (" + std::to_string(a.lon) + ", " +
+                                std::to_string(a.lat) + ") to (" + std::to_string(b.lon) + ", " +
+                                std::to_string(b.lat) +
+                                ") is not closed and does not end on the +-180 meridian; give "
+                                "closed coastlines or land polygons");
+            if (a.lon != b.lon) {
+                double mean = 0;
+                for (const auto &p : pts)
+                    mean += p.lat;
+                double pole = mean < 0 ? -90.0 : 90.0;
+                pts.push_back({b.lon, pole});
+                pts.push_back({a.lon, pole});
+            }
+            pts.push_back(a);
+        }
+        if (pts.size() < 4)
+            continue;
+        GeomPtr ring = make_ring(geos, pts);
+        GeomPtr poly =
+            own(geos, GEOSGeom_createPolygon_r(geos.get(), ring.release(), nullptr, 0), "build");
+        if (GEOSisValid_r(geos.get(), poly.get()) == 1) {
+            faces.push_back(std::move(poly));
+            continue;
+        }
+        // A self-intersecting line: node it and polygonize its faces.
+        GeomPtr line = own(geos, GEOSBoundary_r(geos.get(), poly.get()), "take a boundary");
+        GeomPtr noded = own(geos, GEOSUnaryUnion_r(geos.get(), line.get()), "node a line");
+        const GEOSGeometry *input[] = {noded.get()};
+        GeomPtr pieces = own(geos, GEOSPolygonize_r(geos.get(), input, 1), "polygonize a line");
+        faces.push_back(own(geos, GEOSUnaryUnion_r(geos.get(), pieces.get()), "union faces"));
+    }
+    return symmetric_difference_all(geos, std::move(faces));
+}
+
+std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,
+                              SnapCount &count) {
+    std::vector<GeomPtr> polys;
+    for (const auto &part : parts) {
+        std::vector<const GEOSGeometry *> ps;
+        polygons_of(geos, part.get(), ps);
+        for (const auto *p : ps)
+            polys.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
+    }
+    std::size_t n = polys.size();
+    Groups joined(n);
+    auto find = [&](std::size_t i) { return joined.find(i); };
+    std::vector<char> near_only(n, 0); // joined by distance alone, not by intersection
+    std::vector<int> vertices(n);
+    for (std::size_t i = 0; i < n; ++i)
+        vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
+    join_intersecting(geos, polys, vertices, joined);
+    // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
+    join_near(geos, polys, grid, joined, near_only);
+    // Each group goes to GEOS as one collection: a polygon alone through GEOS's precision
+    // reducer, several through a snap-rounding union. Lone polygons go in batches of about
+    // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap
+    // rounding seeds a random generator through CPUID, which a virtual machine traps. Groups are
+    // far enough apart (2 cells: rounding moves a vertex at most 0.71 cell) that rounding them
+    // apart cannot make them meet.
+    constexpr std::size_t batch_vertices = 100'000;
+    std::vector<std::vector<std::size_t>> groups(n);
+    for (std::size_t i = 0; i < n; ++i)
+        groups[find(i)].push_back(i);
+    std::vector<GeomPtr> out;
+    auto rings_of = [&](const GEOSGeometry *p) {
+        return std::size_t(1 + GEOSGetNumInteriorRings_r(geos.get(), p));
+    };
+    auto add_snapped = [&](GeomPtr snapped, std::size_t rings_in) {
+        std::vector<const GEOSGeometry *> ps;
+        polygons_of(geos, snapped.get(), ps);
+        std::size_t rings_out = 0;
+        for (const auto *p : ps) {
+            rings_out += rings_of(p);
+            out.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
+        }
+        count.changed += rings_out > rings_in ? rings_out - rings_in : rings_in - rings_out;
+    };
+    std::vector<GEOSGeometry *> lone;
+    std::size_t lone_vertices = 0, lone_rings = 0;
+    auto flush_lone = [&] {
+        if (lone.empty())
+            return;
+        GeomPtr multi = own(geos,
+                            GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, lone.data(),
+                                                        static_cast<unsigned>(lone.size())),
+                            "collect polygons");
+        add_snapped(own(geos, GEOSGeom_setPrecision_r(geos.get(), multi.get(), grid, 0),
+                        "snap-round the land"),
+                    lone_rings);
+        lone.clear();
+        lone_vertices = lone_rings = 0;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        if (groups[i].empty())
+            continue;
+        if (groups[i].size() == 1) {
+            lone_rings += rings_of(polys[i].get());
+            lone_vertices += static_cast<std::size_t>(vertices[i]);
+            lone.push_back(polys[i].release());
+            if (lone_vertices >= batch_vertices)
+                flush_lone();
+            continue;
+        }
+        std::vector<GeomPtr> members;
+        std::size_t rings_in = 0;
+        for (std::size_t j : groups[i]) {
+            count.joined += near_only[j];
+            rings_in += rings_of(polys[j].get());
+            members.push_back(std::move(polys[j]));
+        }
+        GeomPtr all = make_collection(geos, members);
+        add_snapped(own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid),
+                        "dissolve the land polygons"),
+                    rings_in);
+    }
+    flush_lone();
+    return out;
+}
+
+GeomPtr clip_to_box(Geos &geos, const GEOSGeometry *g, double x0, double y0, double x1, double y1,
+                    const char *what) {
+    double a0, b0, a1, b1;
+    if (GEOSGeom_getExtent_r(geos.get(), g, &a0, &b0, &a1, &b1) != 0 && a0 >= x0 && a1 <= x1 &&
+        b0 >= y0 && b1 <= y1)
+        return own(geos, GEOSGeom_clone_r(geos.get(), g), what);
+    GeomPtr box = own(geos, GEOSGeom_createRectangle_r(geos.get(), x0, y0, x1, y1), what);
+    GeomPtr out = own(geos, GEOSIntersection_r(geos.get(), g, box.get()), what);
+    const int type = GEOSGeomTypeId_r(geos.get(), out.get());
+    if (type == GEOS_POLYGON || type == GEOS_MULTIPOLYGON)
+        return out;
+    // A part touching the box along an edge comes back as a line too: keep the polygons.
+    std::vector<const GEOSGeometry *> polys;
+    polygons_of(geos, out.get(), polys);
+    std::vector<GeomPtr> parts;
+    for (const auto *q : polys)
+        parts.push_back(own(geos, GEOSGeom_clone_r(geos.get(), q), what));
+    return make_collection(geos, parts);
+}
+
+/// Adds a valid polygonal geometry to `parts`, cutting what lies beyond +-180 (a ring drawn
+/// across the antimeridian with longitudes such as 190) and wrapping it back by 360 degrees.
+void add_wrapped(Geos &geos, GeomPtr g, std::vector<GeomPtr> &parts) {
+    double x0, y0, x1, y1;
+    if (GEOSisEmpty_r(geos.get(), g.get()) ||
+        GEOSGeom_getExtent_r(geos.get(), g.get(), &x0, &y0, &x1, &y1) == 0 ||
+        (x0 >= -180.0 && x1 <= 180.0)) {
+        parts.push_back(std::move(g));
+        return;
+    }
+    for (int k = static_cast<int>(std::floor((x0 + 180.0) / 360.0)); k * 360.0 - 180.0 < x1; ++k) {
+        double shift = -360.0 * k;
+        GeomPtr piece = clip_to_box(geos, g.get(), -180.0 - shift, -90.0, 180.0 - shift, 90.0,
+                                    "cut at the antimeridian");
+        if (GEOSisEmpty_r(geos.get(), piece.get()))
+            continue;
+        auto move = [](double *x, double *, void *user) {
+            *x += *static_cast<double *>(user);
+            return 1;
+        };
+        GeomPtr moved = own(geos, GEOSGeom_transformXY_r(geos.get(), piece.get(), move, &shift),
+                            "wrap longitudes");
+        if (GEOSisValid_r(geos.get(), moved.get()) != 1)
+            moved = make_valid(geos, moved.get());
+        parts.push_back(std::move(moved));
+    }
+}
+
+} // namespace globemesh::coast_detail

@@ -1,0 +1,123 @@
+// Internal to the coast module: the stages of load_coast (coast_load.cpp) shared by their files:
+// the OGR source (coast_source.cpp), the GEOS operations (coast_geos.cpp) and the ocean's rings
+// (coast_rings.cpp).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geos_handles.hpp"
+#include "globemesh/boundary.hpp"
+#include "globemesh/coast.hpp"
+#include "globemesh/sphere.hpp"
+
+namespace globemesh::coast_detail {
+
+using PointList = std::vector<LonLat>;
+
+/// One polygon in lon/lat: shell first, then holes (each ring closed, first == last).
+using PolygonRings = std::vector<PointList>;
+
+struct Source {
+    std::vector<PolygonRings> polygons;
+    std::vector<PointList> lines;
+    std::size_t points = 0;   ///< point geometries seen (ignored)
+    std::size_t features = 0; ///< features read
+    std::string layer;
+};
+
+/// The land is snap-rounded to a lon/lat grid of 2^-20 degree (0.11 m at the equator): near-
+/// touches closer than about half a cell (an islet's vertex 5 cm from the mainland's edge)
+/// become touches, spikes narrower collapse, and what stays apart is at least half a cell
+/// apart. A power of two, so that +-180, +-90 and grid multiples are exact in binary.
+constexpr double snap_grid_deg = 1.0 / (1 << 20);
+
+// ----------------------------------------------------------------------------- OGR source
+
+/// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
+/// `what` names the option for messages (--coast or --region-file). With `near` (a --region
+/// W,S,E,N) a polygon layer is read through OGR's spatial filter: only the features whose
+/// envelope meets the box widened by 1% of its larger side (its latitude band when it crosses
+/// +-180), in the layer's CRS; the land elsewhere plays no part in a region (region_rings cuts
+/// it off), and a layer with an index (GeoPackage, a shapefile's .qix) is then not read whole.
+/// A filter that leaves no feature is dropped (the errors below stay those of the whole layer).
+/// Line layers are read whole: their lines close into land only together.
+/// max_bytes (0: no limit): the layer's vertices are counted while they are read; once they
+/// pass max_bytes / coast_bytes_per_vertex nothing more is kept (memory stays bounded by one
+/// feature), the rest is only counted, and a DataError names the layer, the count and
+/// --max-memory.
+Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
+                   const std::string &srs_override, const char *what, std::uint64_t max_bytes = 0,
+                   const std::optional<std::array<double, 4>> &near = std::nullopt);
+
+// ----------------------------------------------------------------------------- GEOS operations
+
+GeomPtr make_ring(Geos &geos, const PointList &pts);
+GeomPtr make_polygon(Geos &geos, const PolygonRings &rings);
+/// A GEOMETRYCOLLECTION of the parts (taken from `parts`, which is left empty).
+GeomPtr make_collection(Geos &geos, std::vector<GeomPtr> &parts);
+/// MakeValid (STRUCTURE method, collapsed parts dropped): polygonal output only.
+GeomPtr make_valid(Geos &geos, const GEOSGeometry *g);
+/// The non-empty polygons of a polygonal geometry or collection, in order (not owned).
+void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeometry *> &out);
+/// The vertices of a GEOS ring or line.
+PointList ring_points(Geos &geos, const GEOSGeometry *ring);
+/// Polygonizes closed coastline lines (GSHHG / OSM style). Lines are first merged at shared
+/// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
+/// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the
+/// orientation of the lines does not matter and islands in lakes come out right.
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const std::string &where);
+
+/// What snap rounding did to the land (CoastData reports it).
+struct SnapCount {
+    std::size_t joined = 0;  ///< polygons joined to another that they only came within 2 cells of
+    std::size_t changed = 0; ///< rings gained or lost by dissolving and snap rounding, per batch
+};
+
+/// Dissolves valid polygonal parts into non-overlapping polygons, snap-rounded to a lon/lat
+/// grid of `grid` degrees (GEOS's snap-rounding noder, OverlayNG): every vertex on the grid, and
+/// every edge that passes through a vertex's grid cell noded at that vertex, so two rings that
+/// came within about half a cell of each other touch there, and no vertex lies closer than half
+/// a cell to an edge it is not on. Polygons that intersect (an STR tree's candidates confirmed by
+/// GEOS's prepared test) or come within 2 cells of each other (near_pairs) are snap-rounded
+/// together (one union), every other one alone: most coastline polygons are disjoint, and a
+/// union of all of them costs seconds at 1:10m. Output order: each group where its first polygon
+/// stands, the lone polygons with the batch they were rounded in (deterministic).
+std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,
+                              SnapCount &count);
+
+/// The part of a valid polygonal geometry inside a lon/lat box: a copy when it lies inside,
+/// else GEOS's overlay intersection with the box (valid output). Not GEOSClipByRect: its
+/// polygon reconnection leaks memory and can build wrong polygons when edges run along the box
+/// (GEOS 3.11; libgeos/geos#605), as edges on a +-180 cut do (found by fuzz_coast: a leak).
+GeomPtr clip_to_box(Geos &geos, const GEOSGeometry *g, double x0, double y0, double x1, double y1,
+                    const char *what);
+/// Adds a valid polygonal geometry to `parts`, cutting what lies beyond +-180 (a ring drawn
+/// across the antimeridian with longitudes such as 190) and wrapping it back by 360 degrees.
+void add_wrapped(Geos &geos, GeomPtr g, std::vector<GeomPtr> &parts);
+
+// ----------------------------------------------------------------------------- ocean rings
+
+struct Chain {
+    PointList pts;
+    std::vector<SegmentKind> kinds; // kinds[i]: pts[i] -> pts[i+1]
+};
+
+/// The ocean of the whole globe (coast_rings.cpp): the land's rings reversed (ocean on the left),
+/// cut at the seam and the poles and stitched; inland water as keep_inland_seas says.
+std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, bool keep_inland_seas,
+                               CoastData &out);
+/// The ocean of a region (--region box or --region-file polygons): the region less the land.
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const MeshOptions &options,
+                                const std::string &where, CoastData &out);
+/// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
+Ring to_sphere(const Chain &c);
+/// Moves every copy of a node that several arcs share (rings meeting at one point, valid in
+/// GEOS) by 1e-7 rad into the land on its right.
+std::size_t separate_pinches(Boundary &b);
+
+} // namespace globemesh::coast_detail

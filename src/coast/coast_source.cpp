@@ -1,0 +1,442 @@
+// The OGR source of the coast: a layer read into lon/lat polygons and lines (WGS84, GIS axis
+// order), reprojected from its CRS, snapped to the +-180 seam and the poles.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal.h>
+#include <ogr_api.h>
+#include <ogr_srs_api.h>
+
+#include "coast_load_internal.hpp"
+#include "gdal_handles.hpp"
+#include "globemesh/error.hpp"
+
+namespace globemesh::coast_detail {
+namespace {
+
+using gdal::DatasetPtr;
+using gdal::FeaturePtr;
+using gdal::SrsPtr;
+using gdal::TransformPtr;
+using OgrGeometryPtr = gdal::GeometryPtr; // GeomPtr is the GEOS owner
+
+constexpr double seam_snap_deg = 1e-9;
+/// A vertex this close to +-180 (11 m at the equator) next to a vertex on it goes onto it too.
+/// Natural Earth stores coordinates on a grid of 1/20480 degree, and a corner of a polygon cut
+/// at the antimeridian can sit one step off it: Chukotka's western half at 1:50m ends at
+/// -179.999951, leaving a 27 km wedge of "ocean" 2 m wide between the two halves (a face of
+/// quality 1e-4 at 20 km).
+constexpr double seam_notch_deg = 1e-4;
+constexpr double pole_snap_deg = 2e-3;
+
+/// Moves onto the seam each vertex within seam_notch_deg of it whose neighbour along the ring
+/// lies on it, on the same side (neighbours judged as they were before this pass).
+void close_seam_notches(PointList &pts) {
+    std::size_t n = pts.size();
+    const bool closed =
+        n > 1 && pts.front().lon == pts.back().lon && pts.front().lat == pts.back().lat;
+    if (closed)
+        --n;
+    if (n < 3)
+        return;
+    const PointList was(pts.begin(), pts.begin() + static_cast<std::ptrdiff_t>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        const double lon = was[i].lon;
+        const double seam = lon > 0 ? 180.0 : -180.0;
+        if (std::abs(lon) == 180.0 || std::abs(lon) <= 180.0 - seam_notch_deg)
+            continue;
+        const bool has_prev = closed || i > 0, has_next = closed || i + 1 < n;
+        if ((has_prev && was[(i + n - 1) % n].lon == seam) ||
+            (has_next && was[(i + 1) % n].lon == seam))
+            pts[i].lon = seam;
+    }
+    if (closed)
+        pts.back() = pts.front();
+}
+
+/// Longitudes beyond this (degrees) are refused: no ring needs more than one wrap.
+constexpr double max_abs_lon_deg = 540.0;
+
+/// Snaps coordinates of one ring or line to the +-180 seam and the poles (see coast.hpp).
+void snap_coordinates(PointList &pts, bool transformed) {
+    for (auto &p : pts) {
+        if (p.lat > 90.0 - pole_snap_deg)
+            p.lat = 90.0;
+        if (p.lat < -90.0 + pole_snap_deg)
+            p.lat = -90.0;
+    }
+    if (!transformed) {
+        for (auto &p : pts) {
+            if (std::abs(p.lon - 180.0) < seam_snap_deg)
+                p.lon = 180.0;
+            if (std::abs(p.lon + 180.0) < seam_snap_deg)
+                p.lon = -180.0;
+        }
+        close_seam_notches(pts);
+        return;
+    }
+    // A projection's inverse may return either +180 or -180 on the seam: a run of vertices on
+    // the seam takes the side of the vertex before it, up to a pole vertex (where a closure
+    // such as Antarctica's crosses to the other side), and the side of the vertex after it
+    // from there on.
+    auto on_seam = [](const LonLat &p) { return std::abs(p.lon) > 180.0 - seam_snap_deg; };
+    std::size_t n = pts.size();
+    if (n && pts.front().lon == pts.back().lon && pts.front().lat == pts.back().lat)
+        --n; // closed ring
+    std::size_t anchor = n;
+    for (std::size_t i = 0; i < n; ++i)
+        if (!on_seam(pts[i]))
+            anchor = i;
+    if (anchor == n) {
+        for (auto &p : pts)
+            p.lon = p.lon > 0 ? 180.0 : -180.0;
+        return;
+    }
+    auto side_of = [](const LonLat &p) { return p.lon >= 0 ? 180.0 : -180.0; };
+    for (std::size_t k = 1; k <= n; ++k) {
+        std::size_t i = (anchor + k) % n;
+        if (!on_seam(pts[i]))
+            continue;
+        std::size_t end = k; // the run is k .. end-1 (offsets from anchor)
+        while (end <= n && on_seam(pts[(anchor + end) % n]))
+            ++end;
+        double before = side_of(pts[(anchor + k - 1) % n]);
+        double after = side_of(pts[(anchor + end) % n]);
+        bool past_pole = false;
+        for (std::size_t m = k; m < end; ++m) {
+            auto &p = pts[(anchor + m) % n];
+            p.lon = past_pole ? after : before;
+            if (std::abs(p.lat) == 90.0)
+                past_pole = true;
+        }
+        k = end;
+    }
+    if (n < pts.size())
+        pts.back() = pts.front();
+    close_seam_notches(pts);
+}
+
+PointList read_points(OGRGeometryH g, bool transformed) {
+    int n = OGR_G_GetPointCount(g);
+    PointList pts(static_cast<std::size_t>(std::max(n, 0)));
+    for (int i = 0; i < n; ++i)
+        pts[i] = {OGR_G_GetX(g, i), OGR_G_GetY(g, i)};
+    for (const auto &p : pts) {
+        if (!std::isfinite(p.lon) || !std::isfinite(p.lat))
+            throw DataError("coast: a vertex has a non-finite coordinate (failed reprojection?)");
+        // A ring drawn across the antimeridian may reach past +-180 (lon 190, or [0, 360)), and
+        // add_wrapped cuts it back once per 360 degrees: further out, the layer is not in degrees.
+        if (std::abs(p.lon) > max_abs_lon_deg) {
+            char text[160];
+            std::snprintf(
+                text, sizeof text,
+                "coast: a vertex has longitude %.6g, beyond +-%.0f degrees: is the layer in "
+                "lon/lat? (--coast-srs names its CRS)",
+                p.lon, max_abs_lon_deg);
+            throw DataError(text);
+        }
+    }
+    snap_coordinates(pts, transformed);
+    return pts;
+}
+
+void collect_geometry(OGRGeometryH g, bool transformed, Source &out) {
+    if (!g || OGR_G_IsEmpty(g))
+        return;
+    OGRwkbGeometryType t = wkbFlatten(OGR_G_GetGeometryType(g));
+    if (OGR_GT_IsNonLinear(t)) {
+        OgrGeometryPtr linear(OGR_G_GetLinearGeometry(g, 0, nullptr));
+        collect_geometry(linear.get(), transformed, out);
+        return;
+    }
+    switch (t) {
+    case wkbPolygon: {
+        PolygonRings poly;
+        for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i) {
+            PointList ring = read_points(OGR_G_GetGeometryRef(g, i), transformed);
+            if (!ring.empty() &&
+                (ring.front().lon != ring.back().lon || ring.front().lat != ring.back().lat))
+                ring.push_back(ring.front());
+            if (ring.size() < 4) {
+                if (i == 0)
+                    return; // degenerate shell: no polygon
+                continue;
+            }
+            poly.push_back(std::move(ring));
+        }
+        if (!poly.empty())
+            out.polygons.push_back(std::move(poly));
+        return;
+    }
+    case wkbLineString:
+    case wkbLinearRing: {
+        PointList line = read_points(g, transformed);
+        if (line.size() >= 2)
+            out.lines.push_back(std::move(line));
+        return;
+    }
+    case wkbPoint:
+    case wkbMultiPoint:
+        ++out.points;
+        return;
+    default:
+        for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
+            collect_geometry(OGR_G_GetGeometryRef(g, i), transformed, out);
+    }
+}
+
+/// Vertices of a geometry (all its parts and rings), as OGR holds them; curves count their
+/// control points (a linearized curve has more, but curves are rare in coastlines).
+std::uint64_t vertex_count(OGRGeometryH g) {
+    if (!g)
+        return 0;
+    const int parts = OGR_G_GetGeometryCount(g);
+    if (parts == 0)
+        return static_cast<std::uint64_t>(std::max(OGR_G_GetPointCount(g), 0));
+    std::uint64_t n = 0;
+    for (int i = 0; i < parts; ++i)
+        n += vertex_count(OGR_G_GetGeometryRef(g, i));
+    return n;
+}
+
+/// Peak bytes per input vertex of load_coast: the lon/lat copy (16), GEOS's coordinate
+/// sequences of the polygon, its valid and dissolved copies (3 x 24), the rings on the sphere
+/// (24 + tags) and the containers' slack: 170 B/vertex measured, rounded up
+/// (bench/RESULTS-core-coast.md).
+constexpr std::uint64_t coast_bytes_per_vertex = 200;
+
+bool is_polygon_type(OGRwkbGeometryType t) {
+    t = wkbFlatten(t);
+    return OGR_GT_IsSubClassOf(t, wkbCurvePolygon) || OGR_GT_IsSubClassOf(t, wkbMultiSurface);
+}
+
+bool is_area_or_line(OGRwkbGeometryType t) {
+    t = wkbFlatten(t);
+    return is_polygon_type(t) || OGR_GT_IsSubClassOf(t, wkbCurve) ||
+           OGR_GT_IsSubClassOf(t, wkbMultiCurve);
+}
+
+std::string layer_list(GDALDatasetH ds) {
+    std::string list;
+    for (int i = 0; i < GDALDatasetGetLayerCount(ds); ++i) {
+        OGRLayerH l = GDALDatasetGetLayer(ds, i);
+        if (!list.empty())
+            list += ", ";
+        list += std::string(OGR_L_GetName(l)) + " (" + OGRGeometryTypeToName(OGR_L_GetGeomType(l)) +
+                ")";
+    }
+    return list.empty() ? "none" : list;
+}
+
+/// The layer named `layer_name`, or else the one polygon or line layer of the data set.
+OGRLayerH choose_layer(GDALDatasetH h, const std::string &path, const std::string &layer_name,
+                       const char *what) {
+    OGRLayerH layer = nullptr;
+    if (!layer_name.empty()) {
+        layer = GDALDatasetGetLayerByName(h, layer_name.c_str());
+        if (!layer)
+            throw DataError(std::string(what) + " " + path + ": no layer named '" + layer_name +
+                            "'; layers: " + layer_list(h));
+    } else {
+        std::vector<OGRLayerH> candidates, unknown;
+        for (int i = 0; i < GDALDatasetGetLayerCount(h); ++i) {
+            OGRLayerH l = GDALDatasetGetLayer(h, i);
+            OGRwkbGeometryType t = OGR_L_GetGeomType(l);
+            if (is_area_or_line(t))
+                candidates.push_back(l);
+            else if (wkbFlatten(t) == wkbUnknown || wkbFlatten(t) == wkbGeometryCollection)
+                unknown.push_back(l);
+        }
+        if (candidates.empty())
+            candidates = unknown;
+        if (candidates.size() != 1)
+            throw DataError(std::string(what) + " " + path + ": " +
+                            (candidates.empty()
+                                 ? "no polygon or line layer"
+                                 : std::string("several polygon or line layers, choose one with ") +
+                                       (std::string(what) == "--region-file" ? "--region-layer"
+                                                                             : "--coast-layer")) +
+                            "; layers: " + layer_list(h));
+        layer = candidates.front();
+    }
+    return layer;
+}
+
+/// The layer's CRS, or the override for a layer that declares none, in GIS axis order.
+SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const std::string &where_msg,
+                  const char *what) {
+    // Coordinate reference system: the layer's, or the override; lon/lat WGS84 as target. A
+    // local (engineering) CRS of unknown units, as a .prj with LOCAL_CS, counts as none.
+    OGRSpatialReferenceH declared = OGR_L_GetSpatialRef(layer);
+    if (declared && OSRIsLocal(declared))
+        declared = nullptr;
+    SrsPtr source_srs;
+    if (!srs_override.empty()) {
+        source_srs.reset(OSRNewSpatialReference(nullptr));
+        if (OSRSetFromUserInput(source_srs.get(), srs_override.c_str()) != OGRERR_NONE)
+            throw UsageError("--coast-srs '" + srs_override +
+                             "' is not a CRS GDAL/PROJ understands");
+        // A layer's own CRS is not overridden: degrees read as EPSG:3857 metres put the whole
+        // coast within a kilometre of 0,0, and the mesh is silently an aqua-planet.
+        if (declared) {
+            // Both are read lon, lat (traditional order, below): only the CRS themselves are
+            // compared, not their data axis mappings.
+            const char *same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
+            if (!OSRIsSameEx(declared, source_srs.get(), same_options)) {
+                const char *name = OSRGetName(declared);
+                const char *auth = OSRGetAuthorityName(declared, nullptr);
+                const char *code = OSRGetAuthorityCode(declared, nullptr);
+                const std::string declared_name =
+                    std::string(name ? name : "a CRS") +
+                    (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
+                throw DataError(
+                    where_msg + " declares " + declared_name + ", not --coast-srs " + srs_override +
+                    "; --coast-srs is for a layer that declares none (leave it out, or replace a "
+                    "wrong CRS with ogr2ogr -a_srs)");
+            }
+        }
+    } else if (declared) {
+        source_srs.reset(OSRClone(declared));
+    } else {
+        throw DataError(
+            where_msg + " declares no coordinate reference system" +
+            (OGR_L_GetSpatialRef(layer) ? " (only a local one, of unknown units)" : "") +
+            (std::string(what) == "--coast" ? "; give it with --coast-srs (e.g. EPSG:4326)"
+                                            : "; assign one, e.g. ogr2ogr -a_srs EPSG:4326"));
+    }
+    OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    return source_srs;
+}
+
+/// Sets the layer's spatial filter to the box `near` widened (see read_source), in the layer's
+/// CRS; false, with no filter, when that CRS cannot take the box.
+bool filter_near(OGRLayerH layer, const std::array<double, 4> &near,
+                 OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
+                 OGRSpatialReferenceH source_srs) {
+    auto [w, s, e, n] = near;
+    if (e <= w)
+        w = -180, e = 180;
+    const double pad = 0.01 * std::max(e - w, n - s);
+    w = std::max(-180.0, w - pad), e = std::min(180.0, e + pad);
+    s = std::max(-90.0, s - pad), n = std::min(90.0, n + pad);
+    double x0 = w, y0 = s, x1 = e, y1 = n;
+    bool ok = true;
+    if (transform) {
+        // The box in the layer's CRS (densified edges); a CRS that cannot take it: no filter.
+        TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84, source_srs));
+        ok = to_layer && OCTTransformBounds(to_layer.get(), w, s, e, n, &x0, &y0, &x1, &y1, 21) &&
+             x0 < x1 && y0 < y1 && std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) &&
+             std::isfinite(y1);
+    }
+    if (ok)
+        OGR_L_SetSpatialFilterRect(layer, x0, y0, x1, y1);
+    return ok;
+}
+
+} // namespace
+
+Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
+                   const std::string &srs_override, const char *what, std::uint64_t max_bytes,
+                   const std::optional<std::array<double, 4>> &near) {
+    GDALAllRegister();
+    gdal::QuietErrors quiet;
+    DatasetPtr ds(
+        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    if (!ds) {
+        std::string msg = CPLGetLastErrorMsg();
+        throw IoError(std::string(what) + " " + path + ": cannot open as a vector data set" +
+                      (msg.empty() ? "" : " (" + msg + ")") + "; check the path and format");
+    }
+    GDALDatasetH h = ds.get();
+    OGRLayerH layer = choose_layer(h, path, layer_name, what);
+    Source src;
+    src.layer = OGR_L_GetName(layer);
+    std::string where_msg = std::string(what) + " " + path + " layer '" + src.layer + "'";
+    if (!where.empty() && OGR_L_SetAttributeFilter(layer, where.c_str()) != OGRERR_NONE)
+        throw UsageError("--coast-where '" + where + "' is not a valid filter for " + where_msg +
+                         ": " + CPLGetLastErrorMsg());
+
+    SrsPtr source_srs = source_crs(layer, srs_override, where_msg, what);
+    SrsPtr wgs84(OSRNewSpatialReference(nullptr));
+    OSRImportFromEPSG(wgs84.get(), 4326);
+    OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr transform;
+    if (!OSRIsSame(source_srs.get(), wgs84.get())) {
+        transform.reset(OCTNewCoordinateTransformation(source_srs.get(), wgs84.get()));
+        if (!transform)
+            throw DataError(where_msg + ": no transformation from its CRS to WGS84 lon/lat (" +
+                            CPLGetLastErrorMsg() + ")");
+    }
+
+    bool filtered = near && is_polygon_type(OGR_L_GetGeomType(layer)) &&
+                    filter_near(layer, *near, transform.get(), wgs84.get(), source_srs.get());
+
+    OGR_L_ResetReading(layer);
+    CPLErrorReset();
+    const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
+    std::uint64_t vertices = 0;
+    bool too_many = false;
+    for (;;) {
+        FeaturePtr f(OGR_L_GetNextFeature(layer));
+        if (!f && filtered && src.features == 0) {
+            // Nothing near the region: read the whole layer, as without a region.
+            OGR_L_SetSpatialFilter(layer, nullptr);
+            OGR_L_ResetReading(layer);
+            filtered = false;
+            continue;
+        }
+        if (!f)
+            break;
+        ++src.features;
+        OGRGeometryH g = OGR_F_GetGeometryRef(f.get());
+        if (!g)
+            continue;
+        vertices += vertex_count(g);
+        if (max_bytes > 0 && vertices > max_vertices && !too_many) {
+            too_many = true; // from here on only count, to name the total
+            src.polygons = {};
+            src.lines = {};
+        }
+        if (too_many)
+            continue;
+        if (transform) {
+            OgrGeometryPtr copy(OGR_G_Clone(g));
+            if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
+                throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f.get())) +
+                                " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
+            collect_geometry(copy.get(), true, src);
+        } else {
+            collect_geometry(g, false, src);
+        }
+    }
+    if (too_many)
+        throw DataError(where_msg + " has " + std::to_string(vertices) +
+                        " vertices, more than the " + std::to_string(max_vertices) +
+                        " that --max-memory " + memory_text(static_cast<double>(max_bytes)) +
+                        " allows (about " + std::to_string(coast_bytes_per_vertex) +
+                        " bytes each); raise --max-memory, or simplify the layer first (e.g. "
+                        "ogr2ogr -simplify 0.001)");
+    if (src.features == 0 && !where.empty() && CPLGetLastErrorType() >= CE_Failure)
+        throw UsageError("--coast-where '" + where + "' failed on " + where_msg + ": " +
+                         CPLGetLastErrorMsg());
+    if (src.features == 0)
+        throw DataError(where_msg + " has no features" +
+                        (where.empty() ? "" : " matching --coast-where") +
+                        "; give a layer of land polygons or coastlines");
+    if (src.polygons.empty() && src.lines.empty())
+        throw DataError(where_msg + " holds no polygons or lines" +
+                        (src.points ? " (only points)" : "") +
+                        "; give land polygons or coastlines");
+    return src;
+}
+
+} // namespace globemesh::coast_detail
