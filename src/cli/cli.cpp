@@ -366,35 +366,6 @@ struct MeshCommand {
     }
 };
 
-/// Checks that the output files can be written (distinct, not an input, folder there, no file
-/// in the way unless `overwrite`); `outputs` are (option, path) pairs.
-void check_output_files(const std::vector<std::pair<std::string, std::string>>& outputs,
-                        std::span<const std::pair<std::string, std::string>> inputs, bool overwrite) {
-    for (std::size_t i = 0; i < outputs.size(); ++i) {
-        for (std::size_t j = i + 1; j < outputs.size(); ++j) {
-            if (fs::absolute(outputs[i].second).lexically_normal() == fs::absolute(outputs[j].second).lexically_normal())
-                throw UsageError(outputs[i].first + " and " + outputs[j].first + " name the same file " +
-                                 outputs[i].second);
-        }
-    }
-    for (const auto& [name, path] : outputs) check_not_an_input(path, name, inputs);
-    for (const auto& [name, path] : outputs) check_output_path(path, name, overwrite);
-}
-
-/// The mesh files and the JSON files of a run, as (option, path).
-std::vector<std::pair<std::string, std::string>> output_files(std::span<const PlannedOutput> planned,
-                                                              const std::string& timings, const std::string& report,
-                                                              std::span<const Writer> table) {
-    std::vector<std::pair<std::string, std::string>> files;
-    for (const auto& p : planned) files.emplace_back(p.option, p.request.path.string());
-    for (const auto& [name, path] : {std::pair<std::string, std::string>{"--timings", timings}, {"--report", report}}) {
-        if (path.empty()) continue;
-        check_json_output(path, name, table);
-        files.emplace_back(name, path);
-    }
-    return files;
-}
-
 /// The checks run_cli makes before anything is opened: library validation, then the outputs'
 /// formats and paths. Returns the outputs to write.
 std::vector<PlannedOutput> check_mesh_run(const CliOptions& o, std::span<const Writer> table) {
@@ -416,22 +387,6 @@ std::vector<PlannedOutput> check_mesh_run(const CliOptions& o, std::span<const W
     for (const auto& [name, path] : inputs) check_input_path(path, name); // (--config was read)
     check_output_files(files, inputs, o.overwrite);
     return planned;
-}
-
-/// The share of a run's one progress line the mesh (or triangulation) gets, before its outputs:
-/// each output's progress_weight is its writing time relative to the mesh's.
-double mesh_share(std::span<const PlannedOutput> planned) {
-    double total = 1;
-    for (const auto& p : planned) total += p.request.writer->progress_weight;
-    return 1 / total;
-}
-
-/// Writes the outputs of `mesh` (mesh and triangulate alike) into the caller's OutputBatch, on
-/// the rest of the progress line after the mesh's share; a signal stops it (Cancelled).
-void write_run_outputs(const Mesh& mesh, std::span<const PlannedOutput> planned, WriteOptions options,
-                       TerminalProgress& terminal) {
-    options.progress = sub_progress(terminal.callback(), mesh_share(planned), 1);
-    write_outputs(mesh, requests(planned), options, InterruptGuard::interrupted);
 }
 
 void throw_if_interrupted() {

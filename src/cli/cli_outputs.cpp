@@ -177,6 +177,50 @@ void check_json_output(const std::string &path, const std::string &option,
                          ": use --output " + path + " for that");
 }
 
+std::vector<std::pair<std::string, std::string>>
+output_files(std::span<const PlannedOutput> planned, const std::string &timings,
+             const std::string &report, std::span<const Writer> table) {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto &p : planned)
+        files.emplace_back(p.option, p.request.path.string());
+    for (const auto &[name, path] :
+         {std::pair<std::string, std::string>{"--timings", timings}, {"--report", report}}) {
+        if (path.empty())
+            continue;
+        check_json_output(path, name, table);
+        files.emplace_back(name, path);
+    }
+    return files;
+}
+
+void check_output_files(std::span<const std::pair<std::string, std::string>> outputs,
+                        std::span<const std::pair<std::string, std::string>> inputs,
+                        bool overwrite) {
+    for (std::size_t i = 0; i < outputs.size(); ++i)
+        for (std::size_t j = i + 1; j < outputs.size(); ++j)
+            if (fs::absolute(outputs[i].second).lexically_normal() ==
+                fs::absolute(outputs[j].second).lexically_normal())
+                throw UsageError(outputs[i].first + " and " + outputs[j].first +
+                                 " name the same file " + outputs[i].second);
+    for (const auto &[name, path] : outputs)
+        check_not_an_input(path, name, inputs);
+    for (const auto &[name, path] : outputs)
+        check_output_path(path, name, overwrite);
+}
+
+double mesh_share(std::span<const PlannedOutput> planned) {
+    double total = 1;
+    for (const auto &p : planned)
+        total += p.request.writer->progress_weight;
+    return 1 / total;
+}
+
+void write_run_outputs(const Mesh &mesh, std::span<const PlannedOutput> planned,
+                       WriteOptions options, TerminalProgress &terminal) {
+    options.progress = sub_progress(terminal.callback(), mesh_share(planned), 1);
+    write_outputs(mesh, requests(planned), options, InterruptGuard::interrupted);
+}
+
 std::vector<OutputRequest> requests(std::span<const PlannedOutput> planned) {
     std::vector<OutputRequest> r;
     for (const auto &p : planned)

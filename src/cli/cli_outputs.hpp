@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_support.hpp"
 #include "globemesh/writers.hpp"
 
 namespace globemesh::cli {
@@ -50,6 +51,28 @@ plan_outputs(const OutputChoices &c, std::span<const Writer> table,
 /// Throws UsageError when JSON output `option` (--report, --timings) is named for a mesh format.
 void check_json_output(const std::string &path, const std::string &option,
                        std::span<const Writer> table);
+
+/// The mesh files and the JSON files (--timings, --report; checked by check_json_output) of a
+/// run, as (option, path).
+std::vector<std::pair<std::string, std::string>>
+output_files(std::span<const PlannedOutput> planned, const std::string &timings,
+             const std::string &report, std::span<const Writer> table);
+
+/// Checks that the output files can be written: distinct (UsageError), none of `inputs`
+/// (option, path; UsageError), their folders there and no file in the way unless `overwrite`
+/// (IoError).
+void check_output_files(std::span<const std::pair<std::string, std::string>> outputs,
+                        std::span<const std::pair<std::string, std::string>> inputs,
+                        bool overwrite);
+
+/// The share of a run's one progress line the mesh (or triangulation) gets, before its outputs:
+/// each output's progress_weight is its writing time relative to the mesh's.
+double mesh_share(std::span<const PlannedOutput> planned);
+
+/// Writes the outputs of `mesh` (mesh and triangulate alike) into the caller's OutputBatch, on
+/// the rest of `terminal`'s line after the mesh's share; a signal stops it (Cancelled).
+void write_run_outputs(const Mesh &mesh, std::span<const PlannedOutput> planned,
+                       WriteOptions options, TerminalProgress &terminal);
 
 /// The requests of `planned`, in order.
 std::vector<OutputRequest> requests(std::span<const PlannedOutput> planned);
