@@ -20,8 +20,8 @@ void write_as_gpkg(const Mesh &mesh, const fs::path &path,
 void write_as_png(const Mesh &mesh, const fs::path &path,
                   const WriteOptions &options); // preview_png.cpp
 
-// The progress weights: seconds to write a mesh of 1e6 nodes over seconds to mesh it (see
-// bench/RESULTS.md).
+// The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
+// (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
 const std::vector<Writer> &writers() {
     static const std::vector<Writer> table = {
         {.name = "UGRID",
