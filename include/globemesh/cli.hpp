@@ -20,11 +20,11 @@
 #include <string_view>
 #include <vector>
 
-#include "globemesh/gpkg.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 
 namespace globemesh {
 
@@ -38,14 +38,14 @@ int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& 
 struct CliLibrary {
     std::function<Mesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
     std::function<Mesh(const TriangulateOptions&, const Progress&, StageTimings*)> triangulate_file;
-    std::function<void(const Mesh&, const std::filesystem::path&, const UgridOptions&)> write_ugrid;
-    std::function<void(const Mesh&, const std::filesystem::path&, const GpkgOptions&)> write_gpkg;
-    std::function<void(const Mesh&, const std::filesystem::path&, const PreviewOptions&)> write_preview_png;
+    /// The output formats (writers.hpp): -o, -f, --gpkg and --preview choose among them, and
+    /// their rows' write functions write the files.
+    std::vector<Writer> writers;
     std::function<Mesh(const std::filesystem::path&)> read_ugrid;
     std::function<MeshStats(const Mesh&)> compute_stats;
 };
 
-/// The real library functions (pipeline.hpp, ugrid.hpp, gpkg.hpp).
+/// The real library functions (pipeline.hpp, ugrid.hpp, writers.hpp).
 CliLibrary library_calls();
 
 /// run_cli with the given library calls.
@@ -56,10 +56,12 @@ int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& 
 /// "OptionsForBinary" split). CLI11 binds the flags straight to these fields.
 struct CliOptions {
     MeshOptions mesh;
-    std::string output;             ///< -o/--output: UGRID NetCDF file to write (required)
+    std::vector<std::string> output; ///< -o/--output: files to write, each in its extension's format (required)
+    std::string output_format;       ///< -f/--output-format: the writers table's name of -o's format
+    std::vector<std::string> creation_options; ///< --co KEY=VALUE: creation options of the outputs
     std::string gpkg;               ///< --gpkg: also write a GeoPackage
     std::string preview;            ///< --preview: also draw a PNG picture of the mesh
-    std::string format = "netcdf4"; ///< --format: netcdf4 (deflate) or classic (netCDF-3)
+    std::string format = "netcdf4"; ///< --format: netcdf4 (deflate) or classic (netCDF-3), UGRID's FORMAT
     std::string timings;            ///< --timings: JSON file of seconds per stage
     std::string report;             ///< --report: JSON file of the run summary and histogram
     bool overwrite = false;         ///< --overwrite: replace existing outputs

@@ -96,6 +96,9 @@ public:
     /// cannot be written (one appeared without overwrite): the files placed are then removed.
     void commit(const std::function<bool()>& cancelled = {});
 
+    /// True while a batch is alive on this thread (files committed now join it).
+    static bool active();
+
 private:
     friend class OutputFile;
     std::vector<OutputFile::Finished> files_;

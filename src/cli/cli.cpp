@@ -20,15 +20,16 @@
 #include <cpl_error.h>
 #include <gdal.h>
 
+#include "cli_outputs.hpp"
 #include "cli_support.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
-#include "globemesh/gpkg.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 
 namespace globemesh {
 
@@ -194,7 +195,8 @@ struct MeshCommand {
     CLI::Option* bathy_fill_opt = nullptr;
     CLI::Option* min_depth_opt = nullptr;
 
-    MeshCommand() {
+    /// `table`: the output formats the help lists.
+    explicit MeshCommand(std::span<const Writer> table = writers()) {
         app.option_defaults()->always_capture_default();
         app.set_version_flag("--version", version_text(), "Print the version and exit");
         app.get_formatter()->column_width(36);
@@ -303,13 +305,12 @@ struct MeshCommand {
         app.add_option("--smooth", m.smooth_iterations, "Smoothing/relaxation sweeps")->group(mesher)->type_name("N");
         app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")->group(mesher)->type_name("N");
 
-        app.add_option("-o,--output", o.output, "UGRID NetCDF file to write (required)")
-            ->group(output)->type_name("OUT.nc");
+        add_output_flags(app, o.output, o.output_format, o.creation_options, table, output);
         app.add_option("--gpkg", o.gpkg, "Also write a GeoPackage (faces, nodes, boundary, mesh_info)")
             ->group(output)->type_name("OUT.gpkg");
         app.add_option("--preview", o.preview, "Also draw the mesh over the land as a PNG")
             ->group(output)->type_name("OUT.png");
-        app.add_option("--format", o.format, "NetCDF flavour: netcdf4 (deflate) or classic")
+        app.add_option("--format", o.format, "NetCDF flavour of UGRID outputs: netcdf4 (deflate) or classic (= --co FORMAT=NC2)")
             ->group(output)->type_name("FORMAT")->check(CLI::IsMember({"netcdf4", "classic"}));
         app.add_option("--timings", o.timings, "Write the seconds per stage as JSON")
             ->group(output)->type_name("FILE.json");
@@ -352,6 +353,7 @@ struct MeshCommand {
                                          : "; the keys are the long option names, as --print-config writes them";
             throw UsageError("--config " + file + ": unknown key " + key + hint);
         }
+        std::erase(o.output, std::string()); // output = "" (as --print-config shows none) is none
         if (const CLI::Option* config = app.get_config_ptr(); config != nullptr && config->count() > 0)
             o.config = config->as<std::string>();
         if (region_opt->count() > 0 && region.size() == 4)
@@ -364,61 +366,28 @@ struct MeshCommand {
     }
 };
 
-/// The checks run_cli makes before anything is opened: library validation, then the paths.
-void check_mesh_run(const CliOptions& o) {
+/// The checks run_cli makes before anything is opened: library validation, then the outputs'
+/// formats and paths. Returns the outputs to write.
+std::vector<PlannedOutput> check_mesh_run(const CliOptions& o, std::span<const Writer> table) {
     validate(o.mesh);
     if (o.mesh.coast.empty())
         throw UsageError("--coast is required: land polygons or coast lines, e.g. --coast land.gpkg");
     if (o.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o ocean.nc");
-    const std::vector<std::pair<std::string, std::string>> outputs = {
-        {"--output", o.output}, {"--gpkg", o.gpkg}, {"--preview", o.preview},
-        {"--timings", o.timings}, {"--report", o.report}};
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_output_kind(path, name);
-    for (std::size_t i = 0; i < outputs.size(); ++i) {
-        for (std::size_t j = i + 1; j < outputs.size(); ++j) {
-            if (!outputs[i].second.empty() && !outputs[j].second.empty() &&
-                fs::absolute(outputs[i].second).lexically_normal() ==
-                    fs::absolute(outputs[j].second).lexically_normal())
-                throw UsageError(outputs[i].first + " and " + outputs[j].first + " name the same file " +
-                                 outputs[i].second);
-        }
-    }
+    const OutputChoices choices{o.output, o.output_format, o.creation_options,
+                                {{"--gpkg", "GPKG", o.gpkg}, {"--preview", "PNG", o.preview}}};
+    std::vector<std::pair<std::string, std::string>> netcdf_format;
+    if (o.format == "classic") netcdf_format.emplace_back("--format classic", "FORMAT=NC2");
+    const auto planned = plan_outputs(choices, table, netcdf_format, !o.mesh.bathy.empty());
+    const auto files = output_files(planned, o.timings, o.report, table);
     const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
                                                           {"--bathy", o.mesh.bathy},
                                                           {"--region-file", o.mesh.region_file},
                                                           {"--size-regions", o.mesh.size_regions},
                                                           {"--config", o.config}};
     for (const auto& [name, path] : inputs) check_input_path(path, name); // (--config was read)
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_not_an_input(path, name, inputs);
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_output_path(path, name, o.overwrite);
+    check_output_files(files, inputs, o.overwrite);
+    return planned;
 }
-
-/// One progress line for a run: the mesh (or triangulation) and each output get a share of it
-/// as their times compare, asked for in the order they run. Measured at 20 km on 1:50m land
-/// (1.08e6 nodes), seconds for reading and meshing / the UGRID file / the GeoPackage / the PNG:
-/// 1.7 / 2.6 / 7.9 / 1.8.
-class RunShares {
-public:
-    RunShares(TerminalProgress& terminal, bool gpkg, bool preview)
-        : terminal_(terminal), total_(1 + ugrid_weight + (gpkg ? gpkg_weight : 0) + (preview ? preview_weight : 0)) {}
-    Progress mesh() { return next(1); }
-    Progress ugrid() { return next(ugrid_weight); }
-    Progress gpkg() { return next(gpkg_weight); }
-    Progress preview() { return next(preview_weight); }
-
-private:
-    static constexpr double ugrid_weight = 1.5, gpkg_weight = 4.6, preview_weight = 1.1;
-    Progress next(double weight) {
-        const Progress p = sub_progress(terminal_.callback(), at_ / total_, (at_ + weight) / total_);
-        at_ += weight;
-        return p;
-    }
-    TerminalProgress& terminal_;
-    double total_, at_ = 0;
-};
 
 void throw_if_interrupted() {
     if (InterruptGuard::interrupted()) throw Cancelled();
@@ -492,7 +461,7 @@ void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh, bool qu
 
 int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream& err,
              TerminalProgress& terminal, const CliLibrary& lib) {
-    auto command = std::make_unique<MeshCommand>();
+    auto command = std::make_unique<MeshCommand>(lib.writers);
     try {
         command->parse(args);
     } catch (const CLI::CallForHelp&) {
@@ -511,15 +480,14 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
         out << command->app.config_to_str(true, true);
         return 0;
     }
-    check_mesh_run(o);
+    const std::vector<PlannedOutput> planned = check_mesh_run(o, lib.writers);
 
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, o.verbose);
     const auto t0 = std::chrono::steady_clock::now();
     StageTimings timings;
     terminal.configure(o.quiet, o.verbose);
-    RunShares share(terminal, !o.gpkg.empty(), !o.preview.empty());
-    Mesh mesh = lib.mesh_ocean(o.mesh, share.mesh(), &timings);
+    Mesh mesh = lib.mesh_ocean(o.mesh, sub_progress(terminal.callback(), 0, mesh_share(planned)), &timings);
     throw_if_interrupted();
     add_mesh_total(timings);
     // The effective configuration travels with the mesh, so the file itself says how to remake it.
@@ -533,43 +501,19 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
                             "; please report this with the command line");
     }
 
-    // Computed once for the report and both writers (each would otherwise build the topology
+    // Computed once for the report and the writers (each would otherwise build the topology
     // again for it).
     const MeshStats stats = lib.compute_stats(mesh);
     // Every output of the run waits under its temporary name until all are complete.
     OutputBatch batch;
     const auto tw = std::chrono::steady_clock::now();
-    UgridOptions ugrid;
-    ugrid.classic = o.format == "classic";
-    ugrid.overwrite = o.overwrite;
-    ugrid.history = history_text("mesh", args);
-    ugrid.stats = &stats;
-    ugrid.progress = share.ugrid();
-    // The face areas pass from one writer to the other (8 bytes a face, held while the
-    // GeoPackage is written instead of its 8 bytes an edge of geodesic terms).
-    std::vector<double> face_areas;
-    if (!o.gpkg.empty()) ugrid.face_areas_m2 = &face_areas;
-    lib.write_ugrid(mesh, o.output, ugrid);
-    throw_if_interrupted();
-    if (!o.gpkg.empty()) {
-        GpkgOptions gpkg;
-        gpkg.overwrite = o.overwrite;
-        gpkg.stats = &stats;
-        gpkg.face_areas_m2 = &face_areas;
-        gpkg.progress = share.gpkg();
-        lib.write_gpkg(mesh, o.gpkg, gpkg);
-        throw_if_interrupted();
-    }
-    if (!o.preview.empty()) {
-        PreviewOptions preview;
-        preview.land = o.mesh.coast;
-        preview.colour_by = mesh.node_field("depth") ? "depth" : "quality";
-        preview.extent_deg = o.mesh.region;
-        preview.overwrite = o.overwrite;
-        preview.progress = share.preview();
-        lib.write_preview_png(mesh, o.preview, preview);
-        throw_if_interrupted();
-    }
+    WriteOptions write;
+    write.overwrite = o.overwrite;
+    write.history = history_text("mesh", args);
+    write.stats = &stats;
+    write.land = o.mesh.coast;
+    write.extent_deg = o.mesh.region;
+    write_run_outputs(mesh, planned, write, terminal);
     timings.add("write", seconds_since(tw));
     terminal.finish(); // close the progress line if a stage stopped short of its share's end
 
@@ -581,11 +525,9 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     if (!o.report.empty()) {
         std::ostringstream r;
         r << "{\n  \"globemesh\": " << json_string(GLOBEMESH_VERSION) << ",\n"
-          << "  \"history\": " << json_string(ugrid.history) << ",\n"
-          << "  \"outputs\": {\"netcdf\": " << json_string(o.output);
-        if (!o.gpkg.empty()) r << ", \"gpkg\": " << json_string(o.gpkg);
-        if (!o.preview.empty()) r << ", \"preview\": " << json_string(o.preview);
-        r << "},\n  \"mesh\": " << stats_json(stats, "  ") << ",\n";
+          << "  \"history\": " << json_string(write.history) << ",\n"
+          << "  \"outputs\": " << outputs_json(planned);
+        r << ",\n  \"mesh\": " << stats_json(stats, "  ") << ",\n";
         if (const std::string depth = depth_json(mesh); !depth.empty()) r << "  \"depth\": " << depth << ",\n";
         // What the run did to the coast and the land, as the NetCDF file's global attributes say.
         r << "  \"attributes\": {";
@@ -631,8 +573,8 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"
-        << "wrote             " << o.output;
-    for (const auto* p : {&o.gpkg, &o.preview, &o.timings, &o.report})
+        << "wrote             " << outputs_text(planned);
+    for (const auto* p : {&o.timings, &o.report})
         if (!p->empty()) out << ", " << *p;
     out << "\n";
     return 0;
@@ -643,18 +585,19 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
 
 struct TriangulateCommand {
     TriangulateOptions t;
-    std::string output, gpkg, timings;
+    std::vector<std::string> output, creation;
+    std::string format, gpkg, timings;
     bool overwrite = false, quiet = false, verbose = false;
     CLI::App app{"Spherical Delaunay triangulation of scattered points (any OGR point source).",
                  "globemesh triangulate"};
 
-    TriangulateCommand() {
+    explicit TriangulateCommand(std::span<const Writer> table = writers()) {
         app.option_defaults()->always_capture_default();
         app.set_version_flag("--version", version_text(), "Print the version and exit");
         app.get_formatter()->column_width(36);
         app.add_option("POINTS", t.points, "Points: CSV with lon/lat columns, GeoPackage, shapefile, ...")
             ->required()->type_name("SOURCE");
-        app.add_option("-o,--output", output, "UGRID NetCDF file to write (required)")->type_name("OUT.nc");
+        add_output_flags(app, output, format, creation, table, "Options");
         app.add_option("--gpkg", gpkg, "Also write a GeoPackage")->type_name("OUT.gpkg");
         app.add_option("--layer", t.layer, "Layer of POINTS; default the first layer")->type_name("NAME");
         app.add_option("--timings", timings, "Write the seconds per stage as JSON")->type_name("FILE.json");
@@ -666,7 +609,7 @@ struct TriangulateCommand {
 
 int run_triangulate(std::span<const std::string> args, std::ostream& out, std::ostream& err,
                     TerminalProgress& terminal, const CliLibrary& lib) {
-    auto command = std::make_unique<TriangulateCommand>();
+    auto command = std::make_unique<TriangulateCommand>(lib.writers);
     try {
         command->app.parse(reversed(args));
     } catch (const CLI::CallForHelp&) {
@@ -680,42 +623,24 @@ int run_triangulate(std::span<const std::string> args, std::ostream& out, std::o
     if (c.quiet && c.verbose) throw UsageError("--quiet and --verbose exclude each other");
     if (c.output.empty()) throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o out.nc");
     check_input_path(c.t.points, "POINTS");
-    const std::pair<const char*, const std::string&> outputs[] = {
-        {"--output", c.output}, {"--gpkg", c.gpkg}, {"--timings", c.timings}};
+    const OutputChoices choices{c.output, c.format, c.creation, {{"--gpkg", "GPKG", c.gpkg}}};
+    const auto planned = plan_outputs(choices, lib.writers, {}, false);
     const std::pair<std::string, std::string> inputs[] = {{"POINTS", c.t.points}};
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_output_kind(path, name);
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_not_an_input(path, name, inputs);
-    for (const auto& [name, path] : outputs)
-        if (!path.empty()) check_output_path(path, name, c.overwrite);
+    check_output_files(output_files(planned, c.timings, "", lib.writers), inputs, c.overwrite);
 
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, c.verbose);
     StageTimings timings;
     terminal.configure(c.quiet, c.verbose);
-    RunShares share(terminal, !c.gpkg.empty(), false);
-    Mesh mesh = lib.triangulate_file(c.t, share.mesh(), &timings);
+    Mesh mesh = lib.triangulate_file(c.t, sub_progress(terminal.callback(), 0, mesh_share(planned)), &timings);
     throw_if_interrupted();
     OutputBatch batch; // every output waits under its temporary name until all are complete
     const auto tw = std::chrono::steady_clock::now();
-    UgridOptions ugrid;
-    ugrid.overwrite = c.overwrite;
-    ugrid.title = "globemesh spherical Delaunay triangulation";
-    ugrid.history = history_text("triangulate", args);
-    ugrid.progress = share.ugrid();
-    std::vector<double> face_areas;
-    if (!c.gpkg.empty()) ugrid.face_areas_m2 = &face_areas;
-    lib.write_ugrid(mesh, c.output, ugrid);
-    throw_if_interrupted();
-    if (!c.gpkg.empty()) {
-        GpkgOptions gpkg;
-        gpkg.overwrite = c.overwrite;
-        gpkg.face_areas_m2 = &face_areas;
-        gpkg.progress = share.gpkg();
-        lib.write_gpkg(mesh, c.gpkg, gpkg);
-    }
-    throw_if_interrupted();
+    WriteOptions write;
+    write.overwrite = c.overwrite;
+    write.title = "globemesh spherical Delaunay triangulation";
+    write.history = history_text("triangulate", args);
+    write_run_outputs(mesh, planned, write, terminal);
     timings.add("write", seconds_since(tw));
     terminal.finish();
     if (!c.timings.empty()) {

@@ -337,27 +337,6 @@ void check_output_path(const std::string& path, const std::string& what, bool ov
         throw IoError(what + ": " + path + " is not a regular file (a socket?); give a file name");
 }
 
-void check_output_kind(const std::string& path, const std::string& what) {
-    struct Kind {
-        std::string_view extension, format;
-        std::array<std::string_view, 2> options; // the options that write it
-    };
-    static constexpr Kind kinds[] = {{".nc", "UGRID NetCDF", {"--output", ""}},
-                                     {".gpkg", "a GeoPackage", {"--gpkg", ""}},
-                                     {".png", "a PNG picture", {"--preview", ""}},
-                                     {".json", "JSON", {"--report", "--timings"}}};
-    std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    const Kind* own = nullptr;
-    for (const Kind& k : kinds)
-        if (k.options[0] == what || k.options[1] == what) own = &k;
-    for (const Kind& k : kinds)
-        if (own != nullptr && &k != own && extension == k.extension)
-            throw UsageError(what + " writes " + std::string(own->format) + ", but " + path + " is named for " +
-                             std::string(k.format) + ": use " + std::string(k.options[0]) + " " + path + " for that");
-}
-
 void check_input_path(const std::string& path, const std::string& what) {
     if (path.empty() || is_gdal_special(path)) return;
     std::error_code ec;

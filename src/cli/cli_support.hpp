@@ -119,11 +119,6 @@ std::uint64_t default_memory_budget_bytes();
 /// `what` names the option, e.g. "--gpkg".
 void check_output_path(const std::string& path, const std::string& what, bool overwrite);
 
-/// Throws UsageError when output option `what` (--output, --gpkg, --preview, --report or
-/// --timings) names its file with the extension of another output (-o ocean.gpkg would write
-/// NetCDF under a GeoPackage's name, which QGIS then fails to open); other extensions pass.
-void check_output_kind(const std::string& path, const std::string& what);
-
 /// Throws IoError when a local input file is missing; GDAL virtual paths (/vsi...) and
 /// connection strings (PG:..., https://...) are left to GDAL.
 void check_input_path(const std::string& path, const std::string& what);

@@ -11,11 +11,7 @@ CliLibrary library_calls() {
     lib.triangulate_file = [](const TriangulateOptions& o, const Progress& p, StageTimings* t) {
         return triangulate_file(o, p, t);
     };
-    lib.write_ugrid = [](const Mesh& m, const std::filesystem::path& p, const UgridOptions& o) { write_ugrid(m, p, o); };
-    lib.write_gpkg = [](const Mesh& m, const std::filesystem::path& p, const GpkgOptions& o) { write_gpkg(m, p, o); };
-    lib.write_preview_png = [](const Mesh& m, const std::filesystem::path& p, const PreviewOptions& o) {
-        write_preview_png(m, p, o);
-    };
+    lib.writers = writers();
     lib.read_ugrid = [](const std::filesystem::path& p) { return read_ugrid(p); };
     lib.compute_stats = [](const Mesh& m) { return compute_stats(m); };
     return lib;

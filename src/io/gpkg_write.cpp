@@ -24,6 +24,7 @@
 #include "globemesh/gpkg.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
 
@@ -530,6 +531,17 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     io::add_rtree_indexes(out.temp_path(), indexes, path, sub_progress(options.progress, face_share + node_share, 1.0));
     report(options.progress, 1.0, "write_gpkg");
     out.commit();
+}
+
+/// The GPKG row of the writers table (writers.cpp).
+void write_as_gpkg(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options) {
+    GpkgOptions gpkg;
+    gpkg.overwrite = options.overwrite;
+    gpkg.stats = options.stats;
+    gpkg.face_areas_m2 = options.face_areas_m2;
+    gpkg.progress = options.progress;
+    gpkg.after_partial_write = options.after_partial_write;
+    write_gpkg(mesh, path, gpkg);
 }
 
 } // namespace globemesh

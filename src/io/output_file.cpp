@@ -186,6 +186,8 @@ void OutputFile::place(const Finished& f) {
 
 OutputBatch::OutputBatch() : outer_(active_batch) { active_batch = this; }
 
+bool OutputBatch::active() { return active_batch != nullptr; }
+
 OutputBatch::~OutputBatch() {
     active_batch = outer_;
     if (committed_) return;

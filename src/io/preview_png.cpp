@@ -20,6 +20,7 @@
 #include "globemesh/gpkg.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 
 namespace globemesh {
 
@@ -269,6 +270,18 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
                       OutputFile::full_disk_note(path));
     report(options.progress, 1.0, "write_preview");
     out.commit();
+}
+
+/// The PNG row of the writers table (writers.cpp): coloured by depth when the mesh has it.
+void write_as_png(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options) {
+    PreviewOptions preview;
+    preview.land = options.land;
+    preview.colour_by = mesh.node_field("depth") ? "depth" : "quality";
+    preview.extent_deg = options.extent_deg;
+    preview.overwrite = options.overwrite;
+    preview.progress = options.progress;
+    preview.after_partial_write = options.after_partial_write;
+    write_preview_png(mesh, path, preview);
 }
 
 } // namespace globemesh

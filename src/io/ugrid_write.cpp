@@ -20,6 +20,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 #include "face_area.hpp"
 #include "face_geometry.hpp"
 #include "hdf5_chunks.hpp"
@@ -525,6 +526,20 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     });
     w.finish();
     out.commit();
+}
+
+/// The UGRID row of the writers table (writers.cpp).
+void write_as_ugrid(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options) {
+    UgridOptions ugrid;
+    ugrid.classic = creation_option(options.creation_options, "FORMAT", "NC4") == "NC2";
+    ugrid.overwrite = options.overwrite;
+    ugrid.title = options.title;
+    ugrid.history = options.history;
+    ugrid.stats = options.stats;
+    ugrid.face_areas_m2 = options.face_areas_m2;
+    ugrid.progress = options.progress;
+    ugrid.after_partial_write = options.after_partial_write;
+    write_ugrid(mesh, path, ugrid);
 }
 
 } // namespace globemesh

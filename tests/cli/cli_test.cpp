@@ -50,14 +50,20 @@ struct RefusingLibrary {
         };
         l.mesh_ocean = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
         l.triangulate_file = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
-        l.write_ugrid = [refuse](auto&&...) { refuse(); };
-        l.write_gpkg = [refuse](auto&&...) { refuse(); };
-        l.write_preview_png = [refuse](auto&&...) { refuse(); };
+        l.writers = globemesh::writers();
+        for (auto& w : l.writers) w.write = [refuse](auto&&...) { refuse(); };
         l.read_ugrid = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
         l.compute_stats = [refuse](auto&&...) -> globemesh::MeshStats { refuse(); return {}; };
         return l;
     }
 };
+
+/// The row of `lib`'s writers table named `name` (the test replaces its write function).
+globemesh::Writer& row(globemesh::CliLibrary& lib, const std::string& name) {
+    for (auto& w : lib.writers)
+        if (w.name == name) return w;
+    throw std::logic_error("no writer " + name);
+}
 
 Result run(const std::vector<std::string>& args, const globemesh::CliLibrary& lib) {
     std::ostringstream out, err;
@@ -479,11 +485,21 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.gpkg"}, 1, "existing.gpkg"},
         // An output named for another output's format: NetCDF under a GeoPackage's name would
         // not open in QGIS as one.
-        ErrorCase{"output_named_gpkg", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg"}, 2, "use --gpkg "},
+        ErrorCase{"output_named_json", {"mesh", "--coast", coast, "-o", "{dir}/o.json"}, 2, "use --report "},
         ErrorCase{"gpkg_named_nc", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/p.NC"}, 2, "--output"},
         ErrorCase{"preview_named_json", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.json"}, 2, "--preview"},
         ErrorCase{"report_named_png", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/r.png"}, 2, "--report"},
-        ErrorCase{"triangulate_output_named_gpkg", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/t.gpkg"}, 2, "--gpkg"},
+        // -o's format is its extension's or -f's: an unknown one lists the formats, and their
+        // creation options are checked, all before the run.
+        ErrorCase{"output_of_unknown_extension", {"mesh", "--coast", coast, "-o", "{dir}/o.dat"}, 2, "no format has the extension .dat; the formats are UGRID (.nc, .nc4), GPKG (.gpkg), PNG (.png)"},
+        ErrorCase{"triangulate_output_of_unknown_extension", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/t.dat"}, 2, "the formats are UGRID"},
+        ErrorCase{"unknown_output_format", {"mesh", "--coast", coast, "-f", "NOSUCH", "-o", "{dir}/o.dat"}, 2, "-f/--output-format NOSUCH: no such format; the formats are UGRID"},
+        ErrorCase{"output_format_for_two_outputs", {"mesh", "--coast", coast, "-f", "GPKG", "-o", "{dir}/a", "-o", "{dir}/b"}, 2, "-f/--output-format names the format of one -o file"},
+        ErrorCase{"same_file_by_output_and_gpkg", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--gpkg", "{dir}/o.gpkg"}, 2, "name the same file"},
+        ErrorCase{"creation_option_no_output_takes", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--co", "FORMAT=NC2"}, 2, "--co FORMAT=NC2: none of the outputs takes the creation option FORMAT (UGRID"},
+        ErrorCase{"creation_option_value", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "format=nc3"}, 2, "UGRID creation option FORMAT=nc3: use FORMAT=NC4 or NC2"},
+        ErrorCase{"creation_option_without_value", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "FORMAT"}, 2, "--co FORMAT: give KEY=VALUE"},
+        ErrorCase{"classic_without_a_ugrid_output", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--format", "classic"}, 2, "--format classic (FORMAT=NC2): none of the outputs"},
         ErrorCase{"report_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/x/r.json"}, 1, "--report"},
         ErrorCase{"triangulate_missing_points", {"triangulate", "{dir}/none.csv", "-o", "{dir}/t.nc"}, 1, "none.csv"},
         ErrorCase{"triangulate_without_output", {"triangulate", fixture("points/stations.csv").string()}, 2, "--output"},
@@ -626,11 +642,11 @@ TEST(Cli, the_mesh_and_its_outputs_share_one_progress_line) {
         return globemesh::Mesh{};
     };
     lib.compute_stats = [](const globemesh::Mesh&) { return globemesh::MeshStats{}; };
-    lib.write_ugrid = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::UgridOptions& o) {
+    row(lib, "UGRID").write = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::WriteOptions& o) {
         report_all(o.progress, "write_ugrid");
         write_text(path, "ugrid");
     };
-    lib.write_gpkg = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::GpkgOptions& o) {
+    row(lib, "GPKG").write = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::WriteOptions& o) {
         report_all(o.progress, "write_gpkg");
         write_text(path, "gpkg");
     };
@@ -639,7 +655,7 @@ TEST(Cli, the_mesh_and_its_outputs_share_one_progress_line) {
     EXPECT_EQ(order, (std::vector<std::string>{"refine", "write_ugrid", "write_gpkg"}));
     EXPECT_EQ(r.err, "0...10...20...30...40...50...60...70...80...90...100 - done.\n");
     // Cancelled from the terminal while an output is written: no file left.
-    lib.write_ugrid = [&](const globemesh::Mesh&, const fs::path&, const globemesh::UgridOptions& o) {
+    row(lib, "UGRID").write = [&](const globemesh::Mesh&, const fs::path&, const globemesh::WriteOptions& o) {
         globemesh::report(o.progress, 0.1, "write_ugrid");
         std::raise(SIGINT);
         globemesh::report(o.progress, 0.2, "write_ugrid"); // throws Cancelled
@@ -778,19 +794,20 @@ struct FakeRun {
             return m;
         };
         l.triangulate_file = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
-        l.write_ugrid = [this](const globemesh::Mesh& m, const fs::path& p, const globemesh::UgridOptions& o) {
+        l.writers = globemesh::writers();
+        row(l, "UGRID").write = [this](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
             EXPECT_NE(o.history.find("globemesh mesh --coast"), std::string::npos) << o.history;
             for (const auto& [key, value] : m.attributes)
                 if (key == "globemesh_configuration") configuration = value;
             globemesh::OutputFile::write_text(p, "nc", o.overwrite); // as the real writers do
             written.push_back(p.string());
         };
-        l.write_gpkg = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::GpkgOptions& o) {
+        row(l, "GPKG").write = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::WriteOptions& o) {
             if (fail_gpkg) throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
             globemesh::OutputFile::write_text(p, "gpkg", o.overwrite);
             written.push_back(p.string());
         };
-        l.write_preview_png = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::PreviewOptions& o) {
+        row(l, "PNG").write = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::WriteOptions& o) {
             globemesh::OutputFile::write_text(p, "png", o.overwrite);
             written.push_back(p.string());
         };
@@ -853,18 +870,18 @@ TEST(Cli, the_outputs_appear_together_at_the_end_of_the_run) {
     FakeRun fake;
     std::vector<std::set<std::string>> seen; // the folder as each later writer starts
     auto lib = fake.lib();
-    const auto gpkg = lib.write_gpkg;
-    const auto preview = lib.write_preview_png;
+    const auto gpkg = row(lib, "GPKG").write;
+    const auto preview = row(lib, "PNG").write;
     auto names = [&] {
         std::set<std::string> n;
         for (const auto& e : fs::directory_iterator(dir.path())) n.insert(e.path().filename().string());
         return n;
     };
-    lib.write_gpkg = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::GpkgOptions& o) {
+    row(lib, "GPKG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
         seen.push_back(names());
         gpkg(m, p, o);
     };
-    lib.write_preview_png = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::PreviewOptions& o) {
+    row(lib, "PNG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
         seen.push_back(names());
         preview(m, p, o);
     };
@@ -883,7 +900,7 @@ TEST(Cli, the_outputs_appear_together_at_the_end_of_the_run) {
     EXPECT_EQ(read_text(dir / "o.png"), "png");
     // A file that appears under one of the names during the run stops it before any is placed.
     for (const char* name : {"o.nc", "o.gpkg", "o.png", "r.json"}) fs::remove(dir / name);
-    lib.write_preview_png = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::PreviewOptions& o) {
+    row(lib, "PNG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
         write_text(dir / "o.gpkg", "someone else's");
         preview(m, p, o);
     };
@@ -892,6 +909,63 @@ TEST(Cli, the_outputs_appear_together_at_the_end_of_the_run) {
     EXPECT_NE(clash.err.find("o.gpkg already exists"), std::string::npos) << clash.err;
     EXPECT_EQ(names(), (std::set<std::string>{"o.gpkg"}));
     EXPECT_EQ(read_text(dir / "o.gpkg"), "someone else's");
+}
+
+// A format is a row of the writers table: with one more row, -o picks it by its extension and -f
+// by its name, --co reaches it, it has its share of the progress line, and the help, the summary
+// and the report list it, with nothing else of the command line changed.
+TEST(Cli, a_row_added_to_the_writers_table_is_an_output_format_of_the_command_line) {
+    TempDir dir;
+    FakeRun fake;
+    auto lib = fake.lib();
+    std::vector<std::pair<std::string, std::string>> wrote; // file, its FLAVOUR creation option
+    bool stop_halfway = false;
+    globemesh::Writer toy;
+    toy.name = "TOY";
+    toy.long_name = "toy mesh";
+    toy.extensions = {".toy"};
+    toy.report_key = "toy";
+    toy.progress_weight = 2;
+    toy.creation_options = {{"FLAVOUR", {"SWEET", "SOUR"}, "the taste"}};
+    toy.write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+        globemesh::report(o.progress, 0.5, "write_toy");
+        if (stop_halfway) throw globemesh::IoError("the toy stops here");
+        globemesh::OutputFile::write_text(p, std::to_string(m.faces.size()) + " faces\n", o.overwrite);
+        wrote.emplace_back(p.filename().string(), globemesh::creation_option(o.creation_options, "FLAVOUR", "-"));
+    };
+    lib.writers.push_back(toy);
+    const std::string a = (dir / "a.nc").string(), b = (dir / "b.toy").string(), c = (dir / "c.dat").string(),
+                      report = (dir / "r.json").string();
+    const Result r = run({"mesh", "--coast", coast, "-o", a, "-o", b, "--co", "flavour=sour", "--report", report, "-q"}, lib);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_text(dir / "b.toy"), "8 faces\n");
+    EXPECT_NE(r.out.find("wrote             " + a + ", " + b + ", " + report + "\n"), std::string::npos) << r.out;
+    EXPECT_NE(read_text(report).find("\"outputs\": {\"netcdf\": \"" + a + "\", \"toy\": \"" + b + "\"}"), std::string::npos)
+        << read_text(report);
+    const Result f = run({"mesh", "--coast", coast, "-f", "toy", "-o", c, "-q"}, lib);
+    ASSERT_EQ(f.status, 0) << f.err;
+    EXPECT_EQ(wrote, (std::vector<std::pair<std::string, std::string>>{{"b.toy", "SOUR"}, {"c.dat", "-"}}));
+    EXPECT_EQ(fake.written, (std::vector<std::string>{a})); // UGRID for a.nc only
+    // Its share of the line: the mesh 1, UGRID 1.5, the toy 2; half of the toy is at 7/9 of the
+    // line, tick 31 of 40 ("70..."), where its error ends the line.
+    stop_halfway = true;
+    const Result half = run({"mesh", "--coast", coast, "-o", (dir / "d.nc").string(), "-o", (dir / "d.toy").string()}, lib);
+    EXPECT_EQ(half.status, 1);
+    EXPECT_TRUE(regex_search(half.err, R"(^0\.\.\.10(\.\.\.[2-7]0)+\.\.\.\nglobemesh: the toy stops here\n$)")) << half.err;
+    EXPECT_FALSE(fs::exists(dir / "d.nc"));
+    const Result help = run({"mesh", "--help"}, lib);
+    EXPECT_NE(help.out.find(", TOY; default: from its extension"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find(", .toy TOY)"), std::string::npos) << help.out;
+    // What a format needs is checked before the run: a toy that needs depths, and no --bathy.
+    RefusingLibrary refusing;
+    auto refused = refusing.lib();
+    toy.needs = globemesh::needs_depth;
+    refused.writers.push_back(toy);
+    const Result depth = run({"mesh", "--coast", coast, "-o", (dir / "e.toy").string()}, refused);
+    EXPECT_EQ(depth.status, 2);
+    EXPECT_EQ(depth.err, "globemesh: --output " + (dir / "e.toy").string() +
+                             ": TOY needs depths; give a bathymetry (--bathy)\n");
+    EXPECT_EQ(refusing.calls, 0);
 }
 
 // A failure of the library after a cancelling signal is the run stopping (an interrupted GEOS or

@@ -149,6 +149,69 @@ print('OK')
     EXPECT_EQ(same, "OK\n");
 }
 
+// The format of -o is its extension's, or -f's (as ogr2ogr -f); --co FORMAT=NC2 and the older
+// --format classic write the same netCDF-3 file. Read back by OGR (osgeo) and netCDF4.
+TEST(CliE2e, the_output_format_comes_from_the_extension_or_from_f) {
+    TempDir dir;
+    const std::vector<std::string> base = {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "800km", "-q"};
+    auto run = [&](std::vector<std::string> outputs) {
+        std::vector<std::string> args = base;
+        args.insert(args.end(), outputs.begin(), outputs.end());
+        std::string out, err;
+        const int status = run_exe(args, out, err, dir.path());
+        EXPECT_EQ(status, 0) << err;
+        return out;
+    };
+    const auto p = [&](const char* name) { return (dir / name).string(); };
+    run({"-o", p("a.nc"), "-o", p("b.gpkg"), "-o", p("c.png")});
+    run({"-f", "GPKG", "-o", p("d.dat")});
+    run({"-o", p("e.nc"), "--co", "FORMAT=NC2"});
+    run({"-o", p("f.nc"), "--format", "classic"});
+    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "b.gpkg", "c.png", "d.dat", "e.nc", "f.nc"}));
+    expect_mesh_verify(dir / "a.nc");
+    const std::string verdict = python(R"(
+import netCDF4, numpy as np
+from osgeo import gdal, ogr
+gdal.UseExceptions()
+gdal.PushErrorHandler('CPLQuietErrorHandler')  # "non conformant file extension" of d.dat: asked for
+d = ')" + dir.path().string() + R"('
+a = netCDF4.Dataset(d + '/a.nc')
+mesh = [v for v in a.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
+faces = a.variables[mesh.face_node_connectivity].shape[0]
+assert a.data_model == 'NETCDF4', a.data_model
+for name in ('b.gpkg', 'd.dat'):
+    g = ogr.Open(d + '/' + name)
+    assert g.GetDriver().GetName() == 'GPKG', (name, g.GetDriver().GetName())
+    assert g.GetLayerByName('faces').GetFeatureCount() == faces, (name, faces)
+png = gdal.Open(d + '/c.png')
+assert png.GetDriver().ShortName == 'PNG' and png.RasterCount >= 3, png.GetDriver().ShortName
+e, f = netCDF4.Dataset(d + '/e.nc'), netCDF4.Dataset(d + '/f.nc')
+for c in (e, f):
+    assert c.data_model == 'NETCDF3_64BIT_OFFSET', c.data_model
+    assert set(c.variables) == set(a.variables), sorted(set(c.variables) ^ set(a.variables))
+for v in e.variables:
+    assert np.array_equal(e[v][...], f[v][...]), v
+print('OK', faces)
+)",
+                                       dir.path());
+    EXPECT_EQ(verdict.rfind("OK ", 0), 0u) << verdict;
+    // An unknown extension: one line naming the formats (those of today first), status 2,
+    // nothing written.
+    std::string out, err;
+    std::vector<std::string> args = base;
+    args.insert(args.end(), {"-o", p("g.dat")});
+    EXPECT_EQ(run_exe(args, out, err, dir.path()), 2);
+    EXPECT_EQ(err.rfind("globemesh: --output " + p("g.dat") +
+                            ": no format has the extension .dat; the formats are UGRID (.nc, .nc4), GPKG (.gpkg), "
+                            "PNG (.png)",
+                        0),
+              0u)
+        << err;
+    EXPECT_NE(err.find("; name the file so, or choose the format with -f NAME\n"), std::string::npos) << err;
+    EXPECT_EQ(count_lines(err), 1) << err;
+    EXPECT_FALSE(fs::exists(dir / "g.dat"));
+}
+
 TEST(CliE2e, regional_run_has_coast_and_open_boundaries_inside_the_region) {
     TempDir dir;
     std::string out, err;
