@@ -272,9 +272,8 @@ void field_attributes(UgridWriter& w, int v, const Field& f, const char* locatio
     if (!units.empty()) w.text(v, "units", units);
 }
 
-} // namespace
-
-void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const UgridOptions& options) {
+/// Refuses a mesh whose fields do not match its nodes or faces, or that has no faces.
+void check_fields(const Mesh& mesh, const std::filesystem::path& path) {
     for (const auto& f : mesh.node_fields)
         if (f.values.size() != mesh.nodes.size())
             throw DataError("mesh: node field " + f.name + " has " + std::to_string(f.values.size()) +
@@ -284,28 +283,38 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
             throw DataError("mesh: face field " + f.name + " has " + std::to_string(f.values.size()) +
                             " values for " + std::to_string(mesh.faces.size()) + " faces");
     if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
+}
 
-    OutputFile out(path, options.overwrite, "UGRID output");
-    const io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
-    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count(),
-                      nb = topo.boundary_edges.size();
+/// How many nodes, faces, edges and boundary edges the file holds.
+struct Counts {
+    std::size_t nn, nf, ne, nb;
+};
 
-    // Coordinates, quality and area are computed one variable at a time while writing, each in
-    // a buffer freed before the next: all of them at once were most of the writer's peak (about
-    // 250 bytes per node). Nothing of that can fail; a failure of the file itself leaves only
-    // the temporary output, which OutputFile removes.
-    io::NcHandle nc;
-    const int mode = options.classic ? (NC_NOCLOBBER | NC_64BIT_OFFSET) : (NC_NOCLOBBER | NC_NETCDF4);
-    nc.create(out.temp_path(), mode, path, "UGRID output");
-    int old_fill;
-    nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
-    UgridWriter w(nc, out.temp_path(), path, !options.classic, options.progress);
+/// The file's dimensions; bnd is -1 when the mesh has no boundary.
+struct Dims {
+    int node, face, edge, two, three, bnd;
+};
 
-    const int d_node = w.dim("nMesh_node", nn), d_face = w.dim("nMesh_face", nf), d_edge = w.dim("nMesh_edge", ne);
-    const int d_two = w.dim("Two", 2), d_three = w.dim("Three", 3);
-    const int d_bnd = nb ? w.dim("nMesh_boundary", nb) : -1;
+Dims define_dimensions(UgridWriter& w, const Counts& c) {
+    Dims d;
+    d.node = w.dim("nMesh_node", c.nn);
+    d.face = w.dim("nMesh_face", c.nf);
+    d.edge = w.dim("nMesh_edge", c.ne);
+    d.two = w.dim("Two", 2);
+    d.three = w.dim("Three", 3);
+    d.bnd = c.nb ? w.dim("nMesh_boundary", c.nb) : -1;
+    return d;
+}
 
+/// The variables of the mesh itself: the containers crs and mesh, the coordinates (node, face
+/// centre, edge midpoint; lon then lat) and the connectivities (bnd: -1 without a boundary).
+struct TopologyVars {
+    int crs = -1, mesh = -1;
+    int coords[6] = {};
+    int face_nodes = -1, edge_nodes = -1, face_edges = -1, face_links = -1, edge_faces = -1, bnd = -1;
+};
+
+int define_crs(UgridWriter& w) {
     // CRS, read by CF tools (grid_mapping_name, crs_wkt) and by MDAL (EPSG_code, epsg).
     int crs = w.var("crs", NC_INT, {});
     w.text(crs, "grid_mapping_name", "latitude_longitude");
@@ -316,7 +325,10 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.text(crs, "wkt", wgs84_wkt);
     w.ints(crs, "epsg", {4326});
     w.text(crs, "EPSG_code", "EPSG:4326");
+    return crs;
+}
 
+int define_topology(UgridWriter& w, bool has_boundary) {
     int topo_var = w.var("mesh", NC_INT, {});
     w.text(topo_var, "cf_role", "mesh_topology");
     w.text(topo_var, "long_name", "Topology of the 2-D unstructured ocean mesh");
@@ -329,25 +341,38 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.text(topo_var, "face_edge_connectivity", "mesh_face_edges");
     w.text(topo_var, "face_face_connectivity", "mesh_face_links");
     w.text(topo_var, "edge_face_connectivity", "mesh_edge_face_links");
-    if (nb) w.text(topo_var, "boundary_node_connectivity", "mesh_boundary_nodes");
+    if (has_boundary) w.text(topo_var, "boundary_node_connectivity", "mesh_boundary_nodes");
     w.text(topo_var, "face_dimension", "nMesh_face");
     w.text(topo_var, "edge_dimension", "nMesh_edge");
+    return topo_var;
+}
 
-    struct Coord { const char* name; int dim; bool lon; const char* what; };
-    const Coord coords[] = {{"mesh_node_lon", d_node, true, "node"}, {"mesh_node_lat", d_node, false, "node"},
-                            {"mesh_face_lon", d_face, true, "face centre"}, {"mesh_face_lat", d_face, false, "face centre"},
-                            {"mesh_edge_lon", d_edge, true, "edge midpoint"}, {"mesh_edge_lat", d_edge, false, "edge midpoint"}};
-    int coord_vars[6];
+void define_coordinates(UgridWriter& w, const Dims& d, TopologyVars& t) {
+    struct Coord {
+        const char* name;
+        int dim;
+        bool lon;
+        const char* what;
+    };
+    const Coord coords[] = {{"mesh_node_lon", d.node, true, "node"},
+                            {"mesh_node_lat", d.node, false, "node"},
+                            {"mesh_face_lon", d.face, true, "face centre"},
+                            {"mesh_face_lat", d.face, false, "face centre"},
+                            {"mesh_edge_lon", d.edge, true, "edge midpoint"},
+                            {"mesh_edge_lat", d.edge, false, "edge midpoint"}};
     for (int i = 0; i < 6; ++i) {
         const Coord& c = coords[i];
-        int v = coord_vars[i] = w.var(c.name, NC_DOUBLE, {c.dim});
+        int v = t.coords[i] = w.var(c.name, NC_DOUBLE, {c.dim});
         w.text(v, "standard_name", c.lon ? "longitude" : "latitude");
         w.text(v, "long_name", std::string(c.lon ? "longitude of " : "latitude of ") + c.what);
         w.text(v, "units", c.lon ? "degrees_east" : "degrees_north");
         w.text(v, "grid_mapping", "crs");
     }
+}
 
-    auto connectivity = [&](const char* name, const char* role, int d_elem, int d_cols, const char* long_name, bool fill) {
+void define_connectivity(UgridWriter& w, const Dims& d, TopologyVars& t) {
+    auto connectivity = [&](const char* name, const char* role, int d_elem, int d_cols,
+                            const char* long_name, bool fill) {
         int v = w.var(name, NC_INT, {d_elem, d_cols});
         w.text(v, "cf_role", role);
         w.text(v, "long_name", long_name);
@@ -355,23 +380,33 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         if (fill) w.ints(v, "_FillValue", {-1});
         return v;
     };
-    int v_face_nodes = connectivity("mesh_face_nodes", "face_node_connectivity", d_face, d_three,
-                                    "nodes of each face, counter-clockwise", false);
-    int v_edge_nodes = connectivity("mesh_edge_nodes", "edge_node_connectivity", d_edge, d_two,
-                                    "nodes of each edge", false);
-    int v_face_edges = connectivity("mesh_face_edges", "face_edge_connectivity", d_face, d_three,
-                                    "edges of each face (edge k joins nodes k and k+1)", false);
-    int v_face_links = connectivity("mesh_face_links", "face_face_connectivity", d_face, d_three,
-                                    "neighbour faces of each face", true);
-    int v_edge_faces = connectivity("mesh_edge_face_links", "edge_face_connectivity", d_edge, d_two,
-                                    "faces on each side of each edge", true);
-    int v_bnd = nb ? connectivity("mesh_boundary_nodes", "boundary_node_connectivity", d_bnd, d_two,
-                                  "nodes of each boundary edge, mesh on the left", false)
-                   : -1;
+    t.face_nodes = connectivity("mesh_face_nodes", "face_node_connectivity", d.face, d.three,
+                                "nodes of each face, counter-clockwise", false);
+    t.edge_nodes = connectivity("mesh_edge_nodes", "edge_node_connectivity", d.edge, d.two,
+                                "nodes of each edge", false);
+    t.face_edges = connectivity("mesh_face_edges", "face_edge_connectivity", d.face, d.three,
+                                "edges of each face (edge k joins nodes k and k+1)", false);
+    t.face_links = connectivity("mesh_face_links", "face_face_connectivity", d.face, d.three,
+                                "neighbour faces of each face", true);
+    t.edge_faces = connectivity("mesh_edge_face_links", "edge_face_connectivity", d.edge, d.two,
+                                "faces on each side of each edge", true);
+    t.bnd = d.bnd >= 0 ? connectivity("mesh_boundary_nodes", "boundary_node_connectivity", d.bnd,
+                                      d.two, "nodes of each boundary edge, mesh on the left", false)
+                       : -1;
+}
 
+/// The variables of the fields: one per node field (in order), quality and area, one per other
+/// face field (extra_face_fields, in order), and the edges' boundary tags.
+struct FieldVars {
+    std::vector<int> node, face;
+    std::vector<const Field*> extra_face_fields;
+    int quality = -1, area = -1, tag = -1;
+};
+
+FieldVars define_fields(UgridWriter& w, const Mesh& mesh, const Dims& d) {
+    FieldVars v;
     const char* node_coords = "mesh_node_lon mesh_node_lat";
     const char* face_coords = "mesh_face_lon mesh_face_lat";
-    std::vector<int> node_vars, face_vars;
     // Variable and dimension names in use; a field whose name is taken gets a "_node"/"_face"
     // suffix. (netCDF-4 stores a variable named as a dimension under another name in HDF5,
     // where the chunks are written by name.)
@@ -387,32 +422,35 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         return n;
     };
     for (const auto& f : mesh.node_fields) {
-        node_vars.push_back(w.var(var_name(f.name, "_node").c_str(), NC_DOUBLE, {d_node}));
-        field_attributes(w, node_vars.back(), f, "node", node_coords);
+        v.node.push_back(w.var(var_name(f.name, "_node").c_str(), NC_DOUBLE, {d.node}));
+        field_attributes(w, v.node.back(), f, "node", node_coords);
     }
     Field q_field{"quality", "quality (2*sqrt(3)*inradius/longest edge)", "1", "", {}};
     Field a_field{"area", "face area (geodesic, WGS84)", "m2", "cell_area", {}};
-    int v_quality = w.var("quality", NC_DOUBLE, {d_face});
-    field_attributes(w, v_quality, q_field, "face", face_coords);
-    w.text(v_quality, "comment", "shape quality of the chordal triangle: 1 equilateral, 0 degenerate");
-    int v_area = w.var("area", NC_DOUBLE, {d_face});
-    field_attributes(w, v_area, a_field, "face", face_coords);
-    std::vector<const Field*> extra_face_fields;
+    v.quality = w.var("quality", NC_DOUBLE, {d.face});
+    field_attributes(w, v.quality, q_field, "face", face_coords);
+    w.text(v.quality, "comment", "shape quality of the chordal triangle: 1 equilateral, 0 degenerate");
+    v.area = w.var("area", NC_DOUBLE, {d.face});
+    field_attributes(w, v.area, a_field, "face", face_coords);
     for (const auto& f : mesh.face_fields) {
         if (f.name == "quality" || f.name == "area") continue; // recomputed above
-        extra_face_fields.push_back(&f);
-        face_vars.push_back(w.var(var_name(f.name, "_face").c_str(), NC_DOUBLE, {d_face}));
-        field_attributes(w, face_vars.back(), f, "face", face_coords);
+        v.extra_face_fields.push_back(&f);
+        v.face.push_back(w.var(var_name(f.name, "_face").c_str(), NC_DOUBLE, {d.face}));
+        field_attributes(w, v.face.back(), f, "face", face_coords);
     }
-    int v_tag = w.var("boundary_tag", NC_INT, {d_edge});
-    w.text(v_tag, "mesh", "mesh");
-    w.text(v_tag, "location", "edge");
-    w.text(v_tag, "coordinates", "mesh_edge_lon mesh_edge_lat");
-    w.text(v_tag, "long_name", "boundary tag of each edge");
-    w.ints(v_tag, "flag_values", {0, 1, 2});
-    w.text(v_tag, "flag_meanings", "interior coast open");
+    v.tag = w.var("boundary_tag", NC_INT, {d.edge});
+    w.text(v.tag, "mesh", "mesh");
+    w.text(v.tag, "location", "edge");
+    w.text(v.tag, "coordinates", "mesh_edge_lon mesh_edge_lat");
+    w.text(v.tag, "long_name", "boundary tag of each edge");
+    w.ints(v.tag, "flag_values", {0, 1, 2});
+    w.text(v.tag, "flag_meanings", "interior coast open");
+    return v;
+}
 
-    // Global attributes: conventions, provenance, the mesh's run metadata, summary statistics.
+/// Global attributes: conventions, provenance, the mesh's run metadata, summary statistics.
+void define_global_attributes(UgridWriter& w, const Mesh& mesh, const UgridOptions& options,
+                              const MeshStats& stats, const Counts& c) {
     w.text(NC_GLOBAL, "Conventions", "CF-1.8 UGRID-1.0");
     w.text(NC_GLOBAL, "title", options.title);
     w.text(NC_GLOBAL, "source", std::string("globemesh ") + GLOBEMESH_VERSION);
@@ -421,10 +459,10 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         std::string name = attribute_name(key);
         if (!w.has_att(NC_GLOBAL, name.c_str())) w.text(NC_GLOBAL, name.c_str(), value);
     }
-    w.ints(NC_GLOBAL, "node_count", {int(nn)});
-    w.ints(NC_GLOBAL, "face_count", {int(nf)});
-    w.ints(NC_GLOBAL, "edge_count", {int(ne)});
-    w.ints(NC_GLOBAL, "boundary_edge_count", {int(nb)});
+    w.ints(NC_GLOBAL, "node_count", {int(c.nn)});
+    w.ints(NC_GLOBAL, "face_count", {int(c.nf)});
+    w.ints(NC_GLOBAL, "edge_count", {int(c.ne)});
+    w.ints(NC_GLOBAL, "boundary_edge_count", {int(c.nb)});
     w.ints(NC_GLOBAL, "boundary_loop_count", {int(stats.boundary_loops)});
     w.dbl(NC_GLOBAL, "quality_min", stats.quality_min);
     w.dbl(NC_GLOBAL, "quality_mean", stats.quality_mean);
@@ -433,16 +471,12 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
     w.dbl(NC_GLOBAL, "edge_length_km_mean", stats.edge_km_mean);
     w.dbl(NC_GLOBAL, "edge_length_km_max", stats.edge_km_max);
     w.dbl(NC_GLOBAL, "area_km2", stats.area_km2);
+}
 
-    io::nc_check(nc_enddef(nc.id()), path, "leaving define mode", "UGRID output");
-
-    // The container variables hold no data, but NC_NOFILL leaves their bytes undefined: write
-    // them so the same mesh always gives the same file.
-    const int zero = 0;
-    io::nc_check(nc_put_var_int(nc.id(), crs, &zero), path, "writing crs", "UGRID output");
-    io::nc_check(nc_put_var_int(nc.id(), topo_var, &zero), path, "writing the mesh variable", "UGRID output");
-    w.start_data();
-
+/// Writes every variable with dimensions, in the order of the file's layout.
+void write_data(UgridWriter& w, const Mesh& mesh, const io::MeshTopology& topo, const Counts& c,
+                const TopologyVars& t, const FieldVars& fv, const UgridOptions& options) {
+    const std::size_t nn = c.nn, nf = c.nf, ne = c.ne, nb = c.nb;
     // Every variable is computed block by block while it is written (UgridWriter::in_blocks):
     // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
     // table: the edges' area terms (GeodesicFaceAreas, 24 bytes a node).
@@ -465,16 +499,16 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         std::atomic<bool>& stop;
         ~StopOnExit() { stop = true; }
     } stop_on_exit{stop_solving};
-    w.put_rows<int, 3>(v_face_nodes, nf, [&](std::size_t f) {
-        const auto& t = mesh.faces[f];
-        return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
+    w.put_rows<int, 3>(t.face_nodes, nf, [&](std::size_t f) {
+        const auto& tri = mesh.faces[f];
+        return std::array<int, 3>{int(tri[0]), int(tri[1]), int(tri[2])};
     });
     if (options.after_partial_write) options.after_partial_write();
-    w.put_lonlat(coord_vars[2], coord_vars[3], nf, centre);
-    w.put_lonlat(coord_vars[4], coord_vars[5], ne, midpoint);
-    w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
+    w.put_lonlat(t.coords[2], t.coords[3], nf, centre);
+    w.put_lonlat(t.coords[4], t.coords[5], ne, midpoint);
+    w.put_rows<int, 2>(t.edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
     {
-        w.put_lonlat(coord_vars[0], coord_vars[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
+        w.put_lonlat(t.coords[0], t.coords[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
         const io::GeodesicFaceAreas areas = areas_ahead.get();
         if (options.face_areas_m2) options.face_areas_m2->assign(nf, 0.0);
         // Face edges, face neighbours and face areas a block of faces at a time (face_edges): no
@@ -493,27 +527,27 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
                 std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
                 b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
             }
-            block.put(v_face_edges, b.edges.data(), count);
-            block.put(v_face_links, b.links.data(), count);
-            block.put(v_area, b.area.data(), count);
+            block.put(t.face_edges, b.edges.data(), count);
+            block.put(t.face_links, b.links.data(), count);
+            block.put(fv.area, b.area.data(), count);
             if (options.face_areas_m2)
                 std::copy(b.area.begin(), b.area.end(), options.face_areas_m2->begin() + std::ptrdiff_t(first));
         });
     }
-    w.put_rows<int, 2>(v_edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); });
+    w.put_rows<int, 2>(t.edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); });
     if (nb)
-        w.put_rows<int, 2>(v_bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); });
-    for (std::size_t i = 0; i < node_vars.size(); ++i) {
+        w.put_rows<int, 2>(t.bnd, nb, [&](std::size_t i) { return topo.edge_nodes(std::size_t(topo.boundary_edges[i])); });
+    for (std::size_t i = 0; i < fv.node.size(); ++i) {
         const Field& f = mesh.node_fields[i];
-        w.put_values<double>(node_vars[i], nn, [&](std::size_t k) { return f.values[k]; });
+        w.put_values<double>(fv.node[i], nn, [&](std::size_t k) { return f.values[k]; });
     }
-    w.put_values<double>(v_quality, nf, [&](std::size_t f) {
-        const auto& t = mesh.faces[f];
-        return triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
+    w.put_values<double>(fv.quality, nf, [&](std::size_t f) {
+        const auto& tri = mesh.faces[f];
+        return triangle_quality(mesh.nodes[tri[0]], mesh.nodes[tri[1]], mesh.nodes[tri[2]]);
     });
-    for (std::size_t i = 0; i < face_vars.size(); ++i) {
-        const Field& f = *extra_face_fields[i];
-        w.put_values<double>(face_vars[i], nf, [&](std::size_t k) { return f.values[k]; });
+    for (std::size_t i = 0; i < fv.face.size(); ++i) {
+        const Field& f = *fv.extra_face_fields[i];
+        w.put_values<double>(fv.face[i], nf, [&](std::size_t k) { return f.values[k]; });
     }
     w.in_blocks<std::vector<int>>(ne, [&](std::size_t first, std::size_t count, std::vector<int>& tags,
                                           UgridWriter::Block& block) {
@@ -522,8 +556,47 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         auto b = std::lower_bound(topo.boundary_edges.begin(), topo.boundary_edges.end(), std::int32_t(first));
         for (; b != topo.boundary_edges.end() && std::size_t(*b) < first + count; ++b)
             tags[std::size_t(*b) - first] = topo.boundary_tags[std::size_t(b - topo.boundary_edges.begin())];
-        block.put(v_tag, tags.data(), count);
+        block.put(fv.tag, tags.data(), count);
     });
+}
+
+} // namespace
+
+void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const UgridOptions& options) {
+    check_fields(mesh, path);
+    OutputFile out(path, options.overwrite, "UGRID output");
+    const io::MeshTopology topo = io::build_topology(mesh);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
+    const Counts counts{mesh.nodes.size(), mesh.faces.size(), topo.edge_count(), topo.boundary_edges.size()};
+
+    // Coordinates, quality and area are computed one variable at a time while writing, each in
+    // a buffer freed before the next: all of them at once were most of the writer's peak (about
+    // 250 bytes per node). Nothing of that can fail; a failure of the file itself leaves only
+    // the temporary output, which OutputFile removes.
+    io::NcHandle nc;
+    const int mode = options.classic ? (NC_NOCLOBBER | NC_64BIT_OFFSET) : (NC_NOCLOBBER | NC_NETCDF4);
+    nc.create(out.temp_path(), mode, path, "UGRID output");
+    int old_fill;
+    nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
+    UgridWriter w(nc, out.temp_path(), path, !options.classic, options.progress);
+
+    const Dims dims = define_dimensions(w, counts);
+    TopologyVars t;
+    t.crs = define_crs(w);
+    t.mesh = define_topology(w, counts.nb != 0);
+    define_coordinates(w, dims, t);
+    define_connectivity(w, dims, t);
+    const FieldVars fields = define_fields(w, mesh, dims);
+    define_global_attributes(w, mesh, options, stats, counts);
+    io::nc_check(nc_enddef(nc.id()), path, "leaving define mode", "UGRID output");
+
+    // The container variables hold no data, but NC_NOFILL leaves their bytes undefined: write
+    // them so the same mesh always gives the same file.
+    const int zero = 0;
+    io::nc_check(nc_put_var_int(nc.id(), t.crs, &zero), path, "writing crs", "UGRID output");
+    io::nc_check(nc_put_var_int(nc.id(), t.mesh, &zero), path, "writing the mesh variable", "UGRID output");
+    w.start_data();
+    write_data(w, mesh, topo, counts, t, fields, options);
     w.finish();
     out.commit();
 }
