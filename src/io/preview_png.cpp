@@ -114,77 +114,68 @@ std::array<double, 4> default_extent(const Mesh& mesh) {
     return {west - pad_x, std::max(-90.0, south - pad_y), east + pad_x, std::min(90.0, north + pad_y)};
 }
 
-} // namespace
-
-void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, const PreviewOptions& options) {
+/// Checks the options against the mesh; returns the extent W, S, E, N in degrees, with E > W.
+std::array<double, 4> checked_extent(const Mesh& mesh, const std::filesystem::path& path,
+                                     const PreviewOptions& options) {
     if (options.colour_by != "quality" && options.colour_by != "depth")
         throw UsageError("preview colour \"" + options.colour_by + "\": use quality or depth");
     if (options.width_px < 16 || options.width_px > 20000)
         throw UsageError("preview width " + std::to_string(options.width_px) + ": use 16 to 20000 pixels");
-    const Field* depth = mesh.node_field("depth");
-    if (options.colour_by == "depth" && !depth)
+    if (options.colour_by == "depth" && !mesh.node_field("depth"))
         throw DataError("preview " + path.string() + ": the mesh has no depth field to colour by");
     auto [w, s, e, n] = options.extent_deg ? *options.extent_deg : default_extent(mesh);
     if (e <= w) e += 360;
     if (!(n > s) || s < -90 || n > 90 || e - w > 360)
         throw UsageError("preview extent: give W,S,E,N in degrees with S < N, both within [-90, 90]");
-    OutputFile out(path, options.overwrite, "preview");
+    return {w, s, e, n};
+}
 
-    GDALAllRegister();
-    io::QuietGdalErrors quiet;
-    const int width = options.width_px;
-    const int height = std::max(16, int(std::lround(width * (n - s) / (e - w))));
-    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-    GDALDriver* png = GetGDALDriverManager()->GetDriverByName("PNG");
-    if (!mem || !png) throw IoError("preview " + path.string() + ": GDAL lacks the MEM or PNG driver");
-    io::GdalDatasetPtr canvas(mem->Create("", width, height, 4, GDT_Byte, nullptr));
-    if (!canvas) throw IoError("preview " + path.string() + ": cannot allocate the picture: " + io::last_gdal_error());
-    double gt[6] = {w, (e - w) / width, 0, n, 0, -(n - s) / height};
-    canvas->SetGeoTransform(gt);
-    const Rgba background = {236, 242, 248, 255};
-    for (int b = 1; b <= 4; ++b) canvas->GetRasterBand(b)->Fill(background[b - 1]);
-
-    if (!options.land.empty()) {
-        io::GdalDatasetPtr land(GDALDataset::Open(options.land.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
-        if (!land) throw IoError("preview land " + options.land + ": cannot open (" + io::last_gdal_error() + ")");
-        OGRSpatialReference wgs84;
-        wgs84.importFromEPSG(4326);
-        wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-        const Rgba land_colour = {205, 195, 170, 255};
-        std::vector<std::unique_ptr<OGRGeometry>> land_geoms;
-        // The layer named "land" when there is one, else the first (a file may also hold "ocean").
-        OGRLayer* layer = land->GetLayerByName("land");
-        if (!layer) layer = land->GetLayer(0);
-        if (!layer) throw DataError("preview land " + options.land + ": the file has no layer");
-        {
-            std::unique_ptr<OGRCoordinateTransformation> ct;
-            if (const OGRSpatialReference* srs = layer->GetSpatialRef(); srs && !srs->IsSame(&wgs84)) {
-                ct.reset(OGRCreateCoordinateTransformation(srs, &wgs84));
-                if (!ct) throw DataError("preview land " + options.land + ": cannot transform layer " + layer->GetName() + " to EPSG:4326");
-            }
-            for (auto& feature : *layer) {
-                const OGRGeometry* g = feature->GetGeometryRef();
-                if (!g || wkbFlatten(g->getGeometryType()) == wkbPoint) continue;
-                std::unique_ptr<OGRGeometry> copy(g->clone());
-                if (ct && copy->transform(ct.get()) != OGRERR_NONE) continue;
-                land_geoms.push_back(std::move(copy));
-            }
+/// Burns the land polygons of options.land into the canvas (geotransform gt, longitudes w to e).
+void draw_land(GDALDataset* canvas, double (&gt)[6], double w, double e, const PreviewOptions& options,
+               const std::filesystem::path& path) {
+    const double n = gt[3];
+    io::GdalDatasetPtr land(GDALDataset::Open(options.land.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+    if (!land) throw IoError("preview land " + options.land + ": cannot open (" + io::last_gdal_error() + ")");
+    OGRSpatialReference wgs84;
+    wgs84.importFromEPSG(4326);
+    wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    const Rgba land_colour = {205, 195, 170, 255};
+    std::vector<std::unique_ptr<OGRGeometry>> land_geoms;
+    // The layer named "land" when there is one, else the first (a file may also hold "ocean").
+    OGRLayer* layer = land->GetLayerByName("land");
+    if (!layer) layer = land->GetLayer(0);
+    if (!layer) throw DataError("preview land " + options.land + ": the file has no layer");
+    {
+        std::unique_ptr<OGRCoordinateTransformation> ct;
+        if (const OGRSpatialReference* srs = layer->GetSpatialRef(); srs && !srs->IsSame(&wgs84)) {
+            ct.reset(OGRCreateCoordinateTransformation(srs, &wgs84));
+            if (!ct) throw DataError("preview land " + options.land + ": cannot transform layer " + layer->GetName() + " to EPSG:4326");
         }
-        // Land copies one turn east or west are drawn by moving the picture's origin instead.
-        for (double shift : shifts_for(-180, 180, w, e)) {
-            BurnList burn;
-            for (const auto& g : land_geoms) burn.add(g->clone(), land_colour);
-            double shifted[6] = {w - shift, gt[1], 0, n, 0, gt[5]};
-            canvas->SetGeoTransform(shifted);
-            burn.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+        for (auto& feature : *layer) {
+            const OGRGeometry* g = feature->GetGeometryRef();
+            if (!g || wkbFlatten(g->getGeometryType()) == wkbPoint) continue;
+            std::unique_ptr<OGRGeometry> copy(g->clone());
+            if (ct && copy->transform(ct.get()) != OGRERR_NONE) continue;
+            land_geoms.push_back(std::move(copy));
         }
-        canvas->SetGeoTransform(gt);
     }
-    // Shares of the progress, as measured at 20 km (2.1e6 faces, 2.6 s): the land 8%, the faces'
-    // polygons and their burning 86%, the outlines and the PNG the rest.
-    report(options.progress, 0.08, "write_preview");
+    // Land copies one turn east or west are drawn by moving the picture's origin instead.
+    for (double shift : shifts_for(-180, 180, w, e)) {
+        BurnList burn;
+        for (const auto& g : land_geoms) burn.add(g->clone(), land_colour);
+        double shifted[6] = {w - shift, gt[1], 0, n, 0, gt[5]};
+        canvas->SetGeoTransform(shifted);
+        burn.burn(canvas, "ALL_TOUCHED=FALSE", path);
+    }
+    canvas->SetGeoTransform(gt);
+}
 
-    // Faces, coloured by quality (red poor .. green good) or depth (light to dark blue).
+/// Burns the faces into the canvas (geotransform gt, longitudes west to east), coloured by
+/// quality (red poor .. green good) or depth (light to dark blue), with their outlines when
+/// faces are large enough; reports the progress from 0.08 to 0.97.
+void draw_faces(GDALDataset* canvas, const double (&gt)[6], double west, double east, const Mesh& mesh,
+                const PreviewOptions& options, const std::filesystem::path& path) {
+    const Field* depth = mesh.node_field("depth");
     double depth_max = 1;
     if (depth)
         for (double d : depth->values)
@@ -209,7 +200,6 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
         std::vector<Rgba> colours;
     };
     constexpr std::size_t block_faces = 16384, burn_batch = 262144;
-    const double west = w, east = e; // (clang before 16 lets no lambda capture a structured binding)
     io::compute_in_order<Shapes, char>(
         (mesh.faces.size() + block_faces - 1) / block_faces,
         [&](std::size_t k, Shapes& shapes, char&) {
@@ -249,25 +239,57 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
             // Burnt as they come, in order (a later face still covers an earlier one's pixels):
             // all of them held at once made the picture the run's peak (at 20 km, 721 MiB).
             if (faces.size() >= burn_batch) {
-                faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
+                faces.burn(canvas, "ALL_TOUCHED=FALSE", path);
                 faces.clear();
             }
         });
-    faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
-    outlines.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, options.progress, 0.94, 0.97);
-    if (options.after_partial_write) options.after_partial_write();
+    faces.burn(canvas, "ALL_TOUCHED=FALSE", path);
+    outlines.burn(canvas, "ALL_TOUCHED=FALSE", path, options.progress, 0.94, 0.97);
+}
 
+/// Writes the canvas as a PNG to `temp` (the output's temporary file).
+void write_png(GDALDriver* png, GDALDataset* canvas, const std::filesystem::path& temp,
+               const std::filesystem::path& path) {
     // Written without georeferencing sidecars (no .aux.xml, no world file): a picture only.
     double identity[6] = {0, 1, 0, 0, 0, 1};
     canvas->SetGeoTransform(identity);
     io::ScopedGdalConfig no_pam("GDAL_PAM_ENABLED", "NO");
-    io::GdalDatasetPtr written(png->CreateCopy(out.temp_path().c_str(), canvas.get(), FALSE, nullptr, nullptr, nullptr));
+    io::GdalDatasetPtr written(png->CreateCopy(temp.c_str(), canvas, FALSE, nullptr, nullptr, nullptr));
     if (!written)
         throw IoError("preview " + path.string() + ": writing the PNG failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));
     if (!io::close_dataset(written))
         throw IoError("preview " + path.string() + ": closing the PNG failed: " + io::last_gdal_error() +
                       OutputFile::full_disk_note(path));
+}
+
+} // namespace
+
+void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, const PreviewOptions& options) {
+    const auto [w, s, e, n] = checked_extent(mesh, path, options);
+    OutputFile out(path, options.overwrite, "preview");
+
+    GDALAllRegister();
+    io::QuietGdalErrors quiet;
+    const int width = options.width_px;
+    const int height = std::max(16, int(std::lround(width * (n - s) / (e - w))));
+    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+    GDALDriver* png = GetGDALDriverManager()->GetDriverByName("PNG");
+    if (!mem || !png) throw IoError("preview " + path.string() + ": GDAL lacks the MEM or PNG driver");
+    io::GdalDatasetPtr canvas(mem->Create("", width, height, 4, GDT_Byte, nullptr));
+    if (!canvas) throw IoError("preview " + path.string() + ": cannot allocate the picture: " + io::last_gdal_error());
+    double gt[6] = {w, (e - w) / width, 0, n, 0, -(n - s) / height};
+    canvas->SetGeoTransform(gt);
+    const Rgba background = {236, 242, 248, 255};
+    for (int b = 1; b <= 4; ++b) canvas->GetRasterBand(b)->Fill(background[b - 1]);
+
+    if (!options.land.empty()) draw_land(canvas.get(), gt, w, e, options, path);
+    // Shares of the progress, as measured at 20 km (2.1e6 faces, 2.6 s): the land 8%, the faces'
+    // polygons and their burning 86%, the outlines and the PNG the rest.
+    report(options.progress, 0.08, "write_preview");
+    draw_faces(canvas.get(), gt, w, e, mesh, options, path);
+    if (options.after_partial_write) options.after_partial_write();
+    write_png(png, canvas.get(), out.temp_path(), path);
     report(options.progress, 1.0, "write_preview");
     out.commit();
 }
