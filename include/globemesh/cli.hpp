@@ -36,7 +36,7 @@ int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& 
 /// or to interrupt a run at a chosen point (a seam like GDAL's test hooks). Each member must be
 /// set.
 struct CliLibrary {
-    std::function<Mesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
+    std::function<OceanMesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
     std::function<Mesh(const TriangulateOptions&, const Progress&, StageTimings*)> triangulate_file;
     std::function<void(const Mesh&, const std::filesystem::path&, const UgridOptions&)> write_ugrid;
     std::function<void(const Mesh&, const std::filesystem::path&, const GpkgOptions&)> write_gpkg;

@@ -145,16 +145,17 @@ SizeFn SizeField::function() const {
 SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boundary* coast,
                            const Progress& progress, std::size_t max_nodes) {
     validate(o);
-    if (!(o.hmax_km > 0)) throw UsageError("--hmax must be a positive length, e.g. 100km");
+    if (!(o.hmax_km > 0)) throw UsageError(option("hmax_km") + " must be a positive length, e.g. 100km");
     if ((o.wavelength > 0 || o.slope > 0) && !bathy)
-        throw UsageError(std::string(o.wavelength > 0 ? "--wavelength" : "--slope") +
-                         " needs a bathymetry raster: give --bathy");
+        throw UsageError(option(o.wavelength > 0 ? "wavelength" : "slope") + " needs a bathymetry raster: give " +
+                         option("bathy"));
     if (o.coast_size_km > 0 && !coast)
-        throw UsageError("--coast-size needs the coastline: give --coast");
+        throw UsageError(option("coast_size_km") + " needs the coastline: give " + option("coast"));
     const double hmax = o.hmax_km;
     const double hfloor = size_floor_km(o);
     if (o.coast_size_km > 0 && o.coast_size_km > hmax)
-        throw UsageError("--coast-size (" + km(o.coast_size_km) + ") must not be larger than --hmax (" + km(hmax) + ")");
+        throw UsageError(option("coast_size_km") + " (" + km(o.coast_size_km) + ") must not be larger than " +
+                         option("hmax_km") + " (" + km(hmax) + ")");
 
     report(progress, 0.0, "size field");
     detail::BackgroundGrid g = detail::make_background_grid(o, hfloor, max_nodes);
