@@ -69,6 +69,7 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh {
@@ -128,9 +129,6 @@ struct CoastData {
 /// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
 /// region; rings that cannot be repaired), Cancelled.
 CoastData load_coast(const MeshOptions& options, const Progress& progress = {});
-
-/// Target edge length in km at a point of the unit sphere (must be > 0).
-using SizeFn = std::function<double(const Vec3&)>;
 
 struct CoastReport {
     std::size_t rings = 0;            ///< rings in the shaped boundary

@@ -84,6 +84,7 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 
 namespace globemesh {
 
@@ -163,7 +164,7 @@ struct MesherReport {
 /// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
 /// Neighbouring nodes are mostly close in the numbering, and so are neighbouring faces (the
 /// lattice's insertion order or, when the refinement made most nodes, a Hilbert curve's).
-Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
+Mesh mesh_boundary(const Boundary& boundary, const SizeFn& size_km,
                    const MesherOptions& options = {}, MesherReport* report = nullptr,
                    const Progress& progress = {}, StageTimings* timings = nullptr);
 

@@ -54,12 +54,10 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh {
-
-/// A size function: target edge length in km at a unit vector.
-using SizeFn = std::function<double(const Vec3&)>;
 
 /// Gravity used by the wavelength component, m/s2 (standard gravity).
 inline constexpr double standard_gravity = 9.80665;
@@ -74,10 +72,12 @@ double wavelength_size_km(double depth_m, double period_h, double points_per_wav
 /// Infinite where grad is 0.
 double slope_size_km(double depth_m, double grad_m_per_km, double points_per_length);
 
-/// The size field on its background grid (values in km, no NaN).
+/// The size field: one size everywhere (uniform), or values on a background grid (km, no NaN).
 class SizeField {
 public:
     SizeField() = default;
+    /// One size h_km everywhere, without a grid. Throws UsageError unless h_km > 0.
+    static SizeField uniform(double h_km);
     /// Wraps a grid of sizes (km, all finite and > 0). A global grid whose first (last) row lies
     /// within one row spacing of a pole is closed by a polar cap, linear in latitude from that row
     /// to the pole value (south_pole_km, north_pole_km; NaN: the smallest value of the row).
@@ -91,7 +91,9 @@ public:
     double size_km(double lon_deg, double lat_deg) const;
     double operator()(const Vec3& p) const { return size_km(p); }
 
-    /// The background grid (node values in km), for checks and output.
+    /// True when the field is one size everywhere (no term of the options is on): no grid.
+    bool is_uniform() const { return !grid_; }
+    /// The background grid (node values in km), for checks and output; only when !is_uniform().
     const Raster& grid() const { return *grid_; }
     /// A SizeFn sharing this field's grid (cheap to copy).
     SizeFn function() const;
@@ -112,13 +114,16 @@ private:
 };
 
 /// Builds the size field the options ask for (see the file comment). bathy: the bathymetry
-/// (required when --wavelength or --slope is on, else may be null); coast: the boundary rings at
-/// full resolution (required when --coast-size is on). max_nodes caps the background grid.
+/// (required when wavelength or slope is on, else may be null); coast: the boundary rings at
+/// full resolution (required when coast_size_km is on). max_nodes caps the background grid.
+/// When no component is on the field is uniform (max(hmax_km, hmin_km), SizeField::is_uniform)
+/// and no grid is built; otherwise before_grid, when set, is called once before the grid is
+/// allocated (to refuse the run by throwing).
 /// Throws UsageError (bad sizes, a component without its input, naming the option), DataError
-/// (a --size-regions file without a size_km field) or IoError (--size-regions unreadable).
+/// (a size_regions file without a size_km field) or IoError (size_regions unreadable).
 SizeField build_size_field(const MeshOptions& options, const Raster* bathy, const Boundary* coast,
-                           const Progress& progress = {},
-                           std::size_t max_nodes = std::size_t{1} << 24);
+                           const Progress& progress = {}, std::size_t max_nodes = std::size_t{1} << 24,
+                           const std::function<void()>& before_grid = {});
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.
 SizeFn uniform_size(double h_km);

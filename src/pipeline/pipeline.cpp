@@ -183,24 +183,21 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
     }
     clock.lap("read_bathy");
 
-    // --hmax alone is a uniform field: no background grid needed.
-    const bool uniform = o.coast_size_km == 0 && o.wavelength == 0 && o.slope == 0 && o.size_regions.empty();
-    SizeFn size;
-    SizeField field;
-    SizeFieldReport size_report;
-    if (uniform) {
-        size = uniform_size(std::max(o.hmax_km, o.hmin_km));
-        size_report.min_km = size_report.max_km = std::max(o.hmax_km, o.hmin_km);
-    } else {
+    // The background grid, when the field needs one, is held against the budget before it is made.
+    auto reserve_grid = [&] {
         const double grid_nodes = size_grid_nodes(o);
         budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
-                       "the size field's background grid (" +
-                           std::to_string(static_cast<std::uint64_t>(grid_nodes)) + " nodes)",
+                       "the size field's background grid (" + std::to_string(static_cast<std::uint64_t>(grid_nodes)) +
+                           " nodes)",
                        " or " + option("hmin_km"));
-        field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
-                                 sub_progress(progress, 0.15, 0.25), size_grid_max_nodes);
-        size = field.function();
-        size_report = {false, field.grid().values().size(), field.min_km(), field.max_km()};
+    };
+    // Uniform when no component of the field is on: then no background grid is built.
+    const SizeField field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
+                                             sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
+    const SizeFn size = field.function();
+    SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
+    if (!field.is_uniform()) {
+        size_report.grid_nodes = field.grid().values().size();
         budget.hold(static_cast<double>(field.grid().values().size() * sizeof(float)));
     }
     clock.lap("size_field");

@@ -104,14 +104,33 @@ double worst_edge_gradient_ratio(const SizeField& f, double grade) {
 TEST(SizeField, hmax_alone_gives_a_uniform_field) {
     MeshOptions o;
     o.hmax_km = 80;
-    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 16);
-    EXPECT_TRUE(f.grid().global());
+    bool grid_asked = false;
+    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 16, [&] { grid_asked = true; });
+    // No component is on: the field is uniform without a grid, and said so.
+    EXPECT_TRUE(f.is_uniform());
+    EXPECT_FALSE(grid_asked);
+    EXPECT_EQ(f.size_km(normalized({1, 2, 3})), 80); // exactly, not interpolated
+    EXPECT_EQ(f.function()(normalized({-3, 1, 2})), 80);
     EXPECT_EQ(f.min_km(), 80);
     EXPECT_EQ(f.max_km(), 80);
     std::mt19937 rng(3);
     std::normal_distribution<double> n;
     for (int k = 0; k < 100; ++k) EXPECT_NEAR(f.size_km(normalized({n(rng), n(rng), n(rng)})), 80, 1e-12);
     EXPECT_NEAR(f.size_km(lonlat_to_vec(0, 90)), 80, 1e-12);
+}
+
+// A component that is on makes a grid even where it lowers no size (a coast size with an
+// empty boundary): whether the field is uniform follows from the components, not their effect.
+TEST(SizeField, a_component_on_makes_a_grid) {
+    MeshOptions o;
+    o.hmax_km = 80;
+    o.coast_size_km = 10;
+    const Boundary none;
+    int grids = 0;
+    const SizeField f = build_size_field(o, nullptr, &none, {}, 1 << 12, [&] { ++grids; });
+    EXPECT_FALSE(f.is_uniform());
+    EXPECT_EQ(grids, 1);
+    EXPECT_EQ(f.max_km(), 80);
 }
 
 TEST(SizeField, wavelength_component_matches_its_formula_and_depth_floor) {
