@@ -22,8 +22,10 @@
 
 #include "globemesh/gpkg.hpp"
 #include "globemesh/mesh.hpp"
+#include "globemesh/mesh_stats.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/pipeline.hpp"
+#include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
 
 namespace globemesh {
@@ -83,11 +85,5 @@ double parse_area_km2(std::string_view text);
 double parse_duration_h(std::string_view text);
 /// "50m", "0.05km", "50" (m) -> metres (depths). Throws UsageError like parse_length_km.
 double parse_depth_m(std::string_view text);
-
-/// The invariants of mesh.hpp that fail (empty when the mesh is sound): indices in range,
-/// three distinct corners, counter-clockwise faces (sign of det[a,b,c] in floating point), unit nodes (|1-|v|| < 1e-12),
-/// every edge shared by at most two faces with opposite directions, boundary list equal to the
-/// edges used by one face, field sizes. At most `limit` messages.
-std::vector<std::string> check_mesh(const Mesh& mesh, std::size_t limit = 20);
 
 } // namespace globemesh

@@ -20,6 +20,8 @@
 #include "globemesh/gpkg.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/preview.hpp"
+#include "write_hooks.hpp"
 
 namespace globemesh {
 
@@ -254,7 +256,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
         });
     faces.burn(canvas.get(), "ALL_TOUCHED=FALSE", path);
     outlines.burn(canvas.get(), "ALL_TOUCHED=FALSE", path, options.progress, 0.94, 0.97);
-    if (options.after_partial_write) options.after_partial_write();
+    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
 
     // Written without georeferencing sidecars (no .aux.xml, no world file): a picture only.
     double identity[6] = {0, 1, 0, 0, 0, 1};

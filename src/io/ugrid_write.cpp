@@ -26,6 +26,7 @@
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
 #include "netcdf_handle.hpp"
+#include "write_hooks.hpp"
 
 #ifndef GLOBEMESH_VERSION
 #define GLOBEMESH_VERSION "unknown"
@@ -468,7 +469,7 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
         const auto& t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]), int(t[1]), int(t[2])};
     });
-    if (options.after_partial_write) options.after_partial_write();
+    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
     w.put_lonlat(coord_vars[2], coord_vars[3], nf, centre);
     w.put_lonlat(coord_vars[4], coord_vars[5], ne, midpoint);
     w.put_rows<int, 2>(v_edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
