@@ -34,7 +34,9 @@ constexpr std::uint64_t min_memory_budget_bytes = 1'000'000;
 
 } // namespace
 
-void validate(const MeshOptions& o) {
+namespace {
+
+void validate_size(const SizeFieldOptions& o) {
     const ErrorText hmax = option("hmax_km"), hmin = option("hmin_km");
     require(positive(o.hmax_km), hmax + " must be a positive length, e.g. 100km");
     require(o.hmax_km <= max_hmax_km, hmax + " must be at most " + std::to_string(int(max_hmax_km)) +
@@ -50,15 +52,24 @@ void validate(const MeshOptions& o) {
     require(positive(o.wave_period_h), option("wave_period_h") + " must be a positive number of hours");
     require(std::isfinite(o.slope) && o.slope >= 0, option("slope") + " must be >= 0 (points per length scale)");
     require(positive(o.grade) && o.grade < 10, option("grade") + " must be in (0, 10)");
-    require(std::isfinite(o.min_island_area_km2) && o.min_island_area_km2 >= 0,
-            option("min_island_area_km2") + " must be a positive area, e.g. 100km2");
-    require(o.bathy_band >= 1, option("bathy_band") + " must be 1 or more");
+    // A layer without its file would be ignored without a word.
+    require(o.size_regions_layer.empty() || !o.size_regions.empty(),
+            option("size_regions_layer") + " names a layer of " + option("size_regions") + ", which is not given");
+}
+
+void validate_meshing(const MeshingOptions& o) {
     require(o.max_nodes >= 3, option("max_nodes") + " must be at least 3");
     require(o.max_memory_bytes == 0 || o.max_memory_bytes >= min_memory_budget_bytes,
             option("max_memory_bytes") + " must be 0 (no limit) or at least 1MB, e.g. 4GB");
-    require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000, option("smooth_iterations") + " must be in 0..1000");
+    require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000,
+            option("smooth_iterations") + " must be in 0..1000");
     require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,
             option("inlet_width") + " must be in 0..2 (a fraction of the local edge length; 0 keeps every inlet)");
+}
+
+void validate_coast(const CoastOptions& o) {
+    require(std::isfinite(o.min_island_area_km2) && o.min_island_area_km2 >= 0,
+            option("min_island_area_km2") + " must be a positive area, e.g. 100km2");
     const ErrorText region = option("region"), region_file = option("region_file");
     if (o.region) {
         const auto& r = *o.region;
@@ -69,15 +80,27 @@ void validate(const MeshOptions& o) {
         require(r[0] != r[2], region + " W and E must differ (W > E crosses +-180)");
     }
     require(!(o.region && !o.region_file.empty()), region + " and " + region_file + " cannot be used together");
-    // A layer without its file, or a depth floor without depths, would be ignored without a word.
+    // A layer without its file would be ignored without a word.
     require(o.region_layer.empty() || !o.region_file.empty(),
             option("region_layer") + " names a layer of " + region_file + ", which is not given");
-    require(o.size_regions_layer.empty() || !o.size_regions.empty(),
-            option("size_regions_layer") + " names a layer of " + option("size_regions") + ", which is not given");
+}
+
+void validate_bathymetry(const BathymetryOptions& o) {
+    require(o.bathy_band >= 1, option("bathy_band") + " must be 1 or more");
     if (o.min_depth_m) {
         require(std::isfinite(*o.min_depth_m), option("min_depth_m") + " must be a depth in metres, e.g. 5m");
+        // A depth floor without depths would be ignored without a word.
         require(!o.bathy.empty(), option("min_depth_m") + " needs " + option("bathy") + ": it raises the sampled depths");
     }
+}
+
+} // namespace
+
+void validate(const MeshOptions& o) {
+    validate_size(o);
+    validate_coast(o);
+    validate_bathymetry(o);
+    validate_meshing(o);
 }
 
 std::string memory_text(double bytes) {
