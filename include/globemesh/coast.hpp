@@ -123,8 +123,9 @@ struct CoastData {
 };
 
 /// Reads, reprojects, cleans and clips the coast of options.coast (and options.region /
-/// options.region_file) into full-resolution rings. Uses options.coast, coast_layer,
-/// coast_where, coast_srs, region, region_file, min_island_area_km2, keep_inland_seas.
+/// options.region_file) into full-resolution rings. Reads the CoastOptions part of `options`
+/// (coast, coast_layer, coast_where, coast_srs, region, region_file, min_island_area_km2,
+/// keep_inland_seas) and, to refuse a run early, max_nodes and max_memory_bytes.
 /// Throws UsageError (no --coast, bad --coast-where or --coast-srs), IoError (file missing or
 /// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
 /// region; rings that cannot be repaired), Cancelled.

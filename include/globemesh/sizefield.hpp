@@ -3,23 +3,22 @@
 // build_size_field() computes h on a background lon/lat grid and SizeField::size_km() evaluates
 // it piecewise linearly in (lon, lat) between the grid nodes (each cell split into two triangles
 // along its south-east to north-west diagonal), and linearly in latitude from the first and
-// last rows of a global grid to one value at each pole (one vec_to_lonlat and four loads; see
-// bench/RESULTS-sizefield.md). h is
+// last rows of a global grid to one value at each pole (one vec_to_lonlat and four loads). h is
 //   h = grade_limit( clamp( min(components the options turn on, hmax), hfloor, hmax ) )
 // with the components (all km):
 //   coast      h = coast_size + coast_rate * d, d the great-circle distance to the boundary rings
 //              (nearest-point propagation on the grid from the rings densified to a quarter of
 //              the grid spacing: error below about a quarter of the grid spacing);
 //   wavelength h = T * sqrt(g * D) / n      (T = wave_period_h hours, g = 9.80665 m/s2,
-//              n = --wavelength, D the depth in metres);
-//   slope      h = 2 pi D / (n * |grad D|)   (n = --slope, |grad D| in m/km by central
+//              n = wavelength, D the depth in metres);
+//   slope      h = 2 pi D / (n * |grad D|)   (n = slope, |grad D| in m/km by central
 //              differences on the grid);
-//   regions    h = size_km of every --size-regions polygon holding the node (OGR, any CRS).
+//   regions    h = size_km of every size_regions polygon holding the node (OGR, any CRS).
 // Depth floor: where the raster says land or is shallower than min_depth_m (5 m) at a point the
 // mesh treats as ocean, D = 5 m for the wavelength and slope components (a coarse raster puts
 // shallow coastal water above sea level); where the raster has no data and no fill, those two
 // components are off at that node.
-// hfloor is --hmin, or when --hmin is 0 the sane floor max(hmax / 1000, 0.01 km).
+// hfloor is hmin_km, or when hmin_km is 0 the sane floor max(hmax / 1000, 0.01 km).
 // Gradation: h is then lowered where needed so that the evaluated field is grade-Lipschitz on the
 // sphere: |h(p) - h(q)| <= grade * arc(p, q) for every pair of points (great-circle distance,
 // km), not only along the grid lines. The solver (grid.cpp) holds in every cell, corners 00, 10,
@@ -36,8 +35,8 @@
 //
 // Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
 // nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
-// grid; a 1e6-node global mesh, h ~ 20 km, needs a 10 km grid: 6.7 M nodes, 27 MB). Building
-// needs about 4 more arrays of the same size at peak. Global unless options.region is set;
+// grid). Building needs about 4 more arrays of the same size at peak. No grid at all when no
+// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region is set;
 // a regional grid covers the region plus one cell and holds its edge values outside.
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
