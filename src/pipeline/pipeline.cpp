@@ -113,22 +113,9 @@ DepthReport apply_min_depth(std::vector<double>& depths, std::optional<double> m
     return f;
 }
 
-} // namespace
-
-OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
-    // A long GEOS operation of the coast stages stops too when the run is cancelled.
-    const coast::GeosInterrupt geos_interrupt(run_progress);
-    const Progress& progress = geos_interrupt.progress();
-    validate(o);
-    if (o.coast.empty()) throw UsageError(option("coast") + " is required: a land polygon or coastline file (any OGR source)");
-    StageClock clock(timings);
-
-    // load_coast and read_bathymetry check their own reads against --max-memory (the coast
-    // counts its vertices while reading, the raster is read no finer than the mesh needs).
-    MemoryBudget budget(o.max_memory_bytes);
-    CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
-    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
-    clock.lap("read_coast");
+/// Refuses a run whose node count is far above max_nodes from the coast alone, before the
+/// bathymetry, the size field and the coast's shaping spend minutes and gigabytes on it.
+void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
     // The mesher's node estimate (nodes_for_area) with every size at --hmax (the field's
     // largest). The mesher's own estimate, over the shaped ocean and the field's sizes, is larger
     // but for the area the shaping closes (inlets, lakes; a few per mil of the global ocean), so
@@ -146,11 +133,10 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
     // the band takes L * integral of dd / (c (s + g d)^2) = L (1/s - 1/hmax) / (c g) nodes (c h^2
     // the area of a node, nodes_for_area). The mesher counts them exactly, but only after the
     // size field and the coast's shaping, which at a size of metres take seconds to minutes.
-    // Made / counted on 1:50m land at --hmax 100km: --coast-size 1km 5.22 / 6.75 million, 5km
-    // 1.12 / 1.30 million, 20km 217,000 / 273,000 (bays share their bands). The source coast
-    // is longer than the shaped one where the size is above its segments' mean length (the
-    // shaping simplifies it), so the count is held against --max-nodes only below that length,
-    // and at half its value.
+    // It is at most twice the mesher's count (bays share their bands; bench/RESULTS-pipeline.md).
+    // The source coast is longer than the shaped one where the size is above its segments' mean
+    // length (the shaping simplifies it), so the count is held against --max-nodes only below
+    // that length, and at half its value.
     if (o.coast_size_km > 0) {
         double coast_km = 0;
         std::size_t segments = 0;
@@ -175,6 +161,25 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
                             option("coast_size_km") + (s > o.coast_size_km ? " and " + option("hmin_km") : ErrorText("")) +
                             " or " + option("max_nodes"));
     }
+}
+
+} // namespace
+
+OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
+    // A long GEOS operation of the coast stages stops too when the run is cancelled.
+    const coast::GeosInterrupt geos_interrupt(run_progress);
+    const Progress& progress = geos_interrupt.progress();
+    validate(o);
+    if (o.coast.empty()) throw UsageError(option("coast") + " is required: a land polygon or coastline file (any OGR source)");
+    StageClock clock(timings);
+
+    // load_coast and read_bathymetry check their own reads against --max-memory (the coast
+    // counts its vertices while reading, the raster is read no finer than the mesh needs).
+    MemoryBudget budget(o.max_memory_bytes);
+    CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
+    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
+    clock.lap("read_coast");
+    refuse_too_many_nodes(o, coast);
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
