@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "globemesh/gpkg.hpp"
+#include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
 #include "../tests/unit/io_test_meshes.hpp"
 

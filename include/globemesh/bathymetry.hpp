@@ -1,15 +1,15 @@
 // globemesh/bathymetry.hpp: bathymetry from any GDAL raster, as a plain lon/lat grid in memory.
 //
-// read_bathymetry() opens the raster named by --bathy with GDAL, takes band --bathy-band, applies
+// read_bathymetry() opens the raster named by bathy with GDAL, takes band bathy_band, applies
 // GDAL's scale/offset, turns the nodata value and NaN into "no data", flips depth-positive grids
-// (--depth-positive) to elevation positive up, and hands back a Raster: values on a regular
+// (depth_positive) to elevation positive up, and hands back a Raster: values on a regular
 // lon/lat grid of cell centres, in metres, elevation positive up (land > 0, sea floor < 0). No GDAL
 // type appears in this interface.
 //
 // Georeferencing: a raster in a geographic CRS with a north-up (or south-up) geotransform is read
 // as is, longitudes in 0..360 or -180..180 alike. Any other raster (projected, rotated) is read
 // through an in-memory warped VRT to EPSG:4326 (GDALWarp, bilinear, exact transformer -et 0,
-// NaN outside the source footprint). --bathy-srs replaces the file's CRS (or gives one). A file
+// NaN outside the source footprint). bathy_srs replaces the file's CRS (or gives one). A file
 // without a CRS whose coordinates are CF longitude and latitude (GDAL metadata such as
 // lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles, classic global relief
 // NetCDF grids), with a geotransform whose extent can be degrees, is read as WGS 84 lon/lat
@@ -35,18 +35,18 @@
 // average resampling through RasterIO, which uses the raster's overviews when it has some and
 // only the source window a VRT maps otherwise) applies to rasters with more than max_cells
 // cells (default 2^28, 1 GiB: a 1-arc-minute global grid fits) and, through RasterLimits, to
-// cells finer than the mesh can use. With --region (or --region-file, the extent of its ocean),
+// cells finer than the mesh can use. With region (or region_file, the extent of its ocean),
 // only the cells that cover the region (and a margin: 1% of its larger side and three cells) are
 // read: a regional run reads a small window of a global raster,
 // at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half the
 // smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and refuses
-// (DataError naming --max-memory) when the values would take more than half of
+// (DataError naming max_memory_bytes) when the values would take more than half of
 // options.max_memory_bytes. GDAL's block cache (GDAL_CACHEMAX, 5% of RAM by default) comes on
 // top while reading.
 //
 // Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
-// exist or a --bathy-srs that is no CRS; DataError for a raster without georeferencing, with no valid cell, or that does not
-// cover the region (unless --bathy-fill gives a value for the uncovered part).
+// exist or a bathy_srs that is no CRS; DataError for a raster without georeferencing, with no valid cell, or that does not
+// cover the region (unless bathy_fill_m gives a value for the uncovered part).
 #pragma once
 
 #include <cstddef>
@@ -130,7 +130,7 @@ struct RasterLimits {
     /// Cells finer than this (degrees, each axis apart) are averaged to about this size (never
     /// coarser: the cell count per axis is rounded up); 0: the raster's own resolution.
     double min_cell_deg = 0;
-    /// Refuse (DataError naming --max-memory) when the values read would take more bytes; 0: no cap.
+    /// Refuse (DataError naming max_memory_bytes) when the values read would take more bytes; 0: no cap.
     std::uint64_t max_bytes = 0;
     /// Read only the cells that cover this box (degrees; east > west, east may exceed 180), with
     /// a margin of three cells (of the raster's own size or min_cell_deg, the larger), instead of
@@ -142,19 +142,19 @@ struct RasterLimits {
 /// Reads one band of any GDAL raster as elevation in metres (positive up); see the file comment.
 /// path: the raster; band: 1-based; depth_positive: the raster stores depth positive down;
 /// max_cells: decimate (GDAL average) rasters larger than this. Throws IoError, UsageError
-/// (band out of range, naming --bathy-band) or DataError (no georeferencing, all nodata).
+/// (band out of range, naming bathy_band) or DataError (no georeferencing, all nodata).
 Raster read_raster(const std::string& path, int band = 1, bool depth_positive = false,
                    const Progress& progress = {}, std::size_t max_cells = std::size_t{1} << 28);
 
 /// read_raster within `limits`: decimated as they say, and a DataError naming the raster's size,
-/// the bytes needed and --max-memory, before anything large is allocated, when it does not fit.
-/// srs: the raster's CRS (--bathy-srs: any string OGRSpatialReference::SetFromUserInput takes)
+/// the bytes needed and max_memory_bytes, before anything large is allocated, when it does not fit.
+/// srs: the raster's CRS (bathy_srs: any string OGRSpatialReference::SetFromUserInput takes)
 /// in place of the file's; empty: the file's, or lon/lat for CF lon/lat axes (file comment).
-/// Throws UsageError naming --bathy-srs when srs is not a CRS.
+/// Throws UsageError naming bathy_srs when srs is not a CRS.
 Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
                    const RasterLimits& limits, const std::string& srs = {});
 
-/// Throws UsageError (one line naming --bathy-srs) when srs is neither empty nor a CRS that
+/// Throws UsageError (one line naming bathy_srs) when srs is neither empty nor a CRS that
 /// OGRSpatialReference::SetFromUserInput takes. Opens no file.
 void validate_bathy_srs(const std::string& srs);
 
@@ -170,20 +170,20 @@ std::optional<LonLatBounds> ocean_extent(const Boundary& ocean);
 int ocean_pole_winding(const Boundary& ocean);
 
 /// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
-/// --hmin, or max(hmax / 1000, 0.01 km) when it is 0), at most half of --max-memory, and a
+/// hmin_km, or max(hmax / 1000, 0.01 km) when it is 0), at most half of max_memory_bytes, and a
 /// window widened by 1% of its larger side (the size field's grid reaches a cell beyond the
-/// region): --region's box, or with --region-file the ocean_extent of `ocean` (the coast stage's
+/// region): region's box, or with region_file the ocean_extent of `ocean` (the coast stage's
 /// rings) when given.
 RasterLimits bathymetry_limits(const MeshOptions& options, const Boundary* ocean = nullptr);
 
 /// Reads options.bathy (band options.bathy_band, options.depth_positive, options.bathy_srs), sets
 /// the fill to -options.bathy_fill_m when given, and checks the raster covers the region, within
-/// bathymetry_limits(options, ocean). With `ocean` (the rings the coast stage cut for --region
-/// or --region-file) the region is that ocean: the raster must hold every point of its outline
+/// bathymetry_limits(options, ocean). With `ocean` (the rings the coast stage cut for region
+/// or region_file) the region is that ocean: the raster must hold every point of its outline
 /// (a point a quarter of a cell apart along the great-circle segments) and a pole inside it;
-/// land in the region needs no raster. Without: --region's box, or the whole globe.
+/// land in the region needs no raster. Without: region's box, or the whole globe.
 /// Throws as read_raster, and DataError (naming a point not covered) when the raster covers
-/// only part of the region and no --bathy-fill is set.
+/// only part of the region and no bathy_fill_m is set.
 Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {}, const Boundary* ocean = nullptr);
 
 } // namespace globemesh

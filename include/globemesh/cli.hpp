@@ -21,8 +21,10 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/mesh_stats.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/pipeline.hpp"
+#include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
 
@@ -36,7 +38,7 @@ int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& 
 /// or to interrupt a run at a chosen point (a seam like GDAL's test hooks). Each member must be
 /// set.
 struct CliLibrary {
-    std::function<Mesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
+    std::function<OceanMesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
     std::function<Mesh(const TriangulateOptions&, const Progress&, StageTimings*)> triangulate_file;
     /// The output formats (writers.hpp): -o, -f, --gpkg and --preview choose among them, and
     /// their rows' write functions write the files.
@@ -85,11 +87,5 @@ double parse_area_km2(std::string_view text);
 double parse_duration_h(std::string_view text);
 /// "50m", "0.05km", "50" (m) -> metres (depths). Throws UsageError like parse_length_km.
 double parse_depth_m(std::string_view text);
-
-/// The invariants of mesh.hpp that fail (empty when the mesh is sound): indices in range,
-/// three distinct corners, counter-clockwise faces (sign of det[a,b,c] in floating point), unit nodes (|1-|v|| < 1e-12),
-/// every edge shared by at most two faces with opposite directions, boundary list equal to the
-/// edges used by one face, field sizes. At most `limit` messages.
-std::vector<std::string> check_mesh(const Mesh& mesh, std::size_t limit = 20);
 
 } // namespace globemesh

@@ -69,6 +69,7 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh {
@@ -122,15 +123,13 @@ struct CoastData {
 };
 
 /// Reads, reprojects, cleans and clips the coast of options.coast (and options.region /
-/// options.region_file) into full-resolution rings. Uses options.coast, coast_layer,
-/// coast_where, coast_srs, region, region_file, min_island_area_km2, keep_inland_seas.
+/// options.region_file) into full-resolution rings. Reads the CoastOptions part of `options`
+/// (coast, coast_layer, coast_where, coast_srs, region, region_file, min_island_area_km2,
+/// keep_inland_seas) and, to refuse a run early, max_nodes and max_memory_bytes.
 /// Throws UsageError (no --coast, bad --coast-where or --coast-srs), IoError (file missing or
 /// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
 /// region; rings that cannot be repaired), Cancelled.
 CoastData load_coast(const MeshOptions& options, const Progress& progress = {});
-
-/// Target edge length in km at a point of the unit sphere (must be > 0).
-using SizeFn = std::function<double(const Vec3&)>;
 
 struct CoastReport {
     std::size_t rings = 0;            ///< rings in the shaped boundary

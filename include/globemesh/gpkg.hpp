@@ -1,4 +1,4 @@
-// globemesh/gpkg.hpp: GeoPackage output (OGR) and the PNG preview (GDAL rasterization).
+// globemesh/gpkg.hpp: GeoPackage output (OGR).
 //
 // write_gpkg writes layers a QGIS user opens and styles at once: faces (cut at +-180, pole
 // corners split), nodes, boundary (tagged lines), mesh_info, and a default style for faces in
@@ -31,26 +31,9 @@ struct GpkgOptions {
     /// Reports the share written (stage "write_gpkg"); returning false cancels (Cancelled, no
     /// file left).
     Progress progress;
-    /// Test hook: called once after the faces are written, before the rename.
-    std::function<void()> after_partial_write;
 };
 
 /// Writes the mesh as a GeoPackage. Throws IoError and leaves no partial or temporary file.
 void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options = {});
-
-struct PreviewOptions {
-    std::string land;                 ///< optional OGR land polygons drawn under the mesh (layer "land", else the first)
-    std::string colour_by = "quality"; ///< "quality" or "depth"
-    int width_px = 1600;
-    std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N; default the mesh extent or globe
-    bool overwrite = false;
-    /// Reports the share drawn and written (stage "write_preview"); returning false cancels.
-    Progress progress;
-    /// Test hook: called once after the picture is drawn, before it is written and renamed.
-    std::function<void()> after_partial_write;
-};
-
-/// Draws faces coloured by quality or depth over the land, with GDAL's rasterizer and PNG driver.
-void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, const PreviewOptions& options = {});
 
 } // namespace globemesh

@@ -84,6 +84,7 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 
 namespace globemesh {
 
@@ -110,15 +111,14 @@ struct MesherOptions {
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory
-/// estimate before refining. mesh_boundary itself peaks at about 150 B/node from 1e6 nodes up
-/// (the core's 78, the refinement's per-slot badness and heap, then the returned Mesh;
-/// bench/mesher_memory); 800 also covers the UGRID writer's tables that follow in the pipeline.
+/// estimate before refining: mesh_boundary's own peak (bench/mesher_memory measures it) with
+/// room for the UGRID writer's tables that follow in the pipeline.
 inline constexpr std::uint64_t mesher_bytes_per_node = 800;
 
 /// The node estimate of an area meshed at size h (area in h's units squared): equilateral
 /// triangles of side h cover sqrt(3)/4 h^2 each, and a large mesh has two triangles per node.
 /// mesh_boundary sums it over the ocean's triangles before refining (the check against
-/// max_nodes); the pipeline asks it first for the whole ocean at --hmax.
+/// max_nodes); the pipeline asks it first for the whole ocean at hmax_km.
 inline double nodes_for_area(double area, double h) { return area / (0.4330127018922193 /* sqrt(3) / 4 */ * h * h) / 2.0; }
 
 struct OceanComponent {
@@ -163,7 +163,7 @@ struct MesherReport {
 /// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
 /// Neighbouring nodes are mostly close in the numbering, and so are neighbouring faces (the
 /// lattice's insertion order or, when the refinement made most nodes, a Hilbert curve's).
-Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Vec3&)>& size_km,
+Mesh mesh_boundary(const Boundary& boundary, const SizeFn& size_km,
                    const MesherOptions& options = {}, MesherReport* report = nullptr,
                    const Progress& progress = {}, StageTimings* timings = nullptr);
 

@@ -3,23 +3,22 @@
 // build_size_field() computes h on a background lon/lat grid and SizeField::size_km() evaluates
 // it piecewise linearly in (lon, lat) between the grid nodes (each cell split into two triangles
 // along its south-east to north-west diagonal), and linearly in latitude from the first and
-// last rows of a global grid to one value at each pole (one vec_to_lonlat and four loads; see
-// bench/RESULTS-sizefield.md). h is
+// last rows of a global grid to one value at each pole (one vec_to_lonlat and four loads). h is
 //   h = grade_limit( clamp( min(components the options turn on, hmax), hfloor, hmax ) )
 // with the components (all km):
 //   coast      h = coast_size + coast_rate * d, d the great-circle distance to the boundary rings
 //              (nearest-point propagation on the grid from the rings densified to a quarter of
 //              the grid spacing: error below about a quarter of the grid spacing);
 //   wavelength h = T * sqrt(g * D) / n      (T = wave_period_h hours, g = 9.80665 m/s2,
-//              n = --wavelength, D the depth in metres);
-//   slope      h = 2 pi D / (n * |grad D|)   (n = --slope, |grad D| in m/km by central
+//              n = wavelength, D the depth in metres);
+//   slope      h = 2 pi D / (n * |grad D|)   (n = slope, |grad D| in m/km by central
 //              differences on the grid);
-//   regions    h = size_km of every --size-regions polygon holding the node (OGR, any CRS).
+//   regions    h = size_km of every size_regions polygon holding the node (OGR, any CRS).
 // Depth floor: where the raster says land or is shallower than min_depth_m (5 m) at a point the
 // mesh treats as ocean, D = 5 m for the wavelength and slope components (a coarse raster puts
 // shallow coastal water above sea level); where the raster has no data and no fill, those two
 // components are off at that node.
-// hfloor is --hmin, or when --hmin is 0 the sane floor max(hmax / 1000, 0.01 km).
+// hfloor is hmin_km, or when hmin_km is 0 the sane floor max(hmax / 1000, 0.01 km).
 // Gradation: h is then lowered where needed so that the evaluated field is grade-Lipschitz on the
 // sphere: |h(p) - h(q)| <= grade * arc(p, q) for every pair of points (great-circle distance,
 // km), not only along the grid lines. The solver (grid.cpp) holds in every cell, corners 00, 10,
@@ -36,8 +35,8 @@
 //
 // Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
 // nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
-// grid; a 1e6-node global mesh, h ~ 20 km, needs a 10 km grid: 6.7 M nodes, 27 MB). Building
-// needs about 4 more arrays of the same size at peak. Global unless options.region is set;
+// grid). Building needs about 4 more arrays of the same size at peak. No grid at all when no
+// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region is set;
 // a regional grid covers the region plus one cell and holds its edge values outside.
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
@@ -54,12 +53,10 @@
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/progress.hpp"
+#include "globemesh/size_fn.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh {
-
-/// A size function: target edge length in km at a unit vector.
-using SizeFn = std::function<double(const Vec3&)>;
 
 /// Gravity used by the wavelength component, m/s2 (standard gravity).
 inline constexpr double standard_gravity = 9.80665;
@@ -74,10 +71,12 @@ double wavelength_size_km(double depth_m, double period_h, double points_per_wav
 /// Infinite where grad is 0.
 double slope_size_km(double depth_m, double grad_m_per_km, double points_per_length);
 
-/// The size field on its background grid (values in km, no NaN).
+/// The size field: one size everywhere (uniform), or values on a background grid (km, no NaN).
 class SizeField {
 public:
     SizeField() = default;
+    /// One size h_km everywhere, without a grid. Throws UsageError unless h_km > 0.
+    static SizeField uniform(double h_km);
     /// Wraps a grid of sizes (km, all finite and > 0). A global grid whose first (last) row lies
     /// within one row spacing of a pole is closed by a polar cap, linear in latitude from that row
     /// to the pole value (south_pole_km, north_pole_km; NaN: the smallest value of the row).
@@ -91,7 +90,9 @@ public:
     double size_km(double lon_deg, double lat_deg) const;
     double operator()(const Vec3& p) const { return size_km(p); }
 
-    /// The background grid (node values in km), for checks and output.
+    /// True when the field is one size everywhere (no term of the options is on): no grid.
+    bool is_uniform() const { return !grid_; }
+    /// The background grid (node values in km), for checks and output; only when !is_uniform().
     const Raster& grid() const { return *grid_; }
     /// A SizeFn sharing this field's grid (cheap to copy).
     SizeFn function() const;
@@ -112,13 +113,16 @@ private:
 };
 
 /// Builds the size field the options ask for (see the file comment). bathy: the bathymetry
-/// (required when --wavelength or --slope is on, else may be null); coast: the boundary rings at
-/// full resolution (required when --coast-size is on). max_nodes caps the background grid.
+/// (required when wavelength or slope is on, else may be null); coast: the boundary rings at
+/// full resolution (required when coast_size_km is on). max_nodes caps the background grid.
+/// When no component is on the field is uniform (max(hmax_km, hmin_km), SizeField::is_uniform)
+/// and no grid is built; otherwise before_grid, when set, is called once before the grid is
+/// allocated (to refuse the run by throwing).
 /// Throws UsageError (bad sizes, a component without its input, naming the option), DataError
-/// (a --size-regions file without a size_km field) or IoError (--size-regions unreadable).
+/// (a size_regions file without a size_km field) or IoError (size_regions unreadable).
 SizeField build_size_field(const MeshOptions& options, const Raster* bathy, const Boundary* coast,
-                           const Progress& progress = {},
-                           std::size_t max_nodes = std::size_t{1} << 24);
+                           const Progress& progress = {}, std::size_t max_nodes = std::size_t{1} << 24,
+                           const std::function<void()>& before_grid = {});
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.
 SizeFn uniform_size(double h_km);

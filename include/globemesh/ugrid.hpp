@@ -1,4 +1,4 @@
-// globemesh/ugrid.hpp: UGRID 1.0 NetCDF writer and reader (netCDF-C), and mesh statistics.
+// globemesh/ugrid.hpp: UGRID 1.0 NetCDF writer and reader (netCDF-C).
 //
 // write_ugrid writes a CF-1.8 / UGRID-1.0 file that MDAL (QGIS), xarray tools and ocean models
 // read as it is (see issue "Outputs"): every connectivity with cf_role and start_index, the CRS
@@ -15,11 +15,10 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/mesh_stats.hpp"
 #include "globemesh/progress.hpp"
 
 namespace globemesh {
-
-struct MeshStats;
 
 struct UgridOptions {
     bool classic = false;   ///< --format classic: netCDF-3 classic model instead of NetCDF-4+deflate
@@ -36,8 +35,6 @@ struct UgridOptions {
     /// Reports the share of the rows written (stage "write_ugrid"); returning false cancels
     /// (Cancelled, no file left).
     Progress progress;
-    /// Test hook: called once after the data is partly written, before the rename.
-    std::function<void()> after_partial_write;
 };
 
 /// Writes the mesh as UGRID NetCDF. Throws IoError (unwritable folder, existing output, disk
@@ -47,19 +44,5 @@ void write_ugrid(const Mesh& mesh, const std::filesystem::path& path, const Ugri
 /// Reads a UGRID 2-D triangle mesh (first mesh_topology variable). Throws IoError (not readable)
 /// or DataError (not UGRID, not triangles, out-of-range indices).
 Mesh read_ugrid(const std::filesystem::path& path);
-
-/// Summary statistics of a mesh, as `globemesh info` and the run report print them.
-struct MeshStats {
-    std::size_t nodes = 0, faces = 0, edges = 0, boundary_edges = 0, boundary_loops = 0;
-    double lon_min = 0, lon_max = 0, lat_min = 0, lat_max = 0; ///< extent, degrees
-    double quality_min = 0, quality_mean = 0, quality_above_0_8 = 0; ///< fraction above 0.8
-    std::array<std::size_t, 10> quality_histogram{}; ///< counts of q in [0,0.1), ..., [0.9,1]
-    double edge_km_min = 0, edge_km_mean = 0, edge_km_max = 0;
-    double area_km2 = 0; ///< sum of spherical face areas on the sphere of earth_radius_km
-    bool has_size = false;  ///< true when a node field "target_size" exists
-    double size_ratio_median = 0, size_ratio_in_range = 0; ///< edge length / target; fraction in [0.7, 1.4]
-};
-
-MeshStats compute_stats(const Mesh& mesh);
 
 } // namespace globemesh

@@ -46,8 +46,6 @@ struct WriteOptions {
     std::string land; ///< OGR land polygons a picture draws under the mesh; empty: none
     std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N of a picture; unset: the mesh's
     CreationOptions creation_options;                ///< this output's, checked against its row
-    /// Test hook: called once after the data is partly written, before the rename.
-    std::function<void()> after_partial_write;
 };
 
 /// What a format requires of the mesh (bits of Writer::needs).

@@ -98,7 +98,7 @@ DatasetPtr with_srs(GDALDatasetH ds, const std::string& srs, const std::string& 
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
     GDALTranslateOptionsFree(opts);
-    if (!out) throw IoError("--bathy " + path + ": cannot assign its CRS: " + gdal::last_error());
+    if (!out) throw IoError(option("bathy") + " " + path + ": cannot assign its CRS: " + gdal::last_error());
     return out;
 }
 
@@ -112,7 +112,7 @@ gdal::SrsRefPtr parse_bathy_srs(const std::string& srs) {
                     OSRExportToWkt(parsed.get(), &wkt) == OGRERR_NONE;
     CPLFree(wkt);
     if (!ok)
-        throw UsageError("--bathy-srs '" + srs + "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
+        throw UsageError(option("bathy_srs") + " '" + srs + "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
     return parsed;
 }
 
@@ -172,7 +172,7 @@ DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string& path) {
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
     GDALTranslateOptionsFree(opts);
-    if (!out) throw IoError("--bathy " + path + ": cannot select band " + b + ": " + gdal::last_error());
+    if (!out) throw IoError(option("bathy") + " " + path + ": cannot select band " + b + ": " + gdal::last_error());
     return out;
 }
 
@@ -230,7 +230,7 @@ DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string& path) {
     DatasetPtr out(GDALWarp("", nullptr, 1, &src, opts, &usage_error));
     GDALWarpAppOptionsFree(opts);
     if (!out)
-        throw DataError("--bathy " + path + ": cannot reproject to lon/lat (EPSG:4326): " +
+        throw DataError(option("bathy") + " " + path + ": cannot reproject to lon/lat (EPSG:4326): " +
                         gdal::last_error());
     return out;
 }
@@ -322,7 +322,7 @@ void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std:
                                     static_cast<int>(nx), iy1 - iy0, values.data() + s0 * bx, static_cast<int>(bx),
                                     static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
         if (bridge.cancelled) throw Cancelled();
-        if (err != CE_None) throw IoError("--bathy " + path + ": read failed: " + gdal::last_error());
+        if (err != CE_None) throw IoError(option("bathy") + " " + path + ": read failed: " + gdal::last_error());
     }
 }
 
@@ -384,12 +384,12 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
 
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds)
-        throw IoError("--bathy " + path + ": cannot open as a raster: " +
+        throw IoError(option("bathy") + " " + path + ": cannot open as a raster: " +
                       gdal::last_error("not a raster format GDAL reads"));
     GDALDatasetH h = ds.get();
     const int nbands = GDALGetRasterCount(h);
     if (band < 1 || band > nbands)
-        throw UsageError("--bathy-band " + std::to_string(band) + ": " + path + " has " +
+        throw UsageError(option("bathy_band") + " " + std::to_string(band) + ": " + path + " has " +
                          std::to_string(nbands) + " band" + (nbands == 1 ? "" : "s"));
     GDALRasterBandH src_band = GDALGetRasterBand(h, band);
 
@@ -414,9 +414,9 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // units: no more georeferenced than one with none.
     const OGRSpatialReferenceH crs = GDALGetSpatialRef(geo);
     if (GDALGetGeoTransform(geo, gt) != CE_None || !crs || OSRIsLocal(crs))
-        throw DataError("--bathy " + path +
+        throw DataError(option("bathy") + " " + path +
                         ": has no georeferencing (a geotransform and a geographic or projected CRS); give its "
-                        "CRS with --bathy-srs (e.g. EPSG:4326), or assign both, e.g. gdal_translate -a_srs "
+                        "CRS with " + option("bathy_srs") + " (e.g. EPSG:4326), or assign both, e.g. gdal_translate -a_srs "
                         "EPSG:4326 -a_ullr W N E S");
 
     // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
@@ -428,7 +428,7 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         warped = warped_to_lonlat(band_vrt.get(), path);
         read_band = GDALGetRasterBand(warped.get(), 1);
         if (GDALGetGeoTransform(warped.get(), gt) != CE_None)
-            throw DataError("--bathy " + path + ": the warped raster has no geotransform");
+            throw DataError(option("bathy") + " " + path + ": the warped raster has no geotransform");
         has_nodata = 0; // the warper writes NaN where there is no data
     }
     GDALDatasetH read_ds = warped ? warped.get() : h;
@@ -470,10 +470,11 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     }
     const double bytes = cx * cy * static_cast<double>(sizeof(float));
     if (limits.max_bytes > 0 && bytes > static_cast<double>(limits.max_bytes))
-        throw DataError("--bathy " + path + ": " + std::to_string(nx) + " x " + std::to_string(ny) +
+        throw DataError(option("bathy") + " " + path + ": " + std::to_string(nx) + " x " + std::to_string(ny) +
                         " cells, read as " + fmt_count(cx) + " x " + fmt_count(cy) + " (" + memory_text(bytes) +
                         "), exceed the " + memory_text(static_cast<double>(limits.max_bytes)) +
-                        " that --max-memory leaves for it; raise --max-memory or --hmin, or give a "
+                        " that " + option("max_memory_bytes") + " leaves for it; raise " + option("max_memory_bytes") + " or " +
+                        option("hmin_km") + ", or give a "
                         "coarser raster (gdal_translate -tr)");
     const std::size_t bx = static_cast<std::size_t>(cx), by = static_cast<std::size_t>(cy);
     const double sx = static_cast<double>(nx) / static_cast<double>(bx);
@@ -488,7 +489,7 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     const double west = gt[0] + static_cast<double>(c0) * gt[1], top = gt[3] + static_cast<double>(r0) * gt[5];
     Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
     if (raster.valid_count() == 0)
-        throw DataError("--bathy " + path + ": band " + std::to_string(band) +
+        throw DataError(option("bathy") + " " + path + ": band " + std::to_string(band) +
                         " holds no valid value (all nodata)");
     report(progress, 1.0, stage);
     return raster;
@@ -567,22 +568,23 @@ std::optional<LonLat> uncovered_point(const Raster& r, const Boundary& ocean) {
 } // namespace
 
 Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Boundary* ocean) {
-    if (o.bathy.empty()) throw UsageError("--bathy: no raster given");
+    if (o.bathy.empty()) throw UsageError(option("bathy") + ": no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
-        throw UsageError("--bathy-fill must be a depth in metres");
+        throw UsageError(option("bathy_fill_m") + " must be a depth in metres");
     Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress, bathymetry_limits(o, ocean), o.bathy_srs);
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
         return r;
     }
     const LonLatBounds b = r.bounds();
-    const std::string covers = "--bathy " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." + fmt_deg(b.east) +
+    const ErrorText covers = option("bathy") + " " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." + fmt_deg(b.east) +
                                ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north);
-    const std::string remedy = "; pass --bathy-fill DEPTH for the rest, or a --region or --region-file inside the raster";
+    const ErrorText remedy = "; pass " + option("bathy_fill_m") + " DEPTH for the rest, or a " + option("region") + " or " +
+                             option("region_file") + " inside the raster";
     // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
     if (ocean && !ocean->rings.empty() && (o.region || !o.region_file.empty())) {
         if (const auto p = uncovered_point(r, *ocean))
-            throw DataError(covers + " but the ocean of " + (o.region ? "--region" : "--region-file " + o.region_file) +
+            throw DataError(covers + " but the ocean of " + (o.region ? option("region") : option("region_file") + " " + o.region_file) +
                             " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
         return r;
     }
@@ -604,7 +606,7 @@ Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Bou
                   r.contains(lon, s) && r.contains(lon, n);
     }
     if (!covered)
-        throw DataError(covers + (o.region ? " but not all of --region" : " but the region is the whole globe") + remedy);
+        throw DataError(covers + (o.region ? " but not all of " + option("region") : ErrorText(" but the region is the whole globe")) + remedy);
     return r;
 }
 

@@ -22,6 +22,7 @@
 
 #include "cli_outputs.hpp"
 #include "cli_support.hpp"
+#include "option_flags.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
@@ -242,8 +243,7 @@ struct MeshCommand {
                         validate_bathy_srs(value);
                         return {};
                     } catch (const UsageError& e) { // CLI11 puts the option's name in front
-                        const std::string what = e.what(), name = "--bathy-srs ";
-                        return what.rfind(name, 0) == 0 ? what.substr(name.size()) : what;
+                        return e.text().after_leading_option().str(flag_of);
                     }
                 },
                 ""));
@@ -408,13 +408,6 @@ void add_mesh_total(StageTimings& timings) {
     timings.add("mesh", total);
 }
 
-/// The value of the mesh's attribute `key`, or nullopt.
-std::optional<std::string> find_attribute(const Mesh& mesh, std::string_view key) {
-    for (const auto& [k, v] : mesh.attributes)
-        if (k == key) return v;
-    return std::nullopt;
-}
-
 /// A whole number with thousands separators: 33251 -> "33,251", -2505 -> "-2,505".
 std::string grouped(long long v) {
     std::string digits = std::to_string(v < 0 ? -v : v), r;
@@ -425,38 +418,51 @@ std::string grouped(long long v) {
     return (v < 0 ? "-" : "") + r;
 }
 
-/// The depth counts of the pipeline's attributes (nodes above sea level as sampled, those
-/// --min-depth raised) as a JSON object, or "" when the mesh has no depth.
-std::string depth_json(const Mesh& mesh) {
-    const auto above = find_attribute(mesh, "nodes_above_sea_level");
-    if (!above) return "";
-    const auto shallowest = find_attribute(mesh, "min_sampled_depth_m");
-    const auto floor = find_attribute(mesh, "min_depth_m");
-    const auto raised = find_attribute(mesh, "nodes_raised_to_min_depth");
-    return "{\"nodes_above_sea_level\": " + *above + ", \"min_sampled_depth_m\": " + shallowest.value_or("null") +
-           ", \"min_depth_m\": " + floor.value_or("null") + ", \"nodes_raised_to_min_depth\": " + raised.value_or("0") +
-           "}";
+/// The depth counts (nodes above sea level as sampled, those --min-depth raised) as a JSON object.
+std::string depth_json(const DepthReport& d) {
+    auto number_or_null = [](bool set, double v) { return set ? report_number(v) : std::string("null"); };
+    return "{\"nodes_above_sea_level\": " + std::to_string(d.above_sea_level) +
+           ", \"min_sampled_depth_m\": " + number_or_null(d.above_sea_level > 0, d.shallowest_m) +
+           ", \"min_depth_m\": " + number_or_null(d.min_depth_m.has_value(), d.min_depth_m.value_or(0)) +
+           ", \"nodes_raised_to_min_depth\": " + std::to_string(d.min_depth_m ? d.raised : 0) + "}";
 }
 
 /// The summary's depth line, and unless `quiet` the warning on `err` when nodes above sea level
 /// are written with negative depth (no --min-depth).
-void print_depth(std::ostream& out, std::ostream& err, const Mesh& mesh, bool quiet) {
-    const auto above = find_attribute(mesh, "nodes_above_sea_level");
-    if (!above) return;
-    const long long count = std::stoll(*above);
-    const auto floor = find_attribute(mesh, "min_depth_m");
+void print_depth(std::ostream& out, std::ostream& err, const DepthReport& d, bool quiet) {
+    const auto count = static_cast<long long>(d.above_sea_level);
     std::string down_to;
-    if (const auto shallowest = find_attribute(mesh, "min_sampled_depth_m"))
-        down_to = " (down to " + grouped(std::llround(std::stod(*shallowest))) + " m)";
+    if (d.above_sea_level > 0) down_to = " (down to " + grouped(std::llround(d.shallowest_m)) + " m)";
     out << "depth             " << count << " nodes above sea level" << down_to;
-    if (floor)
-        out << ", " << find_attribute(mesh, "nodes_raised_to_min_depth").value_or("0") << " raised to --min-depth "
-            << *floor << " m";
+    if (d.min_depth_m)
+        out << ", " << d.raised << " raised to --min-depth " << report_number(*d.min_depth_m) << " m";
     out << "\n";
-    if (count > 0 && !floor && !quiet)
+    if (count > 0 && !d.min_depth_m && !quiet)
         err << "globemesh: warning: " << grouped(count) << (count == 1 ? " node lies" : " nodes lie")
             << " above sea level" << down_to << (count == 1 ? " and is" : " and are")
             << " written with negative depth; --min-depth 5 would raise them to 5 m\n";
+}
+
+/// What the run changed of the coast and the land: the summary's lines from the typed reports.
+void print_coast(std::ostream& out, const OceanMesh& run) {
+    const MesherReport& m = run.mesher;
+    out << "coast             " << run.coast.rings << " rings kept, islands dropped " << run.coast.islands_removed
+        << ", lakes dropped " << run.coast.lakes_removed << ", inlets closed " << inlets_closed_text(m) << "\n"
+        << "coast repairs     " << coast_repairs_text(run.coast_repairs) << "\n"
+        << "faces on land     " << land_faces_text(m) << "\n";
+    // The first six places (lon lat); all of them, up to 50, are in the file's attribute `key`.
+    auto places = [&](const std::vector<Vec3>& at, const char* key) {
+        constexpr std::size_t shown = 6;
+        if (at.empty()) return;
+        out << "                  at " << places_text(at, shown) << (at.size() > shown ? std::string(" (") + key + ")" : "")
+            << "\n";
+    };
+    places(m.land_faces_at, "faces_on_land_at");
+    if (run.straits_closing && m.straits_closed > 0) {
+        out << "straits closed    " << straits_closed_text(m) << "\n";
+        places(m.straits_closed_at, "straits_closed_at");
+    }
+    out << "ocean components  " << ocean_components_text(m) << "\n";
 }
 
 int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream& err,
@@ -487,7 +493,8 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     const auto t0 = std::chrono::steady_clock::now();
     StageTimings timings;
     terminal.configure(o.quiet, o.verbose);
-    Mesh mesh = lib.mesh_ocean(o.mesh, sub_progress(terminal.callback(), 0, mesh_share(planned)), &timings);
+    OceanMesh run = lib.mesh_ocean(o.mesh, sub_progress(terminal.callback(), 0, mesh_share(planned)), &timings);
+    Mesh& mesh = run.mesh;
     throw_if_interrupted();
     add_mesh_total(timings);
     // The effective configuration travels with the mesh, so the file itself says how to remake it.
@@ -528,7 +535,7 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
           << "  \"history\": " << json_string(write.history) << ",\n"
           << "  \"outputs\": " << outputs_json(planned);
         r << ",\n  \"mesh\": " << stats_json(stats, "  ") << ",\n";
-        if (const std::string depth = depth_json(mesh); !depth.empty()) r << "  \"depth\": " << depth << ",\n";
+        if (run.depth) r << "  \"depth\": " << depth_json(*run.depth) << ",\n";
         // What the run did to the coast and the land, as the NetCDF file's global attributes say.
         r << "  \"attributes\": {";
         for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
@@ -543,33 +550,8 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     InterruptGuard::finished();
 
     print_stats(out, stats, false);
-    // What the run changed of the coast, from the pipeline's attributes.
-    auto attribute = [&](const char* key) {
-        for (const auto& [k, v] : mesh.attributes)
-            if (k == key) return v;
-        return std::string("?");
-    };
-    out << "coast             " << attribute("boundary_rings") << " rings kept, islands dropped "
-        << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
-        << ", inlets closed " << attribute("inlets_closed") << "\n"
-        << "coast repairs     " << attribute("coast_repairs") << "\n"
-        << "faces on land     " << attribute("faces_on_land") << "\n";
-    // The first six places (lon lat) of a list attribute; all of them, up to 50, are the attribute.
-    auto places = [&](const char* key) {
-        std::string at = attribute(key);
-        if (at == "?") return;
-        std::size_t cut = 0;
-        for (int i = 0; i < 6 && cut != std::string::npos; ++i) cut = at.find(", ", cut + (i > 0 ? 2 : 0));
-        if (cut != std::string::npos) at = at.substr(0, cut) + ", ... (" + key + ")";
-        out << "                  at " << at << "\n";
-    };
-    places("faces_on_land_at");
-    if (std::string closed = attribute("straits_closed"); closed != "?" && closed.rfind("0 ", 0) != 0) {
-        out << "straits closed    " << closed << "\n";
-        places("straits_closed_at");
-    }
-    out << "ocean components  " << attribute("ocean_components") << "\n";
-    print_depth(out, err, mesh, o.quiet);
+    print_coast(out, run);
+    if (run.depth) print_depth(out, err, *run.depth, o.quiet);
     print_timings(out, timings);
     out << "total time        " << exact_text(std::round(total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(peak / 1048576.0 * 10) / 10) << " MiB\n"
@@ -813,13 +795,13 @@ int report_error(std::ostream& err, const std::string& command) {
         err << "globemesh: " << usage_text(e, command) << "\n";
         return 2;
     } catch (const UsageError& e) {
-        err << "globemesh: " << one_line(e.what()) << "\n";
+        err << "globemesh: " << one_line(e.message(flag_of)) << "\n";
         return 2;
     } catch (const Cancelled& e) {
         err << "globemesh: cancelled, no output written\n"; // by the library's caller, not a signal
         return 1;
     } catch (const Error& e) {
-        err << "globemesh: " << one_line(e.what()) << "\n";
+        err << "globemesh: " << one_line(e.message(flag_of)) << "\n";
         return 1;
     } catch (const std::exception& e) {
         err << "globemesh: internal error: " << one_line(e.what()) << "\n";

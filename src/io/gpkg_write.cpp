@@ -27,6 +27,7 @@
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
+#include "write_hooks.hpp"
 
 #ifndef GLOBEMESH_VERSION
 #define GLOBEMESH_VERSION "unknown"
@@ -549,7 +550,7 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     write_faces(w, faces, mesh, topo, options, indexes);
     if (options.face_areas_m2) std::vector<double>().swap(*options.face_areas_m2); // not needed any more
     topo = io::MeshTopology{};
-    if (options.after_partial_write) options.after_partial_write();
+    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
     write_nodes(w, mesh, options, indexes);
     // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
     if (!runs.empty()) write_boundary(w, mesh, runs, indexes);
@@ -573,7 +574,6 @@ void write_as_gpkg(const Mesh& mesh, const std::filesystem::path& path, const Wr
     gpkg.stats = options.stats;
     gpkg.face_areas_m2 = options.face_areas_m2;
     gpkg.progress = options.progress;
-    gpkg.after_partial_write = options.after_partial_write;
     write_gpkg(mesh, path, gpkg);
 }
 

@@ -21,6 +21,8 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
+#include "globemesh/preview.hpp"
+#include "write_hooks.hpp"
 
 namespace globemesh {
 
@@ -288,7 +290,7 @@ void write_preview_png(const Mesh& mesh, const std::filesystem::path& path, cons
     // polygons and their burning 86%, the outlines and the PNG the rest.
     report(options.progress, 0.08, "write_preview");
     draw_faces(canvas.get(), gt, w, e, mesh, options, path);
-    if (options.after_partial_write) options.after_partial_write();
+    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
     write_png(png, canvas.get(), out.temp_path(), path);
     report(options.progress, 1.0, "write_preview");
     out.commit();
@@ -302,7 +304,6 @@ void write_as_png(const Mesh& mesh, const std::filesystem::path& path, const Wri
     preview.extent_deg = options.extent_deg;
     preview.overwrite = options.overwrite;
     preview.progress = options.progress;
-    preview.after_partial_write = options.after_partial_write;
     write_preview_png(mesh, path, preview);
 }
 

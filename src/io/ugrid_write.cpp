@@ -27,6 +27,7 @@
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
 #include "netcdf_handle.hpp"
+#include "write_hooks.hpp"
 
 #ifndef GLOBEMESH_VERSION
 #define GLOBEMESH_VERSION "unknown"
@@ -503,7 +504,7 @@ void write_data(UgridWriter& w, const Mesh& mesh, const io::MeshTopology& topo, 
         const auto& tri = mesh.faces[f];
         return std::array<int, 3>{int(tri[0]), int(tri[1]), int(tri[2])};
     });
-    if (options.after_partial_write) options.after_partial_write();
+    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
     w.put_lonlat(t.coords[2], t.coords[3], nf, centre);
     w.put_lonlat(t.coords[4], t.coords[5], ne, midpoint);
     w.put_rows<int, 2>(t.edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
@@ -611,7 +612,6 @@ void write_as_ugrid(const Mesh& mesh, const std::filesystem::path& path, const W
     ugrid.stats = options.stats;
     ugrid.face_areas_m2 = options.face_areas_m2;
     ugrid.progress = options.progress;
-    ugrid.after_partial_write = options.after_partial_write;
     write_ugrid(mesh, path, ugrid);
 }
 

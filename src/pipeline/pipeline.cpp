@@ -39,12 +39,6 @@ private:
     Clock::time_point last_ = Clock::now();
 };
 
-std::string number(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-}
-
 /// Largest background grid of the size field: 2^22 nodes (about 10 km at the equator
 /// globally) builds in a few seconds; regional grids are finer for the same count.
 constexpr std::size_t size_grid_max_nodes = std::size_t{1} << 22;
@@ -88,12 +82,12 @@ public:
     /// Bytes left for the next stages (0: the budget is spent); meaningless without a budget.
     std::uint64_t left() const { return held_ >= static_cast<double>(total_) ? 0 : total_ - static_cast<std::uint64_t>(held_); }
     /// Throws DataError when `bytes` more do not fit; `what` says what needs them.
-    void require(double bytes, const std::string& what, const std::string& remedy) const {
+    void require(double bytes, const std::string& what, const ErrorText& remedy) const {
         if (total_ == 0 || held_ + bytes <= static_cast<double>(total_)) return;
         throw DataError(what + " needs about " + memory_text(bytes) + ", more than the " +
-                        memory_text(static_cast<double>(left())) + " left of --max-memory " +
+                        memory_text(static_cast<double>(left())) + " left of " + option("max_memory_bytes") + " " +
                         memory_text(static_cast<double>(total_)) + " after reading the inputs (" +
-                        memory_text(held_) + "); raise --max-memory" + remedy);
+                        memory_text(held_) + "); raise " + option("max_memory_bytes") + remedy);
     }
 
 private:
@@ -101,17 +95,11 @@ private:
     double held_ = 0;
 };
 
-/// What --min-depth found and changed in the sampled depths.
-struct DepthFloor {
-    std::size_t above_sea_level = 0; ///< nodes with depth < 0 as sampled
-    double shallowest_m = 0;         ///< the smallest sampled depth when some are < 0 (m)
-    std::size_t raised = 0;          ///< nodes set to min_depth_m
-};
-
 /// Counts the depths (m, positive down) above sea level and raises those below `min_depth_m`
 /// (when set) to it; no-data values (NaN) stay as they are.
-DepthFloor apply_min_depth(std::vector<double>& depths, std::optional<double> min_depth_m) {
-    DepthFloor f;
+DepthReport apply_min_depth(std::vector<double>& depths, std::optional<double> min_depth_m) {
+    DepthReport f;
+    f.min_depth_m = min_depth_m;
     for (double& d : depths) {
         if (d < 0) {
             f.shallowest_m = f.above_sea_level == 0 ? d : std::min(f.shallowest_m, d);
@@ -125,22 +113,9 @@ DepthFloor apply_min_depth(std::vector<double>& depths, std::optional<double> mi
     return f;
 }
 
-} // namespace
-
-Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
-    // A long GEOS operation of the coast stages stops too when the run is cancelled.
-    const coast::GeosInterrupt geos_interrupt(run_progress);
-    const Progress& progress = geos_interrupt.progress();
-    validate(o);
-    if (o.coast.empty()) throw UsageError("--coast is required: a land polygon or coastline file (any OGR source)");
-    StageClock clock(timings);
-
-    // load_coast and read_bathymetry check their own reads against --max-memory (the coast
-    // counts its vertices while reading, the raster is read no finer than the mesh needs).
-    MemoryBudget budget(o.max_memory_bytes);
-    CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
-    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
-    clock.lap("read_coast");
+/// Refuses a run whose node count is far above max_nodes from the coast alone, before the
+/// bathymetry, the size field and the coast's shaping spend minutes and gigabytes on it.
+void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
     // The mesher's node estimate (nodes_for_area) with every size at --hmax (the field's
     // largest). The mesher's own estimate, over the shaped ocean and the field's sizes, is larger
     // but for the area the shaping closes (inlets, lakes; a few per mil of the global ocean), so
@@ -150,18 +125,18 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
     if (const double estimate = nodes_for_area(coast.ocean_area_km2, o.hmax_km);
         0.9 * estimate > static_cast<double>(o.max_nodes))
         throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) + " km2) takes about " +
-                        std::to_string(std::llround(estimate)) + " nodes at --hmax " + number(o.hmax_km) +
-                        " km, more than --max-nodes " + std::to_string(o.max_nodes) + ": raise --hmax or --max-nodes");
+                        std::to_string(std::llround(estimate)) + " nodes at " + option("hmax_km") + " " +
+                        report_number(o.hmax_km) + " km, more than " + option("max_nodes") + " " +
+                        std::to_string(o.max_nodes) + ": raise " + option("hmax_km") + " or " + option("max_nodes"));
     // The same for the water along the coast at --coast-size: the size grows from s there at
     // rate g = min(--coast-rate, --grade) up to --hmax, and along a straight coast of length L
     // the band takes L * integral of dd / (c (s + g d)^2) = L (1/s - 1/hmax) / (c g) nodes (c h^2
     // the area of a node, nodes_for_area). The mesher counts them exactly, but only after the
     // size field and the coast's shaping, which at a size of metres take seconds to minutes.
-    // Made / counted on 1:50m land at --hmax 100km: --coast-size 1km 5.22 / 6.75 million, 5km
-    // 1.12 / 1.30 million, 20km 217,000 / 273,000 (bays share their bands). The source coast
-    // is longer than the shaped one where the size is above its segments' mean length (the
-    // shaping simplifies it), so the count is held against --max-nodes only below that length,
-    // and at half its value.
+    // It is at most twice the mesher's count (bays share their bands; bench/RESULTS-pipeline.md).
+    // The source coast is longer than the shaped one where the size is above its segments' mean
+    // length (the shaping simplifies it), so the count is held against --max-nodes only below
+    // that length, and at half its value.
     if (o.coast_size_km > 0) {
         double coast_km = 0;
         std::size_t segments = 0;
@@ -177,11 +152,34 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
                                          : nodes_for_area(coast_km * s, s); // a band one size wide
         if (segments > 0 && s <= coast_km / double(segments) && 0.5 * estimate > static_cast<double>(o.max_nodes))
             throw DataError("the water along the coast (" + std::to_string(std::llround(coast_km)) + " km) takes about " +
-                            std::to_string(std::llround(estimate)) + " nodes at --coast-size " + number(o.coast_size_km) + " km" +
-                            (s > o.coast_size_km ? " (" + number(s) + " km: sizes stop at --hmin, by default --hmax / 1000)" : "") +
-                            ", more than --max-nodes " + std::to_string(o.max_nodes) + ": raise --coast-size" +
-                            (s > o.coast_size_km ? " and --hmin" : "") + " or --max-nodes");
+                            std::to_string(std::llround(estimate)) + " nodes at " + option("coast_size_km") + " " +
+                            report_number(o.coast_size_km) + " km" +
+                            (s > o.coast_size_km ? " (" + report_number(s) + " km: sizes stop at " + option("hmin_km") +
+                                                       ", by default " + option("hmax_km") + " / 1000)"
+                                                 : ErrorText("")) +
+                            ", more than " + option("max_nodes") + " " + std::to_string(o.max_nodes) + ": raise " +
+                            option("coast_size_km") + (s > o.coast_size_km ? " and " + option("hmin_km") : ErrorText("")) +
+                            " or " + option("max_nodes"));
     }
+}
+
+} // namespace
+
+OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
+    // A long GEOS operation of the coast stages stops too when the run is cancelled.
+    const coast::GeosInterrupt geos_interrupt(run_progress);
+    const Progress& progress = geos_interrupt.progress();
+    validate(o);
+    if (o.coast.empty()) throw UsageError(option("coast") + " is required: a land polygon or coastline file (any OGR source)");
+    StageClock clock(timings);
+
+    // load_coast and read_bathymetry check their own reads against --max-memory (the coast
+    // counts its vertices while reading, the raster is read no finer than the mesh needs).
+    MemoryBudget budget(o.max_memory_bytes);
+    CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
+    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
+    clock.lap("read_coast");
+    refuse_too_many_nodes(o, coast);
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
@@ -190,21 +188,21 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
     }
     clock.lap("read_bathy");
 
-    // --hmax alone is a uniform field: no background grid needed.
-    const bool uniform = o.coast_size_km == 0 && o.wavelength == 0 && o.slope == 0 && o.size_regions.empty();
-    SizeFn size;
-    SizeField field;
-    if (uniform) {
-        size = uniform_size(std::max(o.hmax_km, o.hmin_km));
-    } else {
+    // The background grid, when the field needs one, is held against the budget before it is made.
+    auto reserve_grid = [&] {
         const double grid_nodes = size_grid_nodes(o);
         budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
-                       "the size field's background grid (" +
-                           std::to_string(static_cast<std::uint64_t>(grid_nodes)) + " nodes)",
-                       " or --hmin");
-        field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
-                                 sub_progress(progress, 0.15, 0.25), size_grid_max_nodes);
-        size = field.function();
+                       "the size field's background grid (" + std::to_string(static_cast<std::uint64_t>(grid_nodes)) +
+                           " nodes)",
+                       " or " + option("hmin_km"));
+    };
+    // Uniform when no component of the field is on: then no background grid is built.
+    const SizeField field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
+                                             sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
+    const SizeFn size = field.function();
+    SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
+    if (!field.is_uniform()) {
+        size_report.grid_nodes = field.grid().values().size();
         budget.hold(static_cast<double>(field.grid().values().size() * sizeof(float)));
     }
     clock.lap("size_field");
@@ -217,8 +215,9 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
     if (std::size_t n = 0; !boundary.empty()) {
         for (const Ring& r : boundary.rings) n += r.nodes.size();
         if (n < 4)
-            throw DataError("no ocean to mesh: at --hmax " + number(o.hmax_km) + " km the coast and region keep only " +
-                            std::to_string(n) + " boundary nodes; lower --hmax");
+            throw DataError("no ocean to mesh: at " + option("hmax_km") + " " + report_number(o.hmax_km) +
+                            " km the coast and region keep only " + std::to_string(n) + " boundary nodes; lower " +
+                            option("hmax_km"));
     }
     coast.rings = Boundary{}; // done with: the mesher reuses their memory (only coast.layer is used below)
 
@@ -226,7 +225,8 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
     mo.max_nodes = o.max_nodes;
     if (o.max_memory_bytes > 0) {
         // The mesher refuses from its node estimate against what the inputs left.
-        budget.require(static_cast<double>(mesher_bytes_per_node), "meshing", " or --hmin/--hmax");
+        budget.require(static_cast<double>(mesher_bytes_per_node), "meshing",
+                       " or " + option("hmin_km") + "/" + option("hmax_km"));
         mo.max_memory = budget.left();
     }
     mo.smooth_iterations = o.smooth_iterations;
@@ -251,77 +251,26 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
         timings->add("mesh", mesh_seconds);
     }
 
-    std::optional<DepthFloor> depth_floor;
+    OceanMesh run;
     if (bathy) {
         Field depth{"depth", "sea floor depth below mean sea level", "m",
                     "sea_floor_depth_below_mean_sea_level", {}};
         depth.values.reserve(mesh.nodes.size());
         for (const Vec3& p : mesh.nodes) depth.values.push_back(bathy->depth_m(p));
-        depth_floor = apply_min_depth(depth.values, o.min_depth_m);
+        run.depth = apply_min_depth(depth.values, o.min_depth_m);
         mesh.node_fields.insert(mesh.node_fields.begin(), std::move(depth));
     }
-
-    auto& a = mesh.attributes;
-    a.emplace_back("coast_file", o.coast);
-    a.emplace_back("coast_layer", coast.layer);
-    if (!o.bathy.empty()) a.emplace_back("bathymetry_file", o.bathy);
-    if (depth_floor) {
-        // As sampled, before --min-depth (the CLI warns from them when it is not given).
-        a.emplace_back("nodes_above_sea_level", std::to_string(depth_floor->above_sea_level));
-        if (depth_floor->above_sea_level > 0) a.emplace_back("min_sampled_depth_m", number(depth_floor->shallowest_m));
-        if (o.min_depth_m) {
-            a.emplace_back("min_depth_m", number(*o.min_depth_m));
-            a.emplace_back("nodes_raised_to_min_depth", std::to_string(depth_floor->raised));
-        }
-    }
-    a.emplace_back("boundary_rings", std::to_string(coast_report.rings));
-    a.emplace_back("boundary_nodes", std::to_string(coast_report.nodes));
-    a.emplace_back("islands_removed", std::to_string(coast_report.islands_removed));
-    a.emplace_back("lakes_removed", std::to_string(coast_report.lakes_removed));
-    a.emplace_back("coast_repairs", std::to_string(coast.polygons_joined) + " polygons joined at near-touches, " +
-                                        std::to_string(coast.rings_changed) + " rings changed by snap rounding, " +
-                                        std::to_string(coast.arcs_split) + " nodes added to straying arcs");
-    a.emplace_back("faces_on_removed_islands", std::to_string(report.island_centroids_left) + " (" +
-                                                   std::to_string(report.island_centroids_moved) + " moved off)");
-    a.emplace_back("faces_on_land", std::to_string(report.land_faces_left) + " (" +
-                                        std::to_string(report.land_faces_removed) + " removed, opening " +
-                                        std::to_string(report.land_holes) + " holes, joining " +
-                                        std::to_string(report.land_loops_joined) + " loops, " +
-                                        std::to_string(report.land_faces_nudged) + " moved off)");
-    // Places as lon lat (degrees), the first 50.
-    auto places = [](const std::vector<Vec3>& points) {
-        std::string at;
-        char buf[48];
-        for (std::size_t i = 0; i < points.size() && i < 50; ++i) {
-            const LonLat ll = vec_to_lonlat(points[i]);
-            std::snprintf(buf, sizeof buf, "%s%.2f %.2f", i ? ", " : "", ll.lon, ll.lat);
-            at += buf;
-        }
-        if (points.size() > 50) at += ", ...";
-        return at;
-    };
-    if (!report.land_faces_at.empty()) a.emplace_back("faces_on_land_at", places(report.land_faces_at));
-    if (mo.land && mo.close_straits) {
-        std::string closed = std::to_string(report.straits_closed) + " (cutting off " +
-                             std::to_string(report.seas_cut_off.size()) + " basins";
-        for (std::size_t i = 0; i < report.seas_cut_off.size(); ++i)
-            closed += (i ? ", " : ": ") + number(report.seas_cut_off[i]) + " km2";
-        closed += "; " + number(report.straits_water_km2) + " km2 of water closed with them; " +
-                  std::to_string(report.nodes_split) + " nodes split)";
-        a.emplace_back("straits_closed", closed);
-        if (!report.straits_closed_at.empty()) a.emplace_back("straits_closed_at", places(report.straits_closed_at));
-    }
-    a.emplace_back("ocean_area_km2", number(coast_report.ocean_area_km2));
-    a.emplace_back("segments_split", std::to_string(report.segments_split + report.encroached_splits));
-    a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +
-                                        number(report.inlet_area_km2) + " km2)");
-    a.emplace_back("lattice_nodes", std::to_string(report.lattice_nodes));
-    a.emplace_back("sharp_coast_corners", std::to_string(report.sharp_corners));
-    a.emplace_back("faces_at_sharp_corners", std::to_string(report.sharp_corner_faces));
-    std::ostringstream comps;
-    for (const auto& c : report.components) comps << (comps.tellp() ? "; " : "") << number(c.area_km2) << " km2 " << (c.kept ? "kept" : "dropped");
-    a.emplace_back("ocean_components", comps.str());
-    return mesh;
+    run.coast_file = o.coast;
+    run.coast_layer = coast.layer;
+    run.bathymetry_file = o.bathy;
+    run.coast_repairs = {coast.polygons_joined, coast.rings_changed, coast.arcs_split};
+    run.coast = coast_report;
+    run.size_field = size_report;
+    run.mesher = std::move(report);
+    run.straits_closing = mo.land && mo.close_straits;
+    run.mesh = std::move(mesh);
+    run.mesh.attributes = ocean_attributes(run);
+    return run;
 }
 
 } // namespace globemesh

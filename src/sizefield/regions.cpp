@@ -48,10 +48,10 @@ std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string& path, con
     }
     OGRLayerH layer = GDALDatasetGetLayerByName(ds, name.c_str());
     if (!layer)
-        throw DataError("--size-regions " + path + ": no layer named '" + name + "' (--size-regions-layer); layers: " +
+        throw DataError(option("size_regions") + " " + path + ": no layer named '" + name + "' (" + option("size_regions_layer") + "); layers: " +
                         layer_names(ds));
     if (OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), "size_km") < 0)
-        throw DataError("--size-regions " + path + " layer '" + name + "' has no size_km field (edge length in km)");
+        throw DataError(option("size_regions") + " " + path + " layer '" + name + "' has no size_km field (edge length in km)");
     layers.push_back(layer);
     return layers;
 }
@@ -63,7 +63,7 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
     GDALAllRegister();
     gdal::QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds) throw IoError("--size-regions " + path + ": cannot open as vector data: " + last_message());
+    if (!ds) throw IoError(option("size_regions") + " " + path + ": cannot open as vector data: " + last_message());
 
     gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(wgs84.get(), 4326);
@@ -79,12 +79,12 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
         any_field = true;
         OGRSpatialReferenceH srs = OGR_L_GetSpatialRef(layer);
         if (!srs || OSRIsLocal(srs)) // a local CRS (LOCAL_CS, unknown units) is no more use
-            throw DataError("--size-regions " + path + ": layer " + OGR_L_GetName(layer) + " has no CRS" +
+            throw DataError(option("size_regions") + " " + path + ": layer " + OGR_L_GetName(layer) + " has no CRS" +
                             (srs ? " (only a local one, of unknown units)" : "") +
                             "; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
         TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, wgs84.get()));
         if (!to_lonlat)
-            throw DataError("--size-regions " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");
+            throw DataError(option("size_regions") + " " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
@@ -94,16 +94,16 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
             if (type != wkbPolygon && type != wkbMultiPolygon) continue;
             double size = OGR_F_GetFieldAsDouble(fh, field);
             if (!(std::isfinite(size) && size > 0))
-                throw DataError("--size-regions " + path + ": feature " + std::to_string(OGR_F_GetFID(fh)) +
+                throw DataError(option("size_regions") + " " + path + ": feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " has size_km " + OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
             GeometryPtr copy(OGR_G_Clone(geom));
             if (OGR_G_Transform(copy.get(), to_lonlat.get()) != OGRERR_NONE)
-                throw DataError("--size-regions " + path + ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) + " to lon/lat");
+                throw DataError(option("size_regions") + " " + path + ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) + " to lon/lat");
             regions.emplace_back(size, std::move(copy));
         }
     }
     if (!any_field)
-        throw DataError("--size-regions " + path + ": no layer has a size_km field (edge length in km)");
+        throw DataError(option("size_regions") + " " + path + ": no layer has a size_km field (edge length in km)");
     if (regions.empty()) return;
     // Largest first: with the REPLACE rule the smallest size burnt last wins (a minimum).
     std::stable_sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -124,7 +124,7 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
         if (shift < 0 && east <= 180.0) continue;
         if (shift > 0 && west >= -180.0) continue;
         DatasetPtr target(GDALCreate(mem, "", nx, ny, 1, GDT_Float32, nullptr));
-        if (!target) throw IoError("--size-regions: cannot create an in-memory grid: " + last_message());
+        if (!target) throw IoError(option("size_regions") + ": cannot create an in-memory grid: " + last_message());
         // North-up: raster row r is grid row nlat-1-r. Shift moves the polygons' lon by -shift.
         double gt[6] = {west + shift, g.dlon, 0, north, 0, -g.dlat};
         GDALSetGeoTransform(target.get(), gt);
@@ -133,10 +133,10 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
         int one = 1;
         if (GDALRasterizeGeometries(target.get(), 1, &one, static_cast<int>(geoms.size()), geoms.data(),
                                     nullptr, nullptr, burn.data(), nullptr, nullptr, nullptr) != CE_None)
-            throw IoError("--size-regions " + path + ": rasterising failed: " + last_message());
+            throw IoError(option("size_regions") + " " + path + ": rasterising failed: " + last_message());
         for (int r = 0; r < ny; ++r) {
             if (GDALRasterIO(band, GF_Read, 0, r, nx, 1, row.data(), nx, 1, GDT_Float32, 0, 0) != CE_None)
-                throw IoError("--size-regions: reading the in-memory grid failed: " + last_message());
+                throw IoError(option("size_regions") + ": reading the in-memory grid failed: " + last_message());
             std::size_t j = g.nlat - 1 - static_cast<std::size_t>(r);
             for (std::size_t i = 0; i < g.nlon; ++i) h[j * g.nlon + i] = std::min(h[j * g.nlon + i], row[i]);
         }

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "globemesh/error.hpp"
@@ -78,7 +79,15 @@ SizeField::SizeField(Raster grid, double south_pole_km, double north_pole_km) {
     grid_ = std::make_shared<const Raster>(std::move(grid));
 }
 
+SizeField SizeField::uniform(double h_km) {
+    if (!(std::isfinite(h_km) && h_km > 0)) throw UsageError("uniform size: h must be a positive length in km");
+    SizeField f;
+    f.min_ = f.max_ = h_km;
+    return f;
+}
+
 double SizeField::size_km(double lon, double lat) const {
+    if (!grid_) return min_; // uniform
     const Raster& g = *grid_;
     const std::size_t nx = g.nlon(), ny = g.nlat();
     const float* values = g.values().data();
@@ -138,84 +147,111 @@ double SizeField::size_km(const Vec3& p) const {
 }
 
 SizeFn SizeField::function() const {
+    if (is_uniform()) return uniform_size(min_);
     SizeField copy = *this;
     return [copy](const Vec3& p) { return copy.size_km(p); };
 }
 
+namespace {
+
+/// Lowers h (the grid's values, km) to the wavelength and slope components of the depth on
+/// the grid (see sizefield.hpp), where the options turn them on.
+void lower_by_depth(const detail::BackgroundGrid& g, const Raster& bathy, const MeshOptions& o, std::vector<float>& h,
+                    const Progress& progress) {
+    auto lower = [&](std::size_t n, double v) {
+        if (v < h[n]) h[n] = static_cast<float>(v);
+    };
+    std::vector<float> depth(g.size());
+    for (std::size_t j = 0; j < g.nlat; ++j) {
+        for (std::size_t i = 0; i < g.nlon; ++i)
+            depth[j * g.nlon + i] = static_cast<float>(-bathy.elevation_m(g.lon(i), g.lat(j)));
+        if (j % 256 == 0) report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat), "size field");
+    }
+    for (std::size_t n = 0; n < g.size(); ++n) {
+        const double dn = depth[n];
+        if (std::isnan(dn)) continue;
+        if (o.wavelength > 0) lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
+        if (o.slope > 0) {
+            // Central differences of the floored depth (one-sided at edges and no-data).
+            auto floored = [&](std::size_t m) {
+                return std::isnan(depth[m]) ? std::numeric_limits<double>::quiet_NaN()
+                                            : std::max(static_cast<double>(depth[m]), min_depth_m);
+            };
+            auto derivative = [&](const std::size_t nb[2], double step) {
+                double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
+                double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
+                double here = std::max(dn, min_depth_m);
+                if (!std::isnan(lo) && !std::isnan(hi)) return (hi - lo) / (2 * step);
+                if (!std::isnan(hi)) return (hi - here) / step;
+                if (!std::isnan(lo)) return (here - lo) / step;
+                return 0.0;
+            };
+            std::size_t r[2], c[2];
+            g.row_neighbours(n, r);
+            g.column_neighbours(n, c);
+            const double gx = derivative(r, g.dx_km[n / g.nlon]);
+            const double gy = derivative(c, g.dy_km);
+            lower(n, slope_size_km(dn, std::hypot(gx, gy), o.slope));
+        }
+    }
+}
+
+} // namespace
+
 SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boundary* coast,
-                           const Progress& progress, std::size_t max_nodes) {
+                           const Progress& progress, std::size_t max_nodes, const std::function<void()>& before_grid) {
     validate(o);
-    if (!(o.hmax_km > 0)) throw UsageError("--hmax must be a positive length, e.g. 100km");
+    if (!(o.hmax_km > 0)) throw UsageError(option("hmax_km") + " must be a positive length, e.g. 100km");
     if ((o.wavelength > 0 || o.slope > 0) && !bathy)
-        throw UsageError(std::string(o.wavelength > 0 ? "--wavelength" : "--slope") +
-                         " needs a bathymetry raster: give --bathy");
+        throw UsageError(option(o.wavelength > 0 ? "wavelength" : "slope") + " needs a bathymetry raster: give " +
+                         option("bathy"));
     if (o.coast_size_km > 0 && !coast)
-        throw UsageError("--coast-size needs the coastline: give --coast");
+        throw UsageError(option("coast_size_km") + " needs the coastline: give " + option("coast"));
     const double hmax = o.hmax_km;
     const double hfloor = size_floor_km(o);
     if (o.coast_size_km > 0 && o.coast_size_km > hmax)
-        throw UsageError("--coast-size (" + km(o.coast_size_km) + ") must not be larger than --hmax (" + km(hmax) + ")");
+        throw UsageError(option("coast_size_km") + " (" + km(o.coast_size_km) + ") must not be larger than " +
+                         option("hmax_km") + " (" + km(hmax) + ")");
 
-    report(progress, 0.0, "size field");
-    detail::BackgroundGrid g = detail::make_background_grid(o, hfloor, max_nodes);
+    // The background grid, made when the first component that is on asks for it: a field no
+    // component asked for is uniform, so a component cannot be on and left out.
+    std::optional<detail::BackgroundGrid> grid;
     std::vector<float> h;
-    h.reserve(g.size() + 2); // the gradation solver appends the two pole nodes
-    h.assign(g.size(), static_cast<float>(hmax));
+    auto background = [&]() -> const detail::BackgroundGrid& {
+        if (grid) return *grid;
+        if (before_grid) before_grid();
+        report(progress, 0.0, "size field");
+        grid = detail::make_background_grid(o, hfloor, max_nodes);
+        h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
+        h.assign(grid->size(), static_cast<float>(hmax));
+        return *grid;
+    };
     auto lower = [&](std::size_t n, double v) {
         if (v < h[n]) h[n] = static_cast<float>(v);
     };
 
     // Distance to the coast.
-    if (o.coast_size_km > 0 && coast && !coast->empty()) {
-        const double reach = o.coast_rate > 0 ? (hmax - o.coast_size_km) / o.coast_rate : inf;
-        std::vector<float> d = detail::coast_distance_km(g, *coast, std::min(reach * 1.01 + 2 * g.dy_km, pi * earth_radius_km),
-                                                         sub_progress(progress, 0.05, 0.35));
-        for (std::size_t n = 0; n < g.size(); ++n)
-            if (std::isfinite(d[n])) lower(n, o.coast_size_km + o.coast_rate * d[n]);
+    if (o.coast_size_km > 0) {
+        const detail::BackgroundGrid& g = background();
+        if (coast && !coast->empty()) {
+            const double reach = o.coast_rate > 0 ? (hmax - o.coast_size_km) / o.coast_rate : inf;
+            std::vector<float> d = detail::coast_distance_km(
+                g, *coast, std::min(reach * 1.01 + 2 * g.dy_km, pi * earth_radius_km), sub_progress(progress, 0.05, 0.35));
+            for (std::size_t n = 0; n < g.size(); ++n)
+                if (std::isfinite(d[n])) lower(n, o.coast_size_km + o.coast_rate * d[n]);
+        }
     }
-    report(progress, 0.35, "size field");
+    if (grid) report(progress, 0.35, "size field");
 
     // Wavelength and slope, from the depth on the grid.
-    if (bathy && (o.wavelength > 0 || o.slope > 0)) {
-        std::vector<float> depth(g.size());
-        for (std::size_t j = 0; j < g.nlat; ++j) {
-            for (std::size_t i = 0; i < g.nlon; ++i)
-                depth[j * g.nlon + i] = static_cast<float>(-bathy->elevation_m(g.lon(i), g.lat(j)));
-            if (j % 256 == 0) report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat), "size field");
-        }
-        for (std::size_t n = 0; n < g.size(); ++n) {
-            const double dn = depth[n];
-            if (std::isnan(dn)) continue;
-            if (o.wavelength > 0) lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
-            if (o.slope > 0) {
-                // Central differences of the floored depth (one-sided at edges and no-data).
-                auto floored = [&](std::size_t m) {
-                    return std::isnan(depth[m]) ? std::numeric_limits<double>::quiet_NaN()
-                                                : std::max(static_cast<double>(depth[m]), min_depth_m);
-                };
-                auto derivative = [&](const std::size_t nb[2], double step) {
-                    double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
-                    double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
-                    double here = std::max(dn, min_depth_m);
-                    if (!std::isnan(lo) && !std::isnan(hi)) return (hi - lo) / (2 * step);
-                    if (!std::isnan(hi)) return (hi - here) / step;
-                    if (!std::isnan(lo)) return (here - lo) / step;
-                    return 0.0;
-                };
-                std::size_t r[2], c[2];
-                g.row_neighbours(n, r);
-                g.column_neighbours(n, c);
-                const double gx = derivative(r, g.dx_km[n / g.nlon]);
-                const double gy = derivative(c, g.dy_km);
-                lower(n, slope_size_km(dn, std::hypot(gx, gy), o.slope));
-            }
-        }
-    }
-    report(progress, 0.55, "size field");
+    if (o.wavelength > 0 || o.slope > 0) lower_by_depth(background(), *bathy, o, h, progress);
+    if (grid) report(progress, 0.55, "size field");
 
-    if (!o.size_regions.empty()) detail::apply_size_regions(g, o.size_regions, o.size_regions_layer, h);
+    if (!o.size_regions.empty()) detail::apply_size_regions(background(), o.size_regions, o.size_regions_layer, h);
+    if (!grid) return SizeField::uniform(std::max(o.hmax_km, o.hmin_km));
     report(progress, 0.6, "size field");
 
+    const detail::BackgroundGrid& g = *grid;
     for (float& v : h) v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
     const detail::PoleSizes poles = detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
     report(progress, 1.0, "size field");

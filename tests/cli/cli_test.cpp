@@ -48,7 +48,7 @@ struct RefusingLibrary {
             ++calls;
             throw std::logic_error("the library was reached");
         };
-        l.mesh_ocean = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
+        l.mesh_ocean = [refuse](auto&&...) -> globemesh::OceanMesh { refuse(); return {}; };
         l.triangulate_file = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
         l.writers = globemesh::writers();
         for (auto& w : l.writers) w.write = [refuse](auto&&...) { refuse(); };
@@ -533,7 +533,7 @@ TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
     auto with_error = [&](std::function<void()> thrower) {
         RefusingLibrary refusing;
         auto lib = refusing.lib();
-        lib.mesh_ocean = [thrower](auto&&...) -> globemesh::Mesh { thrower(); return {}; };
+        lib.mesh_ocean = [thrower](auto&&...) -> globemesh::OceanMesh { thrower(); return {}; };
         return run(args, lib);
     };
     const Result usage = with_error([] { throw globemesh::UsageError("--coast-layer: no layer 'x'"); });
@@ -542,6 +542,14 @@ TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
     const Result data = with_error([] { throw globemesh::DataError("--region: no ocean in the region"); });
     EXPECT_EQ(data.status, 1);
     EXPECT_EQ(data.err, "globemesh: --region: no ocean in the region\n");
+    // The library names options by their MeshOptions field; the command line says its flags.
+    using globemesh::option;
+    const Result named = with_error([] {
+        throw globemesh::DataError("at " + option("hmax_km") + " 1 km: raise " + option("hmax_km") + " or " +
+                                   option("max_memory_bytes"));
+    });
+    EXPECT_EQ(named.status, 1);
+    EXPECT_EQ(named.err, "globemesh: at --hmax 1 km: raise --hmax or --max-memory\n");
     const Result io = with_error([] { throw globemesh::IoError("cannot read x.gpkg"); });
     EXPECT_EQ(io.status, 1);
     const Result internal = with_error([] { throw std::out_of_range("vector::at\nsecond line"); });
@@ -568,7 +576,7 @@ TEST(Cli, each_cancelling_signal_stops_the_run_leaves_no_output_and_restores_the
         auto lib = refusing.lib();
         bool handled_inside = false;
         lib.mesh_ocean = [&, signal = signal](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                                              globemesh::StageTimings*) -> globemesh::Mesh {
+                                              globemesh::StageTimings*) -> globemesh::OceanMesh {
             globemesh::report(progress, 0.1, "refine");
             std::raise(signal); // our handler only records it, so the test process survives
             handled_inside = true;
@@ -596,7 +604,7 @@ TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
     auto lib_with_progress = [](RefusingLibrary& refusing) {
         auto lib = refusing.lib();
         lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                            globemesh::StageTimings*) -> globemesh::Mesh {
+                            globemesh::StageTimings*) -> globemesh::OceanMesh {
             for (int i = 0; i <= 10; ++i) globemesh::report(progress, i / 10.0, i < 5 ? "size_field" : "refine");
             throw globemesh::DataError("stop here");
         };
@@ -612,7 +620,7 @@ TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
     RefusingLibrary r0;
     auto early = r0.lib();
     early.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                          globemesh::StageTimings*) -> globemesh::Mesh {
+                          globemesh::StageTimings*) -> globemesh::OceanMesh {
         globemesh::report(progress, 0.0, "reading coast");
         globemesh::report(progress, 0.001, "reading coast");
         throw globemesh::DataError("--coast x.gpkg: several layers");
@@ -639,7 +647,7 @@ TEST(Cli, the_mesh_and_its_outputs_share_one_progress_line) {
     };
     lib.mesh_ocean = [&](const globemesh::MeshOptions&, const globemesh::Progress& p, globemesh::StageTimings*) {
         report_all(p, "refine");
-        return globemesh::Mesh{};
+        return globemesh::OceanMesh{};
     };
     lib.compute_stats = [](const globemesh::Mesh&) { return globemesh::MeshStats{}; };
     row(lib, "UGRID").write = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::WriteOptions& o) {
@@ -791,7 +799,9 @@ struct FakeRun {
             globemesh::Mesh m;
             m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
             m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
-            return m;
+            globemesh::OceanMesh run;
+            run.mesh = std::move(m);
+            return run;
         };
         l.triangulate_file = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
         l.writers = globemesh::writers();
@@ -975,7 +985,7 @@ TEST(Cli, an_error_after_a_signal_is_reported_as_the_cancellation) {
     FakeRun fake;
     auto lib = fake.lib();
     lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress&,
-                        globemesh::StageTimings*) -> globemesh::Mesh {
+                        globemesh::StageTimings*) -> globemesh::OceanMesh {
         std::raise(SIGTERM);
         throw globemesh::DataError("coast: GEOS failed to dissolve the land polygons: Interrupted!");
     };

@@ -39,7 +39,8 @@ int main(int argc, char **argv) {
     options.coast = argv[1];
     options.coast_layer = "land";
     options.hmax_km = hmax_km;
-    const globemesh::Mesh mesh = globemesh::mesh_ocean(options);
+    const globemesh::OceanMesh run = globemesh::mesh_ocean(options);
+    const globemesh::Mesh& mesh = run.mesh;
 
     double area = 0;
     bool indices_ok = true, unit_ok = true, ccw_ok = true;

@@ -293,7 +293,7 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     EXPECT_NE(m.find("has no georeferencing"), std::string::npos) << m;
     EXPECT_TRUE(one_line(m));
     m = test::thrown_message<UsageError>([&] { read_raster(ok, 2); }, "band 2 of 1");
-    EXPECT_NE(m.find("--bathy-band 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("bathy_band 2"), std::string::npos) << m;
     const std::string empty = (dir / "nodata.tif").string();
     GridSpec n{0, 10, 1, 1, 4, 4};
     n.nodata = -1.0;
@@ -303,7 +303,7 @@ TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     // A regional raster does not cover the globe, nor a region beyond it, unless filled.
     MeshOptions o = options_for(ok);
     m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a partial coverage");
-    EXPECT_NE(m.find("--bathy-fill"), std::string::npos) << m;
+    EXPECT_NE(m.find("bathy_fill_m"), std::string::npos) << m;
     EXPECT_TRUE(one_line(m));
     o.region = std::array<double, 4>{1, 7, 3, 9};
     EXPECT_NO_THROW(read_bathymetry(o));
@@ -495,7 +495,7 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     o.max_memory_bytes = 500'000'000;  // half of it for the raster: less than 2^28 floats
     const std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a 1 GiB read within a 250 MB share");
     EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
-    EXPECT_NE(m.find("--max-memory"), std::string::npos) << m;
+    EXPECT_NE(m.find("max_memory_bytes"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     // Coarser sizes fit: hmin 40 km asks for cells of 20 km (0.18 degree), rounded up in count.
     o.hmin_km = 40;
@@ -695,7 +695,7 @@ TEST(Bathymetry, a_grid_without_crs_or_lonlat_axes_is_refused_and_bathy_srs_give
     write_cf(bare_path, bare);
     std::string m = test::thrown_message<DataError>([&] { read_raster(bare_path); }, "no CRS, no CF axes");
     EXPECT_NE(m.find("has no georeferencing"), std::string::npos) << m;
-    EXPECT_NE(m.find("--bathy-srs"), std::string::npos) << m;
+    EXPECT_NE(m.find("bathy_srs"), std::string::npos) << m;
     // Degrees by its units but an extent no lon/lat grid has (latitudes in the thousands): refused.
     CfGrid far = g;
     for (double& y : far.lat) y *= 100;
@@ -711,7 +711,7 @@ TEST(Bathymetry, a_grid_without_crs_or_lonlat_axes_is_refused_and_bathy_srs_give
     // A string that is no CRS: one line naming the option, before any file is opened.
     for (const std::string bad : {"EPSG:99999", "not a crs", "LOCAL_CS[\"x\"]"}) {
         m = test::thrown_message<UsageError>([&] { validate_bathy_srs(bad); }, bad);
-        EXPECT_EQ(m.rfind("--bathy-srs '" + bad + "' is not a CRS", 0), 0u) << m;
+        EXPECT_EQ(m.rfind("bathy_srs '" + bad + "' is not a CRS", 0), 0u) << m;
         EXPECT_EQ(m.find('\n'), std::string::npos) << m;
         EXPECT_THROW(read_raster(bare_path, 1, false, {}, RasterLimits{}, bad), UsageError) << bad;
     }
@@ -900,8 +900,8 @@ TEST(Bathymetry, coverage_is_that_of_the_ocean_of_the_region_file_or_box) {
     // farthest out.
     ocean.rings[0] = ring_of({{2, 2}, {11, 2}, {11, 3}, {2, 3}});
     std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "ocean beyond");
-    EXPECT_NE(m.find("the ocean of --region-file " + o.region_file + " reaches lon 11, lat 2"), std::string::npos) << m;
-    EXPECT_NE(m.find("--bathy-fill"), std::string::npos) << m;
+    EXPECT_NE(m.find("the ocean of region_file " + o.region_file + " reaches lon 11, lat 2"), std::string::npos) << m;
+    EXPECT_NE(m.find("bathy_fill_m"), std::string::npos) << m;
     // A --region box running west of the raster over land: its ocean is inside, so it is covered.
     o.region_file.clear();
     o.region = std::array<double, 4>{-5, 1, 9, 9};

@@ -41,7 +41,7 @@ TEST(CoastReal, an_islet_a_fraction_of_a_metre_off_the_mainland_meshes) {
     EXPECT_TRUE(check_boundary(d.rings).empty());
     // The near-touch is resolved, and said so: split arcs or joined polygons are counted.
     EXPECT_GT(d.arcs_split + d.polygons_joined, 0u);
-    const Mesh mesh = mesh_ocean(o);
+    const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GT(mesh.faces.size(), 100u);
     expect_valid_mesh(mesh, o, "strait.nc");
 }
@@ -54,7 +54,7 @@ TEST(CoastReal, a_fjord_coast_clipped_to_its_region_meshes_at_every_size) {
     for (double h : {10.0, 5.0, 4.0, 2.5, 2.2, 1.8, 1.5, 1.0, 0.75, 0.5}) {
         SCOPED_TRACE("--hmax " + std::to_string(h) + " km");
         const MeshOptions o = region_run("coast/hostile/gshhg_f_sogn_25832.shp", {4.8, 61.3, 5.3, 61.6}, h);
-        const Mesh mesh = mesh_ocean(o);
+        const Mesh mesh = mesh_ocean(o).mesh;
         EXPECT_GT(mesh.faces.size(), 10u);
         if (h == 10.0 || h == 1.5 || h == 0.5) expect_valid_mesh(mesh, o, "fjord.nc");
     }

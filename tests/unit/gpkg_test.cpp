@@ -17,7 +17,9 @@
 
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
+#include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
+#include "write_hooks.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
 
@@ -524,12 +526,13 @@ TEST(Gpkg, existing_output_refused_and_failures_leave_no_file) {
     EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"o.gpkg"});
     fs::remove(dir / "o.gpkg");
     EXPECT_THROW(write_gpkg(icosphere(1), dir / "missing/o.gpkg"), IoError);
-    GpkgOptions o;
-    o.after_partial_write = [&] { throw Cancelled(); };
-    EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg", o), Cancelled);
-    EXPECT_TRUE(folder_listing(dir.path()).empty());
-    o.after_partial_write = [&] { throw std::runtime_error("simulated failure"); };
-    EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg", o), std::runtime_error);
+    {
+        const detail::PartialWriteHook hook([&] { throw Cancelled(); });
+        EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg"), Cancelled);
+        EXPECT_TRUE(folder_listing(dir.path()).empty());
+    }
+    const detail::PartialWriteHook hook([&] { throw std::runtime_error("simulated failure"); });
+    EXPECT_THROW(write_gpkg(icosphere(2), dir / "o.gpkg"), std::runtime_error);
     EXPECT_TRUE(folder_listing(dir.path()).empty());
 }
 
@@ -652,9 +655,11 @@ TEST(Preview, default_extent_of_a_pacific_mesh_is_continuous_across_180_and_colo
     EXPECT_GT(double(blue) / double(r.size()), 0.45);
     EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), IoError); // exists, no overwrite
     o.overwrite = true;
-    o.after_partial_write = [] { throw Cancelled(); };
-    EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), Cancelled);
-    EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"pac.png"});
+    {
+        const detail::PartialWriteHook hook([] { throw Cancelled(); });
+        EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), Cancelled);
+        EXPECT_EQ(folder_listing(dir.path()), std::vector<std::string>{"pac.png"});
+    }
     o.colour_by = "salinity";
     EXPECT_THROW(write_preview_png(m, dir / "x.png", o), UsageError);
 }

@@ -85,20 +85,13 @@ void expect_verified(const Mesh& mesh, const std::string& name, const std::strin
     test::expect_mesh_verify(dir / name, "--size-var target_size --min-size-fit " + min_size_fit + " " + more);
 }
 
-std::string attribute(const Mesh& mesh, const std::string& key) {
-    for (const auto& [k, v] : mesh.attributes)
-        if (k == key) return v;
-    return "";
-}
-
 std::size_t count_tag(const Mesh& m, EdgeTag tag) {
     std::size_t n = 0;
     for (const auto& e : m.boundary) n += e.tag == tag;
     return n;
 }
 
-// The straits_closed attribute: "N (cutting off K basins: A km2, ...; W km2 of water closed
-// with them; S nodes split)", and straits_closed_at: "lon lat, ...".
+// The straits the mesher closed (MesherReport): how many, the basins they cut off, where.
 struct Closed {
     std::size_t count = 0, nodes_split = 0;
     std::vector<double> basins_km2;
@@ -109,25 +102,12 @@ struct Closed {
         return false;
     }
 };
-Closed straits_closed(const Mesh& mesh) {
-    Closed c;
-    std::vector<std::string> m;
-    const std::string text = attribute(mesh, "straits_closed");
-    EXPECT_TRUE(test::regex_match(text, R"((\d+) \(cutting off (\d+) basins(: .*)?; ([0-9.e+]+) km2 of water closed with them; (\d+) nodes split\))", &m)) << text;
-    if (m.size() < 6) return c;
-    c.count = std::stoul(m[1]);
-    c.nodes_split = std::stoul(m[5]);
-    std::istringstream basins(m[3].size() > 2 ? m[3].substr(2) : "");
-    for (std::string item; std::getline(basins, item, ',');) c.basins_km2.push_back(std::stod(item));
-    EXPECT_EQ(c.basins_km2.size(), std::stoul(m[2])) << text;
-    std::istringstream at(c.count ? attribute(mesh, "straits_closed_at") : "");
-    for (std::string item; std::getline(at, item, ',');) {
-        std::istringstream ll(item);
-        LonLat p{};
-        EXPECT_TRUE(ll >> p.lon >> p.lat) << item;
-        c.at.push_back(p);
-    }
-    EXPECT_EQ(c.at.size(), std::min<std::size_t>(c.count, 50));
+Closed straits_closed(const OceanMesh& run) {
+    EXPECT_TRUE(run.straits_closing);
+    const MesherReport& r = run.mesher;
+    Closed c{r.straits_closed, r.nodes_split, r.seas_cut_off, {}};
+    for (const Vec3& p : r.straits_closed_at) c.at.push_back(vec_to_lonlat(p));
+    EXPECT_EQ(c.at.size(), c.count);
     return c;
 }
 
@@ -182,7 +162,8 @@ TEST(Mesher, global_ocean_at_200_km_is_valid_fits_the_size_and_keeps_every_ring)
 TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     MeshOptions o = land_110m(100);
     o.coast = fixture("coast/ne_50m_land.gpkg").string();
-    Mesh mesh = mesh_ocean(o);
+    const OceanMesh run = mesh_ocean(o);
+    const Mesh& mesh = run.mesh;
     // Faces centred on land: 577 before the mesher removed them, 129 when it kept every loop
     // apart, 50 with groups and joins; 48 once narrow basins closed whole (Lake Maracaibo),
     // about 20 of them in straits kept open, the rest where a removal would bring a node more
@@ -191,14 +172,12 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     // close (the Dardanelles, Johnstone Strait, Bonifacio, Magellan, Chiloe, the Canadian
     // Arctic). Each hole the removals opened is one more boundary loop, each join one fewer;
     // narrow water between islands and the mainland closes in a few dozen places.
-    std::vector<std::string> m;
-    const std::string on_land = attribute(mesh, "faces_on_land");
-    ASSERT_TRUE(test::regex_match(on_land, R"((\d+) \((\d+) removed, opening (\d+) holes, joining (\d+) loops, (\d+) moved off\))", &m)) << on_land;
-    EXPECT_EQ(std::stoul(m[1]), 0u);
-    EXPECT_GT(std::stoul(m[5]), 25u);
-    EXPECT_GT(std::stoul(m[2]), 450u);
-    EXPECT_GT(std::stoul(m[4]), 10u);
-    const Closed closed = straits_closed(mesh);
+    const MesherReport& report = run.mesher;
+    EXPECT_EQ(report.land_faces_left, 0u);
+    EXPECT_GT(report.land_faces_nudged, 25u);
+    EXPECT_GT(report.land_faces_removed, 450u);
+    EXPECT_GT(report.land_loops_joined, 10u);
+    const Closed closed = straits_closed(run);
     EXPECT_GE(closed.count, 5u);
     EXPECT_TRUE(closed.near(26.5, 40.2)) << "the Dardanelles";
     // The largest basin cut off is the Black Sea (436,000 km2, the Sea of Azov 39,000 more).
@@ -211,7 +190,7 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     // Loops: one per ring, one more per hole, one fewer per join; a closed strait cuts one in
     // two or splits one at a node at most.
     const std::size_t loops = compute_stats(mesh).boundary_loops;
-    const std::size_t rings = std::stoul(attribute(mesh, "boundary_rings")) + std::stoul(m[3]) - std::stoul(m[4]);
+    const std::size_t rings = run.coast.rings + report.land_holes - report.land_loops_joined;
     EXPECT_GE(loops, rings);
     EXPECT_LE(loops, rings + closed.count + closed.nodes_split);
     expect_verified(mesh, "g.nc", "0.95", "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
@@ -239,9 +218,10 @@ TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
     MeshOptions o = land_110m(100);
     o.coast = fixture("coast/ne_50m_land.gpkg").string();
     o.region = std::array<double, 4>{20, 35, 45, 48};
-    const Mesh closed_mesh = mesh_ocean(o);
-    EXPECT_TRUE(test::regex_match(attribute(closed_mesh, "faces_on_land"), R"(0 \(.*)"));
-    const Closed closed = straits_closed(closed_mesh);
+    const OceanMesh closed_run = mesh_ocean(o);
+    const Mesh& closed_mesh = closed_run.mesh;
+    EXPECT_EQ(closed_run.mesher.land_faces_left, 0u);
+    const Closed closed = straits_closed(closed_run);
     EXPECT_GE(closed.count, 1u);
     EXPECT_TRUE(closed.near(26.5, 40.2) || closed.near(29.0, 41.1)) << "the Dardanelles or the Bosphorus";
     // The largest basin cut off is the Black Sea (436,000 km2, and the Sea of Azov), each basin
@@ -255,11 +235,11 @@ TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
     expect_verified(closed_mesh, "straits.nc", "0.5", "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
 
     o.keep_straits = true;
-    const Mesh open_mesh = mesh_ocean(o);
-    std::vector<std::string> m;
-    ASSERT_TRUE(test::regex_match(attribute(open_mesh, "faces_on_land"), R"((\d+) \(.*)", &m));
-    EXPECT_GE(std::stoul(m[1]), 1u);
-    EXPECT_EQ(attribute(open_mesh, "straits_closed"), "");
+    const OceanMesh open_run = mesh_ocean(o);
+    const Mesh& open_mesh = open_run.mesh;
+    EXPECT_GE(open_run.mesher.land_faces_left, 1u);
+    EXPECT_FALSE(open_run.straits_closing); // nothing closed, and no straits_closed attribute
+    EXPECT_EQ(open_run.mesher.straits_closed, 0u);
     EXPECT_EQ(pieces(open_mesh), 1u);
     EXPECT_GT(open_mesh.faces.size(), closed_mesh.faces.size() + 20); // the Sea of Marmara too
     expect_verified(open_mesh, "open_straits.nc", "0.5");
@@ -571,13 +551,11 @@ TEST(Mesher, a_regional_lattice_comes_with_its_triangles_inside_the_cap) {
 TEST(Mesher, regional_box_has_open_boundary_edges) {
     MeshOptions o = land_110m(150);
     o.region = std::array<double, 4>{-70, 10, -10, 55};
-    Mesh mesh = mesh_ocean(o);
+    const OceanMesh run = mesh_ocean(o);
+    const Mesh& mesh = run.mesh;
     // The lattice is walked in a cap around the box only (over the whole sphere it would be 19
     // times the box's nodes, and skipped), and fills the open sea in the box.
-    const auto lattice = std::find_if(mesh.attributes.begin(), mesh.attributes.end(),
-                                      [](const auto& kv) { return kv.first == "lattice_nodes"; });
-    ASSERT_NE(lattice, mesh.attributes.end());
-    EXPECT_GT(std::stoul(lattice->second), mesh.nodes.size() / 4) << lattice->second << " of " << mesh.nodes.size();
+    EXPECT_GT(run.mesher.lattice_nodes, mesh.nodes.size() / 4) << run.mesher.lattice_nodes << " of " << mesh.nodes.size();
     EXPECT_GT(count_tag(mesh, EdgeTag::open), 10u);
     EXPECT_GT(count_tag(mesh, EdgeTag::coast), 10u);
     expect_verified(mesh, "atl.nc", "0.9");
@@ -590,23 +568,23 @@ TEST(Mesher, regional_box_has_open_boundary_edges) {
 
 // A region of open sea 20 degrees square (about 1,100 by 2,200 km): at --hmax 2000 km its
 // outline still makes a mesh; at 3000 km, wider than the region, the outline keeps 3 nodes and
-// the error names --hmax.
+// the error names hmax_km.
 TEST(Mesher, a_size_wider_than_the_region_is_refused_naming_hmax) {
     MeshOptions o = land_110m(2000);
     o.region = std::array<double, 4>{170, -60, -170, -40};
-    const Mesh mesh = mesh_ocean(o);
+    const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GE(mesh.faces.size(), 2u);
     expect_verified(mesh, "wide_region.nc", "0"); // (the region is about one edge across)
     o.hmax_km = 3000;
     const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); }, "a 3000 km size in a 2000 km region");
-    EXPECT_TRUE(test::regex_match(m, R"(no ocean to mesh: at --hmax 3000 km .* [0-3] boundary nodes; lower --hmax)")) << m;
+    EXPECT_TRUE(test::regex_match(m, R"(no ocean to mesh: at hmax_km 3000 km .* [0-3] boundary nodes; lower hmax_km)")) << m;
 }
 
 TEST(Mesher, same_input_gives_the_same_bytes) {
     test::TempDir dir;
     MeshOptions o = land_110m(300);
-    write_ugrid(mesh_ocean(o), dir / "a.nc");
-    write_ugrid(mesh_ocean(o), dir / "b.nc");
+    write_ugrid(mesh_ocean(o).mesh, dir / "a.nc");
+    write_ugrid(mesh_ocean(o).mesh, dir / "b.nc");
     EXPECT_EQ(slurp(dir / "a.nc"), slurp(dir / "b.nc"));
 }
 
@@ -617,13 +595,13 @@ TEST(Mesher, same_input_gives_the_same_bytes) {
 TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
     MeshOptions o = land_110m(400);
     o.coast_size_km = 25;
-    const std::size_t nodes = mesh_ocean(o).nodes.size();
+    const std::size_t nodes = mesh_ocean(o).mesh.nodes.size();
     o.max_nodes = nodes * 3 / 2;
-    EXPECT_EQ(mesh_ocean(o).nodes.size(), nodes);
+    EXPECT_EQ(mesh_ocean(o).mesh.nodes.size(), nodes);
     o.max_nodes = nodes / 2;
     std::string m = test::thrown_message<DataError>(
         [&] { mesh_ocean(o); }, "a run of " + std::to_string(nodes) + " nodes under --max-nodes " + std::to_string(o.max_nodes));
-    EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
+    EXPECT_NE(m.find("max_nodes"), std::string::npos) << m;
     // The pipeline's first count of the coast's band (before the size field): a straight coast's
     // band, so no fewer than the mesher makes (bays share their bands), and under twice that,
     // which its check relies on (it refuses at twice --max-nodes).
@@ -631,7 +609,7 @@ TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
     m = test::thrown_message<DataError>([&] { mesh_ocean(o); },
                                         "a run of " + std::to_string(nodes) + " nodes under --max-nodes 3000");
     std::vector<std::string> g;
-    ASSERT_TRUE(test::regex_search(m, R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at --coast-size 25 km)", &g))
+    ASSERT_TRUE(test::regex_search(m, R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at coast_size_km 25 km)", &g))
         << m;
     const double estimate = std::stod(g[1]);
     EXPECT_GE(estimate, double(nodes));
@@ -652,7 +630,7 @@ TEST(Mesher, a_coast_size_of_metres_is_refused_before_the_size_field) {
             });
         },
         "a 10 m coast size on the 1:110m land (under --max-nodes 2e7)");
-    EXPECT_TRUE(test::regex_search(m, R"(at --coast-size 0\.01 km \(0\.1 km: sizes stop at --hmin.*raise --coast-size and --hmin or --max-nodes$)"))
+    EXPECT_TRUE(test::regex_search(m, R"(at coast_size_km 0\.01 km \(0\.1 km: sizes stop at hmin_km.*raise coast_size_km and hmin_km or max_nodes$)"))
         << m;
     EXPECT_EQ(std::count(stages.begin(), stages.end(), "size field"), 0) << "reached the size field";
 }
@@ -661,7 +639,7 @@ TEST(Mesher, too_many_nodes_are_refused_before_refining) {
     MeshOptions o = land_110m(5);
     o.max_nodes = 100000;
     const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); });
-    EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
+    EXPECT_NE(m.find("max_nodes"), std::string::npos) << m;
 }
 
 TEST(Mesher, without_the_source_land_every_ring_node_stays_in_place_and_sharp_corners_match_the_faces) {
@@ -844,7 +822,7 @@ TEST(Mesher, inlet_width_out_of_range_is_a_usage_error_naming_it) {
     for (double w : {-0.1, 2.5, std::nan("")}) {
         MeshOptions o = land_110m(300);
         o.inlet_width = w;
-        const std::string m = test::thrown_message<UsageError>([&] { mesh_ocean(o); }, "--inlet-width " + std::to_string(w));
-        EXPECT_NE(m.find("--inlet-width"), std::string::npos) << m;
+        const std::string m = test::thrown_message<UsageError>([&] { mesh_ocean(o); }, "inlet_width " + std::to_string(w));
+        EXPECT_EQ(m.rfind("inlet_width must be in 0..2", 0), 0u) << m;
     }
 }

@@ -104,14 +104,33 @@ double worst_edge_gradient_ratio(const SizeField& f, double grade) {
 TEST(SizeField, hmax_alone_gives_a_uniform_field) {
     MeshOptions o;
     o.hmax_km = 80;
-    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 16);
-    EXPECT_TRUE(f.grid().global());
+    bool grid_asked = false;
+    SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 16, [&] { grid_asked = true; });
+    // No component is on: the field is uniform without a grid, and said so.
+    EXPECT_TRUE(f.is_uniform());
+    EXPECT_FALSE(grid_asked);
+    EXPECT_EQ(f.size_km(normalized({1, 2, 3})), 80); // exactly, not interpolated
+    EXPECT_EQ(f.function()(normalized({-3, 1, 2})), 80);
     EXPECT_EQ(f.min_km(), 80);
     EXPECT_EQ(f.max_km(), 80);
     std::mt19937 rng(3);
     std::normal_distribution<double> n;
     for (int k = 0; k < 100; ++k) EXPECT_NEAR(f.size_km(normalized({n(rng), n(rng), n(rng)})), 80, 1e-12);
     EXPECT_NEAR(f.size_km(lonlat_to_vec(0, 90)), 80, 1e-12);
+}
+
+// A component that is on makes a grid even where it lowers no size (a coast size with an
+// empty boundary): whether the field is uniform follows from the components, not their effect.
+TEST(SizeField, a_component_on_makes_a_grid) {
+    MeshOptions o;
+    o.hmax_km = 80;
+    o.coast_size_km = 10;
+    const Boundary none;
+    int grids = 0;
+    const SizeField f = build_size_field(o, nullptr, &none, {}, 1 << 12, [&] { ++grids; });
+    EXPECT_FALSE(f.is_uniform());
+    EXPECT_EQ(grids, 1);
+    EXPECT_EQ(f.max_km(), 80);
 }
 
 TEST(SizeField, wavelength_component_matches_its_formula_and_depth_floor) {
@@ -347,7 +366,7 @@ TEST(SizeField, size_regions_layer_reads_that_layer_alone) {
     // A layer that is not there is named with the layers there are; one without size_km is refused.
     o.size_regions_layer = "coarse";
     std::string m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
-    EXPECT_NE(m.find("no layer named 'coarse' (--size-regions-layer); layers: fine, medium, unsized"),
+    EXPECT_NE(m.find("no layer named 'coarse' (size_regions_layer); layers: fine, medium, unsized"),
               std::string::npos) << m;
     o.size_regions_layer = "unsized";
     m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
@@ -487,7 +506,7 @@ TEST(SizeField, gradation_holds_along_the_edges_of_a_real_mesh) {
     o.wavelength = 40;
     o.slope = 20;
     o.grade = 0.15;
-    Mesh mesh = mesh_ocean(o);
+    Mesh mesh = mesh_ocean(o).mesh;
     const Field* size = mesh.node_field("target_size");
     ASSERT_NE(size, nullptr);
     ASSERT_GT(mesh.faces.size(), 1000u);
@@ -523,26 +542,27 @@ TEST(SizeField, analytic_fields_match_their_definitions) {
 }
 
 TEST(SizeField, bad_options_give_one_line_errors_naming_the_option) {
+    // The library names MeshOptions' fields (a library user never saw the command line's flags).
     auto message = [](const MeshOptions& o, const Raster* bathy) {
         return test::thrown_message<UsageError>([&] { build_size_field(o, bathy, nullptr, {}, 1 << 12); });
     };
     MeshOptions o;
     o.hmin_km = 200;
     o.hmax_km = 100;
-    EXPECT_NE(message(o, nullptr).find("--hmin"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr), "hmin_km (200km) must not be larger than hmax_km (100km)");
     o = MeshOptions{};
     o.hmax_km = 0;
-    EXPECT_NE(message(o, nullptr).find("--hmax"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr).rfind("hmax_km must be a positive length", 0), 0u);
     o = MeshOptions{};
     o.hmax_km = -3;
-    EXPECT_NE(message(o, nullptr).find("--hmax"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr).rfind("hmax_km must be a positive length", 0), 0u);
     o = MeshOptions{};
     o.wavelength = 40;
-    EXPECT_NE(message(o, nullptr).find("--wavelength"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr), "wavelength needs a bathymetry raster: give bathy");
     o = MeshOptions{};
     o.coast_size_km = 5;
-    EXPECT_NE(message(o, nullptr).find("--coast"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr), "coast_size_km needs the coastline: give coast");
     o = MeshOptions{};
     o.coast_size_km = -5;
-    EXPECT_NE(message(o, nullptr).find("--coast-size"), std::string::npos);
+    EXPECT_EQ(message(o, nullptr).rfind("coast_size_km must be", 0), 0u);
 }

@@ -22,6 +22,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
+#include "write_hooks.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
 
@@ -576,12 +577,12 @@ TEST(Ugrid, run_cancelled_during_writing_leaves_no_partial_or_temporary_file) {
     TempDir dir;
     UgridOptions o;
     bool hook_ran = false;
-    o.after_partial_write = [&] {
+    const detail::PartialWriteHook hook([&] {
         hook_ran = true;
         EXPECT_EQ(folder_listing(dir.path()).size(), 1u); // the temporary file, being written
         EXPECT_FALSE(fs::exists(dir / "out.nc"));
         throw Cancelled();
-    };
+    });
     EXPECT_THROW(write_ugrid(icosphere(2), dir / "out.nc", o), Cancelled);
     EXPECT_TRUE(hook_ran);
     EXPECT_TRUE(folder_listing(dir.path()).empty());

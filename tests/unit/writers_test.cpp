@@ -18,6 +18,7 @@
 #include "globemesh/writers.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
+#include "write_hooks.hpp"
 
 namespace fs = std::filesystem;
 using globemesh::test::icosphere;
@@ -162,13 +163,14 @@ TEST(Writers, write_outputs_writes_every_output_with_its_creation_options) {
 TEST(Writers, a_failure_of_the_last_output_leaves_none_of_them) {
     TempDir dir;
     const auto requests = outputs(dir.path(), {"m.nc", "m.gpkg", "m.png"});
-    globemesh::WriteOptions common;
     int partial = 0;
-    common.after_partial_write = [&] {
-        if (++partial == 3)
-            throw globemesh::IoError("the disk is full");
-    };
-    EXPECT_THROW(globemesh::write_outputs(icosphere(2), requests, common), globemesh::IoError);
+    {
+        globemesh::detail::PartialWriteHook hook([&] {
+            if (++partial == 3)
+                throw globemesh::IoError("the disk is full");
+        });
+        EXPECT_THROW(globemesh::write_outputs(icosphere(2), requests, {}), globemesh::IoError);
+    }
     EXPECT_EQ(partial, 3);
     EXPECT_TRUE(files_in(dir.path()).empty());
     // Cancelled between two outputs: nothing either.

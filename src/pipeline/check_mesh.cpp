@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "globemesh/cli.hpp"
+#include "globemesh/mesh_stats.hpp"
 
 namespace globemesh {
 
