@@ -1,6 +1,7 @@
 // Test support shared by every test file: fixture paths, a private temporary directory, and the
-// independent checker ../shared/tools/mesh-verify (run when ../shared is present, as in CI;
-// otherwise the test says clearly that it skipped the check).
+// independent checker ../shared/tools/mesh-verify. Where an outside tool a test needs is absent,
+// the test is marked SKIPPED (ctest lists it), and under CI=true, where every tool must be
+// there, it fails instead (tool_missing).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -75,11 +76,32 @@ std::vector<std::string> regex_all(const std::string& text, const std::string& p
 /// `text` with every match of `pattern` replaced by `with` (std::regex_replace's format).
 std::string regex_replace(const std::string& text, const std::string& pattern, const std::string& with);
 
+/// True under CI=true (as CI services set it), where every outside tool the tests use must be
+/// installed: a missing one is a failure there, not a skip.
+inline bool in_ci() {
+    const char* ci = std::getenv("CI");
+    return ci && std::string(ci) == "true";
+}
+
+/// `tool` (what is missing, and what the test therefore did not check) is absent: under CI a
+/// test failure; elsewhere the running test is marked SKIPPED (from a helper too: its other
+/// assertions still count, and a failure among them still fails it).
+inline void tool_missing(const std::string& tool) {
+    if (in_ci()) {
+        ADD_FAILURE() << tool << " is missing, and CI=true requires it";
+        return;
+    }
+    GTEST_SKIP() << tool << " is missing";
+}
+
+/// The checker: GLOBEMESH_MESH_VERIFY when set (the tests of the skip point it at a missing
+/// file), else ../shared/tools/mesh-verify beside the clone.
 inline std::filesystem::path mesh_verify_path() {
+    if (const char* path = std::getenv("GLOBEMESH_MESH_VERIFY")) return path;
     return std::filesystem::path(GLOBEMESH_SHARED_DIR) / "tools" / "mesh-verify";
 }
 
-/// True when the independent checker can run here (../shared beside the clone, python modules).
+/// True when the independent checker can run here (the script, and its python modules).
 inline bool mesh_verify_available() {
     static int available = -1;
     if (available < 0) {
@@ -90,18 +112,29 @@ inline bool mesh_verify_available() {
     return available == 1;
 }
 
+/// Marks the test skipped (a failure under CI) when the checker cannot run; true when it can.
+inline bool need_mesh_verify() {
+    if (mesh_verify_available()) return true;
+    tool_missing("mesh-verify (" + mesh_verify_path().string() + ", or python3-numpy/scipy/netcdf4)");
+    return false;
+}
+
 /// Runs mesh-verify on `mesh` with extra arguments; a failed check fails the test with its
-/// report. Where the checker is absent, records a clear skip message (the test goes on).
+/// report. Where the checker is absent the test is marked SKIPPED (need_mesh_verify).
 inline void expect_mesh_verify(const std::filesystem::path& mesh, const std::string& args = "") {
-    if (!mesh_verify_available()) {
-        std::cout << "[  NOTE    ] mesh-verify SKIPPED: " << mesh_verify_path()
-                  << " not found (or python3-numpy/scipy/netcdf4 missing); "
-                     "the mesh was not checked independently\n";
-        return;
-    }
+    if (!need_mesh_verify()) return;
     std::string out;
     int status = run_command(mesh_verify_path().string() + " " + mesh.string() + " --quiet " + args, out);
     EXPECT_EQ(status, 0) << "mesh-verify rejected " << mesh << ":\n" << out;
+}
+
+/// mesh-verify's JSON report on `mesh` (`--json -`, with extra arguments), into `json`; its exit
+/// status (0 valid, 1 a check failed), or -1 when the checker is absent (the test then skipped).
+inline int mesh_verify_json(const std::filesystem::path& mesh, const std::string& args, std::string& json) {
+    json.clear();
+    if (!need_mesh_verify()) return -1;
+    return run_command("{ " + mesh_verify_path().string() + " " + mesh.string() + " --json - " + args + " 2>/dev/null; }",
+                       json);
 }
 
 } // namespace globemesh::test

@@ -9,7 +9,9 @@
 #include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "globemesh/predicates.hpp"
@@ -77,16 +79,56 @@ inline double star_count_best(std::size_t n, const CountRule& rule) {
 }
 
 // The two eight-lane scorers below are built three times on x86-64, for AVX-512, AVX2 and the
-// baseline (SSE2, two lanes an instruction), and the loader picks the widest the processor has
-// (target_clones: an ifunc). None of the three enables FMA, so every lane does the same IEEE
-// operations in each: the same values, the same mesh on any machine. Measured on 1:50m land
-// (AVX-512 machine), improve at 64 km 0.190 -> 0.147 s, at 20 km 0.806 -> 0.736 s (medians of
-// alternated runs); the 64 and 20 km files identical.
+// baseline (SSE2, two lanes an instruction), and the widest the processor has runs
+// (star_scorer_in_use). None of the three enables FMA, so every lane does the same IEEE
+// operations in each: the same values, the same mesh on any machine (tests/unit/
+// star_search_test.cpp meshes with each build the processor runs and compares the bytes).
+// Measured on 1:50m land (AVX-512 machine), improve at 64 km 0.190 -> 0.147 s, at 20 km 0.806 ->
+// 0.736 s (medians of alternated runs); the 64 and 20 km files identical.
 #if defined(__x86_64__) && defined(__ELF__)
-#define GLOBEMESH_LANES_CLONED __attribute__((target_clones("avx512f", "avx2", "default")))
+#define GLOBEMESH_LANES_TARGET(isa) __attribute__((target(isa)))
 #else
-#define GLOBEMESH_LANES_CLONED
+#define GLOBEMESH_LANES_TARGET(isa)
 #endif
+
+/// The builds of the eight-lane scorers.
+enum class StarScorer { avx512f, avx2, baseline };
+
+/// Whether this processor can run build `s` (elsewhere than x86-64, only the baseline).
+inline bool star_scorer_supported(StarScorer s) {
+#if defined(__x86_64__) && defined(__ELF__)
+    if (s == StarScorer::avx512f) return __builtin_cpu_supports("avx512f");
+    if (s == StarScorer::avx2) return __builtin_cpu_supports("avx2");
+    return true;
+#else
+    return s == StarScorer::baseline;
+#endif
+}
+
+/// The build that runs: GLOBEMESH_STAR_SCORER's (avx512f, avx2 or default) when the processor
+/// runs it, else the widest it runs. Assignable through force_star_scorer.
+inline StarScorer& star_scorer_in_use() {
+    static StarScorer in_use = [] {
+        const char* forced = std::getenv("GLOBEMESH_STAR_SCORER");
+        const std::string name = forced ? forced : "";
+        const StarScorer named = name == "avx512f" ? StarScorer::avx512f
+                                 : name == "avx2"  ? StarScorer::avx2
+                                                   : StarScorer::baseline;
+        if ((name == "avx512f" || name == "avx2" || name == "default") && star_scorer_supported(named)) return named;
+        for (StarScorer s : {StarScorer::avx512f, StarScorer::avx2})
+            if (star_scorer_supported(s)) return s;
+        return StarScorer::baseline;
+    }();
+    return in_use;
+}
+
+/// Runs build `s` from now on (the tests compare the builds); false, and nothing changed, when
+/// the processor cannot run it.
+inline bool force_star_scorer(StarScorer s) {
+    if (!star_scorer_supported(s)) return false;
+    star_scorer_in_use() = s;
+    return true;
+}
 
 /// The eight points of one step of pattern_search, coordinate by coordinate: the searches score
 /// them together (star_count_accepts, star_worst_accepts), eight lanes the compiler vectorizes.
@@ -164,9 +206,9 @@ inline unsigned folds_exactly(const Points8& p, const std::vector<FarEdge>& far,
 /// and (with `left_of`: slide_node's land edges) orient(p[k], e) > 0 for each e there. Bit k set
 /// for each accepted. The eight scores are computed to the end, with the least of the bounds
 /// star_count_score stops at on the way: the same decisions as eight calls.
-GLOBEMESH_LANES_CLONED
-inline unsigned star_count_accepts(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule, double floor,
-                                   double& best, const std::vector<FarEdge>* left_of = nullptr) {
+[[gnu::always_inline]] inline unsigned star_count_lanes(const Points8& p, const std::vector<FarEdge>& far,
+                                                       const CountRule& rule, double floor, double& best,
+                                                       const std::vector<FarEdge>* left_of) {
     const double worst_goal = rule.worst_goal, count_quality = rule.count_quality, count_cap = rule.count_cap,
                  count_worst_weight = rule.worst_weight;
     double score[8], worst[8], least[8], q[8];
@@ -206,8 +248,8 @@ inline unsigned star_count_accepts(const Points8& p, const std::vector<FarEdge>&
 }
 
 /// The same for the search rounds: star_worst_quality(p[k], far, best + 1e-9) above best + 1e-9.
-GLOBEMESH_LANES_CLONED
-inline unsigned star_worst_accepts(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+[[gnu::always_inline]] inline unsigned star_worst_lanes(const Points8& p, const std::vector<FarEdge>& far,
+                                                       double& best) {
     double worst[8], q[8];
     for (double& w : worst) w = 1;
     unsigned out = 0, undecided = 0;
@@ -226,6 +268,50 @@ inline unsigned star_worst_accepts(const Points8& p, const std::vector<FarEdge>&
         accepted |= 1u << k;
     }
     return accepted;
+}
+
+// The builds of star_count_lanes and star_worst_lanes, and the calls that run the one in use.
+GLOBEMESH_LANES_TARGET("avx512f")
+inline unsigned star_count_avx512f(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule,
+                                   double floor, double& best, const std::vector<FarEdge>* left_of) {
+    return star_count_lanes(p, far, rule, floor, best, left_of);
+}
+GLOBEMESH_LANES_TARGET("avx2")
+inline unsigned star_count_avx2(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule, double floor,
+                                double& best, const std::vector<FarEdge>* left_of) {
+    return star_count_lanes(p, far, rule, floor, best, left_of);
+}
+inline unsigned star_count_baseline(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule,
+                                    double floor, double& best, const std::vector<FarEdge>* left_of) {
+    return star_count_lanes(p, far, rule, floor, best, left_of);
+}
+GLOBEMESH_LANES_TARGET("avx512f")
+inline unsigned star_worst_avx512f(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+    return star_worst_lanes(p, far, best);
+}
+GLOBEMESH_LANES_TARGET("avx2")
+inline unsigned star_worst_avx2(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+    return star_worst_lanes(p, far, best);
+}
+inline unsigned star_worst_baseline(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+    return star_worst_lanes(p, far, best);
+}
+
+inline unsigned star_count_accepts(const Points8& p, const std::vector<FarEdge>& far, const CountRule& rule, double floor,
+                                   double& best, const std::vector<FarEdge>* left_of = nullptr) {
+    switch (star_scorer_in_use()) {
+    case StarScorer::avx512f: return star_count_avx512f(p, far, rule, floor, best, left_of);
+    case StarScorer::avx2: return star_count_avx2(p, far, rule, floor, best, left_of);
+    default: return star_count_baseline(p, far, rule, floor, best, left_of);
+    }
+}
+
+inline unsigned star_worst_accepts(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+    switch (star_scorer_in_use()) {
+    case StarScorer::avx512f: return star_worst_avx512f(p, far, best);
+    case StarScorer::avx2: return star_worst_avx2(p, far, best);
+    default: return star_worst_baseline(p, far, best);
+    }
 }
 
 /// A pattern search on the sphere from `to`: the eight directions at `step` around it, moving

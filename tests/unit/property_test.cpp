@@ -774,7 +774,7 @@ TEST(CoastProperty, polygon_drawn_beyond_minus_180_loads_as_one_valid_ring) {
 // sliver 19 degrees long and 0.3 degree wide at lat -61 touching lon 180. mesh_boundary at a
 // uniform 400 km returns a clockwise face with the mesher at 9bc775c, and did not return at all
 // (refinement going round consider_star) with the lead's work in progress at the time
-// (src/mesher/mesher.cpp, owned by the lead). Disabled until the mesher is fixed.
+// (src/mesher/mesher.cpp). Fixed there; kept so that it stays fixed.
 TEST(MesherProperty, sliver_ring_at_lat_minus_61_meshes_in_bounded_time) {
     Ring ring;
     ring.nodes = {{-0x1.edb694b4fe40bp-2, 0x0p+0, -0x1.c08f4971e5fb1p-1},
@@ -798,7 +798,7 @@ TEST(MesherProperty, sliver_ring_at_lat_minus_61_meshes_in_bounded_time) {
 // across -180 (9 nodes, one on the seam), meshed at a uniform 800 km with keep_inland_seas.
 // mesh_boundary at 9bc775c returns one clockwise face near lon -170, lat 5 (area -0.0013 sr);
 // the same ring rotated 7 degrees about the polar axis makes refinement run away (2.1 GB in 47 s,
-// then std::bad_alloc). src/mesher is the lead's: disabled until fixed there.
+// then std::bad_alloc). Both fixed in src/mesher; kept so that they stay fixed.
 namespace {
 Boundary nine_node_island(double rotate_deg) {
     Ring ring;
@@ -981,8 +981,8 @@ TEST(DelaunayProperty, points_near_the_south_pole_merge_only_into_near_vertices)
 // seed 32: a polar cap closed through the north pole at lat 76-77, and a polygon at lat -70
 // whose hole has a vertex at lon -180.00000000000014, keep_inland_seas, h = 1576 km. The coast
 // stages pass (check_boundary is empty) but mesh_boundary at 9bc775c never returns, and its
-// refinement loop reports no progress, so it cannot be cancelled (src/mesher, the lead's).
-// Disabled until fixed there; run it with a timeout.
+// refinement loop reported no progress, so it could not be cancelled. Fixed in src/mesher; kept
+// so that it stays fixed (a return of the hang shows as this test's ctest timeout).
 TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
     CoastCase c = coast_case(32);
     MemFile file("seed32.geojson", c.json);
@@ -1025,8 +1025,8 @@ TEST(MesherProperty, a_node_split_at_a_closed_strait_keeps_its_fan_counter_clock
 // (60.98, -8.86) -> (-138.54, -90) -> (-88.66, 77.53), a land triangle larger than a hemisphere,
 // at a uniform 400 km. The ocean triangles' areas add up to a negative node estimate (-431),
 // which src/mesher/mesher.cpp (line 251 at 9bc775c) casts to std::size_t: undefined behaviour,
-// and without UBSan "the size field asks for about 18446744073709551615 nodes". The lead's;
-// disabled until fixed there.
+// and without UBSan "the size field asks for about 18446744073709551615 nodes". Fixed in
+// src/mesher; kept so that it stays fixed.
 TEST(MesherProperty, land_triangle_larger_than_a_hemisphere_meshes_or_is_refused_clearly) {
     MemFile file("big_triangle.geojson",
                  feature_collection({"{\"type\":\"LineString\",\"coordinates\":[[60.983829486990587,-8.8619760051369667],"

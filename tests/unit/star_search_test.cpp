@@ -2,19 +2,52 @@
 // it replaces: for each step of a pattern search, the same points accepted and the same best as
 // eight calls of star_count_score / star_worst_quality considered in turn, on random stars
 // (folds, floors and early stops among them) and on the cases the lanes hand to exact
-// arithmetic (points on an edge's great circle, coordinates exactly 0).
+// arithmetic (points on an edge's great circle, coordinates exactly 0). Each test runs with each
+// build of the lanes the processor can run (AVX-512, AVX2, baseline), and the mesher gives the
+// same bytes with each.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <random>
 #include <vector>
 
 #include "star_search.hpp"
+#include "support.hpp"
 
 namespace globemesh::detail {
 namespace {
 
 constexpr CountRule rule{0.6, 0.8, 0.82, 1000};
+
+constexpr StarScorer builds[] = {StarScorer::avx512f, StarScorer::avx2, StarScorer::baseline};
+
+std::string build_name(StarScorer s) {
+    return s == StarScorer::avx512f ? "avx512f" : s == StarScorer::avx2 ? "avx2" : "baseline";
+}
+
+/// Runs the lanes' build `s` while it lives, then the host's pick again.
+class ForcedBuild {
+public:
+    explicit ForcedBuild(StarScorer s) : ran_(force_star_scorer(s)) {}
+    ~ForcedBuild() { star_scorer_in_use() = host_; }
+    ForcedBuild(const ForcedBuild&) = delete;
+    ForcedBuild& operator=(const ForcedBuild&) = delete;
+    bool ran() const { return ran_; }
+
+private:
+    StarScorer host_ = star_scorer_in_use();
+    bool ran_;
+};
+
+/// The tests of the lanes, once per build; a build this processor cannot run is skipped.
+class StarSearch : public ::testing::TestWithParam<StarScorer> {
+protected:
+    void SetUp() override {
+        if (!forced_.ran()) GTEST_SKIP() << "this processor cannot run the " << build_name(GetParam()) << " build";
+    }
+    ForcedBuild forced_{GetParam()};
+};
 
 /// What the quality rounds accepted before the lanes: star_count_score of each point in turn,
 /// against best + 1e-12, after the `left_of` orientations.
@@ -75,7 +108,7 @@ Points8 step_points(const Vec3& to, double step) {
     return points;
 }
 
-TEST(StarSearch, eight_lanes_accept_what_eight_calls_in_turn_accepted) {
+TEST_P(StarSearch, eight_lanes_accept_what_eight_calls_in_turn_accepted) {
     std::mt19937_64 rng(20261203);
     std::uniform_real_distribution<double> u(-1, 1);
     std::size_t trials = 0, accepted_any = 0, rejected_some = 0, with_floor = 0;
@@ -114,7 +147,7 @@ TEST(StarSearch, eight_lanes_accept_what_eight_calls_in_turn_accepted) {
     EXPECT_GT(with_floor, 100u);
 }
 
-TEST(StarSearch, points_on_an_edge_circle_and_zero_coordinates_are_decided_exactly) {
+TEST_P(StarSearch, points_on_an_edge_circle_and_zero_coordinates_are_decided_exactly) {
     // A star around the north pole's neighbourhood on the equator's plane: b and c on the
     // equator (z exactly 0, so the filter's range excludes the edge), candidates on it (orient
     // exactly 0: a fold) and just off it either way.
@@ -141,7 +174,7 @@ TEST(StarSearch, points_on_an_edge_circle_and_zero_coordinates_are_decided_exact
     EXPECT_EQ(worst_lanes, worst_one);
 }
 
-TEST(StarSearch, points_the_filter_cannot_decide_are_decided_exactly) {
+TEST_P(StarSearch, points_the_filter_cannot_decide_are_decided_exactly) {
     // The same star turned so that no coordinate is 0 (the lanes' filter applies), with
     // candidates on the great circle of b -> c up to rounding: the filter leaves them to exact
     // arithmetic, which folds some of them.
@@ -172,6 +205,45 @@ TEST(StarSearch, points_the_filter_cannot_decide_are_decided_exactly) {
     double worst_one = -0.5, worst_lanes = -0.5;
     EXPECT_EQ(star_worst_accepts(p, far, worst_lanes), worst_accepts_one_by_one(p, far, worst_one));
     EXPECT_EQ(worst_lanes, worst_one);
+}
+
+INSTANTIATE_TEST_SUITE_P(Builds, StarSearch, ::testing::ValuesIn(builds),
+                         [](const ::testing::TestParamInfo<StarScorer>& info) { return build_name(info.param); });
+
+// The builds differ in vector width only (none uses FMA), so the improve stage must move every
+// node to the same double in each. The program itself (not this file's copies of the inline
+// scorers) meshes a graded 1:110m ocean with each build the processor runs
+// (GLOBEMESH_STAR_SCORER), and ncdump prints every variable (node coordinates, faces, their
+// quality and areas...) with 17 digits, which tell every double apart.
+TEST(StarSearchBuilds, every_build_the_processor_runs_gives_the_same_mesh) {
+    test::TempDir dir;
+    std::vector<std::string> ran;
+    std::string first;
+    for (StarScorer s : builds) {
+        if (!star_scorer_supported(s)) continue;
+        const std::string name = s == StarScorer::baseline ? "default" : build_name(s);
+        const auto nc = dir / (name + ".nc");
+        std::string out;
+        ASSERT_EQ(test::run_command("GLOBEMESH_STAR_SCORER=" + name + " " GLOBEMESH_EXE " mesh -q --coast " +
+                                        test::fixture("coast/ne_110m_land.gpkg").string() +
+                                        " --coast-layer land --hmin 150km --hmax 400km --bathy " +
+                                        test::fixture("bathy/etopo5_global_10min.nc").string() + " -o " + nc.string(),
+                                    out),
+                  0)
+            << out;
+        ASSERT_EQ(test::run_command("ncdump -p 17,17 " + nc.string() +
+                                        " | sed -n '/^data:/,$p'",
+                                    out),
+                  0)
+            << out;
+        ASSERT_GT(out.size(), 100000u) << out.substr(0, 500);
+        if (ran.empty()) first = out;
+        else EXPECT_TRUE(out == first) << name << " gives another mesh than " << ran.front();
+        ran.push_back(name);
+    }
+    // The baseline runs everywhere; on x86-64, AVX2 too on any processor of the last decade.
+    ASSERT_FALSE(ran.empty());
+    if (ran.size() < 2) GTEST_SKIP() << "only the " << ran.front() << " build runs here: nothing to compare";
 }
 
 } // namespace
