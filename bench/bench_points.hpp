@@ -16,7 +16,8 @@ inline std::vector<Vec3> uniform_points(std::size_t n, std::uint64_t seed = 1) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> z(-1, 1), lon(-180, 180);
     std::vector<Vec3> p(n);
-    for (auto& v : p) v = lonlat_to_vec(lon(rng), std::asin(z(rng)) * rad_to_deg);
+    for (auto &v : p)
+        v = lonlat_to_vec(lon(rng), std::asin(z(rng)) * rad_to_deg);
     return p;
 }
 
@@ -27,7 +28,8 @@ inline std::vector<Vec3> clustered_points(std::size_t n, std::uint64_t seed = 2)
     std::uniform_real_distribution<double> u(0, 1);
     while (p.size() < n) {
         double r = 0.5 * std::sqrt(u(rng)), az = 2 * pi * u(rng);
-        p.push_back(lonlat_to_vec(-30 + r * std::cos(az) / std::cos(45 * deg_to_rad), 45 + r * std::sin(az)));
+        p.push_back(lonlat_to_vec(-30 + r * std::cos(az) / std::cos(45 * deg_to_rad),
+                                  45 + r * std::sin(az)));
     }
     return p;
 }
@@ -56,13 +58,14 @@ inline std::vector<std::vector<Vec3>> coast_like_rings(std::size_t n, std::uint6
         std::vector<Vec3> ring;
         for (int i = 0; i < corners; ++i)
             for (std::size_t j = 0; j < per_arc; ++j)
-                ring.push_back(arc_interpolate(poly[i], poly[(i + 1) % corners], double(j) / double(per_arc)));
+                ring.push_back(
+                    arc_interpolate(poly[i], poly[(i + 1) % corners], double(j) / double(per_arc)));
         rings.push_back(std::move(ring));
     }
     return rings;
 }
 
-inline std::vector<Vec3> points_of_kind(const std::string& kind, std::size_t n) {
+inline std::vector<Vec3> points_of_kind(const std::string &kind, std::size_t n) {
     return kind == "clustered" ? clustered_points(n) : uniform_points(n);
 }
 

@@ -14,15 +14,16 @@
 #include "bench_points.hpp"
 #include "globemesh/delaunay.hpp"
 
-static long vm_kib(const char* key) {
+static long vm_kib(const char *key) {
     std::ifstream f("/proc/self/status");
     std::string line;
     while (std::getline(f, line))
-        if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
+        if (line.rfind(key, 0) == 0)
+            return std::atol(line.c_str() + std::string(key).size());
     return -1;
 }
 
-int main(int argc, char** argv) {
+int main(int argc, char **argv) {
     if (argc != 3) {
         std::fprintf(stderr, "usage: delaunay_memory N uniform|clustered\n");
         return 2;
@@ -43,7 +44,8 @@ int main(int argc, char** argv) {
     const double tri_s = std::chrono::duration<double>(t2 - t1).count();
     const bool check = n <= 200000;
     const bool valid = !check || dt.validate().empty();
-    std::printf("%s %zu points: %.3f s (sort %.3f + triangulate %.3f), %.1f ns/point, peak %.1f bytes/point "
+    std::printf("%s %zu points: %.3f s (sort %.3f + triangulate %.3f), %.1f ns/point, peak %.1f "
+                "bytes/point "
                 "(input points included), %zu triangles, %s\n",
                 kind.c_str(), n, sort_s + tri_s, sort_s, tri_s, 1e9 * (sort_s + tri_s) / double(n),
                 1024.0 * double(peak - base) / double(n), dt.triangle_count(),

@@ -5,14 +5,14 @@
 
 #include <filesystem>
 
+#include "../tests/unit/io_test_meshes.hpp"
 #include "globemesh/gpkg.hpp"
 #include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
-#include "../tests/unit/io_test_meshes.hpp"
 
 namespace {
 
-const globemesh::Mesh& big_mesh() {
+const globemesh::Mesh &big_mesh() {
     static const globemesh::Mesh mesh = [] {
         globemesh::Mesh m = globemesh::test::icosphere(8);
         globemesh::test::add_fields(m);
@@ -21,13 +21,12 @@ const globemesh::Mesh& big_mesh() {
     return mesh;
 }
 
-std::filesystem::path out_path(const char* name) {
+std::filesystem::path out_path(const char *name) {
     return std::filesystem::temp_directory_path() / (std::string("globemesh-bench-") + name);
 }
 
-template <class Write>
-void run(benchmark::State& state, const char* name, Write write) {
-    const auto& m = big_mesh();
+template <class Write> void run(benchmark::State &state, const char *name, Write write) {
+    const auto &m = big_mesh();
     auto path = out_path(name);
     for (auto _ : state) {
         std::filesystem::remove(path);
@@ -38,27 +37,28 @@ void run(benchmark::State& state, const char* name, Write write) {
     std::filesystem::remove(path);
 }
 
-void BM_write_ugrid_netcdf4(benchmark::State& s) {
-    run(s, "n4.nc", [](const auto& m, const auto& p) { globemesh::write_ugrid(m, p); });
+void BM_write_ugrid_netcdf4(benchmark::State &s) {
+    run(s, "n4.nc", [](const auto &m, const auto &p) { globemesh::write_ugrid(m, p); });
 }
-void BM_write_ugrid_classic(benchmark::State& s) {
-    run(s, "c.nc", [](const auto& m, const auto& p) {
+void BM_write_ugrid_classic(benchmark::State &s) {
+    run(s, "c.nc", [](const auto &m, const auto &p) {
         globemesh::UgridOptions o;
         o.classic = true;
         globemesh::write_ugrid(m, p, o);
     });
 }
-void BM_write_gpkg(benchmark::State& s) {
-    run(s, "m.gpkg", [](const auto& m, const auto& p) { globemesh::write_gpkg(m, p); });
+void BM_write_gpkg(benchmark::State &s) {
+    run(s, "m.gpkg", [](const auto &m, const auto &p) { globemesh::write_gpkg(m, p); });
 }
-void BM_write_preview_png(benchmark::State& s) {
-    run(s, "p.png", [](const auto& m, const auto& p) { globemesh::write_preview_png(m, p); });
+void BM_write_preview_png(benchmark::State &s) {
+    run(s, "p.png", [](const auto &m, const auto &p) { globemesh::write_preview_png(m, p); });
 }
-void BM_read_ugrid_and_stats(benchmark::State& s) {
+void BM_read_ugrid_and_stats(benchmark::State &s) {
     auto path = out_path("r.nc");
     std::filesystem::remove(path);
     globemesh::write_ugrid(big_mesh(), path);
-    for (auto _ : s) benchmark::DoNotOptimize(globemesh::compute_stats(globemesh::read_ugrid(path)));
+    for (auto _ : s)
+        benchmark::DoNotOptimize(globemesh::compute_stats(globemesh::read_ugrid(path)));
     std::filesystem::remove(path);
 }
 

@@ -16,9 +16,10 @@
 #include "globemesh/sizefield.hpp"
 #include "globemesh/ugrid.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char **argv) {
     if (argc != 5 && argc != 6) {
-        std::fprintf(stderr, "usage: mesher_fields COAST LAYER uniform:H|gulf-stream|latitude OUT.nc [LATTICE_KM]\n");
+        std::fprintf(stderr, "usage: mesher_fields COAST LAYER uniform:H|gulf-stream|latitude "
+                             "OUT.nc [LATTICE_KM]\n");
         return 2;
     }
     try {
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
         } else {
             throw std::runtime_error("unknown field " + field);
         }
-        if (argc == 6) mo.lattice_km = std::atof(argv[5]);
+        if (argc == 6)
+            mo.lattice_km = std::atof(argv[5]);
         globemesh::Boundary boundary;
         {
             globemesh::CoastData coast = globemesh::load_coast(o);
@@ -50,14 +52,19 @@ int main(int argc, char** argv) {
         globemesh::MesherReport report;
         globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, mo, &report);
         globemesh::write_ugrid(mesh, argv[4]);
-        std::printf("%s: %zu nodes (%zu from the lattice), %zu faces, %zu sharp corners touching %zu faces, "
-                    "%zu inlets closed (%.0f km2), %zu flips towards valence 6, %zu triangles of boundary corners mended, %zu faces moved off "
-                    "dropped islands (%zu left on them), %zu faces on land removed with %zu of water (%zu holes, %zu loops joined, %zu moved off, %zu left)\n",
-                    field.c_str(), mesh.nodes.size(), report.lattice_nodes, mesh.faces.size(), report.sharp_corners,
-                    report.sharp_corner_faces, report.inlets_closed, report.inlet_area_km2, report.valence_flips, report.corners_mended,
-                    report.island_centroids_moved, report.island_centroids_left, report.land_faces_removed, report.water_faces_removed, report.land_holes,
+        std::printf("%s: %zu nodes (%zu from the lattice), %zu faces, %zu sharp corners touching "
+                    "%zu faces, "
+                    "%zu inlets closed (%.0f km2), %zu flips towards valence 6, %zu triangles of "
+                    "boundary corners mended, %zu faces moved off "
+                    "dropped islands (%zu left on them), %zu faces on land removed with %zu of "
+                    "water (%zu holes, %zu loops joined, %zu moved off, %zu left)\n",
+                    field.c_str(), mesh.nodes.size(), report.lattice_nodes, mesh.faces.size(),
+                    report.sharp_corners, report.sharp_corner_faces, report.inlets_closed,
+                    report.inlet_area_km2, report.valence_flips, report.corners_mended,
+                    report.island_centroids_moved, report.island_centroids_left,
+                    report.land_faces_removed, report.water_faces_removed, report.land_holes,
                     report.land_loops_joined, report.land_faces_nudged, report.land_faces_left);
-    } catch (const std::exception& e) {
+    } catch (const std::exception &e) {
         std::fprintf(stderr, "mesher_fields: %s\n", e.what());
         return 1;
     }

@@ -11,9 +11,9 @@
 // Usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc] [LATTICE]
 // (LATTICE 0: no lattice, MesherOptions::lattice_km; by default HMAX_KM).
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -28,11 +28,12 @@
 
 namespace {
 
-long vm_kib(const char* key) {
+long vm_kib(const char *key) {
     std::ifstream f("/proc/self/status");
     std::string line;
     while (std::getline(f, line))
-        if (line.rfind(key, 0) == 0) return std::atol(line.c_str() + std::string(key).size());
+        if (line.rfind(key, 0) == 0)
+            return std::atol(line.c_str() + std::string(key).size());
     return -1;
 }
 
@@ -44,9 +45,10 @@ bool reset_peak() {
 
 } // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char **argv) {
     if (argc < 4) {
-        std::fprintf(stderr, "usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc] [LATTICE]\n");
+        std::fprintf(stderr,
+                     "usage: mesher_memory COAST LAYER HMAX_KM [REPEATS] [OUT.nc] [LATTICE]\n");
         return 2;
     }
     globemesh::MeshOptions o;
@@ -60,7 +62,7 @@ int main(int argc, char** argv) {
     mo.lattice_km = argc > 6 && std::atoi(argv[6]) == 0 ? 0.0 : o.hmax_km;
     // The process's peak in each step (kiB), the high-water mark reset as a step starts.
     std::vector<std::pair<std::string, long>> step_peaks;
-    auto step_done = [&](const std::string& step) {
+    auto step_done = [&](const std::string &step) {
         step_peaks.emplace_back(step, vm_kib("VmHWM:"));
         reset_peak();
     };
@@ -78,22 +80,26 @@ int main(int argc, char** argv) {
         const bool peak_ok = reset_peak();
         const long base = vm_kib("VmRSS:");
         globemesh::StageTimings timings;
-        if (r == repeats - 1) timings.after_stage = step_done;
+        if (r == repeats - 1)
+            timings.after_stage = step_done;
         globemesh::MesherReport report;
         const std::clock_t c0 = std::clock();
         auto t0 = std::chrono::steady_clock::now();
         globemesh::Mesh mesh = globemesh::mesh_boundary(boundary, size, mo, &report, {}, &timings);
-        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double s =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
         const long peak = vm_kib("VmHWM:");
         const double n = static_cast<double>(mesh.nodes.size());
-        std::printf("h %.0f km: %zu nodes, mesh %.3f s = %.2f us/node, CPU %.2f us/node (", o.hmax_km,
-                    mesh.nodes.size(), s, 1e6 * s / n, 1e6 * cpu / n);
-        for (const auto& [name, sec] : timings.stages) std::printf(" %s %.2f", name.c_str(), 1e6 * sec / n);
+        std::printf("h %.0f km: %zu nodes, mesh %.3f s = %.2f us/node, CPU %.2f us/node (",
+                    o.hmax_km, mesh.nodes.size(), s, 1e6 * s / n, 1e6 * cpu / n);
+        for (const auto &[name, sec] : timings.stages)
+            std::printf(" %s %.2f", name.c_str(), 1e6 * sec / n);
         std::printf(" ), peak %.0f B/node%s\n", peak_ok ? 1024.0 * double(peak - base) / n : -1.0,
                     peak_ok ? "" : " (clear_refs refused: not measured)");
         std::fflush(stdout);
-        if (r == repeats - 1) last = std::move(mesh);
+        if (r == repeats - 1)
+            last = std::move(mesh);
     }
     if (argc > 5 && argv[5][0] != '\0') {
         reset_peak();
@@ -104,7 +110,8 @@ int main(int argc, char** argv) {
     }
     const double n = static_cast<double>(last.nodes.size());
     std::printf("h %.0f km: process peak per step, B/node:", o.hmax_km);
-    for (const auto& [step, kib] : step_peaks) std::printf(" %s %.0f", step.c_str(), 1024.0 * double(kib) / n);
+    for (const auto &[step, kib] : step_peaks)
+        std::printf(" %s %.0f", step.c_str(), 1024.0 * double(kib) / n);
     std::printf("\n");
     return 0;
 }

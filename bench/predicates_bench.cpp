@@ -24,7 +24,7 @@ namespace {
 
 using Quad = std::array<Vec3, 4>;
 
-Vec3 random_unit(std::mt19937_64& rng) {
+Vec3 random_unit(std::mt19937_64 &rng) {
     std::normal_distribution<double> n;
     return normalized(Vec3{n(rng), n(rng), n(rng)});
 }
@@ -32,7 +32,8 @@ Vec3 random_unit(std::mt19937_64& rng) {
 std::vector<Quad> random_quads(std::size_t count) {
     std::mt19937_64 rng(1);
     std::vector<Quad> q(count);
-    for (Quad& x : q) x = {random_unit(rng), random_unit(rng), random_unit(rng), random_unit(rng)};
+    for (Quad &x : q)
+        x = {random_unit(rng), random_unit(rng), random_unit(rng), random_unit(rng)};
     return q;
 }
 
@@ -41,7 +42,7 @@ std::vector<Quad> local_quads(std::size_t count) {
     std::mt19937_64 rng(2);
     std::vector<Quad> q(count);
     const double h = 1e-3;
-    for (Quad& x : q) {
+    for (Quad &x : q) {
         const Vec3 a = random_unit(rng);
         const Vec3 u = random_unit(rng), v = random_unit(rng), w = random_unit(rng);
         x = {a, normalized(a + h * u), normalized(a + h * v), normalized(a + 2 * h * w)};
@@ -60,7 +61,8 @@ std::vector<Quad> cocircular_grid_quads(std::size_t count) {
                 const double s = 0.25 * step;
                 Quad x{lonlat_to_vec(lon, lat), lonlat_to_vec(lon + s, lat),
                        lonlat_to_vec(lon + s, lat + s), lonlat_to_vec(lon, lat + s)};
-                if (pr::detail::orient3d_exact(x[0], x[1], x[2], x[3]) == 0) q.push_back(x);
+                if (pr::detail::orient3d_exact(x[0], x[1], x[2], x[3]) == 0)
+                    q.push_back(x);
             }
     return q;
 }
@@ -81,7 +83,7 @@ std::vector<Quad> great_circle_quads(std::size_t count) {
     std::vector<Quad> q(count);
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> lon(-180, 180);
-    for (Quad& x : q)
+    for (Quad &x : q)
         x = {lonlat_to_vec(lon(rng), 0), lonlat_to_vec(lon(rng), 0), lonlat_to_vec(lon(rng), 0),
              lonlat_to_vec(lon(rng), 0)};
     return q;
@@ -89,50 +91,60 @@ std::vector<Quad> great_circle_quads(std::size_t count) {
 
 constexpr std::size_t n_quads = 4096; // a power of two: the loop wraps with a mask
 
-template <class Make> void run_in_circle(benchmark::State& state, Make make) {
+template <class Make> void run_in_circle(benchmark::State &state, Make make) {
     const std::vector<Quad> q = make(n_quads);
     std::size_t i = 0;
     for (auto _ : state) {
-        const Quad& x = q[i];
+        const Quad &x = q[i];
         benchmark::DoNotOptimize(pr::in_circle(x[0], x[1], x[2], x[3]));
         i = (i + 1) & (n_quads - 1);
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 
-void in_circle_random(benchmark::State& s) { run_in_circle(s, random_quads); }
-void in_circle_local(benchmark::State& s) { run_in_circle(s, local_quads); }
-void in_circle_grid_rounded(benchmark::State& s) { run_in_circle(s, grid_quads); }
-void in_circle_grid_cocircular(benchmark::State& s) { run_in_circle(s, cocircular_grid_quads); }
-void in_circle_great_circle(benchmark::State& s) { run_in_circle(s, great_circle_quads); }
+void in_circle_random(benchmark::State &s) {
+    run_in_circle(s, random_quads);
+}
+void in_circle_local(benchmark::State &s) {
+    run_in_circle(s, local_quads);
+}
+void in_circle_grid_rounded(benchmark::State &s) {
+    run_in_circle(s, grid_quads);
+}
+void in_circle_grid_cocircular(benchmark::State &s) {
+    run_in_circle(s, cocircular_grid_quads);
+}
+void in_circle_great_circle(benchmark::State &s) {
+    run_in_circle(s, great_circle_quads);
+}
 
-void orient_random(benchmark::State& state) {
+void orient_random(benchmark::State &state) {
     const std::vector<Quad> q = random_quads(n_quads);
     std::size_t i = 0;
     for (auto _ : state) {
-        const Quad& x = q[i];
+        const Quad &x = q[i];
         benchmark::DoNotOptimize(pr::orient(x[0], x[1], x[2]));
         i = (i + 1) & (n_quads - 1);
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 
-void orient_local(benchmark::State& state) {
+void orient_local(benchmark::State &state) {
     const std::vector<Quad> q = local_quads(n_quads);
     std::size_t i = 0;
     for (auto _ : state) {
-        const Quad& x = q[i];
+        const Quad &x = q[i];
         benchmark::DoNotOptimize(pr::orient(x[1], x[2], x[3]));
         i = (i + 1) & (n_quads - 1);
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 
-void orient_exact_great_circle(benchmark::State& state) {
+void orient_exact_great_circle(benchmark::State &state) {
     const std::vector<Quad> q = great_circle_quads(n_quads);
     std::size_t i = 0;
     for (auto _ : state) {
-        const Quad& x = q[i];
+        const Quad &x = q[i];
         benchmark::DoNotOptimize(pr::orient(x[0], x[1], x[2]));
         i = (i + 1) & (n_quads - 1);
     }

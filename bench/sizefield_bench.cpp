@@ -22,18 +22,20 @@ MeshOptions issue5_options() {
     return o;
 }
 
-const Raster& etopo5() {
+const Raster &etopo5() {
     static const Raster r = read_raster(GLOBEMESH_FIXTURES_DIR "/bathy/etopo5_global_10min.nc");
     return r;
 }
 
-void BM_read_etopo5_global(benchmark::State& state) {
-    for (auto _ : state) benchmark::DoNotOptimize(read_raster(GLOBEMESH_FIXTURES_DIR "/bathy/etopo5_global_10min.nc"));
+void BM_read_etopo5_global(benchmark::State &state) {
+    for (auto _ : state)
+        benchmark::DoNotOptimize(
+            read_raster(GLOBEMESH_FIXTURES_DIR "/bathy/etopo5_global_10min.nc"));
 }
 BENCHMARK(BM_read_etopo5_global)->Unit(benchmark::kMillisecond);
 
-void BM_build_global_size_field(benchmark::State& state) {
-    const Raster& r = etopo5();
+void BM_build_global_size_field(benchmark::State &state) {
+    const Raster &r = etopo5();
     for (auto _ : state) {
         SizeField f = build_size_field(issue5_options(), &r, nullptr);
         state.counters["grid_nodes"] = static_cast<double>(f.grid().values().size());
@@ -42,12 +44,13 @@ void BM_build_global_size_field(benchmark::State& state) {
 }
 BENCHMARK(BM_build_global_size_field)->Unit(benchmark::kMillisecond)->Iterations(1);
 
-void BM_size_km(benchmark::State& state) {
+void BM_size_km(benchmark::State &state) {
     static const SizeField f = build_size_field(issue5_options(), &etopo5(), nullptr);
     std::mt19937 rng(1);
     std::normal_distribution<double> n;
     std::vector<Vec3> points(1 << 16);
-    for (Vec3& p : points) p = normalized({n(rng), n(rng), n(rng)});
+    for (Vec3 &p : points)
+        p = normalized({n(rng), n(rng), n(rng)});
     std::size_t k = 0;
     for (auto _ : state) {
         benchmark::DoNotOptimize(f.size_km(points[k]));
@@ -56,12 +59,13 @@ void BM_size_km(benchmark::State& state) {
 }
 BENCHMARK(BM_size_km);
 
-void BM_elevation_m(benchmark::State& state) {
-    const Raster& r = etopo5();
+void BM_elevation_m(benchmark::State &state) {
+    const Raster &r = etopo5();
     std::mt19937 rng(2);
     std::normal_distribution<double> n;
     std::vector<Vec3> points(1 << 16);
-    for (Vec3& p : points) p = normalized({n(rng), n(rng), n(rng)});
+    for (Vec3 &p : points)
+        p = normalized({n(rng), n(rng), n(rng)});
     std::size_t k = 0;
     for (auto _ : state) {
         benchmark::DoNotOptimize(r.elevation_m(points[k]));

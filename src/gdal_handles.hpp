@@ -27,26 +27,27 @@ public:
         CPLErrorReset();
     }
     ~QuietErrors() { CPLPopErrorHandler(); }
-    QuietErrors(const QuietErrors&) = delete;
-    QuietErrors& operator=(const QuietErrors&) = delete;
+    QuietErrors(const QuietErrors &) = delete;
+    QuietErrors &operator=(const QuietErrors &) = delete;
 };
 
 /// GDAL's last error message, or `fallback` when there is none.
-inline std::string last_error(const char* fallback = "unknown GDAL error") {
-    const char* m = CPLGetLastErrorMsg();
+inline std::string last_error(const char *fallback = "unknown GDAL error") {
+    const char *m = CPLGetLastErrorMsg();
     return m && *m ? m : fallback;
 }
 
 /// Sets a GDAL configuration option for this thread and restores the old value on scope exit.
 class ScopedConfig {
 public:
-    ScopedConfig(const char* key, const char* value) : key_(key) {
-        if (const char* old = CPLGetThreadLocalConfigOption(key, nullptr)) old_ = old, had_ = true;
+    ScopedConfig(const char *key, const char *value) : key_(key) {
+        if (const char *old = CPLGetThreadLocalConfigOption(key, nullptr))
+            old_ = old, had_ = true;
         CPLSetThreadLocalConfigOption(key, value);
     }
     ~ScopedConfig() { CPLSetThreadLocalConfigOption(key_.c_str(), had_ ? old_.c_str() : nullptr); }
-    ScopedConfig(const ScopedConfig&) = delete;
-    ScopedConfig& operator=(const ScopedConfig&) = delete;
+    ScopedConfig(const ScopedConfig &) = delete;
+    ScopedConfig &operator=(const ScopedConfig &) = delete;
 
 private:
     std::string key_, old_;
@@ -54,12 +55,8 @@ private:
 };
 
 /// Calls `Free` on a non-null handle (std::unique_ptr never passes null to its deleter).
-template <auto Free>
-struct Deleter {
-    template <class T>
-    void operator()(T* h) const {
-        Free(h);
-    }
+template <auto Free> struct Deleter {
+    template <class T> void operator()(T *h) const { Free(h); }
 };
 
 template <class Handle, auto Free>
@@ -78,12 +75,12 @@ using TransformPtr = HandlePtr<OGRCoordinateTransformationH, OCTDestroyCoordinat
 /// &ProgressBridge::call and the bridge's address. When the callback asks to stop, GDAL's call
 /// fails and `cancelled` tells the caller to throw Cancelled rather than an error.
 struct ProgressBridge {
-    const Progress* progress;
+    const Progress *progress;
     double lo, hi;
     std::string_view stage;
     bool cancelled = false;
-    static int CPL_STDCALL call(double f, const char*, void* data) {
-        auto* b = static_cast<ProgressBridge*>(data);
+    static int CPL_STDCALL call(double f, const char *, void *data) {
+        auto *b = static_cast<ProgressBridge *>(data);
         if (*b->progress && !(*b->progress)(b->lo + (b->hi - b->lo) * f, b->stage)) {
             b->cancelled = true;
             return FALSE;

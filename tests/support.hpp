@@ -16,7 +16,7 @@
 
 namespace globemesh::test {
 
-inline std::filesystem::path fixture(const std::string& rel) {
+inline std::filesystem::path fixture(const std::string &rel) {
     return std::filesystem::path(GLOBEMESH_FIXTURES_DIR) / rel;
 }
 
@@ -26,17 +26,18 @@ public:
     TempDir() {
         auto base = std::filesystem::temp_directory_path();
         std::string tmpl = (base / "globemesh-test-XXXXXX").string();
-        if (!mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+        if (!mkdtemp(tmpl.data()))
+            throw std::runtime_error("mkdtemp failed");
         path_ = tmpl;
     }
     ~TempDir() {
         std::error_code ec;
         std::filesystem::remove_all(path_, ec);
     }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    const std::filesystem::path& path() const { return path_; }
-    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+    TempDir(const TempDir &) = delete;
+    TempDir &operator=(const TempDir &) = delete;
+    const std::filesystem::path &path() const { return path_; }
+    std::filesystem::path operator/(const std::string &name) const { return path_ / name; }
 
 private:
     std::filesystem::path path_;
@@ -45,10 +46,10 @@ private:
 /// What the exception E that `f` throws says; a test failure (`what` names the call) and "" when
 /// f returns instead. An exception of another type goes on to gtest, which reports it.
 template <class E, class F>
-std::string thrown_message(F&& f, const std::string& what = "the call") {
+std::string thrown_message(F &&f, const std::string &what = "the call") {
     try {
         f();
-    } catch (const E& e) {
+    } catch (const E &e) {
         return e.what();
     }
     ADD_FAILURE() << what << " threw nothing";
@@ -56,12 +57,14 @@ std::string thrown_message(F&& f, const std::string& what = "the call") {
 }
 
 /// Runs a shell command, returns its exit status and puts stdout+stderr in `output`.
-inline int run_command(const std::string& command, std::string& output) {
+inline int run_command(const std::string &command, std::string &output) {
     output.clear();
-    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) return -1;
+    FILE *pipe = popen((command + " 2>&1").c_str(), "r");
+    if (!pipe)
+        return -1;
     char buffer[4096];
-    while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+    while (std::fgets(buffer, sizeof buffer, pipe))
+        output += buffer;
     int status = pclose(pipe);
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -69,24 +72,28 @@ inline int run_command(const std::string& command, std::string& output) {
 /// ECMAScript regular expressions (support_regex.cpp, compiled once for every test). True when
 /// `pattern` matches part of `text` (regex_search) or all of it (regex_match); the groups of
 /// the match go into `groups`, the whole match first.
-bool regex_search(const std::string& text, const std::string& pattern, std::vector<std::string>* groups = nullptr);
-bool regex_match(const std::string& text, const std::string& pattern, std::vector<std::string>* groups = nullptr);
+bool regex_search(const std::string &text, const std::string &pattern,
+                  std::vector<std::string> *groups = nullptr);
+bool regex_match(const std::string &text, const std::string &pattern,
+                 std::vector<std::string> *groups = nullptr);
 /// Group `group` of every match of `pattern` in `text`, in order.
-std::vector<std::string> regex_all(const std::string& text, const std::string& pattern, int group = 0);
+std::vector<std::string> regex_all(const std::string &text, const std::string &pattern,
+                                   int group = 0);
 /// `text` with every match of `pattern` replaced by `with` (std::regex_replace's format).
-std::string regex_replace(const std::string& text, const std::string& pattern, const std::string& with);
+std::string regex_replace(const std::string &text, const std::string &pattern,
+                          const std::string &with);
 
 /// True under CI=true (as CI services set it), where every outside tool the tests use must be
 /// installed: a missing one is a failure there, not a skip.
 inline bool in_ci() {
-    const char* ci = std::getenv("CI");
+    const char *ci = std::getenv("CI");
     return ci && std::string(ci) == "true";
 }
 
 /// `tool` (what is missing, and what the test therefore did not check) is absent: under CI a
 /// test failure; elsewhere the running test is marked SKIPPED (from a helper too: its other
 /// assertions still count, and a failure among them still fails it).
-inline void tool_missing(const std::string& tool) {
+inline void tool_missing(const std::string &tool) {
     if (in_ci()) {
         ADD_FAILURE() << tool << " is missing, and CI=true requires it";
         return;
@@ -97,7 +104,8 @@ inline void tool_missing(const std::string& tool) {
 /// The checker: GLOBEMESH_MESH_VERIFY when set (the tests of the skip point it at a missing
 /// file), else ../shared/tools/mesh-verify beside the clone.
 inline std::filesystem::path mesh_verify_path() {
-    if (const char* path = std::getenv("GLOBEMESH_MESH_VERIFY")) return path;
+    if (const char *path = std::getenv("GLOBEMESH_MESH_VERIFY"))
+        return path;
     return std::filesystem::path(GLOBEMESH_SHARED_DIR) / "tools" / "mesh-verify";
 }
 
@@ -114,26 +122,33 @@ inline bool mesh_verify_available() {
 
 /// Marks the test skipped (a failure under CI) when the checker cannot run; true when it can.
 inline bool need_mesh_verify() {
-    if (mesh_verify_available()) return true;
-    tool_missing("mesh-verify (" + mesh_verify_path().string() + ", or python3-numpy/scipy/netcdf4)");
+    if (mesh_verify_available())
+        return true;
+    tool_missing("mesh-verify (" + mesh_verify_path().string() +
+                 ", or python3-numpy/scipy/netcdf4)");
     return false;
 }
 
 /// Runs mesh-verify on `mesh` with extra arguments; a failed check fails the test with its
 /// report. Where the checker is absent the test is marked SKIPPED (need_mesh_verify).
-inline void expect_mesh_verify(const std::filesystem::path& mesh, const std::string& args = "") {
-    if (!need_mesh_verify()) return;
+inline void expect_mesh_verify(const std::filesystem::path &mesh, const std::string &args = "") {
+    if (!need_mesh_verify())
+        return;
     std::string out;
-    int status = run_command(mesh_verify_path().string() + " " + mesh.string() + " --quiet " + args, out);
+    int status =
+        run_command(mesh_verify_path().string() + " " + mesh.string() + " --quiet " + args, out);
     EXPECT_EQ(status, 0) << "mesh-verify rejected " << mesh << ":\n" << out;
 }
 
 /// mesh-verify's JSON report on `mesh` (`--json -`, with extra arguments), into `json`; its exit
 /// status (0 valid, 1 a check failed), or -1 when the checker is absent (the test then skipped).
-inline int mesh_verify_json(const std::filesystem::path& mesh, const std::string& args, std::string& json) {
+inline int mesh_verify_json(const std::filesystem::path &mesh, const std::string &args,
+                            std::string &json) {
     json.clear();
-    if (!need_mesh_verify()) return -1;
-    return run_command("{ " + mesh_verify_path().string() + " " + mesh.string() + " --json - " + args + " 2>/dev/null; }",
+    if (!need_mesh_verify())
+        return -1;
+    return run_command("{ " + mesh_verify_path().string() + " " + mesh.string() + " --json - " +
+                           args + " 2>/dev/null; }",
                        json);
 }
 

@@ -9,35 +9,40 @@ namespace globemesh::test {
 namespace {
 
 // The groups of a match into `groups` when it was found.
-bool take(bool found, const std::smatch& m, std::vector<std::string>* groups) {
+bool take(bool found, const std::smatch &m, std::vector<std::string> *groups) {
     if (found && groups) {
         groups->clear();
-        for (const auto& g : m) groups->push_back(g.str());
+        for (const auto &g : m)
+            groups->push_back(g.str());
     }
     return found;
 }
 
 } // namespace
 
-bool regex_search(const std::string& text, const std::string& pattern, std::vector<std::string>* groups) {
+bool regex_search(const std::string &text, const std::string &pattern,
+                  std::vector<std::string> *groups) {
     std::smatch m;
     return take(std::regex_search(text, m, std::regex(pattern)), m, groups);
 }
 
-bool regex_match(const std::string& text, const std::string& pattern, std::vector<std::string>* groups) {
+bool regex_match(const std::string &text, const std::string &pattern,
+                 std::vector<std::string> *groups) {
     std::smatch m;
     return take(std::regex_match(text, m, std::regex(pattern)), m, groups);
 }
 
-std::vector<std::string> regex_all(const std::string& text, const std::string& pattern, int group) {
+std::vector<std::string> regex_all(const std::string &text, const std::string &pattern, int group) {
     std::vector<std::string> out;
     const std::regex re(pattern);
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator();
+         ++it)
         out.push_back((*it)[group].str());
     return out;
 }
 
-std::string regex_replace(const std::string& text, const std::string& pattern, const std::string& with) {
+std::string regex_replace(const std::string &text, const std::string &pattern,
+                          const std::string &with) {
     return std::regex_replace(text, std::regex(pattern), with);
 }
 

@@ -38,15 +38,16 @@
 // cells finer than the mesh can use. With region (or region_file, the extent of its ocean),
 // only the cells that cover the region (and a margin: 1% of its larger side and three cells) are
 // read: a regional run reads a small window of a global raster,
-// at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half the
-// smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and refuses
-// (DataError naming max_memory_bytes) when the values would take more than half of
+// at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half
+// the smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and
+// refuses (DataError naming max_memory_bytes) when the values would take more than half of
 // options.max_memory_bytes. GDAL's block cache (GDAL_CACHEMAX, 5% of RAM by default) comes on
 // top while reading.
 //
 // Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
-// exist or a bathy_srs that is no CRS; DataError for a raster without georeferencing, with no valid cell, or that does not
-// cover the region (unless bathy_fill_m gives a value for the uncovered part).
+// exist or a bathy_srs that is no CRS; DataError for a raster without georeferencing, with no valid
+// cell, or that does not cover the region (unless bathy_fill_m gives a value for the uncovered
+// part).
 #pragma once
 
 #include <cstddef>
@@ -90,7 +91,7 @@ public:
     double lat_deg(std::size_t j) const { return lat0_ + static_cast<double>(j) * dlat_; }
     /// Stored value of node (i, j) (NaN = no data).
     float value(std::size_t i, std::size_t j) const { return values_[j * nlon_ + i]; }
-    const std::vector<float>& values() const { return values_; }
+    const std::vector<float> &values() const { return values_; }
     /// True when the columns span 360 degrees: column nlon-1 neighbours column 0.
     bool global() const { return global_; }
     /// Edges of the cells (half a cell beyond the outermost centres), degrees.
@@ -103,9 +104,9 @@ public:
 
     /// Elevation at a point, metres positive up: sample(), or the fill where that is NaN.
     double elevation_m(double lon_deg, double lat_deg) const;
-    double elevation_m(const Vec3& p) const;
+    double elevation_m(const Vec3 &p) const;
     /// Depth at a point, metres positive down (-elevation_m).
-    double depth_m(const Vec3& p) const { return -elevation_m(p); }
+    double depth_m(const Vec3 &p) const { return -elevation_m(p); }
 
     /// Elevation (m, positive up) returned where the raster has no value; nullopt gives NaN.
     void set_fill_elevation_m(std::optional<double> fill) { fill_ = fill; }
@@ -130,7 +131,8 @@ struct RasterLimits {
     /// Cells finer than this (degrees, each axis apart) are averaged to about this size (never
     /// coarser: the cell count per axis is rounded up); 0: the raster's own resolution.
     double min_cell_deg = 0;
-    /// Refuse (DataError naming max_memory_bytes) when the values read would take more bytes; 0: no cap.
+    /// Refuse (DataError naming max_memory_bytes) when the values read would take more bytes; 0: no
+    /// cap.
     std::uint64_t max_bytes = 0;
     /// Read only the cells that cover this box (degrees; east > west, east may exceed 180), with
     /// a margin of three cells (of the raster's own size or min_cell_deg, the larger), instead of
@@ -143,38 +145,38 @@ struct RasterLimits {
 /// path: the raster; band: 1-based; depth_positive: the raster stores depth positive down;
 /// max_cells: decimate (GDAL average) rasters larger than this. Throws IoError, UsageError
 /// (band out of range, naming bathy_band) or DataError (no georeferencing, all nodata).
-Raster read_raster(const std::string& path, int band = 1, bool depth_positive = false,
-                   const Progress& progress = {}, std::size_t max_cells = std::size_t{1} << 28);
+Raster read_raster(const std::string &path, int band = 1, bool depth_positive = false,
+                   const Progress &progress = {}, std::size_t max_cells = std::size_t{1} << 28);
 
 /// read_raster within `limits`: decimated as they say, and a DataError naming the raster's size,
 /// the bytes needed and max_memory_bytes, before anything large is allocated, when it does not fit.
 /// srs: the raster's CRS (bathy_srs: any string OGRSpatialReference::SetFromUserInput takes)
 /// in place of the file's; empty: the file's, or lon/lat for CF lon/lat axes (file comment).
 /// Throws UsageError naming bathy_srs when srs is not a CRS.
-Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
-                   const RasterLimits& limits, const std::string& srs = {});
+Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
+                   const RasterLimits &limits, const std::string &srs = {});
 
 /// Throws UsageError (one line naming bathy_srs) when srs is neither empty nor a CRS that
 /// OGRSpatialReference::SetFromUserInput takes. Opens no file.
-void validate_bathy_srs(const std::string& srs);
+void validate_bathy_srs(const std::string &srs);
 
 /// The lon/lat box of the ocean left of `ocean`'s rings: longitudes the shortest arc of the
 /// circle that holds every segment (to 1/8 degree, outward), latitudes those of the nodes,
 /// reaching a pole that lies in the ocean (then every longitude). nullopt without rings (the
 /// whole sphere).
-std::optional<LonLatBounds> ocean_extent(const Boundary& ocean);
+std::optional<LonLatBounds> ocean_extent(const Boundary &ocean);
 
 /// in(north pole) - in(south pole) for the ocean left of the rings: 1 when the ocean holds the
 /// north pole but not the south one, -1 the reverse, 0 for neither (or both). Rings through a
 /// pole are left out (that pole is on the outline).
-int ocean_pole_winding(const Boundary& ocean);
+int ocean_pole_winding(const Boundary &ocean);
 
 /// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
 /// hmin_km, or max(hmax / 1000, 0.01 km) when it is 0), at most half of max_memory_bytes, and a
 /// window widened by 1% of its larger side (the size field's grid reaches a cell beyond the
 /// region): region's box, or with region_file the ocean_extent of `ocean` (the coast stage's
 /// rings) when given.
-RasterLimits bathymetry_limits(const MeshOptions& options, const Boundary* ocean = nullptr);
+RasterLimits bathymetry_limits(const MeshOptions &options, const Boundary *ocean = nullptr);
 
 /// Reads options.bathy (band options.bathy_band, options.depth_positive, options.bathy_srs), sets
 /// the fill to -options.bathy_fill_m when given, and checks the raster covers the region, within
@@ -184,6 +186,7 @@ RasterLimits bathymetry_limits(const MeshOptions& options, const Boundary* ocean
 /// land in the region needs no raster. Without: region's box, or the whole globe.
 /// Throws as read_raster, and DataError (naming a point not covered) when the raster covers
 /// only part of the region and no bathy_fill_m is set.
-Raster read_bathymetry(const MeshOptions& options, const Progress& progress = {}, const Boundary* ocean = nullptr);
+Raster read_bathymetry(const MeshOptions &options, const Progress &progress = {},
+                       const Boundary *ocean = nullptr);
 
 } // namespace globemesh

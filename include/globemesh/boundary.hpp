@@ -29,9 +29,9 @@ class LandTest {
 public:
     virtual ~LandTest() = default;
     /// True when p lies on land.
-    virtual bool contains(const Vec3& p) const = 0;
+    virtual bool contains(const Vec3 &p) const = 0;
     /// True when the coast comes within `angle` radians of p (on the sphere).
-    virtual bool coast_within(const Vec3& p, double angle) const = 0;
+    virtual bool coast_within(const Vec3 &p, double angle) const = 0;
 };
 
 struct Boundary {

@@ -31,47 +31,50 @@
 namespace globemesh {
 
 /// Runs `globemesh ARGS...` (args exclude the program name). Returns the exit status.
-int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err);
+int run_cli(std::span<const std::string> args, std::ostream &out, std::ostream &err);
 
 /// The library calls run_cli makes. run_cli(args, out, err) uses library_calls(), the real
 /// functions; tests pass their own to show that a bad command stops before any call is made,
 /// or to interrupt a run at a chosen point (a seam like GDAL's test hooks). Each member must be
 /// set.
 struct CliLibrary {
-    std::function<OceanMesh(const MeshOptions&, const Progress&, StageTimings*)> mesh_ocean;
-    std::function<Mesh(const TriangulateOptions&, const Progress&, StageTimings*)> triangulate_file;
+    std::function<OceanMesh(const MeshOptions &, const Progress &, StageTimings *)> mesh_ocean;
+    std::function<Mesh(const TriangulateOptions &, const Progress &, StageTimings *)>
+        triangulate_file;
     /// The output formats (writers.hpp): -o, -f, --gpkg and --preview choose among them, and
     /// their rows' write functions write the files.
     std::vector<Writer> writers;
-    std::function<Mesh(const std::filesystem::path&)> read_ugrid;
-    std::function<MeshStats(const Mesh&)> compute_stats;
+    std::function<Mesh(const std::filesystem::path &)> read_ugrid;
+    std::function<MeshStats(const Mesh &)> compute_stats;
 };
 
 /// The real library functions (pipeline.hpp, ugrid.hpp, writers.hpp).
 CliLibrary library_calls();
 
 /// run_cli with the given library calls.
-int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err,
-            const CliLibrary& library);
+int run_cli(std::span<const std::string> args, std::ostream &out, std::ostream &err,
+            const CliLibrary &library);
 
 /// Program-only choices of `globemesh mesh`, kept apart from the library's MeshOptions (GDAL's
 /// "OptionsForBinary" split). CLI11 binds the flags straight to these fields.
 struct CliOptions {
     MeshOptions mesh;
-    std::vector<std::string> output; ///< -o/--output: files to write, each in its extension's format (required)
-    std::string output_format;       ///< -f/--output-format: the writers table's name of -o's format
+    std::vector<std::string>
+        output; ///< -o/--output: files to write, each in its extension's format (required)
+    std::string output_format; ///< -f/--output-format: the writers table's name of -o's format
     std::vector<std::string> creation_options; ///< --co KEY=VALUE: creation options of the outputs
-    std::string gpkg;               ///< --gpkg: also write a GeoPackage
-    std::string preview;            ///< --preview: also draw a PNG picture of the mesh
-    std::string format = "netcdf4"; ///< --format: netcdf4 (deflate) or classic (netCDF-3), UGRID's FORMAT
-    std::string timings;            ///< --timings: JSON file of seconds per stage
-    std::string report;             ///< --report: JSON file of the run summary and histogram
-    bool overwrite = false;         ///< --overwrite: replace existing outputs
-    bool quiet = false;             ///< --quiet: no progress on stderr
-    bool verbose = false;           ///< --verbose: stage names with the progress
-    bool check = false;             ///< --check: verify the mesh invariants before writing
-    bool print_config = false;      ///< --print-config: print the effective configuration, stop
-    std::string config;             ///< --config: the file read (kept to refuse it as an output)
+    std::string gpkg;                          ///< --gpkg: also write a GeoPackage
+    std::string preview;                       ///< --preview: also draw a PNG picture of the mesh
+    std::string format =
+        "netcdf4";          ///< --format: netcdf4 (deflate) or classic (netCDF-3), UGRID's FORMAT
+    std::string timings;    ///< --timings: JSON file of seconds per stage
+    std::string report;     ///< --report: JSON file of the run summary and histogram
+    bool overwrite = false; ///< --overwrite: replace existing outputs
+    bool quiet = false;     ///< --quiet: no progress on stderr
+    bool verbose = false;   ///< --verbose: stage names with the progress
+    bool check = false;     ///< --check: verify the mesh invariants before writing
+    bool print_config = false; ///< --print-config: print the effective configuration, stop
+    std::string config;        ///< --config: the file read (kept to refuse it as an output)
 };
 
 /// Parses the arguments of `globemesh mesh` (after the word "mesh"), including any --config

@@ -51,8 +51,8 @@
 // split at the edge's midpoint until none does (CoastData::arcs_split). A region's outline takes
 // the land's vertices within 2^-16 degree (1.7 m), so that land clipped to the region (or the
 // region drawn from the same coast in another CRS) leaves no sliver of water along it; the
-// region's box sides lie on the snap grid. Ocean left on one side only of the +-180 seam (halves of an island that do not match,
-// as Fiji at 1:50m) keeps that stretch of meridian as coast.
+// region's box sides lie on the snap grid. Ocean left on one side only of the +-180 seam (halves of
+// an island that do not match, as Fiji at 1:50m) keeps that stretch of meridian as coast.
 //
 // Units: areas km2 (GeographicLib on WGS84), lengths km (mean radius, sphere.hpp).
 // Deterministic: every container is ordered; the same input gives the same rings.
@@ -83,18 +83,18 @@ namespace globemesh {
 class LandMask final : public LandTest {
 public:
     /// Each polygon is its shell, then its holes (lon/lat rings, first == last).
-    explicit LandMask(const std::vector<std::vector<std::vector<LonLat>>>& polygons);
+    explicit LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons);
     ~LandMask();
-    LandMask(const LandMask&) = delete;
-    LandMask& operator=(const LandMask&) = delete;
+    LandMask(const LandMask &) = delete;
+    LandMask &operator=(const LandMask &) = delete;
     /// True when p lies strictly inside a land polygon (not in one of its holes, not on its
     /// outline): GEOS's answer, asked once per component of the lon/lat cells (1/16 degree)
     /// that no outline segment's box touches, and at every point of a cell one touches. Not
     /// thread-safe (one GEOS context, and the components' answers kept as they are asked).
-    bool contains(const Vec3& p) const override;
+    bool contains(const Vec3 &p) const override;
     /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
-    bool coast_within(const Vec3& p, double angle) const override;
+    bool coast_within(const Vec3 &p, double angle) const override;
     std::size_t vertices() const { return vertices_; }
     /// The bytes of the cells in front of `contains` (about 2.7 MB for the world's land).
     std::size_t cell_bytes() const;
@@ -110,15 +110,17 @@ struct CoastData {
     Boundary rings;            ///< ocean on the left, segments tagged coast/open, no resampling
     double ocean_area_km2 = 0; ///< geodesic (WGS84) area of the ocean domain the rings enclose
     std::size_t islands_removed = 0; ///< land polygons dropped by --min-island-area
-    std::size_t lakes_removed = 0;   ///< holes and inland water bodies dropped (area or inland seas)
-    double area_gained_km2 = 0;      ///< ocean added by dropping islands
-    double area_lost_km2 = 0;        ///< ocean lost by dropping lakes and inland seas
-    std::size_t polygons_joined = 0; ///< land polygons joined to another they came within the snap grid of
+    std::size_t lakes_removed = 0; ///< holes and inland water bodies dropped (area or inland seas)
+    double area_gained_km2 = 0;    ///< ocean added by dropping islands
+    double area_lost_km2 = 0;      ///< ocean lost by dropping lakes and inland seas
+    std::size_t polygons_joined =
+        0; ///< land polygons joined to another they came within the snap grid of
     /// rings gained or lost by dissolving and snap rounding (overlapping polygons merged, a ring
     /// split where it touched itself, a sliver collapsed), summed over GEOS's batches
     std::size_t rings_changed = 0;
-    std::size_t arcs_split = 0;      ///< nodes added where a great-circle arc strayed across the lon/lat edge's neighbour
-    std::string layer;               ///< name of the layer that was read
+    std::size_t arcs_split =
+        0; ///< nodes added where a great-circle arc strayed across the lon/lat edge's neighbour
+    std::string layer;                    ///< name of the layer that was read
     std::shared_ptr<const LandMask> land; ///< the land those rings leave out, for the mesher
 };
 
@@ -129,25 +131,25 @@ struct CoastData {
 /// Throws UsageError (no --coast, bad --coast-where or --coast-srs), IoError (file missing or
 /// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
 /// region; rings that cannot be repaired), Cancelled.
-CoastData load_coast(const MeshOptions& options, const Progress& progress = {});
+CoastData load_coast(const MeshOptions &options, const Progress &progress = {});
 
 struct CoastReport {
-    std::size_t rings = 0;            ///< rings in the shaped boundary
-    std::size_t nodes = 0;            ///< nodes in the shaped boundary
-    std::size_t islands_removed = 0;  ///< by --min-island-area (stage 1) and by size (stage 2)
-    std::size_t lakes_removed = 0;    ///< holes and closed water bodies removed (both stages)
+    std::size_t rings = 0;              ///< rings in the shaped boundary
+    std::size_t nodes = 0;              ///< nodes in the shaped boundary
+    std::size_t islands_removed = 0;    ///< by --min-island-area (stage 1) and by size (stage 2)
+    std::size_t lakes_removed = 0;      ///< holes and closed water bodies removed (both stages)
     std::size_t conflicts_repaired = 0; ///< corners added because resampled arcs touched another
-    double area_lost_km2 = 0;         ///< ocean removed: dropped lakes + net loss of simplification
-    double area_gained_km2 = 0;       ///< ocean added: dropped islands + net gain of simplification
-    double ocean_area_km2 = 0;        ///< geodesic area enclosed by the shaped boundary
+    double area_lost_km2 = 0;   ///< ocean removed: dropped lakes + net loss of simplification
+    double area_gained_km2 = 0; ///< ocean added: dropped islands + net gain of simplification
+    double ocean_area_km2 = 0;  ///< geodesic area enclosed by the shaped boundary
 };
 
 /// Stage 2: drops rings smaller than options.min_island_triangles triangles of the local size,
 /// simplifies to the local size with topology preserved and resamples every ring evenly between
-/// its corners so consecutive nodes are about size_km(x) apart along great-circle arcs. Throws DataError when the shaped
-/// rings cannot be made to satisfy boundary.hpp, Cancelled.
-Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
-                        CoastReport* report = nullptr, const Progress& progress = {});
+/// its corners so consecutive nodes are about size_km(x) apart along great-circle arcs. Throws
+/// DataError when the shaped rings cannot be made to satisfy boundary.hpp, Cancelled.
+Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const MeshOptions &options,
+                        CoastReport *report = nullptr, const Progress &progress = {});
 
 /// One violated invariant of a Boundary: a message and where (ring, segment), -1 when none.
 struct BoundaryIssue {
@@ -160,10 +162,10 @@ struct BoundaryIssue {
 /// touching or crossing except consecutive arcs at their shared node, no arc folding back on
 /// the previous one. Double precision: points closer than 1e-14 rad to an arc count as touching
 /// it. Returns the issues found (empty when the boundary is valid), at most max_issues.
-std::vector<BoundaryIssue> check_boundary(const Boundary& boundary, std::size_t max_issues = 100);
+std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t max_issues = 100);
 
 /// Geodesic area (WGS84, GeographicLib) of the region to the left of all rings, km2; the whole
 /// Earth for an empty boundary. Exact for rings whose arcs are geodesics.
-double boundary_area_km2(const Boundary& boundary);
+double boundary_area_km2(const Boundary &boundary);
 
 } // namespace globemesh

@@ -51,9 +51,15 @@ inline constexpr VertexId no_vertex = 0xffffffffu;
 inline constexpr TriangleId no_triangle = 0xffffffffu;
 inline constexpr HalfEdge no_half_edge = 0xffffffffu;
 
-inline constexpr TriangleId triangle_of(HalfEdge h) { return h / 3; }
-inline constexpr int edge_of(HalfEdge h) { return static_cast<int>(h % 3); }
-inline constexpr HalfEdge half_edge(TriangleId t, int i) { return 3 * t + static_cast<HalfEdge>(i); }
+inline constexpr TriangleId triangle_of(HalfEdge h) {
+    return h / 3;
+}
+inline constexpr int edge_of(HalfEdge h) {
+    return static_cast<int>(h % 3);
+}
+inline constexpr HalfEdge half_edge(TriangleId t, int i) {
+    return 3 * t + static_cast<HalfEdge>(i);
+}
 
 class SphericalDelaunay {
 public:
@@ -74,7 +80,8 @@ public:
     /// The insertion order insert_points uses: a permutation of [0, n) in BRIO rounds drawn
     /// from `seed`, each round sorted along the Hilbert curve on the cube faces. Exposed so a
     /// caller can time the ordering apart from the insertions. Needs n < 2^31.
-    static std::vector<std::uint32_t> insertion_order(std::span<const Vec3> points, std::uint64_t seed);
+    static std::vector<std::uint32_t> insertion_order(std::span<const Vec3> points,
+                                                      std::uint64_t seed);
 
     /// Inserts points into an empty triangulation, taking over `points`: they are gathered into
     /// the order of `order` (a permutation from insertion_order), so vertex v is the point at
@@ -85,9 +92,10 @@ public:
     /// order are released before the first triangle (56 B/point at most then). Throws DataError
     /// as insert_points, and std::invalid_argument when the triangulation is not empty or
     /// `order` is not a permutation of [0, points.size()).
-    std::vector<VertexId> insert_points(std::vector<Vec3>&& points, std::vector<std::uint32_t>&& order);
+    std::vector<VertexId> insert_points(std::vector<Vec3> &&points,
+                                        std::vector<std::uint32_t> &&order);
     /// The same with insertion_order(points, options.seed).
-    std::vector<VertexId> insert_points(std::vector<Vec3>&& points);
+    std::vector<VertexId> insert_points(std::vector<Vec3> &&points);
 
     /// Inserts one point, starting the walk at `hint` (any live triangle, or no_triangle).
     /// Returns its vertex, or the vertex it was merged into (then merged_count() grows).
@@ -96,18 +104,18 @@ public:
     /// than any vertex of the cavity's rim) or leaves the triangulation, merged into its nearest
     /// rim vertex (merged_count() grows; insert_points maps its points there).
     /// The cavity never crosses a constrained edge. Triangles created inherit the cavity's label.
-    VertexId insert(const Vec3& p, TriangleId hint = no_triangle);
+    VertexId insert(const Vec3 &p, TriangleId hint = no_triangle);
 
     /// Inserts p, which the caller knows lies in the solid triangle t, into a constrained
     /// triangulation: t is replaced even when constraints make it non-Delaunay, and the cavity
     /// grows from it to the triangles whose circumcircle holds p, never across a constraint.
-    VertexId insert_in_triangle(const Vec3& p, TriangleId t);
+    VertexId insert_in_triangle(const Vec3 &p, TriangleId t);
 
     /// Inserts p into the edge h (constrained or not) and keeps both halves constrained when h
     /// was. p should lie on or very near the edge's arc (e.g. its midpoint). Returns the vertex,
     /// or the existing vertex p merged into (an end of h, or, as for insert(), a vertex within
     /// rounding of p: then vertex_count() does not grow).
-    VertexId split_edge(HalfEdge h, const Vec3& p);
+    VertexId split_edge(HalfEdge h, const Vec3 &p);
 
     /// Makes a-b an edge of the triangulation and constrains it, by flipping the edges that cross
     /// the arc a-b (never inserting points). When a vertex lies exactly on the arc, the
@@ -138,15 +146,15 @@ public:
     /// whose triangle count is not the patch's less twice its new points: the patch and the
     /// region must tile the same surface). The Delaunay property is not restored:
     /// make_delaunay(edges) from the new half-edges does that.
-    bool replace_region(std::span<const HalfEdge> border, std::vector<Vec3>& points,
-                        std::vector<VertexId>& triangles, std::vector<std::uint32_t>& adjacent,
-                        std::uint8_t label, std::vector<TriangleId>* slots = nullptr);
+    bool replace_region(std::span<const HalfEdge> border, std::vector<Vec3> &points,
+                        std::vector<VertexId> &triangles, std::vector<std::uint32_t> &adjacent,
+                        std::uint8_t label, std::vector<TriangleId> *slots = nullptr);
 
     /// Moves vertex v to p (a unit vector) and restores the Delaunay property around it by flips.
     /// Returns false and leaves v and every triangle as they were when the move would fold a
     /// triangle of its star, when its star holds a ghost triangle, or when flips cannot restore
     /// the property (v at p inside the hull of its neighbours: closer than rounding resolves).
-    bool move_vertex(VertexId v, const Vec3& p);
+    bool move_vertex(VertexId v, const Vec3 &p);
     /// The same with a half-edge leaving v (origin == v), which avoids a search for the star.
     /// With `flipped`, a successful move appends the corners of every quadrilateral whose
     /// diagonal it flipped (with repeats; nothing when no flip was needed): with v and its
@@ -154,13 +162,14 @@ public:
     /// With `accept`, called once v is at p and its flips are made (after `flipped` is filled):
     /// when it returns false, the flips are undone and v goes back, so that every triangle is
     /// exactly as before the call, which then returns false. It must not change the triangulation.
-    bool move_vertex_from(HalfEdge leaving_v, const Vec3& p, std::vector<VertexId>* flipped = nullptr,
-                          const std::function<bool()>& accept = {});
+    bool move_vertex_from(HalfEdge leaving_v, const Vec3 &p,
+                          std::vector<VertexId> *flipped = nullptr,
+                          const std::function<bool()> &accept = {});
 
     /// Moves the origin of leaving_v to p without flips, so the triangulation may stop being
     /// Delaunay until make_delaunay(). Returns false and changes nothing when a triangle of its
     /// star would not stay counter-clockwise with v at p.
-    bool place_vertex_from(HalfEdge leaving_v, const Vec3& p);
+    bool place_vertex_from(HalfEdge leaving_v, const Vec3 &p);
 
     /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
     void flip(HalfEdge h);
@@ -175,11 +184,11 @@ public:
     std::size_t make_delaunay();
     /// The same from the half-edges in `edges` only (consumed): enough after changes confined
     /// to the triangles those edges bound.
-    std::size_t make_delaunay(std::vector<HalfEdge>& edges);
+    std::size_t make_delaunay(std::vector<HalfEdge> &edges);
 
     /// A live triangle whose spherical cone contains p, or that p is beyond (for points outside
     /// the solid region). Walks from `hint`.
-    TriangleId locate(const Vec3& p, TriangleId hint = no_triangle) const;
+    TriangleId locate(const Vec3 &p, TriangleId hint = no_triangle) const;
 
     // --- access ---
     std::size_t vertex_count() const { return points_.size(); }
@@ -187,8 +196,8 @@ public:
     std::size_t triangle_count() const { return triangle_slots() - free_.size(); }
     std::size_t merged_count() const { return merged_; }
     bool is_live(TriangleId t) const { return tri_vertices_[3 * t] != no_vertex; }
-    const Vec3& point(VertexId v) const { return points_[v]; }
-    const std::vector<Vec3>& points() const { return points_; }
+    const Vec3 &point(VertexId v) const { return points_[v]; }
+    const std::vector<Vec3> &points() const { return points_; }
     /// Moves the points out (indexed by VertexId) and leaves an empty triangulation: for a caller
     /// done with the triangles, without a copy of the points.
     std::vector<Vec3> release_points() {
@@ -247,27 +256,31 @@ private:
     void set_mark(TriangleId t) { links_[3 * t] |= mark_bit; }
     void clear_mark(TriangleId t) { links_[3 * t] &= ~mark_bit; }
     void reserve_for(std::size_t points);
-    VertexId insert_vertex(const Vec3& p, VertexId id, TriangleId hint);
+    VertexId insert_vertex(const Vec3 &p, VertexId id, TriangleId hint);
     TriangleId start_triangle(TriangleId hint) const;
-    TriangleId walk(const Vec3& p, TriangleId start, bool& inside) const;
-    bool insert_fan(const Vec3& p, TriangleId seed, VertexId id, VertexId& result);
+    TriangleId walk(const Vec3 &p, TriangleId start, bool &inside) const;
+    bool insert_fan(const Vec3 &p, TriangleId seed, VertexId id, VertexId &result);
     TriangleId new_slot();
     // Every coordinate at most 2 in magnitude (false for NaN): unit vectors, with room to spare.
-    static bool bounded(const Vec3& p) { return std::fabs(p.x) <= 2 && std::fabs(p.y) <= 2 && std::fabs(p.z) <= 2; }
+    static bool bounded(const Vec3 &p) {
+        return std::fabs(p.x) <= 2 && std::fabs(p.y) <= 2 && std::fabs(p.z) <= 2;
+    }
 
     void link(HalfEdge a, HalfEdge b);
     TriangleId new_triangle(VertexId a, VertexId b, VertexId c, std::uint8_t label);
     void free_triangle(TriangleId t);
     void initial_tetrahedron(std::span<const Vec3> points, std::span<const std::uint32_t> order,
-                             std::vector<VertexId>& vertex_of);
+                             std::vector<VertexId> &vertex_of);
     void make_tetrahedron(VertexId v[4]);
-    bool visible(TriangleId t, const Vec3& p) const;
+    bool visible(TriangleId t, const Vec3 &p) const;
     // id: the vertex p becomes (an adopted point's slot), or no_vertex to append p.
-    VertexId insert_in_cavity(const Vec3& p, TriangleId seed, HalfEdge split, VertexId id = no_vertex);
+    VertexId insert_in_cavity(const Vec3 &p, TriangleId seed, HalfEdge split,
+                              VertexId id = no_vertex);
     // insert_in_cavity's steps: the cavity (marked, in cavity_, its rim in cavity_boundary_), and
     // the vertex it swallows that p merges into, or no_vertex with the others' drops listed.
-    void grow_cavity(const Vec3& p, TriangleId seed, HalfEdge split);
-    VertexId swallowed_vertex(const Vec3& p, VertexId split_a, VertexId split_b, std::size_t& drops);
+    void grow_cavity(const Vec3 &p, TriangleId seed, HalfEdge split);
+    VertexId swallowed_vertex(const Vec3 &p, VertexId split_a, VertexId split_b,
+                              std::size_t &drops);
     // Both triangles of a flip as they were (vertices and link words), to undo it exactly.
     struct FlipRecord {
         TriangleId t, s;
@@ -275,20 +288,21 @@ private:
         std::uint32_t tl[3], sl[3];
     };
     // flip(h), first recording it in *journal when there is one.
-    void flip_recorded(HalfEdge h, std::vector<FlipRecord>* journal);
+    void flip_recorded(HalfEdge h, std::vector<FlipRecord> *journal);
     // Undoes the journal's flips, newest first, and clears it.
-    void undo_flips(std::vector<FlipRecord>& journal);
+    void undo_flips(std::vector<FlipRecord> &journal);
     // Lawson flips from the half-edges on `stack` until each edge reached is locally Delaunay.
     // A non-Delaunay edge between solid triangles whose flip would fold one (or make it flat,
     // when flat_folds) cannot be mended: without a journal it is skipped; with one, every flip
     // is recorded and the run stops there, returning false. Counts flips in *flips if given.
-    bool legalize_from(std::vector<HalfEdge>& stack, std::vector<FlipRecord>* journal, bool flat_folds,
-                       std::size_t* flips);
-    bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge>& created, std::vector<FlipRecord>& journal,
-                         std::vector<std::pair<VertexId, VertexId>>& constrained);
-    VertexId nearest_vertex(const Vec3& p, TriangleId t) const;
+    bool legalize_from(std::vector<HalfEdge> &stack, std::vector<FlipRecord> *journal,
+                       bool flat_folds, std::size_t *flips);
+    bool recover_segment(VertexId a, VertexId b, std::vector<HalfEdge> &created,
+                         std::vector<FlipRecord> &journal,
+                         std::vector<std::pair<VertexId, VertexId>> &constrained);
+    VertexId nearest_vertex(const Vec3 &p, TriangleId t) const;
     // Maps each vertex left by a swallowing cavity (see insert) to the vertex it merged into.
-    void resolve_dropped(std::vector<VertexId>& map) const;
+    void resolve_dropped(std::vector<VertexId> &map) const;
 
     Options options_;
     std::vector<Vec3> points_;
@@ -300,7 +314,8 @@ private:
     std::vector<std::pair<VertexId, VertexId>> dropped_; // (vertex left by a cavity, merged into)
     std::vector<VertexId> swallowed_, rim_vertices_;     // scratch of insert_in_cavity
     TriangleId last_ = no_triangle;
-    TriangleId recover_hint_ = no_triangle; // recover_segment's: where it last found or flipped an edge
+    TriangleId recover_hint_ =
+        no_triangle;      // recover_segment's: where it last found or flipped an edge
     bool bounded_ = true; // every point ever stored is bounded(): the walk's static filter holds
     // scratch buffers reused across insertions (no allocation per insertion)
     struct Rim {
@@ -311,8 +326,8 @@ private:
     std::vector<TriangleId> cavity_;
     std::vector<HalfEdge> cavity_boundary_;
     std::vector<TriangleId> search_;
-    std::vector<HalfEdge> move_stack_;       // scratch of move_vertex_from
-    std::vector<FlipRecord> move_journal_;   // scratch of move_vertex_from
+    std::vector<HalfEdge> move_stack_;     // scratch of move_vertex_from
+    std::vector<FlipRecord> move_journal_; // scratch of move_vertex_from
     std::vector<Rim> rim_;
     std::vector<std::pair<VertexId, TriangleId>> by_start_;
 };

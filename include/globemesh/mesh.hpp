@@ -46,14 +46,16 @@ struct Mesh {
     /// Run metadata (input files, options, statistics) written as global attributes / mesh_info.
     std::vector<std::pair<std::string, std::string>> attributes;
 
-    const Field* node_field(const std::string& name) const {
-        for (const auto& f : node_fields)
-            if (f.name == name) return &f;
+    const Field *node_field(const std::string &name) const {
+        for (const auto &f : node_fields)
+            if (f.name == name)
+                return &f;
         return nullptr;
     }
-    const Field* face_field(const std::string& name) const {
-        for (const auto& f : face_fields)
-            if (f.name == name) return &f;
+    const Field *face_field(const std::string &name) const {
+        for (const auto &f : face_fields)
+            if (f.name == name)
+                return &f;
         return nullptr;
     }
 };

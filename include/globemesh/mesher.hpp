@@ -90,12 +90,12 @@ namespace globemesh {
 
 struct MesherOptions {
     std::uint64_t max_nodes = 20'000'000; ///< refuse when the size field asks for more nodes
-    std::uint64_t max_memory = 0;         ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
-    int smooth_iterations = 4;            ///< smoothing sweeps
-    bool keep_inland_seas = false;        ///< keep ocean components apart from the largest
-    double inlet_width = 0.5;             ///< close inlets narrower than this times h (0: none)
-    double inlet_area = 1.0;              ///< ... holding at most this times h^2 of water (or narrow on average)
-    std::uint64_t seed = 1;               ///< seed of the core's insertion order
+    std::uint64_t max_memory = 0;  ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
+    int smooth_iterations = 4;     ///< smoothing sweeps
+    bool keep_inland_seas = false; ///< keep ocean components apart from the largest
+    double inlet_width = 0.5;      ///< close inlets narrower than this times h (0: none)
+    double inlet_area = 1.0; ///< ... holding at most this times h^2 of water (or narrow on average)
+    std::uint64_t seed = 1;  ///< seed of the core's insertion order
     /// The size field's largest value (km): where the field reaches it, away from the boundary,
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
@@ -119,7 +119,9 @@ inline constexpr std::uint64_t mesher_bytes_per_node = 800;
 /// triangles of side h cover sqrt(3)/4 h^2 each, and a large mesh has two triangles per node.
 /// mesh_boundary sums it over the ocean's triangles before refining (the check against
 /// max_nodes); the pipeline asks it first for the whole ocean at hmax_km.
-inline double nodes_for_area(double area, double h) { return area / (0.4330127018922193 /* sqrt(3) / 4 */ * h * h) / 2.0; }
+inline double nodes_for_area(double area, double h) {
+    return area / (0.4330127018922193 /* sqrt(3) / 4 */ * h * h) / 2.0;
+}
 
 struct OceanComponent {
     double area_km2 = 0;
@@ -128,43 +130,51 @@ struct OceanComponent {
 
 struct MesherReport {
     std::size_t boundary_nodes = 0;
-    std::size_t segments_split = 0;     ///< segments split because flips could not recover them
-    std::size_t encroached_splits = 0;  ///< segments split during refinement and mending
-    std::size_t estimated_nodes = 0;    ///< the size field's node estimate, checked against max_nodes
-    std::size_t sharp_corners = 0;      ///< boundary nodes with an ocean angle below 60 degrees
+    std::size_t segments_split = 0;    ///< segments split because flips could not recover them
+    std::size_t encroached_splits = 0; ///< segments split during refinement and mending
+    std::size_t estimated_nodes = 0; ///< the size field's node estimate, checked against max_nodes
+    std::size_t sharp_corners = 0;   ///< boundary nodes with an ocean angle below 60 degrees
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
-    std::size_t inlets_closed = 0;      ///< closings (MesherOptions::inlet_width; a long channel may take several)
-    double inlet_area_km2 = 0;          ///< the water they held
-    std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
-    std::size_t lattice_patched = 0;    ///< of which placed with their lattice triangles, not inserted one by one
+    std::size_t inlets_closed =
+        0; ///< closings (MesherOptions::inlet_width; a long channel may take several)
+    double inlet_area_km2 = 0;     ///< the water they held
+    std::size_t lattice_nodes = 0; ///< nodes from the lattice (MesherOptions::lattice_km)
+    std::size_t lattice_patched =
+        0; ///< of which placed with their lattice triangles, not inserted one by one
     std::size_t island_centroids_moved = 0; ///< faces moved off islands the shaping dropped
     std::size_t island_centroids_left = 0;  ///< faces whose centroid is still on such an island
-    std::size_t valence_flips = 0;      ///< flips towards valence 6 before the last restoration
-    std::size_t corners_mended = 0;     ///< triangles of two or three boundary nodes split after smoothing
+    std::size_t valence_flips = 0;          ///< flips towards valence 6 before the last restoration
+    std::size_t corners_mended =
+        0; ///< triangles of two or three boundary nodes split after smoothing
     std::size_t land_faces_removed = 0; ///< faces removed because their centroid lies on land
-    std::size_t land_faces_left = 0;    ///< faces centred on land that could not go (MesherOptions::land)
-    std::size_t land_faces_nudged = 0;  ///< faces that a corner's move took off land instead
-    std::vector<Vec3> land_faces_at;    ///< the centroids of the land_faces_left
-    std::size_t water_faces_removed = 0; ///< faces removed with them so that the mesh stays a manifold
-    std::size_t land_holes = 0;         ///< boundary loops those removals opened (islands back)
-    std::size_t land_loops_joined = 0;  ///< boundary loops those removals joined to another (narrow water closed)
-    std::size_t straits_closed = 0;     ///< of the faces removed, those that closed a strait (MesherOptions::close_straits)
+    std::size_t land_faces_left =
+        0; ///< faces centred on land that could not go (MesherOptions::land)
+    std::size_t land_faces_nudged = 0; ///< faces that a corner's move took off land instead
+    std::vector<Vec3> land_faces_at;   ///< the centroids of the land_faces_left
+    std::size_t water_faces_removed =
+        0;                      ///< faces removed with them so that the mesh stays a manifold
+    std::size_t land_holes = 0; ///< boundary loops those removals opened (islands back)
+    std::size_t land_loops_joined =
+        0; ///< boundary loops those removals joined to another (narrow water closed)
+    std::size_t straits_closed =
+        0; ///< of the faces removed, those that closed a strait (MesherOptions::close_straits)
     std::vector<Vec3> straits_closed_at; ///< their centroids
-    std::vector<double> seas_cut_off;   ///< km2 of each basin those closings cut off (kept)
-    double straits_water_km2 = 0;       ///< water cut off with them and closed (inlet_area, inlet_width)
-    std::size_t nodes_split = 0;        ///< nodes added where a strait closed at a node between two fans of water
+    std::vector<double> seas_cut_off;    ///< km2 of each basin those closings cut off (kept)
+    double straits_water_km2 = 0; ///< water cut off with them and closed (inlet_area, inlet_width)
+    std::size_t nodes_split =
+        0; ///< nodes added where a strait closed at a node between two fans of water
     std::vector<OceanComponent> components;
 };
 
 /// Meshes the ocean bounded by `boundary` (empty: the whole sphere) with edges of about
 /// size_km(x) km. Throws DataError when the rings do not close the ocean, when no ocean is left,
 /// or when the estimated node count exceeds options.max_nodes (or the estimated memory,
-/// estimated_nodes * mesher_bytes_per_node, exceeds options.max_memory); Cancelled through progress.
-/// Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
+/// estimated_nodes * mesher_bytes_per_node, exceeds options.max_memory); Cancelled through
+/// progress. Stage times go to `timings` under insert_boundary, recover, classify, refine, improve.
 /// Neighbouring nodes are mostly close in the numbering, and so are neighbouring faces (the
 /// lattice's insertion order or, when the refinement made most nodes, a Hilbert curve's).
-Mesh mesh_boundary(const Boundary& boundary, const SizeFn& size_km,
-                   const MesherOptions& options = {}, MesherReport* report = nullptr,
-                   const Progress& progress = {}, StageTimings* timings = nullptr);
+Mesh mesh_boundary(const Boundary &boundary, const SizeFn &size_km,
+                   const MesherOptions &options = {}, MesherReport *report = nullptr,
+                   const Progress &progress = {}, StageTimings *timings = nullptr);
 
 } // namespace globemesh

@@ -23,8 +23,8 @@ struct CoastOptions {
     std::string coast_srs;   ///< CRS of a layer that declares none (e.g. EPSG:4326)
     /// W,S,E,N in degrees; W > E crosses +-180. Default: the whole globe.
     std::optional<std::array<double, 4>> region;
-    std::string region_file;  ///< polygons (any OGR source, any CRS) bounding the ocean
-    std::string region_layer; ///< layer of region_file; default the only polygon/line layer
+    std::string region_file;        ///< polygons (any OGR source, any CRS) bounding the ocean
+    std::string region_layer;       ///< layer of region_file; default the only polygon/line layer
     double min_island_area_km2 = 0; ///< drop islands and lakes smaller than this (km2)
     /// Islands whose area is below this many equilateral triangles of the local size are dropped.
     double min_island_triangles = 4;
@@ -49,8 +49,8 @@ struct BathymetryOptions {
 
 /// The size field's options (sizefield.hpp: build_size_field), lengths in km.
 struct SizeFieldOptions {
-    double hmax_km = 100.0;       ///< largest edge length (km, at most 5000); alone gives a uniform mesh
-    double hmin_km = 0.0;         ///< smallest edge length (km); 0: a floor of max(hmax/1000, 10 m)
+    double hmax_km = 100.0; ///< largest edge length (km, at most 5000); alone gives a uniform mesh
+    double hmin_km = 0.0;   ///< smallest edge length (km); 0: a floor of max(hmax/1000, 10 m)
     double coast_size_km = 0.0;   ///< edge length at the coast (km); 0 = off
     double coast_rate = 0.1;      ///< growth of h with distance from the coast (km/km)
     double wavelength = 0.0;      ///< points per wavelength of the tide; 0 = off
@@ -83,14 +83,14 @@ struct MeshOptions : CoastOptions, BathymetryOptions, SizeFieldOptions, MeshingO
 
 /// The size field's floor hfloor (sizefield.hpp) for `options`: hmin_km, or when it is 0 the
 /// sane floor max(hmax_km / 1000, 10 m).
-inline double size_floor_km(const SizeFieldOptions& options) {
+inline double size_floor_km(const SizeFieldOptions &options) {
     return options.hmin_km > 0 ? options.hmin_km : std::max(options.hmax_km / 1000, 0.01);
 }
 
 /// Checks option values alone (ranges, hmin_km <= hmax_km, region bounds, an option that needs
 /// another); throws UsageError naming the option's field (e.g. "hmax_km must be a positive
 /// length"). Opens no file. The one place the options are checked: mesh_ocean calls it first.
-void validate(const MeshOptions& options);
+void validate(const MeshOptions &options);
 
 /// Bytes with an SI unit, as --max-memory takes them: memory_text(1.2e9) == "1.2 GB".
 std::string memory_text(double bytes);

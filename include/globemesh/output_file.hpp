@@ -31,12 +31,12 @@ public:
     /// Throws IoError naming the path and what to do.
     OutputFile(std::filesystem::path target, bool overwrite, std::string what = "output");
     ~OutputFile();
-    OutputFile(const OutputFile&) = delete;
-    OutputFile& operator=(const OutputFile&) = delete;
+    OutputFile(const OutputFile &) = delete;
+    OutputFile &operator=(const OutputFile &) = delete;
 
     /// Where the writer writes; the file does not exist yet when the OutputFile is made.
-    const std::filesystem::path& temp_path() const { return temp_; }
-    const std::filesystem::path& target() const { return target_; }
+    const std::filesystem::path &temp_path() const { return temp_; }
+    const std::filesystem::path &target() const { return target_; }
 
     /// Moves the finished temporary file to the target, or hands it to the thread's OutputBatch.
     /// Throws IoError (target appeared without overwrite, rename failed); the temporary file is
@@ -45,15 +45,15 @@ public:
 
     /// " (the disk is full)" when the folder of `file` has less than 1 MiB left, else "": for
     /// write errors that do not say so themselves (HDF5's "HDF error", SQLite's missing tables).
-    static std::string full_disk_note(const std::filesystem::path& file);
+    static std::string full_disk_note(const std::filesystem::path &file);
 
     /// Writes `text` to the target safely in one go (for small reports such as JSON); to a
     /// terminal or pipe (is_stream: /dev/stdout) directly.
-    static void write_text(const std::filesystem::path& target, const std::string& text, bool overwrite,
-                           const std::string& what = "output");
+    static void write_text(const std::filesystem::path &target, const std::string &text,
+                           bool overwrite, const std::string &what = "output");
 
     /// True when `target` (through symbolic links) is a character device or a named pipe.
-    static bool is_stream(const std::filesystem::path& target);
+    static bool is_stream(const std::filesystem::path &target);
 
     /// Unlinks every temporary file (and sidecar) of the OutputFiles and OutputBatches alive in
     /// the process. Async-signal-safe: for a handler that then ends the process. Does nothing
@@ -71,7 +71,7 @@ private:
         std::string what;
         int slot; ///< its entry in the table remove_temporaries() reads, or -1
     };
-    static void place(const Finished& f); // the final link or rename; throws IoError
+    static void place(const Finished &f); // the final link or rename; throws IoError
 
     std::filesystem::path target_, real_, temp_; // real_: target_ through symbolic links
     bool overwrite_;
@@ -88,13 +88,13 @@ class OutputBatch {
 public:
     OutputBatch();
     ~OutputBatch();
-    OutputBatch(const OutputBatch&) = delete;
-    OutputBatch& operator=(const OutputBatch&) = delete;
+    OutputBatch(const OutputBatch &) = delete;
+    OutputBatch &operator=(const OutputBatch &) = delete;
 
     /// Throws Cancelled, moving nothing, when `cancelled` (when set) says so once the batch holds
     /// off remove_temporaries(); else moves each file in place. Throws IoError when a target
     /// cannot be written (one appeared without overwrite): the files placed are then removed.
-    void commit(const std::function<bool()>& cancelled = {});
+    void commit(const std::function<bool()> &cancelled = {});
 
     /// True while a batch is alive on this thread (files committed now join it).
     static bool active();
@@ -102,7 +102,7 @@ public:
 private:
     friend class OutputFile;
     std::vector<OutputFile::Finished> files_;
-    OutputBatch* outer_ = nullptr;
+    OutputBatch *outer_ = nullptr;
     bool committed_ = false;
 };
 

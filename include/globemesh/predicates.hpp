@@ -49,24 +49,24 @@ namespace globemesh::predicates {
 /// Exact sign of det[a, b, c] = a . (b x c): +1 when c is strictly left of the great circle
 /// through a then b (seen from outside), -1 when right, 0 when the three vectors are coplanar
 /// with the origin. No perturbation.
-inline int orient(const Vec3& a, const Vec3& b, const Vec3& c);
+inline int orient(const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
 /// Exact sign of (d - a) . ((b - a) x (c - a)), no perturbation: +1 when d lies on the side of
 /// the plane through a, b, c that (b - a) x (c - a) points to.
-inline int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+inline int orient3d(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d);
 
 /// orient3d with the symbolic perturbation above. For unit vectors with a, b, c counter-clockwise
 /// seen from outside, +1 means d lies strictly inside the circumcircle of abc on the sphere
 /// (d is beyond the face's plane, "visible" from it as in a 3-D convex hull). Returns 0 only when
 /// two arguments are equal points (the caller must merge duplicates first).
-inline int in_circle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+inline int in_circle(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d);
 
 namespace detail {
 
 // Exact stages (src/sphere/predicates.cpp), called when the filter cannot decide.
-int orient_exact(const Vec3& a, const Vec3& b, const Vec3& c);
-int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
-int in_circle_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+int orient_exact(const Vec3 &a, const Vec3 &b, const Vec3 &c);
+int orient3d_exact(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d);
+int in_circle_exact(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d);
 
 // Semi-static filters (the bound scales with the largest magnitude in each coordinate column,
 // as in CGAL's generated static filters). Derivation, with u = 2^-53:
@@ -91,7 +91,7 @@ inline bool filter_range(double x, double y, double z) {
 }
 
 /// +1 / -1 when the rounded determinant's sign is certified, 0 when undecided.
-inline int orient_filter(const Vec3& a, const Vec3& b, const Vec3& c) {
+inline int orient_filter(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const double m1 = b.y * c.z - b.z * c.y;
     const double m2 = b.z * c.x - b.x * c.z;
     const double m3 = b.x * c.y - b.y * c.x;
@@ -101,14 +101,16 @@ inline int orient_filter(const Vec3& a, const Vec3& b, const Vec3& c) {
     const double mz = std::max(std::max(std::fabs(a.z), std::fabs(b.z)), std::fabs(c.z));
     const double bound = orient_bound * mx * my * mz;
     if (filter_range(mx, my, mz)) {
-        if (det > bound) return 1;
-        if (det < -bound) return -1;
+        if (det > bound)
+            return 1;
+        if (det < -bound)
+            return -1;
     }
     return 0;
 }
 
 /// The same for (d - a) . ((b - a) x (c - a)).
-inline int orient3d_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+inline int orient3d_filter(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
     const double bax = b.x - a.x, bay = b.y - a.y, baz = b.z - a.z;
     const double cax = c.x - a.x, cay = c.y - a.y, caz = c.z - a.z;
     const double dax = d.x - a.x, day = d.y - a.y, daz = d.z - a.z;
@@ -121,25 +123,27 @@ inline int orient3d_filter(const Vec3& a, const Vec3& b, const Vec3& c, const Ve
     const double mz = std::max(std::max(std::fabs(baz), std::fabs(caz)), std::fabs(daz));
     const double bound = orient3d_bound * mx * my * mz;
     if (filter_range(mx, my, mz)) {
-        if (det > bound) return 1;
-        if (det < -bound) return -1;
+        if (det > bound)
+            return 1;
+        if (det < -bound)
+            return -1;
     }
     return 0;
 }
 
 } // namespace detail
 
-inline int orient(const Vec3& a, const Vec3& b, const Vec3& c) {
+inline int orient(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const int s = detail::orient_filter(a, b, c);
     return s != 0 ? s : detail::orient_exact(a, b, c);
 }
 
-inline int orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+inline int orient3d(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
     const int s = detail::orient3d_filter(a, b, c, d);
     return s != 0 ? s : detail::orient3d_exact(a, b, c, d);
 }
 
-inline int in_circle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+inline int in_circle(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
     // A certified non-zero sign of the unperturbed determinant is also the perturbed sign.
     const int s = detail::orient3d_filter(a, b, c, d);
     return s != 0 ? s : detail::in_circle_exact(a, b, c, d);
@@ -153,21 +157,25 @@ struct OrientEdge {
     Vec3 b, c;
     Vec3 minors; // b x c, rounded as orient_filter rounds it
     Vec3 extent; // max(|b.x|, |c.x|), and the same for y and z
-    OrientEdge(const Vec3& b_, const Vec3& c_)
-        : b(b_), c(c_), minors{b_.y * c_.z - b_.z * c_.y, b_.z * c_.x - b_.x * c_.z, b_.x * c_.y - b_.y * c_.x},
-          extent{std::max(std::fabs(b_.x), std::fabs(c_.x)), std::max(std::fabs(b_.y), std::fabs(c_.y)),
+    OrientEdge(const Vec3 &b_, const Vec3 &c_)
+        : b(b_), c(c_), minors{b_.y * c_.z - b_.z * c_.y, b_.z * c_.x - b_.x * c_.z,
+                               b_.x * c_.y - b_.y * c_.x},
+          extent{std::max(std::fabs(b_.x), std::fabs(c_.x)),
+                 std::max(std::fabs(b_.y), std::fabs(c_.y)),
                  std::max(std::fabs(b_.z), std::fabs(c_.z))} {}
 };
 
-inline int orient(const Vec3& a, const OrientEdge& e) {
+inline int orient(const Vec3 &a, const OrientEdge &e) {
     const double det = a.x * e.minors.x + a.y * e.minors.y + a.z * e.minors.z;
     const double mx = std::max(std::fabs(a.x), e.extent.x);
     const double my = std::max(std::fabs(a.y), e.extent.y);
     const double mz = std::max(std::fabs(a.z), e.extent.z);
     const double bound = detail::orient_bound * mx * my * mz;
     if (detail::filter_range(mx, my, mz)) {
-        if (det > bound) return 1;
-        if (det < -bound) return -1;
+        if (det > bound)
+            return 1;
+        if (det < -bound)
+            return -1;
     }
     return detail::orient_exact(a, e.b, e.c);
 }

@@ -18,26 +18,29 @@ namespace globemesh {
 using Progress = std::function<bool(double fraction, std::string_view stage)>;
 
 /// A Progress that maps [0, 1] of a sub-stage onto [lo, hi] of the parent (GDAL's scaled progress).
-inline Progress sub_progress(const Progress& parent, double lo, double hi) {
-    if (!parent) return {};
+inline Progress sub_progress(const Progress &parent, double lo, double hi) {
+    if (!parent)
+        return {};
     return [parent, lo, hi](double f, std::string_view stage) {
         return parent(lo + (hi - lo) * f, stage);
     };
 }
 
 /// Reports f to p (when set) and throws Cancelled when the callback asks to stop.
-inline void report(const Progress& p, double f, std::string_view stage) {
-    if (p && !p(f, stage)) throw Cancelled();
+inline void report(const Progress &p, double f, std::string_view stage) {
+    if (p && !p(f, stage))
+        throw Cancelled();
 }
 
 /// Seconds per named stage, in the order the stages ran. `after_stage`, when set, is called as
 /// each stage is added, while nothing of the next has run (a benchmark samples memory there).
 struct StageTimings {
     std::vector<std::pair<std::string, double>> stages;
-    std::function<void(const std::string& stage)> after_stage;
-    void add(const std::string& name, double seconds) {
+    std::function<void(const std::string &stage)> after_stage;
+    void add(const std::string &name, double seconds) {
         stages.emplace_back(name, seconds);
-        if (after_stage) after_stage(name);
+        if (after_stage)
+            after_stage(name);
     }
 };
 

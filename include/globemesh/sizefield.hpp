@@ -23,7 +23,8 @@
 // sphere: |h(p) - h(q)| <= grade * arc(p, q) for every pair of points (great-circle distance,
 // km), not only along the grid lines. The solver (grid.cpp) holds in every cell, corners 00, 10,
 // 01, 11, the two corner conditions of its triangles
-//   ((h10 - h00) / dx)^2 + ((h01 - h00) / dy)^2 <= grade^2,  ((h11 - h01) / dx)^2 + ((h11 - h10) / dy)^2 <= grade^2
+//   ((h10 - h00) / dx)^2 + ((h01 - h00) / dy)^2 <= grade^2,  ((h11 - h01) / dx)^2 + ((h11 - h10) /
+//   dy)^2 <= grade^2
 // (dx = R dlon cos(lat) at the cell's poleward row, dy = R dlat), which bound the Riemannian
 // gradient of the linear interpolant by grade everywhere in the cell, and the like conditions of
 // the polar caps. It accepts nodes in increasing order of value (fast marching with those
@@ -36,8 +37,8 @@
 // Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
 // nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
 // grid). Building needs about 4 more arrays of the same size at peak. No grid at all when no
-// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region is set;
-// a regional grid covers the region plus one cell and holds its edge values outside.
+// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region
+// is set; a regional grid covers the region plus one cell and holds its edge values outside.
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
 // limiting", Eng. Comput. 22 (2006); Roberts et al., OceanMesh2D, GMD 12 (2019) for the
@@ -86,14 +87,14 @@ public:
 
     /// Target edge length at p, km: piecewise linear on the background grid's triangles (exact
     /// at the nodes; edge values held outside a regional grid, polar caps on a global one).
-    double size_km(const Vec3& p) const;
+    double size_km(const Vec3 &p) const;
     double size_km(double lon_deg, double lat_deg) const;
-    double operator()(const Vec3& p) const { return size_km(p); }
+    double operator()(const Vec3 &p) const { return size_km(p); }
 
     /// True when the field is one size everywhere (no term of the options is on): no grid.
     bool is_uniform() const { return !grid_; }
     /// The background grid (node values in km), for checks and output; only when !is_uniform().
-    const Raster& grid() const { return *grid_; }
+    const Raster &grid() const { return *grid_; }
     /// A SizeFn sharing this field's grid (cheap to copy).
     SizeFn function() const;
 
@@ -120,9 +121,10 @@ private:
 /// allocated (to refuse the run by throwing).
 /// Throws UsageError (bad sizes, a component without its input, naming the option), DataError
 /// (a size_regions file without a size_km field) or IoError (size_regions unreadable).
-SizeField build_size_field(const MeshOptions& options, const Raster* bathy, const Boundary* coast,
-                           const Progress& progress = {}, std::size_t max_nodes = std::size_t{1} << 24,
-                           const std::function<void()>& before_grid = {});
+SizeField build_size_field(const MeshOptions &options, const Raster *bathy, const Boundary *coast,
+                           const Progress &progress = {},
+                           std::size_t max_nodes = std::size_t{1} << 24,
+                           const std::function<void()> &before_grid = {});
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.
 SizeFn uniform_size(double h_km);

@@ -15,7 +15,8 @@ constexpr double nan_value = std::numeric_limits<double>::quiet_NaN();
 /// x modulo m in [0, m).
 double positive_mod(double x, double m) {
     double r = std::fmod(x, m);
-    if (r < 0) r += m;
+    if (r < 0)
+        r += m;
     return r >= m ? 0.0 : r;
 }
 
@@ -38,8 +39,10 @@ Raster::Raster(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_de
     if (global_) {
         for (double pole : {-90.0, 90.0}) {
             double v = (pole - lat0_) / dlat_;
-            if (v < v_lo_ && v >= v_lo_ - 1.0) v_lo_ = v - 1e-9;
-            if (v > v_hi_ && v <= v_hi_ + 1.0) v_hi_ = v + 1e-9;
+            if (v < v_lo_ && v >= v_lo_ - 1.0)
+                v_lo_ = v - 1e-9;
+            if (v > v_hi_ && v <= v_hi_ + 1.0)
+                v_hi_ = v + 1e-9;
         }
     }
 }
@@ -53,12 +56,16 @@ LonLatBounds Raster::bounds() const {
 }
 
 bool Raster::contains(double lon, double lat) const {
-    if (!std::isfinite(lon) || !std::isfinite(lat)) return false;
+    if (!std::isfinite(lon) || !std::isfinite(lat))
+        return false;
     double v = (lat - lat0_) / dlat_;
-    if (v < v_lo_ || v > v_hi_) return false;
-    if (global_) return true;
+    if (v < v_lo_ || v > v_hi_)
+        return false;
+    if (global_)
+        return true;
     double west = lon0_ - 0.5 * dlon_;
-    double u = (west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_ - lon0_) / dlon_;
+    double u =
+        (west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_ - lon0_) / dlon_;
     return u <= static_cast<double>(nlon_) - 0.5 + 1e-9;
 }
 
@@ -66,7 +73,7 @@ namespace {
 
 // The pair of grid lines around position u (in cell units, clamped to [0, n - 1]) and the
 // fraction of the way from the first to the second; a single line is its own pair.
-void bracket(double u, std::size_t n, std::size_t& k0, std::size_t& k1, double& f) {
+void bracket(double u, std::size_t n, std::size_t &k0, std::size_t &k1, double &f) {
     u = std::clamp(u, 0.0, static_cast<double>(n) - 1.0);
     if (n == 1) {
         k0 = k1 = 0;
@@ -81,7 +88,8 @@ void bracket(double u, std::size_t n, std::size_t& k0, std::size_t& k1, double& 
 } // namespace
 
 double Raster::sample(double lon, double lat) const {
-    if (values_.empty() || !std::isfinite(lon) || !std::isfinite(lat)) return nan_value;
+    if (values_.empty() || !std::isfinite(lon) || !std::isfinite(lat))
+        return nan_value;
     const double n_lon = static_cast<double>(nlon_);
     // Column position u in cell units from column 0, and the pair of columns around it.
     std::size_t i0, i1;
@@ -99,11 +107,13 @@ double Raster::sample(double lon, double lat) const {
         if (l < west - 1e-9 * dlon_ || l >= west + 360.0)
             l = west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_;
         double u = (l - lon0_) / dlon_;
-        if (u > n_lon - 0.5 + 1e-9) return nan_value;
+        if (u > n_lon - 0.5 + 1e-9)
+            return nan_value;
         bracket(u, nlon_, i0, i1, fu);
     }
     double v = (lat - lat0_) / dlat_;
-    if (v < v_lo_ || v > v_hi_) return nan_value;
+    if (v < v_lo_ || v > v_hi_)
+        return nan_value;
     std::size_t j0, j1;
     double fv;
     bracket(v, nlat_, j0, j1, fv);
@@ -115,7 +125,8 @@ double Raster::sample(double lon, double lat) const {
     // Some corner has no data: no data when the nearest corner has none, otherwise the
     // renormalised bilinear mean of the valid corners.
     double nearest = fu < 0.5 ? (fv < 0.5 ? z00 : z01) : (fv < 0.5 ? z10 : z11);
-    if (std::isnan(nearest)) return nan_value;
+    if (std::isnan(nearest))
+        return nan_value;
     double sum = 0, weight = 0;
     const double z[4] = {z00, z10, z01, z11}, w[4] = {w00, w10, w01, w11};
     for (int k = 0; k < 4; ++k)
@@ -128,11 +139,12 @@ double Raster::sample(double lon, double lat) const {
 
 double Raster::elevation_m(double lon, double lat) const {
     double z = sample(lon, lat);
-    if (std::isnan(z) && fill_) return *fill_;
+    if (std::isnan(z) && fill_)
+        return *fill_;
     return z;
 }
 
-double Raster::elevation_m(const Vec3& p) const {
+double Raster::elevation_m(const Vec3 &p) const {
     LonLat ll = vec_to_lonlat(p);
     return elevation_m(ll.lon, ll.lat);
 }

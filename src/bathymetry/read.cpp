@@ -28,25 +28,28 @@ using gdal::DatasetPtr;
 /// An argv list for the GDAL utilities, freed on scope exit.
 class StringList {
 public:
-    explicit StringList(std::initializer_list<const char*> items) {
-        for (const char* s : items) list_ = CSLAddString(list_, s);
+    explicit StringList(std::initializer_list<const char *> items) {
+        for (const char *s : items)
+            list_ = CSLAddString(list_, s);
     }
     ~StringList() { CSLDestroy(list_); }
-    StringList(const StringList&) = delete;
-    StringList& operator=(const StringList&) = delete;
-    char** get() const { return list_; }
-    void add(const char* s) { list_ = CSLAddString(list_, s); }
+    StringList(const StringList &) = delete;
+    StringList &operator=(const StringList &) = delete;
+    char **get() const { return list_; }
+    void add(const char *s) { list_ = CSLAddString(list_, s); }
 
 private:
-    char** list_ = nullptr;
+    char **list_ = nullptr;
 };
 
 /// True when the dataset's CRS is geographic in degrees and its geotransform is not rotated.
 bool is_plain_lonlat(GDALDatasetH ds, const double gt[6]) {
     OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
-    if (!srs || !OSRIsGeographic(srs)) return false;
+    if (!srs || !OSRIsGeographic(srs))
+        return false;
     double unit = OSRGetAngularUnits(srs, nullptr);
-    if (std::abs(unit - deg_to_rad) > 1e-12) return false;
+    if (std::abs(unit - deg_to_rad) > 1e-12)
+        return false;
     return gt[2] == 0 && gt[4] == 0 && gt[1] > 0 && gt[5] != 0;
 }
 
@@ -55,20 +58,25 @@ bool is_plain_lonlat(GDALDatasetH ds, const double gt[6]) {
 /// longitude / latitude, or units degrees_east / degrees_north (or CF's other spellings). Not
 /// when the file has 2-D coordinates (GDAL's GEOLOCATION arrays): its grid is not lon/lat.
 bool has_cf_lonlat_axes(GDALDatasetH ds) {
-    if (GDALGetMetadata(ds, "GEOLOCATION") != nullptr) return false;
-    static const char* const east[] = {"degrees_east", "degree_east", "degrees_e", "degree_e", "degreese", "degreee"};
-    static const char* const north[] = {"degrees_north", "degree_north", "degrees_n", "degree_n", "degreesn", "degreen"};
-    auto one_of = [](const std::string& v, const auto& list) {
-        return std::any_of(std::begin(list), std::end(list), [&](const char* u) { return v == u; });
+    if (GDALGetMetadata(ds, "GEOLOCATION") != nullptr)
+        return false;
+    static const char *const east[] = {"degrees_east", "degree_east", "degrees_e",
+                                       "degree_e",     "degreese",    "degreee"};
+    static const char *const north[] = {"degrees_north", "degree_north", "degrees_n",
+                                        "degree_n",      "degreesn",     "degreen"};
+    auto one_of = [](const std::string &v, const auto &list) {
+        return std::any_of(std::begin(list), std::end(list), [&](const char *u) { return v == u; });
     };
     bool lon = false, lat = false;
-    for (char** item = GDALGetMetadata(ds, nullptr); item && *item; ++item) {
+    for (char **item = GDALGetMetadata(ds, nullptr); item && *item; ++item) {
         const std::string s = *item;
         const std::size_t eq = s.find('='), hash = s.rfind('#', eq);
-        if (eq == std::string::npos || hash == std::string::npos) continue;
+        if (eq == std::string::npos || hash == std::string::npos)
+            continue;
         const std::string attribute = s.substr(hash + 1, eq - hash - 1);
         std::string value = s.substr(eq + 1);
-        std::transform(value.begin(), value.end(), value.begin(), [](unsigned char c) { return std::tolower(c); });
+        std::transform(value.begin(), value.end(), value.begin(),
+                       [](unsigned char c) { return std::tolower(c); });
         if (attribute == "standard_name") {
             lon = lon || value == "longitude";
             lat = lat || value == "latitude";
@@ -84,44 +92,51 @@ bool has_cf_lonlat_axes(GDALDatasetH ds) {
 /// degrees: latitudes within a cell of +-90, longitudes in -360..720 and at most 360 degrees
 /// and a cell wide.
 bool lonlat_extent(const double gt[6], int nx, int ny) {
-    if (gt[2] != 0 || gt[4] != 0 || !(gt[1] > 0) || gt[5] == 0) return false;
+    if (gt[2] != 0 || gt[4] != 0 || !(gt[1] > 0) || gt[5] == 0)
+        return false;
     const double west = gt[0], east = gt[0] + nx * gt[1];
     const double lat_a = gt[3], lat_b = gt[3] + ny * gt[5], cell = std::abs(gt[5]);
     return west >= -360 && east <= 720 && east - west <= 360 + 1.01 * gt[1] &&
-           std::min(lat_a, lat_b) >= -90 - 1.01 * cell && std::max(lat_a, lat_b) <= 90 + 1.01 * cell;
+           std::min(lat_a, lat_b) >= -90 - 1.01 * cell &&
+           std::max(lat_a, lat_b) <= 90 + 1.01 * cell;
 }
 
-/// ds with the CRS `srs` (WKT) in place of its own, as a lazy in-memory VRT (gdal_translate -a_srs).
-DatasetPtr with_srs(GDALDatasetH ds, const std::string& srs, const std::string& path) {
+/// ds with the CRS `srs` (WKT) in place of its own, as a lazy in-memory VRT (gdal_translate
+/// -a_srs).
+DatasetPtr with_srs(GDALDatasetH ds, const std::string &srs, const std::string &path) {
     StringList argv{"-of", "VRT", "-a_srs", srs.c_str()};
-    GDALTranslateOptions* opts = GDALTranslateOptionsNew(argv.get(), nullptr);
+    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
     GDALTranslateOptionsFree(opts);
-    if (!out) throw IoError(option("bathy") + " " + path + ": cannot assign its CRS: " + gdal::last_error());
+    if (!out)
+        throw IoError(option("bathy") + " " + path +
+                      ": cannot assign its CRS: " + gdal::last_error());
     return out;
 }
 
 /// --bathy-srs as a CRS; UsageError when it is none (or a local CRS of unknown units, or one
 /// with no WKT).
-gdal::SrsRefPtr parse_bathy_srs(const std::string& srs) {
+gdal::SrsRefPtr parse_bathy_srs(const std::string &srs) {
     gdal::QuietErrors quiet;
     gdal::SrsRefPtr parsed(OSRNewSpatialReference(nullptr));
-    char* wkt = nullptr;
-    const bool ok = OSRSetFromUserInput(parsed.get(), srs.c_str()) == OGRERR_NONE && !OSRIsLocal(parsed.get()) &&
-                    OSRExportToWkt(parsed.get(), &wkt) == OGRERR_NONE;
+    char *wkt = nullptr;
+    const bool ok = OSRSetFromUserInput(parsed.get(), srs.c_str()) == OGRERR_NONE &&
+                    !OSRIsLocal(parsed.get()) && OSRExportToWkt(parsed.get(), &wkt) == OGRERR_NONE;
     CPLFree(wkt);
     if (!ok)
-        throw UsageError(option("bathy_srs") + " '" + srs + "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
+        throw UsageError(option("bathy_srs") + " '" + srs +
+                         "' is not a CRS GDAL/PROJ understands (e.g. EPSG:4326)");
     return parsed;
 }
 
 /// The name of a CRS and its authority code when it has one: "WGS 84 (EPSG:4326)".
 std::string srs_name(OGRSpatialReferenceH srs) {
-    const char* name = OSRGetName(srs);
-    const char* auth = OSRGetAuthorityName(srs, nullptr);
-    const char* code = OSRGetAuthorityCode(srs, nullptr);
-    return std::string(name ? name : "a CRS") + (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
+    const char *name = OSRGetName(srs);
+    const char *auth = OSRGetAuthorityName(srs, nullptr);
+    const char *code = OSRGetAuthorityCode(srs, nullptr);
+    return std::string(name ? name : "a CRS") +
+           (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
 }
 
 /// The CRS read_raster gives a raster in place of its own: --bathy-srs when set (`srs`), WGS 84
@@ -132,26 +147,29 @@ struct AssignedCrs {
     std::string note;
 };
 
-AssignedCrs assign_crs(GDALDatasetH ds, const std::string& srs, const std::string& path) {
+AssignedCrs assign_crs(GDALDatasetH ds, const std::string &srs, const std::string &path) {
     OGRSpatialReferenceH own = GDALGetSpatialRef(ds);
-    if (own && OSRIsLocal(own)) own = nullptr; // a local CRS of unknown units is none
+    if (own && OSRIsLocal(own))
+        own = nullptr; // a local CRS of unknown units is none
     double gt[6];
     if (!srs.empty()) {
         const gdal::SrsRefPtr parsed = parse_bathy_srs(srs);
-        char* wkt = nullptr;
+        char *wkt = nullptr;
         OSRExportToWkt(parsed.get(), &wkt);
         const std::string text = wkt ? wkt : "";
         CPLFree(wkt);
-        const char* same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
+        const char *same_options[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES", nullptr};
         const bool replaced = own && !OSRIsSameEx(own, parsed.get(), same_options);
-        return {with_srs(ds, text, path), "CRS " + srs_name(parsed.get()) + " from --bathy-srs" +
-                                              (replaced ? ", not the file's " + srs_name(own) : "")};
+        return {with_srs(ds, text, path),
+                "CRS " + srs_name(parsed.get()) + " from --bathy-srs" +
+                    (replaced ? ", not the file's " + srs_name(own) : "")};
     }
     if (own || GDALGetGeoTransform(ds, gt) != CE_None || !has_cf_lonlat_axes(ds) ||
         !lonlat_extent(gt, GDALGetRasterXSize(ds), GDALGetRasterYSize(ds)))
         return {};
     return {with_srs(ds, SRS_WKT_WGS84_LAT_LONG, path),
-            "no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84 lon/lat, EPSG:4326"};
+            "no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84 lon/lat, "
+            "EPSG:4326"};
 }
 
 /// Columns of a lon/lat grid of pixel width dx degrees that go once round the globe: nx when
@@ -160,19 +178,22 @@ AssignedCrs assign_crs(GDALDatasetH ds, const std::string& srs, const std::strin
 /// or as float32 miss 360 by a fraction of a cell, and no regional grid comes that close.
 std::size_t global_columns(std::size_t nx, double dx) {
     for (std::size_t n : {nx, nx - 1})
-        if (n > 0 && std::abs(static_cast<double>(n) * dx - 360.0) <= 0.1 * dx) return n;
+        if (n > 0 && std::abs(static_cast<double>(n) * dx - 360.0) <= 0.1 * dx)
+            return n;
     return 0;
 }
 
 /// A VRT holding band `band` of ds alone (the warper takes every band otherwise).
-DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string& path) {
+DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string &path) {
     std::string b = std::to_string(band);
     StringList argv{"-of", "VRT", "-b", b.c_str()};
-    GDALTranslateOptions* opts = GDALTranslateOptionsNew(argv.get(), nullptr);
+    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
     GDALTranslateOptionsFree(opts);
-    if (!out) throw IoError(option("bathy") + " " + path + ": cannot select band " + b + ": " + gdal::last_error());
+    if (!out)
+        throw IoError(option("bathy") + " " + path + ": cannot select band " + b + ": " +
+                      gdal::last_error());
     return out;
 }
 
@@ -182,14 +203,16 @@ DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string& path) {
 double finest_lonlat_step(GDALDatasetH ds) {
     double gt[6];
     OGRSpatialReferenceH src = GDALGetSpatialRef(ds);
-    if (!src || GDALGetGeoTransform(ds, gt) != CE_None) return 0;
+    if (!src || GDALGetGeoTransform(ds, gt) != CE_None)
+        return 0;
     gdal::SrsRefPtr dst(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(dst.get(), 4326);
     OSRSetAxisMappingStrategy(dst.get(), OAMS_TRADITIONAL_GIS_ORDER);
     gdal::SrsRefPtr src_copy(OSRClone(src));
     OSRSetAxisMappingStrategy(src_copy.get(), OAMS_TRADITIONAL_GIS_ORDER);
     gdal::TransformPtr ct(OCTNewCoordinateTransformation(src_copy.get(), dst.get()));
-    if (!ct) return 0;
+    if (!ct)
+        return 0;
     const double nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
     double best = 0;
     for (int a = 0; a <= 20; ++a)
@@ -202,12 +225,12 @@ double finest_lonlat_step(GDALDatasetH ds) {
                 x[k] = gt[0] + qx * gt[1] + qy * gt[2];
                 y[k] = gt[3] + qx * gt[4] + qy * gt[5];
             }
-            if (!OCTTransformEx(ct.get(), 3, x, y, z, ok) ||
-                !ok[0] || !ok[1] || !ok[2])
+            if (!OCTTransformEx(ct.get(), 3, x, y, z, ok) || !ok[0] || !ok[1] || !ok[2])
                 continue;
             for (int k = 1; k < 3; ++k) {
                 double step = std::hypot(x[k] - x[0], y[k] - y[0]);
-                if (step > 0 && std::isfinite(step) && (best == 0 || step < best)) best = step;
+                if (step > 0 && std::isfinite(step) && (best == 0 || step < best))
+                    best = step;
             }
         }
     return best;
@@ -215,23 +238,23 @@ double finest_lonlat_step(GDALDatasetH ds) {
 
 /// ds warped to EPSG:4326 as a lazy in-memory VRT: bilinear, exact transformer, Float32 with NaN
 /// where the source has no data or no coverage, at the source's finest pixel size.
-DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string& path) {
+DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
     const std::string res = std::to_string(finest_lonlat_step(ds));
-    StringList argv{"-of", "VRT", "-t_srs", "EPSG:4326", "-r", "bilinear", "-et", "0",
-                    "-ot", "Float32", "-dstnodata", "nan"};
+    StringList argv{"-of", "VRT", "-t_srs", "EPSG:4326", "-r",         "bilinear",
+                    "-et", "0",   "-ot",    "Float32",   "-dstnodata", "nan"};
     if (res != "0.000000") {
         argv.add("-tr");
         argv.add(res.c_str());
         argv.add(res.c_str());
     }
-    GDALWarpAppOptions* opts = GDALWarpAppOptionsNew(argv.get(), nullptr);
+    GDALWarpAppOptions *opts = GDALWarpAppOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
     GDALDatasetH src = ds;
     DatasetPtr out(GDALWarp("", nullptr, 1, &src, opts, &usage_error));
     GDALWarpAppOptionsFree(opts);
     if (!out)
-        throw DataError(option("bathy") + " " + path + ": cannot reproject to lon/lat (EPSG:4326): " +
-                        gdal::last_error());
+        throw DataError(option("bathy") + " " + path +
+                        ": cannot reproject to lon/lat (EPSG:4326): " + gdal::last_error());
     return out;
 }
 
@@ -244,9 +267,11 @@ struct Window {
     std::size_t c_lo, c_hi, r_lo, r_hi;
 };
 
-Window window_of(const LonLatBounds& b, const double gt[6], std::size_t nx, std::size_t ny, double min_cell_deg) {
+Window window_of(const LonLatBounds &b, const double gt[6], std::size_t nx, std::size_t ny,
+                 double min_cell_deg) {
     const Window whole{0, nx, 0, ny};
-    const double mx = 3 * std::max(std::abs(gt[1]), min_cell_deg), my = 3 * std::max(std::abs(gt[5]), min_cell_deg);
+    const double mx = 3 * std::max(std::abs(gt[1]), min_cell_deg),
+                 my = 3 * std::max(std::abs(gt[5]), min_cell_deg);
     const double r_west = gt[0], r_east = gt[0] + static_cast<double>(nx) * gt[1];
     const bool global = std::abs(r_east - r_west - 360.0) <= 1e-6 * std::abs(gt[1]);
     // Columns: the shift of the box that overlaps the raster most.
@@ -261,17 +286,22 @@ Window window_of(const LonLatBounds& b, const double gt[6], std::size_t nx, std:
             hi = e;
         }
     }
-    if (best_overlap <= 0) return whole;
+    if (best_overlap <= 0)
+        return whole;
     Window out = whole;
     if (hi - lo < 360 && (!global || (lo >= r_west && hi <= r_east))) {
-        out.c_lo = static_cast<std::size_t>(std::clamp(std::floor((std::max(lo, r_west) - r_west) / gt[1]), 0.0, double(nx)));
-        out.c_hi = static_cast<std::size_t>(std::clamp(std::ceil((std::min(hi, r_east) - r_west) / gt[1]), 0.0, double(nx)));
+        out.c_lo = static_cast<std::size_t>(
+            std::clamp(std::floor((std::max(lo, r_west) - r_west) / gt[1]), 0.0, double(nx)));
+        out.c_hi = static_cast<std::size_t>(
+            std::clamp(std::ceil((std::min(hi, r_east) - r_west) / gt[1]), 0.0, double(nx)));
     }
     // Rows (north-up or south-up).
     const double y_s = (b.south - my - gt[3]) / gt[5], y_n = (b.north + my - gt[3]) / gt[5];
-    out.r_lo = static_cast<std::size_t>(std::clamp(std::floor(std::min(y_s, y_n)), 0.0, double(ny)));
+    out.r_lo =
+        static_cast<std::size_t>(std::clamp(std::floor(std::min(y_s, y_n)), 0.0, double(ny)));
     out.r_hi = static_cast<std::size_t>(std::clamp(std::ceil(std::max(y_s, y_n)), 0.0, double(ny)));
-    if (out.c_hi <= out.c_lo || out.r_hi <= out.r_lo) return whole;
+    if (out.c_hi <= out.c_lo || out.r_hi <= out.r_lo)
+        return whole;
     return out;
 }
 
@@ -289,9 +319,9 @@ std::string fmt_count(double v) {
 
 /// Reads the window (columns c0 .. c0 + nx - 1, rows r0 .. r0 + ny - 1) of the band into
 /// `values`, bx x by cells (GDAL's average when that is coarser), as float.
-void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std::size_t nx, std::size_t ny,
-                 std::size_t bx, std::size_t by, std::vector<float>& values, const Progress& progress,
-                 const std::string& stage, const std::string& path) {
+void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std::size_t nx,
+                 std::size_t ny, std::size_t bx, std::size_t by, std::vector<float> &values,
+                 const Progress &progress, const std::string &stage, const std::string &path) {
     const double sy = static_cast<double>(ny) / static_cast<double>(by);
     // Strips of rows, so that progress and cancellation are reported while GDAL reads its blocks.
     int block_x = 0, block_y = 0;
@@ -301,8 +331,9 @@ void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std:
         std::size_t s1 = std::min(by, s0 + strip);
         GDALRasterIOExtraArg extra;
         INIT_RASTERIO_EXTRA_ARG(extra);
-        gdal::ProgressBridge bridge{&progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
-                                    0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
+        gdal::ProgressBridge bridge{
+            &progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
+            0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
         if (progress) {
             extra.pfnProgress = gdal::ProgressBridge::call;
             extra.pProgressData = &bridge;
@@ -318,20 +349,23 @@ void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std:
             extra.dfYOff = static_cast<double>(r0) + y0;
             extra.dfYSize = y1 - y0;
         }
-        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0), static_cast<int>(r0) + iy0,
-                                    static_cast<int>(nx), iy1 - iy0, values.data() + s0 * bx, static_cast<int>(bx),
+        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0),
+                                    static_cast<int>(r0) + iy0, static_cast<int>(nx), iy1 - iy0,
+                                    values.data() + s0 * bx, static_cast<int>(bx),
                                     static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
-        if (bridge.cancelled) throw Cancelled();
-        if (err != CE_None) throw IoError(option("bathy") + " " + path + ": read failed: " + gdal::last_error());
+        if (bridge.cancelled)
+            throw Cancelled();
+        if (err != CE_None)
+            throw IoError(option("bathy") + " " + path + ": read failed: " + gdal::last_error());
     }
 }
 
 /// Raw values -> metres, elevation positive up; nodata and NaN -> NaN.
-void to_elevation(std::vector<float>& values, double scale, double offset, int has_nodata, double nodata,
-                  bool depth_positive) {
+void to_elevation(std::vector<float> &values, double scale, double offset, int has_nodata,
+                  double nodata, bool depth_positive) {
     const float nodata_f = static_cast<float>(nodata);
     const bool nodata_nan = has_nodata && std::isnan(nodata);
-    for (float& v : values) {
+    for (float &v : values) {
         if (!std::isfinite(v) || (has_nodata && !nodata_nan && v == nodata_f)) {
             v = std::numeric_limits<float>::quiet_NaN();
             continue;
@@ -343,7 +377,7 @@ void to_elevation(std::vector<float>& values, double scale, double offset, int h
 
 } // namespace
 
-Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
+Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
                    std::size_t max_cells) {
     RasterLimits limits;
     limits.max_cells = max_cells;
@@ -357,32 +391,37 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
 class BlockCacheCap {
 public:
     explicit BlockCacheCap(std::uint64_t budget_bytes) : old_(GDALGetCacheMax64()) {
-        if (CPLGetConfigOption("GDAL_CACHEMAX", nullptr)) return;
+        if (CPLGetConfigOption("GDAL_CACHEMAX", nullptr))
+            return;
         GIntBig cap = GIntBig{64} << 20;
-        if (budget_bytes > 0) cap = std::min<GIntBig>(cap, std::max<GIntBig>(GIntBig{4} << 20, GIntBig(budget_bytes / 4)));
+        if (budget_bytes > 0)
+            cap = std::min<GIntBig>(cap,
+                                    std::max<GIntBig>(GIntBig{4} << 20, GIntBig(budget_bytes / 4)));
         if (cap < old_) {
             GDALSetCacheMax64(cap);
             set_ = true;
         }
     }
     ~BlockCacheCap() {
-        if (set_) GDALSetCacheMax64(old_);
+        if (set_)
+            GDALSetCacheMax64(old_);
     }
-    BlockCacheCap(const BlockCacheCap&) = delete;
-    BlockCacheCap& operator=(const BlockCacheCap&) = delete;
+    BlockCacheCap(const BlockCacheCap &) = delete;
+    BlockCacheCap &operator=(const BlockCacheCap &) = delete;
 
 private:
     GIntBig old_;
     bool set_ = false;
 };
 
-Raster read_raster(const std::string& path, int band, bool depth_positive, const Progress& progress,
-                   const RasterLimits& limits, const std::string& srs) {
+Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
+                   const RasterLimits &limits, const std::string &srs) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
     const BlockCacheCap cache(limits.max_bytes);
 
-    DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    DatasetPtr ds(
+        GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds)
         throw IoError(option("bathy") + " " + path + ": cannot open as a raster: " +
                       gdal::last_error("not a raster format GDAL reads"));
@@ -396,16 +435,19 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // The CRS given in place of the file's (--bathy-srs, or lon/lat for CF lon/lat axes) is
     // said on the progress line, which --verbose shows.
     const AssignedCrs assigned = assign_crs(h, srs, path);
-    const std::string stage = assigned.dataset ? "read bathymetry (" + assigned.note + ")" : "read bathymetry";
+    const std::string stage =
+        assigned.dataset ? "read bathymetry (" + assigned.note + ")" : "read bathymetry";
     report(progress, 0.0, stage);
     GDALDatasetH geo = assigned.dataset ? assigned.dataset.get() : h; // the source with its CRS
 
     // Scale, offset and nodata belong to the original band; the warper keeps raw values.
     int has = 0;
     double scale = GDALGetRasterScale(src_band, &has);
-    if (!has || !std::isfinite(scale) || scale == 0) scale = 1.0;
+    if (!has || !std::isfinite(scale) || scale == 0)
+        scale = 1.0;
     double offset = GDALGetRasterOffset(src_band, &has);
-    if (!has || !std::isfinite(offset)) offset = 0.0;
+    if (!has || !std::isfinite(offset))
+        offset = 0.0;
     int has_nodata = 0;
     double nodata = GDALGetRasterNoDataValue(src_band, &has_nodata);
 
@@ -414,10 +456,13 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // units: no more georeferenced than one with none.
     const OGRSpatialReferenceH crs = GDALGetSpatialRef(geo);
     if (GDALGetGeoTransform(geo, gt) != CE_None || !crs || OSRIsLocal(crs))
-        throw DataError(option("bathy") + " " + path +
-                        ": has no georeferencing (a geotransform and a geographic or projected CRS); give its "
-                        "CRS with " + option("bathy_srs") + " (e.g. EPSG:4326), or assign both, e.g. gdal_translate -a_srs "
-                        "EPSG:4326 -a_ullr W N E S");
+        throw DataError(
+            option("bathy") + " " + path +
+            ": has no georeferencing (a geotransform and a geographic or projected CRS); give its "
+            "CRS with " +
+            option("bathy_srs") +
+            " (e.g. EPSG:4326), or assign both, e.g. gdal_translate -a_srs "
+            "EPSG:4326 -a_ullr W N E S");
 
     // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
     DatasetPtr band_vrt, warped;
@@ -428,7 +473,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
         warped = warped_to_lonlat(band_vrt.get(), path);
         read_band = GDALGetRasterBand(warped.get(), 1);
         if (GDALGetGeoTransform(warped.get(), gt) != CE_None)
-            throw DataError(option("bathy") + " " + path + ": the warped raster has no geotransform");
+            throw DataError(option("bathy") + " " + path +
+                            ": the warped raster has no geotransform");
         has_nodata = 0; // the warper writes NaN where there is no data
     }
     GDALDatasetH read_ds = warped ? warped.get() : h;
@@ -447,7 +493,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     // The window of limits.window: columns c0 .. c0 + nx - 1 and rows r0 .. r0 + ny - 1.
     std::size_t c0 = 0, r0 = 0;
     if (limits.window) {
-        const auto [c_lo, c_hi, r_lo, r_hi] = window_of(*limits.window, gt, nx, ny, limits.min_cell_deg);
+        const auto [c_lo, c_hi, r_lo, r_hi] =
+            window_of(*limits.window, gt, nx, ny, limits.min_cell_deg);
         c0 = c_lo;
         r0 = r_lo;
         nx = c_hi - c_lo;
@@ -459,9 +506,12 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     double cx = static_cast<double>(nx), cy = static_cast<double>(ny);
     if (limits.min_cell_deg > 0) {
         // Rounded up, so a cell never gets coarser than asked; 1e-9 absorbs the step's rounding.
-        const double fx = limits.min_cell_deg / std::abs(gt[1]), fy = limits.min_cell_deg / std::abs(gt[5]);
-        if (fx > 1) cx = std::max(1.0, std::ceil(cx / fx - 1e-9));
-        if (fy > 1) cy = std::max(1.0, std::ceil(cy / fy - 1e-9));
+        const double fx = limits.min_cell_deg / std::abs(gt[1]),
+                     fy = limits.min_cell_deg / std::abs(gt[5]);
+        if (fx > 1)
+            cx = std::max(1.0, std::ceil(cx / fx - 1e-9));
+        if (fy > 1)
+            cy = std::max(1.0, std::ceil(cy / fy - 1e-9));
     }
     if (limits.max_cells > 0 && cx * cy > static_cast<double>(limits.max_cells)) {
         double f = std::sqrt(cx * cy / static_cast<double>(limits.max_cells));
@@ -470,11 +520,13 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     }
     const double bytes = cx * cy * static_cast<double>(sizeof(float));
     if (limits.max_bytes > 0 && bytes > static_cast<double>(limits.max_bytes))
-        throw DataError(option("bathy") + " " + path + ": " + std::to_string(nx) + " x " + std::to_string(ny) +
-                        " cells, read as " + fmt_count(cx) + " x " + fmt_count(cy) + " (" + memory_text(bytes) +
-                        "), exceed the " + memory_text(static_cast<double>(limits.max_bytes)) +
-                        " that " + option("max_memory_bytes") + " leaves for it; raise " + option("max_memory_bytes") + " or " +
-                        option("hmin_km") + ", or give a "
+        throw DataError(option("bathy") + " " + path + ": " + std::to_string(nx) + " x " +
+                        std::to_string(ny) + " cells, read as " + fmt_count(cx) + " x " +
+                        fmt_count(cy) + " (" + memory_text(bytes) + "), exceed the " +
+                        memory_text(static_cast<double>(limits.max_bytes)) + " that " +
+                        option("max_memory_bytes") + " leaves for it; raise " +
+                        option("max_memory_bytes") + " or " + option("hmin_km") +
+                        ", or give a "
                         "coarser raster (gdal_translate -tr)");
     const std::size_t bx = static_cast<std::size_t>(cx), by = static_cast<std::size_t>(cy);
     const double sx = static_cast<double>(nx) / static_cast<double>(bx);
@@ -486,7 +538,8 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
 
     to_elevation(values, scale, offset, has_nodata, nodata, depth_positive);
 
-    const double west = gt[0] + static_cast<double>(c0) * gt[1], top = gt[3] + static_cast<double>(r0) * gt[5];
+    const double west = gt[0] + static_cast<double>(c0) * gt[1],
+                 top = gt[3] + static_cast<double>(r0) * gt[5];
     Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
     if (raster.valid_count() == 0)
         throw DataError(option("bathy") + " " + path + ": band " + std::to_string(band) +
@@ -495,11 +548,12 @@ Raster read_raster(const std::string& path, int band, bool depth_positive, const
     return raster;
 }
 
-void validate_bathy_srs(const std::string& srs) {
-    if (!srs.empty()) parse_bathy_srs(srs);
+void validate_bathy_srs(const std::string &srs) {
+    if (!srs.empty())
+        parse_bathy_srs(srs);
 }
 
-RasterLimits bathymetry_limits(const MeshOptions& o, const Boundary* ocean) {
+RasterLimits bathymetry_limits(const MeshOptions &o, const Boundary *ocean) {
     // The mesh samples the raster at its nodes and on the size field's grid (spacing hfloor / 2):
     // finer cells only alias there, so they are averaged to that size.
     const double hfloor_km = size_floor_km(o);
@@ -508,18 +562,19 @@ RasterLimits bathymetry_limits(const MeshOptions& o, const Boundary* ocean) {
     limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh
     std::optional<LonLatBounds> box;
     if (o.region) {
-        const auto& r = *o.region;
+        const auto &r = *o.region;
         box = LonLatBounds{r[0], r[1], r[2] > r[0] ? r[2] : r[2] + 360, r[3]};
     } else if (!o.region_file.empty() && ocean) {
         box = ocean_extent(*ocean);
-        if (box && box->east - box->west >= 360 && box->south <= -90 && box->north >= 90) box.reset();
+        if (box && box->east - box->west >= 360 && box->south <= -90 && box->north >= 90)
+            box.reset();
     }
     if (box) {
         // The region and 1% of its larger side: the size field's grid over it reaches a cell
         // beyond, and its cells are at most 1/2048 of that side (pipeline.cpp, 2^22 nodes).
         const double pad = 0.01 * std::max(box->east - box->west, box->north - box->south);
-        limits.window = LonLatBounds{box->west - pad, std::max(-90.0, box->south - pad), box->east + pad,
-                                     std::min(90.0, box->north + pad)};
+        limits.window = LonLatBounds{box->west - pad, std::max(-90.0, box->south - pad),
+                                     box->east + pad, std::min(90.0, box->north + pad)};
     }
     return limits;
 }
@@ -528,11 +583,12 @@ namespace {
 
 /// How far (degrees, the larger of the two axes) a point lies outside the box b, 0 inside it;
 /// longitudes taken modulo 360.
-double outside_deg(const LonLatBounds& b, double lon, double lat) {
+double outside_deg(const LonLatBounds &b, double lon, double lat) {
     const double dlat = std::max({0.0, b.south - lat, lat - b.north});
     double dlon = 0;
     if (b.east - b.west < 360) {
-        const double x = b.west + std::fmod(std::fmod(lon - b.west, 360.0) + 360.0, 360.0); // in [west, west + 360)
+        const double x = b.west + std::fmod(std::fmod(lon - b.west, 360.0) + 360.0,
+                                            360.0); // in [west, west + 360)
         dlon = x <= b.east ? 0.0 : std::min(x - b.east, b.west + 360 - x);
     }
     return std::max(dlat, dlon);
@@ -541,51 +597,64 @@ double outside_deg(const LonLatBounds& b, double lon, double lat) {
 /// The point of the ocean's outline (its rings' nodes, and on segments longer than a raster
 /// cell points a quarter of a cell apart, as the great-circle arcs bulge) or a pole inside it
 /// that r does not cover, farthest outside r; nullopt when r covers them all.
-std::optional<LonLat> uncovered_point(const Raster& r, const Boundary& ocean) {
-    const double cell = std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad, step = 0.25 * cell;
+std::optional<LonLat> uncovered_point(const Raster &r, const Boundary &ocean) {
+    const double cell = std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad,
+                 step = 0.25 * cell;
     const LonLatBounds b = r.bounds();
     std::optional<LonLat> worst;
     double worst_deg = -1;
-    auto check = [&](const LonLat& p) {
-        if (r.contains(p.lon, p.lat)) return;
-        if (const double d = outside_deg(b, p.lon, p.lat); d > worst_deg) worst_deg = d, worst = p;
+    auto check = [&](const LonLat &p) {
+        if (r.contains(p.lon, p.lat))
+            return;
+        if (const double d = outside_deg(b, p.lon, p.lat); d > worst_deg)
+            worst_deg = d, worst = p;
     };
-    for (const Ring& ring : ocean.rings) {
+    for (const Ring &ring : ocean.rings) {
         for (std::size_t i = 0; i < ring.nodes.size(); ++i) {
             const Vec3 &a = ring.nodes[i], &c = ring.nodes[(i + 1) % ring.nodes.size()];
             const double arc = arc_angle(a, c);
-            const int parts = arc > cell ? static_cast<int>(std::min(1e4, std::ceil(arc / step))) : 1;
+            const int parts =
+                arc > cell ? static_cast<int>(std::min(1e4, std::ceil(arc / step))) : 1;
             check(vec_to_lonlat(a));
-            for (int k = 1; k < parts; ++k) check(vec_to_lonlat(arc_interpolate(a, c, double(k) / parts)));
+            for (int k = 1; k < parts; ++k)
+                check(vec_to_lonlat(arc_interpolate(a, c, double(k) / parts)));
         }
     }
     const int winding = ocean_pole_winding(ocean);
-    if (winding > 0) check(LonLat{0, 90});
-    if (winding < 0) check(LonLat{0, -90});
+    if (winding > 0)
+        check(LonLat{0, 90});
+    if (winding < 0)
+        check(LonLat{0, -90});
     return worst;
 }
 
 } // namespace
 
-Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Boundary* ocean) {
-    if (o.bathy.empty()) throw UsageError(option("bathy") + ": no raster given");
+Raster read_bathymetry(const MeshOptions &o, const Progress &progress, const Boundary *ocean) {
+    if (o.bathy.empty())
+        throw UsageError(option("bathy") + ": no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
         throw UsageError(option("bathy_fill_m") + " must be a depth in metres");
-    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress, bathymetry_limits(o, ocean), o.bathy_srs);
+    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress,
+                           bathymetry_limits(o, ocean), o.bathy_srs);
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
         return r;
     }
     const LonLatBounds b = r.bounds();
-    const ErrorText covers = option("bathy") + " " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." + fmt_deg(b.east) +
-                               ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north);
-    const ErrorText remedy = "; pass " + option("bathy_fill_m") + " DEPTH for the rest, or a " + option("region") + " or " +
-                             option("region_file") + " inside the raster";
+    const ErrorText covers = option("bathy") + " " + o.bathy + ": covers only lon " +
+                             fmt_deg(b.west) + ".." + fmt_deg(b.east) + ", lat " +
+                             fmt_deg(b.south) + ".." + fmt_deg(b.north);
+    const ErrorText remedy = "; pass " + option("bathy_fill_m") + " DEPTH for the rest, or a " +
+                             option("region") + " or " + option("region_file") +
+                             " inside the raster";
     // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
     if (ocean && !ocean->rings.empty() && (o.region || !o.region_file.empty())) {
         if (const auto p = uncovered_point(r, *ocean))
-            throw DataError(covers + " but the ocean of " + (o.region ? option("region") : option("region_file") + " " + o.region_file) +
-                            " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
+            throw DataError(
+                covers + " but the ocean of " +
+                (o.region ? option("region") : option("region_file") + " " + o.region_file) +
+                " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
         return r;
     }
     // Coverage of the region (the whole globe without --region), on a dense set of points.
@@ -595,7 +664,8 @@ Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Bou
         s = (*o.region)[1];
         e = (*o.region)[2];
         n = (*o.region)[3];
-        if (e <= w) e += 360;
+        if (e <= w)
+            e += 360;
     }
     const int steps = 720;
     bool covered = true;
@@ -606,7 +676,10 @@ Raster read_bathymetry(const MeshOptions& o, const Progress& progress, const Bou
                   r.contains(lon, s) && r.contains(lon, n);
     }
     if (!covered)
-        throw DataError(covers + (o.region ? " but not all of " + option("region") : ErrorText(" but the region is the whole globe")) + remedy);
+        throw DataError(covers +
+                        (o.region ? " but not all of " + option("region")
+                                  : ErrorText(" but the region is the whole globe")) +
+                        remedy);
     return r;
 }
 

@@ -84,7 +84,7 @@ constexpr std::uintptr_t page_bytes = 4096;
 // fixed table scanned under a lock is enough, and it allocates nothing itself; when it is full,
 // blocks come from malloc as smaller ones do.
 struct Mapping {
-    void* at;
+    void *at;
     std::size_t bytes;
 };
 constexpr std::size_t max_mappings = 1024;
@@ -98,16 +98,20 @@ std::mutex mappings_lock;
 // an advised mapping: the blocks of 1 to 4 MiB that a mesh of 1e5 nodes is made of got few huge
 // pages or none, and were filled 4 KiB page fault by page fault. Rounding a block under 2 MiB up
 // to one huge page costs its unused part once touched, at most 1 MiB a block.
-void* map_block(std::size_t n) {
-    const std::size_t bytes = n < huge_page_bytes ? huge_page_bytes : (n + page_bytes - 1) & ~(page_bytes - 1);
+void *map_block(std::size_t n) {
+    const std::size_t bytes =
+        n < huge_page_bytes ? huge_page_bytes : (n + page_bytes - 1) & ~(page_bytes - 1);
     const std::size_t span = bytes + huge_page_bytes; // room to slide to a 2 MiB boundary
-    void* raw = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (raw == MAP_FAILED) return nullptr;
+    void *raw = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED)
+        return nullptr;
     const auto first = reinterpret_cast<std::uintptr_t>(raw);
     const auto at = (first + huge_page_bytes - 1) & ~(huge_page_bytes - 1);
-    if (at > first) munmap(raw, at - first);
-    if (first + span > at + bytes) munmap(reinterpret_cast<void*>(at + bytes), first + span - (at + bytes));
-    void* p = reinterpret_cast<void*>(at);
+    if (at > first)
+        munmap(raw, at - first);
+    if (first + span > at + bytes)
+        munmap(reinterpret_cast<void *>(at + bytes), first + span - (at + bytes));
+    void *p = reinterpret_cast<void *>(at);
     madvise(p, bytes, MADV_HUGEPAGE); // advice only: a failure changes nothing
     const std::lock_guard<std::mutex> hold(mappings_lock);
     if (mapping_count == max_mappings) {
@@ -120,8 +124,9 @@ void* map_block(std::size_t n) {
 
 // Unmaps p when map_block made it; false otherwise (malloc's blocks are never 2 MiB-aligned
 // but by chance, which the table settles).
-bool unmap_block(void* p) {
-    if ((reinterpret_cast<std::uintptr_t>(p) & (huge_page_bytes - 1)) != 0) return false;
+bool unmap_block(void *p) {
+    if ((reinterpret_cast<std::uintptr_t>(p) & (huge_page_bytes - 1)) != 0)
+        return false;
     const std::lock_guard<std::mutex> hold(mappings_lock);
     for (std::size_t i = 0; i < mapping_count; ++i)
         if (mappings[i].at == p) {
@@ -138,23 +143,29 @@ bool unmap_block(void* p) {
 // blocks from map_block, the others (and large ones map_block cannot give) from malloc as by
 // default. libstdc++'s array, nothrow and sized forms call these two, so these are the two to
 // replace; the over-aligned forms keep their own (aligned_alloc and free).
-void* operator new(std::size_t n) {
-    if (n == 0) n = 1;
+void *operator new(std::size_t n) {
+    if (n == 0)
+        n = 1;
     if (n >= globemesh::own_mapping_bytes)
-        if (void* p = map_block(n)) return p;
-    void* p;
+        if (void *p = map_block(n))
+            return p;
+    void *p;
     while ((p = std::malloc(n)) == nullptr) {
         std::new_handler handler = std::get_new_handler();
-        if (!handler) throw std::bad_alloc();
+        if (!handler)
+            throw std::bad_alloc();
         handler();
     }
     return p;
 }
 
-void operator delete(void* p) noexcept {
-    if (p != nullptr && unmap_block(p)) return;
+void operator delete(void *p) noexcept {
+    if (p != nullptr && unmap_block(p))
+        return;
     std::free(p);
 }
 
-void operator delete(void* p, std::size_t) noexcept { operator delete(p); }
+void operator delete(void *p, std::size_t) noexcept {
+    operator delete(p);
+}
 #endif

@@ -33,8 +33,8 @@ class InterruptGuard {
 public:
     InterruptGuard();
     ~InterruptGuard();
-    InterruptGuard(const InterruptGuard&) = delete;
-    InterruptGuard& operator=(const InterruptGuard&) = delete;
+    InterruptGuard(const InterruptGuard &) = delete;
+    InterruptGuard &operator=(const InterruptGuard &) = delete;
     static bool interrupted();
     /// The signal that cancelled the last run (kept after the guard is gone), or 0.
     static int signal();
@@ -51,7 +51,7 @@ public:
     static constexpr std::chrono::milliseconds stop_grace{1000};
 
 private:
-    struct sigaction previous_[std::size(cancelling)] {};
+    struct sigaction previous_[std::size(cancelling)]{};
     bool installed_[std::size(cancelling)] = {};
     std::thread watchdog_;
 };
@@ -64,7 +64,7 @@ private:
 /// the line starts at the first tick after 0, so an early error is not preceded by a lone "0".
 class TerminalProgress {
 public:
-    explicit TerminalProgress(std::ostream& err) : err_(err) {}
+    explicit TerminalProgress(std::ostream &err) : err_(err) {}
     void configure(bool quiet, bool verbose) { quiet_ = quiet, verbose_ = verbose; }
     bool update(double fraction, std::string_view stage);
     Progress callback() {
@@ -76,7 +76,7 @@ public:
     void finish() { update(1.0, stage_); }
 
 private:
-    std::ostream& err_;
+    std::ostream &err_;
     bool quiet_ = false, verbose_ = false, mid_line_ = false;
     int last_tick_ = -1;
     std::string stage_;
@@ -85,23 +85,23 @@ private:
 /// A JSON number (shortest round-trip form) or null when not finite.
 std::string json_number(double v);
 /// A JSON string literal with escapes.
-std::string json_string(const std::string& s);
+std::string json_string(const std::string &s);
 
 /// {name: seconds, ...} in run order.
-std::string stages_json(const StageTimings& timings);
+std::string stages_json(const StageTimings &timings);
 /// {"stages": {name: seconds, ...}} and a newline: the --timings file.
-inline std::string timings_json(const StageTimings& timings) {
+inline std::string timings_json(const StageTimings &timings) {
     return "{\"stages\": " + stages_json(timings) + "}\n";
 }
 
 /// The statistics of compute_stats as a JSON object (no trailing newline), indented by `indent`.
-std::string stats_json(const MeshStats& stats, const std::string& indent);
+std::string stats_json(const MeshStats &stats, const std::string &indent);
 
 /// Human-readable statistics (counts, extent, quality, edge lengths, size ratio, histogram).
-void print_stats(std::ostream& out, const MeshStats& stats, bool histogram);
+void print_stats(std::ostream &out, const MeshStats &stats, bool histogram);
 
 /// Seconds per stage on one line per stage.
-void print_timings(std::ostream& out, const StageTimings& timings);
+void print_timings(std::ostream &out, const StageTimings &timings);
 
 /// Peak resident memory of this process in bytes (getrusage ru_maxrss).
 long long peak_memory_bytes();
@@ -117,16 +117,16 @@ std::uint64_t default_memory_budget_bytes();
 
 /// Throws IoError when `path`'s folder does not exist, or when `path` exists and !overwrite.
 /// `what` names the option, e.g. "--gpkg".
-void check_output_path(const std::string& path, const std::string& what, bool overwrite);
+void check_output_path(const std::string &path, const std::string &what, bool overwrite);
 
 /// Throws IoError when a local input file is missing; GDAL virtual paths (/vsi...) and
 /// connection strings (PG:..., https://...) are left to GDAL.
-void check_input_path(const std::string& path, const std::string& what);
+void check_input_path(const std::string &path, const std::string &what);
 
 /// Throws UsageError when output `path` (option `what`) is the very file of one of `inputs`
 /// (option, path; through links and other spellings): --overwrite would replace the data the run
 /// reads (gdal_translate refuses the same).
-void check_not_an_input(const std::string& path, const std::string& what,
+void check_not_an_input(const std::string &path, const std::string &what,
                         std::span<const std::pair<std::string, std::string>> inputs);
 
 } // namespace globemesh::cli

@@ -7,17 +7,19 @@ namespace globemesh {
 
 CliLibrary library_calls() {
     CliLibrary lib;
-    lib.mesh_ocean = [](const MeshOptions& o, const Progress& p, StageTimings* t) { return mesh_ocean(o, p, t); };
-    lib.triangulate_file = [](const TriangulateOptions& o, const Progress& p, StageTimings* t) {
+    lib.mesh_ocean = [](const MeshOptions &o, const Progress &p, StageTimings *t) {
+        return mesh_ocean(o, p, t);
+    };
+    lib.triangulate_file = [](const TriangulateOptions &o, const Progress &p, StageTimings *t) {
         return triangulate_file(o, p, t);
     };
     lib.writers = writers();
-    lib.read_ugrid = [](const std::filesystem::path& p) { return read_ugrid(p); };
-    lib.compute_stats = [](const Mesh& m) { return compute_stats(m); };
+    lib.read_ugrid = [](const std::filesystem::path &p) { return read_ugrid(p); };
+    lib.compute_stats = [](const Mesh &m) { return compute_stats(m); };
     return lib;
 }
 
-int run_cli(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
+int run_cli(std::span<const std::string> args, std::ostream &out, std::ostream &err) {
     return run_cli(args, out, err, library_calls());
 }
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <string_view>
 
-#include "globemesh/cli.hpp"
 #include "cli_support.hpp"
+#include "globemesh/cli.hpp"
 #include "globemesh/error.hpp"
 
 namespace globemesh {
@@ -20,8 +20,10 @@ struct Unit {
 };
 
 std::string_view trim(std::string_view s) {
-    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front())))
+        s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back())))
+        s.remove_suffix(1);
     return s;
 }
 
@@ -31,9 +33,10 @@ double parse_quantity(std::string_view text, std::initializer_list<Unit> units,
                       std::string_view example) {
     std::string_view s = trim(text);
     double value = 0;
-    const char* first = s.data();
-    const char* last = s.data() + s.size();
-    if (!s.empty() && *first == '+') ++first; // from_chars refuses a leading '+'
+    const char *first = s.data();
+    const char *last = s.data() + s.size();
+    if (!s.empty() && *first == '+')
+        ++first; // from_chars refuses a leading '+'
     auto [end, ec] = std::from_chars(first, last, value);
     if (ec != std::errc() || s.empty()) {
         throw UsageError("'" + std::string(text) + "' is not a number with a unit (e.g. " +
@@ -43,10 +46,12 @@ double parse_quantity(std::string_view text, std::initializer_list<Unit> units,
         throw UsageError("'" + std::string(text) + "' is not a finite number");
     }
     std::string_view unit = trim(std::string_view(end, static_cast<std::size_t>(last - end)));
-    if (unit.empty()) return value * units.begin()->factor;
+    if (unit.empty())
+        return value * units.begin()->factor;
     std::string known;
-    for (const Unit& u : units) {
-        if (unit == u.name) return value * u.factor;
+    for (const Unit &u : units) {
+        if (unit == u.name)
+            return value * u.factor;
         known += (known.empty() ? "" : ", ") + std::string(u.name);
     }
     throw UsageError("unknown unit '" + std::string(unit) + "' in '" + std::string(text) +
@@ -75,13 +80,20 @@ namespace cli {
 
 std::uint64_t parse_memory_bytes(std::string_view text) {
     const double bytes = parse_quantity(text,
-                                        {{"B", 1.0}, {"kB", 1e3}, {"MB", 1e6}, {"GB", 1e9}, {"TB", 1e12},
-                                         {"KiB", 1024.0}, {"MiB", 1048576.0}, {"GiB", 1073741824.0},
+                                        {{"B", 1.0},
+                                         {"kB", 1e3},
+                                         {"MB", 1e6},
+                                         {"GB", 1e9},
+                                         {"TB", 1e12},
+                                         {"KiB", 1024.0},
+                                         {"MiB", 1048576.0},
+                                         {"GiB", 1073741824.0},
                                          {"TiB", 1099511627776.0}},
                                         "4GB or 500MB");
     // 2^63: far beyond any machine, and exactly representable.
     if (bytes < 0 || bytes >= 9223372036854775808.0)
-        throw UsageError("'" + std::string(text) + "' is not a memory size (e.g. 4GB or 500MB; 0: no limit)");
+        throw UsageError("'" + std::string(text) +
+                         "' is not a memory size (e.g. 4GB or 500MB; 0: no limit)");
     return static_cast<std::uint64_t>(std::llround(bytes));
 }
 

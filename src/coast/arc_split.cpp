@@ -17,31 +17,39 @@ namespace {
 
 /// The midpoint of the lon/lat edge a-b (shorter way round; a node on a pole takes the other
 /// end's longitude, as the meridian to the pole does).
-Vec3 lonlat_midpoint(const Vec3& a, const Vec3& b) {
+Vec3 lonlat_midpoint(const Vec3 &a, const Vec3 &b) {
     LonLat p = vec_to_lonlat(a), q = vec_to_lonlat(b);
     constexpr double polar = 90.0 - 1e-9;
-    if (std::abs(p.lat) >= polar) p.lon = q.lon;
-    if (std::abs(q.lat) >= polar) q.lon = p.lon;
-    if (q.lon - p.lon > 180.0) q.lon -= 360.0;
-    if (q.lon - p.lon < -180.0) q.lon += 360.0;
+    if (std::abs(p.lat) >= polar)
+        p.lon = q.lon;
+    if (std::abs(q.lat) >= polar)
+        q.lon = p.lon;
+    if (q.lon - p.lon > 180.0)
+        q.lon -= 360.0;
+    if (q.lon - p.lon < -180.0)
+        q.lon += 360.0;
     double lon = 0.5 * (p.lon + q.lon);
-    if (lon < -180.0) lon += 360.0;
-    if (lon > 180.0) lon -= 360.0;
+    if (lon < -180.0)
+        lon += 360.0;
+    if (lon > 180.0)
+        lon -= 360.0;
     return lonlat_to_vec(lon, 0.5 * (p.lat + q.lat));
 }
 
 } // namespace
 
-std::size_t split_conflicting_arcs(Boundary& boundary, int max_rounds) {
-    std::vector<const std::vector<Vec3>*> rings;
-    for (const auto& r : boundary.rings) rings.push_back(&r.nodes);
+std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds) {
+    std::vector<const std::vector<Vec3> *> rings;
+    for (const auto &r : boundary.rings)
+        rings.push_back(&r.nodes);
     ArcGrid grid(rings);
     std::size_t added = 0;
     for (int round = 0; round < max_rounds; ++round) {
         const std::vector<ArcPair> pairs = grid.conflicts();
-        if (pairs.empty()) break;
+        if (pairs.empty())
+            break;
         std::vector<std::pair<std::uint32_t, std::uint32_t>> arcs; // (ring, arc) to split
-        for (const auto& p : pairs) {
+        for (const auto &p : pairs) {
             arcs.push_back({p.ring_a, p.seg_a});
             arcs.push_back({p.ring_b, p.seg_b});
         }
@@ -49,7 +57,7 @@ std::size_t split_conflicting_arcs(Boundary& boundary, int max_rounds) {
         arcs.erase(std::unique(arcs.begin(), arcs.end()), arcs.end());
         for (std::size_t k = 0; k < arcs.size();) {
             const std::uint32_t r = arcs[k].first;
-            Ring& ring = boundary.rings[r];
+            Ring &ring = boundary.rings[r];
             const std::size_t n = ring.nodes.size();
             std::vector<Vec3> nodes;
             std::vector<SegmentKind> kinds;
@@ -59,7 +67,8 @@ std::size_t split_conflicting_arcs(Boundary& boundary, int max_rounds) {
                 kinds.push_back(ring.kinds[i]);
                 const bool split = k < arcs.size() && arcs[k].first == r && arcs[k].second == i;
                 old_of.push_back(split ? ArcGrid::none : i);
-                if (!split) continue;
+                if (!split)
+                    continue;
                 ++k;
                 nodes.push_back(lonlat_midpoint(ring.nodes[i], ring.nodes[(i + 1) % n]));
                 kinds.push_back(ring.kinds[i]);

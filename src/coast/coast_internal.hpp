@@ -17,11 +17,11 @@ struct ArcPair {
 };
 
 /// True when the great-circle arcs a-b and c-d (each shorter than pi/2) touch or cross.
-bool arcs_conflict(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+bool arcs_conflict(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d);
 
 /// Every pair of arcs of the closed rings that touch or cross (consecutive arcs of one ring only
 /// when they fold back), found through a uniform 3-D grid; sorted, at most max_pairs.
-std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3>*>& rings,
+std::vector<ArcPair> find_conflicts(const std::vector<const std::vector<Vec3> *> &rings,
                                     std::size_t max_pairs = static_cast<std::size_t>(-1));
 
 /// find_conflicts for rings that change a few arcs at a time: the grid and the conflicting
@@ -32,11 +32,11 @@ class ArcGrid {
 public:
     static constexpr std::uint32_t none = 0xffffffffu;
     /// Indexes every arc of the rings and finds the conflicts.
-    explicit ArcGrid(const std::vector<const std::vector<Vec3>*>& rings);
+    explicit ArcGrid(const std::vector<const std::vector<Vec3> *> &rings);
     /// Ring r has changed: its arc i (from node i to the next) is its former arc old_of[i], the
     /// same two points, or `none` (a new arc). Two arcs kept must stay in their order, and two
     /// that followed each other must still.
-    void replace(std::uint32_t r, const std::vector<std::uint32_t>& old_of);
+    void replace(std::uint32_t r, const std::vector<std::uint32_t> &old_of);
     /// After the rings' replace() calls: the conflicts again.
     void update();
     /// The conflicts, as find_conflicts gives them.
@@ -47,36 +47,37 @@ private:
         double lo[3], hi[3];
     };
     using Entry = std::pair<std::uint64_t, std::uint32_t>; // (cell, arc id)
-    std::uint32_t add_arc(std::uint32_t r, std::uint32_t i, std::vector<Entry>& entries);
+    std::uint32_t add_arc(std::uint32_t r, std::uint32_t i, std::vector<Entry> &entries);
     void test(std::uint32_t s, std::uint32_t t); // adds (s, t) to pairs_ when they conflict
     template <class Also>
-    void test_cells(std::vector<Entry>& entries, Also&& also); // see boundary_check.cpp
+    void test_cells(std::vector<Entry> &entries, Also &&also); // see boundary_check.cpp
     void settle();                                             // sorts pairs_, each once
 
-    const std::vector<const std::vector<Vec3>*>& rings_;
+    const std::vector<const std::vector<Vec3> *> &rings_;
     double cell_ = 0.05;
     std::vector<std::uint32_t> ring_, index_; // per arc id: its ring and its index there now
-    std::vector<char> alive_;                  // per arc id: still in its ring
+    std::vector<char> alive_;                 // per arc id: still in its ring
     std::vector<Box> boxes_;
-    std::vector<std::vector<std::uint32_t>> ids_of_;               // per ring, its arcs' ids in order
-    std::vector<Entry> entries_;                                   // sorted
-    std::vector<Entry> fresh_;                                     // the new arcs', until update()
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;   // conflicting arc ids, smaller first
+    std::vector<std::vector<std::uint32_t>> ids_of_; // per ring, its arcs' ids in order
+    std::vector<Entry> entries_;                     // sorted
+    std::vector<Entry> fresh_;                       // the new arcs', until update()
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>
+        pairs_; // conflicting arc ids, smaller first
 };
 
 /// Pairs (i < j) of polygons (each its closed lon/lat rings) whose outlines come within
 /// `distance` degrees of each other in the lon/lat plane, touching or crossing included
 /// (near_pairs.cpp). Sorted, each once.
-std::vector<std::pair<std::uint32_t, std::uint32_t>> near_pairs(const std::vector<std::vector<std::vector<LonLat>>>& polygons,
-                                                                double distance);
+std::vector<std::pair<std::uint32_t, std::uint32_t>>
+near_pairs(const std::vector<std::vector<std::vector<LonLat>>> &polygons, double distance);
 
 /// Splits every arc that touches or crosses another at the midpoint of its lon/lat edge, and
 /// again for the halves that still do, for at most max_rounds rounds (arc_split.cpp). Returns
 /// the nodes added; conflicts that remain are the data's own (check_boundary reports them).
-std::size_t split_conflicting_arcs(Boundary& boundary, int max_rounds);
+std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds);
 
 /// Geodesic area (WGS84) to the left of all the closed lon/lat rings, km2 (sum of signed
 /// GeographicLib areas modulo the Earth's area); the whole Earth when there is no ring.
-double rings_area_km2(const std::vector<std::vector<LonLat>>& rings);
+double rings_area_km2(const std::vector<std::vector<LonLat>> &rings);
 
 } // namespace globemesh::coast_detail

@@ -21,15 +21,17 @@ namespace {
 constexpr double max_simplified_arc = 0.25;
 
 /// Area to the left of one closed ring on the unit sphere, steradians in [0, 4 pi).
-double left_area_sr(const std::vector<Vec3>& nodes) {
+double left_area_sr(const std::vector<Vec3> &nodes) {
     Vec3 sum{};
-    for (const auto& v : nodes) sum = sum + v;
+    for (const auto &v : nodes)
+        sum = sum + v;
     Vec3 ref = norm(sum) > 1e-3 ? normalized(sum) : normalized(nodes[0] + Vec3{0.3, 0.5, 0.7});
     double s = 0;
     for (std::size_t i = 0; i < nodes.size(); ++i)
         s += spherical_triangle_area(ref, nodes[i], nodes[(i + 1) % nodes.size()]);
     s = std::fmod(s, 4 * pi);
-    if (s < 0) s += 4 * pi;
+    if (s < 0)
+        s += 4 * pi;
     return s;
 }
 
@@ -42,11 +44,11 @@ constexpr double simplify_tolerance = 0.3;
 constexpr double corner_turn = 40.0 * deg_to_rad;
 
 struct ShapedRing {
-    const Ring* ring;
-    std::vector<double> h_rad;        // target size at every node, radians
-    std::vector<std::uint32_t> kept;  // indices of kept nodes, increasing
-    std::vector<bool> anchor;         // nodes that must stay
-    std::vector<bool> corner;         // nodes the resampled ring must pass through
+    const Ring *ring;
+    std::vector<double> h_rad;       // target size at every node, radians
+    std::vector<std::uint32_t> kept; // indices of kept nodes, increasing
+    std::vector<bool> anchor;        // nodes that must stay
+    std::vector<bool> corner;        // nodes the resampled ring must pass through
 };
 
 /// A node of a resampled ring: on the kept arc from source node `node` to the next kept one.
@@ -68,16 +70,18 @@ struct Resampled {
 
 /// Douglas-Peucker between kept nodes i < j (indices modulo n): keeps the node farthest from the
 /// arc while it is farther than `tolerance` times the local size, or while the arc is too long.
-void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, double tolerance, std::vector<bool>& keep) {
-    const auto& nodes = s.ring->nodes;
+void simplify_span(const ShapedRing &s, std::uint32_t i, std::uint32_t j, double tolerance,
+                   std::vector<bool> &keep) {
+    const auto &nodes = s.ring->nodes;
     std::uint32_t n = static_cast<std::uint32_t>(nodes.size());
     std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i, j}};
     while (!stack.empty()) {
         auto [a, b] = stack.back();
         stack.pop_back();
-        if (b <= a + 1) continue;
-        const Vec3& pa = nodes[a % n];
-        const Vec3& pb = nodes[b % n];
+        if (b <= a + 1)
+            continue;
+        const Vec3 &pa = nodes[a % n];
+        const Vec3 &pb = nodes[b % n];
         double worst = 0;
         std::uint32_t at = a + 1;
         for (std::uint32_t k = a + 1; k < b; ++k) {
@@ -89,7 +93,8 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, double
         }
         bool too_long = arc_angle(pa, pb) > max_simplified_arc || pa == pb || norm(pa + pb) < 1e-9;
         if (worst > 1.0 || too_long) {
-            if (worst <= 1.0) at = a + (b - a) / 2;
+            if (worst <= 1.0)
+                at = a + (b - a) / 2;
             keep[at % n] = true;
             stack.push_back({a, at});
             stack.push_back({at, b});
@@ -106,14 +111,17 @@ void simplify_span(const ShapedRing& s, std::uint32_t i, std::uint32_t j, double
 /// made from has changed. `old_of` gets, per arc of the new ring, its arc in `last` with the
 /// same two points, or ArcGrid::none.
 template <class H>
-void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<std::uint32_t>& old_of) {
-    const auto& nodes = s.ring->nodes;
+void resample(const ShapedRing &s, const H &h_at, Resampled &last,
+              std::vector<std::uint32_t> &old_of) {
+    const auto &nodes = s.ring->nodes;
     const std::uint32_t m = static_cast<std::uint32_t>(s.kept.size());
-    auto at = [&](std::uint32_t k) -> const Vec3& { return nodes[s.kept[k % m]]; };
+    auto at = [&](std::uint32_t k) -> const Vec3 & { return nodes[s.kept[k % m]]; };
     std::vector<std::uint32_t> corners;
     for (std::uint32_t k = 0; k < m; ++k)
-        if (s.corner[s.kept[k]]) corners.push_back(k);
-    if (corners.empty()) corners.push_back(0);
+        if (s.corner[s.kept[k]])
+            corners.push_back(k);
+    if (corners.empty())
+        corners.push_back(0);
     // Per run: its arcs' cumulative size-length at sample points, and the pieces it gets.
     struct Point {
         double along; // integral of ds / h from the run's start
@@ -122,22 +130,27 @@ void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<s
     };
     std::vector<std::vector<Point>> runs(corners.size());
     std::vector<long> pieces(corners.size());
-    std::vector<const Resampled::Run*> same(corners.size(), nullptr); // the run of `last` to copy
-    std::vector<const Resampled::Run*> by_from;
-    for (const auto& r : last.runs) by_from.push_back(&r);
-    std::sort(by_from.begin(), by_from.end(), [](const auto* x, const auto* y) { return x->from < y->from; });
-    auto end_of = [&](std::size_t c) { return c + 1 < corners.size() ? corners[c + 1] : corners[0] + m; };
+    std::vector<const Resampled::Run *> same(corners.size(), nullptr); // the run of `last` to copy
+    std::vector<const Resampled::Run *> by_from;
+    for (const auto &r : last.runs)
+        by_from.push_back(&r);
+    std::sort(by_from.begin(), by_from.end(),
+              [](const auto *x, const auto *y) { return x->from < y->from; });
+    auto end_of = [&](std::size_t c) {
+        return c + 1 < corners.size() ? corners[c + 1] : corners[0] + m;
+    };
     auto measure = [&](std::size_t c) {
         const std::uint32_t first = corners[c], end = end_of(c);
-        auto& run = runs[c];
+        auto &run = runs[c];
         double along = 0;
         run.push_back({0, first % m, 0});
         for (std::uint32_t k = first; k < end; ++k) {
-            const Vec3& a = at(k);
-            const Vec3& b = at(k + 1);
+            const Vec3 &a = at(k);
+            const Vec3 &b = at(k + 1);
             const double len = arc_angle(a, b);
             const double ha = s.h_rad[s.kept[k % m]], hb = s.h_rad[s.kept[(k + 1) % m]];
-            const int steps = static_cast<int>(std::clamp(std::ceil(len / (0.25 * std::min(ha, hb))), 1.0, 4096.0));
+            const int steps = static_cast<int>(
+                std::clamp(std::ceil(len / (0.25 * std::min(ha, hb))), 1.0, 4096.0));
             double h_prev = ha;
             for (int i = 1; i <= steps; ++i) {
                 const double t = double(i) / steps;
@@ -151,7 +164,9 @@ void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<s
     };
     for (std::size_t c = 0; c < corners.size(); ++c) {
         const std::uint32_t from = s.kept[corners[c] % m], to = s.kept[end_of(c) % m];
-        const auto it = std::lower_bound(by_from.begin(), by_from.end(), from, [](const auto* r, std::uint32_t x) { return r->from < x; });
+        const auto it =
+            std::lower_bound(by_from.begin(), by_from.end(), from,
+                             [](const auto *r, std::uint32_t x) { return r->from < x; });
         if (it != by_from.end() && (*it)->from == from && (*it)->to == to) {
             same[c] = *it;
             pieces[c] = static_cast<long>((*it)->count);
@@ -169,46 +184,50 @@ void resample(const ShapedRing& s, const H& h_at, Resampled& last, std::vector<s
     for (long total = 0; (total = std::accumulate(pieces.begin(), pieces.end(), 0L)) < 3;) {
         std::size_t best = 0;
         for (std::size_t c = 1; c < runs.size(); ++c)
-            if (runs[c].back().along / pieces[c] > runs[best].back().along / pieces[best]) best = c;
+            if (runs[c].back().along / pieces[c] > runs[best].back().along / pieces[best])
+                best = c;
         ++pieces[best];
     }
     Resampled now;
-    std::vector<Sample>& out = now.samples;
+    std::vector<Sample> &out = now.samples;
     old_of.clear();
     for (std::size_t c = 0; c < runs.size(); ++c) {
         const std::size_t offset = out.size();
-        if (const Resampled::Run* r = same[c]) {
+        if (const Resampled::Run *r = same[c]) {
             out.insert(out.end(), last.samples.begin() + static_cast<std::ptrdiff_t>(r->offset),
                        last.samples.begin() + static_cast<std::ptrdiff_t>(r->offset + r->count));
-            for (std::size_t j = 0; j < r->count; ++j) old_of.push_back(static_cast<std::uint32_t>(r->offset + j));
+            for (std::size_t j = 0; j < r->count; ++j)
+                old_of.push_back(static_cast<std::uint32_t>(r->offset + j));
             now.runs.push_back({r->from, r->to, offset, r->count});
             continue;
         }
-        const auto& run = runs[c];
+        const auto &run = runs[c];
         out.push_back({at(corners[c]), s.kept[corners[c] % m]});
         std::size_t i = 1;
         for (long p = 1; p < pieces[c]; ++p) {
             const double want = run.back().along * double(p) / double(pieces[c]);
-            while (run[i].along < want) ++i;
-            const Point& lo = run[i - 1];
-            const Point& hi = run[i];
+            while (run[i].along < want)
+                ++i;
+            const Point &lo = run[i - 1];
+            const Point &hi = run[i];
             const double f = hi.along > lo.along ? (want - lo.along) / (hi.along - lo.along) : 0.0;
             const double t0 = lo.arc == hi.arc ? lo.t : 0.0;
             const double t = t0 + f * (hi.t - t0);
             out.push_back({arc_interpolate(at(hi.arc), at(hi.arc + 1), t), s.kept[hi.arc]});
         }
         old_of.resize(out.size(), coast_detail::ArcGrid::none);
-        now.runs.push_back({s.kept[corners[c] % m], s.kept[end_of(c) % m], offset, out.size() - offset});
+        now.runs.push_back(
+            {s.kept[corners[c] % m], s.kept[end_of(c) % m], offset, out.size() - offset});
     }
     last = std::move(now);
 }
 
-
 /// Step 1 of shape_boundary: the rings kept, each with its size at every node; the small ones
 /// dropped are counted in `rep` and the islands among them added to `dropped_islands`.
 template <class H>
-std::vector<ShapedRing> drop_small_rings(const CoastData& coast, const H& h_at, const MeshOptions& options,
-                                         CoastReport& rep, std::vector<std::vector<Vec3>>& dropped_islands) {
+std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
+                                         const MeshOptions &options, CoastReport &rep,
+                                         std::vector<std::vector<Vec3>> &dropped_islands) {
     // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
     //    water bodies (ocean on the left that small, also a pocket of water that land cuts off
     //    at a region's edge); the land outside a region's outline is never an island.
@@ -217,26 +236,30 @@ std::vector<ShapedRing> drop_small_rings(const CoastData& coast, const H& h_at, 
     bool dropped_water = false;
     // The largest water ring on a region's outline stays whatever its size (a size wider than
     // the region is refused later, naming it).
-    const auto& source = coast.rings.rings;
+    const auto &source = coast.rings.rings;
     std::vector<double> left_of(source.size()); // each ring's area on its left (sr)
     std::size_t largest_open = source.size();
     for (std::size_t r = 0; r < source.size(); ++r) {
         left_of[r] = left_area_sr(source[r].nodes);
-        const auto& kinds = source[r].kinds;
-        if (left_of[r] < 2 * pi && std::find(kinds.begin(), kinds.end(), SegmentKind::open) != kinds.end() &&
+        const auto &kinds = source[r].kinds;
+        if (left_of[r] < 2 * pi &&
+            std::find(kinds.begin(), kinds.end(), SegmentKind::open) != kinds.end() &&
             (largest_open == source.size() || left_of[r] > left_of[largest_open]))
             largest_open = r;
     }
     for (std::size_t r = 0; r < source.size(); ++r) {
-        const Ring& ring = source[r];
+        const Ring &ring = source[r];
         ShapedRing s{&ring, {}, {}, {}, {}};
         s.h_rad.reserve(ring.nodes.size());
-        for (const auto& v : ring.nodes) s.h_rad.push_back(h_at(v));
-        bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(), [](SegmentKind k) { return k == SegmentKind::open; });
+        for (const auto &v : ring.nodes)
+            s.h_rad.push_back(h_at(v));
+        bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(),
+                                    [](SegmentKind k) { return k == SegmentKind::open; });
         if (options.min_island_triangles > 0 && r != largest_open) {
             const double left = left_of[r];
             Vec3 sum{};
-            for (const auto& v : ring.nodes) sum = sum + v;
+            for (const auto &v : ring.nodes)
+                sum = sum + v;
             double hc = norm(sum) > 1e-9 ? h_at(normalized(sum)) : s.h_rad[0];
             double threshold = options.min_island_triangles * std::sqrt(3.0) / 4.0 * hc * hc;
             if (left < 2 * pi) { // a closed water body
@@ -265,20 +288,22 @@ std::vector<ShapedRing> drop_small_rings(const CoastData& coast, const H& h_at, 
 /// Corners: where the kind changes, and where the line turns sharply at the scale of h;
 /// of two corners less than h/2 apart along the line, the one that turns less goes.
 /// Marks them in s.corner among the nodes `keep` holds.
-void mark_corners(ShapedRing& s, const std::vector<bool>& keep) {
-    const Ring& ring = *s.ring;
+void mark_corners(ShapedRing &s, const std::vector<bool> &keep) {
+    const Ring &ring = *s.ring;
     const std::uint32_t n = static_cast<std::uint32_t>(ring.nodes.size());
     s.corner.assign(n, false);
     std::vector<std::uint32_t> coarse;
     for (std::uint32_t i = 0; i < n; ++i)
-        if (keep[i]) coarse.push_back(i);
+        if (keep[i])
+            coarse.push_back(i);
     const std::size_t m = coarse.size();
     std::vector<double> turn(m, 0.0);
     std::vector<char> must(m, 0);
     for (std::size_t k = 0; k < m; ++k) {
         const std::uint32_t i = coarse[k];
         must[k] = ring.kinds[i] != ring.kinds[(i + n - 1) % n];
-        turn[k] = turn_angle(ring.nodes[coarse[(k + m - 1) % m]], ring.nodes[i], ring.nodes[coarse[(k + 1) % m]]);
+        turn[k] = turn_angle(ring.nodes[coarse[(k + m - 1) % m]], ring.nodes[i],
+                             ring.nodes[coarse[(k + 1) % m]]);
     }
     std::size_t prev = m; // the last corner kept, m: none yet
     double since = 0;     // line length from it, in units of h
@@ -287,10 +312,12 @@ void mark_corners(ShapedRing& s, const std::vector<bool>& keep) {
             const std::uint32_t a = coarse[k - 1], b = coarse[k];
             since += arc_angle(ring.nodes[a], ring.nodes[b]) / std::min(s.h_rad[a], s.h_rad[b]);
         }
-        if (!must[k] && !(turn[k] > corner_turn)) continue;
+        if (!must[k] && !(turn[k] > corner_turn))
+            continue;
         if (prev < m && since < 0.5) {
-            if (must[prev] || (!must[k] && turn[prev] >= turn[k])) continue; // k goes
-            s.corner[coarse[prev]] = false;                                // prev goes
+            if (must[prev] || (!must[k] && turn[prev] >= turn[k]))
+                continue;                   // k goes
+            s.corner[coarse[prev]] = false; // prev goes
         }
         s.corner[coarse[k]] = true;
         prev = k;
@@ -300,30 +327,36 @@ void mark_corners(ShapedRing& s, const std::vector<bool>& keep) {
 
 /// Step 2 of shape_boundary, for one ring: Douglas-Peucker on the sphere between anchors (kind
 /// changes, plus three spread nodes); s gets its anchors, corners and kept nodes.
-void simplify_ring(ShapedRing& s) {
-    const Ring& ring = *s.ring;
+void simplify_ring(ShapedRing &s) {
+    const Ring &ring = *s.ring;
     std::uint32_t n = static_cast<std::uint32_t>(ring.nodes.size());
     std::vector<bool> keep(n, false);
     for (std::uint32_t i = 0; i < n; ++i)
-        if (ring.kinds[i] != ring.kinds[(i + n - 1) % n]) keep[i] = true;
+        if (ring.kinds[i] != ring.kinds[(i + n - 1) % n])
+            keep[i] = true;
     keep[0] = keep[n / 3] = keep[(2 * n) / 3] = true;
     s.anchor = keep;
     // The shape at the scale of h (tolerance h/2, nodes at least h/2 apart) gives the corners.
     auto simplify = [&](double tolerance) {
         std::vector<std::uint32_t> from;
         for (std::uint32_t i = 0; i < n; ++i)
-            if (keep[i]) from.push_back(i);
+            if (keep[i])
+                from.push_back(i);
         for (std::size_t a = 0; a < from.size(); ++a)
-            simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance, keep);
+            simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance,
+                          keep);
     };
     simplify(0.5);
     // Thin nodes closer than half the local size to the previous kept node.
     std::uint32_t last = 0;
     for (std::uint32_t i = 1; i < n; ++i) {
-        if (!keep[i]) continue;
-        if (!s.anchor[i] && arc_angle(ring.nodes[last], ring.nodes[i]) < 0.5 * std::min(s.h_rad[last], s.h_rad[i])) {
+        if (!keep[i])
+            continue;
+        if (!s.anchor[i] && arc_angle(ring.nodes[last], ring.nodes[i]) <
+                                0.5 * std::min(s.h_rad[last], s.h_rad[i])) {
             std::uint32_t next = i + 1;
-            while (next < n && !keep[next]) ++next;
+            while (next < n && !keep[next])
+                ++next;
             std::uint32_t nn = next % n;
             // Only when the merged arc stays short and close to the dropped node.
             if (arc_angle(ring.nodes[last], ring.nodes[nn]) < max_simplified_arc &&
@@ -338,29 +371,32 @@ void simplify_ring(ShapedRing& s) {
     // The line the nodes are placed on: within simplify_tolerance * h of the source.
     simplify(simplify_tolerance);
     for (std::uint32_t i = 0; i < n; ++i)
-        if (keep[i]) s.kept.push_back(i);
+        if (keep[i])
+            s.kept.push_back(i);
 }
 
 /// The coast's nodes at the local size, at least (each arc over the larger size at its
 /// ends): a size of metres asks a global coast for billions, refused here as the mesher
 /// would refuse them, before the resampling spends the time and memory to make them.
-void check_node_count(const std::vector<ShapedRing>& shaped, const MeshOptions& options) {
+void check_node_count(const std::vector<ShapedRing> &shaped, const MeshOptions &options) {
     double coast_nodes = 0;
-    for (const ShapedRing& s : shaped)
+    for (const ShapedRing &s : shaped)
         for (std::size_t k = 0; k < s.kept.size(); ++k) {
             const std::uint32_t a = s.kept[k], b = s.kept[(k + 1) % s.kept.size()];
-            coast_nodes += arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
+            coast_nodes +=
+                arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
         }
     if (coast_nodes > static_cast<double>(options.max_nodes))
-        throw DataError("the coast alone asks for about " + std::to_string(std::llround(coast_nodes)) +
-                        " nodes at the target size, more than --max-nodes " + std::to_string(options.max_nodes) +
-                        ": raise --hmin/--hmax or --max-nodes");
+        throw DataError("the coast alone asks for about " +
+                        std::to_string(std::llround(coast_nodes)) +
+                        " nodes at the target size, more than --max-nodes " +
+                        std::to_string(options.max_nodes) + ": raise --hmin/--hmax or --max-nodes");
 }
 
 /// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
 template <class H>
-std::vector<Resampled> resample_clear(std::vector<ShapedRing>& shaped, const H& h_at, CoastReport& rep,
-                                      const Progress& progress) {
+std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &h_at,
+                                      CoastReport &rep, const Progress &progress) {
     // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
@@ -370,73 +406,86 @@ std::vector<Resampled> resample_clear(std::vector<ShapedRing>& shaped, const H& 
     //    in a fraction of the time (bench/RESULTS-core-coast.md).
     std::vector<Resampled> resampled(shaped.size());
     std::vector<std::vector<Vec3>> rings(shaped.size());
-    std::vector<const std::vector<Vec3>*> ptrs;
-    for (const auto& r : rings) ptrs.push_back(&r);
+    std::vector<const std::vector<Vec3> *> ptrs;
+    for (const auto &r : rings)
+        ptrs.push_back(&r);
     std::vector<char> changed(shaped.size(), 1);
     std::optional<coast_detail::ArcGrid> grid;
     std::vector<std::uint32_t> old_of;
     for (int round = 0;; ++round) {
         for (std::size_t r = 0; r < shaped.size(); ++r) {
-            if (!changed[r]) continue;
+            if (!changed[r])
+                continue;
             resample(shaped[r], h_at, resampled[r], old_of);
             rings[r].clear();
             rings[r].reserve(resampled[r].samples.size());
-            for (const auto& x : resampled[r].samples) rings[r].push_back(x.p);
-            if (grid) grid->replace(static_cast<std::uint32_t>(r), old_of);
+            for (const auto &x : resampled[r].samples)
+                rings[r].push_back(x.p);
+            if (grid)
+                grid->replace(static_cast<std::uint32_t>(r), old_of);
         }
-        if (grid) grid->update();
-        else grid.emplace(ptrs);
+        if (grid)
+            grid->update();
+        else
+            grid.emplace(ptrs);
         const auto conflicts = grid->conflicts();
-        if (conflicts.empty()) break;
+        if (conflicts.empty())
+            break;
         std::vector<std::vector<std::uint32_t>> insert(shaped.size());
         auto refine = [&](std::uint32_t r, std::uint32_t seg) {
-            const auto& s = shaped[r];
-            const auto& x = resampled[r].samples;
+            const auto &s = shaped[r];
+            const auto &x = resampled[r].samples;
             const std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
-            const Sample& p = x[seg];
-            const Sample& q = x[(seg + 1) % x.size()];
+            const Sample &p = x[seg];
+            const Sample &q = x[(seg + 1) % x.size()];
             // From p's arc's start to q's arc's end (the kept node after q's).
             std::uint32_t a = p.node;
             const auto after = std::upper_bound(s.kept.begin(), s.kept.end(), q.node);
             std::uint32_t b = after == s.kept.end() ? s.kept.front() : *after;
-            if (b <= a) b += n;
+            if (b <= a)
+                b += n;
             double worst = -1;
             std::uint32_t at = n;
             for (std::uint32_t k = a + 1; k < b; ++k) {
-                if (s.corner[k % n]) continue;
+                if (s.corner[k % n])
+                    continue;
                 double d = arc_distance(p.p, q.p, s.ring->nodes[k % n]);
                 if (d > worst) {
                     worst = d;
                     at = k % n;
                 }
             }
-            if (at < n) insert[r].push_back(at);
+            if (at < n)
+                insert[r].push_back(at);
         };
-        for (const auto& c : conflicts) {
+        for (const auto &c : conflicts) {
             refine(c.ring_a, c.seg_a);
             refine(c.ring_b, c.seg_b);
         }
         bool progress_made = false;
         for (std::size_t r = 0; r < shaped.size(); ++r) {
-            auto& s = shaped[r];
+            auto &s = shaped[r];
             changed[r] = 0;
             for (auto i : insert[r]) {
-                if (s.corner[i]) continue;
+                if (s.corner[i])
+                    continue;
                 s.corner[i] = true;
                 s.kept.push_back(i);
                 ++rep.conflicts_repaired;
                 changed[r] = 1;
             }
-            if (!changed[r]) continue;
+            if (!changed[r])
+                continue;
             progress_made = true;
             std::sort(s.kept.begin(), s.kept.end());
             s.kept.erase(std::unique(s.kept.begin(), s.kept.end()), s.kept.end());
         }
         if (!progress_made) {
-            const auto& c = conflicts.front();
+            const auto &c = conflicts.front();
             LonLat at = vec_to_lonlat(rings[c.ring_a][c.seg_a]);
-            throw DataError("coast: rings touch or cross near lon " + std::to_string(at.lon) + ", lat " +
-                            std::to_string(at.lat) + " at full resolution; repair the coastline there");
+            throw DataError("coast: rings touch or cross near lon " + std::to_string(at.lon) +
+                            ", lat " + std::to_string(at.lat) +
+                            " at full resolution; repair the coastline there");
         }
         report(progress, 0.5 + 0.4 * (1.0 - 1.0 / (round + 2)), "checking coast topology");
     }
@@ -445,9 +494,10 @@ std::vector<Resampled> resample_clear(std::vector<ShapedRing>& shaped, const H& 
 
 } // namespace
 
-Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const MeshOptions& options,
-                        CoastReport* report_out, const Progress& progress) {
-    if (!size_km) throw UsageError("shape_boundary: no size function given");
+Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const MeshOptions &options,
+                        CoastReport *report_out, const Progress &progress) {
+    if (!size_km)
+        throw UsageError("shape_boundary: no size function given");
     CoastReport rep;
     rep.islands_removed = coast.islands_removed;
     rep.lakes_removed = coast.lakes_removed;
@@ -455,7 +505,7 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     rep.area_lost_km2 = coast.area_lost_km2;
     report(progress, 0.0, "shaping coast");
 
-    auto h_at = [&](const Vec3& v) {
+    auto h_at = [&](const Vec3 &v) {
         double h = size_km(v);
         if (!(h > 0) || !std::isfinite(h))
             throw UsageError("the target size must be positive (got " + std::to_string(h) + " km)");
@@ -466,7 +516,8 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     std::vector<ShapedRing> shaped = drop_small_rings(coast, h_at, options, rep, dropped_islands);
     report(progress, 0.2, "simplifying coast");
 
-    for (auto& s : shaped) simplify_ring(s);
+    for (auto &s : shaped)
+        simplify_ring(s);
     report(progress, 0.5, "resampling coast");
     check_node_count(shaped, options);
 
@@ -474,12 +525,12 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
 
     Boundary out;
     for (std::size_t r = 0; r < shaped.size(); ++r) {
-        const auto& s = shaped[r];
+        const auto &s = shaped[r];
         Ring ring;
-        const auto& samples = resampled[r].samples;
+        const auto &samples = resampled[r].samples;
         ring.nodes.reserve(samples.size());
         ring.kinds.reserve(samples.size());
-        for (const auto& x : samples) {
+        for (const auto &x : samples) {
             ring.nodes.push_back(x.p);
             ring.kinds.push_back(s.ring->kinds[x.node]);
         }
@@ -489,19 +540,24 @@ Boundary shape_boundary(const CoastData& coast, const SizeFn& size_km, const Mes
     out.dropped_islands = std::move(dropped_islands);
     auto issues = check_boundary(out, 1);
     if (!issues.empty()) {
-        const auto& is = issues.front();
+        const auto &is = issues.front();
         LonLat at = vec_to_lonlat(out.rings[is.ring].nodes[std::max(is.segment, 0L)]);
-        throw DataError("coast: the shaped boundary has " + is.what + " near lon " + std::to_string(at.lon) +
-                        ", lat " + std::to_string(at.lat));
+        throw DataError("coast: the shaped boundary has " + is.what + " near lon " +
+                        std::to_string(at.lon) + ", lat " + std::to_string(at.lat));
     }
     rep.rings = out.rings.size();
-    for (const auto& r : out.rings) rep.nodes += r.nodes.size();
+    for (const auto &r : out.rings)
+        rep.nodes += r.nodes.size();
     rep.ocean_area_km2 = boundary_area_km2(out);
-    double dropped_net = rep.area_gained_km2 - coast.area_gained_km2 - (rep.area_lost_km2 - coast.area_lost_km2);
+    double dropped_net =
+        rep.area_gained_km2 - coast.area_gained_km2 - (rep.area_lost_km2 - coast.area_lost_km2);
     double net = rep.ocean_area_km2 - (coast.ocean_area_km2 + dropped_net);
-    if (net > 0) rep.area_gained_km2 += net;
-    else rep.area_lost_km2 -= net;
-    if (report_out) *report_out = rep;
+    if (net > 0)
+        rep.area_gained_km2 += net;
+    else
+        rep.area_lost_km2 -= net;
+    if (report_out)
+        *report_out = rep;
     report(progress, 1.0, "coast shaped");
     return out;
 }

@@ -21,11 +21,11 @@ class GeosInterrupt {
 public:
     explicit GeosInterrupt(Progress parent);
     ~GeosInterrupt();
-    GeosInterrupt(const GeosInterrupt&) = delete;
-    GeosInterrupt& operator=(const GeosInterrupt&) = delete;
+    GeosInterrupt(const GeosInterrupt &) = delete;
+    GeosInterrupt &operator=(const GeosInterrupt &) = delete;
 
     /// `parent` as seen by the run: records each report for the callback to repeat.
-    const Progress& progress() const { return progress_; }
+    const Progress &progress() const { return progress_; }
     /// True once the progress asked to stop while a GeosInterrupt was alive on this thread.
     static bool interrupted();
     /// Throws Cancelled when the run asked to stop (asking it again when 50 ms have passed): for

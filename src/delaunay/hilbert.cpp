@@ -27,7 +27,8 @@ struct HilbertTable {
                     int ry = (swapped ? xb : yb) ^ inverted;
                     out = (out << 2) | ((3 * rx) ^ ry);
                     if (ry == 0) {
-                        if (rx == 1) inverted ^= 1;
+                        if (rx == 1)
+                            inverted ^= 1;
                         swapped ^= 1;
                     }
                 }
@@ -52,15 +53,29 @@ std::uint64_t hilbert_index(std::uint32_t x, std::uint32_t y, int order) {
 
 } // namespace
 
-std::uint32_t hilbert_key(const Vec3& p) {
+std::uint32_t hilbert_key(const Vec3 &p) {
     constexpr int order = 15;
     double ax = std::fabs(p.x), ay = std::fabs(p.y), az = std::fabs(p.z);
     std::uint32_t face;
     double u, v, m;
-    if (ax >= ay && ax >= az) { face = p.x >= 0 ? 0 : 1; m = ax; u = p.y; v = p.z; }
-    else if (ay >= az) { face = p.y >= 0 ? 2 : 3; m = ay; u = p.z; v = p.x; }
-    else { face = p.z >= 0 ? 4 : 5; m = az; u = p.x; v = p.y; }
-    if (!(m > 0)) return 0;
+    if (ax >= ay && ax >= az) {
+        face = p.x >= 0 ? 0 : 1;
+        m = ax;
+        u = p.y;
+        v = p.z;
+    } else if (ay >= az) {
+        face = p.y >= 0 ? 2 : 3;
+        m = ay;
+        u = p.z;
+        v = p.x;
+    } else {
+        face = p.z >= 0 ? 4 : 5;
+        m = az;
+        u = p.x;
+        v = p.y;
+    }
+    if (!(m > 0))
+        return 0;
     const double scale = static_cast<double>((1u << order) - 1);
     auto cell = [&](double w) {
         double t = (w / m + 1.0) * 0.5; // [0, 1]
@@ -85,15 +100,18 @@ std::vector<std::uint32_t> brio_order(std::span<const Vec3> points, std::uint64_
     // Round boundaries: [0, n/2^R), [n/2^R, n/2^(R-1)), ..., [n/2, n).
     std::size_t lo = 0;
     std::vector<std::size_t> ends;
-    for (std::size_t end = n; end > 64; end /= 2) ends.push_back(end);
+    for (std::size_t end = n; end > 64; end /= 2)
+        ends.push_back(end);
     std::reverse(ends.begin(), ends.end());
-    if (ends.empty() || ends.back() != n) ends.push_back(n);
+    if (ends.empty() || ends.back() != n)
+        ends.push_back(n);
     for (std::size_t end : ends) {
         std::sort(keyed.begin() + lo, keyed.begin() + end);
         lo = end;
     }
     std::vector<std::uint32_t> order(n);
-    for (std::size_t j = 0; j < n; ++j) order[j] = static_cast<std::uint32_t>(keyed[j]);
+    for (std::size_t j = 0; j < n; ++j)
+        order[j] = static_cast<std::uint32_t>(keyed[j]);
     return order;
 }
 

@@ -15,7 +15,7 @@ namespace globemesh::detail {
 /// Hilbert key of a point: cube face in the top 3 bits, then the top 29 bits of the Hilbert
 /// index of its cell in a 2^15 x 2^15 grid on that face (cells of ~300 m on the Earth; points
 /// closer than that keep their input order, which only matters for speed).
-std::uint32_t hilbert_key(const Vec3& p);
+std::uint32_t hilbert_key(const Vec3 &p);
 
 /// A permutation of [0, n): BRIO rounds (each point lands in round r with probability 2^-r,
 /// drawn from `seed`), every round sorted by hilbert_key. Rounds smaller than 64 points are merged.

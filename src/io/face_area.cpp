@@ -22,55 +22,63 @@ int prime_meridian_transit(double lon1, double lon2) {
     using GeographicLib::Math;
     // Longitudes in [-180, 180] (vec_to_lonlat's) on one side of the meridian: no crossing, as
     // the rule below gives for them, without its angle reductions.
-    if ((lon1 < 0) == (lon2 < 0) && !(lon1 > 0 && lon2 == 0)) return 0;
+    if ((lon1 < 0) == (lon2 < 0) && !(lon1 > 0 && lon2 == 0))
+        return 0;
     const double d = Math::AngDiff(lon1, lon2);
     lon1 = Math::AngNormalize(lon1);
     lon2 = Math::AngNormalize(lon2);
-    if (d > 0 && ((lon1 < 0 && lon2 >= 0) || (lon1 > 0 && lon2 == 0))) return 1;
-    if (d < 0 && lon1 >= 0 && lon2 < 0) return -1;
+    if (d > 0 && ((lon1 < 0 && lon2 >= 0) || (lon1 > 0 && lon2 == 0)))
+        return 1;
+    if (d < 0 && lon1 >= 0 && lon2 < 0)
+        return -1;
     return 0;
 }
 
 /// Runs slice(k, threads) for k = 0 .. threads - 1, one per core (at most 16), slice 0 on the
 /// calling thread; when the process may start no more threads, the caller runs the rest.
 /// slice must be safe to run concurrently with the others.
-template <class Slice>
-void on_every_core(const Slice& slice) {
+template <class Slice> void on_every_core(const Slice &slice) {
     const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
     std::vector<std::thread> pool;
     std::size_t k = 1;
     try {
-        for (; k < threads; ++k) pool.emplace_back(slice, k, threads);
-    } catch (const std::system_error&) {
+        for (; k < threads; ++k)
+            pool.emplace_back(slice, k, threads);
+    } catch (const std::system_error &) {
         // No more threads (a process limit): this thread runs the slices left.
     }
-    for (; k < threads; ++k) slice(k, threads);
+    for (; k < threads; ++k)
+        slice(k, threads);
     slice(0, threads);
-    for (auto& t : pool) t.join();
+    for (auto &t : pool)
+        t.join();
 }
 
 } // namespace
 
-GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology& topo, const std::atomic<bool>* stop)
+GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *stop)
     : topo_(topo), s12_(topo.edge_count()) {
-    const auto& wgs84 = GeographicLib::Geodesic::WGS84();
+    const auto &wgs84 = GeographicLib::Geodesic::WGS84();
     const std::size_t n = s12_.size();
     on_every_core([&](std::size_t k, std::size_t threads) {
         double t;
         for (std::size_t e = n * k / threads; e < n * (k + 1) / threads; ++e) {
-            if (stop && e % 4096 == 0 && stop->load(std::memory_order_relaxed)) return;
+            if (stop && e % 4096 == 0 && stop->load(std::memory_order_relaxed))
+                return;
             const auto ends = topo.edge_nodes(e);
             const LonLat a = vec_to_lonlat(topo.mesh->nodes[std::size_t(ends[0])]);
             const LonLat b = vec_to_lonlat(topo.mesh->nodes[std::size_t(ends[1])]);
-            wgs84.GenInverse(a.lat, a.lon, b.lat, b.lon, GeographicLib::Geodesic::AREA, t, t, t, t, t, t, s12_[e]);
+            wgs84.GenInverse(a.lat, a.lon, b.lat, b.lon, GeographicLib::Geodesic::AREA, t, t, t, t,
+                             t, t, s12_[e]);
         }
     });
 }
 
-double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t* edges_of_f) const {
-    const auto& face = topo_.mesh->faces[f];
+double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f) const {
+    const auto &face = topo_.mesh->faces[f];
     double lon[3];
-    for (int k = 0; k < 3; ++k) lon[k] = vec_to_lonlat(topo_.mesh->nodes[face[std::size_t(k)]]).lon;
+    for (int k = 0; k < 3; ++k)
+        lon[k] = vec_to_lonlat(topo_.mesh->nodes[face[std::size_t(k)]]).lon;
     GeographicLib::Accumulator<> sum;
     int crossings = 0;
     for (int k = 0; k < 3; ++k) {
@@ -85,10 +93,13 @@ double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t* edges_of_f)
     // face that goes round a pole.
     const double area0 = GeographicLib::Geodesic::WGS84().EllipsoidArea();
     sum.remainder(area0);
-    if (crossings & 1) sum += (sum() < 0 ? 0.5 : -0.5) * area0;
+    if (crossings & 1)
+        sum += (sum() < 0 ? 0.5 : -0.5) * area0;
     double area = sum();
-    if (area > area0 / 2) area -= area0;
-    else if (area <= -area0 / 2) area += area0;
+    if (area > area0 / 2)
+        area -= area0;
+    else if (area <= -area0 / 2)
+        area += area0;
     return std::fabs(area);
 }
 

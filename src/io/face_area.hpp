@@ -27,13 +27,13 @@ class GeodesicFaceAreas {
 public:
     /// Solves every edge's inverse problem, on every core. When `stop` turns true meanwhile,
     /// returns early with the areas unfinished (for a writer that failed or was cancelled).
-    explicit GeodesicFaceAreas(const MeshTopology& topo, const std::atomic<bool>* stop = nullptr);
+    explicit GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *stop = nullptr);
 
     /// The area of face f (m2), whose edges edges_of_f are those face_edges gives.
-    double face_m2(std::size_t f, const std::int32_t* edges_of_f) const;
+    double face_m2(std::size_t f, const std::int32_t *edges_of_f) const;
 
 private:
-    const MeshTopology& topo_;
+    const MeshTopology &topo_;
     std::vector<double> s12_; ///< per edge, from its first node to its second (edge_nodes)
 };
 

@@ -18,9 +18,9 @@ using LonLatPoint = std::array<double, 2>;
 using LonLatPart = std::vector<LonLatPoint>; ///< a ring (not repeated closing point) or a line
 
 /// The face abc (unit vectors, counter-clockwise) as one or more polygon rings within [-180, 180].
-std::vector<LonLatPart> face_polygons(const Vec3& a, const Vec3& b, const Vec3& c);
+std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
 /// A polyline of unit vectors (straight in lon/lat between nodes) cut at +-180 into parts.
-std::vector<LonLatPart> polyline_parts(const std::vector<Vec3>& nodes);
+std::vector<LonLatPart> polyline_parts(const std::vector<Vec3> &nodes);
 
 } // namespace globemesh::io

@@ -16,18 +16,21 @@ namespace globemesh::io {
 using QuietGdalErrors = gdal::QuietErrors;
 using ScopedGdalConfig = gdal::ScopedConfig;
 
-inline std::string last_gdal_error() { return gdal::last_error(); }
+inline std::string last_gdal_error() {
+    return gdal::last_error();
+}
 
 /// Owns a GDALDataset through GDAL's C++ API (the writers use it); closes it with GDALClose.
 struct GdalDatasetCloser {
-    void operator()(GDALDataset* ds) const {
-        if (ds) GDALClose(GDALDataset::ToHandle(ds));
+    void operator()(GDALDataset *ds) const {
+        if (ds)
+            GDALClose(GDALDataset::ToHandle(ds));
     }
 };
 using GdalDatasetPtr = std::unique_ptr<GDALDataset, GdalDatasetCloser>;
 
 /// Closes the dataset now and reports whether GDAL signalled a failure while flushing it.
-inline bool close_dataset(GdalDatasetPtr& ds) {
+inline bool close_dataset(GdalDatasetPtr &ds) {
     CPLErrorReset();
     ds.reset();
     return CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal;

@@ -41,7 +41,7 @@ struct RtreeLayer {
 /// `output` (the path the user gave; `file` is its temporary name) and SQLite's reason. Reports
 /// to `progress` under the stage "write_gpkg" (and stops with Cancelled, none written, when
 /// asked).
-void add_rtree_indexes(const std::filesystem::path& file, const std::vector<RtreeLayer>& layers,
-                       const std::filesystem::path& output, const Progress& progress = {});
+void add_rtree_indexes(const std::filesystem::path &file, const std::vector<RtreeLayer> &layers,
+                       const std::filesystem::path &output, const Progress &progress = {});
 
 } // namespace globemesh::io

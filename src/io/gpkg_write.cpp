@@ -19,12 +19,12 @@
 #include "face_area.hpp"
 #include "face_geometry.hpp"
 #include "gdal_util.hpp"
-#include "gpkg_rtree.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
+#include "gpkg_rtree.hpp"
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
 #include "write_hooks.hpp"
@@ -39,12 +39,14 @@ namespace {
 
 struct QualityClass {
     double lower, upper;
-    const char* colour; ///< "r,g,b,a" as QGIS writes colours
-    const char* label;
+    const char *colour; ///< "r,g,b,a" as QGIS writes colours
+    const char *label;
 };
 constexpr QualityClass quality_classes[] = {
-    {0.0, 0.3, "215,25,28,255", "poor (below 0.3)"},        {0.3, 0.5, "253,174,97,255", "0.3 - 0.5"},
-    {0.5, 0.7, "255,255,191,255", "0.5 - 0.7"},          {0.7, 0.9, "166,217,106,255", "0.7 - 0.9"},
+    {0.0, 0.3, "215,25,28,255", "poor (below 0.3)"},
+    {0.3, 0.5, "253,174,97,255", "0.3 - 0.5"},
+    {0.5, 0.7, "255,255,191,255", "0.5 - 0.7"},
+    {0.7, 0.9, "166,217,106,255", "0.7 - 0.9"},
     {0.9, 1.000001, "26,150,65,255", "good (0.9 and above)"}};
 
 /// A QGIS 3 graduated renderer on "quality" (the style QGIS itself writes, trimmed to symbology).
@@ -52,16 +54,18 @@ std::string faces_style_qml() {
     std::ostringstream q;
     q << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
       << "<qgis version=\"3.22.16-Białowieża\" styleCategories=\"Symbology\">\n"
-      << " <renderer-v2 type=\"graduatedSymbol\" attr=\"quality\" graduatedMethod=\"GraduatedColor\" "
+      << " <renderer-v2 type=\"graduatedSymbol\" attr=\"quality\" "
+         "graduatedMethod=\"GraduatedColor\" "
          "symbollevels=\"0\" enableorderby=\"0\" forceraster=\"0\">\n  <ranges>\n";
     int i = 0;
-    for (const auto& c : quality_classes)
-        q << "   <range render=\"true\" symbol=\"" << i++ << "\" lower=\"" << c.lower << "\" upper=\"" << c.upper
-          << "\" label=\"" << c.label << "\"/>\n";
+    for (const auto &c : quality_classes)
+        q << "   <range render=\"true\" symbol=\"" << i++ << "\" lower=\"" << c.lower
+          << "\" upper=\"" << c.upper << "\" label=\"" << c.label << "\"/>\n";
     q << "  </ranges>\n  <symbols>\n";
     i = 0;
-    for (const auto& c : quality_classes)
-        q << "   <symbol type=\"fill\" name=\"" << i++ << "\" alpha=\"1\" clip_to_extent=\"1\" force_rhr=\"0\">\n"
+    for (const auto &c : quality_classes)
+        q << "   <symbol type=\"fill\" name=\"" << i++
+          << "\" alpha=\"1\" clip_to_extent=\"1\" force_rhr=\"0\">\n"
           << "    <layer class=\"SimpleFill\" enabled=\"1\" pass=\"0\" locked=\"0\">\n"
           << "     <Option type=\"Map\">\n"
           << "      <Option type=\"QString\" name=\"color\" value=\"" << c.colour << "\"/>\n"
@@ -73,7 +77,8 @@ std::string faces_style_qml() {
           << "      <Option type=\"QString\" name=\"style\" value=\"solid\"/>\n"
           << "     </Option>\n    </layer>\n   </symbol>\n";
     q << "  </symbols>\n  <classificationMethod id=\"Pretty\">\n   <symmetricMode enabled=\"0\" "
-         "symmetrypoint=\"0\" astride=\"0\"/>\n   <labelFormat format=\"%1 - %2\" trimtrailingzeroes=\"1\" "
+         "symmetrypoint=\"0\" astride=\"0\"/>\n   <labelFormat format=\"%1 - %2\" "
+         "trimtrailingzeroes=\"1\" "
          "labelprecision=\"2\"/>\n  </classificationMethod>\n  <rotation/>\n  <sizescale/>\n"
       << " </renderer-v2>\n <blendMode>0</blendMode>\n <featureBlendMode>0</featureBlendMode>\n"
       << " <layerGeometryType>2</layerGeometryType>\n</qgis>\n";
@@ -82,51 +87,61 @@ std::string faces_style_qml() {
 
 class GpkgWriter {
 public:
-    GpkgWriter(GDALDataset* ds, const std::filesystem::path& path) : ds_(ds), path_(path) {
+    GpkgWriter(GDALDataset *ds, const std::filesystem::path &path) : ds_(ds), path_(path) {
         srs_.importFromEPSG(4326);
         srs_.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     }
-    [[noreturn]] void fail(const std::string& step) const {
-        throw IoError("GeoPackage output " + path_.string() + ": " + step + ": " + io::last_gdal_error() +
-                      OutputFile::full_disk_note(path_));
+    [[noreturn]] void fail(const std::string &step) const {
+        throw IoError("GeoPackage output " + path_.string() + ": " + step + ": " +
+                      io::last_gdal_error() + OutputFile::full_disk_note(path_));
     }
     /// A layer; a spatial one without GDAL's spatial index (gpkg_rtree.hpp adds it in bulk).
-    OGRLayer* layer(const char* name, OGRwkbGeometryType type, const char* description, const char* fid = "FID=fid") {
+    OGRLayer *layer(const char *name, OGRwkbGeometryType type, const char *description,
+                    const char *fid = "FID=fid") {
         const std::string desc = std::string("DESCRIPTION=") + description;
-        const char* options[] = {fid, desc.c_str(), "SPATIAL_INDEX=NO", nullptr};
-        OGRLayer* l = ds_->CreateLayer(name, type == wkbNone ? nullptr : &srs_, type, const_cast<char**>(options));
-        if (!l) fail(std::string("creating layer ") + name);
+        const char *options[] = {fid, desc.c_str(), "SPATIAL_INDEX=NO", nullptr};
+        OGRLayer *l = ds_->CreateLayer(name, type == wkbNone ? nullptr : &srs_, type,
+                                       const_cast<char **>(options));
+        if (!l)
+            fail(std::string("creating layer ") + name);
         return l;
     }
-    void field(OGRLayer* l, const char* name, OGRFieldType type, const char* default_value = nullptr) {
+    void field(OGRLayer *l, const char *name, OGRFieldType type,
+               const char *default_value = nullptr) {
         OGRFieldDefn f(name, type);
-        if (default_value) f.SetDefault(default_value);
-        if (l->CreateField(&f) != OGRERR_NONE) fail(std::string("creating field ") + name);
+        if (default_value)
+            f.SetDefault(default_value);
+        if (l->CreateField(&f) != OGRERR_NONE)
+            fail(std::string("creating field ") + name);
     }
-    void add(OGRLayer* l, OGRFeature& f) {
-        if (l->CreateFeature(&f) != OGRERR_NONE) fail(std::string("writing a feature of ") + l->GetName());
+    void add(OGRLayer *l, OGRFeature &f) {
+        if (l->CreateFeature(&f) != OGRERR_NONE)
+            fail(std::string("writing a feature of ") + l->GetName());
     }
     void begin() {
-        if (ds_->StartTransaction() != OGRERR_NONE) fail("starting a transaction");
+        if (ds_->StartTransaction() != OGRERR_NONE)
+            fail("starting a transaction");
         in_transaction_ = true;
     }
     void commit() {
-        if (ds_->CommitTransaction() != OGRERR_NONE) fail("committing");
+        if (ds_->CommitTransaction() != OGRERR_NONE)
+            fail("committing");
         in_transaction_ = false;
     }
     /// A transaction still open (the write failed or was cancelled) is rolled back before the
     /// dataset closes as it unwinds: GDAL would otherwise commit the rows written so far, to a
     /// file about to be deleted.
     ~GpkgWriter() {
-        if (in_transaction_) ds_->RollbackTransaction();
+        if (in_transaction_)
+            ds_->RollbackTransaction();
     }
-    GpkgWriter(const GpkgWriter&) = delete;
-    GpkgWriter& operator=(const GpkgWriter&) = delete;
+    GpkgWriter(const GpkgWriter &) = delete;
+    GpkgWriter &operator=(const GpkgWriter &) = delete;
 
 private:
-    GDALDataset* ds_;
+    GDALDataset *ds_;
     bool in_transaction_ = false;
-    const std::filesystem::path& path_;
+    const std::filesystem::path &path_;
     OGRSpatialReference srs_;
 };
 
@@ -134,24 +149,26 @@ private:
 /// wider part (a face round a pole, a coastline loop) is smeared across the map.
 constexpr double max_part_width_deg = 180.0;
 
-std::pair<double, double> lon_range(const io::LonLatPart& part) {
+std::pair<double, double> lon_range(const io::LonLatPart &part) {
     auto [lo, hi] = std::minmax_element(part.begin(), part.end(),
-                                        [](const auto& p, const auto& q) { return p[0] < q[0]; });
+                                        [](const auto &p, const auto &q) { return p[0] < q[0]; });
     return {(*lo)[0], (*hi)[0]};
 }
 
 /// Sutherland-Hodgman clip of a ring to lo <= lon <= hi (exact at the cut meridians).
-io::LonLatPart clip_ring_to_band(const io::LonLatPart& ring, double lo, double hi) {
+io::LonLatPart clip_ring_to_band(const io::LonLatPart &ring, double lo, double hi) {
     io::LonLatPart r = ring;
     for (int side = 0; side < 2; ++side) {
         const double x = side ? hi : lo;
-        auto inside = [&](const io::LonLatPoint& p) { return side ? p[0] <= x : p[0] >= x; };
+        auto inside = [&](const io::LonLatPoint &p) { return side ? p[0] <= x : p[0] >= x; };
         io::LonLatPart out;
         for (std::size_t i = 0; i < r.size(); ++i) {
             const auto &p = r[i], &q = r[(i + 1) % r.size()];
             const bool pin = inside(p), qin = inside(q);
-            if (pin) out.push_back(p);
-            if (pin != qin) out.push_back({x, p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1])});
+            if (pin)
+                out.push_back(p);
+            if (pin != qin)
+                out.push_back({x, p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1])});
         }
         r = std::move(out);
     }
@@ -163,7 +180,8 @@ io::LonLatPart clip_ring_to_band(const io::LonLatPart& ring, double lo, double h
 /// pole, closed along the pole line and so lon-monotone, is that wide: each band holds one piece.
 std::vector<io::LonLatPart> narrow_rings(io::LonLatPart ring) {
     const auto [lo, hi] = lon_range(ring);
-    if (hi - lo <= max_part_width_deg) return {std::move(ring)};
+    if (hi - lo <= max_part_width_deg)
+        return {std::move(ring)};
     std::vector<io::LonLatPart> parts;
     const double w = max_part_width_deg;
     for (double band = std::floor(lo / w) * w; band < hi; band += w) {
@@ -173,62 +191,70 @@ std::vector<io::LonLatPart> narrow_rings(io::LonLatPart ring) {
             const auto &p = piece[i], &q = piece[(i + 1) % piece.size()];
             twice_area += p[0] * q[1] - q[0] * p[1];
         }
-        if (piece.size() >= 3 && std::fabs(twice_area) > 1e-18) parts.push_back(std::move(piece));
+        if (piece.size() >= 3 && std::fabs(twice_area) > 1e-18)
+            parts.push_back(std::move(piece));
     }
     return parts;
 }
 
 /// A line cut into pieces at most 180 degrees wide: a piece ends at the vertex before the one that
 /// would widen it past 180, and the next piece starts at that same vertex (the line stays joined).
-std::vector<io::LonLatPart> narrow_lines(const io::LonLatPart& line) {
+std::vector<io::LonLatPart> narrow_lines(const io::LonLatPart &line) {
     std::vector<io::LonLatPart> parts;
     io::LonLatPart current;
     double lo = 0, hi = 0;
-    for (const auto& p : line) {
+    for (const auto &p : line) {
         if (!current.empty() && std::max(hi, p[0]) - std::min(lo, p[0]) > max_part_width_deg) {
             parts.push_back(current);
             current = {current.back()};
             lo = hi = current.back()[0];
         }
-        if (current.empty()) lo = hi = p[0];
+        if (current.empty())
+            lo = hi = p[0];
         current.push_back(p);
         lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
     }
-    if (current.size() >= 2) parts.push_back(std::move(current));
+    if (current.size() >= 2)
+        parts.push_back(std::move(current));
     return parts;
 }
 
-OGRPolygon* polygon_of(const io::LonLatPart& ring) {
-    auto* r = new OGRLinearRing();
+OGRPolygon *polygon_of(const io::LonLatPart &ring) {
+    auto *r = new OGRLinearRing();
     r->setNumPoints(int(ring.size() + 1), FALSE);
-    for (std::size_t i = 0; i <= ring.size(); ++i) r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
-    auto* p = new OGRPolygon();
+    for (std::size_t i = 0; i <= ring.size(); ++i)
+        r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
+    auto *p = new OGRPolygon();
     p->addRingDirectly(r);
     return p;
 }
 
 /// Sets the feature's geometry to a multipolygon of one ring per part: in place when it holds one
 /// of as many polygons with rings of as many points, else a new one.
-void set_polygons(OGRFeature& feature, const std::vector<io::LonLatPart>& parts) {
-    if (OGRGeometry* g = feature.GetGeometryRef(); g && wkbFlatten(g->getGeometryType()) == wkbMultiPolygon) {
-        OGRMultiPolygon* multi = g->toMultiPolygon();
+void set_polygons(OGRFeature &feature, const std::vector<io::LonLatPart> &parts) {
+    if (OGRGeometry *g = feature.GetGeometryRef();
+        g && wkbFlatten(g->getGeometryType()) == wkbMultiPolygon) {
+        OGRMultiPolygon *multi = g->toMultiPolygon();
         bool same = multi->getNumGeometries() == int(parts.size());
         for (int p = 0; same && p < int(parts.size()); ++p) {
-            const OGRPolygon* polygon = multi->getGeometryRef(p);
-            same = polygon->getNumInteriorRings() == 0 && polygon->getExteriorRing() &&
-                   polygon->getExteriorRing()->getNumPoints() == int(parts[std::size_t(p)].size() + 1);
+            const OGRPolygon *polygon = multi->getGeometryRef(p);
+            same =
+                polygon->getNumInteriorRings() == 0 && polygon->getExteriorRing() &&
+                polygon->getExteriorRing()->getNumPoints() == int(parts[std::size_t(p)].size() + 1);
         }
         if (same) {
             for (int p = 0; p < int(parts.size()); ++p) {
-                const io::LonLatPart& ring = parts[std::size_t(p)];
-                OGRLinearRing* r = multi->getGeometryRef(p)->getExteriorRing();
-                for (std::size_t i = 0; i <= ring.size(); ++i) r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
+                const io::LonLatPart &ring = parts[std::size_t(p)];
+                OGRLinearRing *r = multi->getGeometryRef(p)->getExteriorRing();
+                for (std::size_t i = 0; i <= ring.size(); ++i)
+                    r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
             }
             return;
         }
     }
-    auto* multi = new OGRMultiPolygon();
-    for (const auto& part : parts) multi->addGeometryDirectly(polygon_of(part));
+    auto *multi = new OGRMultiPolygon();
+    for (const auto &part : parts)
+        multi->addGeometryDirectly(polygon_of(part));
     feature.SetGeometryDirectly(multi);
 }
 
@@ -239,32 +265,42 @@ struct BoundaryRun {
     int loop = 0;
 };
 
-std::vector<BoundaryRun> boundary_runs(const io::MeshTopology& topo) {
+std::vector<BoundaryRun> boundary_runs(const io::MeshTopology &topo) {
     // Boundary edges are named here by their position b in topo.boundary_edges (ascending edge
     // index), the index of their tag in topo.boundary_tags.
     const std::size_t nb = topo.boundary_edges.size();
-    auto nodes = [&](std::size_t b) { return topo.edge_nodes(std::size_t(topo.boundary_edges[b])); };
+    auto nodes = [&](std::size_t b) {
+        return topo.edge_nodes(std::size_t(topo.boundary_edges[b]));
+    };
     std::map<std::int32_t, std::vector<std::size_t>> outgoing; // node -> boundary edges leaving it
-    for (std::size_t b = 0; b < nb; ++b) outgoing[nodes(b)[0]].push_back(b);
+    for (std::size_t b = 0; b < nb; ++b)
+        outgoing[nodes(b)[0]].push_back(b);
     std::vector<char> used(nb, 0);
     std::vector<BoundaryRun> runs;
     int loop = 0;
     for (std::size_t start = 0; start < nb; ++start) {
-        if (used[start]) continue;
+        if (used[start])
+            continue;
         std::vector<std::size_t> edges;
         for (std::size_t b = start; b < nb && !used[b];) {
             used[b] = 1;
             edges.push_back(b);
             std::size_t next = nb;
             for (auto cand : outgoing[nodes(b)[1]])
-                if (!used[cand]) { next = cand; break; }
+                if (!used[cand]) {
+                    next = cand;
+                    break;
+                }
             b = next;
         }
         // Start at a change of tag, so a run never wraps round the start of the loop.
-        const auto& tags = topo.boundary_tags;
+        const auto &tags = topo.boundary_tags;
         std::size_t first = 0;
         for (std::size_t i = 0; i < edges.size(); ++i)
-            if (tags[edges[i]] != tags[edges[(i + edges.size() - 1) % edges.size()]]) { first = i; break; }
+            if (tags[edges[i]] != tags[edges[(i + edges.size() - 1) % edges.size()]]) {
+                first = i;
+                break;
+            }
         std::rotate(edges.begin(), edges.begin() + std::ptrdiff_t(first), edges.end());
         for (std::size_t i = 0; i < edges.size(); ++i) {
             int tag = tags[edges[i]];
@@ -283,7 +319,7 @@ std::vector<BoundaryRun> boundary_runs(const io::MeshTopology& topo) {
 constexpr double face_share = 0.47, node_share = 0.19;
 
 /// A geometry's box, for its layer's spatial index (gpkg_rtree.hpp).
-io::RtreeBox box_of(const OGRGeometry& g) {
+io::RtreeBox box_of(const OGRGeometry &g) {
     OGREnvelope e;
     g.getEnvelope(&e);
     return io::rtree_box(e.MinX, e.MaxX, e.MinY, e.MaxY);
@@ -291,25 +327,29 @@ io::RtreeBox box_of(const OGRGeometry& g) {
 
 /// The faces layer and the node and face fields its features carry.
 struct FacesLayer {
-    OGRLayer* layer = nullptr;
-    const Field* depth = nullptr;       ///< the nodes' depth, as the mean of each face's corners
-    const Field* size = nullptr;        ///< the nodes' target_size, likewise
-    std::vector<const Field*> face_fields; ///< the mesh's other face fields, as they are
+    OGRLayer *layer = nullptr;
+    const Field *depth = nullptr; ///< the nodes' depth, as the mean of each face's corners
+    const Field *size = nullptr;  ///< the nodes' target_size, likewise
+    std::vector<const Field *> face_fields; ///< the mesh's other face fields, as they are
 };
 
-FacesLayer define_faces_layer(GpkgWriter& w, const Mesh& mesh) {
+FacesLayer define_faces_layer(GpkgWriter &w, const Mesh &mesh) {
     FacesLayer l;
-    OGRLayer* faces = l.layer = w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
+    OGRLayer *faces = l.layer =
+        w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
     w.field(faces, "face", OFTInteger);
     w.field(faces, "quality", OFTReal);
     w.field(faces, "area_km2", OFTReal);
-    const Field* depth = l.depth = mesh.node_field("depth");
-    const Field* size = l.size = mesh.node_field("target_size");
-    if (depth) w.field(faces, "depth", OFTReal);
-    if (size) w.field(faces, "target_size", OFTReal);
-    for (const auto& f : mesh.face_fields)
+    const Field *depth = l.depth = mesh.node_field("depth");
+    const Field *size = l.size = mesh.node_field("target_size");
+    if (depth)
+        w.field(faces, "depth", OFTReal);
+    if (size)
+        w.field(faces, "target_size", OFTReal);
+    for (const auto &f : mesh.face_fields)
         if (f.name != "quality" && f.name != "area" && f.name != "area_km2" && f.name != "face" &&
-            !(depth && f.name == "depth") && !(size && f.name == "target_size") && f.values.size() == mesh.faces.size()) {
+            !(depth && f.name == "depth") && !(size && f.name == "target_size") &&
+            f.values.size() == mesh.faces.size()) {
             w.field(faces, f.name.c_str(), OFTReal);
             l.face_fields.push_back(&f);
         }
@@ -317,29 +357,34 @@ FacesLayer define_faces_layer(GpkgWriter& w, const Mesh& mesh) {
 }
 
 /// The faces' features, and their boxes into `indexes`.
-void write_faces(GpkgWriter& w, const FacesLayer& l, const Mesh& mesh, const io::MeshTopology& topo,
-                 const GpkgOptions& options, std::vector<io::RtreeLayer>& indexes) {
-    OGRLayer* faces = l.layer;
+void write_faces(GpkgWriter &w, const FacesLayer &l, const Mesh &mesh, const io::MeshTopology &topo,
+                 const GpkgOptions &options, std::vector<io::RtreeLayer> &indexes) {
+    OGRLayer *faces = l.layer;
     const Field *depth = l.depth, *size = l.size;
-    const std::vector<const Field*>& face_fields = l.face_fields;
+    const std::vector<const Field *> &face_fields = l.face_fields;
     // The face areas as the UGRID file has them: those write_ugrid gave, else each edge's
     // geodesic problem solved once here, on every core (freed before the nodes).
-    const std::vector<double>* given = options.face_areas_m2;
-    if (given && given->size() != mesh.faces.size()) given = nullptr;
+    const std::vector<double> *given = options.face_areas_m2;
+    if (given && given->size() != mesh.faces.size())
+        given = nullptr;
     std::optional<io::GeodesicFaceAreas> areas;
-    if (!given) areas.emplace(topo);
-    std::vector<io::RtreeBox>& boxes = indexes.emplace_back(io::RtreeLayer{"faces", "geom", {}}).boxes;
+    if (!given)
+        areas.emplace(topo);
+    std::vector<io::RtreeBox> &boxes =
+        indexes.emplace_back(io::RtreeLayer{"faces", "geom", {}}).boxes;
     boxes.reserve(mesh.faces.size());
     // The features (fields, geometry cut at +-180, box) are made a block at a time on every
     // core, and added in order from this thread, the one that calls GDAL
     // (ordered_blocks.hpp): the same file, with GDAL's CreateFeature alone on this thread.
-    OGRFeatureDefn* defn = faces->GetLayerDefn();
-    const int face_field = defn->GetFieldIndex("face"), quality_field = defn->GetFieldIndex("quality"),
+    OGRFeatureDefn *defn = faces->GetLayerDefn();
+    const int face_field = defn->GetFieldIndex("face"),
+              quality_field = defn->GetFieldIndex("quality"),
               area_field = defn->GetFieldIndex("area_km2");
     const int depth_field = depth ? defn->GetFieldIndex("depth") : -1;
     const int size_field = size ? defn->GetFieldIndex("target_size") : -1;
     std::vector<int> face_field_index;
-    for (const Field* f : face_fields) face_field_index.push_back(defn->GetFieldIndex(f->name.c_str()));
+    for (const Field *f : face_fields)
+        face_field_index.push_back(defn->GetFieldIndex(f->name.c_str()));
     // A slot's features are made once and refilled for each block it holds (every field
     // is set again; a face's polygon takes the new corners in place when it has as many
     // parts and points as before): a feature made and freed per face cost as much as the
@@ -355,17 +400,20 @@ void write_faces(GpkgWriter& w, const FacesLayer& l, const Mesh& mesh, const io:
     constexpr std::size_t block_faces = 4096;
     io::compute_in_order<FaceBlock, Scratch>(
         (mesh.faces.size() + block_faces - 1) / block_faces,
-        [&](std::size_t k, FaceBlock& b, Scratch& scratch) {
-            const std::size_t first = k * block_faces, last = std::min(mesh.faces.size(), first + block_faces);
+        [&](std::size_t k, FaceBlock &b, Scratch &scratch) {
+            const std::size_t first = k * block_faces,
+                              last = std::min(mesh.faces.size(), first + block_faces);
             b.count = last - first;
-            while (b.features.size() < b.count) b.features.push_back(std::make_unique<OGRFeature>(defn));
+            while (b.features.size() < b.count)
+                b.features.push_back(std::make_unique<OGRFeature>(defn));
             b.boxes.clear();
             for (std::size_t i = first; i < last; ++i) {
-                const auto& t = mesh.faces[i];
-                OGRFeature& feature = *b.features[i - first];
+                const auto &t = mesh.faces[i];
+                OGRFeature &feature = *b.features[i - first];
                 feature.SetFID(GIntBig(i) + 1);
                 feature.SetField(face_field, int(i));
-                feature.SetField(quality_field, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
+                feature.SetField(quality_field, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]],
+                                                                 mesh.nodes[t[2]]));
                 double area_m2;
                 if (given) {
                     area_m2 = (*given)[i];
@@ -374,47 +422,63 @@ void write_faces(GpkgWriter& w, const FacesLayer& l, const Mesh& mesh, const io:
                     area_m2 = areas->face_m2(i, scratch.edges.data());
                 }
                 feature.SetField(area_field, area_m2 * 1e-6);
-                auto mean = [&](const Field* f) { return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0; };
-                if (depth) feature.SetField(depth_field, mean(depth));
-                if (size) feature.SetField(size_field, mean(size));
-                for (std::size_t f = 0; f < face_fields.size(); ++f) feature.SetField(face_field_index[f], face_fields[f]->values[i]);
+                auto mean = [&](const Field *f) {
+                    return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0;
+                };
+                if (depth)
+                    feature.SetField(depth_field, mean(depth));
+                if (size)
+                    feature.SetField(size_field, mean(size));
+                for (std::size_t f = 0; f < face_fields.size(); ++f)
+                    feature.SetField(face_field_index[f], face_fields[f]->values[i]);
                 std::vector<io::LonLatPart> parts;
-                for (auto& ring : io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-                    for (auto& part : narrow_rings(std::move(ring))) parts.push_back(std::move(part));
+                for (auto &ring :
+                     io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
+                    for (auto &part : narrow_rings(std::move(ring)))
+                        parts.push_back(std::move(part));
                 set_polygons(feature, parts);
                 b.boxes.push_back(box_of(*feature.GetGeometryRef()));
             }
         },
-        [&](std::size_t k, FaceBlock& b) {
+        [&](std::size_t k, FaceBlock &b) {
             if (k % 4 == 0)
-                report(options.progress, face_share * double(k * block_faces) / double(mesh.faces.size()), "write_gpkg");
-            for (std::size_t f = 0; f < b.count; ++f) w.add(faces, *b.features[f]);
+                report(options.progress,
+                       face_share * double(k * block_faces) / double(mesh.faces.size()),
+                       "write_gpkg");
+            for (std::size_t f = 0; f < b.count; ++f)
+                w.add(faces, *b.features[f]);
             boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
         });
 }
 
 /// The nodes layer with every node field, and its boxes into `indexes`.
-void write_nodes(GpkgWriter& w, const Mesh& mesh, const GpkgOptions& options, std::vector<io::RtreeLayer>& indexes) {
-    OGRLayer* nodes = w.layer("nodes", wkbPoint, "mesh nodes with their fields");
+void write_nodes(GpkgWriter &w, const Mesh &mesh, const GpkgOptions &options,
+                 std::vector<io::RtreeLayer> &indexes) {
+    OGRLayer *nodes = w.layer("nodes", wkbPoint, "mesh nodes with their fields");
     w.field(nodes, "node", OFTInteger);
-    for (const auto& f : mesh.node_fields)
-        if (f.name != "node") w.field(nodes, f.name.c_str(), OFTReal);
-    std::vector<io::RtreeBox>& node_boxes = indexes.emplace_back(io::RtreeLayer{"nodes", "geom", {}}).boxes;
+    for (const auto &f : mesh.node_fields)
+        if (f.name != "node")
+            w.field(nodes, f.name.c_str(), OFTReal);
+    std::vector<io::RtreeBox> &node_boxes =
+        indexes.emplace_back(io::RtreeLayer{"nodes", "geom", {}}).boxes;
     node_boxes.reserve(mesh.nodes.size());
     // One feature and one point, refilled for each node (as the faces' features are).
     OGRFeature feature(nodes->GetLayerDefn());
     const int node_field = feature.GetFieldIndex("node");
-    std::vector<std::pair<int, const Field*>> fields;
-    for (const auto& f : mesh.node_fields)
-        if (f.name != "node" && f.values.size() == mesh.nodes.size()) fields.emplace_back(feature.GetFieldIndex(f.name.c_str()), &f);
-    auto* point = new OGRPoint(0, 0);
+    std::vector<std::pair<int, const Field *>> fields;
+    for (const auto &f : mesh.node_fields)
+        if (f.name != "node" && f.values.size() == mesh.nodes.size())
+            fields.emplace_back(feature.GetFieldIndex(f.name.c_str()), &f);
+    auto *point = new OGRPoint(0, 0);
     feature.SetGeometryDirectly(point);
     for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
         if (i % 16384 == 0)
-            report(options.progress, face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
+            report(options.progress,
+                   face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
         feature.SetFID(GIntBig(i) + 1);
         feature.SetField(node_field, int(i));
-        for (const auto& [index, f] : fields) feature.SetField(index, f->values[i]);
+        for (const auto &[index, f] : fields)
+            feature.SetField(index, f->values[i]);
         LonLat p = vec_to_lonlat(mesh.nodes[i]);
         node_boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
         point->setX(p.lon);
@@ -424,16 +488,18 @@ void write_nodes(GpkgWriter& w, const Mesh& mesh, const GpkgOptions& options, st
 }
 
 /// The boundary layer, one feature per run, and its boxes into `indexes`; runs is not empty.
-void write_boundary(GpkgWriter& w, const Mesh& mesh, const std::vector<BoundaryRun>& runs,
-                    std::vector<io::RtreeLayer>& indexes) {
-    OGRLayer* boundary = w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
+void write_boundary(GpkgWriter &w, const Mesh &mesh, const std::vector<BoundaryRun> &runs,
+                    std::vector<io::RtreeLayer> &indexes) {
+    OGRLayer *boundary =
+        w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
     w.field(boundary, "tag", OFTString);
     w.field(boundary, "tag_code", OFTInteger);
     w.field(boundary, "loop", OFTInteger);
     w.field(boundary, "edges", OFTInteger);
     w.field(boundary, "length_km", OFTReal);
-    std::vector<io::RtreeBox>& run_boxes = indexes.emplace_back(io::RtreeLayer{"boundary", "geom", {}}).boxes;
-    for (const auto& run : runs) {
+    std::vector<io::RtreeBox> &run_boxes =
+        indexes.emplace_back(io::RtreeLayer{"boundary", "geom", {}}).boxes;
+    for (const auto &run : runs) {
         OGRFeature feature(boundary->GetLayerDefn());
         feature.SetFID(GIntBig(run_boxes.size()) + 1);
         feature.SetField("tag", run.tag == int(EdgeTag::open) ? "open" : "coast");
@@ -444,14 +510,16 @@ void write_boundary(GpkgWriter& w, const Mesh& mesh, const std::vector<BoundaryR
         std::vector<Vec3> points;
         for (std::size_t i = 0; i < run.nodes.size(); ++i) {
             points.push_back(mesh.nodes[run.nodes[i]]);
-            if (i) km += arc_km(points[i - 1], points[i]);
+            if (i)
+                km += arc_km(points[i - 1], points[i]);
         }
         feature.SetField("length_km", km);
-        auto* multi = new OGRMultiLineString();
-        for (const auto& cut : io::polyline_parts(points))
-            for (const auto& part : narrow_lines(cut)) {
-                auto* line = new OGRLineString();
-                for (const auto& p : part) line->addPoint(p[0], p[1]);
+        auto *multi = new OGRMultiLineString();
+        for (const auto &cut : io::polyline_parts(points))
+            for (const auto &part : narrow_lines(cut)) {
+                auto *line = new OGRLineString();
+                for (const auto &p : part)
+                    line->addPoint(p[0], p[1]);
                 multi->addGeometryDirectly(line);
             }
         run_boxes.push_back(box_of(*multi));
@@ -461,8 +529,8 @@ void write_boundary(GpkgWriter& w, const Mesh& mesh, const std::vector<BoundaryR
 }
 
 /// The mesh_info table: provenance and summary statistics, then the mesh's run metadata.
-void write_mesh_info(GpkgWriter& w, const Mesh& mesh, const MeshStats& stats) {
-    OGRLayer* info = w.layer("mesh_info", wkbNone, "run metadata and summary statistics");
+void write_mesh_info(GpkgWriter &w, const Mesh &mesh, const MeshStats &stats) {
+    OGRLayer *info = w.layer("mesh_info", wkbNone, "run metadata and summary statistics");
     w.field(info, "key", OFTString);
     w.field(info, "value", OFTString);
     std::vector<std::pair<std::string, std::string>> rows = {
@@ -479,7 +547,7 @@ void write_mesh_info(GpkgWriter& w, const Mesh& mesh, const MeshStats& stats) {
         {"edge_length_km_mean", std::to_string(stats.edge_km_mean)},
         {"edge_length_km_max", std::to_string(stats.edge_km_max)}};
     rows.insert(rows.end(), mesh.attributes.begin(), mesh.attributes.end());
-    for (const auto& [key, value] : rows) {
+    for (const auto &[key, value] : rows) {
         OGRFeature feature(info->GetLayerDefn());
         feature.SetField("key", key.c_str());
         feature.SetField("value", value.c_str());
@@ -489,17 +557,19 @@ void write_mesh_info(GpkgWriter& w, const Mesh& mesh, const MeshStats& stats) {
 
 /// layer_styles, in the schema QGIS creates and reads (QgsOgrProviderUtils / saveStyle), with
 /// the faces' default style.
-void write_layer_styles(GpkgWriter& w) {
-    OGRLayer* styles = w.layer("layer_styles", wkbNone, "QGIS layer styles", "FID=id");
-    for (const char* name : {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
-                             "styleQML", "styleSLD"})
+void write_layer_styles(GpkgWriter &w) {
+    OGRLayer *styles = w.layer("layer_styles", wkbNone, "QGIS layer styles", "FID=id");
+    for (const char *name : {"f_table_catalog", "f_table_schema", "f_table_name",
+                             "f_geometry_column", "styleName", "styleQML", "styleSLD"})
         w.field(styles, name, OFTString);
     {
         OGRFieldDefn f("useAsDefault", OFTInteger);
         f.SetSubType(OFSTBoolean);
-        if (styles->CreateField(&f) != OGRERR_NONE) w.fail("creating field useAsDefault");
+        if (styles->CreateField(&f) != OGRERR_NONE)
+            w.fail("creating field useAsDefault");
     }
-    for (const char* name : {"description", "owner", "ui"}) w.field(styles, name, OFTString);
+    for (const char *name : {"description", "owner", "ui"})
+        w.field(styles, name, OFTString);
     w.field(styles, "update_time", OFTDateTime, "CURRENT_TIMESTAMP");
     OGRFeature style(styles->GetLayerDefn());
     style.SetField("f_table_catalog", "");
@@ -510,7 +580,9 @@ void write_layer_styles(GpkgWriter& w) {
     style.SetField("styleQML", faces_style_qml().c_str());
     style.SetField("styleSLD", "");
     style.SetField("useAsDefault", 1);
-    style.SetField("description", "globemesh default: faces coloured by quality (2*sqrt(3)*inradius/longest edge)");
+    style.SetField(
+        "description",
+        "globemesh default: faces coloured by quality (2*sqrt(3)*inradius/longest edge)");
     style.SetField("owner", "");
     style.SetField("ui", "");
     w.add(styles, style);
@@ -518,8 +590,9 @@ void write_layer_styles(GpkgWriter& w) {
 
 } // namespace
 
-void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgOptions& options) {
-    if (mesh.faces.empty()) throw DataError("mesh: no faces to write to " + path.string());
+void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgOptions &options) {
+    if (mesh.faces.empty())
+        throw DataError("mesh: no faces to write to " + path.string());
     OutputFile out(path, options.overwrite, "GeoPackage output");
     // The topology (about 50 bytes a node) serves the statistics, the boundary's runs and the
     // faces' areas and edges, and goes once the faces are written: held to the end, it made the
@@ -530,12 +603,13 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
 
     GDALAllRegister();
     io::QuietGdalErrors quiet;
-    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
-    if (!driver) throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
+    GDALDriver *driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!driver)
+        throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
     io::GdalDatasetPtr ds(driver->Create(out.temp_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
     if (!ds)
-        throw IoError("GeoPackage output " + path.string() + ": cannot create (" + io::last_gdal_error() + ")" +
-                      OutputFile::full_disk_note(path));
+        throw IoError("GeoPackage output " + path.string() + ": cannot create (" +
+                      io::last_gdal_error() + ")" + OutputFile::full_disk_note(path));
     // Declared after the dataset, so that it rolls back before the dataset closes.
     GpkgWriter w(ds.get(), path);
 
@@ -548,27 +622,32 @@ void write_gpkg(const Mesh& mesh, const std::filesystem::path& path, const GpkgO
     // layer (52.1/66.1 s against 53.7/61.3 s, alternated) and gives the same file.
     w.begin();
     write_faces(w, faces, mesh, topo, options, indexes);
-    if (options.face_areas_m2) std::vector<double>().swap(*options.face_areas_m2); // not needed any more
+    if (options.face_areas_m2)
+        std::vector<double>().swap(*options.face_areas_m2); // not needed any more
     topo = io::MeshTopology{};
-    if (detail::after_partial_write) detail::after_partial_write(); // tests only (write_hooks.hpp)
+    if (detail::after_partial_write)
+        detail::after_partial_write(); // tests only (write_hooks.hpp)
     write_nodes(w, mesh, options, indexes);
     // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
-    if (!runs.empty()) write_boundary(w, mesh, runs, indexes);
+    if (!runs.empty())
+        write_boundary(w, mesh, runs, indexes);
     write_mesh_info(w, mesh, stats);
     write_layer_styles(w);
     w.commit();
 
     report(options.progress, face_share + node_share, "write_gpkg");
     if (!io::close_dataset(ds))
-        throw IoError("GeoPackage output " + path.string() + ": closing failed: " + io::last_gdal_error() +
-                      OutputFile::full_disk_note(path));
-    io::add_rtree_indexes(out.temp_path(), indexes, path, sub_progress(options.progress, face_share + node_share, 1.0));
+        throw IoError("GeoPackage output " + path.string() + ": closing failed: " +
+                      io::last_gdal_error() + OutputFile::full_disk_note(path));
+    io::add_rtree_indexes(out.temp_path(), indexes, path,
+                          sub_progress(options.progress, face_share + node_share, 1.0));
     report(options.progress, 1.0, "write_gpkg");
     out.commit();
 }
 
 /// The GPKG row of the writers table (writers.cpp).
-void write_as_gpkg(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options) {
+void write_as_gpkg(const Mesh &mesh, const std::filesystem::path &path,
+                   const WriteOptions &options) {
     GpkgOptions gpkg;
     gpkg.overwrite = options.overwrite;
     gpkg.stats = options.stats;

@@ -31,17 +31,17 @@ class ChunkEncoder {
 public:
     ChunkEncoder();
     ~ChunkEncoder();
-    ChunkEncoder(const ChunkEncoder&) = delete;
-    ChunkEncoder& operator=(const ChunkEncoder&) = delete;
+    ChunkEncoder(const ChunkEncoder &) = delete;
+    ChunkEncoder &operator=(const ChunkEncoder &) = delete;
 
     /// Encodes `rows` rows of `row_bytes` bytes each (elements of element_size bytes) as one
     /// chunk of chunk_rows rows into `out`. HDF5 stores a variable's last chunk whole: the rows
     /// past `rows` are zeros (a reader never sees them).
-    void encode(const void* data, std::size_t rows, std::size_t chunk_rows, std::size_t row_bytes,
-                std::size_t element_size, std::vector<unsigned char>& out);
+    void encode(const void *data, std::size_t rows, std::size_t chunk_rows, std::size_t row_bytes,
+                std::size_t element_size, std::vector<unsigned char> &out);
 
 private:
-    libdeflate_compressor* compressor_;
+    libdeflate_compressor *compressor_;
     std::vector<unsigned char> shuffled_;
 };
 
@@ -51,24 +51,26 @@ private:
 /// leaves HDF5 holding it.
 class Hdf5ChunkFile {
 public:
-    Hdf5ChunkFile(const std::filesystem::path& temp, const std::filesystem::path& target, const char* what);
+    Hdf5ChunkFile(const std::filesystem::path &temp, const std::filesystem::path &target,
+                  const char *what);
     ~Hdf5ChunkFile();
-    Hdf5ChunkFile(const Hdf5ChunkFile&) = delete;
-    Hdf5ChunkFile& operator=(const Hdf5ChunkFile&) = delete;
+    Hdf5ChunkFile(const Hdf5ChunkFile &) = delete;
+    Hdf5ChunkFile &operator=(const Hdf5ChunkFile &) = delete;
 
     /// Stores an encoded chunk (ChunkEncoder) of variable `name`, the one whose first row is
     /// first_row (a multiple of the variable's chunk rows). Throws IoError.
-    void write(const std::string& name, std::size_t first_row, const std::vector<unsigned char>& chunk);
+    void write(const std::string &name, std::size_t first_row,
+               const std::vector<unsigned char> &chunk);
     /// Flushes and closes the file; throws IoError (the file is then abandoned as above).
     void close();
 
 private:
     void close_datasets();
     /// The IoError of a failed HDF5 call at `step`.
-    IoError failure(const std::string& step) const;
+    IoError failure(const std::string &step) const;
 
     std::filesystem::path temp_, target_;
-    const char* what_;
+    const char *what_;
     hid_t file_ = H5I_INVALID_HID;
     std::map<std::string, hid_t> datasets_;
 };

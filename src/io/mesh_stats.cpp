@@ -35,7 +35,8 @@ public:
     /// Number of values in the bins before bin b.
     std::size_t count_below(std::size_t b) const {
         std::size_t n = 0;
-        for (std::size_t i = 0; i < b; ++i) n += counts_[i];
+        for (std::size_t i = 0; i < b; ++i)
+            n += counts_[i];
         return n;
     }
     /// The bins of the lower and upper middle values (ranks (count-1)/2 and count/2, 0-based).
@@ -46,7 +47,8 @@ public:
 private:
     std::size_t bin_of_rank(std::size_t rank) const {
         std::size_t b = 0, below = counts_[0];
-        while (below <= rank) below += counts_[++b];
+        while (below <= rank)
+            below += counts_[++b];
         return b;
     }
     std::vector<std::size_t> counts_ = std::vector<std::size_t>(bin_count, 0);
@@ -55,7 +57,7 @@ private:
 
 } // namespace
 
-MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
+MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
     MeshStats s;
     s.nodes = mesh.nodes.size();
     s.faces = mesh.faces.size();
@@ -66,26 +68,29 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
     // this one does the edges: each task sets members of `s` of its own, with the same loops as
     // in turn (the same sums), so the statistics do not depend on the timing.
     auto node_extent = [&] {
-        if (mesh.nodes.empty()) return;
+        if (mesh.nodes.empty())
+            return;
         s.lon_min = s.lat_min = 1e300;
         s.lon_max = s.lat_max = -1e300;
-        for (const auto& v : mesh.nodes) {
+        for (const auto &v : mesh.nodes) {
             LonLat p = vec_to_lonlat(v);
             s.lon_min = std::min(s.lon_min, p.lon), s.lon_max = std::max(s.lon_max, p.lon);
             s.lat_min = std::min(s.lat_min, p.lat), s.lat_max = std::max(s.lat_max, p.lat);
         }
     };
     auto face_quality_and_area = [&] {
-        if (mesh.faces.empty()) return;
+        if (mesh.faces.empty())
+            return;
         s.quality_min = 1e300;
         double qsum = 0, area = 0;
         std::size_t above = 0;
-        for (const auto& f : mesh.faces) {
+        for (const auto &f : mesh.faces) {
             const Vec3 &a = mesh.nodes[f[0]], &b = mesh.nodes[f[1]], &c = mesh.nodes[f[2]];
             double q = triangle_quality(a, b, c);
             s.quality_min = std::min(s.quality_min, q);
             qsum += q;
-            if (q > 0.8) ++above;
+            if (q > 0.8)
+                ++above;
             s.quality_histogram[std::clamp(int(q * 10.0), 0, 9)]++;
             area += std::fabs(spherical_triangle_area(a, b, c));
         }
@@ -94,8 +99,9 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
         s.area_km2 = area * earth_radius_km * earth_radius_km;
     };
     // Joined before `s` is returned, or by their destructors should the edges throw.
-    std::future<void> nodes_done = start_task(node_extent), faces_done = start_task(face_quality_and_area);
-    const Field* size = mesh.node_field("target_size");
+    std::future<void> nodes_done = start_task(node_extent),
+                      faces_done = start_task(face_quality_and_area);
+    const Field *size = mesh.node_field("target_size");
     s.has_size = size && size->values.size() == mesh.nodes.size();
     if (topo.edge_count() > 0) {
         s.edge_km_min = 1e300;
@@ -123,9 +129,11 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
             sum += km;
             if (s.has_size) {
                 const double r = ratio(e, km);
-                if (std::isnan(r)) continue;
+                if (std::isnan(r))
+                    continue;
                 edge_bin[e] = bins.add(r);
-                if (r >= 0.7 && r <= 1.4) ++in;
+                if (r >= 0.7 && r <= 1.4)
+                    ++in;
             }
         }
         s.edge_km_mean = sum / double(topo.edge_count());
@@ -136,12 +144,14 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
             std::vector<double> middle;
             middle.reserve(bins.count_below(last + 1) - bins.count_below(first));
             for (std::size_t e = 0; e < edge_bin.size(); ++e)
-                if (edge_bin[e] >= first && edge_bin[e] <= last) middle.push_back(ratio(e, edge_km(e)));
+                if (edge_bin[e] >= first && edge_bin[e] <= last)
+                    middle.push_back(ratio(e, edge_km(e)));
             // Rank of the upper middle value (the median for an odd count) among `middle`.
             auto mid = middle.begin() + std::ptrdiff_t(bins.count() / 2 - bins.count_below(first));
             std::nth_element(middle.begin(), mid, middle.end());
             double median = *mid;
-            if (bins.count() % 2 == 0) median = 0.5 * (median + *std::max_element(middle.begin(), mid));
+            if (bins.count() % 2 == 0)
+                median = 0.5 * (median + *std::max_element(middle.begin(), mid));
             s.size_ratio_median = median;
         }
     }
@@ -152,6 +162,8 @@ MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo) {
 
 } // namespace io
 
-MeshStats compute_stats(const Mesh& mesh) { return io::compute_stats(mesh, io::build_topology(mesh)); }
+MeshStats compute_stats(const Mesh &mesh) {
+    return io::compute_stats(mesh, io::build_topology(mesh));
+}
 
 } // namespace globemesh

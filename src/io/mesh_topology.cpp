@@ -11,20 +11,23 @@ namespace globemesh::io {
 
 namespace {
 std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
-    if (a > b) std::swap(a, b);
+    if (a > b)
+        std::swap(a, b);
     return (std::uint64_t(a) << 32) | b;
 }
 } // namespace
 
-MeshTopology build_topology(const Mesh& mesh) {
+MeshTopology build_topology(const Mesh &mesh) {
     const std::size_t nf = mesh.faces.size(), nn = mesh.nodes.size();
-    if (nf * 3 >= std::size_t(INT32_MAX)) throw DataError("mesh: too many faces for 32-bit indices");
+    if (nf * 3 >= std::size_t(INT32_MAX))
+        throw DataError("mesh: too many faces for 32-bit indices");
     for (std::size_t f = 0; f < nf; ++f) {
-        const auto& t = mesh.faces[f];
+        const auto &t = mesh.faces[f];
         for (auto v : t)
             if (v >= nn)
-                throw DataError("mesh: face " + std::to_string(f) + " uses node " + std::to_string(v) +
-                                " but the mesh has " + std::to_string(nn) + " nodes");
+                throw DataError("mesh: face " + std::to_string(f) + " uses node " +
+                                std::to_string(v) + " but the mesh has " + std::to_string(nn) +
+                                " nodes");
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
             throw DataError("mesh: face " + std::to_string(f) + " repeats a node");
     }
@@ -34,34 +37,39 @@ MeshTopology build_topology(const Mesh& mesh) {
     // the face rather than stored: 4 bytes per half-edge, 28 to 32 bytes per node of scratch.
     const std::size_t nh = 3 * nf;
     auto ends = [&](std::uint32_t h) {
-        const auto& face = mesh.faces[h / 3];
+        const auto &face = mesh.faces[h / 3];
         std::uint32_t a = face[h % 3], b = face[(h % 3 + 1) % 3];
         return a < b ? std::pair{a, b} : std::pair{b, a};
     };
     std::vector<std::uint32_t> start(nn + 1, 0);
-    for (std::uint32_t h = 0; h < nh; ++h) ++start[ends(h).first + 1];
+    for (std::uint32_t h = 0; h < nh; ++h)
+        ++start[ends(h).first + 1];
     std::partial_sum(start.begin(), start.end(), start.begin());
     std::vector<std::uint32_t> bucket(nh);
     {
         std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-        for (std::uint32_t h = 0; h < nh; ++h) bucket[fill[ends(h).first]++] = h;
+        for (std::uint32_t h = 0; h < nh; ++h)
+            bucket[fill[ends(h).first]++] = h;
     }
     auto by_larger_node = [&](std::uint32_t a, std::uint32_t b) {
         return std::pair{ends(a).second, a} < std::pair{ends(b).second, b};
     };
-    for (std::size_t v = 0; v < nn; ++v) std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
+    for (std::size_t v = 0; v < nn; ++v)
+        std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
 
     // Calls edge(i, j, v) for each edge in order: its half-edges are bucket[i..j), one or two,
     // and v is its smaller node.
-    auto for_each_edge = [&](const auto& edge) {
+    auto for_each_edge = [&](const auto &edge) {
         for (std::size_t v = 0; v < nn; ++v) {
             for (std::size_t i = start[v], end = start[v + 1]; i < end;) {
                 const std::uint32_t larger = ends(bucket[i]).second;
                 std::size_t j = i + 1;
-                while (j < end && ends(bucket[j]).second == larger) ++j;
+                while (j < end && ends(bucket[j]).second == larger)
+                    ++j;
                 if (j - i > 2)
-                    throw DataError("mesh: edge " + std::to_string(v) + "-" + std::to_string(larger) +
-                                    " is shared by " + std::to_string(j - i) + " faces (non-manifold)");
+                    throw DataError("mesh: edge " + std::to_string(v) + "-" +
+                                    std::to_string(larger) + " is shared by " +
+                                    std::to_string(j - i) + " faces (non-manifold)");
                 edge(i, j, v);
                 i = j;
             }
@@ -74,35 +82,41 @@ MeshTopology build_topology(const Mesh& mesh) {
     t.edge_halves.reserve(ne); // exactly: growing by push_back would double it
     t.node_edges.assign(nn + 1, 0);
     for_each_edge([&](std::size_t i, std::size_t j, std::size_t v) {
-        if (j - i == 1) t.boundary_edges.push_back(std::int32_t(t.edge_halves.size()));
-        t.edge_halves.push_back({bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge});
+        if (j - i == 1)
+            t.boundary_edges.push_back(std::int32_t(t.edge_halves.size()));
+        t.edge_halves.push_back(
+            {bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge});
         t.node_edges[v + 1] = std::uint32_t(t.edge_halves.size());
     });
-    for (std::size_t v = 0; v < nn; ++v) t.node_edges[v + 1] = std::max(t.node_edges[v + 1], t.node_edges[v]);
+    for (std::size_t v = 0; v < nn; ++v)
+        t.node_edges[v + 1] = std::max(t.node_edges[v + 1], t.node_edges[v]);
     std::vector<std::uint32_t>().swap(start);
     std::vector<std::uint32_t>().swap(bucket);
 
     // Tags: boundary edges from mesh.boundary by node pair (binary search on sorted keys).
     std::vector<std::pair<std::uint64_t, int>> tagged;
     tagged.reserve(mesh.boundary.size());
-    for (const auto& b : mesh.boundary) tagged.emplace_back(edge_key(b.a, b.b), int(b.tag));
+    for (const auto &b : mesh.boundary)
+        tagged.emplace_back(edge_key(b.a, b.b), int(b.tag));
     std::sort(tagged.begin(), tagged.end());
     t.boundary_tags.reserve(t.boundary_edges.size());
     for (auto e : t.boundary_edges) {
         const auto nodes = t.edge_nodes(std::size_t(e));
         std::uint64_t key = edge_key(std::uint32_t(nodes[0]), std::uint32_t(nodes[1]));
         auto it = std::lower_bound(tagged.begin(), tagged.end(), std::make_pair(key, -1));
-        t.boundary_tags.push_back((it != tagged.end() && it->first == key && it->second != 0) ? it->second
-                                                                                             : int(EdgeTag::coast));
+        t.boundary_tags.push_back((it != tagged.end() && it->first == key && it->second != 0)
+                                      ? it->second
+                                      : int(EdgeTag::coast));
     }
     return t;
 }
 
-void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out) {
+void face_edges(const MeshTopology &topo, std::size_t first, std::size_t count,
+                std::vector<std::int32_t> &out) {
     out.assign(3 * count, -1);
-    const auto& faces = topo.mesh->faces;
+    const auto &faces = topo.mesh->faces;
     for (std::size_t i = 0; i < count; ++i) {
-        const auto& face = faces[first + i];
+        const auto &face = faces[first + i];
         for (std::size_t k = 0; k < 3; ++k) {
             // Side k is a half-edge of one of the edges of its smaller node.
             const auto h = std::uint32_t(3 * (first + i) + k);
@@ -116,22 +130,25 @@ void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, 
     }
 }
 
-std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::int32_t* edges_of_f, std::size_t f) {
+std::array<std::int32_t, 3> face_faces(const MeshTopology &topo, const std::int32_t *edges_of_f,
+                                       std::size_t f) {
     std::array<std::int32_t, 3> neighbours = {-1, -1, -1};
     int n = 0;
     for (int k = 0; k < 3; ++k) {
         const auto ef = topo.edge_faces(std::size_t(edges_of_f[k]));
         const std::int32_t other = ef[0] == std::int32_t(f) ? ef[1] : ef[0];
-        if (other >= 0) neighbours[n++] = other;
+        if (other >= 0)
+            neighbours[n++] = other;
     }
     return neighbours;
 }
 
-std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_count) {
+std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_count) {
     std::vector<std::uint32_t> parent(node_count);
     std::iota(parent.begin(), parent.end(), 0u);
     auto find = [&](std::uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        while (parent[x] != x)
+            x = parent[x] = parent[parent[x]];
         return x;
     };
     std::vector<char> on_boundary(node_count, 0);
@@ -140,11 +157,13 @@ std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_coun
         auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
         on_boundary[a] = on_boundary[b] = 1;
         a = find(a), b = find(b);
-        if (a != b) parent[a] = b;
+        if (a != b)
+            parent[a] = b;
     }
     std::size_t loops = 0;
     for (std::uint32_t v = 0; v < node_count; ++v)
-        if (on_boundary[v] && find(v) == v) ++loops;
+        if (on_boundary[v] && find(v) == v)
+            ++loops;
     return loops;
 }
 

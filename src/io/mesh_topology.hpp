@@ -24,23 +24,25 @@ namespace globemesh::io {
 struct MeshTopology {
     static constexpr std::uint32_t no_half_edge = UINT32_MAX;
 
-    const Mesh* mesh = nullptr; ///< the mesh it was built from, which must outlive it
-    std::vector<std::array<std::uint32_t, 2>> edge_halves; ///< second is no_half_edge on the boundary
-    /// The edges whose smaller node is v are node_edges[v] .. node_edges[v + 1] - 1 (nodes + 1 entries).
+    const Mesh *mesh = nullptr; ///< the mesh it was built from, which must outlive it
+    std::vector<std::array<std::uint32_t, 2>>
+        edge_halves; ///< second is no_half_edge on the boundary
+    /// The edges whose smaller node is v are node_edges[v] .. node_edges[v + 1] - 1 (nodes + 1
+    /// entries).
     std::vector<std::uint32_t> node_edges;
-    std::vector<std::int32_t> boundary_edges;              ///< edge indices with one face, ascending
-    std::vector<int> boundary_tags;                        ///< EdgeTag of each of boundary_edges
+    std::vector<std::int32_t> boundary_edges; ///< edge indices with one face, ascending
+    std::vector<int> boundary_tags;           ///< EdgeTag of each of boundary_edges
 
     std::size_t edge_count() const { return edge_halves.size(); }
     /// Nodes of edge e, oriented as its first face.
     std::array<std::int32_t, 2> edge_nodes(std::size_t e) const {
         const std::uint32_t h = edge_halves[e][0];
-        const auto& face = mesh->faces[h / 3];
+        const auto &face = mesh->faces[h / 3];
         return {std::int32_t(face[h % 3]), std::int32_t(face[(h % 3 + 1) % 3])};
     }
     /// Faces on each side of edge e; the second is -1 on the boundary.
     std::array<std::int32_t, 2> edge_faces(std::size_t e) const {
-        const auto& h = edge_halves[e];
+        const auto &h = edge_halves[e];
         return {std::int32_t(h[0] / 3), h[1] == no_half_edge ? -1 : std::int32_t(h[1] / 3)};
     }
 };
@@ -48,19 +50,21 @@ struct MeshTopology {
 /// Builds the edges. Throws DataError on a face with an out-of-range or repeated node, or an
 /// edge shared by more than two faces. Boundary edges take their tag from mesh.boundary (matched
 /// by node pair); untagged boundary edges are coast.
-MeshTopology build_topology(const Mesh& mesh);
+MeshTopology build_topology(const Mesh &mesh);
 
 /// The edges of faces first .. first + count - 1: out[3 * i + k] is the edge joining nodes k and
 /// k+1 of face first + i, found among the edges of the side's smaller node.
-void face_edges(const MeshTopology& topo, std::size_t first, std::size_t count, std::vector<std::int32_t>& out);
+void face_edges(const MeshTopology &topo, std::size_t first, std::size_t count,
+                std::vector<std::int32_t> &out);
 
 /// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from its three edges.
-std::array<std::int32_t, 3> face_faces(const MeshTopology& topo, const std::int32_t* edges_of_f, std::size_t f);
+std::array<std::int32_t, 3> face_faces(const MeshTopology &topo, const std::int32_t *edges_of_f,
+                                       std::size_t f);
 
 /// Number of boundary loops: connected groups of boundary edges (joined at shared nodes).
-std::size_t count_boundary_loops(const MeshTopology& topo, std::size_t node_count);
+std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_count);
 
 /// compute_stats on an already built topology (the writer has one).
-MeshStats compute_stats(const Mesh& mesh, const MeshTopology& topo);
+MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo);
 
 } // namespace globemesh::io

@@ -13,13 +13,13 @@ namespace globemesh::io {
 
 /// Throws IoError("<what> <file>: <step>: <nc_strerror>") when status is not NC_NOERR, with a
 /// note when the file's disk is full (HDF5 reports that as a bare "HDF error").
-void nc_check(int status, const std::filesystem::path& file, const std::string& step,
-              const char* what = "UGRID file");
+void nc_check(int status, const std::filesystem::path &file, const std::string &step,
+              const char *what = "UGRID file");
 
 /// Points every descriptor this process holds on `file` at one new empty memory file, so that
 /// whatever is written through them from now on lands in memory (a temporary file being
 /// abandoned, whose last flush must not fail). Returns how many it moved.
-int divert_to_memory(const std::filesystem::path& file);
+int divert_to_memory(const std::filesystem::path &file);
 
 /// Owns an open netCDF id; abandons (nc_abort) a file that was not closed explicitly.
 ///
@@ -32,16 +32,17 @@ class NcHandle {
 public:
     NcHandle() = default;
     ~NcHandle();
-    NcHandle(const NcHandle&) = delete;
-    NcHandle& operator=(const NcHandle&) = delete;
-    int* out() { return &id_; }
+    NcHandle(const NcHandle &) = delete;
+    NcHandle &operator=(const NcHandle &) = delete;
+    int *out() { return &id_; }
     int id() const { return id_; }
     /// nc_create of `temp`, the temporary file through which `target` is written (messages
     /// name target); throws IoError.
-    void create(const std::filesystem::path& temp, int mode, const std::filesystem::path& target, const char* what);
+    void create(const std::filesystem::path &temp, int mode, const std::filesystem::path &target,
+                const char *what);
     /// Closes the file, flushing it first on its own (when that fails, the file is still open and
     /// the destructor abandons it as above); throws IoError on failure (e.g. a full disk).
-    void close(const std::filesystem::path& file, const char* what = "UGRID file");
+    void close(const std::filesystem::path &file, const char *what = "UGRID file");
 
 private:
     int id_ = -1;

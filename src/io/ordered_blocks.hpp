@@ -22,15 +22,16 @@
 namespace globemesh::io {
 
 /// Threads for the writers' blocks: one per core, at most 8.
-inline std::size_t block_threads() { return std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8); }
+inline std::size_t block_threads() {
+    return std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 8);
+}
 
 /// std::async(task) on a thread of its own, or deferred (run in turn when its result is asked
 /// for) when the process may start no more threads.
-template <class Task>
-auto start_task(const Task& task) {
+template <class Task> auto start_task(const Task &task) {
     try {
         return std::async(std::launch::async, task);
-    } catch (const std::system_error&) {
+    } catch (const std::system_error &) {
         return std::async(std::launch::deferred, task);
     }
 }
@@ -42,8 +43,9 @@ auto start_task(const Task& task) {
 /// must only read shared data. An exception from compute is rethrown here when its block's turn
 /// comes; one from store (a failure, a cancel) stops the threads and propagates.
 template <class Slot, class Worker, class Compute, class Store>
-void compute_in_order(std::size_t blocks, const Compute& compute, const Store& store) {
-    if (blocks == 0) return;
+void compute_in_order(std::size_t blocks, const Compute &compute, const Store &store) {
+    if (blocks == 0)
+        return;
     struct Entry {
         Slot slot{};
         std::exception_ptr error;
@@ -57,10 +59,11 @@ void compute_in_order(std::size_t blocks, const Compute& compute, const Store& s
     bool stop = false;
     // Computes the next block when one is left and its entry is free (the lock held on entry and
     // on return); false otherwise.
-    auto compute_next = [&](std::unique_lock<std::mutex>& lock, Worker& worker) {
-        if (stop || claimed == blocks || claimed == stored + entries.size()) return false;
+    auto compute_next = [&](std::unique_lock<std::mutex> &lock, Worker &worker) {
+        if (stop || claimed == blocks || claimed == stored + entries.size())
+            return false;
         const std::size_t k = claimed++;
-        Entry& e = entries[k % entries.size()];
+        Entry &e = entries[k % entries.size()];
         lock.unlock();
         try {
             compute(k, e.slot, worker);
@@ -77,7 +80,8 @@ void compute_in_order(std::size_t blocks, const Compute& compute, const Store& s
         try {
             Worker worker{};
             while (!stop && claimed < blocks)
-                if (!compute_next(lock, worker)) changed.wait(lock);
+                if (!compute_next(lock, worker))
+                    changed.wait(lock);
         } catch (...) {
             // No memory for the worker's scratch: the other threads do its share.
         }
@@ -85,33 +89,37 @@ void compute_in_order(std::size_t blocks, const Compute& compute, const Store& s
     std::vector<std::thread> pool;
     // Stops and joins the threads however this returns.
     struct Join {
-        std::vector<std::thread>& pool;
-        std::mutex& mutex;
-        bool& stop;
-        std::condition_variable& changed;
+        std::vector<std::thread> &pool;
+        std::mutex &mutex;
+        bool &stop;
+        std::condition_variable &changed;
         ~Join() {
             {
                 std::lock_guard lock(mutex);
                 stop = true;
             }
             changed.notify_all();
-            for (auto& t : pool) t.join();
+            for (auto &t : pool)
+                t.join();
         }
     } join{pool, mutex, stop, changed};
     try {
-        for (std::size_t t = 1; t < threads && t < blocks; ++t) pool.emplace_back(work);
-    } catch (const std::system_error&) {
+        for (std::size_t t = 1; t < threads && t < blocks; ++t)
+            pool.emplace_back(work);
+    } catch (const std::system_error &) {
         // No more threads (a process limit): fewer compute, this one among them.
     }
     Worker worker{};
     for (std::size_t k = 0; k < blocks; ++k) {
-        Entry& e = entries[k % entries.size()];
+        Entry &e = entries[k % entries.size()];
         {
             std::unique_lock lock(mutex);
             while (!e.ready)
-                if (!compute_next(lock, worker)) changed.wait(lock);
+                if (!compute_next(lock, worker))
+                    changed.wait(lock);
         }
-        if (e.error) std::rethrow_exception(e.error);
+        if (e.error)
+            std::rethrow_exception(e.error);
         store(k, e.slot);
         {
             std::lock_guard lock(mutex);

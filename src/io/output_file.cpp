@@ -20,17 +20,18 @@ namespace {
 
 std::atomic<unsigned> temp_counter{0};
 
-constexpr const char* sidecars[] = {".aux.xml", "-journal", "-wal", "-shm"};
+constexpr const char *sidecars[] = {".aux.xml", "-journal", "-wal", "-shm"};
 
-void remove_quietly(const fs::path& p) {
+void remove_quietly(const fs::path &p) {
     std::error_code ec;
     fs::remove(p, ec);
 }
 
 /// The temporary file and its sidecars (GDAL's .aux.xml, SQLite's journals).
-void remove_with_sidecars(const fs::path& temp) {
+void remove_with_sidecars(const fs::path &temp) {
     remove_quietly(temp);
-    for (const char* suffix : sidecars) remove_quietly(fs::path(temp.string() + suffix));
+    for (const char *suffix : sidecars)
+        remove_quietly(fs::path(temp.string() + suffix));
 }
 
 // The temporary names alive, in a fixed table a signal handler can read without allocating:
@@ -48,12 +49,14 @@ static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_alw
 
 /// Enters `path` in the table; -1 when it is full or the path too long (then only the
 /// destructors remove the file).
-int register_temp(const fs::path& path) {
-    const std::string& text = path.native();
-    if (text.size() + 16 >= PATH_MAX) return -1; // room for the longest sidecar suffix
+int register_temp(const fs::path &path) {
+    const std::string &text = path.native();
+    if (text.size() + 16 >= PATH_MAX)
+        return -1; // room for the longest sidecar suffix
     for (int i = 0; i < slot_count; ++i) {
         int expected = 0;
-        if (!temp_slots[i].state.compare_exchange_strong(expected, 1)) continue;
+        if (!temp_slots[i].state.compare_exchange_strong(expected, 1))
+            continue;
         std::memcpy(temp_slots[i].path, text.c_str(), text.size() + 1);
         temp_slots[i].generation.fetch_add(1);
         temp_slots[i].state.store(2);
@@ -63,7 +66,8 @@ int register_temp(const fs::path& path) {
 }
 
 void unregister_temp(int slot) {
-    if (slot < 0) return;
+    if (slot < 0)
+        return;
     temp_slots[slot].state.store(1);
     temp_slots[slot].generation.fetch_add(1);
     temp_slots[slot].state.store(0);
@@ -72,26 +76,31 @@ void unregister_temp(int slot) {
 } // namespace
 
 void OutputFile::remove_temporaries() noexcept {
-    if (g_committing.load()) return;
-    for (TempSlot& slot : temp_slots) {
-        if (slot.state.load() != 2) continue;
+    if (g_committing.load())
+        return;
+    for (TempSlot &slot : temp_slots) {
+        if (slot.state.load() != 2)
+            continue;
         const unsigned generation = slot.generation.load();
         char name[PATH_MAX];
         std::memcpy(name, slot.path, sizeof name);
         name[PATH_MAX - 1] = '\0';
-        if (slot.state.load() != 2 || slot.generation.load() != generation) continue;
+        if (slot.state.load() != 2 || slot.generation.load() != generation)
+            continue;
         ::unlink(name);
         const std::size_t length = std::strlen(name);
-        for (const char* suffix : sidecars) {
+        for (const char *suffix : sidecars) {
             std::memcpy(name + length, suffix, std::strlen(suffix) + 1);
             ::unlink(name);
         }
     }
 }
 
-bool OutputFile::committing() noexcept { return g_committing.load(); }
+bool OutputFile::committing() noexcept {
+    return g_committing.load();
+}
 
-bool OutputFile::is_stream(const fs::path& target) {
+bool OutputFile::is_stream(const fs::path &target) {
     std::error_code ec;
     const fs::file_status s = fs::status(target, ec); // through symbolic links
     return !ec && (s.type() == fs::file_type::character || s.type() == fs::file_type::fifo);
@@ -107,7 +116,8 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
     real_ = target_;
     for (int hops = 0; fs::is_symlink(real_, ec) && hops < 40; ++hops) {
         const fs::path to = fs::read_symlink(real_, ec);
-        if (ec) break;
+        if (ec)
+            break;
         real_ = to.is_absolute() ? to : real_.parent_path() / to;
     }
     fs::path folder = real_.parent_path().empty() ? fs::path(".") : real_.parent_path();
@@ -117,10 +127,12 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
     if (fs::is_directory(real_, ec))
         throw IoError(what_ + " " + target_.string() + " is a folder; give a file name");
     if (fs::exists(real_, ec) && !fs::is_regular_file(real_, ec))
-        throw IoError(what_ + " " + target_.string() + " is not a regular file (a device, pipe or socket); "
+        throw IoError(what_ + " " + target_.string() +
+                      " is not a regular file (a device, pipe or socket); "
                       "give a file name");
     if (fs::exists(real_, ec) && !overwrite_)
-        throw IoError(what_ + " " + target_.string() + " already exists; use --overwrite to replace it");
+        throw IoError(what_ + " " + target_.string() +
+                      " already exists; use --overwrite to replace it");
     if (::access(folder.c_str(), W_OK | X_OK) != 0)
         throw IoError(what_ + " " + target_.string() + ": folder " + folder.string() +
                       " is not writable (" + std::strerror(errno) + ")");
@@ -135,21 +147,25 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
     slot_ = register_temp(temp_);
 }
 
-std::string OutputFile::full_disk_note(const fs::path& file) {
+std::string OutputFile::full_disk_note(const fs::path &file) {
     const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
     struct statvfs disk {};
-    if (::statvfs(folder.c_str(), &disk) != 0) return "";
-    return static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize) < 1048576.0 ? " (the disk is full)" : "";
+    if (::statvfs(folder.c_str(), &disk) != 0)
+        return "";
+    return static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize) < 1048576.0
+               ? " (the disk is full)"
+               : "";
 }
 
 OutputFile::~OutputFile() {
-    if (committed_) return;
+    if (committed_)
+        return;
     remove_with_sidecars(temp_);
     unregister_temp(slot_);
 }
 
 namespace {
-thread_local OutputBatch* active_batch = nullptr;
+thread_local OutputBatch *active_batch = nullptr;
 } // namespace
 
 void OutputFile::commit() {
@@ -166,7 +182,7 @@ void OutputFile::commit() {
     committed_ = true;
 }
 
-void OutputFile::place(const Finished& f) {
+void OutputFile::place(const Finished &f) {
     std::error_code ec;
     if (!f.overwrite) {
         if (::link(f.temp.c_str(), f.real.c_str()) == 0) {
@@ -174,59 +190,74 @@ void OutputFile::place(const Finished& f) {
             return;
         }
         if (errno == EEXIST)
-            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
+            throw IoError(f.what + " " + f.target.string() +
+                          " already exists; use --overwrite to replace it");
         // File systems without hard links: check, then rename.
         if (fs::exists(f.real, ec))
-            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
+            throw IoError(f.what + " " + f.target.string() +
+                          " already exists; use --overwrite to replace it");
     }
     fs::rename(f.temp, f.real, ec);
     if (ec)
-        throw IoError(f.what + " " + f.target.string() + ": cannot move the finished file in place (" + ec.message() + ")");
+        throw IoError(f.what + " " + f.target.string() +
+                      ": cannot move the finished file in place (" + ec.message() + ")");
 }
 
-OutputBatch::OutputBatch() : outer_(active_batch) { active_batch = this; }
+OutputBatch::OutputBatch() : outer_(active_batch) {
+    active_batch = this;
+}
 
-bool OutputBatch::active() { return active_batch != nullptr; }
+bool OutputBatch::active() {
+    return active_batch != nullptr;
+}
 
 OutputBatch::~OutputBatch() {
     active_batch = outer_;
-    if (committed_) return;
-    for (const auto& f : files_) {
+    if (committed_)
+        return;
+    for (const auto &f : files_) {
         remove_with_sidecars(f.temp);
         unregister_temp(f.slot);
     }
 }
 
-void OutputBatch::commit(const std::function<bool()>& cancelled) {
+void OutputBatch::commit(const std::function<bool()> &cancelled) {
     // Held from here to the last file: a signal ending the process now would leave some
     // targets only; SIGKILL still can, in these few system calls.
     struct Committing {
         Committing() { g_committing.store(true); }
         ~Committing() { g_committing.store(false); }
     } committing;
-    if (cancelled && cancelled()) throw Cancelled();
+    if (cancelled && cancelled())
+        throw Cancelled();
     std::error_code ec;
-    for (const auto& f : files_)
+    for (const auto &f : files_)
         if (!f.overwrite && fs::exists(f.real, ec))
-            throw IoError(f.what + " " + f.target.string() + " already exists; use --overwrite to replace it");
+            throw IoError(f.what + " " + f.target.string() +
+                          " already exists; use --overwrite to replace it");
     std::size_t placed = 0;
     try {
-        for (; placed < files_.size(); ++placed) OutputFile::place(files_[placed]);
+        for (; placed < files_.size(); ++placed)
+            OutputFile::place(files_[placed]);
     } catch (...) {
-        for (std::size_t i = 0; i < placed; ++i) remove_quietly(files_[i].real);
+        for (std::size_t i = 0; i < placed; ++i)
+            remove_quietly(files_[i].real);
         throw;
     }
-    for (const auto& f : files_) unregister_temp(f.slot);
+    for (const auto &f : files_)
+        unregister_temp(f.slot);
     committed_ = true;
 }
 
-void OutputFile::write_text(const fs::path& target, const std::string& text, bool overwrite, const std::string& what) {
+void OutputFile::write_text(const fs::path &target, const std::string &text, bool overwrite,
+                            const std::string &what) {
     if (is_stream(target)) {
         // A terminal or a pipe (/dev/stdout, /dev/stderr, a named pipe): written as it is.
         std::ofstream f(target, std::ios::binary | std::ios::app);
         f << text;
         f.flush();
-        if (!f) throw IoError(what + " " + target.string() + ": write failed");
+        if (!f)
+            throw IoError(what + " " + target.string() + ": write failed");
         return;
     }
     OutputFile out(target, overwrite, what);
@@ -234,7 +265,8 @@ void OutputFile::write_text(const fs::path& target, const std::string& text, boo
         std::ofstream f(out.temp_path(), std::ios::binary);
         f << text;
         f.flush();
-        if (!f) throw IoError(what + " " + target.string() + ": write failed" + full_disk_note(target));
+        if (!f)
+            throw IoError(what + " " + target.string() + ": write failed" + full_disk_note(target));
     }
     out.commit();
 }

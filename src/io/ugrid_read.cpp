@@ -24,38 +24,45 @@ namespace {
 
 class Reader {
 public:
-    Reader(int id, const std::filesystem::path& file) : id_(id), file_(file) {}
+    Reader(int id, const std::filesystem::path &file) : id_(id), file_(file) {}
 
-    [[noreturn]] void fail(const std::string& what) const {
+    [[noreturn]] void fail(const std::string &what) const {
         throw DataError("UGRID file " + file_.string() + ": " + what);
     }
-    std::optional<std::string> text(int var, const char* name) const {
+    std::optional<std::string> text(int var, const char *name) const {
         nc_type type;
         std::size_t len;
-        if (nc_inq_att(id_, var, name, &type, &len) != NC_NOERR) return std::nullopt;
+        if (nc_inq_att(id_, var, name, &type, &len) != NC_NOERR)
+            return std::nullopt;
         if (type == NC_STRING) {
-            char* s = nullptr;
-            if (len != 1 || nc_get_att_string(id_, var, name, &s) != NC_NOERR) return std::nullopt;
+            char *s = nullptr;
+            if (len != 1 || nc_get_att_string(id_, var, name, &s) != NC_NOERR)
+                return std::nullopt;
             std::string r = s ? s : "";
             nc_free_string(1, &s);
             return r;
         }
-        if (type != NC_CHAR) return std::nullopt;
+        if (type != NC_CHAR)
+            return std::nullopt;
         std::string s(len, '\0');
-        if (nc_get_att_text(id_, var, name, s.data()) != NC_NOERR) return std::nullopt;
-        while (!s.empty() && s.back() == '\0') s.pop_back();
+        if (nc_get_att_text(id_, var, name, s.data()) != NC_NOERR)
+            return std::nullopt;
+        while (!s.empty() && s.back() == '\0')
+            s.pop_back();
         return s;
     }
-    std::optional<long long> integer(int var, const char* name) const {
+    std::optional<long long> integer(int var, const char *name) const {
         nc_type type;
         std::size_t len;
-        if (nc_inq_att(id_, var, name, &type, &len) != NC_NOERR || len != 1 || type == NC_CHAR || type == NC_STRING)
+        if (nc_inq_att(id_, var, name, &type, &len) != NC_NOERR || len != 1 || type == NC_CHAR ||
+            type == NC_STRING)
             return std::nullopt;
         long long v;
-        if (nc_get_att_longlong(id_, var, name, &v) != NC_NOERR) return std::nullopt;
+        if (nc_get_att_longlong(id_, var, name, &v) != NC_NOERR)
+            return std::nullopt;
         return v;
     }
-    int var_id(const std::string& name, const char* role) const {
+    int var_id(const std::string &name, const char *role) const {
         int v;
         if (nc_inq_varid(id_, name.c_str(), &v) != NC_NOERR)
             fail(std::string(role) + " names variable \"" + name + "\", which does not exist");
@@ -73,9 +80,10 @@ public:
         io::nc_check(nc_inq_dimlen(id_, dim, &len), file_, "reading a dimension");
         return len;
     }
-    int dim_id(const std::string& name) const {
+    int dim_id(const std::string &name) const {
         int d;
-        if (nc_inq_dimid(id_, name.c_str(), &d) != NC_NOERR) fail("dimension \"" + name + "\" does not exist");
+        if (nc_inq_dimid(id_, name.c_str(), &d) != NC_NOERR)
+            fail("dimension \"" + name + "\" does not exist");
         return d;
     }
     nc_type type(int var) const {
@@ -90,24 +98,26 @@ public:
     }
     std::vector<double> doubles(int var, std::size_t n) const {
         std::vector<double> v(n);
-        if (n) io::nc_check(nc_get_var_double(id_, var, v.data()), file_, "reading " + name(var));
+        if (n)
+            io::nc_check(nc_get_var_double(id_, var, v.data()), file_, "reading " + name(var));
         return v;
     }
     std::vector<long long> longs(int var, std::size_t n) const {
         std::vector<long long> v(n);
-        if (n) io::nc_check(nc_get_var_longlong(id_, var, v.data()), file_, "reading " + name(var));
+        if (n)
+            io::nc_check(nc_get_var_longlong(id_, var, v.data()), file_, "reading " + name(var));
         return v;
     }
     int id() const { return id_; }
 
 private:
     int id_;
-    const std::filesystem::path& file_;
+    const std::filesystem::path &file_;
 };
 
 bool is_integer_type(nc_type t) {
-    return t == NC_BYTE || t == NC_SHORT || t == NC_INT || t == NC_INT64 || t == NC_UBYTE || t == NC_USHORT ||
-           t == NC_UINT || t == NC_UINT64;
+    return t == NC_BYTE || t == NC_SHORT || t == NC_INT || t == NC_INT64 || t == NC_UBYTE ||
+           t == NC_USHORT || t == NC_UINT || t == NC_UINT64;
 }
 
 /// A connectivity table read as rows of indices relative to start_index, fill entries as -1.
@@ -116,17 +126,22 @@ struct Table {
     std::vector<long long> values; ///< row-major, 0-based, -1 = missing
 };
 
-Table read_connectivity(const Reader& r, const std::string& name, const char* role, int element_dim,
+Table read_connectivity(const Reader &r, const std::string &name, const char *role, int element_dim,
                         std::size_t target_count) {
     int v = r.var_id(name, role);
-    if (!is_integer_type(r.type(v))) r.fail(std::string(role) + " " + name + " is not an integer variable");
+    if (!is_integer_type(r.type(v)))
+        r.fail(std::string(role) + " " + name + " is not an integer variable");
     auto d = r.dims(v);
-    if (d.size() != 2) r.fail(std::string(role) + " " + name + " is not 2-D");
+    if (d.size() != 2)
+        r.fail(std::string(role) + " " + name + " is not 2-D");
     bool transposed = false;
     if (element_dim >= 0) {
-        if (d[0] == element_dim) transposed = false;
-        else if (d[1] == element_dim) transposed = true;
-        else r.fail(std::string(role) + " " + name + " does not use the element dimension");
+        if (d[0] == element_dim)
+            transposed = false;
+        else if (d[1] == element_dim)
+            transposed = true;
+        else
+            r.fail(std::string(role) + " " + name + " does not use the element dimension");
     }
     std::size_t n0 = r.dim_len(d[0]), n1 = r.dim_len(d[1]);
     Table t;
@@ -134,7 +149,8 @@ Table read_connectivity(const Reader& r, const std::string& name, const char* ro
     t.cols = transposed ? n0 : n1;
     auto raw = r.longs(v, n0 * n1);
     long long start = r.integer(v, "start_index").value_or(0);
-    if (start != 0 && start != 1) r.fail(std::string(role) + " " + name + ": start_index must be 0 or 1");
+    if (start != 0 && start != 1)
+        r.fail(std::string(role) + " " + name + ": start_index must be 0 or 1");
     std::optional<long long> fill = r.integer(v, "_FillValue");
     t.values.resize(raw.size());
     for (std::size_t i = 0; i < t.rows; ++i)
@@ -146,25 +162,26 @@ Table read_connectivity(const Reader& r, const std::string& name, const char* ro
             }
             long long idx = x - start;
             if (idx < 0 || std::size_t(idx) >= target_count)
-                r.fail(std::string(role) + " " + name + ": row " + std::to_string(i) + " has index " +
-                       std::to_string(x) + ", outside [" + std::to_string(start) + ", " +
-                       std::to_string(start + (long long)target_count - 1) + "]" +
+                r.fail(std::string(role) + " " + name + ": row " + std::to_string(i) +
+                       " has index " + std::to_string(x) + ", outside [" + std::to_string(start) +
+                       ", " + std::to_string(start + (long long)target_count - 1) + "]" +
                        (fill ? "" : " (no _FillValue marks missing entries)"));
             t.values[i * t.cols + k] = idx;
         }
     return t;
 }
 
-std::vector<std::string> split_words(const std::string& s) {
+std::vector<std::string> split_words(const std::string &s) {
     std::istringstream in(s);
     std::vector<std::string> words;
-    for (std::string w; in >> w;) words.push_back(w);
+    for (std::string w; in >> w;)
+        words.push_back(w);
     return words;
 }
 
 } // namespace
 
-Mesh read_ugrid(const std::filesystem::path& path) {
+Mesh read_ugrid(const std::filesystem::path &path) {
     io::NcHandle nc;
     int status = nc_open(path.c_str(), NC_NOWRITE, nc.out());
     if (status != NC_NOERR) {
@@ -172,8 +189,10 @@ Mesh read_ugrid(const std::filesystem::path& path) {
         // netCDF-C's "Unknown file format".
         char head[16] = {};
         std::ifstream(path, std::ios::binary).read(head, sizeof head);
-        if (status == NC_ENOTNC && std::string(head, sizeof head) == std::string("SQLite format 3\0", 16))
-            throw IoError("UGRID file " + path.string() + ": is a GeoPackage (SQLite), not NetCDF; give the UGRID "
+        if (status == NC_ENOTNC &&
+            std::string(head, sizeof head) == std::string("SQLite format 3\0", 16))
+            throw IoError("UGRID file " + path.string() +
+                          ": is a GeoPackage (SQLite), not NetCDF; give the UGRID "
                           "file that -o wrote (ogrinfo reads the GeoPackage)");
         throw IoError("UGRID file " + path.string() + ": cannot open (" + nc_strerror(status) +
                       "); give an existing NetCDF file");
@@ -184,23 +203,30 @@ Mesh read_ugrid(const std::filesystem::path& path) {
     io::nc_check(nc_inq_nvars(nc.id(), &nvars), path, "listing variables");
     int topo = -1;
     for (int v = 0; v < nvars && topo < 0; ++v)
-        if (r.text(v, "cf_role") == std::optional<std::string>("mesh_topology")) topo = v;
-    if (topo < 0) r.fail("no variable with cf_role = \"mesh_topology\": not a UGRID mesh");
+        if (r.text(v, "cf_role") == std::optional<std::string>("mesh_topology"))
+            topo = v;
+    if (topo < 0)
+        r.fail("no variable with cf_role = \"mesh_topology\": not a UGRID mesh");
     const std::string topo_name = r.name(topo);
     if (r.integer(topo, "topology_dimension").value_or(0) != 2)
         r.fail("mesh " + topo_name + " has no topology_dimension = 2; only 2-D meshes are read");
 
     // Nodes: longitude and latitude, told apart by standard_name or units, else in x y order.
     auto coord_names = split_words(r.text(topo, "node_coordinates").value_or(""));
-    if (coord_names.size() != 2) r.fail("mesh " + topo_name + ": node_coordinates must name two variables");
-    int cx = r.var_id(coord_names[0], "node_coordinates"), cy = r.var_id(coord_names[1], "node_coordinates");
+    if (coord_names.size() != 2)
+        r.fail("mesh " + topo_name + ": node_coordinates must name two variables");
+    int cx = r.var_id(coord_names[0], "node_coordinates"),
+        cy = r.var_id(coord_names[1], "node_coordinates");
     auto is_lat = [&](int v) {
         auto sn = r.text(v, "standard_name").value_or(""), u = r.text(v, "units").value_or("");
-        return sn == "latitude" || u.rfind("degrees_n", 0) == 0 || u.rfind("degree_n", 0) == 0 || u == "degree_N";
+        return sn == "latitude" || u.rfind("degrees_n", 0) == 0 || u.rfind("degree_n", 0) == 0 ||
+               u == "degree_N";
     };
-    if (is_lat(cx) && !is_lat(cy)) std::swap(cx, cy);
+    if (is_lat(cx) && !is_lat(cy))
+        std::swap(cx, cy);
     auto node_dims = r.dims(cx);
-    if (node_dims.size() != 1 || r.dims(cy) != node_dims) r.fail("node coordinates must be 1-D on one dimension");
+    if (node_dims.size() != 1 || r.dims(cy) != node_dims)
+        r.fail("node coordinates must be 1-D on one dimension");
     const int node_dim = node_dims[0];
     const std::size_t nn = r.dim_len(node_dim);
     auto lon = r.doubles(cx, nn), lat = r.doubles(cy, nn);
@@ -209,17 +235,20 @@ Mesh read_ugrid(const std::filesystem::path& path) {
     mesh.nodes.resize(nn);
     for (std::size_t i = 0; i < nn; ++i) {
         if (!std::isfinite(lon[i]) || !std::isfinite(lat[i]) || std::fabs(lat[i]) > 90.0)
-            r.fail("node " + std::to_string(i) + " has an invalid position (" + std::to_string(lon[i]) + ", " +
-                   std::to_string(lat[i]) + ")");
+            r.fail("node " + std::to_string(i) + " has an invalid position (" +
+                   std::to_string(lon[i]) + ", " + std::to_string(lat[i]) + ")");
         mesh.nodes[i] = lonlat_to_vec(lon[i], lat[i]);
     }
 
     // Faces.
     auto face_name = r.text(topo, "face_node_connectivity");
-    if (!face_name) r.fail("mesh " + topo_name + " has no face_node_connectivity");
+    if (!face_name)
+        r.fail("mesh " + topo_name + " has no face_node_connectivity");
     int face_dim = -1;
-    if (auto fd = r.text(topo, "face_dimension")) face_dim = r.dim_id(*fd);
-    else face_dim = r.dims(r.var_id(*face_name, "face_node_connectivity")).at(0);
+    if (auto fd = r.text(topo, "face_dimension"))
+        face_dim = r.dim_id(*fd);
+    else
+        face_dim = r.dims(r.var_id(*face_name, "face_node_connectivity")).at(0);
     Table faces = read_connectivity(r, *face_name, "face_node_connectivity", face_dim, nn);
     mesh.faces.resize(faces.rows);
     for (std::size_t f = 0; f < faces.rows; ++f) {
@@ -227,44 +256,58 @@ Mesh read_ugrid(const std::filesystem::path& path) {
         bool gap = false;
         for (std::size_t k = 0; k < faces.cols; ++k) {
             long long x = faces.values[f * faces.cols + k];
-            if (x < 0) { gap = true; continue; }
-            if (gap) r.fail("face " + std::to_string(f) + " has a fill value before a node");
-            if (count < 3) mesh.faces[f][count] = NodeIndex(x);
+            if (x < 0) {
+                gap = true;
+                continue;
+            }
+            if (gap)
+                r.fail("face " + std::to_string(f) + " has a fill value before a node");
+            if (count < 3)
+                mesh.faces[f][count] = NodeIndex(x);
             ++count;
         }
         if (count != 3)
-            r.fail("face " + std::to_string(f) + " has " + std::to_string(count) + " nodes; only triangle meshes are read");
+            r.fail("face " + std::to_string(f) + " has " + std::to_string(count) +
+                   " nodes; only triangle meshes are read");
     }
     const std::size_t nf = faces.rows;
 
     // Data variables on nodes and faces, and boundary tags on edges.
     int edge_dim = -1;
-    if (auto ed = r.text(topo, "edge_dimension")) edge_dim = r.dim_id(*ed);
+    if (auto ed = r.text(topo, "edge_dimension"))
+        edge_dim = r.dim_id(*ed);
     auto edge_name = r.text(topo, "edge_node_connectivity");
     std::vector<std::pair<std::uint64_t, int>> edge_tags;
     for (int v = 0; v < nvars; ++v) {
-        if (r.text(v, "mesh") != std::optional<std::string>(topo_name)) continue;
+        if (r.text(v, "mesh") != std::optional<std::string>(topo_name))
+            continue;
         auto location = r.text(v, "location").value_or("");
         auto d = r.dims(v);
         nc_type t = r.type(v);
-        if (d.size() != 1 || t == NC_CHAR || t == NC_STRING) continue;
+        if (d.size() != 1 || t == NC_CHAR || t == NC_STRING)
+            continue;
         if (location == "edge" && r.name(v) == "boundary_tag" && edge_name) {
             int ev = r.var_id(*edge_name, "edge_node_connectivity");
-            if (edge_dim < 0) edge_dim = r.dims(ev).at(0);
-            if (d[0] != edge_dim) continue;
+            if (edge_dim < 0)
+                edge_dim = r.dims(ev).at(0);
+            if (d[0] != edge_dim)
+                continue;
             Table edges = read_connectivity(r, *edge_name, "edge_node_connectivity", edge_dim, nn);
             auto tags = r.longs(v, edges.rows);
             for (std::size_t e = 0; e < edges.rows; ++e) {
                 long long a = edges.values[2 * e], b = edges.values[2 * e + 1];
-                if (a < 0 || b < 0 || tags[e] <= 0 || tags[e] > 2) continue;
-                if (a > b) std::swap(a, b);
+                if (a < 0 || b < 0 || tags[e] <= 0 || tags[e] > 2)
+                    continue;
+                if (a > b)
+                    std::swap(a, b);
                 edge_tags.emplace_back((std::uint64_t(a) << 32) | std::uint64_t(b), int(tags[e]));
             }
             continue;
         }
         bool on_nodes = location == "node" && d[0] == node_dim;
         bool on_faces = location == "face" && d[0] == face_dim;
-        if (!on_nodes && !on_faces) continue;
+        if (!on_nodes && !on_faces)
+            continue;
         Field f;
         f.name = r.name(v);
         f.long_name = r.text(v, "long_name").value_or("");
@@ -273,8 +316,9 @@ Mesh read_ugrid(const std::filesystem::path& path) {
         f.values = r.doubles(v, on_nodes ? nn : nf);
         double fill;
         if (nc_get_att_double(nc.id(), v, "_FillValue", &fill) == NC_NOERR)
-            for (auto& x : f.values)
-                if (x == fill) x = std::nan("");
+            for (auto &x : f.values)
+                if (x == fill)
+                    x = std::nan("");
         (on_nodes ? mesh.node_fields : mesh.face_fields).push_back(std::move(f));
     }
 
@@ -283,7 +327,7 @@ Mesh read_ugrid(const std::filesystem::path& path) {
     const io::MeshTopology topology = [&] {
         try {
             return io::build_topology(mesh);
-        } catch (const DataError& e) {
+        } catch (const DataError &e) {
             r.fail(e.what());
         }
     }();
@@ -292,7 +336,8 @@ Mesh read_ugrid(const std::filesystem::path& path) {
         auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
         std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
         auto it = std::lower_bound(edge_tags.begin(), edge_tags.end(), std::make_pair(key, 0));
-        EdgeTag tag = (it != edge_tags.end() && it->first == key) ? EdgeTag(it->second) : EdgeTag::coast;
+        EdgeTag tag =
+            (it != edge_tags.end() && it->first == key) ? EdgeTag(it->second) : EdgeTag::coast;
         mesh.boundary.push_back({a, b, tag});
     }
 
@@ -302,8 +347,10 @@ Mesh read_ugrid(const std::filesystem::path& path) {
     io::nc_check(nc_inq_natts(nc.id(), &natts), path, "listing global attributes");
     for (int i = 0; i < natts; ++i) {
         char name[NC_MAX_NAME + 1];
-        if (nc_inq_attname(nc.id(), NC_GLOBAL, i, name) != NC_NOERR || regenerated.count(name)) continue;
-        if (auto value = r.text(NC_GLOBAL, name)) mesh.attributes.emplace_back(name, *value);
+        if (nc_inq_attname(nc.id(), NC_GLOBAL, i, name) != NC_NOERR || regenerated.count(name))
+            continue;
+        if (auto value = r.text(NC_GLOBAL, name))
+            mesh.attributes.emplace_back(name, *value);
     }
     return mesh;
 }

@@ -10,11 +10,14 @@ namespace globemesh {
 
 namespace {
 
-void require(bool ok, const ErrorText& message) {
-    if (!ok) throw UsageError(message);
+void require(bool ok, const ErrorText &message) {
+    if (!ok)
+        throw UsageError(message);
 }
 
-bool positive(double v) { return std::isfinite(v) && v > 0; }
+bool positive(double v) {
+    return std::isfinite(v) && v > 0;
+}
 
 /// The largest --hmax: 45 degrees of arc. Coarser, the shaping drops the continents as islands
 /// (1:50m land: one ring kept at 5000 and 6000 km, 33 and 19 nodes; none from 7000 km), and from
@@ -36,67 +39,79 @@ constexpr std::uint64_t min_memory_budget_bytes = 1'000'000;
 
 namespace {
 
-void validate_size(const SizeFieldOptions& o) {
+void validate_size(const SizeFieldOptions &o) {
     const ErrorText hmax = option("hmax_km"), hmin = option("hmin_km");
     require(positive(o.hmax_km), hmax + " must be a positive length, e.g. 100km");
-    require(o.hmax_km <= max_hmax_km, hmax + " must be at most " + std::to_string(int(max_hmax_km)) +
+    require(o.hmax_km <= max_hmax_km, hmax + " must be at most " +
+                                          std::to_string(int(max_hmax_km)) +
                                           "km (an eighth of the Earth's circumference)");
-    require(std::isfinite(o.hmin_km) && o.hmin_km >= 0, hmin + " must be a positive length, e.g. 10km");
-    require(o.hmin_km <= o.hmax_km,
-            hmin + " (" + km(o.hmin_km) + ") must not be larger than " + hmax + " (" + km(o.hmax_km) + ")");
+    require(std::isfinite(o.hmin_km) && o.hmin_km >= 0,
+            hmin + " must be a positive length, e.g. 10km");
+    require(o.hmin_km <= o.hmax_km, hmin + " (" + km(o.hmin_km) + ") must not be larger than " +
+                                        hmax + " (" + km(o.hmax_km) + ")");
     require(std::isfinite(o.coast_size_km) && o.coast_size_km >= 0,
             option("coast_size_km") + " must be a positive length, e.g. 20km");
-    require(std::isfinite(o.coast_rate) && o.coast_rate >= 0, option("coast_rate") + " must be >= 0");
+    require(std::isfinite(o.coast_rate) && o.coast_rate >= 0,
+            option("coast_rate") + " must be >= 0");
     require(std::isfinite(o.wavelength) && o.wavelength >= 0,
             option("wavelength") + " must be >= 0 (points per wavelength)");
-    require(positive(o.wave_period_h), option("wave_period_h") + " must be a positive number of hours");
-    require(std::isfinite(o.slope) && o.slope >= 0, option("slope") + " must be >= 0 (points per length scale)");
+    require(positive(o.wave_period_h),
+            option("wave_period_h") + " must be a positive number of hours");
+    require(std::isfinite(o.slope) && o.slope >= 0,
+            option("slope") + " must be >= 0 (points per length scale)");
     require(positive(o.grade) && o.grade < 10, option("grade") + " must be in (0, 10)");
     // A layer without its file would be ignored without a word.
     require(o.size_regions_layer.empty() || !o.size_regions.empty(),
-            option("size_regions_layer") + " names a layer of " + option("size_regions") + ", which is not given");
+            option("size_regions_layer") + " names a layer of " + option("size_regions") +
+                ", which is not given");
 }
 
-void validate_meshing(const MeshingOptions& o) {
+void validate_meshing(const MeshingOptions &o) {
     require(o.max_nodes >= 3, option("max_nodes") + " must be at least 3");
     require(o.max_memory_bytes == 0 || o.max_memory_bytes >= min_memory_budget_bytes,
             option("max_memory_bytes") + " must be 0 (no limit) or at least 1MB, e.g. 4GB");
     require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000,
             option("smooth_iterations") + " must be in 0..1000");
     require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,
-            option("inlet_width") + " must be in 0..2 (a fraction of the local edge length; 0 keeps every inlet)");
+            option("inlet_width") +
+                " must be in 0..2 (a fraction of the local edge length; 0 keeps every inlet)");
 }
 
-void validate_coast(const CoastOptions& o) {
+void validate_coast(const CoastOptions &o) {
     require(std::isfinite(o.min_island_area_km2) && o.min_island_area_km2 >= 0,
             option("min_island_area_km2") + " must be a positive area, e.g. 100km2");
     const ErrorText region = option("region"), region_file = option("region_file");
     if (o.region) {
-        const auto& r = *o.region;
-        for (double v : r) require(std::isfinite(v), region + " values must be numbers: W,S,E,N in degrees");
+        const auto &r = *o.region;
+        for (double v : r)
+            require(std::isfinite(v), region + " values must be numbers: W,S,E,N in degrees");
         require(r[0] >= -180 && r[0] <= 180 && r[2] >= -180 && r[2] <= 180,
                 region + " longitudes must be in [-180, 180]");
-        require(r[1] >= -90 && r[3] <= 90 && r[1] < r[3], region + " needs -90 <= S < N <= 90 (W,S,E,N in degrees)");
+        require(r[1] >= -90 && r[3] <= 90 && r[1] < r[3],
+                region + " needs -90 <= S < N <= 90 (W,S,E,N in degrees)");
         require(r[0] != r[2], region + " W and E must differ (W > E crosses +-180)");
     }
-    require(!(o.region && !o.region_file.empty()), region + " and " + region_file + " cannot be used together");
+    require(!(o.region && !o.region_file.empty()),
+            region + " and " + region_file + " cannot be used together");
     // A layer without its file would be ignored without a word.
     require(o.region_layer.empty() || !o.region_file.empty(),
             option("region_layer") + " names a layer of " + region_file + ", which is not given");
 }
 
-void validate_bathymetry(const BathymetryOptions& o) {
+void validate_bathymetry(const BathymetryOptions &o) {
     require(o.bathy_band >= 1, option("bathy_band") + " must be 1 or more");
     if (o.min_depth_m) {
-        require(std::isfinite(*o.min_depth_m), option("min_depth_m") + " must be a depth in metres, e.g. 5m");
+        require(std::isfinite(*o.min_depth_m),
+                option("min_depth_m") + " must be a depth in metres, e.g. 5m");
         // A depth floor without depths would be ignored without a word.
-        require(!o.bathy.empty(), option("min_depth_m") + " needs " + option("bathy") + ": it raises the sampled depths");
+        require(!o.bathy.empty(), option("min_depth_m") + " needs " + option("bathy") +
+                                      ": it raises the sampled depths");
     }
 }
 
 } // namespace
 
-void validate(const MeshOptions& o) {
+void validate(const MeshOptions &o) {
     validate_size(o);
     validate_coast(o);
     validate_bathymetry(o);
@@ -104,9 +119,10 @@ void validate(const MeshOptions& o) {
 }
 
 std::string memory_text(double bytes) {
-    const char* units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
+    const char *units[] = {"B", "kB", "MB", "GB", "TB", "PB"};
     int u = 0;
-    while (bytes >= 1000 && u < 5) bytes /= 1000, ++u;
+    while (bytes >= 1000 && u < 5)
+        bytes /= 1000, ++u;
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g %s", bytes, units[u]);
     return buf;

@@ -3,9 +3,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cmath>
 #include <optional>
 #include <sstream>
 #include <vector>
@@ -25,17 +25,18 @@ using Clock = std::chrono::steady_clock;
 
 class StageClock {
 public:
-    explicit StageClock(StageTimings* t) : timings_(t) {}
-    void lap(const std::string& name) {
+    explicit StageClock(StageTimings *t) : timings_(t) {}
+    void lap(const std::string &name) {
         auto now = Clock::now();
-        if (timings_) timings_->add(name, std::chrono::duration<double>(now - last_).count());
+        if (timings_)
+            timings_->add(name, std::chrono::duration<double>(now - last_).count());
         last_ = now;
     }
     /// Starts the next lap now, for a stage timed elsewhere.
     void restart() { last_ = Clock::now(); }
 
 private:
-    StageTimings* timings_;
+    StageTimings *timings_;
     Clock::time_point last_ = Clock::now();
 };
 
@@ -60,12 +61,12 @@ constexpr std::uint64_t land_bytes_per_vertex = 100;
 
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
 /// the region plus a cell of margin, at most size_grid_max_nodes).
-double size_grid_nodes(const MeshOptions& o) {
+double size_grid_nodes(const MeshOptions &o) {
     const double hfloor = size_floor_km(o);
     const double spacing = std::max(1e-6, 0.5 * hfloor / earth_radius_km * rad_to_deg);
     double lon_span = 360, lat_span = 180;
     if (o.region) {
-        const auto& r = *o.region;
+        const auto &r = *o.region;
         lon_span = std::min(360.0, (r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360) + 2 * spacing);
         lat_span = std::min(180.0, r[3] - r[1] + 2 * spacing);
     }
@@ -80,12 +81,17 @@ public:
     explicit MemoryBudget(std::uint64_t total) : total_(total) {}
     void hold(double bytes) { held_ += bytes; }
     /// Bytes left for the next stages (0: the budget is spent); meaningless without a budget.
-    std::uint64_t left() const { return held_ >= static_cast<double>(total_) ? 0 : total_ - static_cast<std::uint64_t>(held_); }
+    std::uint64_t left() const {
+        return held_ >= static_cast<double>(total_) ? 0
+                                                    : total_ - static_cast<std::uint64_t>(held_);
+    }
     /// Throws DataError when `bytes` more do not fit; `what` says what needs them.
-    void require(double bytes, const std::string& what, const ErrorText& remedy) const {
-        if (total_ == 0 || held_ + bytes <= static_cast<double>(total_)) return;
+    void require(double bytes, const std::string &what, const ErrorText &remedy) const {
+        if (total_ == 0 || held_ + bytes <= static_cast<double>(total_))
+            return;
         throw DataError(what + " needs about " + memory_text(bytes) + ", more than the " +
-                        memory_text(static_cast<double>(left())) + " left of " + option("max_memory_bytes") + " " +
+                        memory_text(static_cast<double>(left())) + " left of " +
+                        option("max_memory_bytes") + " " +
                         memory_text(static_cast<double>(total_)) + " after reading the inputs (" +
                         memory_text(held_) + "); raise " + option("max_memory_bytes") + remedy);
     }
@@ -97,10 +103,10 @@ private:
 
 /// Counts the depths (m, positive down) above sea level and raises those below `min_depth_m`
 /// (when set) to it; no-data values (NaN) stay as they are.
-DepthReport apply_min_depth(std::vector<double>& depths, std::optional<double> min_depth_m) {
+DepthReport apply_min_depth(std::vector<double> &depths, std::optional<double> min_depth_m) {
     DepthReport f;
     f.min_depth_m = min_depth_m;
-    for (double& d : depths) {
+    for (double &d : depths) {
         if (d < 0) {
             f.shallowest_m = f.above_sea_level == 0 ? d : std::min(f.shallowest_m, d);
             ++f.above_sea_level;
@@ -115,7 +121,7 @@ DepthReport apply_min_depth(std::vector<double>& depths, std::optional<double> m
 
 /// Refuses a run whose node count is far above max_nodes from the coast alone, before the
 /// bathymetry, the size field and the coast's shaping spend minutes and gigabytes on it.
-void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
+void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
     // The mesher's node estimate (nodes_for_area) with every size at --hmax (the field's
     // largest). The mesher's own estimate, over the shaped ocean and the field's sizes, is larger
     // but for the area the shaping closes (inlets, lakes; a few per mil of the global ocean), so
@@ -124,10 +130,12 @@ void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
     // on it.
     if (const double estimate = nodes_for_area(coast.ocean_area_km2, o.hmax_km);
         0.9 * estimate > static_cast<double>(o.max_nodes))
-        throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) + " km2) takes about " +
-                        std::to_string(std::llround(estimate)) + " nodes at " + option("hmax_km") + " " +
-                        report_number(o.hmax_km) + " km, more than " + option("max_nodes") + " " +
-                        std::to_string(o.max_nodes) + ": raise " + option("hmax_km") + " or " + option("max_nodes"));
+        throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) +
+                        " km2) takes about " + std::to_string(std::llround(estimate)) +
+                        " nodes at " + option("hmax_km") + " " + report_number(o.hmax_km) +
+                        " km, more than " + option("max_nodes") + " " +
+                        std::to_string(o.max_nodes) + ": raise " + option("hmax_km") + " or " +
+                        option("max_nodes"));
     // The same for the water along the coast at --coast-size: the size grows from s there at
     // rate g = min(--coast-rate, --grade) up to --hmax, and along a straight coast of length L
     // the band takes L * integral of dd / (c (s + g d)^2) = L (1/s - 1/hmax) / (c g) nodes (c h^2
@@ -140,7 +148,7 @@ void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
     if (o.coast_size_km > 0) {
         double coast_km = 0;
         std::size_t segments = 0;
-        for (const Ring& r : coast.rings.rings)
+        for (const Ring &r : coast.rings.rings)
             for (std::size_t i = 0; i < r.nodes.size(); ++i)
                 if (r.kinds[i] == SegmentKind::coast) {
                     coast_km += arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]);
@@ -148,42 +156,51 @@ void refuse_too_many_nodes(const MeshOptions& o, const CoastData& coast) {
                 }
         const double floor = size_floor_km(o), s = std::clamp(o.coast_size_km, floor, o.hmax_km);
         const double rate = std::min(o.coast_rate, o.grade);
-        const double estimate = rate > 0 ? nodes_for_area(coast_km * (1 / s - 1 / o.hmax_km) / rate, 1.0)
-                                         : nodes_for_area(coast_km * s, s); // a band one size wide
-        if (segments > 0 && s <= coast_km / double(segments) && 0.5 * estimate > static_cast<double>(o.max_nodes))
-            throw DataError("the water along the coast (" + std::to_string(std::llround(coast_km)) + " km) takes about " +
-                            std::to_string(std::llround(estimate)) + " nodes at " + option("coast_size_km") + " " +
+        const double estimate = rate > 0
+                                    ? nodes_for_area(coast_km * (1 / s - 1 / o.hmax_km) / rate, 1.0)
+                                    : nodes_for_area(coast_km * s, s); // a band one size wide
+        if (segments > 0 && s <= coast_km / double(segments) &&
+            0.5 * estimate > static_cast<double>(o.max_nodes))
+            throw DataError("the water along the coast (" + std::to_string(std::llround(coast_km)) +
+                            " km) takes about " + std::to_string(std::llround(estimate)) +
+                            " nodes at " + option("coast_size_km") + " " +
                             report_number(o.coast_size_km) + " km" +
-                            (s > o.coast_size_km ? " (" + report_number(s) + " km: sizes stop at " + option("hmin_km") +
-                                                       ", by default " + option("hmax_km") + " / 1000)"
+                            (s > o.coast_size_km ? " (" + report_number(s) + " km: sizes stop at " +
+                                                       option("hmin_km") + ", by default " +
+                                                       option("hmax_km") + " / 1000)"
                                                  : ErrorText("")) +
-                            ", more than " + option("max_nodes") + " " + std::to_string(o.max_nodes) + ": raise " +
-                            option("coast_size_km") + (s > o.coast_size_km ? " and " + option("hmin_km") : ErrorText("")) +
+                            ", more than " + option("max_nodes") + " " +
+                            std::to_string(o.max_nodes) + ": raise " + option("coast_size_km") +
+                            (s > o.coast_size_km ? " and " + option("hmin_km") : ErrorText("")) +
                             " or " + option("max_nodes"));
     }
 }
 
 } // namespace
 
-OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings* timings) {
+OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTimings *timings) {
     // A long GEOS operation of the coast stages stops too when the run is cancelled.
     const coast::GeosInterrupt geos_interrupt(run_progress);
-    const Progress& progress = geos_interrupt.progress();
+    const Progress &progress = geos_interrupt.progress();
     validate(o);
-    if (o.coast.empty()) throw UsageError(option("coast") + " is required: a land polygon or coastline file (any OGR source)");
+    if (o.coast.empty())
+        throw UsageError(option("coast") +
+                         " is required: a land polygon or coastline file (any OGR source)");
     StageClock clock(timings);
 
     // load_coast and read_bathymetry check their own reads against --max-memory (the coast
     // counts its vertices while reading, the raster is read no finer than the mesh needs).
     MemoryBudget budget(o.max_memory_bytes);
     CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
-    for (const Ring& r : coast.rings.rings) budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
+    for (const Ring &r : coast.rings.rings)
+        budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
     clock.lap("read_coast");
     refuse_too_many_nodes(o, coast);
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
-        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15), &coast.rings); // covering the ocean cut
+        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15),
+                                &coast.rings); // covering the ocean cut
         budget.hold(static_cast<double>(bathy->values().size() * sizeof(float)));
     }
     clock.lap("read_bathy");
@@ -192,13 +209,14 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
     auto reserve_grid = [&] {
         const double grid_nodes = size_grid_nodes(o);
         budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
-                       "the size field's background grid (" + std::to_string(static_cast<std::uint64_t>(grid_nodes)) +
-                           " nodes)",
+                       "the size field's background grid (" +
+                           std::to_string(static_cast<std::uint64_t>(grid_nodes)) + " nodes)",
                        " or " + option("hmin_km"));
     };
     // Uniform when no component of the field is on: then no background grid is built.
-    const SizeField field = build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
-                                             sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
+    const SizeField field =
+        build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
+                         sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
     if (!field.is_uniform()) {
@@ -208,18 +226,21 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
     clock.lap("size_field");
 
     CoastReport coast_report;
-    Boundary boundary = shape_boundary(coast, size, o, &coast_report, sub_progress(progress, 0.25, 0.3));
+    Boundary boundary =
+        shape_boundary(coast, size, o, &coast_report, sub_progress(progress, 0.25, 0.3));
     clock.lap("boundary");
     // A size wider than the region leaves too little of its outline for a triangle: say so, and
     // which option to change, rather than the mesher's "fewer than 4 nodes".
     if (std::size_t n = 0; !boundary.empty()) {
-        for (const Ring& r : boundary.rings) n += r.nodes.size();
+        for (const Ring &r : boundary.rings)
+            n += r.nodes.size();
         if (n < 4)
-            throw DataError("no ocean to mesh: at " + option("hmax_km") + " " + report_number(o.hmax_km) +
-                            " km the coast and region keep only " + std::to_string(n) + " boundary nodes; lower " +
-                            option("hmax_km"));
+            throw DataError("no ocean to mesh: at " + option("hmax_km") + " " +
+                            report_number(o.hmax_km) + " km the coast and region keep only " +
+                            std::to_string(n) + " boundary nodes; lower " + option("hmax_km"));
     }
-    coast.rings = Boundary{}; // done with: the mesher reuses their memory (only coast.layer is used below)
+    coast.rings =
+        Boundary{}; // done with: the mesher reuses their memory (only coast.layer is used below)
 
     MesherOptions mo;
     mo.max_nodes = o.max_nodes;
@@ -237,26 +258,33 @@ OceanMesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTi
     mo.seed = o.seed;
     if (coast.land) {
         // The land test holds the land polygons (GEOS coordinates and their prepared index).
-        budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex + coast.land->cell_bytes()));
+        budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex +
+                                        coast.land->cell_bytes()));
         mo.land = coast.land;
     }
     MesherReport report;
     StageTimings mesher_times;
     auto mesh_start = Clock::now();
-    Mesh mesh = mesh_boundary(boundary, size, mo, &report, sub_progress(progress, 0.3, 0.97), &mesher_times);
+    Mesh mesh = mesh_boundary(boundary, size, mo, &report, sub_progress(progress, 0.3, 0.97),
+                              &mesher_times);
     double mesh_seconds = std::chrono::duration<double>(Clock::now() - mesh_start).count();
     clock.restart();
     if (timings) {
-        for (auto& s : mesher_times.stages) timings->stages.push_back(s);
+        for (auto &s : mesher_times.stages)
+            timings->stages.push_back(s);
         timings->add("mesh", mesh_seconds);
     }
 
     OceanMesh run;
     if (bathy) {
-        Field depth{"depth", "sea floor depth below mean sea level", "m",
-                    "sea_floor_depth_below_mean_sea_level", {}};
+        Field depth{"depth",
+                    "sea floor depth below mean sea level",
+                    "m",
+                    "sea_floor_depth_below_mean_sea_level",
+                    {}};
         depth.values.reserve(mesh.nodes.size());
-        for (const Vec3& p : mesh.nodes) depth.values.push_back(bathy->depth_m(p));
+        for (const Vec3 &p : mesh.nodes)
+            depth.values.push_back(bathy->depth_m(p));
         run.depth = apply_min_depth(depth.values, o.min_depth_m);
         mesh.node_fields.insert(mesh.node_fields.begin(), std::move(depth));
     }

@@ -45,8 +45,8 @@ struct PointSource {
 
 // Appends the point(s) of g (a point or a multipoint, possibly in a collection) in lon/lat,
 // checking each coordinate. Throws DataError naming the file and the feature.
-void collect_points(OGRGeometryH g, OGRCoordinateTransformationH to_lonlat, const std::string& where,
-                    std::vector<Vec3>& out) {
+void collect_points(OGRGeometryH g, OGRCoordinateTransformationH to_lonlat,
+                    const std::string &where, std::vector<Vec3> &out) {
     const OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(g));
     if (type == wkbMultiPoint || type == wkbGeometryCollection) {
         for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
@@ -56,25 +56,26 @@ void collect_points(OGRGeometryH g, OGRCoordinateTransformationH to_lonlat, cons
     if (type != wkbPoint)
         throw DataError(where + " is a " + OGRGeometryTypeToName(OGR_G_GetGeometryType(g)) +
                         ", not a point: give a layer of points");
-    if (OGR_G_IsEmpty(g)) throw DataError(where + " has an empty point: give every feature a lon/lat");
+    if (OGR_G_IsEmpty(g))
+        throw DataError(where + " has an empty point: give every feature a lon/lat");
     double x = OGR_G_GetX(g, 0), y = OGR_G_GetY(g, 0), z = 0;
     if (!std::isfinite(x) || !std::isfinite(y))
         throw DataError(where + " has a non-finite coordinate: every point needs finite lon/lat");
     if (to_lonlat && !OCTTransform(to_lonlat, 1, &x, &y, &z))
         throw DataError(where + " cannot be transformed to lon/lat" + gdal_message());
     if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(y) > 90.0)
-        throw DataError(where + " has latitude " + std::to_string(y) + " (longitude " + std::to_string(x) +
-                        "): latitudes lie in [-90, 90] degrees");
+        throw DataError(where + " has latitude " + std::to_string(y) + " (longitude " +
+                        std::to_string(x) + "): latitudes lie in [-90, 90] degrees");
     out.push_back(lonlat_to_vec(x, y));
 }
 
-PointSource read_point_source(const TriangulateOptions& options, const Progress& progress) {
-    const std::string& path = options.points;
+PointSource read_point_source(const TriangulateOptions &options, const Progress &progress) {
+    const std::string &path = options.points;
     GDALAllRegister();
     gdal::QuietErrors quiet;
     // CSV: take lon/lat columns as the geometry and drop them from the attributes (other drivers
     // ignore these open options).
-    const char* open_options[] = {"X_POSSIBLE_NAMES=lon*,long*,x", "Y_POSSIBLE_NAMES=lat*,y",
+    const char *open_options[] = {"X_POSSIBLE_NAMES=lon*,long*,x", "Y_POSSIBLE_NAMES=lat*,y",
                                   "KEEP_GEOM_COLUMNS=NO", nullptr};
     const bool is_csv = path.size() >= 4 && CPLGetExtension(path.c_str()) != nullptr &&
                         EQUAL(CPLGetExtension(path.c_str()), "csv");
@@ -87,9 +88,11 @@ PointSource read_point_source(const TriangulateOptions& options, const Progress&
     if (!options.layer.empty()) {
         layer = GDALDatasetGetLayerByName(ds.get(), options.layer.c_str());
         if (!layer)
-            throw DataError("POINTS " + path + ": no layer named '" + options.layer + "'; see ogrinfo " + path);
+            throw DataError("POINTS " + path + ": no layer named '" + options.layer +
+                            "'; see ogrinfo " + path);
     } else {
-        if (GDALDatasetGetLayerCount(ds.get()) == 0) throw DataError("POINTS " + path + ": has no layer");
+        if (GDALDatasetGetLayerCount(ds.get()) == 0)
+            throw DataError("POINTS " + path + ": has no layer");
         layer = GDALDatasetGetLayer(ds.get(), 0);
     }
     PointSource src;
@@ -110,11 +113,14 @@ PointSource read_point_source(const TriangulateOptions& options, const Progress&
                 throw DataError(at + ": its CRS cannot be transformed to lon/lat" + gdal_message());
         }
     } else if (!EQUAL(GDALGetDriverShortName(GDALGetDatasetDriver(ds.get())), "CSV")) {
-        throw DataError(at + " declares no CRS: add one (e.g. ogr2ogr -a_srs EPSG:4326) or give a CSV of lon/lat");
+        throw DataError(
+            at +
+            " declares no CRS: add one (e.g. ogr2ogr -a_srs EPSG:4326) or give a CSV of lon/lat");
     }
 
     const GIntBig expected = OGR_L_GetFeatureCount(layer, FALSE);
-    if (expected > 0) src.points.reserve(static_cast<std::size_t>(expected));
+    if (expected > 0)
+        src.points.reserve(static_cast<std::size_t>(expected));
     OGR_L_ResetReading(layer);
     std::size_t features = 0;
     for (FeaturePtr f(OGR_L_GetNextFeature(layer)); f; f.reset(OGR_L_GetNextFeature(layer))) {
@@ -128,24 +134,29 @@ PointSource read_point_source(const TriangulateOptions& options, const Progress&
     }
     if (CPLGetLastErrorType() == CE_Failure)
         throw IoError("POINTS " + path + ": reading failed" + gdal_message());
-    if (src.points.empty()) throw DataError(at + " has no points");
+    if (src.points.empty())
+        throw DataError(at + " has no points");
     return src;
 }
 
 } // namespace
 
-Mesh triangulate_file(const TriangulateOptions& options, const Progress& progress, StageTimings* timings) {
+Mesh triangulate_file(const TriangulateOptions &options, const Progress &progress,
+                      StageTimings *timings) {
     auto t0 = std::chrono::steady_clock::now();
     report(progress, 0.0, "read");
     PointSource src = read_point_source(options, sub_progress(progress, 0.0, 0.3));
     const std::size_t n = src.points.size();
-    if (timings) timings->add("read", seconds_since(t0));
+    if (timings)
+        timings->add("read", seconds_since(t0));
 
     report(progress, 0.3, "sort");
     t0 = std::chrono::steady_clock::now();
-    if (n >= 0x80000000u) throw DataError("POINTS " + options.points + ": more than 2^31 points");
+    if (n >= 0x80000000u)
+        throw DataError("POINTS " + options.points + ": more than 2^31 points");
     std::vector<std::uint32_t> order = SphericalDelaunay::insertion_order(src.points, options.seed);
-    if (timings) timings->add("sort", seconds_since(t0));
+    if (timings)
+        timings->add("sort", seconds_since(t0));
 
     report(progress, 0.4, "triangulate");
     t0 = std::chrono::steady_clock::now();
@@ -153,7 +164,7 @@ Mesh triangulate_file(const TriangulateOptions& options, const Progress& progres
     std::vector<VertexId> vertex_of;
     try {
         vertex_of = dt.insert_points(std::move(src.points), std::move(order));
-    } catch (const DataError& e) {
+    } catch (const DataError &e) {
         throw DataError("POINTS " + options.points + ": " + e.what());
     }
     report(progress, 0.9, "triangulate");
@@ -167,7 +178,8 @@ Mesh triangulate_file(const TriangulateOptions& options, const Progress& progres
         if (dt.is_live(t) && dt.is_solid(t)) {
             is_solid[t] = 1;
             ++solid;
-            for (int i = 0; i < 3; ++i) in_mesh[dt.vertex(t, i)] = 1;
+            for (int i = 0; i < 3; ++i)
+                in_mesh[dt.vertex(t, i)] = 1;
         }
     Mesh mesh;
     std::vector<NodeIndex> node_of(dt.vertex_count(), 0xffffffffu);
@@ -178,22 +190,27 @@ Mesh triangulate_file(const TriangulateOptions& options, const Progress& progres
         }
     mesh.faces.reserve(solid);
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-        if (!is_solid[t]) continue;
-        mesh.faces.push_back({node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]});
+        if (!is_solid[t])
+            continue;
+        mesh.faces.push_back(
+            {node_of[dt.vertex(t, 0)], node_of[dt.vertex(t, 1)], node_of[dt.vertex(t, 2)]});
         // An edge whose other side is a ghost triangle bounds the solid region (a hemisphere set).
         for (int i = 0; i < 3; ++i)
             if (!is_solid[dt.neighbour(t, i)]) {
                 const HalfEdge h = half_edge(t, i);
-                mesh.boundary.push_back({node_of[dt.origin(h)], node_of[dt.destination(h)], EdgeTag::open});
+                mesh.boundary.push_back(
+                    {node_of[dt.origin(h)], node_of[dt.destination(h)], EdgeTag::open});
             }
     }
     if (mesh.faces.empty())
-        throw DataError("POINTS " + options.points + ": the points give no triangle (all on one circle?)");
+        throw DataError("POINTS " + options.points +
+                        ": the points give no triangle (all on one circle?)");
     mesh.attributes.emplace_back("source_points", options.points);
     mesh.attributes.emplace_back("source_layer", src.layer);
     mesh.attributes.emplace_back("input_point_count", std::to_string(n));
     mesh.attributes.emplace_back("merged_point_count", std::to_string(dt.merged_count()));
-    if (timings) timings->add("triangulate", seconds_since(t0));
+    if (timings)
+        timings->add("triangulate", seconds_since(t0));
     report(progress, 1.0, "triangulate");
     return mesh;
 }

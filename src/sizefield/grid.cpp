@@ -17,11 +17,13 @@ constexpr float float_inf = std::numeric_limits<float>::infinity();
 struct HeapEntry {
     float key;
     std::uint32_t node;
-    bool operator>(const HeapEntry& o) const { return key > o.key || (key == o.key && node > o.node); }
+    bool operator>(const HeapEntry &o) const {
+        return key > o.key || (key == o.key && node > o.node);
+    }
 };
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<HeapEntry>>;
 
-double chord2(const Vec3& a, const Vec3& b) {
+double chord2(const Vec3 &a, const Vec3 &b) {
     Vec3 d = a - b;
     return dot(d, d);
 }
@@ -29,7 +31,8 @@ double chord2(const Vec3& a, const Vec3& b) {
 /// Largest float not above x (so a stored size never exceeds the solver's value).
 float float_down(double x) {
     float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = std::nextafter(f, -float_inf);
+    if (static_cast<double>(f) > x)
+        f = std::nextafter(f, -float_inf);
     return f;
 }
 
@@ -41,7 +44,8 @@ BackgroundGrid::BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg
       global(global_) {
     sin_lon.resize(nlon);
     cos_lon.resize(nlon);
-    for (std::size_t i = 0; i < nlon; ++i) sincosd(lon(i), sin_lon[i], cos_lon[i]);
+    for (std::size_t i = 0; i < nlon; ++i)
+        sincosd(lon(i), sin_lon[i], cos_lon[i]);
     sin_lat.resize(nlat);
     cos_lat.resize(nlat);
     dx_km.resize(nlat);
@@ -69,7 +73,7 @@ void BackgroundGrid::column_neighbours(std::size_t n, std::size_t out[2]) const 
     out[1] = j + 1 < nlat ? n + nlon : (global ? (nlat - 1) * nlon + across : npos);
 }
 
-BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std::size_t max_nodes) {
+BackgroundGrid make_background_grid(const MeshOptions &o, double hfloor_km, std::size_t max_nodes) {
     max_nodes = std::max<std::size_t>(max_nodes, 64);
     const double spacing = std::max(1e-6, 0.5 * hfloor_km / earth_radius_km * rad_to_deg);
     double w = -180, s = -90, e = 180, n = 90;
@@ -77,12 +81,14 @@ BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std:
     if (o.region) {
         w = (*o.region)[0];
         e = (*o.region)[2];
-        if (e <= w) e += 360;
+        if (e <= w)
+            e += 360;
         // One cell of margin beyond the great circles through the region's corners (they bulge
         // poleward of the parallels, and the mesh's open boundary follows them), within the poles.
         const double half = 0.5 * (e - w);
         auto bulge = [&](double lat) {
-            if (half >= 90.0 || lat == 0) return lat;
+            if (half >= 90.0 || lat == 0)
+                return lat;
             return std::atan(std::tan(lat * deg_to_rad) / std::cos(half * deg_to_rad)) * rad_to_deg;
         };
         s = std::max(-90.0, std::min((*o.region)[1], bulge((*o.region)[1])) - spacing);
@@ -104,26 +110,31 @@ BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std:
     }
     std::size_t nlon = std::max<std::size_t>(2, static_cast<std::size_t>(nx));
     std::size_t nlat = std::max<std::size_t>(2, static_cast<std::size_t>(ny));
-    if (global && nlon % 2) --nlon;
+    if (global && nlon % 2)
+        --nlon;
     nlon = std::max<std::size_t>(nlon, 2);
     double dlon = (e - w) / static_cast<double>(nlon), dlat = (n - s) / static_cast<double>(nlat);
     return BackgroundGrid(w + 0.5 * dlon, s + 0.5 * dlat, dlon, dlat, nlon, nlat, global);
 }
 
-std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b, double max_km,
-                                     const Progress& progress) {
+std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b, double max_km,
+                                     const Progress &progress) {
     // Sources: the rings densified to a quarter of the smallest grid spacing.
     const double step = 0.25 * std::min(g.dlat, g.dlon) * deg_to_rad;
     std::vector<Vec3> sources;
-    for (const Ring& ring : b.rings) {
+    for (const Ring &ring : b.rings) {
         const std::size_t m = ring.nodes.size();
         for (std::size_t k = 0; k < m; ++k) {
-            const Vec3& a = ring.nodes[k];
-            const Vec3& c = ring.nodes[(k + 1) % m];
+            const Vec3 &a = ring.nodes[k];
+            const Vec3 &c = ring.nodes[(k + 1) % m];
             double angle = arc_angle(a, c);
-            std::size_t pieces = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(angle / step)));
+            std::size_t pieces =
+                std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(angle / step)));
             for (std::size_t p = 0; p < pieces; ++p)
-                sources.push_back(p == 0 ? a : arc_interpolate(a, c, static_cast<double>(p) / static_cast<double>(pieces)));
+                sources.push_back(
+                    p == 0 ? a
+                           : arc_interpolate(a, c,
+                                             static_cast<double>(p) / static_cast<double>(pieces)));
         }
     }
     std::vector<float> key(g.size(), float_inf); // chord^2 to the nearest source found
@@ -141,40 +152,59 @@ std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b,
     for (std::size_t s = 0; s < sources.size(); ++s) {
         LonLat ll = vec_to_lonlat(sources[s]);
         double u = (ll.lon - g.lon0) / g.dlon, v = (ll.lat - g.lat0) / g.dlat;
-        if (g.global) u = u - std::floor(u / static_cast<double>(g.nlon)) * static_cast<double>(g.nlon);
+        if (g.global)
+            u = u - std::floor(u / static_cast<double>(g.nlon)) * static_cast<double>(g.nlon);
         else if (u < -1 || u > static_cast<double>(g.nlon)) {
             double u2 = (ll.lon + 360.0 - g.lon0) / g.dlon;
-            if (u2 >= -1 && u2 <= static_cast<double>(g.nlon)) u = u2;
-            else continue;
+            if (u2 >= -1 && u2 <= static_cast<double>(g.nlon))
+                u = u2;
+            else
+                continue;
         }
-        if (v < -1 || v > static_cast<double>(g.nlat)) continue;
+        if (v < -1 || v > static_cast<double>(g.nlat))
+            continue;
         long i0 = static_cast<long>(std::floor(u)), j0 = static_cast<long>(std::floor(v));
         for (long dj = 0; dj <= 1; ++dj)
             for (long di = 0; di <= 1; ++di) {
                 long i = i0 + di, j = std::clamp(j0 + dj, 0L, static_cast<long>(g.nlat) - 1);
-                if (g.global) i = (i % static_cast<long>(g.nlon) + static_cast<long>(g.nlon)) % static_cast<long>(g.nlon);
-                else if (i < 0 || i >= static_cast<long>(g.nlon)) continue;
-                offer(static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(i), static_cast<std::uint32_t>(s));
+                if (g.global)
+                    i = (i % static_cast<long>(g.nlon) + static_cast<long>(g.nlon)) %
+                        static_cast<long>(g.nlon);
+                else if (i < 0 || i >= static_cast<long>(g.nlon))
+                    continue;
+                offer(static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(i),
+                      static_cast<std::uint32_t>(s));
             }
     }
     // Dijkstra over the 8-neighbourhood, each node carrying its nearest source.
     const double max_angle = std::min(pi, max_km / earth_radius_km);
-    const float max_key = static_cast<float>(4.0 * std::pow(std::sin(0.5 * max_angle), 2)) * 1.0001f;
+    const float max_key =
+        static_cast<float>(4.0 * std::pow(std::sin(0.5 * max_angle), 2)) * 1.0001f;
     std::vector<std::uint8_t> done(g.size(), 0);
     std::size_t popped = 0;
     while (!heap.empty()) {
         HeapEntry top = heap.top();
         heap.pop();
-        if (top.key > max_key) break;
-        if (done[top.node] || top.key > key[top.node]) continue;
+        if (top.key > max_key)
+            break;
+        if (done[top.node] || top.key > key[top.node])
+            continue;
         done[top.node] = 1;
         if (++popped % (1u << 20) == 0)
-            report(progress, std::min(0.99, static_cast<double>(popped) / static_cast<double>(g.size())), "coast distance");
+            report(progress,
+                   std::min(0.99, static_cast<double>(popped) / static_cast<double>(g.size())),
+                   "coast distance");
         std::size_t r[2], c[2];
         g.row_neighbours(top.node, r);
         g.column_neighbours(top.node, c);
-        std::size_t around[8] = {r[0], r[1], c[0], c[1], BackgroundGrid::npos, BackgroundGrid::npos,
-                                 BackgroundGrid::npos, BackgroundGrid::npos};
+        std::size_t around[8] = {r[0],
+                                 r[1],
+                                 c[0],
+                                 c[1],
+                                 BackgroundGrid::npos,
+                                 BackgroundGrid::npos,
+                                 BackgroundGrid::npos,
+                                 BackgroundGrid::npos};
         for (int k = 0; k < 2; ++k)
             if (c[k] != BackgroundGrid::npos) {
                 std::size_t cr[2];
@@ -183,11 +213,15 @@ std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b,
                 around[5 + 2 * k] = cr[1];
             }
         for (std::size_t m : around)
-            if (m != BackgroundGrid::npos && !done[m]) offer(m, nearest[top.node]);
+            if (m != BackgroundGrid::npos && !done[m])
+                offer(m, nearest[top.node]);
     }
     std::vector<float> d(g.size(), float_inf);
     for (std::size_t n = 0; n < g.size(); ++n)
-        if (done[n]) d[n] = static_cast<float>(2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(static_cast<double>(key[n])))) * earth_radius_km);
+        if (done[n])
+            d[n] = static_cast<float>(
+                2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(static_cast<double>(key[n])))) *
+                earth_radius_km);
     return d;
 }
 
@@ -236,14 +270,15 @@ struct Corner {
 
 /// Largest v >= the accepted nodes for which the condition holds when its unaccepted nodes take
 /// the value v; +inf when no edge ties an unknown node to an accepted one.
-double corner_bound(const Corner& c, const std::vector<float>& h, const std::vector<std::uint8_t>& accepted,
-                    double grade) {
+double corner_bound(const Corner &c, const std::vector<float> &h,
+                    const std::vector<std::uint8_t> &accepted, double grade) {
     const double inf = std::numeric_limits<double>::infinity();
     double fixed[2] = {0, 0}, partner[2] = {inf, inf};
     const std::size_t ends[2] = {c.row, c.col};
     for (int dir = 0; dir < 2; ++dir) {
         const std::size_t p = c.k, q = ends[dir];
-        if (p == q) continue;
+        if (p == q)
+            continue;
         const bool pa = accepted[p] != 0, qa = accepted[q] != 0;
         if (pa && qa) {
             const double diff = static_cast<double>(h[p]) - h[q];
@@ -262,18 +297,22 @@ double corner_bound(const Corner& c, const std::vector<float>& h, const std::vec
         const double disc = (ix + iy) * g2 - ix * iy * (sx - sy) * (sx - sy);
         return (ix * sx + iy * sy + std::sqrt(std::max(0.0, disc))) / (ix + iy);
     }
-    if (var_x) return partner[0] + c.dx * std::sqrt(std::max(0.0, g2 - fixed[1] * iy));
-    if (var_y) return partner[1] + c.dy * std::sqrt(std::max(0.0, g2 - fixed[0] * ix));
+    if (var_x)
+        return partner[0] + c.dx * std::sqrt(std::max(0.0, g2 - fixed[1] * iy));
+    if (var_y)
+        return partner[1] + c.dy * std::sqrt(std::max(0.0, g2 - fixed[0] * ix));
     return inf;
 }
 
 } // namespace
 
-PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade, const Progress& progress) {
+PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double grade,
+                         const Progress &progress) {
     const std::size_t n_grid = g.size();
     const std::size_t south = n_grid, north = n_grid + 1; // the pole nodes, when capped
     float top_value = 0;
-    for (float v : h) top_value = std::max(top_value, v);
+    for (float v : h)
+        top_value = std::max(top_value, v);
     h.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
 
     const double rad_lon = g.dlon * deg_to_rad * earth_radius_km;
@@ -284,12 +323,17 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
     const double cap_dy_north = (90.0 - g.lat(g.nlat - 1)) * deg_to_rad * earth_radius_km;
     // Column i in [-1, nlon] (a cell's corners around a node), wrapped on global grids.
     auto node_id = [&](long i, long j) -> std::size_t {
-        return static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(i < 0 ? i + nlon : i >= nlon ? i - nlon : i);
+        return static_cast<std::size_t>(j) * g.nlon + static_cast<std::size_t>(i < 0 ? i + nlon
+                                                                               : i >= nlon
+                                                                                   ? i - nlon
+                                                                                   : i);
     };
     // The two corner conditions of the cell with lower-left corner (i, j); 0 where there is none.
     auto corners = [&](long i, long j, Corner out[2]) -> int {
-        if (j < j_first || j > j_last) return 0;
-        if (!g.global && (i < 0 || i > nlon - 2)) return 0;
+        if (j < j_first || j > j_last)
+            return 0;
+        if (!g.global && (i < 0 || i > nlon - 2))
+            return 0;
         if (j < 0) { // south cap: the pole below row 0
             const std::size_t c01 = node_id(i, 0), c11 = node_id(i + 1, 0);
             out[0] = {c01, c11, south, row_dx(0), cap_dy_south};
@@ -310,16 +354,18 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
         return 2;
     };
     // Every corner condition a node takes part in.
-    auto for_each_corner = [&](std::size_t n, const auto& visit) {
+    auto for_each_corner = [&](std::size_t n, const auto &visit) {
         Corner c[2];
         auto cell = [&](long i, long j) {
             const int k = corners(i, j, c);
             for (int m = 0; m < k; ++m)
-                if (c[m].involves(n)) visit(c[m]);
+                if (c[m].involves(n))
+                    visit(c[m]);
         };
         if (n >= n_grid) {
             const long j = n == south ? -1 : nlat - 1;
-            for (long i = 0; i < nlon; ++i) cell(i, j);
+            for (long i = 0; i < nlon; ++i)
+                cell(i, j);
             return;
         }
         const long i = static_cast<long>(n % g.nlon), j = static_cast<long>(n / g.nlon);
@@ -339,8 +385,10 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
     // Nodes at the largest value never lower a neighbour: they enter only when lowered.
     std::vector<HeapEntry> seeds;
     for (std::size_t n = 0; n < n_grid; ++n)
-        if (h[n] < top_value) seeds.push_back({h[n], static_cast<std::uint32_t>(n)});
-    std::sort(seeds.begin(), seeds.end(), [](const HeapEntry& a, const HeapEntry& b) { return b > a; });
+        if (h[n] < top_value)
+            seeds.push_back({h[n], static_cast<std::uint32_t>(n)});
+    std::sort(seeds.begin(), seeds.end(),
+              [](const HeapEntry &a, const HeapEntry &b) { return b > a; });
     std::size_t next_seed = 0;
     MinHeap heap;
     std::vector<std::uint8_t> accepted(n_grid + 2, 0);
@@ -349,7 +397,8 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
     // node of one of its conditions is accepted, so no running minimum is kept.
     auto tentative = [&](std::size_t m) {
         double t = initial[m];
-        for_each_corner(m, [&](const Corner& c) { t = std::min(t, corner_bound(c, h, accepted, grade)); });
+        for_each_corner(
+            m, [&](const Corner &c) { t = std::min(t, corner_bound(c, h, accepted, grade)); });
         return t;
     };
     std::vector<std::size_t> around;
@@ -361,14 +410,18 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
             top = heap.top();
             heap.pop();
         }
-        if (accepted[top.node] || top.key != h[top.node]) continue;
+        if (accepted[top.node] || top.key != h[top.node])
+            continue;
         accepted[top.node] = 1;
         if (++popped % (1u << 20) == 0)
-            report(progress, std::min(0.99, static_cast<double>(popped) / static_cast<double>(n_grid)), "gradation");
+            report(progress,
+                   std::min(0.99, static_cast<double>(popped) / static_cast<double>(n_grid)),
+                   "gradation");
         around.clear();
-        for_each_corner(top.node, [&](const Corner& c) {
+        for_each_corner(top.node, [&](const Corner &c) {
             for (std::size_t m : {c.k, c.row, c.col})
-                if (!accepted[m] && std::find(around.begin(), around.end(), m) == around.end()) around.push_back(m);
+                if (!accepted[m] && std::find(around.begin(), around.end(), m) == around.end())
+                    around.push_back(m);
         });
         for (std::size_t m : around) {
             // Never below the value just accepted (the conditions held with every unknown node
@@ -381,8 +434,10 @@ PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double 
         }
     }
     PoleSizes poles;
-    if (g.south_cap) poles.south = h[south];
-    if (g.north_cap) poles.north = h[north];
+    if (g.south_cap)
+        poles.south = h[south];
+    if (g.north_cap)
+        poles.north = h[north];
     h.resize(n_grid);
     return poles;
 }

@@ -49,12 +49,12 @@ struct BackgroundGrid {
 };
 
 /// The grid build_size_field uses for these options: see sizefield.hpp.
-BackgroundGrid make_background_grid(const MeshOptions& o, double hfloor_km, std::size_t max_nodes);
+BackgroundGrid make_background_grid(const MeshOptions &o, double hfloor_km, std::size_t max_nodes);
 
 /// Great-circle distance (km) from every node to the nearest point of the boundary rings, up to
 /// max_km (nodes farther get +infinity).
-std::vector<float> coast_distance_km(const BackgroundGrid& g, const Boundary& b, double max_km,
-                                     const Progress& progress);
+std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b, double max_km,
+                                     const Progress &progress);
 
 /// Sizes at the two poles (km) for the polar caps; NaN where the grid has no cap.
 struct PoleSizes {
@@ -65,12 +65,12 @@ struct PoleSizes {
 /// bilinear in lon/lat in each cell and linear in latitude over the polar caps, has
 /// |grad h| <= grade everywhere on the sphere; returns the pole values of the caps. See
 /// grid.cpp for the cell condition and the ordered (Dijkstra-like) solver.
-PoleSizes limit_gradient(const BackgroundGrid& g, std::vector<float>& h, double grade,
-                         const Progress& progress);
+PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double grade,
+                         const Progress &progress);
 
 /// min(h, size_km) over the nodes inside each polygon of an OGR source with a size_km field:
 /// of its layer `layer_name`, or of every layer with that field when it is empty.
-void apply_size_regions(const BackgroundGrid& g, const std::string& path, const std::string& layer_name,
-                        std::vector<float>& h);
+void apply_size_regions(const BackgroundGrid &g, const std::string &path,
+                        const std::string &layer_name, std::vector<float> &h);
 
 } // namespace globemesh::detail

@@ -28,7 +28,9 @@ using gdal::FeaturePtr;
 using gdal::GeometryPtr;
 using gdal::TransformPtr;
 
-std::string last_message() { return gdal::last_error("unknown error"); }
+std::string last_message() {
+    return gdal::last_error("unknown error");
+}
 
 /// "a, b, c": the layer names of `ds`, for messages.
 std::string layer_names(GDALDatasetH ds) {
@@ -40,30 +42,36 @@ std::string layer_names(GDALDatasetH ds) {
 
 /// The layers to read: `name` alone when given (DataError when the file has no such layer or
 /// it has no size_km field), else every layer of `ds`.
-std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string& path, const std::string& name) {
+std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string &path,
+                                   const std::string &name) {
     std::vector<OGRLayerH> layers;
     if (name.empty()) {
-        for (int l = 0; l < GDALDatasetGetLayerCount(ds); ++l) layers.push_back(GDALDatasetGetLayer(ds, l));
+        for (int l = 0; l < GDALDatasetGetLayerCount(ds); ++l)
+            layers.push_back(GDALDatasetGetLayer(ds, l));
         return layers;
     }
     OGRLayerH layer = GDALDatasetGetLayerByName(ds, name.c_str());
     if (!layer)
-        throw DataError(option("size_regions") + " " + path + ": no layer named '" + name + "' (" + option("size_regions_layer") + "); layers: " +
-                        layer_names(ds));
+        throw DataError(option("size_regions") + " " + path + ": no layer named '" + name + "' (" +
+                        option("size_regions_layer") + "); layers: " + layer_names(ds));
     if (OGR_FD_GetFieldIndex(OGR_L_GetLayerDefn(layer), "size_km") < 0)
-        throw DataError(option("size_regions") + " " + path + " layer '" + name + "' has no size_km field (edge length in km)");
+        throw DataError(option("size_regions") + " " + path + " layer '" + name +
+                        "' has no size_km field (edge length in km)");
     layers.push_back(layer);
     return layers;
 }
 
 } // namespace
 
-void apply_size_regions(const BackgroundGrid& g, const std::string& path, const std::string& layer_name,
-                        std::vector<float>& h) {
+void apply_size_regions(const BackgroundGrid &g, const std::string &path,
+                        const std::string &layer_name, std::vector<float> &h) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
-    DatasetPtr ds(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds) throw IoError(option("size_regions") + " " + path + ": cannot open as vector data: " + last_message());
+    DatasetPtr ds(
+        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+    if (!ds)
+        throw IoError(option("size_regions") + " " + path +
+                      ": cannot open as vector data: " + last_message());
 
     gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(wgs84.get(), 4326);
@@ -75,70 +83,91 @@ void apply_size_regions(const BackgroundGrid& g, const std::string& path, const 
     for (OGRLayerH layer : size_layers(ds.get(), path, layer_name)) {
         OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
         int field = OGR_FD_GetFieldIndex(defn, "size_km");
-        if (field < 0) continue;
+        if (field < 0)
+            continue;
         any_field = true;
         OGRSpatialReferenceH srs = OGR_L_GetSpatialRef(layer);
         if (!srs || OSRIsLocal(srs)) // a local CRS (LOCAL_CS, unknown units) is no more use
-            throw DataError(option("size_regions") + " " + path + ": layer " + OGR_L_GetName(layer) + " has no CRS" +
+            throw DataError(option("size_regions") + " " + path + ": layer " +
+                            OGR_L_GetName(layer) + " has no CRS" +
                             (srs ? " (only a local one, of unknown units)" : "") +
                             "; assign one (e.g. ogr2ogr -a_srs EPSG:4326)");
         TransformPtr to_lonlat(OCTNewCoordinateTransformation(srs, wgs84.get()));
         if (!to_lonlat)
-            throw DataError(option("size_regions") + " " + path + ": cannot transform layer " + OGR_L_GetName(layer) + " to lon/lat");
+            throw DataError(option("size_regions") + " " + path + ": cannot transform layer " +
+                            OGR_L_GetName(layer) + " to lon/lat");
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
             OGRGeometryH geom = OGR_F_GetGeometryRef(fh);
-            if (!geom || !OGR_F_IsFieldSetAndNotNull(fh, field)) continue;
+            if (!geom || !OGR_F_IsFieldSetAndNotNull(fh, field))
+                continue;
             OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geom));
-            if (type != wkbPolygon && type != wkbMultiPolygon) continue;
+            if (type != wkbPolygon && type != wkbMultiPolygon)
+                continue;
             double size = OGR_F_GetFieldAsDouble(fh, field);
             if (!(std::isfinite(size) && size > 0))
-                throw DataError(option("size_regions") + " " + path + ": feature " + std::to_string(OGR_F_GetFID(fh)) +
-                                " has size_km " + OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
+                throw DataError(option("size_regions") + " " + path + ": feature " +
+                                std::to_string(OGR_F_GetFID(fh)) + " has size_km " +
+                                OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
             GeometryPtr copy(OGR_G_Clone(geom));
             if (OGR_G_Transform(copy.get(), to_lonlat.get()) != OGRERR_NONE)
-                throw DataError(option("size_regions") + " " + path + ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) + " to lon/lat");
+                throw DataError(option("size_regions") + " " + path +
+                                ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +
+                                " to lon/lat");
             regions.emplace_back(size, std::move(copy));
         }
     }
     if (!any_field)
-        throw DataError(option("size_regions") + " " + path + ": no layer has a size_km field (edge length in km)");
-    if (regions.empty()) return;
+        throw DataError(option("size_regions") + " " + path +
+                        ": no layer has a size_km field (edge length in km)");
+    if (regions.empty())
+        return;
     // Largest first: with the REPLACE rule the smallest size burnt last wins (a minimum).
-    std::stable_sort(regions.begin(), regions.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::stable_sort(regions.begin(), regions.end(),
+                     [](const auto &a, const auto &b) { return a.first > b.first; });
     std::vector<OGRGeometryH> geoms;
     std::vector<double> burn;
-    for (auto& r : regions) {
+    for (auto &r : regions) {
         geoms.push_back(r.second.get());
         burn.push_back(r.first);
     }
 
     GDALDriverH mem = GDALGetDriverByName("MEM");
     const int nx = static_cast<int>(g.nlon), ny = static_cast<int>(g.nlat);
-    const double west = g.lon0 - 0.5 * g.dlon, north = g.lat0 + (static_cast<double>(g.nlat) - 0.5) * g.dlat;
+    const double west = g.lon0 - 0.5 * g.dlon,
+                 north = g.lat0 + (static_cast<double>(g.nlat) - 0.5) * g.dlat;
     std::vector<float> row(g.nlon);
     // Grids reaching beyond [-180, 180] also burn the polygons shifted by 360 degrees.
     for (double shift : {0.0, -360.0, 360.0}) {
         const double east = west + static_cast<double>(g.nlon) * g.dlon;
-        if (shift < 0 && east <= 180.0) continue;
-        if (shift > 0 && west >= -180.0) continue;
+        if (shift < 0 && east <= 180.0)
+            continue;
+        if (shift > 0 && west >= -180.0)
+            continue;
         DatasetPtr target(GDALCreate(mem, "", nx, ny, 1, GDT_Float32, nullptr));
-        if (!target) throw IoError(option("size_regions") + ": cannot create an in-memory grid: " + last_message());
+        if (!target)
+            throw IoError(option("size_regions") +
+                          ": cannot create an in-memory grid: " + last_message());
         // North-up: raster row r is grid row nlat-1-r. Shift moves the polygons' lon by -shift.
         double gt[6] = {west + shift, g.dlon, 0, north, 0, -g.dlat};
         GDALSetGeoTransform(target.get(), gt);
         GDALRasterBandH band = GDALGetRasterBand(target.get(), 1);
         GDALFillRaster(band, std::numeric_limits<double>::infinity(), 0);
         int one = 1;
-        if (GDALRasterizeGeometries(target.get(), 1, &one, static_cast<int>(geoms.size()), geoms.data(),
-                                    nullptr, nullptr, burn.data(), nullptr, nullptr, nullptr) != CE_None)
-            throw IoError(option("size_regions") + " " + path + ": rasterising failed: " + last_message());
+        if (GDALRasterizeGeometries(target.get(), 1, &one, static_cast<int>(geoms.size()),
+                                    geoms.data(), nullptr, nullptr, burn.data(), nullptr, nullptr,
+                                    nullptr) != CE_None)
+            throw IoError(option("size_regions") + " " + path +
+                          ": rasterising failed: " + last_message());
         for (int r = 0; r < ny; ++r) {
-            if (GDALRasterIO(band, GF_Read, 0, r, nx, 1, row.data(), nx, 1, GDT_Float32, 0, 0) != CE_None)
-                throw IoError(option("size_regions") + ": reading the in-memory grid failed: " + last_message());
+            if (GDALRasterIO(band, GF_Read, 0, r, nx, 1, row.data(), nx, 1, GDT_Float32, 0, 0) !=
+                CE_None)
+                throw IoError(option("size_regions") +
+                              ": reading the in-memory grid failed: " + last_message());
             std::size_t j = g.nlat - 1 - static_cast<std::size_t>(r);
-            for (std::size_t i = 0; i < g.nlon; ++i) h[j * g.nlon + i] = std::min(h[j * g.nlon + i], row[i]);
+            for (std::size_t i = 0; i < g.nlon; ++i)
+                h[j * g.nlon + i] = std::min(h[j * g.nlon + i], row[i]);
         }
     }
 }

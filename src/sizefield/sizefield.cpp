@@ -30,7 +30,8 @@ double wavelength_size_km(double depth_m, double period_h, double n) {
 
 double slope_size_km(double depth_m, double grad_m_per_km, double n) {
     const double d = std::max(depth_m, min_depth_m);
-    if (!(grad_m_per_km > 0)) return inf;
+    if (!(grad_m_per_km > 0))
+        return inf;
     return 2.0 * pi * d / (n * grad_m_per_km);
 }
 
@@ -38,18 +39,21 @@ namespace {
 
 /// The same grid with rows south to north (dlat > 0).
 Raster south_to_north(Raster grid) {
-    if (grid.dlat_deg() > 0) return grid;
+    if (grid.dlat_deg() > 0)
+        return grid;
     const std::size_t nx = grid.nlon(), ny = grid.nlat();
     std::vector<float> v(grid.values().size());
     for (std::size_t j = 0; j < ny; ++j)
         std::copy_n(grid.values().begin() + static_cast<std::ptrdiff_t>((ny - 1 - j) * nx), nx,
                     v.begin() + static_cast<std::ptrdiff_t>(j * nx));
-    return Raster(grid.lon0_deg(), grid.lat_deg(ny - 1), grid.dlon_deg(), -grid.dlat_deg(), nx, ny, std::move(v));
+    return Raster(grid.lon0_deg(), grid.lat_deg(ny - 1), grid.dlon_deg(), -grid.dlat_deg(), nx, ny,
+                  std::move(v));
 }
 
-double row_min(const Raster& g, std::size_t j) {
+double row_min(const Raster &g, std::size_t j) {
     double m = inf;
-    for (std::size_t i = 0; i < g.nlon(); ++i) m = std::min(m, static_cast<double>(g.value(i, j)));
+    for (std::size_t i = 0; i < g.nlon(); ++i)
+        m = std::min(m, static_cast<double>(g.value(i, j)));
     return m;
 }
 
@@ -58,39 +62,49 @@ double row_min(const Raster& g, std::size_t j) {
 SizeField::SizeField(Raster grid) : SizeField(std::move(grid), std::nan(""), std::nan("")) {}
 
 SizeField::SizeField(Raster grid, double south_pole_km, double north_pole_km) {
-    if (grid.values().empty()) throw DataError("size field: empty background grid");
+    if (grid.values().empty())
+        throw DataError("size field: empty background grid");
     grid = south_to_north(std::move(grid));
     min_ = inf;
     max_ = 0;
     for (float v : grid.values()) {
-        if (!(std::isfinite(v) && v > 0)) throw DataError("size field: a background node is not a positive size");
+        if (!(std::isfinite(v) && v > 0))
+            throw DataError("size field: a background node is not a positive size");
         min_ = std::min(min_, static_cast<double>(v));
         max_ = std::max(max_, static_cast<double>(v));
     }
-    const double dlat = grid.dlat_deg(), first = grid.lat_deg(0), last = grid.lat_deg(grid.nlat() - 1);
+    const double dlat = grid.dlat_deg(), first = grid.lat_deg(0),
+                 last = grid.lat_deg(grid.nlat() - 1);
     south_cap_ = grid.global() && first > -90.0 && first - dlat <= -90.0 + 1e-9 * dlat;
     north_cap_ = grid.global() && last < 90.0 && last + dlat >= 90.0 - 1e-9 * dlat;
-    if (south_cap_) south_ = std::isnan(south_pole_km) ? row_min(grid, 0) : south_pole_km;
-    if (north_cap_) north_ = std::isnan(north_pole_km) ? row_min(grid, grid.nlat() - 1) : north_pole_km;
+    if (south_cap_)
+        south_ = std::isnan(south_pole_km) ? row_min(grid, 0) : south_pole_km;
+    if (north_cap_)
+        north_ = std::isnan(north_pole_km) ? row_min(grid, grid.nlat() - 1) : north_pole_km;
     for (double v : {south_cap_ ? south_ : 1.0, north_cap_ ? north_ : 1.0})
-        if (!(v > 0 && std::isfinite(v))) throw DataError("size field: a pole value is not a positive size");
-    if (south_cap_) min_ = std::min(min_, south_), max_ = std::max(max_, south_);
-    if (north_cap_) min_ = std::min(min_, north_), max_ = std::max(max_, north_);
+        if (!(v > 0 && std::isfinite(v)))
+            throw DataError("size field: a pole value is not a positive size");
+    if (south_cap_)
+        min_ = std::min(min_, south_), max_ = std::max(max_, south_);
+    if (north_cap_)
+        min_ = std::min(min_, north_), max_ = std::max(max_, north_);
     grid_ = std::make_shared<const Raster>(std::move(grid));
 }
 
 SizeField SizeField::uniform(double h_km) {
-    if (!(std::isfinite(h_km) && h_km > 0)) throw UsageError("uniform size: h must be a positive length in km");
+    if (!(std::isfinite(h_km) && h_km > 0))
+        throw UsageError("uniform size: h must be a positive length in km");
     SizeField f;
     f.min_ = f.max_ = h_km;
     return f;
 }
 
 double SizeField::size_km(double lon, double lat) const {
-    if (!grid_) return min_; // uniform
-    const Raster& g = *grid_;
+    if (!grid_)
+        return min_; // uniform
+    const Raster &g = *grid_;
     const std::size_t nx = g.nlon(), ny = g.nlat();
-    const float* values = g.values().data();
+    const float *values = g.values().data();
     // Column pair and fraction; a regional grid holds its edge columns outside.
     double u;
     std::size_t i0, i1;
@@ -109,29 +123,32 @@ double SizeField::size_km(double lon, double lat) const {
         u -= static_cast<double>(i0);
     }
     auto row = [&](std::size_t j) {
-        const float* r = values + j * nx;
+        const float *r = values + j * nx;
         return (1 - u) * static_cast<double>(r[i0]) + u * static_cast<double>(r[i1]);
     };
     // Polar caps: linear in latitude between the edge row and the pole value.
     const double first = g.lat0_deg(), last = g.lat_deg(ny - 1);
     if (lat < first) {
-        if (!south_cap_) return row(0);
+        if (!south_cap_)
+            return row(0);
         const double t = std::max(0.0, (lat + 90.0) / (first + 90.0));
         return (1 - t) * south_ + t * row(0);
     }
     if (lat > last) {
-        if (!north_cap_) return row(ny - 1);
+        if (!north_cap_)
+            return row(ny - 1);
         const double t = std::max(0.0, (90.0 - lat) / (90.0 - last));
         return (1 - t) * north_ + t * row(ny - 1);
     }
-    if (ny == 1) return row(0);
+    if (ny == 1)
+        return row(0);
     double v = (lat - first) / g.dlat_deg();
     const std::size_t j0 = std::min(static_cast<std::size_t>(v), ny - 2);
     v -= static_cast<double>(j0);
     // Two triangles split along the 10-01 diagonal, linear in (lon, lat): the gradation
     // solver's corner conditions hold their gradients below --grade (grid.cpp).
-    const float* r0 = values + j0 * nx;
-    const float* r1 = r0 + nx;
+    const float *r0 = values + j0 * nx;
+    const float *r1 = r0 + nx;
     const double h10 = r0[i1], h01 = r1[i0];
     if (u + v <= 1) {
         const double h00 = r0[i0];
@@ -141,36 +158,42 @@ double SizeField::size_km(double lon, double lat) const {
     return h11 + (1 - u) * (h01 - h11) + (1 - v) * (h10 - h11);
 }
 
-double SizeField::size_km(const Vec3& p) const {
+double SizeField::size_km(const Vec3 &p) const {
     const LonLat ll = vec_to_lonlat(p);
     return size_km(ll.lon, ll.lat);
 }
 
 SizeFn SizeField::function() const {
-    if (is_uniform()) return uniform_size(min_);
+    if (is_uniform())
+        return uniform_size(min_);
     SizeField copy = *this;
-    return [copy](const Vec3& p) { return copy.size_km(p); };
+    return [copy](const Vec3 &p) { return copy.size_km(p); };
 }
 
 namespace {
 
 /// Lowers h (the grid's values, km) to the wavelength and slope components of the depth on
 /// the grid (see sizefield.hpp), where the options turn them on.
-void lower_by_depth(const detail::BackgroundGrid& g, const Raster& bathy, const MeshOptions& o, std::vector<float>& h,
-                    const Progress& progress) {
+void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const MeshOptions &o,
+                    std::vector<float> &h, const Progress &progress) {
     auto lower = [&](std::size_t n, double v) {
-        if (v < h[n]) h[n] = static_cast<float>(v);
+        if (v < h[n])
+            h[n] = static_cast<float>(v);
     };
     std::vector<float> depth(g.size());
     for (std::size_t j = 0; j < g.nlat; ++j) {
         for (std::size_t i = 0; i < g.nlon; ++i)
             depth[j * g.nlon + i] = static_cast<float>(-bathy.elevation_m(g.lon(i), g.lat(j)));
-        if (j % 256 == 0) report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat), "size field");
+        if (j % 256 == 0)
+            report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat),
+                   "size field");
     }
     for (std::size_t n = 0; n < g.size(); ++n) {
         const double dn = depth[n];
-        if (std::isnan(dn)) continue;
-        if (o.wavelength > 0) lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
+        if (std::isnan(dn))
+            continue;
+        if (o.wavelength > 0)
+            lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
         if (o.slope > 0) {
             // Central differences of the floored depth (one-sided at edges and no-data).
             auto floored = [&](std::size_t m) {
@@ -181,9 +204,12 @@ void lower_by_depth(const detail::BackgroundGrid& g, const Raster& bathy, const 
                 double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
                 double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
                 double here = std::max(dn, min_depth_m);
-                if (!std::isnan(lo) && !std::isnan(hi)) return (hi - lo) / (2 * step);
-                if (!std::isnan(hi)) return (hi - here) / step;
-                if (!std::isnan(lo)) return (here - lo) / step;
+                if (!std::isnan(lo) && !std::isnan(hi))
+                    return (hi - lo) / (2 * step);
+                if (!std::isnan(hi))
+                    return (hi - here) / step;
+                if (!std::isnan(lo))
+                    return (here - lo) / step;
                 return 0.0;
             };
             std::size_t r[2], c[2];
@@ -198,28 +224,32 @@ void lower_by_depth(const detail::BackgroundGrid& g, const Raster& bathy, const 
 
 } // namespace
 
-SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boundary* coast,
-                           const Progress& progress, std::size_t max_nodes, const std::function<void()>& before_grid) {
+SizeField build_size_field(const MeshOptions &o, const Raster *bathy, const Boundary *coast,
+                           const Progress &progress, std::size_t max_nodes,
+                           const std::function<void()> &before_grid) {
     validate(o);
-    if (!(o.hmax_km > 0)) throw UsageError(option("hmax_km") + " must be a positive length, e.g. 100km");
+    if (!(o.hmax_km > 0))
+        throw UsageError(option("hmax_km") + " must be a positive length, e.g. 100km");
     if ((o.wavelength > 0 || o.slope > 0) && !bathy)
-        throw UsageError(option(o.wavelength > 0 ? "wavelength" : "slope") + " needs a bathymetry raster: give " +
-                         option("bathy"));
+        throw UsageError(option(o.wavelength > 0 ? "wavelength" : "slope") +
+                         " needs a bathymetry raster: give " + option("bathy"));
     if (o.coast_size_km > 0 && !coast)
         throw UsageError(option("coast_size_km") + " needs the coastline: give " + option("coast"));
     const double hmax = o.hmax_km;
     const double hfloor = size_floor_km(o);
     if (o.coast_size_km > 0 && o.coast_size_km > hmax)
-        throw UsageError(option("coast_size_km") + " (" + km(o.coast_size_km) + ") must not be larger than " +
-                         option("hmax_km") + " (" + km(hmax) + ")");
+        throw UsageError(option("coast_size_km") + " (" + km(o.coast_size_km) +
+                         ") must not be larger than " + option("hmax_km") + " (" + km(hmax) + ")");
 
     // The background grid, made when the first component that is on asks for it: a field no
     // component asked for is uniform, so a component cannot be on and left out.
     std::optional<detail::BackgroundGrid> grid;
     std::vector<float> h;
-    auto background = [&]() -> const detail::BackgroundGrid& {
-        if (grid) return *grid;
-        if (before_grid) before_grid();
+    auto background = [&]() -> const detail::BackgroundGrid & {
+        if (grid)
+            return *grid;
+        if (before_grid)
+            before_grid();
         report(progress, 0.0, "size field");
         grid = detail::make_background_grid(o, hfloor, max_nodes);
         h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
@@ -227,59 +257,76 @@ SizeField build_size_field(const MeshOptions& o, const Raster* bathy, const Boun
         return *grid;
     };
     auto lower = [&](std::size_t n, double v) {
-        if (v < h[n]) h[n] = static_cast<float>(v);
+        if (v < h[n])
+            h[n] = static_cast<float>(v);
     };
 
     // Distance to the coast.
     if (o.coast_size_km > 0) {
-        const detail::BackgroundGrid& g = background();
+        const detail::BackgroundGrid &g = background();
         if (coast && !coast->empty()) {
             const double reach = o.coast_rate > 0 ? (hmax - o.coast_size_km) / o.coast_rate : inf;
             std::vector<float> d = detail::coast_distance_km(
-                g, *coast, std::min(reach * 1.01 + 2 * g.dy_km, pi * earth_radius_km), sub_progress(progress, 0.05, 0.35));
+                g, *coast, std::min(reach * 1.01 + 2 * g.dy_km, pi * earth_radius_km),
+                sub_progress(progress, 0.05, 0.35));
             for (std::size_t n = 0; n < g.size(); ++n)
-                if (std::isfinite(d[n])) lower(n, o.coast_size_km + o.coast_rate * d[n]);
+                if (std::isfinite(d[n]))
+                    lower(n, o.coast_size_km + o.coast_rate * d[n]);
         }
     }
-    if (grid) report(progress, 0.35, "size field");
+    if (grid)
+        report(progress, 0.35, "size field");
 
     // Wavelength and slope, from the depth on the grid.
-    if (o.wavelength > 0 || o.slope > 0) lower_by_depth(background(), *bathy, o, h, progress);
-    if (grid) report(progress, 0.55, "size field");
+    if (o.wavelength > 0 || o.slope > 0)
+        lower_by_depth(background(), *bathy, o, h, progress);
+    if (grid)
+        report(progress, 0.55, "size field");
 
-    if (!o.size_regions.empty()) detail::apply_size_regions(background(), o.size_regions, o.size_regions_layer, h);
-    if (!grid) return SizeField::uniform(std::max(o.hmax_km, o.hmin_km));
+    if (!o.size_regions.empty())
+        detail::apply_size_regions(background(), o.size_regions, o.size_regions_layer, h);
+    if (!grid)
+        return SizeField::uniform(std::max(o.hmax_km, o.hmin_km));
     report(progress, 0.6, "size field");
 
-    const detail::BackgroundGrid& g = *grid;
-    for (float& v : h) v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
-    const detail::PoleSizes poles = detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
+    const detail::BackgroundGrid &g = *grid;
+    for (float &v : h)
+        v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
+    const detail::PoleSizes poles =
+        detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
     report(progress, 1.0, "size field");
-    return SizeField(Raster(g.lon0, g.lat0, g.dlon, g.dlat, g.nlon, g.nlat, std::move(h)), poles.south, poles.north);
+    return SizeField(Raster(g.lon0, g.lat0, g.dlon, g.dlat, g.nlon, g.nlat, std::move(h)),
+                     poles.south, poles.north);
 }
 
 SizeFn uniform_size(double h_km) {
-    if (!(std::isfinite(h_km) && h_km > 0)) throw UsageError("uniform size: h must be a positive length in km");
-    return [h_km](const Vec3&) { return h_km; };
+    if (!(std::isfinite(h_km) && h_km > 0))
+        throw UsageError("uniform size: h must be a positive length in km");
+    return [h_km](const Vec3 &) { return h_km; };
 }
 
-SizeFn gulf_stream_size(Vec3 centre, double h_near_km, double h_far_km, double radius_km, double ramp_km) {
+SizeFn gulf_stream_size(Vec3 centre, double h_near_km, double h_far_km, double radius_km,
+                        double ramp_km) {
     if (!(h_near_km > 0 && h_far_km > 0 && std::isfinite(h_near_km) && std::isfinite(h_far_km)))
         throw UsageError("gulf_stream_size: sizes must be positive lengths in km");
-    if (!(radius_km >= 0 && ramp_km >= 0)) throw UsageError("gulf_stream_size: radius and ramp must be >= 0 km");
+    if (!(radius_km >= 0 && ramp_km >= 0))
+        throw UsageError("gulf_stream_size: radius and ramp must be >= 0 km");
     const Vec3 c = normalized(centre);
-    return [=](const Vec3& p) {
+    return [=](const Vec3 &p) {
         const double d = arc_km(c, p);
-        if (d <= radius_km) return h_near_km;
-        if (d >= radius_km + ramp_km) return h_far_km;
+        if (d <= radius_km)
+            return h_near_km;
+        if (d >= radius_km + ramp_km)
+            return h_far_km;
         return h_near_km + (h_far_km - h_near_km) * (d - radius_km) / ramp_km;
     };
 }
 
 SizeFn latitude_size(double h_equator_km, double h_pole_km) {
-    if (!(h_equator_km > 0 && h_pole_km > 0 && std::isfinite(h_equator_km) && std::isfinite(h_pole_km)))
+    if (!(h_equator_km > 0 && h_pole_km > 0 && std::isfinite(h_equator_km) &&
+          std::isfinite(h_pole_km)))
         throw UsageError("latitude_size: sizes must be positive lengths in km");
-    return [=](const Vec3& p) {
+    return [=](const Vec3 &p) {
         const double s = std::min(1.0, std::abs(p.z) / norm(p));
         return h_equator_km + (h_pole_km - h_equator_km) * s;
     };

@@ -5,17 +5,29 @@
 
 namespace globemesh {
 
-void sincosd(double deg, double& s, double& c) {
+void sincosd(double deg, double &s, double &c) {
     // Reduce to [-45, 45] around a multiple of 90 so that quadrant values are exact.
     double r = std::remainder(deg, 360.0);
     double q = std::round(r / 90.0);
     double t = (r - 90.0 * q) * deg_to_rad;
     double st = std::sin(t), ct = std::cos(t);
     switch (static_cast<int>(q) & 3) {
-    case 0: s = st; c = ct; break;
-    case 1: s = ct; c = -st; break;
-    case 2: s = -st; c = -ct; break;
-    default: s = -ct; c = st; break;
+    case 0:
+        s = st;
+        c = ct;
+        break;
+    case 1:
+        s = ct;
+        c = -st;
+        break;
+    case 2:
+        s = -st;
+        c = -ct;
+        break;
+    default:
+        s = -ct;
+        c = st;
+        break;
     }
     s += 0.0; // turn -0 into +0
     c += 0.0;
@@ -28,31 +40,38 @@ Vec3 lonlat_to_vec(double lon_deg, double lat_deg) {
     return {clat * clon, clat * slon, slat};
 }
 
-LonLat vec_to_lonlat(const Vec3& v) {
+LonLat vec_to_lonlat(const Vec3 &v) {
     double h = std::hypot(v.x, v.y);
     double lat = std::atan2(v.z, h) * rad_to_deg;
     double lon = h == 0 ? 0.0 : std::atan2(v.y, v.x) * rad_to_deg;
-    if (lon >= 180.0) lon -= 360.0;
+    if (lon >= 180.0)
+        lon -= 360.0;
     return {lon, lat};
 }
 
-double arc_angle(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
+double arc_angle(const Vec3 &a, const Vec3 &b) {
+    return std::atan2(norm(cross(a, b)), dot(a, b));
+}
 
-Vec3 arc_midpoint(const Vec3& a, const Vec3& b) { return normalized(a + b); }
+Vec3 arc_midpoint(const Vec3 &a, const Vec3 &b) {
+    return normalized(a + b);
+}
 
-double arc_distance(const Vec3& a, const Vec3& b, const Vec3& p) {
+double arc_distance(const Vec3 &a, const Vec3 &b, const Vec3 &p) {
     Vec3 n = cross(a, b);
     double ln = norm(n);
     if (ln > 1e-15) {
         n = (1.0 / ln) * n;
-        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0) return std::asin(std::min(1.0, std::abs(dot(n, p))));
+        if (dot(cross(a, p), n) >= 0 && dot(cross(p, b), n) >= 0)
+            return std::asin(std::min(1.0, std::abs(dot(n, p))));
     }
     return std::min(arc_angle(a, p), arc_angle(p, b));
 }
 
-Vec3 arc_interpolate(const Vec3& a, const Vec3& b, double t) {
+Vec3 arc_interpolate(const Vec3 &a, const Vec3 &b, double t) {
     double w = arc_angle(a, b);
-    if (w < 1e-9) return normalized((1.0 - t) * a + t * b);
+    if (w < 1e-9)
+        return normalized((1.0 - t) * a + t * b);
     double s = std::sin(w);
     return normalized((std::sin((1.0 - t) * w) / s) * a + (std::sin(t * w) / s) * b);
 }
@@ -70,14 +89,14 @@ double diff_of_products(double a, double d, double b, double c) {
 
 // p x q, each component accurate to a few ulps of itself: the direction of the arc between
 // nearly antipodal (or nearly equal) points survives.
-Vec3 accurate_cross(const Vec3& p, const Vec3& q) {
+Vec3 accurate_cross(const Vec3 &p, const Vec3 &q) {
     return {diff_of_products(p.y, q.z, p.z, q.y), diff_of_products(p.z, q.x, p.x, q.z),
             diff_of_products(p.x, q.y, p.y, q.x)};
 }
 
 } // namespace
 
-double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+double spherical_triangle_area(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const double det = dot(a, cross(b, c));
     const double den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
     // det^2 + den^2 = 2 (1 + a.b)(1 + b.c)(1 + c.a): both vanish when two vertices are nearly
@@ -88,7 +107,7 @@ double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
     // direction of their arc), unsigned (each angle in [0, pi], so an angle near pi has no sign
     // to lose), with the sign of the exact orientation.
     if (det * det + den * den < 1e-6) {
-        auto angle = [](const Vec3& p, const Vec3& q, const Vec3& r) { // angle at p, q to r
+        auto angle = [](const Vec3 &p, const Vec3 &q, const Vec3 &r) { // angle at p, q to r
             const Vec3 u = accurate_cross(p, q), v = accurate_cross(p, r);
             return std::atan2(norm(cross(u, v)), dot(u, v));
         };
@@ -102,7 +121,8 @@ double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
     // a closed hull of points near one great circle still add up to 0.
     if (std::fabs(det) < 1e-14) {
         const int s = predicates::orient(a, b, c);
-        if ((s > 0 && area < 0) || (s < 0 && area > 0)) area = -area;
+        if ((s > 0 && area < 0) || (s < 0 && area > 0))
+            area = -area;
     }
     return area;
 }
@@ -111,10 +131,11 @@ double spherical_triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 namespace globemesh {
 
-double turn_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
+double turn_angle(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const Vec3 n1 = cross(a, b), n2 = cross(b, c);
     const double l1 = norm(n1), l2 = norm(n2);
-    if (l1 == 0 || l2 == 0) return 0;
+    if (l1 == 0 || l2 == 0)
+        return 0;
     return std::acos(std::clamp(dot(n1, n2) / (l1 * l2), -1.0, 1.0));
 }
 

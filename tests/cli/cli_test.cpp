@@ -27,10 +27,10 @@
 
 namespace fs = std::filesystem;
 using globemesh::test::fixture;
-using globemesh::test::TempDir;
 using globemesh::test::regex_match;
 using globemesh::test::regex_replace;
 using globemesh::test::regex_search;
+using globemesh::test::TempDir;
 
 namespace {
 
@@ -48,24 +48,38 @@ struct RefusingLibrary {
             ++calls;
             throw std::logic_error("the library was reached");
         };
-        l.mesh_ocean = [refuse](auto&&...) -> globemesh::OceanMesh { refuse(); return {}; };
-        l.triangulate_file = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
+        l.mesh_ocean = [refuse](auto &&...) -> globemesh::OceanMesh {
+            refuse();
+            return {};
+        };
+        l.triangulate_file = [refuse](auto &&...) -> globemesh::Mesh {
+            refuse();
+            return {};
+        };
         l.writers = globemesh::writers();
-        for (auto& w : l.writers) w.write = [refuse](auto&&...) { refuse(); };
-        l.read_ugrid = [refuse](auto&&...) -> globemesh::Mesh { refuse(); return {}; };
-        l.compute_stats = [refuse](auto&&...) -> globemesh::MeshStats { refuse(); return {}; };
+        for (auto &w : l.writers)
+            w.write = [refuse](auto &&...) { refuse(); };
+        l.read_ugrid = [refuse](auto &&...) -> globemesh::Mesh {
+            refuse();
+            return {};
+        };
+        l.compute_stats = [refuse](auto &&...) -> globemesh::MeshStats {
+            refuse();
+            return {};
+        };
         return l;
     }
 };
 
 /// The row of `lib`'s writers table named `name` (the test replaces its write function).
-globemesh::Writer& row(globemesh::CliLibrary& lib, const std::string& name) {
-    for (auto& w : lib.writers)
-        if (w.name == name) return w;
+globemesh::Writer &row(globemesh::CliLibrary &lib, const std::string &name) {
+    for (auto &w : lib.writers)
+        if (w.name == name)
+            return w;
     throw std::logic_error("no writer " + name);
 }
 
-Result run(const std::vector<std::string>& args, const globemesh::CliLibrary& lib) {
+Result run(const std::vector<std::string> &args, const globemesh::CliLibrary &lib) {
     std::ostringstream out, err;
     Result r;
     r.status = globemesh::run_cli(args, out, err, lib);
@@ -75,35 +89,36 @@ Result run(const std::vector<std::string>& args, const globemesh::CliLibrary& li
 }
 
 /// Runs with a refusing library and checks the library was not reached.
-Result run_refused(const std::vector<std::string>& args) {
+Result run_refused(const std::vector<std::string> &args) {
     RefusingLibrary refusing;
     Result r = run(args, refusing.lib());
     EXPECT_EQ(refusing.calls, 0) << "the library was called for a command that should stop first";
     return r;
 }
 
-int count_lines(const std::string& s) {
+int count_lines(const std::string &s) {
     int n = 0;
-    for (char c : s) n += c == '\n';
+    for (char c : s)
+        n += c == '\n';
     return n;
 }
 
 const std::string coast = fixture("coast/ne_110m_land.gpkg").string();
 
-std::string read_text(const fs::path& p) {
+std::string read_text(const fs::path &p) {
     std::ifstream f(p);
     std::stringstream s;
     s << f.rdbuf();
     return s.str();
 }
 
-void write_text(const fs::path& p, const std::string& text) {
+void write_text(const fs::path &p, const std::string &text) {
     std::ofstream f(p);
     f << text;
 }
 
 /// Field by field comparison of two MeshOptions.
-void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshOptions& b) {
+void expect_same_options(const globemesh::MeshOptions &a, const globemesh::MeshOptions &b) {
     EXPECT_EQ(a.coast, b.coast);
     EXPECT_EQ(a.coast_layer, b.coast_layer);
     EXPECT_EQ(a.coast_where, b.coast_where);
@@ -138,7 +153,7 @@ void expect_same_options(const globemesh::MeshOptions& a, const globemesh::MeshO
     EXPECT_EQ(a.seed, b.seed);
 }
 
-void expect_same_cli(const globemesh::CliOptions& a, const globemesh::CliOptions& b) {
+void expect_same_cli(const globemesh::CliOptions &a, const globemesh::CliOptions &b) {
     expect_same_options(a.mesh, b.mesh);
     EXPECT_EQ(a.output, b.output);
     EXPECT_EQ(a.gpkg, b.gpkg);
@@ -153,19 +168,77 @@ void expect_same_cli(const globemesh::CliOptions& a, const globemesh::CliOptions
 }
 
 /// Every option except the program-only ones, each away from its default, in all unit styles.
-std::vector<std::string> every_option(const std::string& out_dir) {
-    return {"--coast", coast, "--coast-layer", "ne_110m_land", "--coast-where", "featurecla = 'Land'",
-            "--coast-srs", "EPSG:4326", "--region", "-20.5,40,10.25,65", "--min-island-area", "2.5e7m2",
-            "--keep-inland-seas", "--keep-straits", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
-            "--bathy-band", "1", "--bathy-srs", "EPSG:4326", "--depth-positive", "--bathy-fill", "0.05km",
-            "--min-depth", "-2.5m", "--hmax", "45000m",
-            "--hmin", "3.3", "--coast-size", "7.5km", "--coast-rate", "0.123456789012345",
-            "--wavelength", "30", "--wave-period", "745.2min", "--slope", "12",
-            "--size-regions", out_dir + "/sizes.gpkg", "--size-regions-layer", "fine", "--grade", "0.2",
-            "--max-nodes", "123456", "--max-memory", "3.5GiB", "--smooth", "7", "--inlet-width", "0.25", "--seed", "42",
-            "-o", out_dir + "/o.nc", "--gpkg", out_dir + "/o.gpkg", "--preview", out_dir + "/o.png",
-            "--format", "classic", "--timings", out_dir + "/t.json", "--report", out_dir + "/r.json",
-            "--overwrite", "--verbose", "--check"};
+std::vector<std::string> every_option(const std::string &out_dir) {
+    return {"--coast",
+            coast,
+            "--coast-layer",
+            "ne_110m_land",
+            "--coast-where",
+            "featurecla = 'Land'",
+            "--coast-srs",
+            "EPSG:4326",
+            "--region",
+            "-20.5,40,10.25,65",
+            "--min-island-area",
+            "2.5e7m2",
+            "--keep-inland-seas",
+            "--keep-straits",
+            "--bathy",
+            fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+            "--bathy-band",
+            "1",
+            "--bathy-srs",
+            "EPSG:4326",
+            "--depth-positive",
+            "--bathy-fill",
+            "0.05km",
+            "--min-depth",
+            "-2.5m",
+            "--hmax",
+            "45000m",
+            "--hmin",
+            "3.3",
+            "--coast-size",
+            "7.5km",
+            "--coast-rate",
+            "0.123456789012345",
+            "--wavelength",
+            "30",
+            "--wave-period",
+            "745.2min",
+            "--slope",
+            "12",
+            "--size-regions",
+            out_dir + "/sizes.gpkg",
+            "--size-regions-layer",
+            "fine",
+            "--grade",
+            "0.2",
+            "--max-nodes",
+            "123456",
+            "--max-memory",
+            "3.5GiB",
+            "--smooth",
+            "7",
+            "--inlet-width",
+            "0.25",
+            "--seed",
+            "42",
+            "-o",
+            out_dir + "/o.nc",
+            "--gpkg",
+            out_dir + "/o.gpkg",
+            "--preview",
+            out_dir + "/o.png",
+            "--format",
+            "classic",
+            "--timings",
+            out_dir + "/t.json",
+            "--report",
+            out_dir + "/r.json",
+            "--overwrite",
+            "--verbose",
+            "--check"};
 }
 
 /// Three quarters of the physical memory (the documented default of --max-memory), from sysconf.
@@ -219,8 +292,9 @@ TEST(Cli, unknown_units_and_non_numbers_are_usage_errors) {
 }
 
 TEST(Cli, memory_sizes_take_si_and_binary_units_and_auto) {
-    auto bytes = [](const std::string& text) {
-        return globemesh::parse_mesh_args(std::vector<std::string>{"--max-memory", text}).mesh.max_memory_bytes;
+    auto bytes = [](const std::string &text) {
+        return globemesh::parse_mesh_args(std::vector<std::string>{"--max-memory", text})
+            .mesh.max_memory_bytes;
     };
     EXPECT_EQ(bytes("4GB"), 4'000'000'000u);
     EXPECT_EQ(bytes("500MB"), 500'000'000u);
@@ -230,7 +304,7 @@ TEST(Cli, memory_sizes_take_si_and_binary_units_and_auto) {
     EXPECT_EQ(bytes("123456"), 123456u); // bare: bytes
     EXPECT_EQ(bytes("0"), 0u);           // no limit
     EXPECT_EQ(bytes("auto"), three_quarters_of_ram());
-    for (const char* bad : {"4G", "4gb", "-1GB", "lots", "1e30TB"})
+    for (const char *bad : {"4G", "4gb", "-1GB", "lots", "1e30TB"})
         EXPECT_THROW(bytes(bad), globemesh::UsageError) << bad;
     // The configuration says what was asked ("auto", "4GB"), not this machine's memory.
     const Result asked = run_refused({"mesh", "--max-memory", "4GB", "--print-config"});
@@ -261,8 +335,11 @@ TEST(Cli, flags_with_units_fill_the_fields_in_their_units) {
 }
 
 TEST(Cli, max_nodes_takes_a_whole_number_also_as_a_power_of_ten) {
-    EXPECT_EQ(globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "2e7"}).mesh.max_nodes, 20'000'000u);
-    EXPECT_EQ(globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "123456789"}).mesh.max_nodes,
+    EXPECT_EQ(
+        globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "2e7"}).mesh.max_nodes,
+        20'000'000u);
+    EXPECT_EQ(globemesh::parse_mesh_args(std::vector<std::string>{"--max-nodes", "123456789"})
+                  .mesh.max_nodes,
               123'456'789u);
 }
 
@@ -292,17 +369,26 @@ TEST(Cli, region_takes_four_comma_separated_degrees) {
 TEST(Cli, config_file_equals_the_same_options_given_as_flags) {
     TempDir dir;
     const fs::path toml = dir / "run.toml";
-    write_text(toml, "# a run\ncoast = \"" + coast + "\"\nhmax = \"45km\"\nhmin = \"2000m\"\n"
-                     "region = [-20, 40, 10, 65]\nkeep-inland-seas = true\nmin-island-area = \"1e8m2\"\n"
-                     "seed = 9\nformat = \"classic\"\noutput = \"x.nc\"\n");
+    write_text(
+        toml,
+        "# a run\ncoast = \"" + coast +
+            "\"\nhmax = \"45km\"\nhmin = \"2000m\"\n"
+            "region = [-20, 40, 10, 65]\nkeep-inland-seas = true\nmin-island-area = \"1e8m2\"\n"
+            "seed = 9\nformat = \"classic\"\noutput = \"x.nc\"\n");
     const fs::path ini = dir / "run.ini";
-    write_text(ini, "; a run\ncoast=" + coast + "\nhmax=45km\nhmin=2000m\nregion=-20,40,10,65\n"
-                    "keep-inland-seas=true\nmin-island-area=1e8m2\nseed=9\nformat=classic\noutput=x.nc\n");
-    const auto flags = globemesh::parse_mesh_args(std::vector<std::string>{
-        "--coast", coast, "--hmax", "45", "--hmin", "2", "--region", "-20,40,10,65", "--keep-inland-seas",
-        "--min-island-area", "100", "--seed", "9", "--format", "classic", "-o", "x.nc"});
-    const auto from_toml = globemesh::parse_mesh_args(std::vector<std::string>{"--config", toml.string()});
-    const auto from_ini = globemesh::parse_mesh_args(std::vector<std::string>{"--config", ini.string()});
+    write_text(
+        ini,
+        "; a run\ncoast=" + coast +
+            "\nhmax=45km\nhmin=2000m\nregion=-20,40,10,65\n"
+            "keep-inland-seas=true\nmin-island-area=1e8m2\nseed=9\nformat=classic\noutput=x.nc\n");
+    const auto flags = globemesh::parse_mesh_args(
+        std::vector<std::string>{"--coast", coast, "--hmax", "45", "--hmin", "2", "--region",
+                                 "-20,40,10,65", "--keep-inland-seas", "--min-island-area", "100",
+                                 "--seed", "9", "--format", "classic", "-o", "x.nc"});
+    const auto from_toml =
+        globemesh::parse_mesh_args(std::vector<std::string>{"--config", toml.string()});
+    const auto from_ini =
+        globemesh::parse_mesh_args(std::vector<std::string>{"--config", ini.string()});
     expect_same_cli(from_toml, flags);
     expect_same_cli(from_ini, flags);
     EXPECT_DOUBLE_EQ(flags.mesh.hmax_km, 45.0); // and not the default
@@ -328,7 +414,8 @@ TEST(Cli, print_config_round_trips_every_option) {
     ASSERT_EQ(printed.status, 0) << printed.err;
     EXPECT_EQ(printed.err, "");
     write_text(dir / "printed.toml", printed.out);
-    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "printed.toml").string()});
+    const auto again = globemesh::parse_mesh_args(
+        std::vector<std::string>{"--config", (dir / "printed.toml").string()});
     expect_same_cli(again, original);
     // Not vacuous: the values differ from the defaults.
     EXPECT_DOUBLE_EQ(original.mesh.hmax_km, 45.0);
@@ -348,15 +435,17 @@ TEST(Cli, print_config_round_trips_every_option) {
 // --region-layer goes with --region-file, which every_option leaves out (it has --region).
 TEST(Cli, print_config_round_trips_the_region_layer) {
     TempDir dir;
-    const std::vector<std::string> args = {"--coast", coast, "--region-file", (dir / "r.gpkg").string(),
-                                           "--region-layer", "north sea", "-o", (dir / "o.nc").string()};
+    const std::vector<std::string> args = {
+        "--coast",   coast, "--region-file",        (dir / "r.gpkg").string(), "--region-layer",
+        "north sea", "-o",  (dir / "o.nc").string()};
     std::vector<std::string> print_args = args;
     print_args.insert(print_args.begin(), "mesh");
     print_args.push_back("--print-config");
     const Result printed = run_refused(print_args);
     ASSERT_EQ(printed.status, 0) << printed.err;
     write_text(dir / "printed.toml", printed.out);
-    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "printed.toml").string()});
+    const auto again = globemesh::parse_mesh_args(
+        std::vector<std::string>{"--config", (dir / "printed.toml").string()});
     EXPECT_EQ(again.mesh.region_layer, "north sea");
     expect_same_cli(again, globemesh::parse_mesh_args(args));
 }
@@ -367,7 +456,8 @@ TEST(Cli, print_config_of_defaults_reads_back_as_the_defaults) {
     ASSERT_EQ(printed.status, 0) << printed.err;
     write_text(dir / "d.toml", printed.out);
     SCOPED_TRACE(printed.out);
-    const auto again = globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "d.toml").string()});
+    const auto again =
+        globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "d.toml").string()});
     globemesh::CliOptions defaults;
     defaults.mesh = cli_default_options();
     expect_same_cli(again, defaults);
@@ -387,15 +477,20 @@ TEST(Cli, an_unknown_config_key_is_a_usage_error_naming_it) {
     struct Case {
         std::string text, named;
     };
-    for (const Case& c : {Case{"hmax = \"50km\"\nhmaxx = \"20km\"\n", "unknown key hmaxx; the keys are the long option names"},
-                          Case{"coast_layer = \"land\"\n", "unknown key coast_layer; did you mean coast-layer?"},
-                          Case{"[mesh]\nhmax = \"50km\"\n", "[mesh]: the file takes no sections"}}) {
+    for (const Case &c :
+         {Case{"hmax = \"50km\"\nhmaxx = \"20km\"\n",
+               "unknown key hmaxx; the keys are the long option names"},
+          Case{"coast_layer = \"land\"\n", "unknown key coast_layer; did you mean coast-layer?"},
+          Case{"[mesh]\nhmax = \"50km\"\n", "[mesh]: the file takes no sections"}}) {
         SCOPED_TRACE(c.text);
         write_text(dir / "run.toml", c.text);
-        const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--config", (dir / "run.toml").string()});
+        const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(),
+                                      "--config", (dir / "run.toml").string()});
         EXPECT_EQ(r.status, 2);
         EXPECT_EQ(count_lines(r.err), 1) << r.err;
-        EXPECT_NE(r.err.find("--config " + (dir / "run.toml").string() + ": " + c.named), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("--config " + (dir / "run.toml").string() + ": " + c.named),
+                  std::string::npos)
+            << r.err;
     }
 }
 
@@ -412,7 +507,7 @@ struct ErrorCase {
 class CliErrors : public ::testing::TestWithParam<ErrorCase> {};
 
 TEST_P(CliErrors, one_line_naming_the_culprit_and_no_output) {
-    const ErrorCase& c = GetParam();
+    const ErrorCase &c = GetParam();
     TempDir dir;
     std::vector<std::string> args;
     for (auto a : c.args) {
@@ -426,11 +521,13 @@ TEST_P(CliErrors, one_line_naming_the_culprit_and_no_output) {
     EXPECT_EQ(r.status, c.status) << r.err;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
     EXPECT_EQ(r.err.rfind("globemesh: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(c.named), std::string::npos) << "expected '" << c.named << "' in: " << r.err;
+    EXPECT_NE(r.err.find(c.named), std::string::npos)
+        << "expected '" << c.named << "' in: " << r.err;
     EXPECT_EQ(r.out, "");
     // Nothing but the files the test made is in the folder, and they are untouched.
     std::vector<std::string> files;
-    for (const auto& e : fs::directory_iterator(dir.path())) files.push_back(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir.path()))
+        files.push_back(e.path().filename().string());
     std::sort(files.begin(), files.end());
     EXPECT_EQ(files, (std::vector<std::string>{"existing.gpkg", "existing.nc"}));
     EXPECT_EQ(read_text(dir / "existing.nc"), "keep me");
@@ -440,79 +537,236 @@ TEST_P(CliErrors, one_line_naming_the_culprit_and_no_output) {
 INSTANTIATE_TEST_SUITE_P(
     Cli, CliErrors,
     ::testing::Values(
-        ErrorCase{"unknown_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "20parsecs"}, 2, "--hmax"},
-        ErrorCase{"not_a_number", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmin", "small"}, 2, "--hmin"},
-        ErrorCase{"negative_size", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "-5km"}, 2, "--hmax"},
-        ErrorCase{"hmax_beyond_an_eighth_of_the_globe", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5001km"}, 2, "--hmax must be at most 5000km"},
-        ErrorCase{"max_nodes_not_whole", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--max-nodes", "2.5e-1"}, 2, "--max-nodes: '2.5e-1' is not a whole number"},
-        ErrorCase{"gpkg_to_a_device", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "/dev/null", "--overwrite"}, 1, "/dev/null is not a regular file"},
-        ErrorCase{"hmin_above_hmax", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20.5km"}, 2, "--hmin (20.5km) must not be larger than --hmax (10km)"},
-        ErrorCase{"area_with_length_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"}, 2, "--min-island-area"},
-        ErrorCase{"bad_region", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"}, 2, "--region"},
-        ErrorCase{"region_layer_without_region_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region-layer", "a"}, 2, "--region-layer names a layer of --region-file, which is not given"},
-        ErrorCase{"size_regions_layer_without_file", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--size-regions-layer", "a"}, 2, "--size-regions-layer"},
-        ErrorCase{"min_depth_without_bathy", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5"}, 2, "--min-depth needs --bathy"},
-        ErrorCase{"min_depth_with_area_unit", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5m2"}, 2, "--min-depth"},
-        ErrorCase{"bad_format", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"}, 2, "--format"},
-        ErrorCase{"bad_bathy_srs", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--bathy-srs", "EPSG:99999"}, 2, "--bathy-srs: 'EPSG:99999' is not a CRS"},
-        ErrorCase{"unknown_option", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmaxx", "3"}, 2, "unknown option --hmaxx for globemesh mesh"},
+        ErrorCase{"unknown_unit",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "20parsecs"},
+                  2,
+                  "--hmax"},
+        ErrorCase{"not_a_number",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmin", "small"},
+                  2,
+                  "--hmin"},
+        ErrorCase{"negative_size",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "-5km"},
+                  2,
+                  "--hmax"},
+        ErrorCase{"hmax_beyond_an_eighth_of_the_globe",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5001km"},
+                  2,
+                  "--hmax must be at most 5000km"},
+        ErrorCase{"max_nodes_not_whole",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--max-nodes", "2.5e-1"},
+                  2,
+                  "--max-nodes: '2.5e-1' is not a whole number"},
+        ErrorCase{
+            "gpkg_to_a_device",
+            {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "/dev/null", "--overwrite"},
+            1,
+            "/dev/null is not a regular file"},
+        ErrorCase{
+            "hmin_above_hmax",
+            {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "10km", "--hmin", "20.5km"},
+            2,
+            "--hmin (20.5km) must not be larger than --hmax (10km)"},
+        ErrorCase{"area_with_length_unit",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-island-area", "10km"},
+                  2,
+                  "--min-island-area"},
+        ErrorCase{"bad_region",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "0,80,10,60"},
+                  2,
+                  "--region"},
+        ErrorCase{"region_layer_without_region_file",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region-layer", "a"},
+                  2,
+                  "--region-layer names a layer of --region-file, which is not given"},
+        ErrorCase{"size_regions_layer_without_file",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--size-regions-layer", "a"},
+                  2,
+                  "--size-regions-layer"},
+        ErrorCase{"min_depth_without_bathy",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5"},
+                  2,
+                  "--min-depth needs --bathy"},
+        ErrorCase{"min_depth_with_area_unit",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--min-depth", "5m2"},
+                  2,
+                  "--min-depth"},
+        ErrorCase{"bad_format",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--format", "hdf5"},
+                  2,
+                  "--format"},
+        ErrorCase{"bad_bathy_srs",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--bathy-srs", "EPSG:99999"},
+                  2,
+                  "--bathy-srs: 'EPSG:99999' is not a CRS"},
+        ErrorCase{"unknown_option",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmaxx", "3"},
+                  2,
+                  "unknown option --hmaxx for globemesh mesh"},
         // CLI11's own words ("At Most 1 required but received 2") in globemesh's.
-        ErrorCase{"option_given_twice", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5km", "--hmax", "6km"}, 2, "--hmax is given 2 times; give it once"},
-        ErrorCase{"option_without_value", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax"}, 2, "--hmax needs a value (LENGTH)"},
-        ErrorCase{"region_of_three_numbers", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3"}, 2, "--region needs 4 values, got 3"},
-        ErrorCase{"coast_without_its_option", {"mesh", coast, "-o", "{dir}/o.nc"}, 2, "unexpected argument " + coast + " for globemesh mesh (a value goes after"},
-        ErrorCase{"info_unknown_option", {"info", "-q", "{dir}/existing.nc"}, 2, "unknown option -q for globemesh info"},
-        ErrorCase{"quiet_and_verbose", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "-q", "-v"}, 2, "--quiet"},
+        ErrorCase{"option_given_twice",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax", "5km", "--hmax", "6km"},
+                  2,
+                  "--hmax is given 2 times; give it once"},
+        ErrorCase{"option_without_value",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax"},
+                  2,
+                  "--hmax needs a value (LENGTH)"},
+        ErrorCase{"region_of_three_numbers",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3"},
+                  2,
+                  "--region needs 4 values, got 3"},
+        ErrorCase{"coast_without_its_option",
+                  {"mesh", coast, "-o", "{dir}/o.nc"},
+                  2,
+                  "unexpected argument " + coast + " for globemesh mesh (a value goes after"},
+        ErrorCase{"info_unknown_option",
+                  {"info", "-q", "{dir}/existing.nc"},
+                  2,
+                  "unknown option -q for globemesh info"},
+        ErrorCase{"quiet_and_verbose",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "-q", "-v"},
+                  2,
+                  "--quiet"},
         ErrorCase{"no_coast", {"mesh", "-o", "{dir}/o.nc"}, 2, "--coast"},
         ErrorCase{"no_output", {"mesh", "--coast", coast}, 2, "--output"},
-        ErrorCase{"same_output_twice", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/o.nc"}, 2, "--gpkg"},
+        ErrorCase{"same_output_twice",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/o.nc"},
+                  2,
+                  "--gpkg"},
         ErrorCase{"unknown_subcommand", {"meshh", "--coast", coast}, 2, "meshh"},
         ErrorCase{"no_subcommand", {}, 2, "subcommand"},
         ErrorCase{"unknown_top_level_option", {"--hmax", "3"}, 2, "--hmax"},
         ErrorCase{"help_on_unknown_subcommand", {"help", "bogus"}, 2, "bogus"},
-        ErrorCase{"missing_coast_file", {"mesh", "--coast", "{dir}/nowhere.gpkg", "-o", "{dir}/o.nc"}, 1, "nowhere.gpkg"},
-        ErrorCase{"missing_bathy_file", {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"}, 1, "nodem.tif"},
-        ErrorCase{"output_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"}, 1, "--output"},
-        ErrorCase{"existing_output", {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"}, 1, "--overwrite"},
+        ErrorCase{"missing_coast_file",
+                  {"mesh", "--coast", "{dir}/nowhere.gpkg", "-o", "{dir}/o.nc"},
+                  1,
+                  "nowhere.gpkg"},
+        ErrorCase{"missing_bathy_file",
+                  {"mesh", "--coast", coast, "--bathy", "{dir}/nodem.tif", "-o", "{dir}/o.nc"},
+                  1,
+                  "nodem.tif"},
+        ErrorCase{"output_in_missing_folder",
+                  {"mesh", "--coast", coast, "-o", "{dir}/no/such/o.nc"},
+                  1,
+                  "--output"},
+        ErrorCase{"existing_output",
+                  {"mesh", "--coast", coast, "-o", "{dir}/existing.nc"},
+                  1,
+                  "--overwrite"},
         // Said at once, not "exists; use --overwrite" first (which would not help).
-        ErrorCase{"output_is_a_folder", {"mesh", "--coast", coast, "-o", "{dir}"}, 1, "is a folder; give a file name"},
-        ErrorCase{"gpkg_is_a_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/"}, 1, "/ is a folder; give a file name"},
+        ErrorCase{"output_is_a_folder",
+                  {"mesh", "--coast", coast, "-o", "{dir}"},
+                  1,
+                  "is a folder; give a file name"},
+        ErrorCase{"gpkg_is_a_folder",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/"},
+                  1,
+                  "/ is a folder; give a file name"},
         // An output that is an input, even with --overwrite (and through another spelling):
         // the run would replace the data it reads.
-        ErrorCase{"gpkg_is_the_coast", {"mesh", "--coast", "{dir}/existing.gpkg", "-o", "{dir}/o.nc", "--gpkg", "{dir}/./existing.gpkg", "--overwrite"}, 2, "existing.gpkg is the --coast file: the run would replace what it reads"},
-        ErrorCase{"output_is_the_bathy", {"mesh", "--coast", coast, "--bathy", "{dir}/existing.nc", "-o", "{dir}/existing.nc", "--overwrite"}, 2, "--output"},
-        ErrorCase{"triangulate_output_is_its_points", {"triangulate", "{dir}/existing.nc", "-o", "{dir}/existing.nc", "--overwrite"}, 2, "is the POINTS file"},
-        ErrorCase{"existing_gpkg_output", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.gpkg"}, 1, "existing.gpkg"},
+        ErrorCase{"gpkg_is_the_coast",
+                  {"mesh", "--coast", "{dir}/existing.gpkg", "-o", "{dir}/o.nc", "--gpkg",
+                   "{dir}/./existing.gpkg", "--overwrite"},
+                  2,
+                  "existing.gpkg is the --coast file: the run would replace what it reads"},
+        ErrorCase{"output_is_the_bathy",
+                  {"mesh", "--coast", coast, "--bathy", "{dir}/existing.nc", "-o",
+                   "{dir}/existing.nc", "--overwrite"},
+                  2,
+                  "--output"},
+        ErrorCase{"triangulate_output_is_its_points",
+                  {"triangulate", "{dir}/existing.nc", "-o", "{dir}/existing.nc", "--overwrite"},
+                  2,
+                  "is the POINTS file"},
+        ErrorCase{"existing_gpkg_output",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/existing.gpkg"},
+                  1,
+                  "existing.gpkg"},
         // An output named for another output's format: NetCDF under a GeoPackage's name would
         // not open in QGIS as one.
-        ErrorCase{"output_named_json", {"mesh", "--coast", coast, "-o", "{dir}/o.json"}, 2, "use --report "},
-        ErrorCase{"gpkg_named_nc", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/p.NC"}, 2, "--output"},
-        ErrorCase{"preview_named_json", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.json"}, 2, "--preview"},
-        ErrorCase{"report_named_png", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/r.png"}, 2, "--report"},
+        ErrorCase{"output_named_json",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.json"},
+                  2,
+                  "use --report "},
+        ErrorCase{"gpkg_named_nc",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "{dir}/p.NC"},
+                  2,
+                  "--output"},
+        ErrorCase{"preview_named_json",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.json"},
+                  2,
+                  "--preview"},
+        ErrorCase{"report_named_png",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/r.png"},
+                  2,
+                  "--report"},
         // -o's format is its extension's or -f's: an unknown one lists the formats, and their
         // creation options are checked, all before the run.
-        ErrorCase{"output_of_unknown_extension", {"mesh", "--coast", coast, "-o", "{dir}/o.dat"}, 2, "no format has the extension .dat; the formats are UGRID (.nc, .nc4), GPKG (.gpkg), PNG (.png)"},
-        ErrorCase{"triangulate_output_of_unknown_extension", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/t.dat"}, 2, "the formats are UGRID"},
-        ErrorCase{"unknown_output_format", {"mesh", "--coast", coast, "-f", "NOSUCH", "-o", "{dir}/o.dat"}, 2, "-f/--output-format NOSUCH: no such format; the formats are UGRID"},
-        ErrorCase{"output_format_for_two_outputs", {"mesh", "--coast", coast, "-f", "GPKG", "-o", "{dir}/a", "-o", "{dir}/b"}, 2, "-f/--output-format names the format of one -o file"},
-        ErrorCase{"same_file_by_output_and_gpkg", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--gpkg", "{dir}/o.gpkg"}, 2, "name the same file"},
-        ErrorCase{"creation_option_no_output_takes", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--co", "FORMAT=NC2"}, 2, "--co FORMAT=NC2: none of the outputs takes the creation option FORMAT (UGRID"},
-        ErrorCase{"creation_option_value", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "format=nc3"}, 2, "UGRID creation option FORMAT=nc3: use FORMAT=NC4 or NC2"},
-        ErrorCase{"creation_option_without_value", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "FORMAT"}, 2, "--co FORMAT: give KEY=VALUE"},
-        ErrorCase{"classic_without_a_ugrid_output", {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--format", "classic"}, 2, "--format classic (FORMAT=NC2): none of the outputs"},
-        ErrorCase{"report_in_missing_folder", {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/x/r.json"}, 1, "--report"},
-        ErrorCase{"triangulate_missing_points", {"triangulate", "{dir}/none.csv", "-o", "{dir}/t.nc"}, 1, "none.csv"},
-        ErrorCase{"triangulate_without_output", {"triangulate", fixture("points/stations.csv").string()}, 2, "--output"},
-        ErrorCase{"triangulate_existing_output", {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/existing.nc"}, 1, "existing.nc"},
+        ErrorCase{"output_of_unknown_extension",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.dat"},
+                  2,
+                  "no format has the extension .dat; the formats are UGRID (.nc, .nc4), GPKG "
+                  "(.gpkg), PNG (.png)"},
+        ErrorCase{"triangulate_output_of_unknown_extension",
+                  {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/t.dat"},
+                  2,
+                  "the formats are UGRID"},
+        ErrorCase{"unknown_output_format",
+                  {"mesh", "--coast", coast, "-f", "NOSUCH", "-o", "{dir}/o.dat"},
+                  2,
+                  "-f/--output-format NOSUCH: no such format; the formats are UGRID"},
+        ErrorCase{"output_format_for_two_outputs",
+                  {"mesh", "--coast", coast, "-f", "GPKG", "-o", "{dir}/a", "-o", "{dir}/b"},
+                  2,
+                  "-f/--output-format names the format of one -o file"},
+        ErrorCase{"same_file_by_output_and_gpkg",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--gpkg", "{dir}/o.gpkg"},
+                  2,
+                  "name the same file"},
+        ErrorCase{"creation_option_no_output_takes",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--co", "FORMAT=NC2"},
+                  2,
+                  "--co FORMAT=NC2: none of the outputs takes the creation option FORMAT (UGRID"},
+        ErrorCase{"creation_option_value",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "format=nc3"},
+                  2,
+                  "UGRID creation option FORMAT=nc3: use FORMAT=NC4 or NC2"},
+        ErrorCase{"creation_option_without_value",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--co", "FORMAT"},
+                  2,
+                  "--co FORMAT: give KEY=VALUE"},
+        ErrorCase{"classic_without_a_ugrid_output",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.gpkg", "--format", "classic"},
+                  2,
+                  "--format classic (FORMAT=NC2): none of the outputs"},
+        ErrorCase{"report_in_missing_folder",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/x/r.json"},
+                  1,
+                  "--report"},
+        ErrorCase{"triangulate_missing_points",
+                  {"triangulate", "{dir}/none.csv", "-o", "{dir}/t.nc"},
+                  1,
+                  "none.csv"},
+        ErrorCase{"triangulate_without_output",
+                  {"triangulate", fixture("points/stations.csv").string()},
+                  2,
+                  "--output"},
+        ErrorCase{
+            "triangulate_existing_output",
+            {"triangulate", fixture("points/stations.csv").string(), "-o", "{dir}/existing.nc"},
+            1,
+            "existing.nc"},
         ErrorCase{"info_missing_file", {"info", "{dir}/none.nc"}, 1, "none.nc"},
         ErrorCase{"info_without_file", {"info"}, 2, "MESH"}),
-    [](const auto& info) { return info.param.name; });
+    [](const auto &info) { return info.param.name; });
 
 TEST(Cli, the_config_file_is_not_an_output) {
     TempDir dir;
     write_text(dir / "run.toml", "hmax = \"500km\"\n");
-    const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--config",
-                                  (dir / "run.toml").string(), "--report", (dir / "run.toml").string(), "--overwrite"});
+    const Result r = run_refused({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(),
+                                  "--config", (dir / "run.toml").string(), "--report",
+                                  (dir / "run.toml").string(), "--overwrite"});
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("run.toml is the --config file"), std::string::npos) << r.err;
     EXPECT_EQ(read_text(dir / "run.toml"), "hmax = \"500km\"\n");
@@ -529,24 +783,30 @@ TEST(Cli, the_folder_named_in_a_missing_folder_error_is_the_real_one) {
 
 TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
     TempDir dir;
-    const std::vector<std::string> args = {"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "-q"};
+    const std::vector<std::string> args = {"mesh", "--coast", coast, "-o", (dir / "o.nc").string(),
+                                           "-q"};
     auto with_error = [&](std::function<void()> thrower) {
         RefusingLibrary refusing;
         auto lib = refusing.lib();
-        lib.mesh_ocean = [thrower](auto&&...) -> globemesh::OceanMesh { thrower(); return {}; };
+        lib.mesh_ocean = [thrower](auto &&...) -> globemesh::OceanMesh {
+            thrower();
+            return {};
+        };
         return run(args, lib);
     };
-    const Result usage = with_error([] { throw globemesh::UsageError("--coast-layer: no layer 'x'"); });
+    const Result usage =
+        with_error([] { throw globemesh::UsageError("--coast-layer: no layer 'x'"); });
     EXPECT_EQ(usage.status, 2);
     EXPECT_EQ(usage.err, "globemesh: --coast-layer: no layer 'x'\n");
-    const Result data = with_error([] { throw globemesh::DataError("--region: no ocean in the region"); });
+    const Result data =
+        with_error([] { throw globemesh::DataError("--region: no ocean in the region"); });
     EXPECT_EQ(data.status, 1);
     EXPECT_EQ(data.err, "globemesh: --region: no ocean in the region\n");
     // The library names options by their MeshOptions field; the command line says its flags.
     using globemesh::option;
     const Result named = with_error([] {
-        throw globemesh::DataError("at " + option("hmax_km") + " 1 km: raise " + option("hmax_km") + " or " +
-                                   option("max_memory_bytes"));
+        throw globemesh::DataError("at " + option("hmax_km") + " 1 km: raise " + option("hmax_km") +
+                                   " or " + option("max_memory_bytes"));
     });
     EXPECT_EQ(named.status, 1);
     EXPECT_EQ(named.err, "globemesh: at --hmax 1 km: raise --hmax or --max-memory\n");
@@ -555,7 +815,8 @@ TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
     const Result internal = with_error([] { throw std::out_of_range("vector::at\nsecond line"); });
     EXPECT_EQ(internal.status, 1);
     EXPECT_EQ(internal.err, "globemesh: internal error: vector::at; second line\n");
-    for (const auto* r : {&usage, &data, &io, &internal}) EXPECT_EQ(r->out, "");
+    for (const auto *r : {&usage, &data, &io, &internal})
+        EXPECT_EQ(r->out, "");
     EXPECT_FALSE(fs::exists(dir / "o.nc"));
 }
 
@@ -565,9 +826,10 @@ TEST(Cli, errors_of_the_library_map_to_their_exit_status) {
 // Ctrl-C, `kill` (and a batch scheduler's time limit: SIGTERM) and a closed terminal (SIGHUP)
 // each cancel the run the same way; any but Ctrl-C is named in the message.
 TEST(Cli, each_cancelling_signal_stops_the_run_leaves_no_output_and_restores_the_handler) {
-    for (const auto& [signal, message] : {std::pair{SIGINT, "globemesh: cancelled, no output written\n"},
-                                          std::pair{SIGTERM, "globemesh: cancelled by SIGTERM, no output written\n"},
-                                          std::pair{SIGHUP, "globemesh: cancelled by SIGHUP, no output written\n"}}) {
+    for (const auto &[signal, message] :
+         {std::pair{SIGINT, "globemesh: cancelled, no output written\n"},
+          std::pair{SIGTERM, "globemesh: cancelled by SIGTERM, no output written\n"},
+          std::pair{SIGHUP, "globemesh: cancelled by SIGHUP, no output written\n"}}) {
         SCOPED_TRACE(signal);
         TempDir dir;
         struct sigaction before {};
@@ -575,8 +837,9 @@ TEST(Cli, each_cancelling_signal_stops_the_run_leaves_no_output_and_restores_the
         RefusingLibrary refusing;
         auto lib = refusing.lib();
         bool handled_inside = false;
-        lib.mesh_ocean = [&, signal = signal](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                                              globemesh::StageTimings*) -> globemesh::OceanMesh {
+        lib.mesh_ocean = [&, signal = signal](const globemesh::MeshOptions &,
+                                              const globemesh::Progress &progress,
+                                              globemesh::StageTimings *) -> globemesh::OceanMesh {
             globemesh::report(progress, 0.1, "refine");
             std::raise(signal); // our handler only records it, so the test process survives
             handled_inside = true;
@@ -601,35 +864,41 @@ TEST(Cli, each_cancelling_signal_stops_the_run_leaves_no_output_and_restores_the
 
 TEST(Cli, progress_is_gdal_style_on_stderr_and_silent_with_quiet) {
     TempDir dir;
-    auto lib_with_progress = [](RefusingLibrary& refusing) {
+    auto lib_with_progress = [](RefusingLibrary &refusing) {
         auto lib = refusing.lib();
-        lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                            globemesh::StageTimings*) -> globemesh::OceanMesh {
-            for (int i = 0; i <= 10; ++i) globemesh::report(progress, i / 10.0, i < 5 ? "size_field" : "refine");
+        lib.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &progress,
+                            globemesh::StageTimings *) -> globemesh::OceanMesh {
+            for (int i = 0; i <= 10; ++i)
+                globemesh::report(progress, i / 10.0, i < 5 ? "size_field" : "refine");
             throw globemesh::DataError("stop here");
         };
         return lib;
     };
     RefusingLibrary r1, r2, r3;
     // The mesh has a share of the run's one progress line; the line ends before the error.
-    const Result normal = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib_with_progress(r1));
-    EXPECT_TRUE(regex_search(normal.err, R"(^0(\.\.\.[1-9]0)+\.*\nglobemesh: stop here\n$)")) << normal.err;
+    const Result normal =
+        run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, lib_with_progress(r1));
+    EXPECT_TRUE(regex_search(normal.err, R"(^0(\.\.\.[1-9]0)+\.*\nglobemesh: stop here\n$)"))
+        << normal.err;
     EXPECT_EQ(normal.err.find("100"), std::string::npos) << normal.err;
     EXPECT_EQ(normal.out, "");
     // An error before the run made any progress stands alone: no "0" before it.
     RefusingLibrary r0;
     auto early = r0.lib();
-    early.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& progress,
-                          globemesh::StageTimings*) -> globemesh::OceanMesh {
+    early.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &progress,
+                          globemesh::StageTimings *) -> globemesh::OceanMesh {
         globemesh::report(progress, 0.0, "reading coast");
         globemesh::report(progress, 0.001, "reading coast");
         throw globemesh::DataError("--coast x.gpkg: several layers");
     };
     EXPECT_EQ(run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string()}, early).err,
               "globemesh: --coast x.gpkg: several layers\n");
-    const Result quiet = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--quiet"}, lib_with_progress(r2));
+    const Result quiet = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--quiet"},
+                             lib_with_progress(r2));
     EXPECT_EQ(quiet.err, "globemesh: stop here\n");
-    const Result verbose = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--verbose"}, lib_with_progress(r3));
+    const Result verbose =
+        run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--verbose"},
+            lib_with_progress(r3));
     EXPECT_NE(verbose.err.find("[size_field] 0"), std::string::npos) << verbose.err;
     EXPECT_NE(verbose.err.find("\n[refine] "), std::string::npos) << verbose.err;
 }
@@ -641,34 +910,42 @@ TEST(Cli, the_mesh_and_its_outputs_share_one_progress_line) {
     RefusingLibrary refusing;
     auto lib = refusing.lib();
     std::vector<std::string> order;
-    auto report_all = [&](const globemesh::Progress& p, const char* stage) {
+    auto report_all = [&](const globemesh::Progress &p, const char *stage) {
         order.push_back(stage);
-        for (int i = 0; i <= 20; ++i) globemesh::report(p, i / 20.0, stage);
+        for (int i = 0; i <= 20; ++i)
+            globemesh::report(p, i / 20.0, stage);
     };
-    lib.mesh_ocean = [&](const globemesh::MeshOptions&, const globemesh::Progress& p, globemesh::StageTimings*) {
+    lib.mesh_ocean = [&](const globemesh::MeshOptions &, const globemesh::Progress &p,
+                         globemesh::StageTimings *) {
         report_all(p, "refine");
         return globemesh::OceanMesh{};
     };
-    lib.compute_stats = [](const globemesh::Mesh&) { return globemesh::MeshStats{}; };
-    row(lib, "UGRID").write = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::WriteOptions& o) {
+    lib.compute_stats = [](const globemesh::Mesh &) { return globemesh::MeshStats{}; };
+    row(lib, "UGRID").write = [&](const globemesh::Mesh &, const fs::path &path,
+                                  const globemesh::WriteOptions &o) {
         report_all(o.progress, "write_ugrid");
         write_text(path, "ugrid");
     };
-    row(lib, "GPKG").write = [&](const globemesh::Mesh&, const fs::path& path, const globemesh::WriteOptions& o) {
+    row(lib, "GPKG").write = [&](const globemesh::Mesh &, const fs::path &path,
+                                 const globemesh::WriteOptions &o) {
         report_all(o.progress, "write_gpkg");
         write_text(path, "gpkg");
     };
-    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg", (dir / "o.gpkg").string()}, lib);
+    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg",
+                          (dir / "o.gpkg").string()},
+                         lib);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(order, (std::vector<std::string>{"refine", "write_ugrid", "write_gpkg"}));
     EXPECT_EQ(r.err, "0...10...20...30...40...50...60...70...80...90...100 - done.\n");
     // Cancelled from the terminal while an output is written: no file left.
-    row(lib, "UGRID").write = [&](const globemesh::Mesh&, const fs::path&, const globemesh::WriteOptions& o) {
+    row(lib, "UGRID").write = [&](const globemesh::Mesh &, const fs::path &,
+                                  const globemesh::WriteOptions &o) {
         globemesh::report(o.progress, 0.1, "write_ugrid");
         std::raise(SIGINT);
         globemesh::report(o.progress, 0.2, "write_ugrid"); // throws Cancelled
     };
-    const Result cancelled = run({"mesh", "--coast", coast, "-o", (dir / "p.nc").string(), "-q"}, lib);
+    const Result cancelled =
+        run({"mesh", "--coast", coast, "-o", (dir / "p.nc").string(), "-q"}, lib);
     EXPECT_EQ(cancelled.status, 1);
     EXPECT_EQ(cancelled.err, "globemesh: cancelled, no output written\n");
     EXPECT_FALSE(fs::exists(dir / "p.nc"));
@@ -682,7 +959,8 @@ TEST(Cli, version_prints_the_project_version) {
     const std::string cmake = read_text(fs::path(GLOBEMESH_FIXTURES_DIR) / ".." / "CMakeLists.txt");
     std::vector<std::string> m;
     ASSERT_TRUE(regex_search(cmake, R"(project\(globemesh VERSION ([0-9.]+))", &m));
-    for (const auto& args : {std::vector<std::string>{"--version"}, std::vector<std::string>{"mesh", "--version"}}) {
+    for (const auto &args :
+         {std::vector<std::string>{"--version"}, std::vector<std::string>{"mesh", "--version"}}) {
         const Result r = run_refused(args);
         EXPECT_EQ(r.status, 0);
         EXPECT_EQ(r.out.rfind("globemesh " + m[1] + " ", 0), 0u) << r.out;
@@ -692,12 +970,14 @@ TEST(Cli, version_prints_the_project_version) {
 }
 
 TEST(Cli, help_lists_the_subcommands) {
-    for (const auto& args : {std::vector<std::string>{"help"}, std::vector<std::string>{"--help"}}) {
+    for (const auto &args :
+         {std::vector<std::string>{"help"}, std::vector<std::string>{"--help"}}) {
         const Result r = run_refused(args);
         EXPECT_EQ(r.status, 0);
         EXPECT_EQ(r.err, "");
-        for (const char* sub : {"mesh", "triangulate", "info", "help"})
-            EXPECT_TRUE(regex_search(r.out, std::string("\\n\\s+") + sub + "\\s")) << sub << " in\n" << r.out;
+        for (const char *sub : {"mesh", "triangulate", "info", "help"})
+            EXPECT_TRUE(regex_search(r.out, std::string("\\n\\s+") + sub + "\\s")) << sub << " in\n"
+                                                                                   << r.out;
     }
 }
 
@@ -722,8 +1002,9 @@ namespace {
 
 const fs::path man_page = fs::path(GLOBEMESH_FIXTURES_DIR) / ".." / "man" / "globemesh.1";
 
-std::set<std::string> long_options(const std::string& text) {
-    const auto names = globemesh::test::regex_all(text, R"((^|[^A-Za-z0-9-])(--[a-z][a-z0-9-]*))", 2);
+std::set<std::string> long_options(const std::string &text) {
+    const auto names =
+        globemesh::test::regex_all(text, R"((^|[^A-Za-z0-9-])(--[a-z][a-z0-9-]*))", 2);
     return {names.begin(), names.end()};
 }
 
@@ -737,21 +1018,24 @@ std::string man_text_plain() {
 TEST(Cli, every_option_in_help_is_in_the_man_page) {
     ASSERT_TRUE(fs::exists(man_page)) << man_page;
     const auto documented = long_options(man_text_plain());
-    for (const char* sub : {"mesh", "triangulate", "info"}) {
+    for (const char *sub : {"mesh", "triangulate", "info"}) {
         const Result r = run_refused({sub, "--help"});
         const auto listed = long_options(r.out);
         EXPECT_GT(listed.size(), 2u) << sub;
-        for (const auto& o : listed) EXPECT_TRUE(documented.count(o)) << o << " of " << sub << " is not in " << man_page;
+        for (const auto &o : listed)
+            EXPECT_TRUE(documented.count(o)) << o << " of " << sub << " is not in " << man_page;
     }
 }
 
 TEST(Cli, every_option_in_the_man_page_is_in_help) {
     std::set<std::string> listed = long_options(run_refused({"--help"}).out);
-    for (const char* sub : {"mesh", "triangulate", "info"})
-        for (const auto& o : long_options(run_refused({sub, "--help"}).out)) listed.insert(o);
+    for (const char *sub : {"mesh", "triangulate", "info"})
+        for (const auto &o : long_options(run_refused({sub, "--help"}).out))
+            listed.insert(o);
     const auto documented = long_options(man_text_plain());
     EXPECT_GT(documented.size(), 30u);
-    for (const auto& o : documented) EXPECT_TRUE(listed.count(o)) << o << " is in the man page but in no --help";
+    for (const auto &o : documented)
+        EXPECT_TRUE(listed.count(o)) << o << " is in the man page but in no --help";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -760,7 +1044,8 @@ TEST(Cli, every_option_in_the_man_page_is_in_help) {
 TEST(Cli, check_mesh_accepts_the_octahedron_and_names_broken_faces) {
     globemesh::Mesh m;
     m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4},
+               {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
     EXPECT_TRUE(globemesh::check_mesh(m).empty());
     auto flipped = m;
     std::swap(flipped.faces[2][0], flipped.faces[2][1]);
@@ -771,10 +1056,12 @@ TEST(Cli, check_mesh_accepts_the_octahedron_and_names_broken_faces) {
     open.faces.resize(4);
     EXPECT_FALSE(globemesh::check_mesh(open).empty());
     for (int k = 0; k < 4; ++k)
-        open.boundary.push_back({globemesh::NodeIndex((k + 1) % 4), globemesh::NodeIndex(k), globemesh::EdgeTag::open});
+        open.boundary.push_back(
+            {globemesh::NodeIndex((k + 1) % 4), globemesh::NodeIndex(k), globemesh::EdgeTag::open});
     // Faces (k, k+1, 4) leave the edge k -> k+1 open; the list above has them reversed.
     EXPECT_FALSE(globemesh::check_mesh(open).empty());
-    for (auto& e : open.boundary) std::swap(e.a, e.b);
+    for (auto &e : open.boundary)
+        std::swap(e.a, e.b);
     EXPECT_TRUE(globemesh::check_mesh(open).empty());
 }
 
@@ -790,39 +1077,47 @@ struct FakeRun {
     bool fail_gpkg = false;
     globemesh::CliLibrary lib() {
         globemesh::CliLibrary l;
-        l.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress& p,
-                          globemesh::StageTimings* t) {
+        l.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &p,
+                          globemesh::StageTimings *t) {
             globemesh::report(p, 0.5, "refine");
             t->add("read_coast", 0.5);
             t->add("refine", 1.25);
             t->add("improve", 0.25);
             globemesh::Mesh m;
             m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-            m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+            m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4},
+                       {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
             globemesh::OceanMesh run;
             run.mesh = std::move(m);
             return run;
         };
-        l.triangulate_file = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
+        l.triangulate_file = [](auto &&...) -> globemesh::Mesh {
+            throw std::logic_error("not here");
+        };
         l.writers = globemesh::writers();
-        row(l, "UGRID").write = [this](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+        row(l, "UGRID").write = [this](const globemesh::Mesh &m, const fs::path &p,
+                                       const globemesh::WriteOptions &o) {
             EXPECT_NE(o.history.find("globemesh mesh --coast"), std::string::npos) << o.history;
-            for (const auto& [key, value] : m.attributes)
-                if (key == "globemesh_configuration") configuration = value;
+            for (const auto &[key, value] : m.attributes)
+                if (key == "globemesh_configuration")
+                    configuration = value;
             globemesh::OutputFile::write_text(p, "nc", o.overwrite); // as the real writers do
             written.push_back(p.string());
         };
-        row(l, "GPKG").write = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::WriteOptions& o) {
-            if (fail_gpkg) throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
+        row(l, "GPKG").write = [this](const globemesh::Mesh &, const fs::path &p,
+                                      const globemesh::WriteOptions &o) {
+            if (fail_gpkg)
+                throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
             globemesh::OutputFile::write_text(p, "gpkg", o.overwrite);
             written.push_back(p.string());
         };
-        row(l, "PNG").write = [this](const globemesh::Mesh&, const fs::path& p, const globemesh::WriteOptions& o) {
+        row(l, "PNG").write = [this](const globemesh::Mesh &, const fs::path &p,
+                                     const globemesh::WriteOptions &o) {
             globemesh::OutputFile::write_text(p, "png", o.overwrite);
             written.push_back(p.string());
         };
-        l.read_ugrid = [](auto&&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
-        l.compute_stats = [](const globemesh::Mesh& m) {
+        l.read_ugrid = [](auto &&...) -> globemesh::Mesh { throw std::logic_error("not here"); };
+        l.compute_stats = [](const globemesh::Mesh &m) {
             globemesh::MeshStats s;
             s.nodes = m.nodes.size();
             s.faces = m.faces.size();
@@ -838,24 +1133,28 @@ struct FakeRun {
 TEST(Cli, timings_and_report_hold_the_stages_and_the_mesh_total) {
     TempDir dir;
     FakeRun fake;
-    const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--timings",
-                          (dir / "t.json").string(), "--report", (dir / "r.json").string(), "-q", "--check"},
-                         fake.lib());
+    const Result r =
+        run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--timings",
+             (dir / "t.json").string(), "--report", (dir / "r.json").string(), "-q", "--check"},
+            fake.lib());
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.err, "");
     const std::string t = read_text(dir / "t.json");
     // Issue 4's "mesh" key: every stage but the reading, 1.25 + 0.25 s here.
     EXPECT_TRUE(regex_search(
-        t, R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write": [0-9.e-]+\}\}\n$)"))
+        t,
+        R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write": [0-9.e-]+\}\}\n$)"))
         << t;
     const std::string report = read_text(dir / "r.json");
     EXPECT_NE(report.find("\"nodes\": 6"), std::string::npos) << report;
-    EXPECT_NE(report.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos) << report;
+    EXPECT_NE(report.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos)
+        << report;
     EXPECT_TRUE(regex_search(report, R"("peak_memory_bytes": [1-9][0-9]{5,})")) << report;
     EXPECT_TRUE(regex_search(r.out, R"(nodes\s+6\n)")) << r.out;
     EXPECT_TRUE(regex_search(r.out, R"(faces\s+8\n)")) << r.out;
     std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir.path())) names.insert(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir.path()))
+        names.insert(e.path().filename().string());
     EXPECT_EQ(names, (std::set<std::string>{"o.nc", "t.json", "r.json"})); // no temporary files
 }
 
@@ -869,7 +1168,7 @@ TEST(Cli, a_failing_writer_leaves_none_of_the_run_outputs) {
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.err, "globemesh: cannot write " + (dir / "o.gpkg").string() + " (disk full)\n");
     EXPECT_EQ(fake.written, std::vector<std::string>{(dir / "o.nc").string()}); // it was written...
-    EXPECT_TRUE(fs::is_empty(dir.path()));                                       // ...and removed
+    EXPECT_TRUE(fs::is_empty(dir.path()));                                      // ...and removed
     EXPECT_EQ(r.out, "");
 }
 
@@ -884,33 +1183,48 @@ TEST(Cli, the_outputs_appear_together_at_the_end_of_the_run) {
     const auto preview = row(lib, "PNG").write;
     auto names = [&] {
         std::set<std::string> n;
-        for (const auto& e : fs::directory_iterator(dir.path())) n.insert(e.path().filename().string());
+        for (const auto &e : fs::directory_iterator(dir.path()))
+            n.insert(e.path().filename().string());
         return n;
     };
-    row(lib, "GPKG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+    row(lib, "GPKG").write = [&](const globemesh::Mesh &m, const fs::path &p,
+                                 const globemesh::WriteOptions &o) {
         seen.push_back(names());
         gpkg(m, p, o);
     };
-    row(lib, "PNG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+    row(lib, "PNG").write = [&](const globemesh::Mesh &m, const fs::path &p,
+                                const globemesh::WriteOptions &o) {
         seen.push_back(names());
         preview(m, p, o);
     };
-    const std::vector<std::string> args = {"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "--gpkg",
-                                           (dir / "o.gpkg").string(), "--preview", (dir / "o.png").string(),
-                                           "--report", (dir / "r.json").string(), "-q"};
+    const std::vector<std::string> args = {"mesh",
+                                           "--coast",
+                                           coast,
+                                           "-o",
+                                           (dir / "o.nc").string(),
+                                           "--gpkg",
+                                           (dir / "o.gpkg").string(),
+                                           "--preview",
+                                           (dir / "o.png").string(),
+                                           "--report",
+                                           (dir / "r.json").string(),
+                                           "-q"};
     const Result r = run(args, lib);
     ASSERT_EQ(r.status, 0) << r.err;
     ASSERT_EQ(seen.size(), 2u);
-    for (const auto& before : seen) {
+    for (const auto &before : seen) {
         EXPECT_EQ(before.count("o.nc"), 0u); // waiting under a hidden temporary name
         EXPECT_EQ(before.size(), &before == &seen[0] ? 1u : 2u);
-        for (const auto& name : before) EXPECT_EQ(name[0], '.') << name;
+        for (const auto &name : before)
+            EXPECT_EQ(name[0], '.') << name;
     }
     EXPECT_EQ(names(), (std::set<std::string>{"o.nc", "o.gpkg", "o.png", "r.json"}));
     EXPECT_EQ(read_text(dir / "o.png"), "png");
     // A file that appears under one of the names during the run stops it before any is placed.
-    for (const char* name : {"o.nc", "o.gpkg", "o.png", "r.json"}) fs::remove(dir / name);
-    row(lib, "PNG").write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+    for (const char *name : {"o.nc", "o.gpkg", "o.png", "r.json"})
+        fs::remove(dir / name);
+    row(lib, "PNG").write = [&](const globemesh::Mesh &m, const fs::path &p,
+                                const globemesh::WriteOptions &o) {
         write_text(dir / "o.gpkg", "someone else's");
         preview(m, p, o);
     };
@@ -937,31 +1251,45 @@ TEST(Cli, a_row_added_to_the_writers_table_is_an_output_format_of_the_command_li
     toy.report_key = "toy";
     toy.progress_weight = 2;
     toy.creation_options = {{"FLAVOUR", {"SWEET", "SOUR"}, "the taste"}};
-    toy.write = [&](const globemesh::Mesh& m, const fs::path& p, const globemesh::WriteOptions& o) {
+    toy.write = [&](const globemesh::Mesh &m, const fs::path &p, const globemesh::WriteOptions &o) {
         globemesh::report(o.progress, 0.5, "write_toy");
-        if (stop_halfway) throw globemesh::IoError("the toy stops here");
-        globemesh::OutputFile::write_text(p, std::to_string(m.faces.size()) + " faces\n", o.overwrite);
-        wrote.emplace_back(p.filename().string(), globemesh::creation_option(o.creation_options, "FLAVOUR", "-"));
+        if (stop_halfway)
+            throw globemesh::IoError("the toy stops here");
+        globemesh::OutputFile::write_text(p, std::to_string(m.faces.size()) + " faces\n",
+                                          o.overwrite);
+        wrote.emplace_back(p.filename().string(),
+                           globemesh::creation_option(o.creation_options, "FLAVOUR", "-"));
     };
     lib.writers.push_back(toy);
-    const std::string a = (dir / "a.nc").string(), b = (dir / "b.toy").string(), c = (dir / "c.dat").string(),
-                      report = (dir / "r.json").string();
-    const Result r = run({"mesh", "--coast", coast, "-o", a, "-o", b, "--co", "flavour=sour", "--report", report, "-q"}, lib);
+    const std::string a = (dir / "a.nc").string(), b = (dir / "b.toy").string(),
+                      c = (dir / "c.dat").string(), report = (dir / "r.json").string();
+    const Result r = run({"mesh", "--coast", coast, "-o", a, "-o", b, "--co", "flavour=sour",
+                          "--report", report, "-q"},
+                         lib);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(read_text(dir / "b.toy"), "8 faces\n");
-    EXPECT_NE(r.out.find("wrote             " + a + ", " + b + ", " + report + "\n"), std::string::npos) << r.out;
-    EXPECT_NE(read_text(report).find("\"outputs\": {\"netcdf\": \"" + a + "\", \"toy\": \"" + b + "\"}"), std::string::npos)
+    EXPECT_NE(r.out.find("wrote             " + a + ", " + b + ", " + report + "\n"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(
+        read_text(report).find("\"outputs\": {\"netcdf\": \"" + a + "\", \"toy\": \"" + b + "\"}"),
+        std::string::npos)
         << read_text(report);
     const Result f = run({"mesh", "--coast", coast, "-f", "toy", "-o", c, "-q"}, lib);
     ASSERT_EQ(f.status, 0) << f.err;
-    EXPECT_EQ(wrote, (std::vector<std::pair<std::string, std::string>>{{"b.toy", "SOUR"}, {"c.dat", "-"}}));
+    EXPECT_EQ(wrote, (std::vector<std::pair<std::string, std::string>>{{"b.toy", "SOUR"},
+                                                                       {"c.dat", "-"}}));
     EXPECT_EQ(fake.written, (std::vector<std::string>{a})); // UGRID for a.nc only
     // Its share of the line: the mesh 1, UGRID 1.5, the toy 2; half of the toy is at 7/9 of the
     // line, tick 31 of 40 ("70..."), where its error ends the line.
     stop_halfway = true;
-    const Result half = run({"mesh", "--coast", coast, "-o", (dir / "d.nc").string(), "-o", (dir / "d.toy").string()}, lib);
+    const Result half = run(
+        {"mesh", "--coast", coast, "-o", (dir / "d.nc").string(), "-o", (dir / "d.toy").string()},
+        lib);
     EXPECT_EQ(half.status, 1);
-    EXPECT_TRUE(regex_search(half.err, R"(^0\.\.\.10(\.\.\.[2-7]0)+\.\.\.\nglobemesh: the toy stops here\n$)")) << half.err;
+    EXPECT_TRUE(regex_search(
+        half.err, R"(^0\.\.\.10(\.\.\.[2-7]0)+\.\.\.\nglobemesh: the toy stops here\n$)"))
+        << half.err;
     EXPECT_FALSE(fs::exists(dir / "d.nc"));
     const Result help = run({"mesh", "--help"}, lib);
     EXPECT_NE(help.out.find(", TOY; default: from its extension"), std::string::npos) << help.out;
@@ -984,16 +1312,18 @@ TEST(Cli, an_error_after_a_signal_is_reported_as_the_cancellation) {
     TempDir dir;
     FakeRun fake;
     auto lib = fake.lib();
-    lib.mesh_ocean = [](const globemesh::MeshOptions&, const globemesh::Progress&,
-                        globemesh::StageTimings*) -> globemesh::OceanMesh {
+    lib.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &,
+                        globemesh::StageTimings *) -> globemesh::OceanMesh {
         std::raise(SIGTERM);
-        throw globemesh::DataError("coast: GEOS failed to dissolve the land polygons: Interrupted!");
+        throw globemesh::DataError(
+            "coast: GEOS failed to dissolve the land polygons: Interrupted!");
     };
     const Result r = run({"mesh", "--coast", coast, "-o", (dir / "o.nc").string(), "-q"}, lib);
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.err, "globemesh: cancelled by SIGTERM, no output written\n");
     // The next run in the process starts afresh: its own error is its own.
-    const Result next = run({"mesh", "--coast", coast, "-o", (dir / "x" / "o.nc").string(), "-q"}, lib);
+    const Result next =
+        run({"mesh", "--coast", coast, "-o", (dir / "x" / "o.nc").string(), "-q"}, lib);
     EXPECT_EQ(next.status, 1);
     EXPECT_NE(next.err.find("does not exist"), std::string::npos) << next.err;
     EXPECT_TRUE(fs::is_empty(dir.path()));
@@ -1002,15 +1332,17 @@ TEST(Cli, an_error_after_a_signal_is_reported_as_the_cancellation) {
 TEST(Cli, the_mesh_carries_a_configuration_that_remakes_the_run) {
     TempDir dir;
     FakeRun fake;
-    const std::vector<std::string> args = {"--coast", coast, "-o", (dir / "o.nc").string(), "--hmax", "3500m",
-                                           "--region", "170,-50,-170,-30", "--seed", "77", "-q"};
+    const std::vector<std::string> args = {"--coast", coast,   "-o",       (dir / "o.nc").string(),
+                                           "--hmax",  "3500m", "--region", "170,-50,-170,-30",
+                                           "--seed",  "77",    "-q"};
     std::vector<std::string> with_sub = args;
     with_sub.insert(with_sub.begin(), "mesh");
     const Result r = run(with_sub, fake.lib());
     ASSERT_EQ(r.status, 0) << r.err;
     ASSERT_FALSE(fake.configuration.empty());
     write_text(dir / "from_file.toml", fake.configuration);
-    expect_same_cli(globemesh::parse_mesh_args(std::vector<std::string>{"--config", (dir / "from_file.toml").string()}),
+    expect_same_cli(globemesh::parse_mesh_args(
+                        std::vector<std::string>{"--config", (dir / "from_file.toml").string()}),
                     globemesh::parse_mesh_args(args));
 }
 
@@ -1018,12 +1350,13 @@ TEST(Cli, info_reads_back_a_written_octahedron) {
     TempDir dir;
     globemesh::Mesh m;
     m.nodes = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}, {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
+    m.faces = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4},
+               {1, 0, 5}, {2, 1, 5}, {3, 2, 5}, {0, 3, 5}};
     globemesh::write_ugrid(m, dir / "octa.nc");
     RefusingLibrary refusing;
     auto lib = refusing.lib();
-    lib.read_ugrid = [](const fs::path& p) { return globemesh::read_ugrid(p); };
-    lib.compute_stats = [](const globemesh::Mesh& mesh) { return globemesh::compute_stats(mesh); };
+    lib.read_ugrid = [](const fs::path &p) { return globemesh::read_ugrid(p); };
+    lib.compute_stats = [](const globemesh::Mesh &mesh) { return globemesh::compute_stats(mesh); };
     const Result json = run({"info", (dir / "octa.nc").string(), "--json"}, lib);
     ASSERT_EQ(json.status, 0) << json.err;
     EXPECT_EQ(json.err, "");
@@ -1031,7 +1364,8 @@ TEST(Cli, info_reads_back_a_written_octahedron) {
     EXPECT_NE(json.out.find("\"nodes\": 6,"), std::string::npos) << json.out;
     EXPECT_NE(json.out.find("\"faces\": 8,"), std::string::npos) << json.out;
     EXPECT_NE(json.out.find("\"edges\": 12,"), std::string::npos) << json.out;
-    EXPECT_NE(json.out.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"histogram\": [0, 0, 0, 0, 0, 0, 0, 0, 0, 8]"), std::string::npos)
+        << json.out;
     std::vector<std::string> area;
     ASSERT_TRUE(regex_search(json.out, R"("area_km2": ([0-9.e+]+))", &area));
     const double r = globemesh::earth_radius_km;
@@ -1055,7 +1389,7 @@ namespace {
 
 /// A variable of a NetCDF file as doubles, read with netCDF-C; empty (and a test failure) when
 /// it is not there.
-std::vector<double> nc_doubles(const fs::path& file, const char* name) {
+std::vector<double> nc_doubles(const fs::path &file, const char *name) {
     int nc = -1, var = -1, ndims = 0, dim = -1;
     std::size_t n = 0;
     if (nc_open(file.c_str(), NC_NOWRITE, &nc) != NC_NOERR) {
@@ -1063,25 +1397,31 @@ std::vector<double> nc_doubles(const fs::path& file, const char* name) {
         return {};
     }
     std::vector<double> values;
-    if (nc_inq_varid(nc, name, &var) == NC_NOERR && nc_inq_varndims(nc, var, &ndims) == NC_NOERR && ndims == 1 &&
-        nc_inq_vardimid(nc, var, &dim) == NC_NOERR && nc_inq_dimlen(nc, dim, &n) == NC_NOERR) {
+    if (nc_inq_varid(nc, name, &var) == NC_NOERR && nc_inq_varndims(nc, var, &ndims) == NC_NOERR &&
+        ndims == 1 && nc_inq_vardimid(nc, var, &dim) == NC_NOERR &&
+        nc_inq_dimlen(nc, dim, &n) == NC_NOERR) {
         values.resize(n);
-        if (nc_get_var_double(nc, var, values.data()) != NC_NOERR) values.clear();
+        if (nc_get_var_double(nc, var, values.data()) != NC_NOERR)
+            values.clear();
     }
-    if (values.empty()) ADD_FAILURE() << "no 1-D variable " << name << " in " << file;
+    if (values.empty())
+        ADD_FAILURE() << "no 1-D variable " << name << " in " << file;
     nc_close(nc);
     return values;
 }
 
 /// A text attribute of a variable, read with netCDF-C ("" when missing).
-std::string nc_text(const fs::path& file, const char* var_name, const char* attribute) {
+std::string nc_text(const fs::path &file, const char *var_name, const char *attribute) {
     int nc = -1, var = -1;
     std::size_t n = 0;
     std::string text;
-    if (nc_open(file.c_str(), NC_NOWRITE, &nc) != NC_NOERR) return text;
-    if (nc_inq_varid(nc, var_name, &var) == NC_NOERR && nc_inq_attlen(nc, var, attribute, &n) == NC_NOERR) {
+    if (nc_open(file.c_str(), NC_NOWRITE, &nc) != NC_NOERR)
+        return text;
+    if (nc_inq_varid(nc, var_name, &var) == NC_NOERR &&
+        nc_inq_attlen(nc, var, attribute, &n) == NC_NOERR) {
         text.resize(n);
-        if (nc_get_att_text(nc, var, attribute, text.data()) != NC_NOERR) text.clear();
+        if (nc_get_att_text(nc, var, attribute, text.data()) != NC_NOERR)
+            text.clear();
     }
     nc_close(nc);
     return text;
@@ -1094,13 +1434,14 @@ struct ReportedDepth {
     std::string floor;
 };
 
-ReportedDepth reported_depth(const std::string& report) {
+ReportedDepth reported_depth(const std::string &report) {
     std::vector<std::string> g;
     ReportedDepth d;
-    if (!regex_search(report,
-                      R"re("depth": \{"nodes_above_sea_level": ([0-9]+), "min_sampled_depth_m": ([-0-9.e+]+|null), )re"
-                      R"re("min_depth_m": ([-0-9.e+]+|null), "nodes_raised_to_min_depth": ([0-9]+)\})re",
-                      &g)) {
+    if (!regex_search(
+            report,
+            R"re("depth": \{"nodes_above_sea_level": ([0-9]+), "min_sampled_depth_m": ([-0-9.e+]+|null), )re"
+            R"re("min_depth_m": ([-0-9.e+]+|null), "nodes_raised_to_min_depth": ([0-9]+)\})re",
+            &g)) {
         ADD_FAILURE() << "no depth object in the report:\n" << report;
         return d;
     }
@@ -1117,33 +1458,46 @@ ReportedDepth reported_depth(const std::string& report) {
 // warns without --min-depth, and with it raises exactly the nodes shallower than DEPTH.
 TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
     TempDir dir;
-    const std::vector<std::string> common = {
-        "mesh", "--coast", coast, "--coast-layer", "land", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(),
-        "--region", "-10,48,10,60", "--hmax", "30km"};
+    const std::vector<std::string> common = {"mesh",
+                                             "--coast",
+                                             coast,
+                                             "--coast-layer",
+                                             "land",
+                                             "--bathy",
+                                             fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+                                             "--region",
+                                             "-10,48,10,60",
+                                             "--hmax",
+                                             "30km"};
     auto with = [&](std::vector<std::string> extra) {
         std::vector<std::string> args = common;
         args.insert(args.end(), extra.begin(), extra.end());
         return run(args, globemesh::library_calls());
     };
-    const Result plain = with({"-o", (dir / "d0.nc").string(), "--report", (dir / "r0.json").string()});
+    const Result plain =
+        with({"-o", (dir / "d0.nc").string(), "--report", (dir / "r0.json").string()});
     ASSERT_EQ(plain.status, 0) << plain.err;
-    const Result floored = with({"-o", (dir / "d5.nc").string(), "--report", (dir / "r5.json").string(),
-                                 "--min-depth", "5m", "-q"});
+    const Result floored = with({"-o", (dir / "d5.nc").string(), "--report",
+                                 (dir / "r5.json").string(), "--min-depth", "5m", "-q"});
     ASSERT_EQ(floored.status, 0) << floored.err;
 
-    const std::vector<double> d0 = nc_doubles(dir / "d0.nc", "depth"), d5 = nc_doubles(dir / "d5.nc", "depth");
+    const std::vector<double> d0 = nc_doubles(dir / "d0.nc", "depth"),
+                              d5 = nc_doubles(dir / "d5.nc", "depth");
     EXPECT_EQ(nc_text(dir / "d0.nc", "depth", "positive"), "down");
     ASSERT_EQ(d0.size(), d5.size());
     // The same mesh: --min-depth changes the depths only.
-    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lon"), nc_doubles(dir / "d5.nc", "mesh_node_lon"));
-    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lat"), nc_doubles(dir / "d5.nc", "mesh_node_lat"));
+    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lon"),
+              nc_doubles(dir / "d5.nc", "mesh_node_lon"));
+    EXPECT_EQ(nc_doubles(dir / "d0.nc", "mesh_node_lat"),
+              nc_doubles(dir / "d5.nc", "mesh_node_lat"));
     const long long above = std::count_if(d0.begin(), d0.end(), [](double d) { return d < 0; });
     const long long shallower = std::count_if(d0.begin(), d0.end(), [](double d) { return d < 5; });
     const double shallowest = *std::min_element(d0.begin(), d0.end());
     ASSERT_GT(above, 10); // not vacuous: coast nodes on land cells
     EXPECT_GT(shallower, above);
     EXPECT_GE(*std::min_element(d5.begin(), d5.end()), 5.0);
-    for (std::size_t i = 0; i < d0.size(); ++i) ASSERT_EQ(d5[i], std::max(d0[i], 5.0)) << "node " << i;
+    for (std::size_t i = 0; i < d0.size(); ++i)
+        ASSERT_EQ(d5[i], std::max(d0[i], 5.0)) << "node " << i;
 
     const ReportedDepth r0 = reported_depth(read_text(dir / "r0.json"));
     EXPECT_EQ(r0.above, above);
@@ -1158,19 +1512,23 @@ TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
     // The warning (one line after the progress, counts grouped by thousands) comes only without
     // --min-depth, and not with --quiet.
     std::vector<std::string> g;
-    ASSERT_TRUE(regex_search(plain.err, R"(done\.\nglobemesh: warning: ([0-9,]+) nodes lie above sea level \(down to )"
-                                        R"((-?[0-9,]+) m\) and are written with negative depth; --min-depth 5 would )"
-                                        R"(raise them to 5 m\n$)",
-                             &g))
+    ASSERT_TRUE(
+        regex_search(plain.err,
+                     R"(done\.\nglobemesh: warning: ([0-9,]+) nodes lie above sea level \(down to )"
+                     R"((-?[0-9,]+) m\) and are written with negative depth; --min-depth 5 would )"
+                     R"(raise them to 5 m\n$)",
+                     &g))
         << plain.err;
     EXPECT_EQ(with({"-o", (dir / "quiet.nc").string(), "-q"}).err, "");
     auto plain_number = [](std::string t) { return std::stoll(regex_replace(t, ",", "")); };
     EXPECT_EQ(plain_number(g[1]), above);
     EXPECT_EQ(plain_number(g[2]), std::llround(shallowest));
     EXPECT_EQ(floored.err, "");
-    const std::string depth_line = "\ndepth +" + std::to_string(above) + " nodes above sea level \\(down to -[0-9,]+ m\\)";
+    const std::string depth_line =
+        "\ndepth +" + std::to_string(above) + " nodes above sea level \\(down to -[0-9,]+ m\\)";
     EXPECT_TRUE(regex_search(plain.out, depth_line + "\n")) << plain.out;
-    EXPECT_TRUE(regex_search(floored.out, depth_line + ", " + std::to_string(shallower) + " raised to --min-depth 5 m\n"))
+    EXPECT_TRUE(regex_search(floored.out, depth_line + ", " + std::to_string(shallower) +
+                                              " raised to --min-depth 5 m\n"))
         << floored.out;
     globemesh::test::expect_mesh_verify(dir / "d5.nc");
 }
@@ -1179,10 +1537,13 @@ namespace {
 
 /// Adds a layer `name` (EPSG:4326) holding the box W,S,E,N (degrees) to the GeoPackage `path`,
 /// created when missing.
-void add_box_layer(const std::string& path, const char* name, double w, double s, double e, double n) {
+void add_box_layer(const std::string &path, const char *name, double w, double s, double e,
+                   double n) {
     GDALAllRegister();
-    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
-    if (!ds) ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    GDALDatasetH ds =
+        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+    if (!ds)
+        ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
     ASSERT_NE(ds, nullptr) << path;
     OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
     OSRImportFromEPSG(wgs84, 4326);
@@ -1190,8 +1551,10 @@ void add_box_layer(const std::string& path, const char* name, double w, double s
     OSRRelease(wgs84);
     ASSERT_NE(layer, nullptr);
     OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
-    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing), polygon = OGR_G_CreateGeometry(wkbPolygon);
-    for (auto [x, y] : {std::pair{w, s}, {e, s}, {e, n}, {w, n}, {w, s}}) OGR_G_AddPoint_2D(ring, x, y);
+    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing),
+                 polygon = OGR_G_CreateGeometry(wkbPolygon);
+    for (auto [x, y] : {std::pair{w, s}, {e, s}, {e, n}, {w, n}, {w, s}})
+        OGR_G_AddPoint_2D(ring, x, y);
     OGR_G_AddGeometryDirectly(polygon, ring);
     OGR_F_SetGeometryDirectly(f, polygon);
     EXPECT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
@@ -1206,30 +1569,37 @@ TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
     const std::string regions = (dir / "regions.gpkg").string();
     add_box_layer(regions, "north_sea", -4, 51, 9, 59);
     add_box_layer(regions, "biscay", -10, 43.5, -1, 48);
-    auto mesh = [&](const std::string& out, std::vector<std::string> extra) {
-        std::vector<std::string> args = {"mesh", "--coast", coast, "--coast-layer", "land", "--region-file", regions,
-                                         "--hmax", "40km", "-q", "-o", (dir / out).string()};
+    auto mesh = [&](const std::string &out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"mesh",  "--coast",
+                                         coast,   "--coast-layer",
+                                         "land",  "--region-file",
+                                         regions, "--hmax",
+                                         "40km",  "-q",
+                                         "-o",    (dir / out).string()};
         args.insert(args.end(), extra.begin(), extra.end());
         return run(args, globemesh::library_calls());
     };
     const Result both = mesh("both.nc", {});
     EXPECT_EQ(both.status, 1);
-    EXPECT_EQ(both.err, "globemesh: --region-file " + regions +
-                            ": several polygon or line layers, choose one with --region-layer; layers: "
-                            "north_sea (Polygon), biscay (Polygon)\n");
+    EXPECT_EQ(both.err,
+              "globemesh: --region-file " + regions +
+                  ": several polygon or line layers, choose one with --region-layer; layers: "
+                  "north_sea (Polygon), biscay (Polygon)\n");
     EXPECT_FALSE(fs::exists(dir / "both.nc"));
     const Result missing = mesh("missing.nc", {"--region-layer", "baltic"});
     EXPECT_EQ(missing.status, 1);
     EXPECT_NE(missing.err.find("no layer named 'baltic'"), std::string::npos) << missing.err;
 
     // Each layer alone: the nodes lie in its box and reach across it.
-    for (const auto& [layer, box] : {std::pair{"biscay", std::array<double, 4>{-10, 43.5, -1, 48}},
-                                     std::pair{"north_sea", std::array<double, 4>{-4, 51, 9, 59}}}) {
+    for (const auto &[layer, box] :
+         {std::pair{"biscay", std::array<double, 4>{-10, 43.5, -1, 48}},
+          std::pair{"north_sea", std::array<double, 4>{-4, 51, 9, 59}}}) {
         SCOPED_TRACE(layer);
         const std::string out = std::string(layer) + ".nc";
         const Result r = mesh(out, {"--region-layer", layer});
         ASSERT_EQ(r.status, 0) << r.err;
-        const auto lon = nc_doubles(dir / out, "mesh_node_lon"), lat = nc_doubles(dir / out, "mesh_node_lat");
+        const auto lon = nc_doubles(dir / out, "mesh_node_lon"),
+                   lat = nc_doubles(dir / out, "mesh_node_lat");
         ASSERT_FALSE(lon.empty());
         const auto [lon_min, lon_max] = std::minmax_element(lon.begin(), lon.end());
         const auto [lat_min, lat_max] = std::minmax_element(lat.begin(), lat.end());
@@ -1239,7 +1609,9 @@ TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
         // The outline's edges are great circles: the northern one bulges north of its parallel
         // to atan(tan(N) / cos(half its longitude span)) at its middle.
         const double half_span = 0.5 * (box[2] - box[0]) * M_PI / 180;
-        EXPECT_LE(*lat_max, std::atan(std::tan(box[3] * M_PI / 180) / std::cos(half_span)) * 180 / M_PI + 1e-9);
+        EXPECT_LE(*lat_max,
+                  std::atan(std::tan(box[3] * M_PI / 180) / std::cos(half_span)) * 180 / M_PI +
+                      1e-9);
         EXPECT_GT(*lon_max - *lon_min, 0.8 * (box[2] - box[0]));
         EXPECT_GT(*lat_max - *lat_min, 0.8 * (box[3] - box[1]));
         globemesh::test::expect_mesh_verify(dir / out);

@@ -40,7 +40,7 @@ int main(int argc, char **argv) {
     options.coast_layer = "land";
     options.hmax_km = hmax_km;
     const globemesh::OceanMesh run = globemesh::mesh_ocean(options);
-    const globemesh::Mesh& mesh = run.mesh;
+    const globemesh::Mesh &mesh = run.mesh;
 
     double area = 0;
     bool indices_ok = true, unit_ok = true, ccw_ok = true;

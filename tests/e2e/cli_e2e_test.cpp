@@ -33,12 +33,15 @@ const std::string land110 = fixture("coast/ne_110m_land.gpkg").string();
 const std::string land50 = fixture("coast/ne_50m_land.gpkg").string();
 const std::string shelf_dem = fixture("bathy/etopo5_nwshelf_5min.tif").string();
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+std::string quote(const std::string &s) {
+    return "'" + s + "'";
+}
 
 /// Runs the executable; `out` gets stdout only, `err` stderr only.
-int run_exe(const std::vector<std::string>& args, std::string& out, std::string& err, const fs::path& dir) {
+int run_exe(const std::vector<std::string> &args, std::string &out, std::string &err,
+            const fs::path &dir) {
     std::string command = quote(exe);
-    for (const auto& a : args) {
+    for (const auto &a : args) {
         command += ' '; // appended apart: GCC 12 warns (-Wrestrict, a false positive) on " " + s
         command += quote(a);
     }
@@ -53,7 +56,7 @@ int run_exe(const std::vector<std::string>& args, std::string& out, std::string&
 }
 
 /// Runs a python3 script (independent reader) and returns its stdout; fails the test on error.
-std::string python(const std::string& script, const fs::path& dir) {
+std::string python(const std::string &script, const fs::path &dir) {
     const fs::path file = dir / ".check.py";
     std::ofstream(file) << script;
     std::string out;
@@ -63,15 +66,17 @@ std::string python(const std::string& script, const fs::path& dir) {
     return out;
 }
 
-std::set<std::string> files_in(const fs::path& dir) {
+std::set<std::string> files_in(const fs::path &dir) {
     std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir))
+        names.insert(e.path().filename().string());
     return names;
 }
 
-int count_lines(const std::string& s) {
+int count_lines(const std::string &s) {
     int n = 0;
-    for (char c : s) n += c == '\n';
+    for (char c : s)
+        n += c == '\n';
     return n;
 }
 
@@ -80,11 +85,12 @@ int count_lines(const std::string& s) {
 TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
     TempDir dir;
     std::string out, err;
-    const int status = run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "400km",
-                                "-o", (dir / "g.nc").string(), "--gpkg", (dir / "g.gpkg").string(),
-                                "--preview", (dir / "g.png").string(), "--report", (dir / "r.json").string(),
-                                "--timings", (dir / "t.json").string(), "--check"},
-                               out, err, dir.path());
+    const int status =
+        run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "400km", "-o",
+                 (dir / "g.nc").string(), "--gpkg", (dir / "g.gpkg").string(), "--preview",
+                 (dir / "g.png").string(), "--report", (dir / "r.json").string(), "--timings",
+                 (dir / "t.json").string(), "--check"},
+                out, err, dir.path());
     ASSERT_EQ(status, 0) << err;
     EXPECT_NE(out.find("nodes"), std::string::npos) << out;
     EXPECT_NE(out.find("peak memory"), std::string::npos) << out;
@@ -94,23 +100,35 @@ TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
     // loops it joined, each one fewer; each strait closed (the Bosphorus at 400 km) cuts a loop
     // in two or splits one at a node at most.
     std::vector<std::string> rings, holes, straits;
-    ASSERT_TRUE(globemesh::test::regex_search(out, R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, inlets closed \d+ \()", &rings))
+    ASSERT_TRUE(globemesh::test::regex_search(
+        out,
+        R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, inlets closed \d+ \()",
+        &rings))
         << out;
-    ASSERT_TRUE(globemesh::test::regex_search(out, R"(\nfaces on land +0 \(\d+ removed, opening (\d+) holes, joining (\d+) loops, \d+ moved off\))", &holes))
+    ASSERT_TRUE(globemesh::test::regex_search(
+        out,
+        R"(\nfaces on land +0 \(\d+ removed, opening (\d+) holes, joining (\d+) loops, \d+ moved off\))",
+        &holes))
         << out;
-    ASSERT_TRUE(globemesh::test::regex_search(out, R"(\nstraits closed +(\d+) \(cutting off \d+ basins.*; (\d+) nodes split\)\n +at )", &straits))
+    ASSERT_TRUE(globemesh::test::regex_search(
+        out, R"(\nstraits closed +(\d+) \(cutting off \d+ basins.*; (\d+) nodes split\)\n +at )",
+        &straits))
         << out;
     const int loops = std::stoi(rings[1]) + std::stoi(holes[1]) - std::stoi(holes[2]);
     const int loops_at_most = loops + std::stoi(straits[1]) + std::stoi(straits[2]);
     // Exactly the outputs asked for: no temporary file left beside them.
-    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"g.nc", "g.gpkg", "g.png", "r.json", "t.json"}));
+    EXPECT_EQ(files_in(dir.path()),
+              (std::set<std::string>{"g.nc", "g.gpkg", "g.png", "r.json", "t.json"}));
     expect_mesh_verify(dir / "g.nc");
     // The report and timings against the NetCDF file, read by netCDF4 and json.
     const std::string verdict = python(R"(
 import json, netCDF4, numpy as np
-r = json.load(open(')" + (dir / "r.json").string() + R"('))
-t = json.load(open(')" + (dir / "t.json").string() + R"('))
-ds = netCDF4.Dataset(')" + (dir / "g.nc").string() + R"(')
+r = json.load(open(')" + (dir / "r.json").string() +
+                                           R"('))
+t = json.load(open(')" + (dir / "t.json").string() +
+                                           R"('))
+ds = netCDF4.Dataset(')" + (dir / "g.nc").string() +
+                                           R"(')
 mesh = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
 lon = ds.variables[mesh.node_coordinates.split()[0]]
 faces = ds.variables[mesh.face_node_connectivity]
@@ -123,7 +141,9 @@ for k in ('mesh', 'write'):
     assert k in t['stages'], t
 assert all(v >= 0 for v in t['stages'].values())
 assert 0.6 * 400 < r['mesh']['edge_km']['mean'] < 1.3 * 400, r['mesh']['edge_km']
-assert )" + std::to_string(loops) + R"( <= r['mesh']['boundary_loops'] <= )" + std::to_string(loops_at_most) + R"(, r['mesh']['boundary_loops']
+assert )" + std::to_string(loops) + R"( <= r['mesh']['boundary_loops'] <= )" +
+                                           std::to_string(loops_at_most) +
+                                           R"(, r['mesh']['boundary_loops']
 # The run's attributes, as in the NetCDF file's global attributes.
 for k in ('coast_file', 'boundary_rings', 'faces_on_land', 'inlets_closed', 'straits_closed', 'straits_closed_at'):
     assert r['attributes'][k] == ds.getncattr(k), (k, r['attributes'].get(k), ds.getncattr(k))
@@ -133,13 +153,17 @@ print('OK', lon.shape[0])
     EXPECT_EQ(verdict.rfind("OK ", 0), 0u) << verdict;
     // info reads back the same counts.
     std::string info_out, info_err;
-    ASSERT_EQ(run_exe({"info", (dir / "g.nc").string(), "--json"}, info_out, info_err, dir.path()), 0) << info_err;
+    ASSERT_EQ(run_exe({"info", (dir / "g.nc").string(), "--json"}, info_out, info_err, dir.path()),
+              0)
+        << info_err;
     fs::path info_json = dir / "info.json";
     std::ofstream(info_json) << info_out;
     const std::string same = python(R"(
 import json
-a = json.load(open(')" + info_json.string() + R"('))
-b = json.load(open(')" + (dir / "r.json").string() + R"('))['mesh']
+a = json.load(open(')" + info_json.string() +
+                                        R"('))
+b = json.load(open(')" + (dir / "r.json").string() +
+                                        R"('))['mesh']
 for k in ('nodes', 'faces', 'edges', 'boundary_edges', 'boundary_loops'):
     assert a[k] == b[k], (k, a[k], b[k])
 assert abs(a['quality']['mean'] - b['quality']['mean']) < 1e-9
@@ -153,7 +177,8 @@ print('OK')
 // --format classic write the same netCDF-3 file. Read back by OGR (osgeo) and netCDF4.
 TEST(CliE2e, the_output_format_comes_from_the_extension_or_from_f) {
     TempDir dir;
-    const std::vector<std::string> base = {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "800km", "-q"};
+    const std::vector<std::string> base = {"mesh", "--coast", land110, "--coast-layer",
+                                           "land", "--hmax",  "800km", "-q"};
     auto run = [&](std::vector<std::string> outputs) {
         std::vector<std::string> args = base;
         args.insert(args.end(), outputs.begin(), outputs.end());
@@ -162,12 +187,13 @@ TEST(CliE2e, the_output_format_comes_from_the_extension_or_from_f) {
         EXPECT_EQ(status, 0) << err;
         return out;
     };
-    const auto p = [&](const char* name) { return (dir / name).string(); };
+    const auto p = [&](const char *name) { return (dir / name).string(); };
     run({"-o", p("a.nc"), "-o", p("b.gpkg"), "-o", p("c.png")});
     run({"-f", "GPKG", "-o", p("d.dat")});
     run({"-o", p("e.nc"), "--co", "FORMAT=NC2"});
     run({"-o", p("f.nc"), "--format", "classic"});
-    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "b.gpkg", "c.png", "d.dat", "e.nc", "f.nc"}));
+    EXPECT_EQ(files_in(dir.path()),
+              (std::set<std::string>{"a.nc", "b.gpkg", "c.png", "d.dat", "e.nc", "f.nc"}));
     expect_mesh_verify(dir / "a.nc");
     const std::string verdict = python(R"(
 import netCDF4, numpy as np
@@ -202,12 +228,15 @@ print('OK', faces)
     args.insert(args.end(), {"-o", p("g.dat")});
     EXPECT_EQ(run_exe(args, out, err, dir.path()), 2);
     EXPECT_EQ(err.rfind("globemesh: --output " + p("g.dat") +
-                            ": no format has the extension .dat; the formats are UGRID (.nc, .nc4), GPKG (.gpkg), "
+                            ": no format has the extension .dat; the formats are UGRID (.nc, "
+                            ".nc4), GPKG (.gpkg), "
                             "PNG (.png)",
                         0),
               0u)
         << err;
-    EXPECT_NE(err.find("; name the file so, or choose the format with -f NAME\n"), std::string::npos) << err;
+    EXPECT_NE(err.find("; name the file so, or choose the format with -f NAME\n"),
+              std::string::npos)
+        << err;
     EXPECT_EQ(count_lines(err), 1) << err;
     EXPECT_FALSE(fs::exists(dir / "g.dat"));
 }
@@ -215,16 +244,18 @@ print('OK', faces)
 TEST(CliE2e, regional_run_has_coast_and_open_boundaries_inside_the_region) {
     TempDir dir;
     std::string out, err;
-    const int status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-12,46,13,62",
-                                "--bathy", shelf_dem, "--hmax", "60km", "--hmin", "10km", "--coast-size", "15km",
-                                "-o", (dir / "r.nc").string(), "--quiet"},
-                               out, err, dir.path());
+    const int status =
+        run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-12,46,13,62",
+                 "--bathy", shelf_dem, "--hmax", "60km", "--hmin", "10km", "--coast-size", "15km",
+                 "-o", (dir / "r.nc").string(), "--quiet"},
+                out, err, dir.path());
     ASSERT_EQ(status, 0) << err;
     EXPECT_EQ(err, ""); // --quiet
     expect_mesh_verify(dir / "r.nc");
     const std::string verdict = python(R"(
 import netCDF4, numpy as np
-ds = netCDF4.Dataset(')" + (dir / "r.nc").string() + R"(')
+ds = netCDF4.Dataset(')" + (dir / "r.nc").string() +
+                                           R"(')
 mesh = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
 lon = ds.variables[mesh.node_coordinates.split()[0]][:]
 lat = ds.variables[mesh.node_coordinates.split()[1]][:]
@@ -245,21 +276,25 @@ print('OK')
 TEST(CliE2e, a_config_file_run_equals_the_same_run_by_options) {
     TempDir dir;
     std::string out, err;
-    ASSERT_EQ(run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "600km", "--seed", "3",
-                       "--smooth", "2", "-o", (dir / "a.nc").string(), "-q"},
+    ASSERT_EQ(run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "600km",
+                       "--seed", "3", "--smooth", "2", "-o", (dir / "a.nc").string(), "-q"},
                       out, err, dir.path()),
               0)
         << err;
-    std::ofstream(dir / "run.toml") << "coast = \"" << land110 << "\"\ncoast-layer = \"land\"\nhmax = \"600000m\"\n"
-                                    << "seed = 3\nsmooth = 2\nquiet = true\n";
-    ASSERT_EQ(run_exe({"mesh", "--config", (dir / "run.toml").string(), "-o", (dir / "b.nc").string()}, out, err,
-                      dir.path()),
-              0)
+    std::ofstream(dir / "run.toml")
+        << "coast = \"" << land110 << "\"\ncoast-layer = \"land\"\nhmax = \"600000m\"\n"
+        << "seed = 3\nsmooth = 2\nquiet = true\n";
+    ASSERT_EQ(
+        run_exe({"mesh", "--config", (dir / "run.toml").string(), "-o", (dir / "b.nc").string()},
+                out, err, dir.path()),
+        0)
         << err;
     const std::string verdict = python(R"(
 import netCDF4, numpy as np
-a = netCDF4.Dataset(')" + (dir / "a.nc").string() + R"(')
-b = netCDF4.Dataset(')" + (dir / "b.nc").string() + R"(')
+a = netCDF4.Dataset(')" + (dir / "a.nc").string() +
+                                           R"(')
+b = netCDF4.Dataset(')" + (dir / "b.nc").string() +
+                                           R"(')
 assert set(a.variables) == set(b.variables)
 for name in a.variables:
     if a.variables[name].shape == ():
@@ -274,14 +309,17 @@ print('OK', len(a.variables))
 TEST(CliE2e, print_config_output_reads_back_to_the_same_configuration) {
     TempDir dir;
     std::string first, second, err;
-    ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-12,46,13,62",
-                       "--bathy", shelf_dem, "--hmax", "20km", "--min-island-area", "5e7m2", "--wave-period", "25h",
-                       "-o", (dir / "x.nc").string(), "--print-config"},
-                      first, err, dir.path()),
-              0)
+    ASSERT_EQ(
+        run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-12,46,13,62",
+                 "--bathy", shelf_dem, "--hmax", "20km", "--min-island-area", "5e7m2",
+                 "--wave-period", "25h", "-o", (dir / "x.nc").string(), "--print-config"},
+                first, err, dir.path()),
+        0)
         << err;
     std::ofstream(dir / "p.toml") << first;
-    ASSERT_EQ(run_exe({"mesh", "--config", (dir / "p.toml").string(), "--print-config"}, second, err, dir.path()), 0)
+    ASSERT_EQ(run_exe({"mesh", "--config", (dir / "p.toml").string(), "--print-config"}, second,
+                      err, dir.path()),
+              0)
         << err;
     EXPECT_EQ(first, second);
     EXPECT_NE(first.find("hmax=20"), std::string::npos) << first;
@@ -292,8 +330,8 @@ TEST(CliE2e, print_config_output_reads_back_to_the_same_configuration) {
 TEST(CliE2e, triangulate_stations_gives_a_closed_triangulation) {
     TempDir dir;
     std::string out, err;
-    ASSERT_EQ(run_exe({"triangulate", fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(),
-                       "--timings", (dir / "t.json").string(), "-q"},
+    ASSERT_EQ(run_exe({"triangulate", fixture("points/stations.csv").string(), "-o",
+                       (dir / "s.nc").string(), "--timings", (dir / "t.json").string(), "-q"},
                       out, err, dir.path()),
               0)
         << err;
@@ -301,12 +339,14 @@ TEST(CliE2e, triangulate_stations_gives_a_closed_triangulation) {
     // 2000 points in general position on the sphere: V - E + F = 2 and 3F = 2E give F = 2V - 4.
     const std::string verdict = python(R"(
 import json, netCDF4
-ds = netCDF4.Dataset(')" + (dir / "s.nc").string() + R"(')
+ds = netCDF4.Dataset(')" + (dir / "s.nc").string() +
+                                           R"(')
 mesh = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
 n = ds.variables[mesh.node_coordinates.split()[0]].shape[0]
 f = ds.variables[mesh.face_node_connectivity].shape[0]
 assert n == 2000 and f == 2 * n - 4, (n, f)
-t = json.load(open(')" + (dir / "t.json").string() + R"('))
+t = json.load(open(')" + (dir / "t.json").string() +
+                                           R"('))
 assert 'read' in t['stages'] and 'write' in t['stages'], t
 print('OK')
 )",
@@ -325,12 +365,13 @@ struct ExeError {
 class CliE2eErrors : public ::testing::TestWithParam<ExeError> {};
 
 TEST_P(CliE2eErrors, exit_status_one_line_and_no_output) {
-    const ExeError& c = GetParam();
+    const ExeError &c = GetParam();
     TempDir dir;
     std::ofstream(dir / "existing.nc") << "keep me";
     std::vector<std::string> args;
     for (auto a : c.args) {
-        for (auto p = a.find("{dir}"); p != std::string::npos; p = a.find("{dir}")) a.replace(p, 5, dir.path().string());
+        for (auto p = a.find("{dir}"); p != std::string::npos; p = a.find("{dir}"))
+            a.replace(p, 5, dir.path().string());
         args.push_back(a);
     }
     std::string out, err;
@@ -346,23 +387,56 @@ TEST_P(CliE2eErrors, exit_status_one_line_and_no_output) {
 INSTANTIATE_TEST_SUITE_P(
     CliE2e, CliE2eErrors,
     ::testing::Values(
-        ExeError{"unknown_unit", {"mesh", "--coast", land110, "--hmax", "20parsecs", "-o", "{dir}/o.nc"}, {2}, "--hmax"},
-        ExeError{"negative_size", {"mesh", "--coast", land110, "--coast-size", "-3km", "-o", "{dir}/o.nc"}, {2}, "--coast-size"},
-        ExeError{"hmin_above_hmax", {"mesh", "--coast", land110, "--hmin", "200km", "-o", "{dir}/o.nc"}, {2}, "--hmin"},
+        ExeError{"unknown_unit",
+                 {"mesh", "--coast", land110, "--hmax", "20parsecs", "-o", "{dir}/o.nc"},
+                 {2},
+                 "--hmax"},
+        ExeError{"negative_size",
+                 {"mesh", "--coast", land110, "--coast-size", "-3km", "-o", "{dir}/o.nc"},
+                 {2},
+                 "--coast-size"},
+        ExeError{"hmin_above_hmax",
+                 {"mesh", "--coast", land110, "--hmin", "200km", "-o", "{dir}/o.nc"},
+                 {2},
+                 "--hmin"},
         // A layer that is not there: the option's value is wrong (2) or the data lacks it (1).
-        ExeError{"unknown_layer", {"mesh", "--coast", land110, "--coast-layer", "nosuch", "-o", "{dir}/o.nc", "-q"}, {1, 2}, "nosuch"},
-        ExeError{"missing_file", {"mesh", "--coast", "{dir}/land.gpkg", "-o", "{dir}/o.nc"}, {1}, "land.gpkg"},
-        ExeError{"region_without_ocean", {"mesh", "--coast", land110, "--coast-layer", "land", "--region", "0,20,10,25", "-o", "{dir}/o.nc", "-q"}, {1}, "region"},
-        ExeError{"output_in_missing_folder", {"mesh", "--coast", land110, "-o", "{dir}/none/o.nc"}, {1}, "none"},
-        ExeError{"existing_output", {"mesh", "--coast", land110, "-o", "{dir}/existing.nc"}, {1}, "--overwrite"},
+        ExeError{"unknown_layer",
+                 {"mesh", "--coast", land110, "--coast-layer", "nosuch", "-o", "{dir}/o.nc", "-q"},
+                 {1, 2},
+                 "nosuch"},
+        ExeError{"missing_file",
+                 {"mesh", "--coast", "{dir}/land.gpkg", "-o", "{dir}/o.nc"},
+                 {1},
+                 "land.gpkg"},
+        ExeError{"region_without_ocean",
+                 {"mesh", "--coast", land110, "--coast-layer", "land", "--region", "0,20,10,25",
+                  "-o", "{dir}/o.nc", "-q"},
+                 {1},
+                 "region"},
+        ExeError{"output_in_missing_folder",
+                 {"mesh", "--coast", land110, "-o", "{dir}/none/o.nc"},
+                 {1},
+                 "none"},
+        ExeError{"existing_output",
+                 {"mesh", "--coast", land110, "-o", "{dir}/existing.nc"},
+                 {1},
+                 "--overwrite"},
         // The ocean at 1 m would take some 4e14 nodes: refused at once from its area, not after
         // minutes of shaping a coast of billions of nodes.
-        ExeError{"a_size_of_metres", {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "1m", "-o", "{dir}/o.nc", "-q"}, {1}, "--max-nodes"},
+        ExeError{"a_size_of_metres",
+                 {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "1m", "-o",
+                  "{dir}/o.nc", "-q"},
+                 {1},
+                 "--max-nodes"},
         // GDAL opens a vector file as no raster without a message of its own.
-        ExeError{"bathy_not_a_raster", {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "500km", "--bathy", land110, "-o", "{dir}/o.nc", "-q"}, {1}, "not a raster format GDAL reads"},
+        ExeError{"bathy_not_a_raster",
+                 {"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "500km", "--bathy",
+                  land110, "-o", "{dir}/o.nc", "-q"},
+                 {1},
+                 "not a raster format GDAL reads"},
         ExeError{"unknown_subcommand", {"mesj"}, {2}, "mesj"},
         ExeError{"info_on_a_non_mesh", {"info", "{dir}/existing.nc"}, {1}, "existing.nc"}),
-    [](const auto& info) { return info.param.name; });
+    [](const auto &info) { return info.param.name; });
 
 class CliE2eSignal : public ::testing::TestWithParam<int> {};
 
@@ -373,16 +447,20 @@ TEST_P(CliE2eSignal, stops_a_run_and_leaves_no_output) {
     const int signal = GetParam();
     TempDir dir;
     const std::string output = (dir / "big.nc").string();
-    std::vector<std::string> args = {exe,      "mesh",  "--coast", land50, "--coast-layer", "land",
-                                     "--hmax", "15km",  "--gpkg",  (dir / "big.gpkg").string(),
-                                     "-o",     output,  "-q"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
+    std::vector<std::string> args = {
+        exe,    "mesh",   "--coast", land50,   "--coast-layer",
+        "land", "--hmax", "15km",    "--gpkg", (dir / "big.gpkg").string(),
+        "-o",   output,   "-q"};
+    std::vector<char *> argv;
+    for (auto &a : args)
+        argv.push_back(a.data());
     argv.push_back(nullptr);
-    const std::string err_path = (dir.path().parent_path() / (dir.path().filename().string() + ".err")).string();
+    const std::string err_path =
+        (dir.path().parent_path() / (dir.path().filename().string() + ".err")).string();
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     // Run it in the test's folder, so that a temporary file written next to the cwd would show.
     posix_spawn_file_actions_addchdir_np(&actions, dir.path().c_str());
     pid_t pid = 0;
@@ -394,7 +472,8 @@ TEST_P(CliE2eSignal, stops_a_run_and_leaves_no_output) {
     kill(pid, signal);
     int wstatus = 0;
     ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
-    const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    const double stop_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
     std::stringstream err;
     err << std::ifstream(err_path).rdbuf();
     fs::remove(err_path);
@@ -403,47 +482,62 @@ TEST_P(CliE2eSignal, stops_a_run_and_leaves_no_output) {
     if (WIFSIGNALED(wstatus)) {
         EXPECT_EQ(WTERMSIG(wstatus), signal);
     } else {
-        ASSERT_NE(WEXITSTATUS(wstatus), 0) << "the run finished within 2.5 s: it is too short for this test";
+        ASSERT_NE(WEXITSTATUS(wstatus), 0)
+            << "the run finished within 2.5 s: it is too short for this test";
         EXPECT_EQ(WEXITSTATUS(wstatus), 1); // cli.hpp: cancellation is status 1
     }
-    EXPECT_EQ(err.str(), signal == SIGINT ? "globemesh: cancelled, no output written\n"
-                                         : "globemesh: cancelled by SIGTERM, no output written\n"); // one line, nothing else
+    EXPECT_EQ(
+        err.str(),
+        signal == SIGINT
+            ? "globemesh: cancelled, no output written\n"
+            : "globemesh: cancelled by SIGTERM, no output written\n"); // one line, nothing else
     EXPECT_TRUE(fs::is_empty(dir.path())) << "output or temporary files left behind";
     EXPECT_LT(stop_s, 10.0) << "the run took " << stop_s << " s to stop after the signal";
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, CliE2eSignal, ::testing::Values(SIGINT, SIGTERM),
-                         [](const auto& info) { return info.param == SIGINT ? "sigint" : "sigterm"; });
+                         [](const auto &info) {
+                             return info.param == SIGINT ? "sigint" : "sigterm";
+                         });
 
 namespace {
 
 /// Writes a GeoPackage of `features` square-ish polygons of `vertices_each` vertices (a circle
 /// of radius 0.4 degree around a distinct centre each) with python3's GDAL bindings, from WKB
 /// built with numpy: an independent writer, and fast enough for 1e7 vertices.
-void write_many_vertex_layer(const fs::path& path, int features, int vertices_each, const fs::path& dir) {
+void write_many_vertex_layer(const fs::path &path, int features, int vertices_each,
+                             const fs::path &dir) {
     python("import numpy as np, struct\n"
            "from osgeo import ogr, osr\n"
            "ogr.UseExceptions()\n"
-           "ds = ogr.GetDriverByName('GPKG').CreateDataSource('" + path.string() + "')\n"
-           "srs = osr.SpatialReference(); srs.ImportFromEPSG(4326)\n"
-           "lyr = ds.CreateLayer('dense_land', srs, ogr.wkbPolygon)\n"
-           "n = " + std::to_string(vertices_each) + "\n"
-           "t = np.linspace(0, 2 * np.pi, n)  # n vertices, the last equal to the first\n"
-           "lyr.StartTransaction()\n"
-           "for k in range(" + std::to_string(features) + "):\n"
-           "    cx, cy = -170 + (k % 100) * 3.0, -60 + (k // 100) * 3.0\n"
-           "    xy = np.empty((n, 2)); xy[:, 0] = cx + 0.4 * np.cos(t); xy[:, 1] = cy + 0.4 * np.sin(t)\n"
-           "    xy[-1] = xy[0]\n"
-           "    wkb = struct.pack('<BIII', 1, 3, 1, n) + xy.astype('<f8').tobytes()\n"
-           "    f = ogr.Feature(lyr.GetLayerDefn()); f.SetGeometry(ogr.CreateGeometryFromWkb(wkb))\n"
-           "    lyr.CreateFeature(f)\n"
-           "lyr.CommitTransaction()\n"
-           "ds = None\n",
+           "ds = ogr.GetDriverByName('GPKG').CreateDataSource('" +
+               path.string() +
+               "')\n"
+               "srs = osr.SpatialReference(); srs.ImportFromEPSG(4326)\n"
+               "lyr = ds.CreateLayer('dense_land', srs, ogr.wkbPolygon)\n"
+               "n = " +
+               std::to_string(vertices_each) +
+               "\n"
+               "t = np.linspace(0, 2 * np.pi, n)  # n vertices, the last equal to the first\n"
+               "lyr.StartTransaction()\n"
+               "for k in range(" +
+               std::to_string(features) +
+               "):\n"
+               "    cx, cy = -170 + (k % 100) * 3.0, -60 + (k // 100) * 3.0\n"
+               "    xy = np.empty((n, 2)); xy[:, 0] = cx + 0.4 * np.cos(t); xy[:, 1] = cy + 0.4 * "
+               "np.sin(t)\n"
+               "    xy[-1] = xy[0]\n"
+               "    wkb = struct.pack('<BIII', 1, 3, 1, n) + xy.astype('<f8').tobytes()\n"
+               "    f = ogr.Feature(lyr.GetLayerDefn()); "
+               "f.SetGeometry(ogr.CreateGeometryFromWkb(wkb))\n"
+               "    lyr.CreateFeature(f)\n"
+               "lyr.CommitTransaction()\n"
+               "ds = None\n",
            dir);
 }
 
 /// Runs `globemesh mesh ARGS` in-process through the real library.
-int run_mesh_in_process(std::vector<std::string> args, std::string& out, std::string& err) {
+int run_mesh_in_process(std::vector<std::string> args, std::string &out, std::string &err) {
     args.insert(args.begin(), "mesh");
     std::ostringstream o, e;
     const int status = globemesh::run_cli(args, o, e);
@@ -461,9 +555,9 @@ TEST(CliE2e, a_coastline_of_ten_million_vertices_is_refused_in_one_line_without_
     std::string out, err;
     // 1 GB keeps at most 5e6 vertices (200 B each): the loader stops keeping them half-way and
     // only counts the rest.
-    const int status = run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "o.nc").string(),
-                                            "--max-memory", "1GB", "-q"},
-                                           out, err);
+    const int status = run_mesh_in_process(
+        {"--coast", coast.string(), "-o", (dir / "o.nc").string(), "--max-memory", "1GB", "-q"},
+        out, err);
     EXPECT_EQ(status, 1);
     EXPECT_EQ(count_lines(err), 1) << err;
     EXPECT_NE(err.find("layer 'dense_land' has 10000000 vertices"), std::string::npos) << err;
@@ -479,10 +573,14 @@ TEST(CliE2e, a_coastline_within_the_budget_is_read_and_meshed) {
     write_many_vertex_layer(coast, 4, 5000, dir.path());
     std::string out, err;
     EXPECT_EQ(run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "refused.nc").string(),
-                                   "--max-memory", "3MB", "--hmax", "500km", "-q"}, out, err), 1);
+                                   "--max-memory", "3MB", "--hmax", "500km", "-q"},
+                                  out, err),
+              1);
     EXPECT_NE(err.find("has 20000 vertices, more than the 15000"), std::string::npos) << err;
     ASSERT_EQ(run_mesh_in_process({"--coast", coast.string(), "-o", (dir / "o.nc").string(),
-                                   "--max-memory", "500MB", "--hmax", "500km", "-q"}, out, err), 0)
+                                   "--max-memory", "500MB", "--hmax", "500km", "-q"},
+                                  out, err),
+              0)
         << err;
     expect_mesh_verify(dir / "o.nc");
 }
@@ -494,7 +592,8 @@ TEST(CliE2e, a_four_gigabyte_raster_is_read_coarse_or_refused_without_reading_it
     const fs::path vrt = dir / "huge.vrt";
     std::ofstream(vrt) << "<VRTDataset rasterXSize=\"69120\" rasterYSize=\"34560\">\n"
                           "  <SRS>EPSG:4326</SRS>\n"
-                          "  <GeoTransform>-180, 0.005208333333333333, 0, 90, 0, -0.005208333333333333</GeoTransform>\n"
+                          "  <GeoTransform>-180, 0.005208333333333333, 0, 90, 0, "
+                          "-0.005208333333333333</GeoTransform>\n"
                           "  <VRTRasterBand dataType=\"Int16\" band=\"1\">\n"
                           "    <SimpleSource>\n"
                           "      <SourceFilename relativeToVRT=\"0\">"
@@ -508,19 +607,24 @@ TEST(CliE2e, a_four_gigabyte_raster_is_read_coarse_or_refused_without_reading_it
                           "</VRTDataset>\n";
     std::string out, err;
     // Fine sizes ask for cells of 1 km: refused before any large allocation, naming the option.
-    EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
-                                   "--hmax", "300km", "--hmin", "2km", "--coast-size", "100km",
-                                   "--max-memory", "200MB", "-o", (dir / "fine.nc").string(), "-q"},
-                                  out, err), 1);
+    EXPECT_EQ(
+        run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
+                             "--hmax", "300km", "--hmin", "2km", "--coast-size", "100km",
+                             "--max-memory", "200MB", "-o", (dir / "fine.nc").string(), "-q"},
+                            out, err),
+        1);
     EXPECT_EQ(count_lines(err), 1) << err;
-    EXPECT_NE(err.find("--bathy " + vrt.string() + ": 69120 x 34560 cells"), std::string::npos) << err;
+    EXPECT_NE(err.find("--bathy " + vrt.string() + ": 69120 x 34560 cells"), std::string::npos)
+        << err;
     EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(dir / "fine.nc"));
     // Coarse sizes (hmin 100 km: cells of 50 km) read about 800 x 400 cells and mesh.
-    ASSERT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
-                                   "--hmax", "300km", "--hmin", "100km",
-                                   "--max-memory", "200MB", "-o", (dir / "coarse.nc").string(), "-q"},
-                                  out, err), 0)
+    ASSERT_EQ(
+        run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--bathy", vrt.string(),
+                             "--hmax", "300km", "--hmin", "100km", "--max-memory", "200MB", "-o",
+                             (dir / "coarse.nc").string(), "-q"},
+                            out, err),
+        0)
         << err;
     expect_mesh_verify(dir / "coarse.nc");
 }
@@ -531,14 +635,18 @@ TEST(CliE2e, a_size_field_grid_or_a_mesh_beyond_the_budget_is_refused_before_it_
     // 2^22 grid nodes at 64 B: 268 MB.
     EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--hmax", "100km",
                                    "--hmin", "1km", "--coast-size", "5km", "--max-memory", "100MB",
-                                   "-o", (dir / "o.nc").string(), "-q"}, out, err), 1);
+                                   "-o", (dir / "o.nc").string(), "-q"},
+                                  out, err),
+              1);
     EXPECT_EQ(count_lines(err), 1) << err;
     EXPECT_NE(err.find("background grid"), std::string::npos) << err;
     EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
     // A uniform 5 km mesh: about 25 M nodes, far beyond 1 GB at the mesher's 800 B a node.
     EXPECT_EQ(run_mesh_in_process({"--coast", land110, "--coast-layer", "land", "--hmax", "5km",
-                                   "--max-nodes", "1000000000", "--max-memory", "1GB",
-                                   "-o", (dir / "o.nc").string(), "-q"}, out, err), 1);
+                                   "--max-nodes", "1000000000", "--max-memory", "1GB", "-o",
+                                   (dir / "o.nc").string(), "-q"},
+                                  out, err),
+              1);
     EXPECT_EQ(count_lines(err), 1) << err;
     EXPECT_NE(err.find("--max-memory"), std::string::npos) << err;
     EXPECT_TRUE(fs::is_empty(dir.path()));
@@ -550,12 +658,13 @@ TEST(CliE2e, a_size_field_grid_or_a_mesh_beyond_the_budget_is_refused_before_it_
 TEST(CliE2e, a_report_to_dev_stdout_is_printed_and_dev_stdout_is_kept) {
     TempDir dir;
     const auto before = fs::symlink_status("/dev/stdout").type();
-    for (const char* overwrite : {"--quiet", "--overwrite"}) {
+    for (const char *overwrite : {"--quiet", "--overwrite"}) {
         std::string out, err;
-        ASSERT_EQ(run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "800km", "-o",
-                           (dir / "p.nc").string(), "--report", "/dev/stdout", "--overwrite", overwrite},
-                          out, err, dir.path()),
-                  0)
+        ASSERT_EQ(
+            run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--hmax", "800km", "-o",
+                     (dir / "p.nc").string(), "--report", "/dev/stdout", "--overwrite", overwrite},
+                    out, err, dir.path()),
+            0)
             << err;
         EXPECT_NE(out.find("\"peak_memory_bytes\": "), std::string::npos) << out;
         EXPECT_NE(out.find("faces"), std::string::npos) << out; // and the summary
@@ -567,8 +676,9 @@ TEST(CliE2e, a_report_to_dev_stdout_is_printed_and_dev_stdout_is_kept) {
 TEST(CliE2e, run_cli_in_process_prints_the_summary_on_out_only) {
     TempDir dir;
     std::ostringstream out, err;
-    const std::vector<std::string> args = {"mesh", "--coast", land110, "--coast-layer", "land",
-                                           "--hmax", "800km", "-o", (dir / "p.nc").string(), "--quiet"};
+    const std::vector<std::string> args = {
+        "mesh",   "--coast", land110, "--coast-layer",         "land",
+        "--hmax", "800km",   "-o",    (dir / "p.nc").string(), "--quiet"};
     ASSERT_EQ(globemesh::run_cli(args, out, err), 0) << err.str();
     EXPECT_EQ(err.str(), "");
     EXPECT_NE(out.str().find("faces"), std::string::npos);
@@ -593,25 +703,29 @@ for name, south in (('inside', 29.7530), ('beyond', 29.7450)):
         ring.AddPoint_2D(x, y)
     poly = ogr.Geometry(ogr.wkbPolygon); poly.AddGeometry(ring)
     poly.Transform(osr.CoordinateTransformation(wgs, utm))
-    ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" + dir.path().string() + R"(/' + name + '.gpkg')
+    ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
+               dir.path().string() + R"(/' + name + '.gpkg')
     layer = ds.CreateLayer('region', utm, ogr.wkbPolygon)
     f = ogr.Feature(layer.GetLayerDefn()); f.SetGeometry(poly); layer.CreateFeature(f)
     ds = None
 )",
            dir.path());
     std::string out, err;
-    int status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile, "--region-file",
-                          (dir / "inside.gpkg").string(), "--hmax", "100m", "--wavelength", "40", "-o",
-                          (dir / "m.nc").string(), "--verbose"},
+    int status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile,
+                          "--region-file", (dir / "inside.gpkg").string(), "--hmax", "100m",
+                          "--wavelength", "40", "-o", (dir / "m.nc").string(), "--verbose"},
                          out, err, dir.path());
     ASSERT_EQ(status, 0) << err;
-    EXPECT_NE(err.find("its axes are CF longitude/latitude: read as WGS 84 lon/lat"), std::string::npos) << err;
+    EXPECT_NE(err.find("its axes are CF longitude/latitude: read as WGS 84 lon/lat"),
+              std::string::npos)
+        << err;
     expect_mesh_verify(dir / "m.nc");
     const std::string verdict = python(R"(
 import netCDF4, numpy as np
 t = netCDF4.Dataset(')" + tile + R"(')
 x, y, z = t['lon'][:], t['lat'][:], t['Band1'][:].astype(float)
-m = netCDF4.Dataset(')" + (dir / "m.nc").string() + R"(')
+m = netCDF4.Dataset(')" + (dir / "m.nc").string() +
+                                           R"(')
 lon, lat, depth = m['mesh_node_lon'][:], m['mesh_node_lat'][:], m['depth'][:]
 assert len(lon) > 100 and not np.isnan(depth).any(), len(lon)
 i = np.clip(np.searchsorted(x, lon) - 1, 0, len(x) - 2); j = np.clip(np.searchsorted(y, lat) - 1, 0, len(y) - 2)
@@ -622,12 +736,15 @@ print('OK')
 )",
                                        dir.path());
     EXPECT_EQ(verdict, "OK\n");
-    status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile, "--region-file",
-                      (dir / "beyond.gpkg").string(), "--hmax", "100m", "-o", (dir / "b.nc").string(), "--quiet"},
+    status = run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--bathy", tile,
+                      "--region-file", (dir / "beyond.gpkg").string(), "--hmax", "100m", "-o",
+                      (dir / "b.nc").string(), "--quiet"},
                      out, err, dir.path());
     EXPECT_EQ(status, 1) << err;
     EXPECT_EQ(count_lines(err), 1) << err;
-    EXPECT_NE(err.find("but the ocean of --region-file " + (dir / "beyond.gpkg").string() + " reaches lon"),
-              std::string::npos) << err;
+    EXPECT_NE(err.find("but the ocean of --region-file " + (dir / "beyond.gpkg").string() +
+                       " reaches lon"),
+              std::string::npos)
+        << err;
     EXPECT_FALSE(fs::exists(dir / "b.nc"));
 }

@@ -36,8 +36,21 @@ const std::string exe = GLOBEMESH_EXE;
 /// The run: a global mesh of the 1:110m land at 100 km with a UGRID file, a GeoPackage and a
 /// preview, written into the folder it runs in (about 45,000 nodes: a second or two).
 std::vector<std::string> run_args() {
-    return {exe,   "mesh", "--coast", fixture("coast/ne_110m_land.gpkg").string(), "--coast-layer", "land",
-            "--hmax", "100km", "-o", "o.nc", "--gpkg", "o.gpkg", "--preview", "o.png", "-q"};
+    return {exe,
+            "mesh",
+            "--coast",
+            fixture("coast/ne_110m_land.gpkg").string(),
+            "--coast-layer",
+            "land",
+            "--hmax",
+            "100km",
+            "-o",
+            "o.nc",
+            "--gpkg",
+            "o.gpkg",
+            "--preview",
+            "o.png",
+            "-q"};
 }
 
 struct Outcome {
@@ -47,16 +60,18 @@ struct Outcome {
 
 /// Starts the run in `dir`, sends `signals` (each after its delay from the start, in order),
 /// and waits for it to end. Stderr goes to a file beside the folder, not in it.
-Outcome interrupt(const fs::path& dir, const std::vector<std::pair<int, double>>& signals) {
+Outcome interrupt(const fs::path &dir, const std::vector<std::pair<int, double>> &signals) {
     std::vector<std::string> args = run_args();
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
+    std::vector<char *> argv;
+    for (auto &a : args)
+        argv.push_back(a.data());
     argv.push_back(nullptr);
     const fs::path err_path = dir.parent_path() / (dir.filename().string() + ".err");
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     posix_spawn_file_actions_addchdir_np(&actions, dir.c_str());
     pid_t pid = 0;
     const auto start = Clock::now();
@@ -64,10 +79,13 @@ Outcome interrupt(const fs::path& dir, const std::vector<std::pair<int, double>>
     posix_spawn_file_actions_destroy(&actions);
     EXPECT_EQ(spawned, 0);
     Outcome outcome;
-    if (spawned != 0) return outcome;
-    for (const auto& [signal, at_s] : signals) {
+    if (spawned != 0)
+        return outcome;
+    for (const auto &[signal, at_s] : signals) {
         std::this_thread::sleep_until(start + std::chrono::duration<double>(at_s));
-        kill(pid, signal); // a run that already ended is a zombie until waited for: never another process
+        kill(
+            pid,
+            signal); // a run that already ended is a zombie until waited for: never another process
     }
     EXPECT_EQ(waitpid(pid, &outcome.wstatus, 0), pid);
     std::stringstream err;
@@ -77,15 +95,16 @@ Outcome interrupt(const fs::path& dir, const std::vector<std::pair<int, double>>
     return outcome;
 }
 
-std::set<std::string> files_in(const fs::path& dir) {
+std::set<std::string> files_in(const fs::path &dir) {
     std::set<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir))
+        names.insert(e.path().filename().string());
     return names;
 }
 
 /// The three outputs read by other tools agree: netCDF4's face count is the GeoPackage's
 /// (sqlite3), and the PNG ends with its IEND chunk. Fails the test otherwise.
-void expect_complete(const fs::path& dir) {
+void expect_complete(const fs::path &dir) {
     std::ofstream(dir / ".check.py") << R"(
 import netCDF4, sqlite3
 nc = netCDF4.Dataset('o.nc')
@@ -108,7 +127,7 @@ const std::set<std::string> all_three = {"o.nc", "o.gpkg", "o.png"};
 
 /// What any interrupted run must leave: nothing, or all three outputs complete (status 0).
 /// Returns true when it was cancelled.
-bool expect_nothing_or_everything(const fs::path& dir, const Outcome& o, const std::string& what) {
+bool expect_nothing_or_everything(const fs::path &dir, const Outcome &o, const std::string &what) {
     SCOPED_TRACE(what);
     const std::set<std::string> left = files_in(dir);
     if (WIFEXITED(o.wstatus) && WEXITSTATUS(o.wstatus) == 0) {
@@ -116,10 +135,12 @@ bool expect_nothing_or_everything(const fs::path& dir, const Outcome& o, const s
         expect_complete(dir);
         return false;
     }
-    EXPECT_TRUE(left.empty()) << "left behind: " << *left.begin() << " (and " << left.size() - 1 << " more)";
+    EXPECT_TRUE(left.empty()) << "left behind: " << *left.begin() << " (and " << left.size() - 1
+                              << " more)";
     if (WIFSIGNALED(o.wstatus)) {
         // Before the handlers were installed, or a second signal: ended by it, nothing written.
-        EXPECT_TRUE(WTERMSIG(o.wstatus) == SIGINT || WTERMSIG(o.wstatus) == SIGTERM) << WTERMSIG(o.wstatus);
+        EXPECT_TRUE(WTERMSIG(o.wstatus) == SIGINT || WTERMSIG(o.wstatus) == SIGTERM)
+            << WTERMSIG(o.wstatus);
     } else {
         EXPECT_EQ(WEXITSTATUS(o.wstatus), 1) << o.err;
         // One line, the cancellation (cli.hpp: status 1), and no stray progress.
@@ -154,17 +175,20 @@ TEST(Interrupt, signals_at_many_points_leave_no_output_or_all_of_them) {
             TempDir dir;
             const double gap = second_after_s[k++ % std::size(second_after_s)];
             const Outcome o = interrupt(dir.path(), {{SIGINT, t}, {SIGINT, t + gap}});
-            (expect_nothing_or_everything(dir.path(), o, "SIGINT twice at " + std::to_string(t) + " s") ? cancelled
-                                                                                                     : finished)++;
+            (expect_nothing_or_everything(dir.path(), o,
+                                          "SIGINT twice at " + std::to_string(t) + " s")
+                 ? cancelled
+                 : finished)++;
         }
         {
             TempDir dir;
             const Outcome o = interrupt(dir.path(), {{SIGTERM, t}});
-            (expect_nothing_or_everything(dir.path(), o, "SIGTERM at " + std::to_string(t) + " s") ? cancelled
-                                                                                                : finished)++;
+            (expect_nothing_or_everything(dir.path(), o, "SIGTERM at " + std::to_string(t) + " s")
+                 ? cancelled
+                 : finished)++;
         }
     }
     // Not asserted (it depends on the machine's load): how the signals fell.
-    std::cout << "[  NOTE    ] run " << run_s << " s; " << cancelled << " runs cancelled, " << finished
-              << " finished before the signal\n";
+    std::cout << "[  NOTE    ] run " << run_s << " s; " << cancelled << " runs cancelled, "
+              << finished << " finished before the signal\n";
 }

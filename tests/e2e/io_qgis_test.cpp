@@ -7,9 +7,9 @@
 
 #include <fstream>
 
+#include "../unit/io_test_meshes.hpp"
 #include "globemesh/gpkg.hpp"
 #include "globemesh/ugrid.hpp"
-#include "../unit/io_test_meshes.hpp"
 #include "support.hpp"
 
 using namespace globemesh;
@@ -17,36 +17,49 @@ using namespace globemesh::test;
 
 namespace {
 
-std::filesystem::path qgis_check() { return std::filesystem::path(GLOBEMESH_SHARED_DIR) / "tools" / "qgis-check"; }
+std::filesystem::path qgis_check() {
+    return std::filesystem::path(GLOBEMESH_SHARED_DIR) / "tools" / "qgis-check";
+}
 
 bool qgis_available() {
     std::string out;
-    return std::filesystem::exists(qgis_check()) && run_command("/usr/bin/python3 -c 'import qgis.core'", out) == 0;
+    return std::filesystem::exists(qgis_check()) &&
+           run_command("/usr/bin/python3 -c 'import qgis.core'", out) == 0;
 }
 
-void check_in_qgis(const Mesh& m, const std::string& name, const std::string& crs) {
-    if (!qgis_available()) return tool_missing("qgis-check (" + qgis_check().string() + ") or QGIS (python3-qgis)");
+void check_in_qgis(const Mesh &m, const std::string &name, const std::string &crs) {
+    if (!qgis_available())
+        return tool_missing("qgis-check (" + qgis_check().string() + ") or QGIS (python3-qgis)");
     TempDir dir;
     write_ugrid(m, dir / (name + ".nc"));
     write_gpkg(m, dir / (name + ".gpkg"));
     std::string out;
-    const std::string files = (dir / (name + ".nc")).string() + " " + (dir / (name + ".gpkg")).string();
-    int status = run_command(qgis_check().string() + " --expect-faces " + std::to_string(m.faces.size()) +
-                                 " --expect-nodes " + std::to_string(m.nodes.size()) + " --crs " + crs + " --png " +
-                                 (dir / "look.png").string() + " " + files,
-                             out);
+    const std::string files =
+        (dir / (name + ".nc")).string() + " " + (dir / (name + ".gpkg")).string();
+    int status =
+        run_command(qgis_check().string() + " --expect-faces " + std::to_string(m.faces.size()) +
+                        " --expect-nodes " + std::to_string(m.nodes.size()) + " --crs " + crs +
+                        " --png " + (dir / "look.png").string() + " " + files,
+                    out);
     EXPECT_EQ(status, 0) << out;
     EXPECT_NE(out.find("(MDAL driver Ugrid)"), std::string::npos) << out;
     EXPECT_NE(out.find("crs EPSG:4326"), std::string::npos) << out;
-    EXPECT_NE(out.find("vertices " + std::to_string(m.nodes.size()) + ", faces " + std::to_string(m.faces.size())),
-              std::string::npos) << out;
-    for (const char* dataset : {"'sea floor depth' on vertices", "'quality (2*sqrt(3)*inradius/longest edge)' on faces",
-                                "'target edge length' on vertices", "'face area (geodesic, WGS84)' on faces"})
+    EXPECT_NE(out.find("vertices " + std::to_string(m.nodes.size()) + ", faces " +
+                       std::to_string(m.faces.size())),
+              std::string::npos)
+        << out;
+    for (const char *dataset :
+         {"'sea floor depth' on vertices", "'quality (2*sqrt(3)*inradius/longest edge)' on faces",
+          "'target edge length' on vertices", "'face area (geodesic, WGS84)' on faces"})
         EXPECT_NE(out.find(dataset), std::string::npos) << dataset << "\n" << out;
-    EXPECT_NE(out.find("layer 'faces' (provider ogr): valid, " + std::to_string(m.faces.size()) + " features, MultiPolygon"),
-              std::string::npos) << out;
-    EXPECT_NE(out.find("layer 'nodes' (provider ogr): valid, " + std::to_string(m.nodes.size()) + " features, Point"),
-              std::string::npos) << out;
+    EXPECT_NE(out.find("layer 'faces' (provider ogr): valid, " + std::to_string(m.faces.size()) +
+                       " features, MultiPolygon"),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("layer 'nodes' (provider ogr): valid, " + std::to_string(m.nodes.size()) +
+                       " features, Point"),
+              std::string::npos)
+        << out;
     // qgis-check warns about smeared parts through the R-tree; the .gpkg must have none (the .nc
     // stores each node once, so its warning about long triangles in lon/lat is expected).
     std::string gpkg_part = out.substr(out.find(name + ".gpkg"));
@@ -56,13 +69,16 @@ void check_in_qgis(const Mesh& m, const std::string& name, const std::string& cr
     EXPECT_TRUE(std::filesystem::file_size(dir / "look.png") > 1000);
 
     // The stored default style is what QGIS applies when it opens the faces layer.
-    std::ofstream(dir / "style.py") << "import os, sys\nos.environ['QT_QPA_PLATFORM'] = 'offscreen'\n"
-                                       "from qgis.core import QgsApplication, QgsVectorLayer\n"
-                                       "app = QgsApplication([], False)\napp.initQgis()\n"
-                                       "l = QgsVectorLayer(sys.argv[1] + '|layername=faces', 'f', 'ogr')\n"
-                                       "r = l.renderer()\nprint('RENDERER', r.type(), r.classAttribute() if "
-                                       "r.type() == 'graduatedSymbol' else '-', flush=True)\nos._exit(0)\n";
-    status = run_command("/usr/bin/python3 " + (dir / "style.py").string() + " " + (dir / (name + ".gpkg")).string(), out);
+    std::ofstream(dir / "style.py")
+        << "import os, sys\nos.environ['QT_QPA_PLATFORM'] = 'offscreen'\n"
+           "from qgis.core import QgsApplication, QgsVectorLayer\n"
+           "app = QgsApplication([], False)\napp.initQgis()\n"
+           "l = QgsVectorLayer(sys.argv[1] + '|layername=faces', 'f', 'ogr')\n"
+           "r = l.renderer()\nprint('RENDERER', r.type(), r.classAttribute() if "
+           "r.type() == 'graduatedSymbol' else '-', flush=True)\nos._exit(0)\n";
+    status = run_command("/usr/bin/python3 " + (dir / "style.py").string() + " " +
+                             (dir / (name + ".gpkg")).string(),
+                         out);
     EXPECT_EQ(status, 0) << out;
     EXPECT_NE(out.find("RENDERER graduatedSymbol quality"), std::string::npos) << out;
 }

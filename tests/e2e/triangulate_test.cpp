@@ -37,23 +37,28 @@ CliRun triangulate(std::vector<std::string> args) {
     return {status, out.str(), err.str()};
 }
 
-void write_csv(const fs::path& path, const std::vector<std::array<double, 2>>& lonlat) {
+void write_csv(const fs::path &path, const std::vector<std::array<double, 2>> &lonlat) {
     std::ofstream f(path);
     f.precision(17);
     f << "id,lon,lat\n";
-    for (std::size_t i = 0; i < lonlat.size(); ++i) f << i << "," << lonlat[i][0] << "," << lonlat[i][1] << "\n";
+    for (std::size_t i = 0; i < lonlat.size(); ++i)
+        f << i << "," << lonlat[i][0] << "," << lonlat[i][1] << "\n";
 }
 
-std::vector<std::array<double, 2>> random_lonlat(std::size_t n, double lat_min, double lat_max, unsigned seed) {
+std::vector<std::array<double, 2>> random_lonlat(std::size_t n, double lat_min, double lat_max,
+                                                 unsigned seed) {
     std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> lon(-180, 180), z(std::sin(lat_min * M_PI / 180), std::sin(lat_max * M_PI / 180));
+    std::uniform_real_distribution<double> lon(-180, 180),
+        z(std::sin(lat_min * M_PI / 180), std::sin(lat_max * M_PI / 180));
     std::vector<std::array<double, 2>> p(n);
-    for (auto& q : p) q = {lon(rng), std::asin(z(rng)) * 180 / M_PI};
+    for (auto &q : p)
+        q = {lon(rng), std::asin(z(rng)) * 180 / M_PI};
     return p;
 }
 
-// Faces as a set of vertex triples, each rotated to start at its smallest index (keeps orientation).
-std::set<std::array<globemesh::NodeIndex, 3>> face_set(const globemesh::Mesh& m) {
+// Faces as a set of vertex triples, each rotated to start at its smallest index (keeps
+// orientation).
+std::set<std::array<globemesh::NodeIndex, 3>> face_set(const globemesh::Mesh &m) {
     std::set<std::array<globemesh::NodeIndex, 3>> s;
     for (auto f : m.faces) {
         std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
@@ -62,14 +67,16 @@ std::set<std::array<globemesh::NodeIndex, 3>> face_set(const globemesh::Mesh& m)
     return s;
 }
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+int line_count(const std::string &s) {
+    return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
 
 } // namespace
 
 TEST(Triangulate, stations_csv_gives_a_closed_delaunay_mesh_in_netcdf_and_geopackage) {
     TempDir dir;
-    CliRun r = triangulate({fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(), "--gpkg",
-                         (dir / "s.gpkg").string(), "-q"});
+    CliRun r = triangulate({fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(),
+                            "--gpkg", (dir / "s.gpkg").string(), "-q"});
     ASSERT_EQ(r.status, 0) << r.err;
     ASSERT_TRUE(fs::exists(dir / "s.gpkg"));
     globemesh::Mesh m = globemesh::read_ugrid(dir / "s.nc");
@@ -92,24 +99,28 @@ TEST(Triangulate, random_points_csv_gives_a_closed_mesh_with_every_point) {
 
 TEST(Triangulate, geopackage_in_web_mercator_gives_the_same_triangles_as_the_lonlat_csv) {
     std::string out;
-    if (globemesh::test::run_command("ogr2ogr --version", out) != 0) GTEST_SKIP() << "ogr2ogr not found";
+    if (globemesh::test::run_command("ogr2ogr --version", out) != 0)
+        GTEST_SKIP() << "ogr2ogr not found";
     TempDir dir;
     write_csv(dir / "p.csv", random_lonlat(3000, -80, 80, 11));
     // ogr2ogr (GDAL's own tool, not our reader) writes the same points in EPSG:3857.
-    ASSERT_EQ(globemesh::test::run_command("ogr2ogr -f GPKG " + (dir / "p3857.gpkg").string() + " " +
-                                               (dir / "p.csv").string() +
+    ASSERT_EQ(globemesh::test::run_command("ogr2ogr -f GPKG " + (dir / "p3857.gpkg").string() +
+                                               " " + (dir / "p.csv").string() +
                                                " -oo X_POSSIBLE_NAMES=lon -oo Y_POSSIBLE_NAMES=lat "
                                                "-s_srs EPSG:4326 -t_srs EPSG:3857 -nln merc",
                                            out),
               0)
         << out;
     CliRun a = triangulate({(dir / "p.csv").string(), "-o", (dir / "a.nc").string(), "-q"});
-    CliRun b = triangulate({(dir / "p3857.gpkg").string(), "--layer", "merc", "-o", (dir / "b.nc").string(), "-q"});
+    CliRun b = triangulate(
+        {(dir / "p3857.gpkg").string(), "--layer", "merc", "-o", (dir / "b.nc").string(), "-q"});
     ASSERT_EQ(a.status, 0) << a.err;
     ASSERT_EQ(b.status, 0) << b.err;
-    globemesh::Mesh ma = globemesh::read_ugrid(dir / "a.nc"), mb = globemesh::read_ugrid(dir / "b.nc");
+    globemesh::Mesh ma = globemesh::read_ugrid(dir / "a.nc"),
+                    mb = globemesh::read_ugrid(dir / "b.nc");
     ASSERT_EQ(ma.nodes.size(), mb.nodes.size());
-    for (std::size_t i = 0; i < ma.nodes.size(); ++i) // same node order (the input's), nearly same place
+    for (std::size_t i = 0; i < ma.nodes.size();
+         ++i) // same node order (the input's), nearly same place
         ASSERT_LT(globemesh::arc_angle(ma.nodes[i], mb.nodes[i]), 1e-9) << "node " << i;
     EXPECT_EQ(face_set(ma), face_set(mb));
 }
@@ -118,7 +129,8 @@ TEST(Triangulate, one_degree_grid_with_both_poles_merges_the_pole_rows) {
     TempDir dir;
     std::vector<std::array<double, 2>> grid;
     for (int lat = -90; lat <= 90; ++lat)
-        for (int lon = -180; lon < 180; ++lon) grid.push_back({double(lon), double(lat)});
+        for (int lon = -180; lon < 180; ++lon)
+            grid.push_back({double(lon), double(lat)});
     write_csv(dir / "grid.csv", grid);
     CliRun r = triangulate({(dir / "grid.csv").string(), "-o", (dir / "g.nc").string(), "-q"});
     ASSERT_EQ(r.status, 0) << r.err;
@@ -138,54 +150,59 @@ TEST(Triangulate, points_in_one_hemisphere_give_a_disk_with_an_open_boundary) {
     ASSERT_FALSE(m.boundary.empty());
     // A triangulated disk: F = 2V - B - 2, with B boundary edges (= boundary vertices).
     EXPECT_EQ(m.faces.size(), 2 * m.nodes.size() - m.boundary.size() - 2);
-    for (const auto& e : m.boundary) EXPECT_EQ(e.tag, globemesh::EdgeTag::open);
+    for (const auto &e : m.boundary)
+        EXPECT_EQ(e.tag, globemesh::EdgeTag::open);
     globemesh::test::expect_mesh_verify(dir / "n.nc");
 }
 
 TEST(Triangulate, timings_json_has_read_sort_triangulate_and_write) {
     TempDir dir;
-    CliRun r = triangulate({fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(), "--timings",
-                         (dir / "t.json").string(), "-q"});
+    CliRun r = triangulate({fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(),
+                            "--timings", (dir / "t.json").string(), "-q"});
     ASSERT_EQ(r.status, 0) << r.err;
     std::ifstream f(dir / "t.json");
     std::string json((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     EXPECT_EQ(json.rfind("{\"stages\": {", 0), 0u) << json;
-    for (const char* key : {"\"read\": ", "\"sort\": ", "\"triangulate\": ", "\"write\": "})
+    for (const char *key : {"\"read\": ", "\"sort\": ", "\"triangulate\": ", "\"write\": "})
         EXPECT_NE(json.find(key), std::string::npos) << key << " missing in " << json;
 }
 
 struct BadInput {
-    const char* name;
-    const char* csv; // file content; nullptr: the file does not exist
-    const char* message; // a word the error line must hold
+    const char *name;
+    const char *csv;     // file content; nullptr: the file does not exist
+    const char *message; // a word the error line must hold
 };
 
 class TriangulateBadInput : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(TriangulateBadInput, fails_with_one_line_and_leaves_no_output) {
-    const BadInput& bad = GetParam();
+    const BadInput &bad = GetParam();
     TempDir dir;
     const fs::path in = dir / "in.csv";
     if (bad.csv) {
         std::ofstream f(in);
         f << bad.csv;
     }
-    CliRun r = triangulate({in.string(), "-o", (dir / "out.nc").string(), "--gpkg", (dir / "out.gpkg").string(),
-                         "--timings", (dir / "t.json").string(), "-q"});
+    CliRun r =
+        triangulate({in.string(), "-o", (dir / "out.nc").string(), "--gpkg",
+                     (dir / "out.gpkg").string(), "--timings", (dir / "t.json").string(), "-q"});
     EXPECT_EQ(r.status, 1) << r.err;
     EXPECT_EQ(line_count(r.err), 1) << r.err;
     EXPECT_EQ(r.err.rfind("globemesh: ", 0), 0u) << r.err;
     EXPECT_NE(r.err.find(bad.message), std::string::npos) << r.err;
-    for (const auto& e : fs::directory_iterator(dir.path()))
+    for (const auto &e : fs::directory_iterator(dir.path()))
         EXPECT_EQ(e.path().filename(), "in.csv") << "left behind: " << e.path();
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Triangulate, TriangulateBadInput,
-    ::testing::Values(BadInput{"missing_file", nullptr, "in.csv"},
-                      BadInput{"empty_layer", "id,lon,lat\n", "no points"},
-                      BadInput{"two_points", "id,lon,lat\n1,0,0\n2,10,10\n", "fewer than 3 distinct points"},
-                      BadInput{"all_on_the_equator", "id,lon,lat\n1,0,0\n2,10,0\n3,50,0\n4,120,0\n5,-100,0\n", "one circle"},
-                      BadInput{"non_numeric_longitude", "id,lon,lat\n1,0,0\n2,abc,10\n3,50,5\n4,20,-3\n", "feature 2"},
-                      BadInput{"latitude_95", "id,lon,lat\n1,0,0\n2,10,95\n3,50,5\n4,20,-3\n", "feature 2"}),
-    [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+    ::testing::Values(
+        BadInput{"missing_file", nullptr, "in.csv"},
+        BadInput{"empty_layer", "id,lon,lat\n", "no points"},
+        BadInput{"two_points", "id,lon,lat\n1,0,0\n2,10,10\n", "fewer than 3 distinct points"},
+        BadInput{"all_on_the_equator", "id,lon,lat\n1,0,0\n2,10,0\n3,50,0\n4,120,0\n5,-100,0\n",
+                 "one circle"},
+        BadInput{"non_numeric_longitude", "id,lon,lat\n1,0,0\n2,abc,10\n3,50,5\n4,20,-3\n",
+                 "feature 2"},
+        BadInput{"latitude_95", "id,lon,lat\n1,0,0\n2,10,95\n3,50,5\n4,20,-3\n", "feature 2"}),
+    [](const ::testing::TestParamInfo<BadInput> &info) { return std::string(info.param.name); });

@@ -57,22 +57,24 @@ namespace {
 // through -timeout).
 constexpr bool known_mesher_bugs = false;
 
-std::string g_json;  // for failure messages
-bool g_print = false; // GLOBEMESH_FUZZ_PRINT set: print every decoded input (to replay a finding) and refusal
+std::string g_json; // for failure messages
+bool g_print =
+    false; // GLOBEMESH_FUZZ_PRINT set: print every decoded input (to replay a finding) and refusal
 
 // Outcomes of the inputs run so far, printed at exit.
 std::size_t g_meshed = 0, g_refused = 0;
 
-void refused(const std::exception& e) {
+void refused(const std::exception &e) {
     ++g_refused;
-    if (g_print) std::fprintf(stderr, "refused: %s\n", e.what());
+    if (g_print)
+        std::fprintf(stderr, "refused: %s\n", e.what());
 }
 
 void print_outcomes() {
     std::fprintf(stderr, "fuzz_coast outcomes: %zu meshed, %zu refused\n", g_meshed, g_refused);
 }
 
-[[noreturn]] void fail(const std::string& what) {
+[[noreturn]] void fail(const std::string &what) {
     std::fprintf(stderr, "fuzz_coast: %s\ninput GeoJSON:\n%s\n", what.c_str(), g_json.c_str());
     std::abort();
 }
@@ -84,31 +86,60 @@ std::string num(double v) {
 }
 
 struct Decoder {
-    FuzzedDataProvider& in;
+    FuzzedDataProvider &in;
     double last_lon = 0, last_lat = 0;
 
     std::pair<double, double> vertex(int shape, int i, int n, double cx, double cy, double r) {
         double lon, lat;
         const int mode = in.ConsumeIntegralInRange<int>(0, 15);
         switch (mode) {
-        case 0: lon = in.ConsumeFloatingPointInRange<double>(-180, 180); lat = in.ConsumeFloatingPointInRange<double>(-90, 90); break;
-        case 1: lon = in.ConsumeBool() ? 180.0 : -180.0; lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r); break;
-        case 2: lon = in.ConsumeBool() ? 180.00000000000014 : -180.00000000000014; lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r); break;
-        case 3: lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r); lat = in.ConsumeBool() ? 90.0 : -90.0; break;
-        case 4: lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r); lat = (in.ConsumeBool() ? 1 : -1) * (90 - std::pow(10.0, in.ConsumeFloatingPointInRange<double>(-12, 0))); break;
-        case 5: lon = last_lon; lat = last_lat; break;
+        case 0:
+            lon = in.ConsumeFloatingPointInRange<double>(-180, 180);
+            lat = in.ConsumeFloatingPointInRange<double>(-90, 90);
+            break;
+        case 1:
+            lon = in.ConsumeBool() ? 180.0 : -180.0;
+            lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r);
+            break;
+        case 2:
+            lon = in.ConsumeBool() ? 180.00000000000014 : -180.00000000000014;
+            lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r);
+            break;
+        case 3:
+            lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r);
+            lat = in.ConsumeBool() ? 90.0 : -90.0;
+            break;
+        case 4:
+            lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r);
+            lat = (in.ConsumeBool() ? 1 : -1) *
+                  (90 - std::pow(10.0, in.ConsumeFloatingPointInRange<double>(-12, 0)));
+            break;
+        case 5:
+            lon = last_lon;
+            lat = last_lat;
+            break;
         case 6: {
             const double e = std::pow(10.0, in.ConsumeFloatingPointInRange<double>(-12, -5));
             lon = last_lon + e * in.ConsumeIntegralInRange<int>(-1, 1);
             lat = last_lat + e * in.ConsumeIntegralInRange<int>(-1, 1);
             break;
         }
-        case 7: lon = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1), -in.ConsumeIntegralInRange<int>(0, 1000));
-                lat = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1), -in.ConsumeIntegralInRange<int>(0, 1000)); break;
-        case 8: lon = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1), in.ConsumeIntegralInRange<int>(8, 996));
-                lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r); break;
-        case 9: lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r);
-                lat = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1), in.ConsumeIntegralInRange<int>(7, 996)); break;
+        case 7:
+            lon = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1),
+                             -in.ConsumeIntegralInRange<int>(0, 1000));
+            lat = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1),
+                             -in.ConsumeIntegralInRange<int>(0, 1000));
+            break;
+        case 8:
+            lon = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1),
+                             in.ConsumeIntegralInRange<int>(8, 996));
+            lat = cy + in.ConsumeFloatingPointInRange<double>(-r, r);
+            break;
+        case 9:
+            lon = cx + in.ConsumeFloatingPointInRange<double>(-r, r);
+            lat = std::ldexp(in.ConsumeFloatingPointInRange<double>(-1, 1),
+                             in.ConsumeIntegralInRange<int>(7, 996));
+            break;
         default: { // on a (possibly self-intersecting) star polygon about (cx, cy)
             const int turns = shape; // 1: simple, 2+: a star that crosses itself
             const double t = 2 * pi * turns * i / n;
@@ -133,16 +164,19 @@ struct Decoder {
         for (int i = 0; i < n; ++i) {
             const auto [lon, lat] = vertex(shape, i, n, cx, cy, r);
             const std::string p = "[" + num(lon) + "," + num(lat) + "]";
-            if (i == 0) first = p;
+            if (i == 0)
+                first = p;
             s += (i ? "," : "") + p;
         }
-        if (closed) s += "," + first;
+        if (closed)
+            s += "," + first;
         return s + "]";
     }
 
     std::string polygon_rings() {
         std::string s = "[" + ring(true);
-        for (int h = in.ConsumeIntegralInRange<int>(0, 2); h > 0; --h) s += "," + ring(true);
+        for (int h = in.ConsumeIntegralInRange<int>(0, 2); h > 0; --h)
+            s += "," + ring(true);
         return s + "]";
     }
 
@@ -150,49 +184,62 @@ struct Decoder {
         switch (in.ConsumeIntegralInRange<int>(0, 5)) {
         case 0:
         case 1:
-        case 2: return "{\"type\":\"Polygon\",\"coordinates\":" + polygon_rings() + "}";
+        case 2:
+            return "{\"type\":\"Polygon\",\"coordinates\":" + polygon_rings() + "}";
         case 3: {
             std::string s = "{\"type\":\"MultiPolygon\",\"coordinates\":[" + polygon_rings();
-            for (int k = in.ConsumeIntegralInRange<int>(0, 2); k > 0; --k) s += "," + polygon_rings();
+            for (int k = in.ConsumeIntegralInRange<int>(0, 2); k > 0; --k)
+                s += "," + polygon_rings();
             return s + "]}";
         }
-        default: return "{\"type\":\"LineString\",\"coordinates\":" + ring(in.ConsumeBool()) + "}";
+        default:
+            return "{\"type\":\"LineString\",\"coordinates\":" + ring(in.ConsumeBool()) + "}";
         }
     }
 };
 
-void check_mesh(const Mesh& m) {
+void check_mesh(const Mesh &m) {
     const std::size_t n = m.nodes.size();
-    for (const Vec3& p : m.nodes)
-        if (!(std::fabs(norm(p) - 1) < 1e-12)) fail("a node is not a unit vector");
+    for (const Vec3 &p : m.nodes)
+        if (!(std::fabs(norm(p) - 1) < 1e-12))
+            fail("a node is not a unit vector");
     std::set<std::pair<NodeIndex, NodeIndex>> directed;
-    for (const auto& f : m.faces) {
+    for (const auto &f : m.faces) {
         for (NodeIndex v : f)
-            if (v >= n) fail("a face refers to a node out of range");
-        if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) fail("a face repeats a node");
+            if (v >= n)
+                fail("a face refers to a node out of range");
+        if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
+            fail("a face repeats a node");
         const int o = predicates::orient(m.nodes[f[0]], m.nodes[f[1]], m.nodes[f[2]]);
-        if (o == 0 || (o < 0 && !known_mesher_bugs)) fail("a face is not counter-clockwise on the sphere");
+        if (o == 0 || (o < 0 && !known_mesher_bugs))
+            fail("a face is not counter-clockwise on the sphere");
         for (int k = 0; k < 3; ++k)
-            if (!directed.insert({f[k], f[(k + 1) % 3]}).second) fail("a directed edge appears in two faces");
+            if (!directed.insert({f[k], f[(k + 1) % 3]}).second)
+                fail("a directed edge appears in two faces");
     }
     std::set<std::pair<NodeIndex, NodeIndex>> boundary;
-    for (const BoundaryEdge& e : m.boundary) {
-        if (!directed.count({e.a, e.b})) fail("a boundary edge is not an edge of a face, oriented like it");
-        if (directed.count({e.b, e.a})) fail("a boundary edge has faces on both sides");
+    for (const BoundaryEdge &e : m.boundary) {
+        if (!directed.count({e.a, e.b}))
+            fail("a boundary edge is not an edge of a face, oriented like it");
+        if (directed.count({e.b, e.a}))
+            fail("a boundary edge has faces on both sides");
         boundary.insert({e.a, e.b});
     }
-    for (const auto& [a, b] : directed)
-        if (!directed.count({b, a}) && !boundary.count({a, b})) fail("an edge with one face is not a boundary edge");
+    for (const auto &[a, b] : directed)
+        if (!directed.count({b, a}) && !boundary.count({a, b}))
+            fail("an edge with one face is not a boundary edge");
     std::vector<char> used(n, 0);
-    for (const auto& f : m.faces)
-        for (NodeIndex v : f) used[v] = 1;
+    for (const auto &f : m.faces)
+        for (NodeIndex v : f)
+            used[v] = 1;
     for (std::size_t i = 0; i < n; ++i)
-        if (!used[i]) fail("a node belongs to no face");
+        if (!used[i])
+            fail("a node belongs to no face");
 }
 
 } // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
+extern "C" int LLVMFuzzerInitialize(int *, char ***) {
     CPLSetErrorHandler(CPLQuietErrorHandler);
     g_print = std::getenv("GLOBEMESH_FUZZ_PRINT") != nullptr;
     GDALAllRegister();
@@ -200,13 +247,14 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     return 0;
 }
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
     FuzzedDataProvider in(data, size);
     Decoder dec{in};
     std::string json = "{\"type\":\"FeatureCollection\",\"features\":[";
     const int features = in.ConsumeIntegralInRange<int>(1, 3);
     for (int k = 0; k < features; ++k)
-        json += std::string(k ? "," : "") + "{\"type\":\"Feature\",\"properties\":{},\"geometry\":" + dec.geometry() + "}";
+        json += std::string(k ? "," : "") +
+                "{\"type\":\"Feature\",\"properties\":{},\"geometry\":" + dec.geometry() + "}";
     json += "]}";
     g_json = json;
 
@@ -228,31 +276,36 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     g_json += "\nh " + num(h) + " keep_inland_seas " + std::to_string(options.keep_inland_seas) +
               " min_island_triangles " + num(options.min_island_triangles);
 
-    if (g_print) std::fprintf(stderr, "%s\n", g_json.c_str());
-    VSILFILE* f = VSIFileFromMemBuffer(options.coast.c_str(), reinterpret_cast<GByte*>(json.data()),
-                                       static_cast<vsi_l_offset>(json.size()), FALSE);
-    if (!f) fail("cannot create the /vsimem/ file");
+    if (g_print)
+        std::fprintf(stderr, "%s\n", g_json.c_str());
+    VSILFILE *f =
+        VSIFileFromMemBuffer(options.coast.c_str(), reinterpret_cast<GByte *>(json.data()),
+                             static_cast<vsi_l_offset>(json.size()), FALSE);
+    if (!f)
+        fail("cannot create the /vsimem/ file");
     VSIFCloseL(f);
     try {
         const CoastData coast = load_coast(options);
-        const SizeFn size = [h](const Vec3&) { return h; };
+        const SizeFn size = [h](const Vec3 &) { return h; };
         const Boundary boundary = shape_boundary(coast, size, options);
         const auto issues = check_boundary(boundary);
-        if (!issues.empty()) fail("shape_boundary returned an invalid boundary: " + issues.front().what);
+        if (!issues.empty())
+            fail("shape_boundary returned an invalid boundary: " + issues.front().what);
         if (g_print)
-            for (const Ring& r : boundary.rings) {
+            for (const Ring &r : boundary.rings) {
                 std::fprintf(stderr, "ring:");
                 for (std::size_t i = 0; i < r.nodes.size(); ++i)
-                    std::fprintf(stderr, " {%a, %a, %a}%s", r.nodes[i].x, r.nodes[i].y, r.nodes[i].z,
-                                 r.kinds[i] == SegmentKind::open ? "o" : "");
+                    std::fprintf(stderr, " {%a, %a, %a}%s", r.nodes[i].x, r.nodes[i].y,
+                                 r.nodes[i].z, r.kinds[i] == SegmentKind::open ? "o" : "");
                 std::fprintf(stderr, "\n");
             }
         MesherOptions mo;
         mo.max_nodes = 20000;
         mo.keep_inland_seas = options.keep_inland_seas;
         mo.smooth_iterations = 2;
-        mo.lattice_km = h; // as the pipeline
-        mo.land = coast.land; // faces centred on land removed, straits closed (MesherOptions::close_straits)
+        mo.lattice_km = h;    // as the pipeline
+        mo.land = coast.land; // faces centred on land removed, straits closed
+                              // (MesherOptions::close_straits)
         // Refinement reports progress every 16384 insertions; with at most 20000 nodes asked
         // for, a 5th report is a runaway (a known mesher bug, see known_mesher_bugs).
         std::size_t reports = 0;
@@ -262,18 +315,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         Mesh mesh;
         try {
             mesh = mesh_boundary(boundary, size, mo, nullptr, guard);
-        } catch (const Cancelled&) {
-            if (!known_mesher_bugs) fail("mesh_boundary ran away (over 65000 insertions for <= 20000 nodes)");
+        } catch (const Cancelled &) {
+            if (!known_mesher_bugs)
+                fail("mesh_boundary ran away (over 65000 insertions for <= 20000 nodes)");
             VSIUnlink(options.coast.c_str());
             return 0;
         }
         check_mesh(mesh);
         ++g_meshed;
-    } catch (const DataError& e) {
+    } catch (const DataError &e) {
         refused(e);
-    } catch (const UsageError& e) {
+    } catch (const UsageError &e) {
         refused(e);
-    } catch (const std::exception& e) {
+    } catch (const std::exception &e) {
         fail(std::string("unexpected exception: ") + typeid(e).name() + ": " + e.what());
     }
     VSIUnlink(options.coast.c_str());

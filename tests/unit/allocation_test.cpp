@@ -16,7 +16,7 @@
 namespace {
 
 // The VmFlags line of the mapping that holds p, or "" when none does (no smaps: not Linux).
-std::string mapping_flags(const void* p) {
+std::string mapping_flags(const void *p) {
     const auto at = reinterpret_cast<std::uintptr_t>(p);
     std::ifstream smaps("/proc/self/smaps");
     std::string line;
@@ -25,21 +25,26 @@ std::string mapping_flags(const void* p) {
         std::uintptr_t lo = 0, hi = 0;
         char dash = 0;
         std::istringstream range(line);
-        if (range >> std::hex >> lo >> dash >> hi && dash == '-' && line.find(':') > line.find(' ')) {
+        if (range >> std::hex >> lo >> dash >> hi && dash == '-' &&
+            line.find(':') > line.find(' ')) {
             inside = lo <= at && at < hi;
             continue;
         }
-        if (inside && line.rfind("VmFlags:", 0) == 0) return line;
+        if (inside && line.rfind("VmFlags:", 0) == 0)
+            return line;
     }
     return "";
 }
 
-bool advised_huge(const std::string& flags) { return flags.find(" hg") != std::string::npos; }
+bool advised_huge(const std::string &flags) {
+    return flags.find(" hg") != std::string::npos;
+}
 
 class Allocation : public ::testing::Test {
 protected:
     void SetUp() override {
-        if (!globemesh::replaces_operator_new()) GTEST_SKIP() << "operator new is not replaced in this build";
+        if (!globemesh::replaces_operator_new())
+            GTEST_SKIP() << "operator new is not replaced in this build";
         globemesh::configure_allocation();
     }
 };
@@ -58,14 +63,15 @@ TEST_F(Allocation, blocks_of_1_mib_and_more_start_on_a_huge_page_boundary) {
     // would be filled 4 KiB at a time.
     for (const std::size_t kib : {1024, 1500, 3000, 16384}) {
         const std::unique_ptr<char[]> block(new char[kib << 10]);
-        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(block.get()) % (std::uintptr_t{2} << 20), 0u) << kib << " KiB";
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(block.get()) % (std::uintptr_t{2} << 20), 0u)
+            << kib << " KiB";
         EXPECT_TRUE(advised_huge(mapping_flags(block.get()))) << kib << " KiB";
         block[(kib << 10) - 1] = 1; // the whole block is there to write
     }
 }
 
 TEST_F(Allocation, a_freed_large_block_is_given_back) {
-    char* block = new char[3 << 20];
+    char *block = new char[3 << 20];
     ASSERT_FALSE(mapping_flags(block).empty());
     delete[] block;
     EXPECT_EQ(mapping_flags(block), "") << "the block's mapping is still there after delete";
@@ -73,7 +79,8 @@ TEST_F(Allocation, a_freed_large_block_is_given_back) {
 
 TEST_F(Allocation, more_large_blocks_than_the_table_holds_come_from_malloc_and_are_freed_alike) {
     std::vector<std::unique_ptr<char[]>> blocks;
-    for (int i = 0; i < 1100; ++i) blocks.emplace_back(new char[1 << 20]); // the table holds 1024
+    for (int i = 0; i < 1100; ++i)
+        blocks.emplace_back(new char[1 << 20]); // the table holds 1024
     std::size_t aligned = 0;
     for (std::size_t i = 0; i < blocks.size(); ++i) {
         if (reinterpret_cast<std::uintptr_t>(blocks[i].get()) % (std::uintptr_t{2} << 20) == 0) {

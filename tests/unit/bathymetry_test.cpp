@@ -40,7 +40,8 @@ struct GridSpec {
 };
 
 /// Writes a GeoTIFF whose pixel (i, j) holds value(x_centre, y_centre) (CRS units).
-void write_tiff(const std::string& path, const GridSpec& s, const std::function<double(double, double)>& value) {
+void write_tiff(const std::string &path, const GridSpec &s,
+                const std::function<double(double, double)> &value) {
     GDALAllRegister();
     GDALDriverH drv = GDALGetDriverByName("GTiff");
     GDALDatasetH ds = GDALCreate(drv, path.c_str(), s.nx, s.ny, s.bands, s.type, nullptr);
@@ -56,35 +57,42 @@ void write_tiff(const std::string& path, const GridSpec& s, const std::function<
     std::vector<double> row(static_cast<std::size_t>(s.nx));
     for (int b = 1; b <= s.bands; ++b) {
         GDALRasterBandH band = GDALGetRasterBand(ds, b);
-        if (s.nodata) GDALSetRasterNoDataValue(band, *s.nodata);
+        if (s.nodata)
+            GDALSetRasterNoDataValue(band, *s.nodata);
         if (s.scale_offset) {
             GDALSetRasterScale(band, s.scale_offset->first);
             GDALSetRasterOffset(band, s.scale_offset->second);
         }
         for (int j = 0; j < s.ny; ++j) {
             for (int i = 0; i < s.nx; ++i)
-                row[static_cast<std::size_t>(i)] = value(s.west + (i + 0.5) * s.dx, s.north - (j + 0.5) * s.dy);
-            ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, j, s.nx, 1, row.data(), s.nx, 1, GDT_Float64, 0, 0), CE_None);
+                row[static_cast<std::size_t>(i)] =
+                    value(s.west + (i + 0.5) * s.dx, s.north - (j + 0.5) * s.dy);
+            ASSERT_EQ(
+                GDALRasterIO(band, GF_Write, 0, j, s.nx, 1, row.data(), s.nx, 1, GDT_Float64, 0, 0),
+                CE_None);
         }
     }
     GDALClose(ds);
 }
 
 /// The value a Float32 raster stores for v.
-double f32(double v) { return static_cast<double>(static_cast<float>(v)); }
+double f32(double v) {
+    return static_cast<double>(static_cast<float>(v));
+}
 
-MeshOptions options_for(const std::string& path) {
+MeshOptions options_for(const std::string &path) {
     MeshOptions o;
     o.bathy = path;
     return o;
 }
 
 /// One pixel of a raster read with GDALRasterIO as Float64, for independent checks.
-double gdal_pixel(const std::string& path, int i, int j) {
+double gdal_pixel(const std::string &path, int i, int j) {
     GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
     double v = std::nan("");
     if (ds) {
-        if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, i, j, 1, 1, &v, 1, 1, GDT_Float64, 0, 0) != CE_None)
+        if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, i, j, 1, 1, &v, 1, 1, GDT_Float64, 0,
+                         0) != CE_None)
             v = std::nan("");
         GDALClose(ds);
     }
@@ -105,7 +113,8 @@ TEST(Bathymetry, linear_slope_is_exact_at_nodes_and_inside_cells) {
     EXPECT_FALSE(r.global());
     for (std::size_t j = 0; j < r.nlat(); ++j)
         for (std::size_t i = 0; i < r.nlon(); ++i) {
-            double lon = 10.25 + 0.5 * static_cast<double>(i), lat = 49.75 - 0.5 * static_cast<double>(j);
+            double lon = 10.25 + 0.5 * static_cast<double>(i),
+                   lat = 49.75 - 0.5 * static_cast<double>(j);
             EXPECT_NEAR(r.elevation_m(lon, lat), plane(lon, lat), 1e-9);
             EXPECT_NEAR(r.elevation_m(lonlat_to_vec(lon, lat)), plane(lon, lat), 1e-9);
             EXPECT_NEAR(r.depth_m(lonlat_to_vec(lon, lat)), -plane(lon, lat), 1e-9);
@@ -126,7 +135,9 @@ TEST(Bathymetry, linear_slope_is_exact_at_nodes_and_inside_cells) {
 TEST(Bathymetry, bilinear_function_is_reproduced_exactly_inside_cells) {
     TempDir dir;
     const std::string path = (dir / "bilinear.tif").string();
-    auto f = [](double lon, double lat) { return 3.0 * (lon - 10.0) * (lat - 40.0) - 2.0 * lon + lat - 500.0; };
+    auto f = [](double lon, double lat) {
+        return 3.0 * (lon - 10.0) * (lat - 40.0) - 2.0 * lon + lat - 500.0;
+    };
     write_tiff(path, {10, 50, 0.5, 0.5, 21, 15}, f);
     Raster r = read_raster(path);
     std::mt19937 rng(7);
@@ -150,10 +161,13 @@ TEST(Bathymetry, gaussian_seamount_matches_its_formula) {
     double max_node_err = 0, max_err = 0;
     for (std::size_t j = 0; j < r.nlat(); j += 7)
         for (std::size_t i = 0; i < r.nlon(); i += 7) {
-            double lon = -32 + 0.01 + 0.02 * static_cast<double>(i), lat = 22 - 0.01 - 0.02 * static_cast<double>(j);
-            max_node_err = std::max(max_node_err, std::abs(r.elevation_m(lon, lat) - f32(z(lon, lat))));
+            double lon = -32 + 0.01 + 0.02 * static_cast<double>(i),
+                   lat = 22 - 0.01 - 0.02 * static_cast<double>(j);
+            max_node_err =
+                std::max(max_node_err, std::abs(r.elevation_m(lon, lat) - f32(z(lon, lat))));
             // Between nodes: bilinear error bounded by |second derivative| * h^2 / 8.
-            max_err = std::max(max_err, std::abs(r.elevation_m(lon + 0.007, lat - 0.013) - z(lon + 0.007, lat - 0.013)));
+            max_err = std::max(max_err, std::abs(r.elevation_m(lon + 0.007, lat - 0.013) -
+                                                 z(lon + 0.007, lat - 0.013)));
         }
     EXPECT_LT(max_node_err, 1e-9);
     // |z''| <= 4000 / 0.25 per degree^2 = 16000; h = 0.02 deg: 16000 * 4e-4 / 8 * 2 axes = 1.6 m.
@@ -165,7 +179,9 @@ TEST(Bathymetry, global_grid_in_0_360_wraps_across_the_antimeridian) {
     TempDir dir;
     const std::string path = (dir / "global360.tif").string();
     // 1-degree cells, lon 0..360; integer values so that float storage is exact.
-    auto z = [](double lon, double lat) { return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000; };
+    auto z = [](double lon, double lat) {
+        return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000;
+    };
     write_tiff(path, {0, 90, 1, 1, 360, 180}, z);
     MeshOptions o = options_for(path);
     Raster r = read_bathymetry(o); // covers the globe: no DataError
@@ -177,12 +193,14 @@ TEST(Bathymetry, global_grid_in_0_360_wraps_across_the_antimeridian) {
     // Across the seam between column 359 (359.5) and column 0 (0.5 == 360.5).
     for (double lon : {-0.3, 359.7, 0.2, -359.8}) {
         double u = (std::fmod(lon + 360.0, 360.0) - 359.5 + (lon > 0 && lon < 0.5 ? 360 : 0));
-        if (u < 0) u += 360;
+        if (u < 0)
+            u += 360;
         double expect = (1 - u) * z(359.5, 10.5) + u * z(0.5, 10.5);
         EXPECT_NEAR(r.elevation_m(lon, 10.5), expect, 1e-9) << lon;
     }
     // Near the poles the first and last rows are held.
-    EXPECT_NEAR(r.elevation_m(lonlat_to_vec(0, 90)), z(0.5, 89.5) * 0.5 + z(359.5, 89.5) * 0.5, 1e-9);
+    EXPECT_NEAR(r.elevation_m(lonlat_to_vec(0, 90)), z(0.5, 89.5) * 0.5 + z(359.5, 89.5) * 0.5,
+                1e-9);
     EXPECT_NEAR(r.elevation_m(45.5, -89.9), z(45.5, -89.5), 1e-9);
 }
 
@@ -190,7 +208,9 @@ TEST(Bathymetry, node_registered_global_grid_drops_its_repeated_meridian) {
     TempDir dir;
     const std::string path = (dir / "nodes.tif").string();
     // 361 x 181 nodes from -180 to 180: pixel centres on whole degrees.
-    auto z = [](double lon, double lat) { return std::round(lat * 10) + std::round(std::sin(lon * deg_to_rad) * 100); };
+    auto z = [](double lon, double lat) {
+        return std::round(lat * 10) + std::round(std::sin(lon * deg_to_rad) * 100);
+    };
     write_tiff(path, {-180.5, 90.5, 1, 1, 361, 181}, z);
     Raster r = read_raster(path);
     EXPECT_EQ(r.nlon(), 360u);
@@ -211,7 +231,8 @@ TEST(Bathymetry, projected_raster_is_read_through_a_warp_to_lonlat) {
     EXPECT_NEAR(r.bounds().west, 0.0, 0.1);
     for (double lon = 1; lon <= 8; lon += 0.7)
         for (double lat = 41; lat <= 46; lat += 0.6) {
-            double x = a * lon * deg_to_rad, y = a * std::log(std::tan(pi / 4 + lat * deg_to_rad / 2));
+            double x = a * lon * deg_to_rad,
+                   y = a * std::log(std::tan(pi / 4 + lat * deg_to_rad / 2));
             // Warp (upsampling, bilinear): exact on a plane but for float storage (1.2e-4 m);
             // our lon/lat bilinear errs by 5e-4 * y'' * dlat^2 / 8 < 1e-3 m.
             EXPECT_NEAR(r.elevation_m(lon, lat), plane(x, y), 2e-3) << lon << " " << lat;
@@ -224,8 +245,10 @@ TEST(Bathymetry, nodata_holes_give_nan_or_the_fill) {
     TempDir dir;
     const std::string path = (dir / "holes.tif").string();
     auto z = [](double lon, double lat) {
-        if (lon > 2 && lon < 4 && lat > 2 && lat < 4) return -9999.0;
-        if (lon > 6 && lat < 1) return std::nan("");
+        if (lon > 2 && lon < 4 && lat > 2 && lat < 4)
+            return -9999.0;
+        if (lon > 6 && lat < 1)
+            return std::nan("");
         return -100.0 * std::round(lon) - std::round(lat);
     };
     GridSpec s{0, 10, 0.5, 0.5, 20, 20};
@@ -239,7 +262,8 @@ TEST(Bathymetry, nodata_holes_give_nan_or_the_fill) {
     // Cell (1.75..2.25) x (1.75..2.25): the hole corner is (2.25, 2.25).
     double lon = 1.85, lat = 1.95, fu = (lon - 1.75) / 0.5, fv = (lat - 1.75) / 0.5;
     double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv;
-    double expect = (w00 * z(1.75, 1.75) + w10 * z(2.25, 1.75) + w01 * z(1.75, 2.25)) / (w00 + w10 + w01);
+    double expect =
+        (w00 * z(1.75, 1.75) + w10 * z(2.25, 1.75) + w01 * z(1.75, 2.25)) / (w00 + w10 + w01);
     EXPECT_NEAR(r.elevation_m(lon, lat), expect, 1e-9);
     // Nearest corner in the hole: no data.
     EXPECT_TRUE(std::isnan(r.elevation_m(2.2, 2.2)));
@@ -257,7 +281,8 @@ TEST(Bathymetry, scale_offset_and_depth_positive_are_honoured) {
     s.scale_offset = std::make_pair(0.5, -1000.0);
     write_tiff(path, s, [](double lon, double lat) { return std::round(lon * 10 + lat); });
     Raster r = read_raster(path);
-    EXPECT_NEAR(r.elevation_m(3.5, 4.5), std::round(39.5) * 0.5 - 1000.0, 1e-9); // raw = round(3.5*10 + 4.5)
+    EXPECT_NEAR(r.elevation_m(3.5, 4.5), std::round(39.5) * 0.5 - 1000.0,
+                1e-9); // raw = round(3.5*10 + 4.5)
     Raster d = read_raster(path, 1, true);
     EXPECT_NEAR(d.elevation_m(3.5, 4.5), -r.elevation_m(3.5, 4.5), 1e-9);
     EXPECT_NEAR(d.depth_m(lonlat_to_vec(3.5, 4.5)), r.elevation_m(3.5, 4.5), 1e-9);
@@ -265,12 +290,13 @@ TEST(Bathymetry, scale_offset_and_depth_positive_are_honoured) {
 
 TEST(Bathymetry, bad_inputs_give_one_line_errors_naming_the_file_or_option) {
     TempDir dir;
-    auto one_line = [](const std::string& m) { return m.find('\n') == std::string::npos; };
+    auto one_line = [](const std::string &m) { return m.find('\n') == std::string::npos; };
     const std::string bare = (dir / "bare.tif").string();
     GridSpec s{0, 10, 1, 1, 4, 4};
     s.georeferenced = false;
     write_tiff(bare, s, [](double, double) { return -1.0; });
-    std::string m = test::thrown_message<DataError>([&] { read_raster(bare); }, "a raster without georeferencing");
+    std::string m = test::thrown_message<DataError>([&] { read_raster(bare); },
+                                                    "a raster without georeferencing");
     EXPECT_NE(m.find(bare), std::string::npos) << m;
     EXPECT_NE(m.find("georeferencing"), std::string::npos) << m;
     EXPECT_TRUE(one_line(m));
@@ -352,8 +378,8 @@ TEST(Bathymetry, etopo5_global_netcdf_matches_its_own_coordinates_and_values) {
         (z > 0 ? land : sea)++;
     }
     nc_close(nc);
-    EXPECT_GT(sea, land); // most of the Earth is ocean
-    EXPECT_LT(r.elevation_m(-155, 0), -3000);  // central Pacific
+    EXPECT_GT(sea, land);                       // most of the Earth is ocean
+    EXPECT_LT(r.elevation_m(-155, 0), -3000);   // central Pacific
     EXPECT_GT(r.elevation_m(86.9, 28.0), 3000); // Himalaya
 }
 
@@ -411,15 +437,17 @@ TEST(Bathymetry, etopo5_nwshelf_geotiff_nodes_sit_on_whole_5_minutes) {
     EXPECT_LE(b.south, 47.55);
     EXPECT_GE(b.north, 60.45);
     EXPECT_LT(b.north, 60.45 + 1.0 / 12);
-    const int i0 = static_cast<int>(std::lround((r.lon_deg(0) + 12) * 12)), j0 = static_cast<int>(std::lround((62 - r.lat_deg(0)) * 12));
+    const int i0 = static_cast<int>(std::lround((r.lon_deg(0) + 12) * 12)),
+              j0 = static_cast<int>(std::lround((62 - r.lat_deg(0)) * 12));
     EXPECT_NEAR(r.lon_deg(0), -12.0 + i0 / 12.0, 1e-9);
     EXPECT_NEAR(r.lat_deg(0), 62.0 - j0 / 12.0, 1e-9);
     for (std::size_t j = 0; j < r.nlat(); j += 15)
         for (std::size_t i = 0; i < r.nlon(); i += 23) {
             double lon = r.lon_deg(i), lat = r.lat_deg(j);
-            EXPECT_NEAR(r.elevation_m(lon, lat), gdal_pixel(path, int(i) + i0, int(j) + j0), 1e-9) << lon << " " << lat;
+            EXPECT_NEAR(r.elevation_m(lon, lat), gdal_pixel(path, int(i) + i0, int(j) + j0), 1e-9)
+                << lon << " " << lat;
         }
-    EXPECT_LT(r.elevation_m(3.0, 56.0), 0);   // North Sea
+    EXPECT_LT(r.elevation_m(3.0, 56.0), 0);    // North Sea
     EXPECT_GT(r.elevation_m(-4.0, 57.0), 100); // Scottish Highlands
     // The whole globe is not covered.
     EXPECT_THROW(read_bathymetry(options_for(path)), DataError);
@@ -429,20 +457,22 @@ namespace {
 
 /// A VRT of nx x ny Int16 cells over the globe whose source is the whole 10-minute ETOPO5
 /// fixture (2160 x 1080) stretched onto it: 69120 x 34560 declares 4.8 GB and costs nothing.
-std::string huge_global_vrt(const TempDir& dir, int nx, int ny) {
+std::string huge_global_vrt(const TempDir &dir, int nx, int ny) {
     const std::string path = (dir / "huge.vrt").string();
     const double dx = 360.0 / nx, dy = 180.0 / ny;
-    std::ofstream(path) << "<VRTDataset rasterXSize=\"" << nx << "\" rasterYSize=\"" << ny << "\">\n"
+    std::ofstream(path) << "<VRTDataset rasterXSize=\"" << nx << "\" rasterYSize=\"" << ny
+                        << "\">\n"
                         << "  <SRS>EPSG:4326</SRS>\n"
-                        << std::setprecision(17) << "  <GeoTransform>-180, " << dx << ", 0, 90, 0, " << -dy
-                        << "</GeoTransform>\n"
+                        << std::setprecision(17) << "  <GeoTransform>-180, " << dx << ", 0, 90, 0, "
+                        << -dy << "</GeoTransform>\n"
                         << "  <VRTRasterBand dataType=\"Int16\" band=\"1\">\n"
                         << "    <SimpleSource>\n"
                         << "      <SourceFilename relativeToVRT=\"0\">"
                         << fixture("bathy/etopo5_global_10min.nc").string() << "</SourceFilename>\n"
                         << "      <SourceBand>1</SourceBand>\n"
                         << "      <SrcRect xOff=\"0\" yOff=\"0\" xSize=\"2160\" ySize=\"1080\"/>\n"
-                        << "      <DstRect xOff=\"0\" yOff=\"0\" xSize=\"" << nx << "\" ySize=\"" << ny << "\"/>\n"
+                        << "      <DstRect xOff=\"0\" yOff=\"0\" xSize=\"" << nx << "\" ySize=\""
+                        << ny << "\"/>\n"
                         << "    </SimpleSource>\n"
                         << "  </VRTRasterBand>\n"
                         << "</VRTDataset>\n";
@@ -454,10 +484,11 @@ std::string huge_global_vrt(const TempDir& dir, int nx, int ny) {
 std::vector<double> etopo5_cells() {
     const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
     GDALDatasetH ds = GDALOpen(source.c_str(), GA_ReadOnly);
-    if (!ds) return {};
+    if (!ds)
+        return {};
     std::vector<double> cells(2160 * 1080);
-    if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, 2160, 1080, cells.data(), 2160, 1080, GDT_Float64, 0, 0) !=
-        CE_None)
+    if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, 2160, 1080, cells.data(), 2160, 1080,
+                     GDT_Float64, 0, 0) != CE_None)
         cells.clear();
     GDALClose(ds);
     return cells;
@@ -481,7 +512,8 @@ TEST(Bathymetry, four_gigabyte_raster_is_read_at_the_cell_size_asked_and_equals_
     ASSERT_EQ(truth.size(), 2160u * 1080u);
     std::size_t differ = 0;
     for (std::size_t j = 0; j < 1080; ++j)
-        for (std::size_t i = 0; i < 2160; ++i) differ += r.value(i, j) != truth[j * 2160 + i];
+        for (std::size_t i = 0; i < 2160; ++i)
+            differ += r.value(i, j) != truth[j * 2160 + i];
     EXPECT_EQ(differ, 0u);
     EXPECT_NEAR(r.lon_deg(0), -180 + 1.0 / 12, 1e-9);
     EXPECT_NEAR(r.lat_deg(0), 90 - 1.0 / 12, 1e-9);
@@ -491,9 +523,10 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     TempDir dir;
     const std::string vrt = huge_global_vrt(dir, 69120, 34560);
     MeshOptions o = options_for(vrt);
-    o.hmin_km = 1;                     // cells of 0.5 km asked: more than the 2^28-cell cap
-    o.max_memory_bytes = 500'000'000;  // half of it for the raster: less than 2^28 floats
-    const std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a 1 GiB read within a 250 MB share");
+    o.hmin_km = 1;                    // cells of 0.5 km asked: more than the 2^28-cell cap
+    o.max_memory_bytes = 500'000'000; // half of it for the raster: less than 2^28 floats
+    const std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o); },
+                                                          "a 1 GiB read within a 250 MB share");
     EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
     EXPECT_NE(m.find("max_memory_bytes"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
@@ -514,7 +547,7 @@ TEST(Bathymetry, a_region_reads_only_its_window_of_a_four_gigabyte_global_raster
     TempDir dir;
     const std::string vrt = huge_global_vrt(dir, 69120, 34560); // cells of 1/192 degree
     MeshOptions o = options_for(vrt);
-    o.hmin_km = 1;                    // cells of 0.5 km asked (0.0045 degree): finer than the file's
+    o.hmin_km = 1; // cells of 0.5 km asked (0.0045 degree): finer than the file's
     o.max_memory_bytes = 500'000'000; // the whole globe at that size is refused (test above)
     o.region = std::array<double, 4>{-10, 40, 0, 50};
     // A run on the region reads a few million cells of the 2.4 billion, within the budget.
@@ -544,7 +577,9 @@ TEST(Bathymetry, a_region_reads_only_its_window_of_a_four_gigabyte_global_raster
 
 TEST(Bathymetry, a_region_across_the_antimeridian_reads_its_rows_and_wraps) {
     TempDir dir;
-    auto z = [](double lon, double lat) { return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000; };
+    auto z = [](double lon, double lat) {
+        return std::round(1000 * std::cos(lon * deg_to_rad) * std::cos(lat * deg_to_rad)) - 2000;
+    };
     for (double west : {0.0, -180.0}) {
         const std::string path = (dir / (west == 0 ? "g360.tif" : "g180.tif")).string();
         write_tiff(path, {west, 90, 1, 1, 360, 180}, z);
@@ -565,7 +600,8 @@ TEST(Bathymetry, a_region_across_the_antimeridian_reads_its_rows_and_wraps) {
         }
         for (double lat : {-9.5, 0.5, 9.5})
             for (double lon : {170.5, 179.5, -179.5, -170.5})
-                EXPECT_NEAR(r.elevation_m(lon, lat), z(lon, lat), 1e-9) << path << " " << lon << " " << lat;
+                EXPECT_NEAR(r.elevation_m(lon, lat), z(lon, lat), 1e-9)
+                    << path << " " << lon << " " << lat;
         // Across 180: halfway between the cells at 179.5 and -179.5.
         EXPECT_NEAR(r.elevation_m(180, 0.5), 0.5 * (z(179.5, 0.5) + z(-179.5, 0.5)), 1e-9) << path;
     }
@@ -597,11 +633,13 @@ struct CfGrid {
     std::vector<double> lon, lat;
     std::vector<float> z; // row j (lat[j]) after row
     nc_type lon_type = NC_DOUBLE;
-    std::vector<std::pair<std::string, std::string>> lon_attributes{{"standard_name", "longitude"}, {"units", "degrees_east"}};
-    std::vector<std::pair<std::string, std::string>> lat_attributes{{"standard_name", "latitude"}, {"units", "degrees_north"}};
+    std::vector<std::pair<std::string, std::string>> lon_attributes{{"standard_name", "longitude"},
+                                                                    {"units", "degrees_east"}};
+    std::vector<std::pair<std::string, std::string>> lat_attributes{{"standard_name", "latitude"},
+                                                                    {"units", "degrees_north"}};
 };
 
-void write_cf(const std::string& path, const CfGrid& g) {
+void write_cf(const std::string &path, const CfGrid &g) {
     int nc = -1, dims[2], lon_id, lat_id, z_id;
     ASSERT_EQ(nc_create(path.c_str(), NC_CLOBBER | NC_64BIT_OFFSET, &nc), NC_NOERR);
     ASSERT_EQ(nc_def_dim(nc, "lat", g.lat.size(), &dims[0]), NC_NOERR);
@@ -609,8 +647,10 @@ void write_cf(const std::string& path, const CfGrid& g) {
     ASSERT_EQ(nc_def_var(nc, "lat", NC_DOUBLE, 1, &dims[0], &lat_id), NC_NOERR);
     ASSERT_EQ(nc_def_var(nc, "lon", g.lon_type, 1, &dims[1], &lon_id), NC_NOERR);
     ASSERT_EQ(nc_def_var(nc, "z", NC_FLOAT, 2, dims, &z_id), NC_NOERR);
-    for (const auto& [k, v] : g.lon_attributes) nc_put_att_text(nc, lon_id, k.c_str(), v.size(), v.c_str());
-    for (const auto& [k, v] : g.lat_attributes) nc_put_att_text(nc, lat_id, k.c_str(), v.size(), v.c_str());
+    for (const auto &[k, v] : g.lon_attributes)
+        nc_put_att_text(nc, lon_id, k.c_str(), v.size(), v.c_str());
+    for (const auto &[k, v] : g.lat_attributes)
+        nc_put_att_text(nc, lat_id, k.c_str(), v.size(), v.c_str());
     ASSERT_EQ(nc_enddef(nc), NC_NOERR);
     ASSERT_EQ(nc_put_var_double(nc, lat_id, g.lat.data()), NC_NOERR);
     ASSERT_EQ(nc_put_var_double(nc, lon_id, g.lon.data()), NC_NOERR); // netCDF converts to lon_type
@@ -623,19 +663,21 @@ struct Stages {
     std::vector<std::string> names;
     Progress callback() {
         return [this](double, std::string_view s) {
-            if (names.empty() || names.back() != s) names.emplace_back(s);
+            if (names.empty() || names.back() != s)
+                names.emplace_back(s);
             return true;
         };
     }
-    bool any_contains(const std::string& text) const {
-        return std::any_of(names.begin(), names.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+    bool any_contains(const std::string &text) const {
+        return std::any_of(names.begin(), names.end(),
+                           [&](const std::string &n) { return n.find(text) != std::string::npos; });
     }
 };
 
 /// A closed ring of unit vectors through the lon/lat points, all segments tagged open.
-Ring ring_of(const std::vector<std::pair<double, double>>& points) {
+Ring ring_of(const std::vector<std::pair<double, double>> &points) {
     Ring r;
-    for (const auto& [lon, lat] : points) {
+    for (const auto &[lon, lat] : points) {
         r.nodes.push_back(lonlat_to_vec(lon, lat));
         r.kinds.push_back(SegmentKind::open);
     }
@@ -651,7 +693,8 @@ TEST(Bathymetry, cf_lonlat_grid_without_a_crs_is_read_as_wgs84_and_says_so) {
     const std::string path = fixture("bathy/cudem_sabine_unequal_48x40.nc").string();
     Stages stages;
     Raster r = read_raster(path, 1, false, stages.callback(), RasterLimits{});
-    EXPECT_TRUE(stages.any_contains("no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84"))
+    EXPECT_TRUE(stages.any_contains(
+        "no CRS in the file, and its axes are CF longitude/latitude: read as WGS 84"))
         << stages.names.front();
     ASSERT_EQ(r.nlon(), 48u);
     ASSERT_EQ(r.nlat(), 40u);
@@ -673,7 +716,8 @@ TEST(Bathymetry, cf_lonlat_grid_without_a_crs_is_read_as_wgs84_and_says_so) {
         }
     EXPECT_GT(sea, 300); // water and marsh both
     // Inside a cell: bilinear between the file's four values, at the file's coordinates.
-    const double fu = 0.3, fv = 0.8, x = lon[10] + fu * (lon[11] - lon[10]), y = lat[20] + fv * (lat[21] - lat[20]);
+    const double fu = 0.3, fv = 0.8, x = lon[10] + fu * (lon[11] - lon[10]),
+                 y = lat[20] + fv * (lat[21] - lat[20]);
     const double expect = (1 - fu) * (1 - fv) * z[20 * 48 + 10] + fu * (1 - fv) * z[20 * 48 + 11] +
                           (1 - fu) * fv * z[21 * 48 + 10] + fu * fv * z[21 * 48 + 11];
     EXPECT_NEAR(r.elevation_m(x, y), expect, 1e-5);
@@ -683,31 +727,38 @@ TEST(Bathymetry, a_grid_without_crs_or_lonlat_axes_is_refused_and_bathy_srs_give
     TempDir dir;
     auto z = [](double x, double y) { return -100.0 - 2.0 * x - 3.0 * y; };
     CfGrid g;
-    for (int i = 0; i < 12; ++i) g.lon.push_back(0.25 + 0.5 * i);
-    for (int j = 0; j < 10; ++j) g.lat.push_back(40.25 + 0.5 * j);
+    for (int i = 0; i < 12; ++i)
+        g.lon.push_back(0.25 + 0.5 * i);
+    for (int j = 0; j < 10; ++j)
+        g.lat.push_back(40.25 + 0.5 * j);
     for (double y : g.lat)
-        for (double x : g.lon) g.z.push_back(static_cast<float>(z(x, y)));
+        for (double x : g.lon)
+            g.z.push_back(static_cast<float>(z(x, y)));
     // The same grid with axes that do not say they are degrees: refused, naming --bathy-srs.
     CfGrid bare = g;
     bare.lon_attributes = {{"long_name", "x"}};
     bare.lat_attributes = {{"long_name", "y"}};
     const std::string bare_path = (dir / "bare.nc").string();
     write_cf(bare_path, bare);
-    std::string m = test::thrown_message<DataError>([&] { read_raster(bare_path); }, "no CRS, no CF axes");
+    std::string m =
+        test::thrown_message<DataError>([&] { read_raster(bare_path); }, "no CRS, no CF axes");
     EXPECT_NE(m.find("has no georeferencing"), std::string::npos) << m;
     EXPECT_NE(m.find("bathy_srs"), std::string::npos) << m;
     // Degrees by its units but an extent no lon/lat grid has (latitudes in the thousands): refused.
     CfGrid far = g;
-    for (double& y : far.lat) y *= 100;
+    for (double &y : far.lat)
+        y *= 100;
     const std::string far_path = (dir / "far.nc").string();
     write_cf(far_path, far);
     EXPECT_THROW(read_raster(far_path), DataError);
     // --bathy-srs gives the CRS: values as written.
     Stages stages;
     Raster r = read_raster(bare_path, 1, false, stages.callback(), RasterLimits{}, "EPSG:4326");
-    EXPECT_TRUE(stages.any_contains("CRS WGS 84 (EPSG:4326) from --bathy-srs")) << stages.names.front();
+    EXPECT_TRUE(stages.any_contains("CRS WGS 84 (EPSG:4326) from --bathy-srs"))
+        << stages.names.front();
     for (double y : {40.3, 42.0, 44.7})
-        for (double x : {0.3, 2.2, 5.7}) EXPECT_NEAR(r.elevation_m(x, y), z(x, y), 1e-4) << x << " " << y;
+        for (double x : {0.3, 2.2, 5.7})
+            EXPECT_NEAR(r.elevation_m(x, y), z(x, y), 1e-4) << x << " " << y;
     // A string that is no CRS: one line naming the option, before any file is opened.
     for (const std::string bad : {"EPSG:99999", "not a crs", "LOCAL_CS[\"x\"]"}) {
         m = test::thrown_message<UsageError>([&] { validate_bathy_srs(bad); }, bad);
@@ -731,11 +782,13 @@ TEST(Bathymetry, bathy_srs_replaces_a_wrong_declared_crs) {
     EXPECT_LT(declared.bounds().east, 0.01);
     Stages stages;
     Raster r = read_raster(path, 1, false, stages.callback(), RasterLimits{}, "EPSG:4326");
-    EXPECT_TRUE(stages.any_contains("from --bathy-srs, not the file's WGS 84 / Pseudo-Mercator (EPSG:3857)"))
+    EXPECT_TRUE(stages.any_contains(
+        "from --bathy-srs, not the file's WGS 84 / Pseudo-Mercator (EPSG:3857)"))
         << stages.names.front();
     EXPECT_NEAR(r.bounds().west, 100, 1e-9);
     EXPECT_NEAR(r.bounds().north, 30, 1e-9);
-    for (double lon : {100.3, 105.1, 119.7}) EXPECT_NEAR(r.elevation_m(lon, 25.2), plane(lon, 25.2), 1e-3) << lon;
+    for (double lon : {100.3, 105.1, 119.7})
+        EXPECT_NEAR(r.elevation_m(lon, 25.2), plane(lon, 25.2), 1e-3) << lon;
     // The file's own CRS given again: nothing replaced, nothing said of it.
     Stages same;
     read_raster(path, 1, false, same.callback(), RasterLimits{}, "EPSG:3857");
@@ -756,20 +809,25 @@ TEST(Bathymetry, a_repeated_wrap_column_is_recognised_and_interpolated_across) {
     const double step = 1.0 / 3.0;
     for (const Case c : {Case{20 + 1.0 / 6, NC_FLOAT}, Case{20, NC_DOUBLE}, Case{-180, NC_FLOAT}}) {
         auto f = [&](double lon, double lat) {
-            return -1000.0 - 500.0 * std::sin((lon - c.west) * deg_to_rad) * std::cos(lat * deg_to_rad);
+            return -1000.0 -
+                   500.0 * std::sin((lon - c.west) * deg_to_rad) * std::cos(lat * deg_to_rad);
         };
         CfGrid g;
         g.lon_type = c.type;
         for (int i = 0; i <= 1080; ++i) {
             const double lon = c.west + i * step;
-            g.lon.push_back(c.type == NC_FLOAT ? static_cast<double>(static_cast<float>(lon)) : lon);
+            g.lon.push_back(c.type == NC_FLOAT ? static_cast<double>(static_cast<float>(lon))
+                                               : lon);
         }
-        for (int j = 0; j <= 36; ++j) g.lat.push_back(-90.0 + 5.0 * j);
+        for (int j = 0; j <= 36; ++j)
+            g.lat.push_back(-90.0 + 5.0 * j);
         for (double lat : g.lat)
-            for (int i = 0; i <= 1080; ++i) g.z.push_back(static_cast<float>(f(c.west + i * step, lat)));
+            for (int i = 0; i <= 1080; ++i)
+                g.z.push_back(static_cast<float>(f(c.west + i * step, lat)));
         const std::string path = (dir / "wrap.nc").string();
         write_cf(path, g);
-        const std::string what = std::to_string(c.west) + (c.type == NC_FLOAT ? " float" : " double");
+        const std::string what =
+            std::to_string(c.west) + (c.type == NC_FLOAT ? " float" : " double");
         MeshOptions o = options_for(path);
         Raster r = read_bathymetry(o); // covers the globe: no DataError
         ASSERT_TRUE(r.global()) << what;
@@ -780,8 +838,10 @@ TEST(Bathymetry, a_repeated_wrap_column_is_recognised_and_interpolated_across) {
         for (double lat : {-45.0, 0.0, 30.0, 85.0})
             for (double t : {0.1, 0.5, 0.9}) {
                 const double lon = c.west - step + t * step;
-                const double expect = (1 - t) * f32(f(c.west - step, lat)) + t * f32(f(c.west, lat));
-                EXPECT_NEAR(r.elevation_m(lon, lat), expect, 2e-3) << what << " " << lon << " " << lat;
+                const double expect =
+                    (1 - t) * f32(f(c.west - step, lat)) + t * f32(f(c.west, lat));
+                EXPECT_NEAR(r.elevation_m(lon, lat), expect, 2e-3)
+                    << what << " " << lon << " " << lat;
                 EXPECT_NEAR(r.elevation_m(lon + 360, lat), expect, 2e-3) << what;
                 EXPECT_NEAR(r.elevation_m(lon - 360, lat), expect, 2e-3) << what;
                 // Bilinear within h^2/8 |f''| = 0.0085 m of the field itself.
@@ -813,10 +873,12 @@ TEST(Bathymetry, etopo5_with_a_repeated_wrap_column_reads_as_etopo5) {
     ASSERT_NEAR(lon[k0], 20 + 1.0 / 12, 1e-9);
     CfGrid g;
     g.lon_type = NC_FLOAT;
-    for (std::size_t i = 0; i <= 2160; ++i) g.lon.push_back(lon[(k0 + i) % 2160] + (k0 + i >= 2160 ? 360 : 0));
+    for (std::size_t i = 0; i <= 2160; ++i)
+        g.lon.push_back(lon[(k0 + i) % 2160] + (k0 + i >= 2160 ? 360 : 0));
     for (std::size_t j = 1; j < 1080; j += 3) {
         g.lat.push_back(lat[j]);
-        for (std::size_t i = 0; i <= 2160; ++i) g.z.push_back(z[j * 2160 + (k0 + i) % 2160]);
+        for (std::size_t i = 0; i <= 2160; ++i)
+            g.z.push_back(z[j * 2160 + (k0 + i) % 2160]);
     }
     TempDir dir;
     const std::string path = (dir / "etopo5_wrap20.nc").string();
@@ -859,7 +921,8 @@ TEST(Bathymetry, ocean_extent_takes_the_short_way_round_and_the_pole_an_ocean_ho
     EXPECT_NEAR(e->north, 10, 1e-9);
     // A parallel at 60 N walked east: the ocean on its left is the cap round the north pole.
     std::vector<std::pair<double, double>> parallel;
-    for (int k = 0; k < 36; ++k) parallel.emplace_back(-180 + 10 * k, 60);
+    for (int k = 0; k < 36; ++k)
+        parallel.emplace_back(-180 + 10 * k, 60);
     Boundary cap;
     cap.rings.push_back(ring_of(parallel));
     EXPECT_EQ(ocean_pole_winding(cap), 1);
@@ -884,7 +947,8 @@ TEST(Bathymetry, ocean_extent_takes_the_short_way_round_and_the_pole_an_ocean_ho
 TEST(Bathymetry, coverage_is_that_of_the_ocean_of_the_region_file_or_box) {
     TempDir dir;
     const std::string path = (dir / "regional.tif").string();
-    write_tiff(path, {0, 10, 0.05, 0.05, 200, 200}, [](double lon, double lat) { return -50.0 - lon - lat; });
+    write_tiff(path, {0, 10, 0.05, 0.05, 200, 200},
+               [](double lon, double lat) { return -50.0 - lon - lat; });
     MeshOptions o = options_for(path);
     o.region_file = (dir / "region.gpkg").string(); // not opened here: the coast stage read it
     Boundary ocean;
@@ -899,8 +963,11 @@ TEST(Bathymetry, coverage_is_that_of_the_ocean_of_the_region_file_or_box) {
     // An ocean reaching east of the raster (10 E): refused, naming the file and the place
     // farthest out.
     ocean.rings[0] = ring_of({{2, 2}, {11, 2}, {11, 3}, {2, 3}});
-    std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "ocean beyond");
-    EXPECT_NE(m.find("the ocean of region_file " + o.region_file + " reaches lon 11, lat 2"), std::string::npos) << m;
+    std::string m =
+        test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "ocean beyond");
+    EXPECT_NE(m.find("the ocean of region_file " + o.region_file + " reaches lon 11, lat 2"),
+              std::string::npos)
+        << m;
     EXPECT_NE(m.find("bathy_fill_m"), std::string::npos) << m;
     // A --region box running west of the raster over land: its ocean is inside, so it is covered.
     o.region_file.clear();

@@ -1,9 +1,9 @@
 // Hostile coast inputs, written as small GeoJSON/CSV files into a temporary directory: each is
 // repaired into valid rings (checked by an independent brute force and by area oracles) or
 // refused with a one-line UsageError / DataError / IoError, never a crash.
-#include <gtest/gtest.h>
 #include <gdal.h>
 #include <gdal_utils.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
@@ -20,7 +20,7 @@ using globemesh::test::TempDir;
 
 namespace {
 
-std::string write(const TempDir& dir, const std::string& name, const std::string& text) {
+std::string write(const TempDir &dir, const std::string &name, const std::string &text) {
     auto path = dir / name;
     std::ofstream(path) << text;
     return path.string();
@@ -30,27 +30,32 @@ std::string write(const TempDir& dir, const std::string& name, const std::string
 std::string geojson(std::initializer_list<std::string> geometries) {
     std::string s = "{\"type\":\"FeatureCollection\",\"features\":[";
     bool first = true;
-    for (const auto& g : geometries) {
-        if (!first) s += ",";
+    for (const auto &g : geometries) {
+        if (!first)
+            s += ",";
         first = false;
         s += "{\"type\":\"Feature\",\"properties\":{\"name\":\"f\"},\"geometry\":" + g + "}";
     }
     return s + "]}";
 }
 
-std::string polygon(const std::string& rings) { return "{\"type\":\"Polygon\",\"coordinates\":[" + rings + "]}"; }
+std::string polygon(const std::string &rings) {
+    return "{\"type\":\"Polygon\",\"coordinates\":[" + rings + "]}";
+}
 
-MeshOptions options_for(const std::string& path) {
+MeshOptions options_for(const std::string &path) {
     MeshOptions o;
     o.coast = path;
     return o;
 }
 
-double earth_km2() { return GeographicLib::Geodesic::WGS84().EllipsoidArea() * 1e-6; }
+double earth_km2() {
+    return GeographicLib::Geodesic::WGS84().EllipsoidArea() * 1e-6;
+}
 
 /// Geodesic area (km2) of a lon/lat polygon given by its corners, edges densified to 0.01 degree
 /// in lon/lat (the planar GIS meaning of an edge).
-double planar_polygon_area_km2(const std::vector<LonLat>& corners) {
+double planar_polygon_area_km2(const std::vector<LonLat> &corners) {
     GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
     for (std::size_t i = 0; i < corners.size(); ++i) {
         LonLat a = corners[i], b = corners[(i + 1) % corners.size()];
@@ -63,19 +68,19 @@ double planar_polygon_area_km2(const std::vector<LonLat>& corners) {
     return std::min(area, GeographicLib::Geodesic::WGS84().EllipsoidArea() - area) * 1e-6;
 }
 
-void expect_valid_both_stages(const CoastData& d, double h_km = 50) {
+void expect_valid_both_stages(const CoastData &d, double h_km = 50) {
     EXPECT_TRUE(check_boundary(d.rings).empty());
     EXPECT_EQ(count_violations(d.rings), 0u);
     MeshOptions o;
     o.min_island_triangles = 0;
-    Boundary b = shape_boundary(d, [h_km](const Vec3&) { return h_km; }, o);
+    Boundary b = shape_boundary(
+        d, [h_km](const Vec3 &) { return h_km; }, o);
     EXPECT_TRUE(check_boundary(b).empty());
     EXPECT_EQ(count_violations(b), 0u);
 }
 
 /// What load_coast(o) throws as an E, checked to be one line.
-template <class E>
-std::string message_of(const MeshOptions& o) {
+template <class E> std::string message_of(const MeshOptions &o) {
     std::string m = test::thrown_message<E>([&] { load_coast(o); }, "load_coast");
     EXPECT_EQ(m.find('\n'), std::string::npos) << "not one line: " << m;
     return m;
@@ -85,20 +90,24 @@ std::string message_of(const MeshOptions& o) {
 
 TEST(CoastHostile, bow_tie_becomes_two_triangles_touching_apart) {
     TempDir dir;
-    auto path = write(dir, "bowtie.geojson", geojson({polygon("[[0,0],[10,10],[10,0],[0,10],[0,0]]")}));
+    auto path =
+        write(dir, "bowtie.geojson", geojson({polygon("[[0,0],[10,10],[10,0],[0,10],[0,0]]")}));
     CoastData d = load_coast(options_for(path));
     EXPECT_EQ(d.rings.rings.size(), 2u);
     expect_valid_both_stages(d);
-    double land = planar_polygon_area_km2({{5, 5}, {10, 0}, {10, 10}}) + planar_polygon_area_km2({{5, 5}, {0, 10}, {0, 0}});
+    double land = planar_polygon_area_km2({{5, 5}, {10, 0}, {10, 10}}) +
+                  planar_polygon_area_km2({{5, 5}, {0, 10}, {0, 0}});
     EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
 }
 
 TEST(CoastHostile, spike_is_removed) {
     TempDir dir;
-    auto path = write(dir, "spike.geojson", geojson({polygon("[[0,0],[10,0],[10,10],[10,15],[10,10],[0,10],[0,0]]")}));
+    auto path = write(dir, "spike.geojson",
+                      geojson({polygon("[[0,0],[10,0],[10,10],[10,15],[10,10],[0,10],[0,0]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
-    for (const auto& v : d.rings.rings[0].nodes) EXPECT_LE(vec_to_lonlat(v).lat, 10.0 + 1e-9);
+    for (const auto &v : d.rings.rings[0].nodes)
+        EXPECT_LE(vec_to_lonlat(v).lat, 10.0 + 1e-9);
     expect_valid_both_stages(d);
     double land = planar_polygon_area_km2({{0, 0}, {10, 0}, {10, 10}, {0, 10}});
     EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
@@ -109,22 +118,27 @@ TEST(CoastHostile, spike_is_removed) {
 // spike collapses: no two nodes of the cleaned coast are closer than a kilometre.
 TEST(CoastHostile, a_spike_narrower_than_the_snap_grid_collapses) {
     TempDir dir;
-    auto path = write(dir, "thin.geojson",
-                      geojson({polygon("[[0,0],[10,0],[10,10],[5.0000001,10],[5.0000001,13],[5,13],[5,10],[0,10],[0,0]]")}));
+    auto path = write(
+        dir, "thin.geojson",
+        geojson({polygon(
+            "[[0,0],[10,0],[10,10],[5.0000001,10],[5.0000001,13],[5,13],[5,10],[0,10],[0,0]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
-    const auto& nodes = d.rings.rings[0].nodes;
+    const auto &nodes = d.rings.rings[0].nodes;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         EXPECT_LE(vec_to_lonlat(nodes[i]).lat, 10.0 + 1e-6);
-        for (std::size_t j = i + 1; j < nodes.size(); ++j) EXPECT_GT(norm(nodes[i] - nodes[j]), 1.0 / 6371.0);
+        for (std::size_t j = i + 1; j < nodes.size(); ++j)
+            EXPECT_GT(norm(nodes[i] - nodes[j]), 1.0 / 6371.0);
     }
     expect_valid_both_stages(d);
 }
 
 TEST(CoastHostile, duplicate_consecutive_vertices_are_merged) {
     TempDir dir;
-    auto path = write(dir, "dups.geojson",
-                      geojson({polygon("[[0,0],[0,0],[0,0],[10,0],[10,0],[10,10],[10,10],[10,10],[0,10],[0,0],[0,0]]")}));
+    auto path = write(
+        dir, "dups.geojson",
+        geojson({polygon(
+            "[[0,0],[0,0],[0,0],[10,0],[10,0],[10,10],[10,10],[10,10],[0,10],[0,0],[0,0]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
     expect_valid_both_stages(d);
@@ -134,18 +148,20 @@ TEST(CoastHostile, island_split_at_the_antimeridian_is_stitched_into_one_ring) {
     TempDir dir;
     // As datasets store it: two halves sharing the seam.
     auto halves = write(dir, "halves.geojson",
-                        geojson({"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10],[180,10],[170,10],[170,-10]]],"
+                        geojson({"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10]"
+                                 ",[180,10],[170,10],[170,-10]]],"
                                  "[[[-180,-10],[-170,-10],[-170,10],[-180,10],[-180,-10]]]]}"}));
     // Drawn across it with longitudes beyond 180.
-    auto across = write(dir, "across.geojson", geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
+    auto across = write(dir, "across.geojson",
+                        geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
     double land = planar_polygon_area_km2({{170, -10}, {190, -10}, {190, 10}, {170, 10}});
-    for (const auto& path : {halves, across}) {
+    for (const auto &path : {halves, across}) {
         CoastData d = load_coast(options_for(path));
         ASSERT_EQ(d.rings.rings.size(), 1u) << path;
         expect_valid_both_stages(d);
         EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land) << path;
         // No node on the cut except where the coast itself (lat +-10) crosses it.
-        for (const auto& v : d.rings.rings[0].nodes) {
+        for (const auto &v : d.rings.rings[0].nodes) {
             LonLat p = vec_to_lonlat(v);
             if (std::abs(std::abs(p.lon) - 180) < 1e-9) {
                 EXPECT_NEAR(std::abs(p.lat), 10.0, 1e-9);
@@ -158,17 +174,21 @@ TEST(CoastHostile, island_split_at_the_antimeridian_is_stitched_into_one_ring) {
 // Chukotka ends its cut at -179.999951 rather than -180, which left a wedge of ocean 2 m wide
 // and 27 km long between the halves (a face of quality 1e-4 in a 20 km mesh). A vertex within
 // 1e-4 degree of the seam next to a vertex on it now goes onto the seam, and the halves glue.
-TEST(CoastHostile, island_halves_cut_one_grid_step_off_the_antimeridian_are_stitched_without_a_notch) {
+TEST(CoastHostile,
+     island_halves_cut_one_grid_step_off_the_antimeridian_are_stitched_without_a_notch) {
     TempDir dir;
-    auto path = write(dir, "notch.geojson",
-                      geojson({"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10],[180,10],[170,10],[170,-10]]],"
-                               "[[[-180,-10],[-170,-10],[-170,10],[-179.999951171875,10],[-180,5],[-180,-10]]]]}"}));
+    auto path = write(
+        dir, "notch.geojson",
+        geojson(
+            {"{\"type\":\"MultiPolygon\",\"coordinates\":[[[[170,-10],[180,-10],[180,10],[170,10],["
+             "170,-10]]],"
+             "[[[-180,-10],[-170,-10],[-170,10],[-179.999951171875,10],[-180,5],[-180,-10]]]]}"}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
     expect_valid_both_stages(d);
     // No node on or near the cut except where the coast crosses it (lat +-10): the notch's
     // corner (-180, 5) is gone.
-    for (const auto& v : d.rings.rings[0].nodes) {
+    for (const auto &v : d.rings.rings[0].nodes) {
         LonLat p = vec_to_lonlat(v);
         if (std::abs(std::abs(p.lon) - 180) < 1e-3) {
             EXPECT_NEAR(std::abs(p.lat), 10.0, 1e-9) << p.lon << " " << p.lat;
@@ -176,11 +196,13 @@ TEST(CoastHostile, island_halves_cut_one_grid_step_off_the_antimeridian_are_stit
     }
     // A real coast vertex that near the seam but not next to it stays where it is (on the land's
     // snap grid of 2^-20 degree).
-    auto far = write(dir, "far.geojson", geojson({polygon("[[170,-10],[179.99995,0],[170,10],[170,-10]]")}));
+    auto far = write(dir, "far.geojson",
+                     geojson({polygon("[[170,-10],[179.99995,0],[170,10],[170,-10]]")}));
     CoastData e = load_coast(options_for(far));
     ASSERT_EQ(e.rings.rings.size(), 1u);
     double max_lon = -180;
-    for (const auto& v : e.rings.rings[0].nodes) max_lon = std::max(max_lon, vec_to_lonlat(v).lon);
+    for (const auto &v : e.rings.rings[0].nodes)
+        max_lon = std::max(max_lon, vec_to_lonlat(v).lon);
     EXPECT_NEAR(max_lon, 179.99995, 1.0 / (1 << 21));
 }
 
@@ -191,30 +213,38 @@ TEST(CoastHostile, island_halves_cut_one_grid_step_off_the_antimeridian_are_stit
 // The leak shows under the sanitizer build (tools/test runs this test with LeakSanitizer on).
 TEST(CoastHostile, ring_beyond_minus_180_with_overlapping_spikes_is_cut_without_leaking) {
     TempDir dir;
-    auto path = write(dir, "spikes.geojson",
-                           "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{},\"geometry"
-                           "\":{\"type\":\"Polygon\",\"coordinates\":[[[-35.397778356997634,42.704586982847758],[-231.048300"
-                           "0747416,42.704586982847772],[-35.397778356997634,42.704586982847736],[-231.0483000747416,42.7045"
-                           "86982847793],[62.427482501874351,42.704586982847665],[-180,-90],[-35.397778356997634,42.70458698"
-                           "2847758]]]}},{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\",\"coordi"
-                           "nates\":[[[-180,-90],[-180,-90],[-180,-90]]]}},{\"type\":\"Feature\",\"properties\":{},\"geometr"
-                           "y\":{\"type\":\"Polygon\",\"coordinates\":[[[-180,-90],[-180,-90],[-180,-90]]]}}]}");
+    auto path =
+        write(dir, "spikes.geojson",
+              "{\"type\":\"FeatureCollection\",\"features\":[{\"type\":\"Feature\",\"properties\":{"
+              "},\"geometry"
+              "\":{\"type\":\"Polygon\",\"coordinates\":[[[-35.397778356997634,42.704586982847758],"
+              "[-231.048300"
+              "0747416,42.704586982847772],[-35.397778356997634,42.704586982847736],[-231."
+              "0483000747416,42.7045"
+              "86982847793],[62.427482501874351,42.704586982847665],[-180,-90],[-35."
+              "397778356997634,42.70458698"
+              "2847758]]]}},{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":"
+              "\"Polygon\",\"coordi"
+              "nates\":[[[-180,-90],[-180,-90],[-180,-90]]]}},{\"type\":\"Feature\",\"properties\":"
+              "{},\"geometr"
+              "y\":{\"type\":\"Polygon\",\"coordinates\":[[[-180,-90],[-180,-90],[-180,-90]]]}}]}");
     try {
         CoastData d = load_coast(options_for(path));
         expect_valid_both_stages(d, 400);
-    } catch (const DataError& e) {
+    } catch (const DataError &e) {
         EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
     }
 }
 
 TEST(CoastHostile, polygon_covering_the_north_pole_becomes_a_ring_around_it) {
     TempDir dir;
-    auto path = write(dir, "cap.geojson", geojson({polygon("[[-180,80],[180,80],[180,90],[-180,90],[-180,80]]")}));
+    auto path = write(dir, "cap.geojson",
+                      geojson({polygon("[[-180,80],[180,80],[180,90],[-180,90],[-180,80]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
     expect_valid_both_stages(d);
     double winding = 0;
-    const auto& nodes = d.rings.rings[0].nodes;
+    const auto &nodes = d.rings.rings[0].nodes;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
         LonLat p = vec_to_lonlat(nodes[i]);
         EXPECT_NEAR(p.lat, 80.0, 1e-9);
@@ -222,7 +252,8 @@ TEST(CoastHostile, polygon_covering_the_north_pole_becomes_a_ring_around_it) {
     }
     EXPECT_NEAR(winding, -360.0, 1e-6); // westward: the ocean (south) on the left
     GeographicLib::PolygonArea cap(GeographicLib::Geodesic::WGS84());
-    for (int k = 0; k < 36000; ++k) cap.AddPoint(80, -180 + 0.01 * k);
+    for (int k = 0; k < 36000; ++k)
+        cap.AddPoint(80, -180 + 0.01 * k);
     double perimeter, area;
     cap.Compute(false, false, perimeter, area);
     double cap_km2 = std::min(area, GeographicLib::Geodesic::WGS84().EllipsoidArea() - area) * 1e-6;
@@ -232,10 +263,12 @@ TEST(CoastHostile, polygon_covering_the_north_pole_becomes_a_ring_around_it) {
 TEST(CoastHostile, zero_area_sliver_is_dropped) {
     TempDir dir;
     auto path = write(dir, "sliver.geojson",
-                      geojson({polygon("[[0,0],[10,0],[20,0],[0,0]]"), polygon("[[30,30],[31,30],[31,31],[30,31],[30,30]]")}));
+                      geojson({polygon("[[0,0],[10,0],[20,0],[0,0]]"),
+                               polygon("[[30,30],[31,30],[31,31],[30,31],[30,30]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
-    for (const auto& v : d.rings.rings[0].nodes) EXPECT_GE(vec_to_lonlat(v).lat, 30.0 - 1e-9);
+    for (const auto &v : d.rings.rings[0].nodes)
+        EXPECT_GE(vec_to_lonlat(v).lat, 30.0 - 1e-9);
     expect_valid_both_stages(d, 20);
 }
 
@@ -250,7 +283,8 @@ TEST(CoastHostile, only_a_sliver_leaves_an_aqua_planet) {
 TEST(CoastHostile, polygons_touching_at_one_point_are_moved_apart) {
     TempDir dir;
     auto path = write(dir, "touch.geojson",
-                      geojson({polygon("[[0,0],[5,0],[5,5],[0,5],[0,0]]"), polygon("[[5,5],[10,5],[10,10],[5,10],[5,5]]")}));
+                      geojson({polygon("[[0,0],[5,0],[5,5],[0,5],[0,0]]"),
+                               polygon("[[5,5],[10,5],[10,10],[5,10],[5,5]]")}));
     CoastData d = load_coast(options_for(path));
     expect_valid_both_stages(d);
 }
@@ -258,19 +292,22 @@ TEST(CoastHostile, polygons_touching_at_one_point_are_moved_apart) {
 TEST(CoastHostile, overlapping_polygons_are_dissolved) {
     TempDir dir;
     auto path = write(dir, "overlap.geojson",
-                      geojson({polygon("[[0,0],[10,0],[10,10],[0,10],[0,0]]"), polygon("[[5,5],[15,5],[15,15],[5,15],[5,5]]")}));
+                      geojson({polygon("[[0,0],[10,0],[10,10],[0,10],[0,0]]"),
+                               polygon("[[5,5],[15,5],[15,15],[5,15],[5,5]]")}));
     CoastData d = load_coast(options_for(path));
     ASSERT_EQ(d.rings.rings.size(), 1u);
     expect_valid_both_stages(d);
-    double land = planar_polygon_area_km2({{0, 0}, {10, 0}, {10, 5}, {15, 5}, {15, 15}, {5, 15}, {5, 10}, {0, 10}});
+    double land = planar_polygon_area_km2(
+        {{0, 0}, {10, 0}, {10, 5}, {15, 5}, {15, 15}, {5, 15}, {5, 10}, {0, 10}});
     EXPECT_NEAR(earth_km2() - d.ocean_area_km2, land, 0.002 * land);
 }
 
 TEST(CoastHostile, island_in_a_lake_goes_with_the_lake_unless_inland_seas_are_kept) {
     TempDir dir;
-    auto path = write(dir, "lake.geojson",
-                      geojson({polygon("[[0,0],[20,0],[20,20],[0,20],[0,0]],[[5,5],[5,15],[15,15],[15,5],[5,5]]"),
-                               polygon("[[9,9],[11,9],[11,11],[9,11],[9,9]]")}));
+    auto path = write(
+        dir, "lake.geojson",
+        geojson({polygon("[[0,0],[20,0],[20,20],[0,20],[0,0]],[[5,5],[5,15],[15,15],[15,5],[5,5]]"),
+                 polygon("[[9,9],[11,9],[11,11],[9,11],[9,9]]")}));
     CoastData d = load_coast(options_for(path));
     EXPECT_EQ(d.rings.rings.size(), 1u);
     EXPECT_EQ(d.lakes_removed, 1u);
@@ -280,7 +317,8 @@ TEST(CoastHostile, island_in_a_lake_goes_with_the_lake_unless_inland_seas_are_ke
     CoastData all = load_coast(o);
     EXPECT_EQ(all.rings.rings.size(), 3u);
     expect_valid_both_stages(all);
-    double lake = planar_polygon_area_km2({{5, 5}, {15, 5}, {15, 15}, {5, 15}}) - planar_polygon_area_km2({{9, 9}, {11, 9}, {11, 11}, {9, 11}});
+    double lake = planar_polygon_area_km2({{5, 5}, {15, 5}, {15, 15}, {5, 15}}) -
+                  planar_polygon_area_km2({{9, 9}, {11, 9}, {11, 11}, {9, 11}});
     EXPECT_NEAR(all.ocean_area_km2 - d.ocean_area_km2, lake, 0.002 * lake);
     EXPECT_NEAR(d.area_lost_km2, lake, 0.002 * lake);
 }
@@ -288,8 +326,10 @@ TEST(CoastHostile, island_in_a_lake_goes_with_the_lake_unless_inland_seas_are_ke
 TEST(CoastHostile, islands_across_a_strait_narrower_than_h_stay_apart) {
     TempDir dir;
     // Two comb-shaped islands whose teeth interleave 0.02 degree (2 km) apart; h = 100 km.
-    std::string a = "[[0,0],[1,0],[1,0.2],[0.2,0.2],[0.2,0.4],[1,0.4],[1,0.6],[0.2,0.6],[0.2,0.8],[1,0.8],[1,1],[0,1],[0,0]]";
-    std::string b = "[[2,0],[2,1],[1.02,1],[1.02,0.78],[0.22,0.78],[0.22,0.62],[1.02,0.62],[1.02,0.38],[0.22,0.38],"
+    std::string a = "[[0,0],[1,0],[1,0.2],[0.2,0.2],[0.2,0.4],[1,0.4],[1,0.6],[0.2,0.6],[0.2,0.8],["
+                    "1,0.8],[1,1],[0,1],[0,0]]";
+    std::string b = "[[2,0],[2,1],[1.02,1],[1.02,0.78],[0.22,0.78],[0.22,0.62],[1.02,0.62],[1.02,0."
+                    "38],[0.22,0.38],"
                     "[0.22,0.22],[1.02,0.22],[1.02,0],[2,0]]";
     auto path = write(dir, "comb.geojson", geojson({polygon(a), polygon(b)}));
     CoastData d = load_coast(options_for(path));
@@ -297,7 +337,8 @@ TEST(CoastHostile, islands_across_a_strait_narrower_than_h_stay_apart) {
     MeshOptions o;
     o.min_island_triangles = 0;
     CoastReport rep;
-    Boundary shaped = shape_boundary(d, [](const Vec3&) { return 100.0; }, o, &rep);
+    Boundary shaped = shape_boundary(
+        d, [](const Vec3 &) { return 100.0; }, o, &rep);
     EXPECT_EQ(shaped.rings.size(), 2u);
     EXPECT_GT(rep.conflicts_repaired, 0u); // plain Douglas-Peucker at h/2 would cross the teeth
     EXPECT_TRUE(check_boundary(shaped).empty());
@@ -313,7 +354,8 @@ TEST(CoastHostile, empty_layer_is_refused) {
 
 TEST(CoastHostile, point_layer_is_refused) {
     TempDir dir;
-    auto path = write(dir, "points.geojson", geojson({"{\"type\":\"Point\",\"coordinates\":[1,2]}"}));
+    auto path =
+        write(dir, "points.geojson", geojson({"{\"type\":\"Point\",\"coordinates\":[1,2]}"}));
     auto m = message_of<DataError>(options_for(path));
     EXPECT_NE(m.find("Point"), std::string::npos) << m;
     MeshOptions named = options_for(path);
@@ -324,7 +366,8 @@ TEST(CoastHostile, point_layer_is_refused) {
 
 TEST(CoastHostile, region_without_ocean_is_refused) {
     TempDir dir;
-    auto path = write(dir, "big.geojson", geojson({polygon("[[0,0],[40,0],[40,40],[0,40],[0,0]]")}));
+    auto path =
+        write(dir, "big.geojson", geojson({polygon("[[0,0],[40,0],[40,40],[0,40],[0,0]]")}));
     MeshOptions o = options_for(path);
     o.region = std::array<double, 4>{10, 10, 20, 20};
     auto m = message_of<DataError>(o);
@@ -363,14 +406,16 @@ TEST(CoastHostile, a_local_crs_counts_as_none) {
     // A .prj of LOCAL_CS (unknown units): before, "no transformation from its CRS to WGS84 ...
     // ENGCRS[...]"; now as a layer with no CRS, which --coast-srs then gives.
     TempDir dir;
-    const std::string csv = write(dir, "local.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
+    const std::string csv =
+        write(dir, "local.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
     const std::string shp = (dir / "local.shp").string();
     {
         GDALAllRegister();
         GDALDatasetH src = GDALOpenEx(csv.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
         ASSERT_NE(src, nullptr);
-        const char* argv[] = {"-a_srs", "LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]", nullptr};
-        GDALVectorTranslateOptions* opts = GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+        const char *argv[] = {"-a_srs", "LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]", nullptr};
+        GDALVectorTranslateOptions *opts =
+            GDALVectorTranslateOptionsNew(const_cast<char **>(argv), nullptr);
         GDALDatasetH out = GDALVectorTranslate(shp.c_str(), nullptr, 1, &src, opts, nullptr);
         GDALVectorTranslateOptionsFree(opts);
         ASSERT_NE(out, nullptr);
@@ -379,8 +424,10 @@ TEST(CoastHostile, a_local_crs_counts_as_none) {
     }
     MeshOptions o = options_for(shp);
     auto m = message_of<DataError>(o);
-    EXPECT_NE(m.find("declares no coordinate reference system (only a local one, of unknown units); give it with --coast-srs"),
-              std::string::npos) << m;
+    EXPECT_NE(m.find("declares no coordinate reference system (only a local one, of unknown "
+                     "units); give it with --coast-srs"),
+              std::string::npos)
+        << m;
     o.coast_srs = "EPSG:4326";
     EXPECT_EQ(load_coast(o).rings.rings.size(), 1u);
     // The same file as --region-file: the remedy is not --coast-srs, which is for --coast.
@@ -399,9 +446,10 @@ TEST(CoastHostile, coast_srs_does_not_override_a_declared_crs) {
     o.coast_layer = "land";
     o.coast_srs = "EPSG:3857";
     auto m = message_of<DataError>(o);
-    EXPECT_NE(m.find("declares WGS 84 (EPSG:4326), not --coast-srs EPSG:3857"), std::string::npos) << m;
+    EXPECT_NE(m.find("declares WGS 84 (EPSG:4326), not --coast-srs EPSG:3857"), std::string::npos)
+        << m;
     // The same CRS in another spelling is no contradiction (OGC:CRS84 is lon/lat WGS 84).
-    for (const char* same : {"EPSG:4326", "OGC:CRS84", "WGS84"}) {
+    for (const char *same : {"EPSG:4326", "OGC:CRS84", "WGS84"}) {
         o.coast_srs = same;
         EXPECT_GT(load_coast(o).rings.rings.size(), 50u) << same;
     }
@@ -430,13 +478,16 @@ TEST(CoastHostile, longitude_far_beyond_the_antimeridian_is_refused_at_once) {
     // degrees. A ring drawn across the seam needs one wrap (lon 190, or [0, 360)); one beyond
     // +-540 is not in degrees.
     TempDir dir;
-    auto path = write(dir, "huge.geojson",
-                      geojson({polygon("[[-38.77,-20.07],[-38.77,-20.08],[8.872457321089761e+57,-20.08],[-38.77,-20.07]]")}));
+    auto path = write(
+        dir, "huge.geojson",
+        geojson({polygon(
+            "[[-38.77,-20.07],[-38.77,-20.08],[8.872457321089761e+57,-20.08],[-38.77,-20.07]]")}));
     auto m = message_of<DataError>(options_for(path));
     EXPECT_NE(m.find("longitude 8.87246e+57"), std::string::npos) << m;
     EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
     // One wrap is fine: an island drawn from 170 to 190.
-    path = write(dir, "wrap.geojson", geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
+    path = write(dir, "wrap.geojson",
+                 geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));
     EXPECT_EQ(load_coast(options_for(path)).rings.rings.size(), 1u);
 }
 
@@ -445,8 +496,9 @@ TEST(CoastHostile, a_region_reads_only_the_polygons_near_it) {
     // region is not read at all, so one the whole layer refuses (a longitude beyond +-540) leaves
     // a run on the region alone.
     TempDir dir;
-    auto path = write(dir, "two.geojson", geojson({polygon("[[10,10],[12,10],[12,12],[10,12],[10,10]]"),
-                                                   polygon("[[600,-20],[601,-20],[601,-19],[600,-20]]")}));
+    auto path = write(dir, "two.geojson",
+                      geojson({polygon("[[10,10],[12,10],[12,12],[10,12],[10,10]]"),
+                               polygon("[[600,-20],[601,-20],[601,-19],[600,-20]]")}));
     auto m = message_of<DataError>(options_for(path));
     EXPECT_NE(m.find("longitude 60"), std::string::npos) << m;
     MeshOptions o = options_for(path);
@@ -455,8 +507,9 @@ TEST(CoastHostile, a_region_reads_only_the_polygons_near_it) {
     // The box's edges (open) and the island's coast: two rings.
     ASSERT_EQ(d.rings.rings.size(), 2u);
     std::size_t coast = 0;
-    for (const auto& r : d.rings.rings)
-        for (SegmentKind k : r.kinds) coast += k == SegmentKind::coast;
+    for (const auto &r : d.rings.rings)
+        for (SegmentKind k : r.kinds)
+            coast += k == SegmentKind::coast;
     EXPECT_GE(coast, 4u);
     // A region that meets no polygon reads the whole layer, as without a region.
     o.region = std::array<double, 4>{-50, -50, -40, -40};
@@ -466,7 +519,9 @@ TEST(CoastHostile, a_region_reads_only_the_polygons_near_it) {
 
 TEST(CoastHostile, open_coastline_far_from_the_seam_is_refused) {
     TempDir dir;
-    auto path = write(dir, "open.geojson", geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,0],[10,10],[0,10]]}"}));
+    auto path =
+        write(dir, "open.geojson",
+              geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,0],[10,10],[0,10]]}"}));
     auto m = message_of<DataError>(options_for(path));
     EXPECT_NE(m.find("not closed"), std::string::npos) << m;
 }
@@ -474,9 +529,11 @@ TEST(CoastHostile, open_coastline_far_from_the_seam_is_refused) {
 TEST(CoastHostile, closed_coastline_lines_are_polygonized) {
     TempDir dir;
     // A figure-eight line (self-crossing) and a plain closed line.
-    auto path = write(dir, "lines.geojson",
-                      geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,10],[10,0],[0,10],[0,0]]}",
-                               "{\"type\":\"LineString\",\"coordinates\":[[30,30],[31,30],[31,31],[30,31],[30,30]]}"}));
+    auto path = write(
+        dir, "lines.geojson",
+        geojson({"{\"type\":\"LineString\",\"coordinates\":[[0,0],[10,10],[10,0],[0,10],[0,0]]}",
+                 "{\"type\":\"LineString\",\"coordinates\":[[30,30],[31,30],[31,31],[30,31],[30,30]"
+                 "]}"}));
     CoastData d = load_coast(options_for(path));
     EXPECT_EQ(d.rings.rings.size(), 3u);
     expect_valid_both_stages(d, 20);

@@ -24,43 +24,45 @@ using globemesh::test::layer_area_km2;
 
 namespace {
 
-MeshOptions coast_options(const std::string& rel, const std::string& layer = "land") {
+MeshOptions coast_options(const std::string &rel, const std::string &layer = "land") {
     MeshOptions o;
     o.coast = fixture(rel).string();
     o.coast_layer = layer;
     return o;
 }
 
-const CoastData& ne110() {
+const CoastData &ne110() {
     static const CoastData data = load_coast(coast_options("coast/ne_110m_land.gpkg"));
     return data;
 }
-const CoastData& ne50() {
+const CoastData &ne50() {
     static const CoastData data = load_coast(coast_options("coast/ne_50m_land.gpkg"));
     return data;
 }
 
-std::size_t node_count(const Boundary& b) {
+std::size_t node_count(const Boundary &b) {
     std::size_t n = 0;
-    for (const auto& r : b.rings) n += r.nodes.size();
+    for (const auto &r : b.rings)
+        n += r.nodes.size();
     return n;
 }
 
 /// Sum of longitude steps along a ring, degrees: +-360 for a ring around a pole, 0 otherwise.
-double winding_deg(const Ring& r) {
+double winding_deg(const Ring &r) {
     double sum = 0;
     for (std::size_t i = 0; i < r.nodes.size(); ++i) {
-        double a = vec_to_lonlat(r.nodes[i]).lon, b = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]).lon;
+        double a = vec_to_lonlat(r.nodes[i]).lon,
+               b = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]).lon;
         sum += std::remainder(b - a, 360.0);
     }
     return sum;
 }
 
 SizeFn uniform(double h) {
-    return [h](const Vec3&) { return h; };
+    return [h](const Vec3 &) { return h; };
 }
 
-void expect_valid(const Boundary& b) {
+void expect_valid(const Boundary &b) {
     auto issues = check_boundary(b);
     EXPECT_TRUE(issues.empty()) << issues.front().what << " ring " << issues.front().ring << " seg "
                                 << issues.front().segment;
@@ -69,13 +71,14 @@ void expect_valid(const Boundary& b) {
 } // namespace
 
 TEST(Coast, natural_earth_110m_gives_simple_non_crossing_rings) {
-    const auto& d = ne110();
+    const auto &d = ne110();
     ASSERT_GT(d.rings.rings.size(), 100u);
     EXPECT_EQ(count_violations(d.rings), 0u);
     expect_valid(d.rings);
-    for (const auto& r : d.rings.rings) {
+    for (const auto &r : d.rings.rings) {
         ASSERT_EQ(r.kinds.size(), r.nodes.size());
-        for (auto k : r.kinds) EXPECT_EQ(k, SegmentKind::coast);
+        for (auto k : r.kinds)
+            EXPECT_EQ(k, SegmentKind::coast);
     }
 }
 
@@ -89,20 +92,21 @@ TEST(Coast, ocean_area_110m_matches_the_source_ocean_layer) {
     CoastData with_caspian = load_coast(o);
     double all = layer_area_km2(fixture("coast/ne_110m_land.gpkg").string(), "ocean");
     EXPECT_NEAR(with_caspian.ocean_area_km2, all, 0.005 * all);
-    EXPECT_NEAR(with_caspian.ocean_area_km2 - ne110().ocean_area_km2, all - oracle, 0.01 * (all - oracle));
+    EXPECT_NEAR(with_caspian.ocean_area_km2 - ne110().ocean_area_km2, all - oracle,
+                0.01 * (all - oracle));
 }
 
 TEST(Coast, antarctica_is_one_ring_around_the_south_pole_without_cut_nodes) {
-    for (const CoastData* d : {&ne110(), &ne50()}) {
+    for (const CoastData *d : {&ne110(), &ne50()}) {
         int around_south = 0;
-        for (const auto& r : d->rings.rings) {
+        for (const auto &r : d->rings.rings) {
             double w = winding_deg(r);
             if (std::abs(std::abs(w) - 360.0) > 1e-6) {
                 EXPECT_NEAR(w, 0.0, 1e-6);
                 continue;
             }
             ++around_south;
-            for (const auto& v : r.nodes) {
+            for (const auto &v : r.nodes) {
                 LonLat p = vec_to_lonlat(v);
                 EXPECT_LT(p.lat, -60.0);
                 EXPECT_GT(p.lat, -86.0) << "node on the artificial closure near the pole";
@@ -111,7 +115,8 @@ TEST(Coast, antarctica_is_one_ring_around_the_south_pole_without_cut_nodes) {
                     EXPECT_GT(p.lat, -84.8);
                 }
             }
-            // Ocean on the left: walking east along the coast (positive winding) keeps the sea north.
+            // Ocean on the left: walking east along the coast (positive winding) keeps the sea
+            // north.
             EXPECT_GT(w, 0.0);
         }
         EXPECT_EQ(around_south, 1);
@@ -127,7 +132,7 @@ TEST(Coast, shapefile_and_geopackage_give_the_same_rings) {
 
 TEST(Coast, projected_copy_gives_the_same_rings_within_one_metre) {
     CoastData proj = load_coast(coast_options("coast/ne_110m_land_equal_earth.gpkg"));
-    const auto& ref = ne110().rings.rings;
+    const auto &ref = ne110().rings.rings;
     ASSERT_EQ(proj.rings.rings.size(), ref.size());
     double worst_km = 0;
     for (std::size_t r = 0; r < ref.size(); ++r) {
@@ -140,7 +145,7 @@ TEST(Coast, projected_copy_gives_the_same_rings_within_one_metre) {
 }
 
 TEST(Coast, natural_earth_50m_rings_are_valid_and_enclose_the_ocean_area) {
-    const auto& d = ne50();
+    const auto &d = ne50();
     expect_valid(d.rings);
     double oracle = layer_area_km2(fixture("coast/ne_50m_land.gpkg").string(), "ocean", true);
     EXPECT_NEAR(d.ocean_area_km2, oracle, 0.005 * oracle);
@@ -151,11 +156,12 @@ TEST(Coast, coastline_lines_are_polygonized_like_the_land_polygons) {
     EXPECT_EQ(lines.layer, "coastline");
     expect_valid(lines.rings);
     EXPECT_NEAR(lines.ocean_area_km2, ne50().ocean_area_km2, 0.005 * ne50().ocean_area_km2);
-    EXPECT_NEAR(static_cast<double>(lines.rings.rings.size()), static_cast<double>(ne50().rings.rings.size()), 10.0);
+    EXPECT_NEAR(static_cast<double>(lines.rings.rings.size()),
+                static_cast<double>(ne50().rings.rings.size()), 10.0);
 }
 
 TEST(Coast, shaping_at_100_and_10_km_keeps_every_invariant) {
-    for (const CoastData* d : {&ne110(), &ne50()}) {
+    for (const CoastData *d : {&ne110(), &ne50()}) {
         for (double h : {100.0, 10.0}) {
             CoastReport rep;
             MeshOptions o;
@@ -168,25 +174,29 @@ TEST(Coast, shaping_at_100_and_10_km_keeps_every_invariant) {
             EXPECT_EQ(rep.nodes, node_count(b));
             // Consecutive nodes are at most about h apart (arcs are split to round(L/h) pieces).
             double longest = 0;
-            for (const auto& r : b.rings)
+            for (const auto &r : b.rings)
                 for (std::size_t i = 0; i < r.nodes.size(); ++i)
-                    longest = std::max(longest, arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]));
+                    longest =
+                        std::max(longest, arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]));
             EXPECT_LT(longest, 1.5 * h) << "h " << h;
             // Small islands go, the ocean area hardly changes.
-            EXPECT_NEAR(rep.ocean_area_km2, d->ocean_area_km2, 0.01 * d->ocean_area_km2) << "h " << h;
+            EXPECT_NEAR(rep.ocean_area_km2, d->ocean_area_km2, 0.01 * d->ocean_area_km2)
+                << "h " << h;
             EXPECT_NEAR(boundary_area_km2(b), rep.ocean_area_km2, 1.0);
             // Islands (land area < a quarter of the Earth) survive iff their full-resolution
             // area reaches 4 equilateral triangles of side h (1 % margin: spherical vs WGS84).
             double earth = GeographicLib::Geodesic::WGS84().EllipsoidArea() * 1e-6;
             double min_island = 4 * std::sqrt(3.0) / 4 * h * h;
             std::size_t surely_kept = 0, maybe_kept = 0;
-            for (const auto& r : d->rings.rings) {
+            for (const auto &r : d->rings.rings) {
                 Boundary one;
                 one.rings.push_back(r);
                 double land = earth - boundary_area_km2(one);
                 bool island = land < 0.25 * earth;
-                if (!island || land > 1.01 * min_island) ++surely_kept;
-                if (!island || land > 0.99 * min_island) ++maybe_kept;
+                if (!island || land > 1.01 * min_island)
+                    ++surely_kept;
+                if (!island || land > 0.99 * min_island)
+                    ++maybe_kept;
             }
             EXPECT_GE(b.rings.size(), surely_kept) << "h " << h;
             EXPECT_LE(b.rings.size(), maybe_kept) << "h " << h;
@@ -202,22 +212,25 @@ TEST(Coast, shaped_nodes_stay_near_the_source_and_segments_near_the_size) {
     MeshOptions o;
     Boundary b = shape_boundary(ne110(), uniform(h), o);
     std::vector<double> distance, length;
-    for (const auto& r : b.rings)
+    for (const auto &r : b.rings)
         for (std::size_t i = 0; i < r.nodes.size(); ++i) {
-            const Vec3& p = r.nodes[i];
+            const Vec3 &p = r.nodes[i];
             double nearest = pi;
-            for (const auto& s : ne110().rings.rings)
+            for (const auto &s : ne110().rings.rings)
                 for (std::size_t k = 0; k < s.nodes.size(); ++k)
-                    nearest = std::min(nearest, arc_distance(s.nodes[k], s.nodes[(k + 1) % s.nodes.size()], p));
+                    nearest = std::min(
+                        nearest, arc_distance(s.nodes[k], s.nodes[(k + 1) % s.nodes.size()], p));
             distance.push_back(nearest * earth_radius_km);
             length.push_back(arc_km(p, r.nodes[(i + 1) % r.nodes.size()]));
         }
     std::sort(distance.begin(), distance.end());
     EXPECT_LT(distance[distance.size() * 95 / 100], h / 4);
     EXPECT_LT(distance.back(), h / 2);
-    const auto near_h = std::count_if(length.begin(), length.end(), [&](double l) { return l >= 0.7 * h && l <= 1.4 * h; });
-    std::printf("nodes %zu: distance p95 %.1f km, max %.1f km; segments in [0.7, 1.4] h: %.1f%%\n", distance.size(),
-                distance[distance.size() * 95 / 100], distance.back(), 100.0 * near_h / length.size());
+    const auto near_h = std::count_if(length.begin(), length.end(),
+                                      [&](double l) { return l >= 0.7 * h && l <= 1.4 * h; });
+    std::printf("nodes %zu: distance p95 %.1f km, max %.1f km; segments in [0.7, 1.4] h: %.1f%%\n",
+                distance.size(), distance[distance.size() * 95 / 100], distance.back(),
+                100.0 * near_h / length.size());
     EXPECT_GT(double(near_h), 0.8 * length.size());
 }
 
@@ -227,12 +240,14 @@ TEST(Coast, shaped_nodes_stay_near_the_source_and_segments_near_the_size) {
 // for over 1e8 nodes and 100 km for a few thousand.
 TEST(Coast, a_coast_that_alone_exceeds_max_nodes_is_refused_before_it_is_resampled) {
     double length_km = 0;
-    for (const auto& r : ne110().rings.rings)
-        for (std::size_t k = 0; k < r.nodes.size(); ++k) length_km += arc_km(r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]);
+    for (const auto &r : ne110().rings.rings)
+        for (std::size_t k = 0; k < r.nodes.size(); ++k)
+            length_km += arc_km(r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]);
     ASSERT_GT(length_km / 0.001, 1e8);
     MeshOptions o;
     o.max_nodes = 20'000'000;
-    const std::string m = test::thrown_message<DataError>([&] { shape_boundary(ne110(), uniform(0.001), o); }, "a 1 m coast");
+    const std::string m = test::thrown_message<DataError>(
+        [&] { shape_boundary(ne110(), uniform(0.001), o); }, "a 1 m coast");
     EXPECT_NE(m.find("--max-nodes"), std::string::npos) << m;
     // At 100 km the same bound lets it through, with nodes to spare.
     o.max_nodes = static_cast<std::uint64_t>(length_km / 100 * 2);
@@ -243,17 +258,19 @@ TEST(Coast, a_coast_that_alone_exceeds_max_nodes_is_refused_before_it_is_resampl
 
 TEST(Coast, shaping_follows_a_varying_size) {
     // h = 20 km north of the equator, 200 km south of it.
-    auto size = [](const Vec3& v) { return v.z > 0 ? 20.0 : 200.0; };
+    auto size = [](const Vec3 &v) { return v.z > 0 ? 20.0 : 200.0; };
     MeshOptions o;
     Boundary b = shape_boundary(ne110(), size, o);
     expect_valid(b);
     double north = 0, south = 0;
     std::size_t nn = 0, ns = 0;
-    for (const auto& r : b.rings)
+    for (const auto &r : b.rings)
         for (std::size_t i = 0; i < r.nodes.size(); ++i) {
             double d = arc_km(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()]);
-            if (r.nodes[i].z > 0.1) north += d, ++nn;
-            if (r.nodes[i].z < -0.1) south += d, ++ns;
+            if (r.nodes[i].z > 0.1)
+                north += d, ++nn;
+            if (r.nodes[i].z < -0.1)
+                south += d, ++ns;
         }
     ASSERT_GT(nn, 0u);
     ASSERT_GT(ns, 0u);
@@ -268,7 +285,7 @@ TEST(Coast, region_across_the_antimeridian_gets_open_edges_on_the_box) {
     expect_valid(d.rings);
     EXPECT_EQ(count_violations(d.rings), 0u);
     std::size_t open = 0, coast = 0;
-    for (const auto& r : d.rings.rings)
+    for (const auto &r : d.rings.rings)
         for (std::size_t i = 0; i < r.nodes.size(); ++i) {
             LonLat p = vec_to_lonlat(r.nodes[i]);
             EXPECT_TRUE(p.lon >= 170 - 1e-9 || p.lon <= -170 + 1e-9) << p.lon;
@@ -277,11 +294,14 @@ TEST(Coast, region_across_the_antimeridian_gets_open_edges_on_the_box) {
             if (r.kinds[i] == SegmentKind::open) {
                 ++open;
                 LonLat q = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]);
-                bool on_box = (std::abs(p.lat - q.lat) < 1e-9 && (std::abs(p.lat + 25) < 1e-9 || std::abs(p.lat + 10) < 1e-9)) ||
-                              (std::abs(p.lon - q.lon) < 1e-9 && (std::abs(p.lon - 170) < 1e-9 || std::abs(p.lon + 170) < 1e-9));
+                bool on_box = (std::abs(p.lat - q.lat) < 1e-9 &&
+                               (std::abs(p.lat + 25) < 1e-9 || std::abs(p.lat + 10) < 1e-9)) ||
+                              (std::abs(p.lon - q.lon) < 1e-9 &&
+                               (std::abs(p.lon - 170) < 1e-9 || std::abs(p.lon + 170) < 1e-9));
                 EXPECT_TRUE(on_box) << p.lon << " " << p.lat << " -> " << q.lon << " " << q.lat;
                 // No open edge along the glued +-180 seam.
-                EXPECT_FALSE(std::abs(std::abs(p.lon) - 180) < 1e-9 && std::abs(std::abs(q.lon) - 180) < 1e-9);
+                EXPECT_FALSE(std::abs(std::abs(p.lon) - 180) < 1e-9 &&
+                             std::abs(std::abs(q.lon) - 180) < 1e-9);
             } else {
                 ++coast;
             }
@@ -290,10 +310,14 @@ TEST(Coast, region_across_the_antimeridian_gets_open_edges_on_the_box) {
     EXPECT_GT(coast, 0u);
     // Ocean area: the box (20 x 15 degrees) less a little land; the box's geodesic area bounds it.
     GeographicLib::PolygonArea box(GeographicLib::Geodesic::WGS84());
-    for (double lon = 170; lon < 190; lon += 0.5) box.AddPoint(-25, lon);
-    for (double lat = -25; lat < -10; lat += 0.5) box.AddPoint(lat, 190);
-    for (double lon = 190; lon > 170; lon -= 0.5) box.AddPoint(-10, lon);
-    for (double lat = -10; lat > -25; lat -= 0.5) box.AddPoint(lat, 170);
+    for (double lon = 170; lon < 190; lon += 0.5)
+        box.AddPoint(-25, lon);
+    for (double lat = -25; lat < -10; lat += 0.5)
+        box.AddPoint(lat, 190);
+    for (double lon = 190; lon > 170; lon -= 0.5)
+        box.AddPoint(-10, lon);
+    for (double lat = -10; lat > -25; lat -= 0.5)
+        box.AddPoint(lat, 170);
     double perimeter, area;
     box.Compute(false, true, perimeter, area);
     area *= 1e-6;
@@ -310,7 +334,7 @@ TEST(Coast, region_reaching_the_north_pole_has_no_pole_node) {
     expect_valid(d.rings);
     EXPECT_EQ(count_violations(d.rings), 0u);
     std::size_t open = 0;
-    for (const auto& r : d.rings.rings)
+    for (const auto &r : d.rings.rings)
         for (std::size_t i = 0; i < r.nodes.size(); ++i) {
             LonLat p = vec_to_lonlat(r.nodes[i]);
             EXPECT_LT(p.lat, 89.0);
@@ -333,33 +357,40 @@ TEST(Coast, open_region_box_in_the_open_sea_is_all_open_boundary) {
     o.region = std::array<double, 4>{-150, -30, -130, -10};
     CoastData d = load_coast(o);
     ASSERT_EQ(d.rings.rings.size(), 1u);
-    for (auto k : d.rings.rings[0].kinds) EXPECT_EQ(k, SegmentKind::open);
+    for (auto k : d.rings.rings[0].kinds)
+        EXPECT_EQ(k, SegmentKind::open);
     // Oracle: the box's geodesic area with edges densified as the rings are (0.5 degree).
     GeographicLib::PolygonArea box(GeographicLib::Geodesic::WGS84());
-    for (double lon = -150; lon < -130; lon += 0.5) box.AddPoint(-30, lon);
-    for (double lat = -30; lat < -10; lat += 0.5) box.AddPoint(lat, -130);
-    for (double lon = -130; lon > -150; lon -= 0.5) box.AddPoint(-10, lon);
-    for (double lat = -10; lat > -30; lat -= 0.5) box.AddPoint(lat, -150);
+    for (double lon = -150; lon < -130; lon += 0.5)
+        box.AddPoint(-30, lon);
+    for (double lat = -30; lat < -10; lat += 0.5)
+        box.AddPoint(lat, -130);
+    for (double lon = -130; lon > -150; lon -= 0.5)
+        box.AddPoint(-10, lon);
+    for (double lat = -10; lat > -30; lat -= 0.5)
+        box.AddPoint(lat, -150);
     double perimeter, area;
     box.Compute(false, true, perimeter, area);
     EXPECT_NEAR(d.ocean_area_km2, area * 1e-6, 1e-6 * area * 1e-6);
 }
 
 TEST(Coast, region_boxes_reaching_the_south_pole_or_the_seam_keep_the_invariants) {
-    for (std::array<double, 4> box : {std::array<double, 4>{-180, -90, 180, -60}, std::array<double, 4>{-180, -50, 100, 10},
-                                      std::array<double, 4>{0, 70, 90, 90}, std::array<double, 4>{150, -60, -120, 60}}) {
+    for (std::array<double, 4> box :
+         {std::array<double, 4>{-180, -90, 180, -60}, std::array<double, 4>{-180, -50, 100, 10},
+          std::array<double, 4>{0, 70, 90, 90}, std::array<double, 4>{150, -60, -120, 60}}) {
         MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
         o.region = box;
         CoastData d = load_coast(o);
         expect_valid(d.rings);
         EXPECT_EQ(count_violations(d.rings), 0u) << box[0] << " " << box[1];
         std::size_t open = 0;
-        for (const auto& r : d.rings.rings)
+        for (const auto &r : d.rings.rings)
             for (std::size_t i = 0; i < r.nodes.size(); ++i) {
                 LonLat p = vec_to_lonlat(r.nodes[i]);
                 EXPECT_GE(p.lat, box[1] - 1e-9);
                 EXPECT_LE(p.lat, box[3] + 1e-9);
-                if (r.kinds[i] == SegmentKind::open) ++open;
+                if (r.kinds[i] == SegmentKind::open)
+                    ++open;
             }
         EXPECT_GT(open, 0u);
         expect_valid(shape_boundary(d, uniform(100), o));
@@ -370,22 +401,26 @@ TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
     globemesh::test::TempDir dir;
     // A 2000 km square in the North Atlantic, in Web Mercator metres.
     auto path = (dir / "region.geojson").string();
-    std::ofstream(path) << "{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"name\",\"properties\":{\"name\":\"EPSG:3857\"}},"
-                           "\"features\":[{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
-                           "\"coordinates\":[[[-4000000,4000000],[-2000000,4000000],[-2000000,7000000],[-4000000,7000000],[-4000000,4000000]]]}}]}";
+    std::ofstream(path) << "{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"name\","
+                           "\"properties\":{\"name\":\"EPSG:3857\"}},"
+                           "\"features\":[{\"type\":\"Feature\",\"properties\":{},\"geometry\":{"
+                           "\"type\":\"Polygon\","
+                           "\"coordinates\":[[[-4000000,4000000],[-2000000,4000000],[-2000000,"
+                           "7000000],[-4000000,7000000],[-4000000,4000000]]]}}]}";
     MeshOptions o = coast_options("coast/ne_50m_land.gpkg");
     o.region_file = path;
     CoastData d = load_coast(o);
     expect_valid(d.rings);
     EXPECT_EQ(count_violations(d.rings), 0u);
     std::size_t open = 0;
-    for (const auto& r : d.rings.rings)
+    for (const auto &r : d.rings.rings)
         for (std::size_t i = 0; i < r.nodes.size(); ++i) {
             LonLat p = vec_to_lonlat(r.nodes[i]);
             // -4e6 m and -2e6 m are lon -35.93 and -17.97 degrees in Web Mercator.
             EXPECT_GE(p.lon, -35.94);
             EXPECT_LE(p.lon, -17.96);
-            if (r.kinds[i] == SegmentKind::open) ++open;
+            if (r.kinds[i] == SegmentKind::open)
+                ++open;
         }
     EXPECT_GT(open, 0u);
     expect_valid(shape_boundary(d, uniform(30), o));
@@ -398,7 +433,8 @@ TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
 TEST(Coast, a_region_outline_along_the_coast_is_land_there) {
     MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
     o.region_file = fixture("coast/ne_110m_land_equal_earth.gpkg").string();
-    const std::string m = test::thrown_message<DataError>([&] { load_coast(o); }, "a region that is all land");
+    const std::string m =
+        test::thrown_message<DataError>([&] { load_coast(o); }, "a region that is all land");
     EXPECT_NE(m.find("no ocean is left in the region (it is all land)"), std::string::npos) << m;
 }
 
@@ -418,7 +454,8 @@ TEST(Coast, min_island_area_drops_small_islands_by_geodesic_area) {
     expect_valid(d.rings);
     EXPECT_GT(d.islands_removed, 10u);
     EXPECT_LT(d.rings.rings.size(), ne110().rings.rings.size());
-    EXPECT_NEAR(d.ocean_area_km2 - ne110().ocean_area_km2, d.area_gained_km2 - d.area_lost_km2 + ne110().area_lost_km2,
+    EXPECT_NEAR(d.ocean_area_km2 - ne110().ocean_area_km2,
+                d.area_gained_km2 - d.area_lost_km2 + ne110().area_lost_km2,
                 1e-6 * ne110().ocean_area_km2);
 }
 
@@ -426,10 +463,11 @@ TEST(Coast, min_island_area_drops_small_islands_by_geodesic_area) {
 // on the source features (GIS semantics: a lake, a hole of the land, is not land), and its coast
 // distance against a brute-force distance to the loaded rings on the sphere.
 TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
-    const CoastData& d = ne110();
+    const CoastData &d = ne110();
     ASSERT_TRUE(d.land);
     GDALAllRegister();
-    GDALDatasetH ds = GDALOpenEx(fixture("coast/ne_110m_land.gpkg").string().c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+    GDALDatasetH ds = GDALOpenEx(fixture("coast/ne_110m_land.gpkg").string().c_str(),
+                                 GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
     ASSERT_NE(ds, nullptr);
     OGRLayerH layer = GDALDatasetGetLayerByName(ds, "land");
     std::vector<OGRGeometryH> source;
@@ -439,11 +477,12 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
         OGR_F_Destroy(f);
     }
     GDALClose(ds);
-    auto ogr_land = [&](const LonLat& ll) {
+    auto ogr_land = [&](const LonLat &ll) {
         OGRGeometryH pt = OGR_G_CreateGeometry(wkbPoint);
         OGR_G_SetPoint_2D(pt, 0, ll.lon, ll.lat);
         bool in = false;
-        for (auto g : source) in = in || OGR_G_Contains(g, pt);
+        for (auto g : source)
+            in = in || OGR_G_Contains(g, pt);
         OGR_G_DestroyGeometry(pt);
         return in;
     };
@@ -457,7 +496,7 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
         disagree += in != ogr_land(vec_to_lonlat(p));
     }
     EXPECT_EQ(disagree, 0u);
-    EXPECT_NEAR(double(land) / 3000, 0.29, 0.03); // land covers 29% of the Earth
+    EXPECT_NEAR(double(land) / 3000, 0.29, 0.03);            // land covers 29% of the Earth
     EXPECT_TRUE(d.land->contains(lonlat_to_vec(15, 25)));    // the Sahara
     EXPECT_FALSE(d.land->contains(lonlat_to_vec(-30, 30)));  // the Atlantic
     EXPECT_FALSE(d.land->contains(lonlat_to_vec(50.5, 42))); // the Caspian, a hole of the land
@@ -465,14 +504,17 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
     std::vector<std::vector<Vec3>> outlines;
     std::function<void(OGRGeometryH)> collect = [&](OGRGeometryH g) {
         if (OGR_G_GetGeometryCount(g) > 0) {
-            for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i) collect(OGR_G_GetGeometryRef(g, i));
+            for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
+                collect(OGR_G_GetGeometryRef(g, i));
             return;
         }
         std::vector<Vec3> ring;
-        for (int i = 0; i < OGR_G_GetPointCount(g); ++i) ring.push_back(lonlat_to_vec(OGR_G_GetX(g, i), OGR_G_GetY(g, i)));
+        for (int i = 0; i < OGR_G_GetPointCount(g); ++i)
+            ring.push_back(lonlat_to_vec(OGR_G_GetX(g, i), OGR_G_GetY(g, i)));
         outlines.push_back(std::move(ring));
     };
-    for (auto g : source) collect(g);
+    for (auto g : source)
+        collect(g);
 
     // Near the coast too, where the land test's cells (a cell no segment's box touches answers
     // from the first point asked in its component) meet the outline: points within a few cells
@@ -482,10 +524,12 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
     std::uniform_real_distribution<double> offset(-0.15, 0.15);
     std::size_t near_land = 0, near_disagree = 0;
     for (int i = 0; i < 3000; ++i) {
-        const auto& r = outlines[pick(rng)];
-        const LonLat v = vec_to_lonlat(r[std::uniform_int_distribution<std::size_t>(0, r.size() - 1)(rng)]);
+        const auto &r = outlines[pick(rng)];
+        const LonLat v =
+            vec_to_lonlat(r[std::uniform_int_distribution<std::size_t>(0, r.size() - 1)(rng)]);
         LonLat q{v.lon + offset(rng), std::clamp(v.lat + offset(rng), -90.0, 90.0)};
-        if (i % 3 == 0) q = {std::round(q.lon * 16) / 16, std::round(q.lat * 16) / 16};
+        if (i % 3 == 0)
+            q = {std::round(q.lon * 16) / 16, std::round(q.lat * 16) / 16};
         const Vec3 p = lonlat_to_vec(q.lon, q.lat);
         const bool in = d.land->contains(p);
         EXPECT_EQ(d.land->contains(p), in);
@@ -495,22 +539,26 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
     EXPECT_EQ(near_disagree, 0u);
     EXPECT_GT(near_land, 600u);
     EXPECT_LT(near_land, 2400u);
-    for (auto g : source) OGR_G_DestroyGeometry(g);
+    for (auto g : source)
+        OGR_G_DestroyGeometry(g);
 
     // coast_within agrees with the brute-force distance on the sphere, at every latitude and
     // across +-180 (the source splits land there; a cap that crosses it must find both sides).
     std::uniform_real_distribution<double> lon(-180, 180), lat(-85, 85), reach(0.002, 0.1);
     int yes = 0, no = 0;
     for (int i = 0; i < 400; ++i) {
-        const Vec3 p = i < 20 ? lonlat_to_vec(i % 2 ? 179.9 : -179.9, 66 + i * 0.3) : lonlat_to_vec(lon(rng), lat(rng));
+        const Vec3 p = i < 20 ? lonlat_to_vec(i % 2 ? 179.9 : -179.9, 66 + i * 0.3)
+                              : lonlat_to_vec(lon(rng), lat(rng));
         const double a = reach(rng);
         double nearest = pi;
-        for (const auto& r : outlines)
-            for (std::size_t k = 0; k + 1 < r.size(); ++k) nearest = std::min(nearest, arc_distance(r[k], r[k + 1], p));
-        if (std::abs(nearest - a) < 1e-9) continue; // a tie: either answer is right
+        for (const auto &r : outlines)
+            for (std::size_t k = 0; k + 1 < r.size(); ++k)
+                nearest = std::min(nearest, arc_distance(r[k], r[k + 1], p));
+        if (std::abs(nearest - a) < 1e-9)
+            continue; // a tie: either answer is right
         const bool within = d.land->coast_within(p, a);
-        EXPECT_EQ(within, nearest <= a) << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat << " reach " << a
-                                        << " nearest " << nearest;
+        EXPECT_EQ(within, nearest <= a) << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat
+                                        << " reach " << a << " nearest " << nearest;
         (within ? yes : no) += 1;
     }
     EXPECT_GT(yes, 30);

@@ -26,14 +26,16 @@ std::vector<Vec3> random_points(std::size_t n, std::uint64_t seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> z(-1, 1), lon(-180, 180);
     std::vector<Vec3> p(n);
-    for (auto& v : p) v = lonlat_to_vec(lon(rng), std::asin(z(rng)) * rad_to_deg);
+    for (auto &v : p)
+        v = lonlat_to_vec(lon(rng), std::asin(z(rng)) * rad_to_deg);
     return p;
 }
 
 std::vector<Vec3> grid_points(double step_deg) {
     std::vector<Vec3> p;
     for (double lat = -90; lat <= 90; lat += step_deg)
-        for (double lon = -180; lon < 180; lon += step_deg) p.push_back(lonlat_to_vec(lon, lat));
+        for (double lon = -180; lon < 180; lon += step_deg)
+            p.push_back(lonlat_to_vec(lon, lat));
     return p; // the poles appear once per longitude: duplicates the core must merge
 }
 
@@ -41,13 +43,14 @@ using Tri = std::array<std::array<double, 3>, 3>;
 
 // Triangles as coordinate triples, rotated to start at the lexicographically smallest corner,
 // sorted: two triangulations of the same points are equal iff these lists are.
-std::vector<Tri> canonical(const SphericalDelaunay& dt, bool solid_only) {
+std::vector<Tri> canonical(const SphericalDelaunay &dt, bool solid_only) {
     std::vector<Tri> out;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-        if (!dt.is_live(t) || (solid_only && !dt.is_solid(t))) continue;
+        if (!dt.is_live(t) || (solid_only && !dt.is_solid(t)))
+            continue;
         Tri tri;
         for (int i = 0; i < 3; ++i) {
-            const Vec3& p = dt.point(dt.vertex(t, i));
+            const Vec3 &p = dt.point(dt.vertex(t, i));
             tri[i] = {p.x, p.y, p.z};
         }
         auto m = std::min_element(tri.begin(), tri.end()) - tri.begin();
@@ -58,7 +61,7 @@ std::vector<Tri> canonical(const SphericalDelaunay& dt, bool solid_only) {
     return out;
 }
 
-double solid_area(const SphericalDelaunay& dt) {
+double solid_area(const SphericalDelaunay &dt) {
     double a = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
         if (dt.is_live(t) && dt.is_solid(t))
@@ -69,34 +72,41 @@ double solid_area(const SphericalDelaunay& dt) {
 
 // Brute force, independent of the predicates: no vertex strictly inside any solid triangle's
 // circumcircle by more than `slack` in the plane-distance sense (long double).
-std::size_t brute_force_violations(const SphericalDelaunay& dt, long double slack) {
+std::size_t brute_force_violations(const SphericalDelaunay &dt, long double slack) {
     std::size_t bad = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-        if (!dt.is_live(t) || !dt.is_solid(t)) continue;
-        const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)), &c = dt.point(dt.vertex(t, 2));
-        long double nx = (long double)(b.y - a.y) * (c.z - a.z) - (long double)(b.z - a.z) * (c.y - a.y);
-        long double ny = (long double)(b.z - a.z) * (c.x - a.x) - (long double)(b.x - a.x) * (c.z - a.z);
-        long double nz = (long double)(b.x - a.x) * (c.y - a.y) - (long double)(b.y - a.y) * (c.x - a.x);
+        if (!dt.is_live(t) || !dt.is_solid(t))
+            continue;
+        const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)),
+                   &c = dt.point(dt.vertex(t, 2));
+        long double nx =
+            (long double)(b.y - a.y) * (c.z - a.z) - (long double)(b.z - a.z) * (c.y - a.y);
+        long double ny =
+            (long double)(b.z - a.z) * (c.x - a.x) - (long double)(b.x - a.x) * (c.z - a.z);
+        long double nz =
+            (long double)(b.x - a.x) * (c.y - a.y) - (long double)(b.y - a.y) * (c.x - a.x);
         long double len = std::sqrt(nx * nx + ny * ny + nz * nz);
         for (VertexId v = 0; v < dt.vertex_count(); ++v) {
-            const Vec3& d = dt.point(v);
+            const Vec3 &d = dt.point(v);
             long double h = ((d.x - a.x) * nx + (d.y - a.y) * ny + (d.z - a.z) * nz) / len;
-            if (h > slack) ++bad;
+            if (h > slack)
+                ++bad;
         }
     }
     return bad;
 }
 
-std::size_t euler(const SphericalDelaunay& dt) {
+std::size_t euler(const SphericalDelaunay &dt) {
     std::set<VertexId> used;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
         if (dt.is_live(t))
-            for (int i = 0; i < 3; ++i) used.insert(dt.vertex(t, i));
+            for (int i = 0; i < 3; ++i)
+                used.insert(dt.vertex(t, i));
     std::size_t f = dt.triangle_count();
     return used.size() - 3 * f / 2 + f;
 }
 
-void expect_valid_closed(const SphericalDelaunay& dt) {
+void expect_valid_closed(const SphericalDelaunay &dt) {
     auto problems = dt.validate();
     EXPECT_TRUE(problems.empty()) << problems.front();
     EXPECT_EQ(euler(dt), 2u);
@@ -125,7 +135,8 @@ TEST(Delaunay, release_points_hands_over_the_vertices_and_empties_the_triangulat
     const std::vector<VertexId> ids = dt.insert_points(p);
     const std::vector<Vec3> released = dt.release_points();
     ASSERT_EQ(released.size(), p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_EQ(released[ids[i]], p[i]);
+    for (std::size_t i = 0; i < p.size(); ++i)
+        EXPECT_EQ(released[ids[i]], p[i]);
     EXPECT_EQ(dt.vertex_count(), 0u);
     EXPECT_EQ(dt.triangle_slots(), 0u);
     // Empty, not broken: it triangulates again.
@@ -142,7 +153,8 @@ TEST(Delaunay, random_points_1e5_are_valid_and_cover_the_sphere) {
     EXPECT_EQ(dt.vertex_count(), 100000u);
     EXPECT_EQ(dt.triangle_count(), 2 * 100000u - 4);
     EXPECT_NEAR(solid_area(dt), 4 * pi, 1e-9);
-    for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(dt.point(ids[i]), p[i]);
+    for (std::size_t i = 0; i < p.size(); ++i)
+        ASSERT_EQ(dt.point(ids[i]), p[i]);
 }
 
 TEST(Delaunay, brute_force_empty_circumcircles_on_2000_random_points) {
@@ -174,7 +186,7 @@ TEST(Delaunay, reserved_room_holds_the_points_added_one_by_one_without_moving_th
     plain.insert_points(first);
     reserved.insert_points(first);
     reserved.reserve(p.size());
-    const Vec3* storage = reserved.points().data();
+    const Vec3 *storage = reserved.points().data();
     for (std::size_t i = first.size(); i < p.size(); ++i) {
         plain.insert(p[i], plain.last_triangle());
         reserved.insert(p[i], reserved.last_triangle());
@@ -202,7 +214,8 @@ TEST(Delaunay, one_degree_grid_with_both_poles_is_valid_and_order_independent) {
 
 TEST(Delaunay, great_circle_plus_two_poles) {
     std::vector<Vec3> p;
-    for (int i = 0; i < 360; ++i) p.push_back(lonlat_to_vec(i, 0));
+    for (int i = 0; i < 360; ++i)
+        p.push_back(lonlat_to_vec(i, 0));
     p.push_back({0, 0, 1});
     p.push_back({0, 0, -1});
     SphericalDelaunay dt;
@@ -238,14 +251,16 @@ TEST(Delaunay, duplicates_are_merged_and_reported) {
     auto p = random_points(1000, 2);
     std::vector<Vec3> q = p;
     q.insert(q.end(), p.begin(), p.begin() + 100); // exact duplicates
-    Vec3 near = lonlat_to_vec(vec_to_lonlat(p[500]).lon + 1e-13 * rad_to_deg, vec_to_lonlat(p[500]).lat);
+    Vec3 near =
+        lonlat_to_vec(vec_to_lonlat(p[500]).lon + 1e-13 * rad_to_deg, vec_to_lonlat(p[500]).lat);
     q.push_back(near); // within the default 1e-12 rad
     SphericalDelaunay dt;
     auto ids = dt.insert_points(q);
     expect_valid_closed(dt);
     EXPECT_EQ(dt.vertex_count(), 1000u);
     EXPECT_EQ(dt.merged_count(), 101u);
-    for (int i = 0; i < 100; ++i) EXPECT_EQ(ids[1000 + i], ids[i]);
+    for (int i = 0; i < 100; ++i)
+        EXPECT_EQ(ids[1000 + i], ids[i]);
     EXPECT_EQ(ids.back(), ids[500]);
 }
 
@@ -253,13 +268,15 @@ TEST(Delaunay, points_in_one_hemisphere_give_ghost_triangles_closing_the_hull) {
     std::mt19937_64 rng(8);
     std::uniform_real_distribution<double> lon(-40, 40), lat(10, 60);
     std::vector<Vec3> p(3000);
-    for (auto& v : p) v = lonlat_to_vec(lon(rng), lat(rng));
+    for (auto &v : p)
+        v = lonlat_to_vec(lon(rng), lat(rng));
     SphericalDelaunay dt;
     dt.insert_points(p);
     expect_valid_closed(dt);
     std::size_t ghosts = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (dt.is_live(t) && !dt.is_solid(t)) ++ghosts;
+        if (dt.is_live(t) && !dt.is_solid(t))
+            ++ghosts;
     EXPECT_GT(ghosts, 0u);
     EXPECT_EQ(brute_force_violations(dt, 1e-15L), 0u);
     // Solid triangles tile the spherical convex hull: their area is below a hemisphere.
@@ -272,11 +289,13 @@ TEST(Delaunay, too_few_or_circular_points_are_refused) {
     std::vector<Vec3> two = {{1, 0, 0}, {0, 1, 0}, {1, 0, 0}};
     EXPECT_THROW(a.insert_points(two), DataError);
     std::vector<Vec3> circle;
-    for (int i = 0; i < 50; ++i) circle.push_back(lonlat_to_vec(i * 7.0, 0));
+    for (int i = 0; i < 50; ++i)
+        circle.push_back(lonlat_to_vec(i * 7.0, 0));
     SphericalDelaunay b;
     EXPECT_THROW(b.insert_points(circle), DataError);
     std::vector<Vec3> small_circle;
-    for (int i = 0; i < 50; ++i) small_circle.push_back(lonlat_to_vec(i * 7.0, 30));
+    for (int i = 0; i < 50; ++i)
+        small_circle.push_back(lonlat_to_vec(i * 7.0, 30));
     SphericalDelaunay c;
     EXPECT_THROW(c.insert_points(small_circle), DataError);
 }
@@ -289,8 +308,10 @@ TEST(Delaunay, constraints_are_recovered_by_flips_and_never_flipped_again) {
     // many Delaunay edges.
     std::vector<VertexId> ring;
     for (int k = 0; k < 40; ++k)
-        ring.push_back(dt.insert(lonlat_to_vec(10 + 25 * std::cos(k * 2 * pi / 40), 20 + 15 * std::sin(k * 2 * pi / 40))));
-    for (int k = 0; k < 40; ++k) ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 40]));
+        ring.push_back(dt.insert(lonlat_to_vec(10 + 25 * std::cos(k * 2 * pi / 40),
+                                               20 + 15 * std::sin(k * 2 * pi / 40))));
+    for (int k = 0; k < 40; ++k)
+        ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 40]));
     auto problems = dt.validate();
     ASSERT_TRUE(problems.empty()) << problems.front();
     auto star = dt.vertex_half_edges();
@@ -301,11 +322,13 @@ TEST(Delaunay, constraints_are_recovered_by_flips_and_never_flipped_again) {
     }
     // Inserting more points keeps every constraint and the constrained Delaunay property.
     auto more = random_points(2000, 22);
-    for (const Vec3& q : more) dt.insert(q);
+    for (const Vec3 &q : more)
+        dt.insert(q);
     problems = dt.validate();
     ASSERT_TRUE(problems.empty()) << problems.front();
     star = dt.vertex_half_edges();
-    for (int k = 0; k < 40; ++k) EXPECT_NE(dt.find_edge(star[ring[k]], ring[(k + 1) % 40]), no_half_edge);
+    for (int k = 0; k < 40; ++k)
+        EXPECT_NE(dt.find_edge(star[ring[k]], ring[(k + 1) % 40]), no_half_edge);
     (void)ids;
 }
 
@@ -315,22 +338,27 @@ TEST(Delaunay, renumbering_keeps_every_triangle_constraint_and_label_and_lays_th
     auto ids = dt.insert_points(random_points(3000, 31));
     std::vector<VertexId> ring;
     for (int k = 0; k < 30; ++k)
-        ring.push_back(dt.insert(lonlat_to_vec(-40 + 20 * std::cos(k * 2 * pi / 30), 10 + 20 * std::sin(k * 2 * pi / 30))));
-    for (int k = 0; k < 30; ++k) ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 30]));
-    for (const Vec3& q : random_points(1000, 32)) dt.insert(q);
+        ring.push_back(dt.insert(lonlat_to_vec(-40 + 20 * std::cos(k * 2 * pi / 30),
+                                               10 + 20 * std::sin(k * 2 * pi / 30))));
+    for (int k = 0; k < 30; ++k)
+        ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 30]));
+    for (const Vec3 &q : random_points(1000, 32))
+        dt.insert(q);
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
-        if (dt.is_live(t)) dt.set_label(t, static_cast<std::uint8_t>(t % 3));
+        if (dt.is_live(t))
+            dt.set_label(t, static_cast<std::uint8_t>(t % 3));
     // Each triangle as its corners' points, rotated to start at the smallest, with its label and
     // which of its edges are constrained: the triangulation whatever the numbering.
     using Described = std::tuple<Tri, std::uint8_t, std::array<bool, 3>>;
-    auto describe = [](const SphericalDelaunay& d) {
+    auto describe = [](const SphericalDelaunay &d) {
         std::vector<Described> out;
         for (TriangleId t = 0; t < d.triangle_slots(); ++t) {
-            if (!d.is_live(t)) continue;
+            if (!d.is_live(t))
+                continue;
             Tri tri;
             std::array<bool, 3> constrained;
             for (int i = 0; i < 3; ++i) {
-                const Vec3& p = d.point(d.vertex(t, i));
+                const Vec3 &p = d.point(d.vertex(t, i));
                 tri[i] = {p.x, p.y, p.z};
                 constrained[i] = d.is_constrained(half_edge(t, i));
             }
@@ -351,15 +379,21 @@ TEST(Delaunay, renumbering_keeps_every_triangle_constraint_and_label_and_lays_th
     std::vector<Vec3> old_points(dt.points());
     const auto new_of_slot = dt.renumber(new_of_old);
     ASSERT_EQ(new_of_slot.size(), slots);
-    EXPECT_EQ(static_cast<std::size_t>(std::count(new_of_slot.begin(), new_of_slot.end(), no_triangle)), slots - live);
+    EXPECT_EQ(
+        static_cast<std::size_t>(std::count(new_of_slot.begin(), new_of_slot.end(), no_triangle)),
+        slots - live);
     auto problems = dt.validate();
     ASSERT_TRUE(problems.empty()) << problems.front();
-    for (VertexId v = 0; v < old_points.size(); ++v) ASSERT_EQ(dt.point(new_of_old[v]), old_points[v]);
+    for (VertexId v = 0; v < old_points.size(); ++v)
+        ASSERT_EQ(dt.point(new_of_old[v]), old_points[v]);
     EXPECT_EQ(dt.triangle_slots(), live);
     EXPECT_EQ(describe(dt), before);
     // Laid out by their smallest corner, in increasing order.
-    auto smallest = [&](TriangleId t) { return std::min({dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)}); };
-    for (TriangleId t = 1; t < dt.triangle_slots(); ++t) ASSERT_LE(smallest(t - 1), smallest(t));
+    auto smallest = [&](TriangleId t) {
+        return std::min({dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)});
+    };
+    for (TriangleId t = 1; t < dt.triangle_slots(); ++t)
+        ASSERT_LE(smallest(t - 1), smallest(t));
     // The constraints are still found from their new ends, and insertion goes on from here.
     auto star = dt.vertex_half_edges();
     for (int k = 0; k < 30; ++k) {
@@ -367,15 +401,17 @@ TEST(Delaunay, renumbering_keeps_every_triangle_constraint_and_label_and_lays_th
         ASSERT_NE(h, no_half_edge);
         EXPECT_TRUE(dt.is_constrained(h));
     }
-    for (const Vec3& q : random_points(500, 34)) dt.insert(q);
+    for (const Vec3 &q : random_points(500, 34))
+        dt.insert(q);
     problems = dt.validate();
     EXPECT_TRUE(problems.empty()) << problems.front();
     (void)ids;
 }
 
 TEST(Delaunay, crossing_constraint_is_refused) {
-    std::vector<Vec3> p = {lonlat_to_vec(0, 0), lonlat_to_vec(10, 0), lonlat_to_vec(5, -5), lonlat_to_vec(5, 5),
-                           {0, 0, 1}, {0, 0, -1}, lonlat_to_vec(180, 0)};
+    std::vector<Vec3> p = {
+        lonlat_to_vec(0, 0), lonlat_to_vec(10, 0), lonlat_to_vec(5, -5), lonlat_to_vec(5, 5),
+        {0, 0, 1},           {0, 0, -1},           lonlat_to_vec(180, 0)};
     SphericalDelaunay dt;
     auto id = dt.insert_points(p);
     ASSERT_TRUE(dt.insert_constraint(id[0], id[1]));
@@ -423,7 +459,7 @@ namespace {
 
 // A move's target that usually needs flips: 55% of the way from the origin of `from` to its
 // destination.
-Vec3 past_halfway(const SphericalDelaunay& dt, HalfEdge from) {
+Vec3 past_halfway(const SphericalDelaunay &dt, HalfEdge from) {
     return normalized(0.45 * dt.point(dt.origin(from)) + 0.55 * dt.point(dt.destination(from)));
 }
 
@@ -440,7 +476,8 @@ TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_change
         std::vector<std::set<VertexId>> n(dt.vertex_count());
         for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
             if (dt.is_live(t))
-                for (int i = 0; i < 3; ++i) n[dt.vertex(t, i)].insert(dt.vertex(t, (i + 1) % 3));
+                for (int i = 0; i < 3; ++i)
+                    n[dt.vertex(t, i)].insert(dt.vertex(t, (i + 1) % 3));
         return n;
     };
     std::size_t with_flips = 0;
@@ -450,7 +487,8 @@ TEST(Delaunay, a_move_names_the_corners_of_its_flips_and_they_cover_every_change
         const Vec3 to = past_halfway(dt, from);
         const auto before = neighbours();
         std::vector<VertexId> flipped;
-        if (!dt.move_vertex_from(from, to, &flipped)) continue;
+        if (!dt.move_vertex_from(from, to, &flipped))
+            continue;
         ASSERT_TRUE(dt.validate().empty());
         const auto after = neighbours();
         std::set<VertexId> covered(flipped.begin(), flipped.end());
@@ -497,7 +535,8 @@ TEST(Delaunay, a_move_its_caller_refuses_leaves_every_triangle_as_it_was) {
             return false;
         });
         EXPECT_FALSE(moved);
-        if (!seen_moved) continue; // refused by the fold test: accept never ran
+        if (!seen_moved)
+            continue; // refused by the fold test: accept never ran
         EXPECT_EQ(dt.point(v), was);
         EXPECT_EQ(snapshot(), before) << "after refusing the move of " << v;
         ASSERT_TRUE(dt.validate().empty());
@@ -509,7 +548,8 @@ TEST(Delaunay, a_move_its_caller_refuses_leaves_every_triangle_as_it_was) {
     EXPECT_GE(refused, 20u);
 }
 
-TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_restores_the_property) {
+TEST(Delaunay,
+     placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_restores_the_property) {
     auto p = random_points(2000, 7);
     SphericalDelaunay dt;
     auto ids = dt.insert_points(p);
@@ -520,7 +560,8 @@ TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_
     EXPECT_FALSE(dt.place_vertex_from(from, -before));
     EXPECT_EQ(dt.point(v), before);
     // Most of the way to a neighbour: no fold, but circumcircles now hold points.
-    for (HalfEdge h = from; !dt.place_vertex_from(from, normalized(0.3 * before + 0.7 * dt.point(dt.destination(h))));) {
+    for (HalfEdge h = from; !dt.place_vertex_from(
+             from, normalized(0.3 * before + 0.7 * dt.point(dt.destination(h))));) {
         h = dt.next_around_origin(h);
         ASSERT_NE(h, from) << "no neighbour could be approached";
     }
@@ -533,7 +574,8 @@ TEST(Delaunay, placing_a_vertex_keeps_the_links_and_make_delaunay_from_its_star_
         edges.push_back(h);
         edges.push_back(half_edge(triangle_of(h), (edge_of(h) + 1) % 3));
         h = dt.next_around_origin(h);
-        if (h == edges.front()) break;
+        if (h == edges.front())
+            break;
     }
     EXPECT_GT(dt.make_delaunay(edges), 0u);
     EXPECT_EQ(brute_force_violations(dt, 1e-15L), 0u);
@@ -544,14 +586,16 @@ TEST(Delaunay, insert_in_triangle_of_a_constrained_triangulation) {
     auto p = random_points(400, 31);
     SphericalDelaunay dt;
     auto ids = dt.insert_points(p);
-    for (int k = 0; k + 1 < 20; k += 2) dt.insert_constraint(ids[k], ids[k + 1]);
+    for (int k = 0; k + 1 < 20; k += 2)
+        dt.insert_constraint(ids[k], ids[k + 1]);
     // Insert the centroid of every 7th solid triangle through insert_in_triangle.
     std::vector<std::pair<TriangleId, Vec3>> todo;
     for (TriangleId t = 0; t < dt.triangle_slots(); t += 7)
         if (dt.is_live(t) && dt.is_solid(t))
-            todo.emplace_back(t, normalized(dt.point(dt.vertex(t, 0)) + dt.point(dt.vertex(t, 1)) + dt.point(dt.vertex(t, 2))));
+            todo.emplace_back(t, normalized(dt.point(dt.vertex(t, 0)) + dt.point(dt.vertex(t, 1)) +
+                                            dt.point(dt.vertex(t, 2))));
     std::size_t before = dt.vertex_count();
-    for (auto& [t, c] : todo) {
+    for (auto &[t, c] : todo) {
         TriangleId where = dt.locate(c, t);
         dt.insert_in_triangle(c, where);
     }
@@ -579,15 +623,19 @@ TEST(Delaunay, adopted_points_in_brio_order_give_the_same_triangulation_as_the_s
 TEST(Delaunay, adopting_insert_refuses_an_order_that_is_not_a_permutation) {
     auto p = random_points(100, 42);
     std::vector<std::uint32_t> repeated(100);
-    for (std::uint32_t i = 0; i < 100; ++i) repeated[i] = i;
+    for (std::uint32_t i = 0; i < 100; ++i)
+        repeated[i] = i;
     repeated[7] = 3;
     SphericalDelaunay dt;
-    EXPECT_THROW(dt.insert_points(std::vector<Vec3>(p), std::move(repeated)), std::invalid_argument);
+    EXPECT_THROW(dt.insert_points(std::vector<Vec3>(p), std::move(repeated)),
+                 std::invalid_argument);
     std::vector<std::uint32_t> out_of_range(100);
-    for (std::uint32_t i = 0; i < 100; ++i) out_of_range[i] = i;
+    for (std::uint32_t i = 0; i < 100; ++i)
+        out_of_range[i] = i;
     out_of_range[99] = 100;
     SphericalDelaunay dt2;
-    EXPECT_THROW(dt2.insert_points(std::vector<Vec3>(p), std::move(out_of_range)), std::invalid_argument);
+    EXPECT_THROW(dt2.insert_points(std::vector<Vec3>(p), std::move(out_of_range)),
+                 std::invalid_argument);
     EXPECT_EQ(dt2.triangle_count(), 0u);
 }
 
@@ -597,14 +645,16 @@ TEST(Delaunay, locate_from_any_hint_finds_a_triangle_containing_the_point) {
     dt.insert_points(p);
     auto q = random_points(500, 44);
     std::size_t k = 0;
-    for (const Vec3& x : q) {
+    for (const Vec3 &x : q) {
         // Hints: none, a far live slot, and an out-of-range id.
-        const TriangleId hints[] = {no_triangle, static_cast<TriangleId>((k * 7919) % dt.triangle_slots()), 0xfffffff0u};
+        const TriangleId hints[] = {
+            no_triangle, static_cast<TriangleId>((k * 7919) % dt.triangle_slots()), 0xfffffff0u};
         for (TriangleId h : hints) {
             TriangleId t = dt.locate(x, h);
             ASSERT_NE(t, no_triangle);
             ASSERT_TRUE(dt.is_live(t));
-            const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)), &c = dt.point(dt.vertex(t, 2));
+            const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)),
+                       &c = dt.point(dt.vertex(t, 2));
             EXPECT_GE(predicates::orient(a, b, x), 0);
             EXPECT_GE(predicates::orient(b, c, x), 0);
             EXPECT_GE(predicates::orient(c, a, x), 0);
@@ -651,12 +701,14 @@ TEST(Delaunay, constraint_recovery_flips_to_a_flat_triangle_on_three_collinear_r
     // Independently of validate(): every unconstrained edge is locally Delaunay (the opposite
     // vertex is not inside the circumcircle).
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
-        if (!dt.is_live(t)) continue;
+        if (!dt.is_live(t))
+            continue;
         for (int i = 0; i < 3; ++i) {
             const HalfEdge e = half_edge(t, i);
-            if (dt.is_constrained(e)) continue;
+            if (dt.is_constrained(e))
+                continue;
             const HalfEdge g = dt.twin(e);
-            const Vec3& opposite = dt.point(dt.vertex(triangle_of(g), edge_of(g)));
+            const Vec3 &opposite = dt.point(dt.vertex(triangle_of(g), edge_of(g)));
             EXPECT_LE(predicates::in_circle(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
                                             dt.point(dt.vertex(t, 2)), opposite),
                       0)
@@ -668,7 +720,7 @@ TEST(Delaunay, constraint_recovery_flips_to_a_flat_triangle_on_three_collinear_r
 // Every ordered pair of vertices of p, as a constraint on a copy of its triangulation:
 // validate() stays empty, a refused pair leaves the same triangles and no constrained edge, a
 // recovered pair is a constrained edge. Returns how many were refused.
-static int check_every_constraint(const std::vector<Vec3>& p) {
+static int check_every_constraint(const std::vector<Vec3> &p) {
     SphericalDelaunay dt;
     const auto id = dt.insert_points(p);
     EXPECT_TRUE(dt.validate().empty());
@@ -677,7 +729,8 @@ static int check_every_constraint(const std::vector<Vec3>& p) {
     int refused = 0;
     for (VertexId a : used)
         for (VertexId b : used) {
-            if (a == b) continue;
+            if (a == b)
+                continue;
             SphericalDelaunay d = dt;
             const bool ok = d.insert_constraint(a, b);
             const auto problems = d.validate();
@@ -692,7 +745,8 @@ static int check_every_constraint(const std::vector<Vec3>& p) {
                 ++refused;
                 EXPECT_EQ(canonical(d, false), before) << a << "-" << b;
                 for (TriangleId t = 0; t < d.triangle_slots(); ++t)
-                    for (int i = 0; i < 3 && d.is_live(t); ++i) EXPECT_FALSE(d.is_constrained(half_edge(t, i)));
+                    for (int i = 0; i < 3 && d.is_live(t); ++i)
+                        EXPECT_FALSE(d.is_constrained(half_edge(t, i)));
             }
         }
     return refused;
@@ -716,8 +770,9 @@ TEST(Delaunay, constraint_that_flips_cannot_recover_leaves_the_triangulation_unc
         {-0x1.11e5d7e45a0a2p-2, -0x1.742540680f87ap-2, -0x1.c8e8baafcf7dep-1},
     };
     // The premise: all within 2e-10 rad, closer than rounding off the sphere resolves.
-    for (const Vec3& a : p)
-        for (const Vec3& b : p) EXPECT_LT(arc_angle(a, b), 2e-10);
+    for (const Vec3 &a : p)
+        for (const Vec3 &b : p)
+            EXPECT_LT(arc_angle(a, b), 2e-10);
 
     // The finding's pair is refused, and others are recovered: both branches are checked.
     const int refused = check_every_constraint(p);
@@ -790,7 +845,8 @@ TEST(Delaunay, duplicate_landing_on_a_flat_triangle_merges_into_its_twin) {
     EXPECT_EQ(id[9], id[7]);
     // Every point maps to a vertex no farther than the merge distance of points the hull cannot
     // resolve (about 1e-8 rad; p4 is 1e-12 from p3, the near-pole points 1e-13 and 5e-11).
-    for (std::size_t i = 0; i < p.size(); ++i) EXPECT_LT(arc_angle(dt.point(id[i]), p[i]), 1e-7) << "point " << i;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        EXPECT_LT(arc_angle(dt.point(id[i]), p[i]), 1e-7) << "point " << i;
 }
 
 namespace {
@@ -805,7 +861,7 @@ struct CentroidPatch {
     std::vector<std::uint32_t> adjacent;
 };
 
-CentroidPatch centroid_patch(const SphericalDelaunay& dt, const std::vector<TriangleId>& ts) {
+CentroidPatch centroid_patch(const SphericalDelaunay &dt, const std::vector<TriangleId> &ts) {
     CentroidPatch p;
     for (TriangleId t : ts) {
         const VertexId v[3] = {dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)};
@@ -816,7 +872,8 @@ CentroidPatch centroid_patch(const SphericalDelaunay& dt, const std::vector<Tria
             const std::uint32_t next = r0 + (i + 1) % 3, prev = r0 + (i + 2) % 3;
             p.triangles.insert(p.triangles.end(), {v[(i + 1) % 3], v[(i + 2) % 3], c});
             p.adjacent.insert(p.adjacent.end(), {3 * next + 1, 3 * prev + 0,
-                                                 SphericalDelaunay::patch_border | static_cast<std::uint32_t>(p.border.size())});
+                                                 SphericalDelaunay::patch_border |
+                                                     static_cast<std::uint32_t>(p.border.size())});
             p.border.push_back(half_edge(t, i));
         }
     }
@@ -825,7 +882,7 @@ CentroidPatch centroid_patch(const SphericalDelaunay& dt, const std::vector<Tria
 
 // replace_region on copies of the patch's vectors: it empties them when it succeeds, and leaves
 // them as they were when it refuses.
-bool replace(SphericalDelaunay& dt, const CentroidPatch& q, std::uint8_t label) {
+bool replace(SphericalDelaunay &dt, const CentroidPatch &q, std::uint8_t label) {
     std::vector<Vec3> points = q.points;
     std::vector<VertexId> triangles = q.triangles;
     std::vector<std::uint32_t> adjacent = q.adjacent;
@@ -839,28 +896,33 @@ bool replace(SphericalDelaunay& dt, const CentroidPatch& q, std::uint8_t label) 
     return done;
 }
 
-std::vector<HalfEdge> all_half_edges(const SphericalDelaunay& dt) {
+std::vector<HalfEdge> all_half_edges(const SphericalDelaunay &dt) {
     std::vector<HalfEdge> h;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
         if (dt.is_live(t))
-            for (int i = 0; i < 3; ++i) h.push_back(half_edge(t, i));
+            for (int i = 0; i < 3; ++i)
+                h.push_back(half_edge(t, i));
     return h;
 }
 
 } // namespace
 
-TEST(Delaunay, replacing_regions_by_known_patches_then_flipping_gives_the_delaunay_triangulation_of_all_points) {
+TEST(
+    Delaunay,
+    replacing_regions_by_known_patches_then_flipping_gives_the_delaunay_triangulation_of_all_points) {
     const auto p = random_points(3000, 17);
     SphericalDelaunay dt;
     dt.insert_points(p);
     // Every third triangle: many of them neighbours, so border edges are taken from both sides.
     std::vector<TriangleId> ts;
     for (TriangleId t = 0; t < dt.triangle_slots(); t += 3)
-        if (dt.is_live(t)) ts.push_back(t);
+        if (dt.is_live(t))
+            ts.push_back(t);
     const CentroidPatch patch = centroid_patch(dt, ts);
     std::size_t shared = 0;
     for (HalfEdge h : patch.border)
-        shared += std::find(patch.border.begin(), patch.border.end(), dt.twin(h)) != patch.border.end();
+        shared +=
+            std::find(patch.border.begin(), patch.border.end(), dt.twin(h)) != patch.border.end();
     ASSERT_GT(shared, 100u);
     const std::size_t before = dt.triangle_count();
     ASSERT_TRUE(replace(dt, patch, 7));
@@ -868,7 +930,8 @@ TEST(Delaunay, replacing_regions_by_known_patches_then_flipping_gives_the_delaun
     EXPECT_EQ(dt.triangle_count(), before + 2 * ts.size());
     EXPECT_EQ(euler(dt), 2u);
     std::size_t labelled = 0;
-    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) labelled += dt.is_live(t) && dt.label(t) == 7;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        labelled += dt.is_live(t) && dt.label(t) == 7;
     EXPECT_EQ(labelled, 3 * ts.size());
     // Centroids are not Delaunay where a neighbour's circumcircle holds them: the flips mend that,
     // and the result is the triangulation of all the points inserted one by one.
@@ -889,7 +952,7 @@ TEST(Delaunay, a_patch_that_does_not_fit_its_region_is_refused_and_changes_nothi
     const auto before = canonical(dt, false);
     const std::vector<TriangleId> ts = {4, 5, 40};
     const CentroidPatch good = centroid_patch(dt, ts);
-    auto refused = [&](const CentroidPatch& q) {
+    auto refused = [&](const CentroidPatch &q) {
         EXPECT_FALSE(replace(dt, q, 1));
         EXPECT_EQ(dt.vertex_count(), p.size());
         EXPECT_EQ(canonical(dt, false), before);
@@ -908,12 +971,14 @@ TEST(Delaunay, a_patch_that_does_not_fit_its_region_is_refused_and_changes_nothi
     q = good;
     q.points.pop_back();
     for (std::size_t i = q.triangles.size() - 9; i < q.triangles.size(); ++i)
-        if (q.triangles[i] >= p.size()) q.triangles[i] = dt.vertex(dt.triangle_slots() - 1, 0);
+        if (q.triangles[i] >= p.size())
+            q.triangles[i] = dt.vertex(dt.triangle_slots() - 1, 0);
     refused(q);
     // The border turned round (the region's outside on its left): no new edge matches its ends.
     q = good;
     const TriangleId t = ts[0];
-    for (int i = 0; i < 3; ++i) q.border[i] = dt.twin(half_edge(t, i)); // the region's outside
+    for (int i = 0; i < 3; ++i)
+        q.border[i] = dt.twin(half_edge(t, i)); // the region's outside
     refused(q);
     // The right patch still fits after all the refusals.
     ASSERT_TRUE(replace(dt, good, 1));

@@ -24,34 +24,42 @@ struct Context {
 };
 
 /// 60 x 60 overlapping discs: their union takes GEOS many interrupt checks.
-GEOSGeometry* discs(const Context& c) {
-    std::vector<GEOSGeometry*> parts;
+GEOSGeometry *discs(const Context &c) {
+    std::vector<GEOSGeometry *> parts;
     for (int i = 0; i < 60; ++i) {
         for (int j = 0; j < 60; ++j) {
-            GEOSGeometry* point = GEOSGeom_createPointFromXY_r(c.h, i * 0.7 + 0.01 * j, j * 0.7 + 0.01 * i);
+            GEOSGeometry *point =
+                GEOSGeom_createPointFromXY_r(c.h, i * 0.7 + 0.01 * j, j * 0.7 + 0.01 * i);
             parts.push_back(GEOSBuffer_r(c.h, point, 0.5, 8));
             GEOSGeom_destroy_r(c.h, point);
         }
     }
-    return GEOSGeom_createCollection_r(c.h, GEOS_MULTIPOLYGON, parts.data(), static_cast<unsigned>(parts.size()));
+    return GEOSGeom_createCollection_r(c.h, GEOS_MULTIPOLYGON, parts.data(),
+                                       static_cast<unsigned>(parts.size()));
 }
 
 /// The union of `g`, or null when GEOS failed (was interrupted).
-std::unique_ptr<GEOSGeometry, void (*)(GEOSGeometry*)> union_of(const Context& c, const GEOSGeometry* g) {
+std::unique_ptr<GEOSGeometry, void (*)(GEOSGeometry *)> union_of(const Context &c,
+                                                                 const GEOSGeometry *g) {
     static thread_local GEOSContextHandle_t h;
     h = c.h;
-    return {GEOSUnaryUnion_r(c.h, g), [](GEOSGeometry* p) { if (p) GEOSGeom_destroy_r(h, p); }};
+    return {GEOSUnaryUnion_r(c.h, g), [](GEOSGeometry *p) {
+                if (p)
+                    GEOSGeom_destroy_r(h, p);
+            }};
 }
 
 } // namespace
 
 TEST(GeosInterrupt, a_union_stops_when_the_progress_asks_and_reads_as_cancelled) {
     Context c;
-    GEOSGeometry* all = discs(c);
+    GEOSGeometry *all = discs(c);
     int asked = 0;
     {
-        const GeosInterrupt scope([&](double, std::string_view) { return ++asked < 0; }); // always "stop"
-        EXPECT_FALSE(scope.progress()(0.5, "cleaning coast")); // a report of the run passes through...
+        const GeosInterrupt scope(
+            [&](double, std::string_view) { return ++asked < 0; }); // always "stop"
+        EXPECT_FALSE(
+            scope.progress()(0.5, "cleaning coast")); // a report of the run passes through...
         EXPECT_EQ(asked, 1);
         EXPECT_TRUE(GeosInterrupt::interrupted());
         EXPECT_THROW(GeosInterrupt::poll(), Cancelled);
@@ -76,13 +84,14 @@ TEST(GeosInterrupt, a_union_stops_when_the_progress_asks_and_reads_as_cancelled)
     ASSERT_NE(whole, nullptr);
     double area = 0;
     GEOSArea_r(c.h, whole.get(), &area);
-    EXPECT_GT(area, 40 * 40 * 0.7 * 0.7 * 0.9); // the discs overlap into one blob of about 41.8 x 41.8
+    EXPECT_GT(area,
+              40 * 40 * 0.7 * 0.7 * 0.9); // the discs overlap into one blob of about 41.8 x 41.8
     GEOSGeom_destroy_r(c.h, all);
 }
 
 TEST(GeosInterrupt, a_progress_that_goes_on_or_none_leaves_geos_alone) {
     Context c;
-    GEOSGeometry* all = discs(c);
+    GEOSGeometry *all = discs(c);
     int asked = 0;
     {
         const GeosInterrupt scope([&](double, std::string_view) { return ++asked > 0; });

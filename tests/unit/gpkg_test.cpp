@@ -3,10 +3,10 @@
 // part widths, and pixel colours at places known to be face, land or background.
 #include <gtest/gtest.h>
 
-#include <gdal_priv.h>
-#include <ogrsf_frmts.h>
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
+#include <gdal_priv.h>
+#include <ogrsf_frmts.h>
 
 #include <cmath>
 #include <fstream>
@@ -19,9 +19,9 @@
 #include "globemesh/gpkg.hpp"
 #include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
-#include "write_hooks.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
+#include "write_hooks.hpp"
 
 using namespace globemesh;
 using namespace globemesh::test;
@@ -30,30 +30,31 @@ namespace fs = std::filesystem;
 namespace {
 
 struct Dataset {
-    explicit Dataset(const fs::path& p, unsigned flags = GDAL_OF_VECTOR) {
+    explicit Dataset(const fs::path &p, unsigned flags = GDAL_OF_VECTOR) {
         GDALAllRegister();
         ds.reset(GDALDataset::Open(p.c_str(), flags | GDAL_OF_READONLY));
     }
     struct Close {
-        void operator()(GDALDataset* d) const { GDALClose(d); }
+        void operator()(GDALDataset *d) const { GDALClose(d); }
     };
     std::unique_ptr<GDALDataset, Close> ds;
 };
 
-std::vector<std::string> folder_listing(const fs::path& dir) {
+std::vector<std::string> folder_listing(const fs::path &dir) {
     std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir))
+        names.push_back(e.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
 }
 
 /// Sum of planar lon/lat areas of all features, and the widest polygon part, degrees.
-std::pair<double, double> faces_area_and_widest_part(OGRLayer* layer) {
+std::pair<double, double> faces_area_and_widest_part(OGRLayer *layer) {
     double area = 0, widest = 0;
     layer->ResetReading();
-    for (auto& f : *layer) {
-        const auto* multi = f->GetGeometryRef()->toMultiPolygon();
-        for (const auto* part : multi) {
+    for (auto &f : *layer) {
+        const auto *multi = f->GetGeometryRef()->toMultiPolygon();
+        for (const auto *part : multi) {
             OGREnvelope env;
             part->getEnvelope(&env);
             widest = std::max(widest, env.MaxX - env.MinX);
@@ -65,13 +66,15 @@ std::pair<double, double> faces_area_and_widest_part(OGRLayer* layer) {
     return {area, widest};
 }
 
-std::array<int, 4> pixel(GDALDataset* ds, double lon, double lat, const std::array<double, 4>& extent) {
+std::array<int, 4> pixel(GDALDataset *ds, double lon, double lat,
+                         const std::array<double, 4> &extent) {
     int x = int((lon - extent[0]) / (extent[2] - extent[0]) * ds->GetRasterXSize());
     int y = int((extent[3] - lat) / (extent[3] - extent[1]) * ds->GetRasterYSize());
     std::array<int, 4> c{};
     for (int b = 0; b < std::min(4, ds->GetRasterCount()); ++b) {
         GByte v = 0;
-        EXPECT_EQ(ds->GetRasterBand(b + 1)->RasterIO(GF_Read, x, y, 1, 1, &v, 1, 1, GDT_Byte, 0, 0), CE_None);
+        EXPECT_EQ(ds->GetRasterBand(b + 1)->RasterIO(GF_Read, x, y, 1, 1, &v, 1, 1, GDT_Byte, 0, 0),
+                  CE_None);
         c[b] = v;
     }
     return c;
@@ -80,49 +83,57 @@ std::array<int, 4> pixel(GDALDataset* ds, double lon, double lat, const std::arr
 /// The file as SQLite itself reads it (not through GDAL): each query's rows, as text.
 class Sqlite {
 public:
-    explicit Sqlite(const fs::path& p) { EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK); }
+    explicit Sqlite(const fs::path &p) {
+        EXPECT_EQ(sqlite3_open_v2(p.c_str(), &db_, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    }
     ~Sqlite() { sqlite3_close(db_); }
-    Sqlite(const Sqlite&) = delete;
-    Sqlite& operator=(const Sqlite&) = delete;
-    std::vector<std::vector<std::string>> rows(const std::string& sql) const {
+    Sqlite(const Sqlite &) = delete;
+    Sqlite &operator=(const Sqlite &) = delete;
+    std::vector<std::vector<std::string>> rows(const std::string &sql) const {
         std::vector<std::vector<std::string>> out;
-        sqlite3_stmt* s = nullptr;
-        EXPECT_EQ(sqlite3_prepare_v2(db_, sql.c_str(), -1, &s, nullptr), SQLITE_OK) << sql << ": " << sqlite3_errmsg(db_);
+        sqlite3_stmt *s = nullptr;
+        EXPECT_EQ(sqlite3_prepare_v2(db_, sql.c_str(), -1, &s, nullptr), SQLITE_OK)
+            << sql << ": " << sqlite3_errmsg(db_);
         while (s && sqlite3_step(s) == SQLITE_ROW) {
             out.emplace_back();
             for (int c = 0; c < sqlite3_column_count(s); ++c) {
-                const auto* text = sqlite3_column_text(s, c);
-                out.back().push_back(text ? reinterpret_cast<const char*>(text) : "");
+                const auto *text = sqlite3_column_text(s, c);
+                out.back().push_back(text ? reinterpret_cast<const char *>(text) : "");
             }
         }
         sqlite3_finalize(s);
         return out;
     }
-    std::string one(const std::string& sql) const {
+    std::string one(const std::string &sql) const {
         const auto r = rows(sql);
         return r.empty() || r[0].empty() ? "" : r[0][0];
     }
     /// The RTree's box of each feature id, read as doubles (the floats it stores, exactly).
-    std::map<GIntBig, std::array<double, 4>> boxes(const std::string& rtree) const {
+    std::map<GIntBig, std::array<double, 4>> boxes(const std::string &rtree) const {
         std::map<GIntBig, std::array<double, 4>> out;
-        sqlite3_stmt* s = nullptr;
-        EXPECT_EQ(sqlite3_prepare_v2(db_, ("SELECT id, minx, maxx, miny, maxy FROM " + rtree).c_str(), -1, &s, nullptr), SQLITE_OK);
+        sqlite3_stmt *s = nullptr;
+        EXPECT_EQ(sqlite3_prepare_v2(db_,
+                                     ("SELECT id, minx, maxx, miny, maxy FROM " + rtree).c_str(),
+                                     -1, &s, nullptr),
+                  SQLITE_OK);
         while (s && sqlite3_step(s) == SQLITE_ROW)
-            out[sqlite3_column_int64(s, 0)] = {sqlite3_column_double(s, 1), sqlite3_column_double(s, 2), sqlite3_column_double(s, 3),
-                                               sqlite3_column_double(s, 4)};
+            out[sqlite3_column_int64(s, 0)] = {
+                sqlite3_column_double(s, 1), sqlite3_column_double(s, 2),
+                sqlite3_column_double(s, 3), sqlite3_column_double(s, 4)};
         sqlite3_finalize(s);
         return out;
     }
 
 private:
-    sqlite3* db_ = nullptr;
+    sqlite3 *db_ = nullptr;
 };
 
 /// Each feature's envelope as OGR reads its geometry back, by fid.
-std::map<GIntBig, OGREnvelope> envelopes(OGRLayer* layer) {
+std::map<GIntBig, OGREnvelope> envelopes(OGRLayer *layer) {
     std::map<GIntBig, OGREnvelope> out;
     layer->ResetReading();
-    for (auto& f : *layer) f->GetGeometryRef()->getEnvelope(&out[f->GetFID()]);
+    for (auto &f : *layer)
+        f->GetGeometryRef()->getEnvelope(&out[f->GetFID()]);
     return out;
 }
 
@@ -130,71 +141,80 @@ std::map<GIntBig, OGREnvelope> envelopes(OGRLayer* layer) {
 
 TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     TempDir dir;
-    Mesh m = icosphere_with_holes(5); // the faces' features are made in blocks of 4,096 on every core
+    Mesh m =
+        icosphere_with_holes(5); // the faces' features are made in blocks of 4,096 on every core
     m.attributes = {{"coast", "land.gpkg"}};
     write_gpkg(m, dir / "m.gpkg");
     Dataset d(dir / "m.gpkg");
     ASSERT_TRUE(d.ds);
-    OGRLayer* faces = d.ds->GetLayerByName("faces");
-    OGRLayer* nodes = d.ds->GetLayerByName("nodes");
-    OGRLayer* boundary = d.ds->GetLayerByName("boundary");
-    OGRLayer* info = d.ds->GetLayerByName("mesh_info");
+    OGRLayer *faces = d.ds->GetLayerByName("faces");
+    OGRLayer *nodes = d.ds->GetLayerByName("nodes");
+    OGRLayer *boundary = d.ds->GetLayerByName("boundary");
+    OGRLayer *info = d.ds->GetLayerByName("mesh_info");
     ASSERT_TRUE(faces && nodes && boundary && info);
     EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
     EXPECT_EQ(nodes->GetFeatureCount(), GIntBig(m.nodes.size()));
     EXPECT_EQ(wkbFlatten(faces->GetGeomType()), wkbMultiPolygon);
     EXPECT_TRUE(faces->GetSpatialRef() && faces->GetSpatialRef()->GetEPSGGeogCS() == 4326);
-    for (const char* field : {"quality", "area_km2", "depth", "target_size"})
+    for (const char *field : {"quality", "area_km2", "depth", "target_size"})
         EXPECT_GE(faces->GetLayerDefn()->GetFieldIndex(field), 0) << field;
-    for (const char* field : {"depth", "target_size"}) EXPECT_GE(nodes->GetLayerDefn()->GetFieldIndex(field), 0) << field;
+    for (const char *field : {"depth", "target_size"})
+        EXPECT_GE(nodes->GetLayerDefn()->GetFieldIndex(field), 0) << field;
 
     // Face 7: mean depth of its nodes, quality as the sphere module computes it.
     std::unique_ptr<OGRFeature> f7(faces->GetFeature(8));
     ASSERT_TRUE(f7);
-    const auto& t = m.faces[7];
-    const auto& depth = m.node_field("depth")->values;
+    const auto &t = m.faces[7];
+    const auto &depth = m.node_field("depth")->values;
     EXPECT_NEAR(f7->GetFieldAsDouble("depth"), (depth[t[0]] + depth[t[1]] + depth[t[2]]) / 3, 1e-9);
-    EXPECT_NEAR(f7->GetFieldAsDouble("quality"), triangle_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]]), 1e-12);
+    EXPECT_NEAR(f7->GetFieldAsDouble("quality"),
+                triangle_quality(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]]), 1e-12);
     // Every face's number, quality and area_km2, the area GeographicLib's PolygonArea of its
     // corners (the writer shares each edge's geodesic problem between its two faces).
     GIntBig fid = 0;
     std::size_t parts = 0;
-    for (auto& f : *faces) {
+    for (auto &f : *faces) {
         EXPECT_EQ(f->GetFID(), ++fid);
         EXPECT_EQ(f->GetFieldAsInteger("face"), fid - 1);
-        const auto& c = m.faces[std::size_t(f->GetFID() - 1)];
-        EXPECT_EQ(f->GetFieldAsDouble("quality"), triangle_quality(m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]]));
+        const auto &c = m.faces[std::size_t(f->GetFID() - 1)];
+        EXPECT_EQ(f->GetFieldAsDouble("quality"),
+                  triangle_quality(m.nodes[c[0]], m.nodes[c[1]], m.nodes[c[2]]));
         GeographicLib::PolygonArea poly(GeographicLib::Geodesic::WGS84());
-        for (NodeIndex k : c) poly.AddPoint(vec_to_lonlat(m.nodes[k]).lat, vec_to_lonlat(m.nodes[k]).lon);
+        for (NodeIndex k : c)
+            poly.AddPoint(vec_to_lonlat(m.nodes[k]).lat, vec_to_lonlat(m.nodes[k]).lon);
         double perimeter, area_m2;
         poly.Compute(false, true, perimeter, area_m2);
-        EXPECT_NEAR(f->GetFieldAsDouble("area_km2"), std::fabs(area_m2) * 1e-6, 1e-7) << "face " << f->GetFID() - 1;
+        EXPECT_NEAR(f->GetFieldAsDouble("area_km2"), std::fabs(area_m2) * 1e-6, 1e-7)
+            << "face " << f->GetFID() - 1;
         // Its polygon holds each of its corners away from the cuts (the writer refills the
         // features and polygons of a block for later blocks: none keeps another face's). The
         // longitudes are unwrapped from the previous corner's, to rounding.
-        const OGRMultiPolygon* multi = f->GetGeometryRef()->toMultiPolygon();
+        const OGRMultiPolygon *multi = f->GetGeometryRef()->toMultiPolygon();
         parts += multi->getNumGeometries();
         for (NodeIndex k : c) {
             const LonLat ll = vec_to_lonlat(m.nodes[k]);
-            if (std::fabs(ll.lon) > 179.9 || std::fabs(ll.lat) > 89.9) continue;
+            if (std::fabs(ll.lon) > 179.9 || std::fabs(ll.lat) > 89.9)
+                continue;
             bool found = false;
-            for (const OGRPolygon* polygon : *multi)
-                for (const OGRPoint& point : *polygon->getExteriorRing())
-                    found = found || (std::fabs(point.getX() - ll.lon) < 1e-9 && point.getY() == ll.lat);
-            EXPECT_TRUE(found) << "face " << f->GetFID() - 1 << " lacks its corner " << ll.lon << " " << ll.lat;
+            for (const OGRPolygon *polygon : *multi)
+                for (const OGRPoint &point : *polygon->getExteriorRing())
+                    found = found ||
+                            (std::fabs(point.getX() - ll.lon) < 1e-9 && point.getY() == ll.lat);
+            EXPECT_TRUE(found) << "face " << f->GetFID() - 1 << " lacks its corner " << ll.lon
+                               << " " << ll.lat;
         }
     }
     // Faces cut at +-180 (two parts) among the others: both kinds follow each other in a slot.
     EXPECT_GT(parts, m.faces.size());
     // Every node: its number, its fields and its point (one feature refilled for each).
     fid = 0;
-    for (auto& f : *nodes) {
+    for (auto &f : *nodes) {
         EXPECT_EQ(f->GetFID(), ++fid);
         const auto i = std::size_t(fid - 1);
         EXPECT_EQ(f->GetFieldAsInteger("node"), int(i));
         EXPECT_EQ(f->GetFieldAsDouble("depth"), m.node_field("depth")->values[i]);
         EXPECT_EQ(f->GetFieldAsDouble("target_size"), m.node_field("target_size")->values[i]);
-        const OGRPoint* point = f->GetGeometryRef()->toPoint();
+        const OGRPoint *point = f->GetGeometryRef()->toPoint();
         EXPECT_EQ(point->getX(), vec_to_lonlat(m.nodes[i]).lon);
         EXPECT_EQ(point->getY(), vec_to_lonlat(m.nodes[i]).lat);
     }
@@ -202,7 +222,7 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
 
     // Boundary runs: every boundary edge once, tags coast and open both present.
     int edges = 0, coast = 0, open = 0;
-    for (auto& f : *boundary) {
+    for (auto &f : *boundary) {
         edges += f->GetFieldAsInteger("edges");
         std::string tag = f->GetFieldAsString("tag");
         coast += tag == "coast", open += tag == "open";
@@ -211,7 +231,8 @@ TEST(Gpkg, layers_hold_one_feature_per_face_and_node_with_their_fields) {
     EXPECT_GT(coast, 0);
     EXPECT_GT(open, 0);
     bool found = false;
-    for (auto& f : *info) found |= std::string(f->GetFieldAsString("key")) == "coast";
+    for (auto &f : *info)
+        found |= std::string(f->GetFieldAsString("key")) == "coast";
     EXPECT_TRUE(found);
 }
 
@@ -226,7 +247,8 @@ TEST(Gpkg, face_areas_from_the_ugrid_writer_are_taken_as_given_and_freed_after_t
     write_gpkg(m, dir / "own.gpkg"); // computed by the writer
     // Doubled, so that the file shows they were taken as given, not computed again.
     std::vector<double> doubled = areas;
-    for (double& a : doubled) a *= 2;
+    for (double &a : doubled)
+        a *= 2;
     GpkgOptions g;
     g.face_areas_m2 = &doubled;
     write_gpkg(m, dir / "given.gpkg", g);
@@ -237,12 +259,12 @@ TEST(Gpkg, face_areas_from_the_ugrid_writer_are_taken_as_given_and_freed_after_t
     write_gpkg(m, dir / "short.gpkg", g);
     Dataset own(dir / "own.gpkg"), given(dir / "given.gpkg"), fallback(dir / "short.gpkg");
     ASSERT_TRUE(own.ds && given.ds && fallback.ds);
-    OGRLayer* a = own.ds->GetLayerByName("faces");
-    OGRLayer* b = given.ds->GetLayerByName("faces");
-    OGRLayer* c = fallback.ds->GetLayerByName("faces");
+    OGRLayer *a = own.ds->GetLayerByName("faces");
+    OGRLayer *b = given.ds->GetLayerByName("faces");
+    OGRLayer *c = fallback.ds->GetLayerByName("faces");
     ASSERT_TRUE(a && b && c);
     std::size_t n = 0;
-    for (auto& fa : *a) {
+    for (auto &fa : *a) {
         std::unique_ptr<OGRFeature> fb(b->GetNextFeature()), fc(c->GetNextFeature());
         ASSERT_TRUE(fb && fc);
         const double km2 = fa->GetFieldAsDouble("area_km2");
@@ -268,13 +290,16 @@ TEST(Gpkg, spatial_indexes_are_rtrees_holding_each_features_tightest_float_box) 
     for (const std::string table : {"faces", "nodes", "boundary"}) {
         SCOPED_TRACE(table);
         const std::string rtree = "rtree_" + table + "_geom";
-        OGRLayer* layer = d.ds->GetLayerByName(table.c_str());
+        OGRLayer *layer = d.ds->GetLayerByName(table.c_str());
         ASSERT_TRUE(layer);
         EXPECT_EQ(db.one("SELECT rtreecheck('" + rtree + "')"), "ok");
         EXPECT_EQ(db.one("SELECT scope FROM gpkg_extensions WHERE table_name = '" + table +
                          "' AND column_name = 'geom' AND extension_name = 'gpkg_rtree_index'"),
                   "write-only");
-        EXPECT_EQ(db.one("SELECT count(*) FROM sqlite_master WHERE type = 'trigger' AND name LIKE '" + rtree + "_%'"), "6");
+        EXPECT_EQ(
+            db.one("SELECT count(*) FROM sqlite_master WHERE type = 'trigger' AND name LIKE '" +
+                   rtree + "_%'"),
+            "6");
         const auto boxes = db.boxes(rtree);
         const auto env = envelopes(layer);
         ASSERT_EQ(boxes.size(), env.size());
@@ -283,38 +308,48 @@ TEST(Gpkg, spatial_indexes_are_rtrees_holding_each_features_tightest_float_box) 
             // More than one leaf below the root: the tree has inner levels to get right.
             EXPECT_GT(std::stoi(db.one("SELECT count(*) FROM " + rtree + "_parent")), 51);
         }
-        for (const auto& [fid, e] : env) {
+        for (const auto &[fid, e] : env) {
             ASSERT_TRUE(boxes.count(fid)) << fid;
-            const auto& b = boxes.at(fid);
+            const auto &b = boxes.at(fid);
             const double bound[4] = {e.MinX, e.MaxX, e.MinY, e.MaxY};
             for (int k = 0; k < 4; ++k) {
                 const float f = static_cast<float>(b[std::size_t(k)]);
                 const bool low = k % 2 == 0;
                 // Holds the envelope, and the next float inwards would not.
-                EXPECT_TRUE(low ? b[std::size_t(k)] <= bound[k] : b[std::size_t(k)] >= bound[k]) << fid << " side " << k;
+                EXPECT_TRUE(low ? b[std::size_t(k)] <= bound[k] : b[std::size_t(k)] >= bound[k])
+                    << fid << " side " << k;
                 const float inwards = std::nextafter(f, low ? INFINITY : -INFINITY);
-                EXPECT_TRUE(low ? double(inwards) > bound[k] : double(inwards) < bound[k]) << fid << " side " << k;
+                EXPECT_TRUE(low ? double(inwards) > bound[k] : double(inwards) < bound[k])
+                    << fid << " side " << k;
             }
         }
         // Windows: every feature whose envelope meets one is found through the tree; any other
         // found meets it within a float's rounding.
-        for (const std::array<double, 4> w : {std::array<double, 4>{-10.3, 10.7, -12.1, 9.9}, {150.5, 180, -90, 90},
-                                              {-180, -172.2, 55.5, 90}, {100.1, 141.3, -51.7, -19.2}}) {
+        for (const std::array<double, 4> w : {std::array<double, 4>{-10.3, 10.7, -12.1, 9.9},
+                                              {150.5, 180, -90, 90},
+                                              {-180, -172.2, 55.5, 90},
+                                              {100.1, 141.3, -51.7, -19.2}}) {
             std::set<GIntBig> brute, tree;
-            for (const auto& [fid, e] : env)
-                if (e.MaxX >= w[0] && e.MinX <= w[1] && e.MaxY >= w[2] && e.MinY <= w[3]) brute.insert(fid);
-            for (const auto& row : db.rows("SELECT id FROM " + rtree + " WHERE maxx >= " + std::to_string(w[0]) + " AND minx <= " +
-                                           std::to_string(w[1]) + " AND maxy >= " + std::to_string(w[2]) +
-                                           " AND miny <= " + std::to_string(w[3])))
+            for (const auto &[fid, e] : env)
+                if (e.MaxX >= w[0] && e.MinX <= w[1] && e.MaxY >= w[2] && e.MinY <= w[3])
+                    brute.insert(fid);
+            for (const auto &row :
+                 db.rows("SELECT id FROM " + rtree + " WHERE maxx >= " + std::to_string(w[0]) +
+                         " AND minx <= " + std::to_string(w[1]) + " AND maxy >= " +
+                         std::to_string(w[2]) + " AND miny <= " + std::to_string(w[3])))
                 tree.insert(std::stoll(row[0]));
             if (table != "boundary") {
                 EXPECT_GT(brute.size(), 0u) << w[0];
             }
-            for (GIntBig fid : brute) EXPECT_TRUE(tree.count(fid)) << "window " << w[0] << ": feature " << fid << " missed";
+            for (GIntBig fid : brute)
+                EXPECT_TRUE(tree.count(fid))
+                    << "window " << w[0] << ": feature " << fid << " missed";
             for (GIntBig fid : tree) {
-                if (brute.count(fid)) continue;
-                const OGREnvelope& e = env.at(fid);
-                EXPECT_TRUE(e.MaxX >= w[0] - 1e-4 && e.MinX <= w[1] + 1e-4 && e.MaxY >= w[2] - 1e-4 && e.MinY <= w[3] + 1e-4)
+                if (brute.count(fid))
+                    continue;
+                const OGREnvelope &e = env.at(fid);
+                EXPECT_TRUE(e.MaxX >= w[0] - 1e-4 && e.MinX <= w[1] + 1e-4 &&
+                            e.MaxY >= w[2] - 1e-4 && e.MinY <= w[3] + 1e-4)
                     << "window " << w[0] << ": feature " << fid << " found far from it";
             }
         }
@@ -330,13 +365,14 @@ TEST(Gpkg, spatial_index_follows_features_edited_later_through_gdal) {
     {
         Dataset d(dir / "m.gpkg", GDAL_OF_VECTOR | GDAL_OF_UPDATE);
         ASSERT_TRUE(d.ds);
-        OGRLayer* faces = d.ds->GetLayerByName("faces");
+        OGRLayer *faces = d.ds->GetLayerByName("faces");
         ASSERT_TRUE(faces);
         EXPECT_EQ(faces->DeleteFeature(5), OGRERR_NONE);
         OGRFeature f(faces->GetLayerDefn());
         OGRPolygon poly;
         OGRLinearRing ring;
-        for (const auto& [x, y] : {std::pair{10.0, 80.0}, {11.0, 80.0}, {11.0, 81.0}, {10.0, 80.0}}) ring.addPoint(x, y);
+        for (const auto &[x, y] : {std::pair{10.0, 80.0}, {11.0, 80.0}, {11.0, 81.0}, {10.0, 80.0}})
+            ring.addPoint(x, y);
         poly.addRing(&ring);
         OGRMultiPolygon multi;
         multi.addGeometry(&poly);
@@ -346,9 +382,11 @@ TEST(Gpkg, spatial_index_follows_features_edited_later_through_gdal) {
     }
     const Sqlite db(dir / "m.gpkg");
     EXPECT_EQ(db.one("SELECT rtreecheck('rtree_faces_geom')"), "ok");
-    EXPECT_EQ(db.one("SELECT count(*) FROM rtree_faces_geom"), db.one("SELECT count(*) FROM faces"));
+    EXPECT_EQ(db.one("SELECT count(*) FROM rtree_faces_geom"),
+              db.one("SELECT count(*) FROM faces"));
     EXPECT_EQ(db.one("SELECT count(*) FROM rtree_faces_geom WHERE id = 5"), "0");
-    const auto box = db.rows("SELECT minx, maxx, miny, maxy FROM rtree_faces_geom WHERE id = " + std::to_string(added));
+    const auto box = db.rows("SELECT minx, maxx, miny, maxy FROM rtree_faces_geom WHERE id = " +
+                             std::to_string(added));
     ASSERT_EQ(box.size(), 1u);
     EXPECT_EQ(box[0], (std::vector<std::string>{"10.0", "11.0", "80.0", "81.0"}));
 }
@@ -362,7 +400,11 @@ TEST(Gpkg, gdal_validator_accepts_the_file) {
     }
     TempDir dir;
     write_gpkg(icosphere_with_holes(3), dir / "m.gpkg");
-    EXPECT_EQ(run_command("/usr/bin/python3 -m osgeo_utils.samples.validate_gpkg " + (dir / "m.gpkg").string(), out), 0) << out;
+    EXPECT_EQ(run_command("/usr/bin/python3 -m osgeo_utils.samples.validate_gpkg " +
+                              (dir / "m.gpkg").string(),
+                          out),
+              0)
+        << out;
     EXPECT_EQ(out, "");
 }
 
@@ -391,10 +433,11 @@ TEST(Gpkg, pole_corner_is_written_as_two_points_at_the_neighbouring_longitudes) 
     write_gpkg(m, dir / "ico.gpkg");
     Dataset d(dir / "ico.gpkg");
     std::unique_ptr<OGRFeature> f(d.ds->GetLayerByName("faces")->GetFeature(1));
-    const auto* ring = f->GetGeometryRef()->toMultiPolygon()->getGeometryRef(0)->getExteriorRing();
+    const auto *ring = f->GetGeometryRef()->toMultiPolygon()->getGeometryRef(0)->getExteriorRing();
     std::vector<double> pole_lons;
     for (int i = 0; i + 1 < ring->getNumPoints(); ++i)
-        if (ring->getY(i) == 90.0) pole_lons.push_back(ring->getX(i));
+        if (ring->getY(i) == 90.0)
+            pole_lons.push_back(ring->getX(i));
     ASSERT_EQ(pole_lons.size(), 2u);
     std::sort(pole_lons.begin(), pole_lons.end());
     EXPECT_NEAR(pole_lons[0], -180.0, 1e-9); // the corners of face 0 are at lon -180 and -108
@@ -406,18 +449,19 @@ TEST(Gpkg, faces_crossing_the_antimeridian_are_cut_into_two_parts) {
     Mesh m = icosphere_cap(4, 180, 0, 30);
     write_gpkg(m, dir / "pacific.gpkg");
     Dataset d(dir / "pacific.gpkg");
-    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    OGRLayer *faces = d.ds->GetLayerByName("faces");
     EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
     auto [area, widest] = faces_area_and_widest_part(faces);
     EXPECT_LT(widest, 30.0);
     int cut = 0;
     faces->ResetReading();
-    for (auto& f : *faces) cut += f->GetGeometryRef()->toMultiPolygon()->getNumGeometries() == 2;
+    for (auto &f : *faces)
+        cut += f->GetGeometryRef()->toMultiPolygon()->getNumGeometries() == 2;
     EXPECT_GT(cut, 5);
     // Boundary lines are cut too: no segment jumps across the map.
-    for (auto& f : *d.ds->GetLayerByName("boundary")) {
+    for (auto &f : *d.ds->GetLayerByName("boundary")) {
         OGREnvelope env;
-        for (const auto* line : f->GetGeometryRef()->toMultiLineString()) {
+        for (const auto *line : f->GetGeometryRef()->toMultiLineString()) {
             line->getEnvelope(&env);
             EXPECT_LT(env.MaxX - env.MinX, 90.0);
         }
@@ -430,7 +474,7 @@ TEST(Gpkg, face_round_a_pole_is_cut_into_parts_no_wider_than_180) {
     write_gpkg(m, dir / "nopole.gpkg");
     Dataset d(dir / "nopole.gpkg");
     ASSERT_TRUE(d.ds);
-    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    OGRLayer *faces = d.ds->GetLayerByName("faces");
     EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size())); // still one feature per face
     auto [area, widest] = faces_area_and_widest_part(faces);
     EXPECT_NEAR(area, 360.0 * 180.0, 1e-6); // the polar faces still reach the pole lines
@@ -439,10 +483,11 @@ TEST(Gpkg, face_round_a_pole_is_cut_into_parts_no_wider_than_180) {
     // the pole line over every longitude, in parts (uncut, it is one part 360 degrees wide).
     int round_pole = 0;
     faces->ResetReading();
-    for (auto& f : *faces) {
+    for (auto &f : *faces) {
         OGREnvelope env;
         f->GetGeometryRef()->getEnvelope(&env);
-        if (env.MaxY != 90.0 && env.MinY != -90.0) continue;
+        if (env.MaxY != 90.0 && env.MinY != -90.0)
+            continue;
         ++round_pole;
         EXPECT_EQ(env.MinX, -180.0);
         EXPECT_EQ(env.MaxX, 180.0);
@@ -457,63 +502,72 @@ TEST(Gpkg, boundary_loops_wider_than_180_are_split_into_joined_parts) {
     // lat 30..50 (one loop 240 degrees wide, like the Afro-Eurasian coast), round-the-pole faces.
     Mesh full = icosphere_without_pole_nodes(3);
     add_fields(full);
-    Mesh m = keep_faces(full, [&](std::size_t f) {
-        const auto& t = full.faces[f];
-        LonLat c = vec_to_lonlat(normalized(full.nodes[t[0]] + full.nodes[t[1]] + full.nodes[t[2]]));
-        return !(c.lat > -20 && c.lat < -10) && !(c.lat > 30 && c.lat < 50 && std::fabs(c.lon) < 120);
-    }, [](const Vec3&, const Vec3&) { return EdgeTag::coast; });
+    Mesh m = keep_faces(
+        full,
+        [&](std::size_t f) {
+            const auto &t = full.faces[f];
+            LonLat c =
+                vec_to_lonlat(normalized(full.nodes[t[0]] + full.nodes[t[1]] + full.nodes[t[2]]));
+            return !(c.lat > -20 && c.lat < -10) &&
+                   !(c.lat > 30 && c.lat < 50 && std::fabs(c.lon) < 120);
+        },
+        [](const Vec3 &, const Vec3 &) { return EdgeTag::coast; });
     write_gpkg(m, dir / "holes.gpkg");
     Dataset d(dir / "holes.gpkg");
     ASSERT_TRUE(d.ds);
-    OGRLayer* faces = d.ds->GetLayerByName("faces");
+    OGRLayer *faces = d.ds->GetLayerByName("faces");
     EXPECT_EQ(faces->GetFeatureCount(), GIntBig(m.faces.size()));
     EXPECT_LE(faces_area_and_widest_part(faces).second, 180.0);
-    OGRLayer* boundary = d.ds->GetLayerByName("boundary");
+    OGRLayer *boundary = d.ds->GetLayerByName("boundary");
     EXPECT_EQ(boundary->GetFeatureCount(), 3); // one feature per loop (all coast), as before
     int edges = 0, split = 0;
     double widest_feature = 0;
     boundary->ResetReading();
-    for (auto& f : *boundary) {
+    for (auto &f : *boundary) {
         edges += f->GetFieldAsInteger("edges");
         OGREnvelope all;
         f->GetGeometryRef()->getEnvelope(&all);
         widest_feature = std::max(widest_feature, all.MaxX - all.MinX);
-        const auto* multi = f->GetGeometryRef()->toMultiLineString();
+        const auto *multi = f->GetGeometryRef()->toMultiLineString();
         split += multi->getNumGeometries() > 1;
-        const OGRLineString* previous = nullptr;
-        for (const auto* line : multi) {
+        const OGRLineString *previous = nullptr;
+        for (const auto *line : multi) {
             OGREnvelope env;
             line->getEnvelope(&env);
             EXPECT_LE(env.MaxX - env.MinX, 180.0);
-            if (previous) { // a loop's parts chain: each starts where the last ended, or across +-180
+            if (previous) { // a loop's parts chain: each starts where the last ended, or across
+                            // +-180
                 OGRPoint end, start;
                 previous->EndPoint(&end);
                 line->StartPoint(&start);
                 const double jump = std::fabs(start.getX() - end.getX());
                 EXPECT_NEAR(start.getY(), end.getY(), 1e-9);
-                EXPECT_TRUE(jump < 1e-9 || std::fabs(jump - 360.0) < 1e-9) << end.getX() << " -> " << start.getX();
+                EXPECT_TRUE(jump < 1e-9 || std::fabs(jump - 360.0) < 1e-9)
+                    << end.getX() << " -> " << start.getX();
             }
             previous = line;
         }
     }
     EXPECT_EQ(std::size_t(edges), m.boundary.size()); // every boundary edge once
-    EXPECT_GT(widest_feature, 300.0);                  // the loops really were wide ...
-    EXPECT_EQ(split, 3);                                // ... and every one was split
+    EXPECT_GT(widest_feature, 300.0);                 // the loops really were wide ...
+    EXPECT_EQ(split, 3);                              // ... and every one was split
 }
 
 TEST(Gpkg, default_qgis_style_colours_faces_by_quality) {
     TempDir dir;
     write_gpkg(icosphere(1), dir / "s.gpkg");
     Dataset d(dir / "s.gpkg");
-    OGRLayer* styles = d.ds->GetLayerByName("layer_styles");
+    OGRLayer *styles = d.ds->GetLayerByName("layer_styles");
     ASSERT_TRUE(styles);
-    for (const char* field : {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
-                              "styleQML", "styleSLD", "useAsDefault", "description", "owner", "ui", "update_time"})
+    for (const char *field :
+         {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName",
+          "styleQML", "styleSLD", "useAsDefault", "description", "owner", "ui", "update_time"})
         EXPECT_GE(styles->GetLayerDefn()->GetFieldIndex(field), 0) << field;
     ASSERT_EQ(styles->GetFeatureCount(), 1);
     std::unique_ptr<OGRFeature> s(styles->GetNextFeature());
     EXPECT_STREQ(s->GetFieldAsString("f_table_name"), "faces");
-    EXPECT_STREQ(s->GetFieldAsString("f_geometry_column"), d.ds->GetLayerByName("faces")->GetGeometryColumn());
+    EXPECT_STREQ(s->GetFieldAsString("f_geometry_column"),
+                 d.ds->GetLayerByName("faces")->GetGeometryColumn());
     EXPECT_EQ(s->GetFieldAsInteger("useAsDefault"), 1);
     std::string qml = s->GetFieldAsString("styleQML");
     EXPECT_NE(qml.find("type=\"graduatedSymbol\" attr=\"quality\""), std::string::npos);
@@ -543,13 +597,21 @@ TEST(Gpkg, gpkg_and_preview_report_progress_and_stop_when_asked) {
     TempDir dir;
     const Mesh m = icosphere(5); // 20,480 faces: a few reports
     struct Writer {
-        const char* stage;
-        std::function<void(const Progress&)> write;
+        const char *stage;
+        std::function<void(const Progress &)> write;
     };
-    const std::vector<Writer> writers = {
-        {"write_gpkg", [&](const Progress& p) { GpkgOptions o; o.progress = p; write_gpkg(m, dir / "o.gpkg", o); }},
-        {"write_preview", [&](const Progress& p) { PreviewOptions o; o.progress = p; write_preview_png(m, dir / "o.png", o); }}};
-    for (const Writer& w : writers) {
+    const std::vector<Writer> writers = {{"write_gpkg",
+                                          [&](const Progress &p) {
+                                              GpkgOptions o;
+                                              o.progress = p;
+                                              write_gpkg(m, dir / "o.gpkg", o);
+                                          }},
+                                         {"write_preview", [&](const Progress &p) {
+                                              PreviewOptions o;
+                                              o.progress = p;
+                                              write_preview_png(m, dir / "o.png", o);
+                                          }}};
+    for (const Writer &w : writers) {
         SCOPED_TRACE(w.stage);
         std::vector<double> seen;
         w.write([&](double f, std::string_view stage) {
@@ -563,13 +625,18 @@ TEST(Gpkg, gpkg_and_preview_report_progress_and_stop_when_asked) {
         // The GeoPackage's last part, its spatial indexes, reports as it goes too: the stop past
         // 0.8 below comes inside them, and leaves no file either.
         if (std::string(w.stage) == "write_gpkg") {
-            EXPECT_GE(std::count_if(seen.begin(), seen.end(), [](double f) { return f > 0.8 && f < 1; }), 8);
+            EXPECT_GE(
+                std::count_if(seen.begin(), seen.end(), [](double f) { return f > 0.8 && f < 1; }),
+                8);
         }
-        for (const auto& e : fs::directory_iterator(dir.path())) fs::remove(e.path());
+        for (const auto &e : fs::directory_iterator(dir.path()))
+            fs::remove(e.path());
         // Stop at the first report, and at the first past 0.8 (the preview: inside GDAL's
         // rasterizer, whose progress the writer passes on).
         for (const double stop_at : {0.0, 0.8}) {
-            EXPECT_THROW(w.write([&](double f, std::string_view) { return f < stop_at; }), Cancelled) << stop_at;
+            EXPECT_THROW(w.write([&](double f, std::string_view) { return f < stop_at; }),
+                         Cancelled)
+                << stop_at;
             EXPECT_TRUE(folder_listing(dir.path()).empty()) << stop_at;
         }
     }
@@ -591,17 +658,20 @@ TEST(Preview, draws_faces_over_land_without_smearing_across_the_map) {
     EXPECT_EQ(d.ds->GetRasterYSize(), 360);
     const auto extent = *o.extent_deg;
     const std::array<int, 4> background = {236, 242, 248, 255}, land = {205, 195, 170, 255};
-    EXPECT_EQ(pixel(d.ds.get(), 20, 5, extent), land);           // central Africa
-    EXPECT_EQ(pixel(d.ds.get(), -30, -40, extent), background);  // South Atlantic, no mesh
-    EXPECT_EQ(pixel(d.ds.get(), 0, 1, extent), background);      // a smeared face would cover this
+    EXPECT_EQ(pixel(d.ds.get(), 20, 5, extent), land);          // central Africa
+    EXPECT_EQ(pixel(d.ds.get(), -30, -40, extent), background); // South Atlantic, no mesh
+    EXPECT_EQ(pixel(d.ds.get(), 0, 1, extent), background);     // a smeared face would cover this
     // Face centres (not edges, where outlines are drawn) east and west of the antimeridian.
     LonLat east{0, 0}, west{0, 0};
-    for (const auto& t : m.faces) {
+    for (const auto &t : m.faces) {
         LonLat c = vec_to_lonlat(normalized(m.nodes[t[0]] + m.nodes[t[1]] + m.nodes[t[2]]));
-        if (c.lon > 170 && std::fabs(c.lat) < 10) east = c;
-        if (c.lon < -170 && std::fabs(c.lat) < 10) west = c;
+        if (c.lon > 170 && std::fabs(c.lat) < 10)
+            east = c;
+        if (c.lon < -170 && std::fabs(c.lat) < 10)
+            west = c;
     }
-    auto at_cap_east = pixel(d.ds.get(), east.lon, east.lat, extent), at_cap_west = pixel(d.ds.get(), west.lon, west.lat, extent);
+    auto at_cap_east = pixel(d.ds.get(), east.lon, east.lat, extent),
+         at_cap_west = pixel(d.ds.get(), west.lon, west.lat, extent);
     EXPECT_NE(at_cap_east, background);
     EXPECT_NE(at_cap_west, background);
     EXPECT_GT(at_cap_east[1], at_cap_east[0]); // quality ~0.9: green over red
@@ -625,7 +695,9 @@ TEST(Preview, faces_smaller_than_a_pixel_leave_no_pixel_of_a_closed_sphere_unpai
         ASSERT_EQ(nx, width);
         std::vector<std::uint8_t> rgb(3 * std::size_t(nx) * std::size_t(ny));
         int bands[3] = {1, 2, 3};
-        ASSERT_EQ(d.ds->RasterIO(GF_Read, 0, 0, nx, ny, rgb.data(), nx, ny, GDT_Byte, 3, bands, 3, 3 * nx, 1, nullptr), CE_None);
+        ASSERT_EQ(d.ds->RasterIO(GF_Read, 0, 0, nx, ny, rgb.data(), nx, ny, GDT_Byte, 3, bands, 3,
+                                 3 * nx, 1, nullptr),
+                  CE_None);
         std::size_t background = 0;
         for (std::size_t i = 0; i < rgb.size(); i += 3)
             background += rgb[i] == 236 && rgb[i + 1] == 242 && rgb[i + 2] == 248;
@@ -648,10 +720,13 @@ TEST(Preview, default_extent_of_a_pacific_mesh_is_continuous_across_180_and_colo
     // Most of the picture is faces in blue depth colours: the cap is drawn in one piece.
     const int w = d.ds->GetRasterXSize(), h = d.ds->GetRasterYSize();
     std::vector<GByte> r(std::size_t(w) * h), b(std::size_t(w) * h);
-    ASSERT_EQ(d.ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, r.data(), w, h, GDT_Byte, 0, 0), CE_None);
-    ASSERT_EQ(d.ds->GetRasterBand(3)->RasterIO(GF_Read, 0, 0, w, h, b.data(), w, h, GDT_Byte, 0, 0), CE_None);
+    ASSERT_EQ(d.ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, r.data(), w, h, GDT_Byte, 0, 0),
+              CE_None);
+    ASSERT_EQ(d.ds->GetRasterBand(3)->RasterIO(GF_Read, 0, 0, w, h, b.data(), w, h, GDT_Byte, 0, 0),
+              CE_None);
     std::size_t blue = 0;
-    for (std::size_t i = 0; i < r.size(); ++i) blue += b[i] > r[i] + 50;
+    for (std::size_t i = 0; i < r.size(); ++i)
+        blue += b[i] > r[i] + 50;
     EXPECT_GT(double(blue) / double(r.size()), 0.45);
     EXPECT_THROW(write_preview_png(m, dir / "pac.png", o), IoError); // exists, no overwrite
     o.overwrite = true;

@@ -38,35 +38,43 @@ MeshOptions land_110m(double h_km) {
 // Quality of every face, and whether it touches a boundary node whose ocean angle is below 60
 // degrees (a sharp coastline corner, reported apart as the issue asks).
 struct QualityCheck {
-    double worst = 1, worst_away_from_corners = 1, mean = 0, above_0_8 = 0, below_0_6_away_from_corners = 0;
+    double worst = 1, worst_away_from_corners = 1, mean = 0, above_0_8 = 0,
+           below_0_6_away_from_corners = 0;
     std::size_t corner_faces = 0;
 };
 
-QualityCheck quality(const Mesh& mesh) {
+QualityCheck quality(const Mesh &mesh) {
     std::vector<double> angle(mesh.nodes.size(), 0);
     std::map<std::pair<NodeIndex, NodeIndex>, int> edge_use;
-    for (const auto& f : mesh.faces)
+    for (const auto &f : mesh.faces)
         for (int i = 0; i < 3; ++i) {
-            const Vec3 &p = mesh.nodes[f[i]], &q = mesh.nodes[f[(i + 1) % 3]], &r = mesh.nodes[f[(i + 2) % 3]];
+            const Vec3 &p = mesh.nodes[f[i]], &q = mesh.nodes[f[(i + 1) % 3]],
+                       &r = mesh.nodes[f[(i + 2) % 3]];
             angle[f[i]] += std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p));
             auto e = std::minmax(f[i], f[(i + 1) % 3]);
             ++edge_use[{e.first, e.second}];
         }
     std::vector<char> boundary(mesh.nodes.size(), 0);
-    for (const auto& [e, n] : edge_use)
-        if (n == 1) boundary[e.first] = boundary[e.second] = 1;
+    for (const auto &[e, n] : edge_use)
+        if (n == 1)
+            boundary[e.first] = boundary[e.second] = 1;
     QualityCheck c;
     std::size_t good = 0;
-    for (const auto& f : mesh.faces) {
+    for (const auto &f : mesh.faces) {
         double q = triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]);
         c.mean += q;
         c.worst = std::min(c.worst, q);
-        if (q > 0.8) ++good;
+        if (q > 0.8)
+            ++good;
         bool corner = false;
-        for (int i = 0; i < 3; ++i) corner |= boundary[f[i]] && angle[f[i]] < 60 * deg_to_rad;
-        if (corner) ++c.corner_faces;
-        else c.worst_away_from_corners = std::min(c.worst_away_from_corners, q);
-        if (!corner && q < 0.6) c.below_0_6_away_from_corners += 1;
+        for (int i = 0; i < 3; ++i)
+            corner |= boundary[f[i]] && angle[f[i]] < 60 * deg_to_rad;
+        if (corner)
+            ++c.corner_faces;
+        else
+            c.worst_away_from_corners = std::min(c.worst_away_from_corners, q);
+        if (!corner && q < 0.6)
+            c.below_0_6_away_from_corners += 1;
     }
     c.mean /= double(mesh.faces.size());
     c.above_0_8 = double(good) / double(mesh.faces.size());
@@ -74,7 +82,7 @@ QualityCheck quality(const Mesh& mesh) {
     return c;
 }
 
-std::string slurp(const std::filesystem::path& p) {
+std::string slurp(const std::filesystem::path &p) {
     std::ifstream f(p, std::ios::binary);
     return {std::istreambuf_iterator<char>(f), {}};
 }
@@ -86,7 +94,7 @@ struct Verified {
     double boundary_to_coast_max_km = -1;
 };
 
-double json_number(const std::string& json, const std::string& pattern) {
+double json_number(const std::string &json, const std::string &pattern) {
     std::vector<std::string> g;
     if (!test::regex_search(json, pattern, &g)) {
         ADD_FAILURE() << "mesh-verify's report has no " << pattern << ":\n" << json.substr(0, 2000);
@@ -98,36 +106,42 @@ double json_number(const std::string& json, const std::string& pattern) {
 // Writes the mesh as UGRID (to `name` in a temporary folder) and has mesh-verify judge it, the
 // size fit against the mesh's own target_size; what it measured, nothing where it is absent (the
 // test is then skipped, or fails under CI=true).
-std::optional<Verified> expect_verified(const Mesh& mesh, const std::string& name, const std::string& min_size_fit = "0.95",
-                                        const std::string& more = "") {
+std::optional<Verified> expect_verified(const Mesh &mesh, const std::string &name,
+                                        const std::string &min_size_fit = "0.95",
+                                        const std::string &more = "") {
     test::TempDir dir;
     write_ugrid(mesh, dir / name);
     std::string json;
-    const int status =
-        test::mesh_verify_json(dir / name, "--size-var target_size --min-size-fit " + min_size_fit + " " + more, json);
-    if (status < 0) return std::nullopt;
+    const int status = test::mesh_verify_json(
+        dir / name, "--size-var target_size --min-size-fit " + min_size_fit + " " + more, json);
+    if (status < 0)
+        return std::nullopt;
     EXPECT_EQ(status, 0) << "mesh-verify rejected " << name << ":\n" << json;
     Verified v;
     v.worst = json_number(json, R"("quality": \{\s*"min": ([^,\s]+))");
     v.mean = json_number(json, R"("quality": \{[^}]*"mean": ([^,\s]+))");
     v.above_0_8 = json_number(json, R"("quality": \{[^}]*"pct_above_0\.8": ([^,\s]+))") / 100;
     if (more.find("--coast ") != std::string::npos)
-        v.boundary_to_coast_max_km = json_number(json, R"("boundary_to_coast": \{[^}]*"max_km": ([^,\s]+))");
+        v.boundary_to_coast_max_km =
+            json_number(json, R"("boundary_to_coast": \{[^}]*"max_km": ([^,\s]+))");
     return v;
 }
 
 // The quality measured here (triangle_quality) is mesh-verify's, from the file's coordinates:
 // the same worst and mean, and the same share above 0.8 (a face or two at 0.8 may fall either way).
-void expect_same_measure(const std::optional<Verified>& v, const QualityCheck& q, std::size_t faces) {
-    if (!v) return;
+void expect_same_measure(const std::optional<Verified> &v, const QualityCheck &q,
+                         std::size_t faces) {
+    if (!v)
+        return;
     EXPECT_NEAR(v->worst, q.worst, 1e-9);
     EXPECT_NEAR(v->mean, q.mean, 1e-9);
     EXPECT_NEAR(v->above_0_8, q.above_0_8, 2.5 / double(faces));
 }
 
-std::size_t count_tag(const Mesh& m, EdgeTag tag) {
+std::size_t count_tag(const Mesh &m, EdgeTag tag) {
     std::size_t n = 0;
-    for (const auto& e : m.boundary) n += e.tag == tag;
+    for (const auto &e : m.boundary)
+        n += e.tag == tag;
     return n;
 }
 
@@ -137,45 +151,54 @@ struct Closed {
     std::vector<double> basins_km2;
     std::vector<LonLat> at;
     bool near(double lon, double lat) const {
-        for (const LonLat& p : at)
-            if (std::abs(p.lon - lon) < 1 && std::abs(p.lat - lat) < 1) return true;
+        for (const LonLat &p : at)
+            if (std::abs(p.lon - lon) < 1 && std::abs(p.lat - lat) < 1)
+                return true;
         return false;
     }
 };
-Closed straits_closed(const OceanMesh& run) {
+Closed straits_closed(const OceanMesh &run) {
     EXPECT_TRUE(run.straits_closing);
-    const MesherReport& r = run.mesher;
+    const MesherReport &r = run.mesher;
     Closed c{r.straits_closed, r.nodes_split, r.seas_cut_off, {}};
-    for (const Vec3& p : r.straits_closed_at) c.at.push_back(vec_to_lonlat(p));
+    for (const Vec3 &p : r.straits_closed_at)
+        c.at.push_back(vec_to_lonlat(p));
     EXPECT_EQ(c.at.size(), c.count);
     return c;
 }
 
 // Pairs of nodes closer than `metres` (brute force along x): the nodes a closed strait split.
-std::size_t close_node_pairs(const Mesh& mesh, double metres) {
+std::size_t close_node_pairs(const Mesh &mesh, double metres) {
     const double d = metres / (earth_radius_km * 1000);
     std::vector<std::size_t> order(mesh.nodes.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return mesh.nodes[a].x < mesh.nodes[b].x; });
+    for (std::size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return mesh.nodes[a].x < mesh.nodes[b].x; });
     std::size_t pairs = 0;
     for (std::size_t i = 0; i < order.size(); ++i)
-        for (std::size_t j = i + 1; j < order.size() && mesh.nodes[order[j]].x - mesh.nodes[order[i]].x < d; ++j)
+        for (std::size_t j = i + 1;
+             j < order.size() && mesh.nodes[order[j]].x - mesh.nodes[order[i]].x < d; ++j)
             pairs += norm(mesh.nodes[order[j]] - mesh.nodes[order[i]]) < d;
     return pairs;
 }
 
 // Pieces of the mesh (faces connected through their nodes).
-std::size_t pieces(const Mesh& mesh) {
+std::size_t pieces(const Mesh &mesh) {
     std::vector<std::size_t> parent(mesh.nodes.size());
-    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-    std::function<std::size_t(std::size_t)> find = [&](std::size_t i) { return parent[i] == i ? i : parent[i] = find(parent[i]); };
-    for (const auto& f : mesh.faces)
+    for (std::size_t i = 0; i < parent.size(); ++i)
+        parent[i] = i;
+    std::function<std::size_t(std::size_t)> find = [&](std::size_t i) {
+        return parent[i] == i ? i : parent[i] = find(parent[i]);
+    };
+    for (const auto &f : mesh.faces)
         for (int k = 1; k < 3; ++k) {
             const std::size_t a = find(f[0]), b = find(f[k]);
             parent[b] = a;
         }
     std::set<std::size_t> roots;
-    for (const auto& f : mesh.faces) roots.insert(find(f[0]));
+    for (const auto &f : mesh.faces)
+        roots.insert(find(f[0]));
     return roots.size();
 }
 
@@ -203,11 +226,11 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     MeshOptions o = land_110m(100);
     o.coast = fixture("coast/ne_50m_land.gpkg").string();
     const OceanMesh run = mesh_ocean(o);
-    const Mesh& mesh = run.mesh;
+    const Mesh &mesh = run.mesh;
     // No face centred on land (also mesh-verify's --max-land-faces 0 below), straits narrower
     // than a face closed. Each hole the removals opened is one more boundary loop, each join one
     // fewer; narrow water between islands and the mainland closes in a few dozen places.
-    const MesherReport& report = run.mesher;
+    const MesherReport &report = run.mesher;
     EXPECT_EQ(report.land_faces_left, 0u);
     const Closed closed = straits_closed(run);
     EXPECT_GE(closed.count, 5u);
@@ -225,7 +248,8 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     const std::size_t rings = run.coast.rings + report.land_holes - report.land_loops_joined;
     EXPECT_GE(loops, rings);
     EXPECT_LE(loops, rings + closed.count + closed.nodes_split);
-    const auto v = expect_verified(mesh, "g.nc", "0.95", "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
+    const auto v = expect_verified(mesh, "g.nc", "0.95",
+                                   "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
     // Removing the land faces keeps the water's edge on the coast: within one face (h) of it.
     if (v) {
         EXPECT_LE(v->boundary_to_coast_max_km, 100.0);
@@ -255,24 +279,27 @@ TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
     o.coast = fixture("coast/ne_50m_land.gpkg").string();
     o.region = std::array<double, 4>{20, 35, 45, 48};
     const OceanMesh closed_run = mesh_ocean(o);
-    const Mesh& closed_mesh = closed_run.mesh;
+    const Mesh &closed_mesh = closed_run.mesh;
     EXPECT_EQ(closed_run.mesher.land_faces_left, 0u);
     const Closed closed = straits_closed(closed_run);
     EXPECT_GE(closed.count, 1u);
-    EXPECT_TRUE(closed.near(26.5, 40.2) || closed.near(29.0, 41.1)) << "the Dardanelles or the Bosphorus";
+    EXPECT_TRUE(closed.near(26.5, 40.2) || closed.near(29.0, 41.1))
+        << "the Dardanelles or the Bosphorus";
     // The largest basin cut off is the Black Sea (436,000 km2, and the Sea of Azov), each basin
     // a piece of its own beside the main one.
     ASSERT_GE(closed.basins_km2.size(), 1u);
     EXPECT_GT(closed.basins_km2[0], 3.5e5);
     EXPECT_LT(closed.basins_km2[0], 5.0e5);
-    for (std::size_t i = 1; i < closed.basins_km2.size(); ++i) EXPECT_LT(closed.basins_km2[i], 5e4);
+    for (std::size_t i = 1; i < closed.basins_km2.size(); ++i)
+        EXPECT_LT(closed.basins_km2[i], 5e4);
     EXPECT_EQ(pieces(closed_mesh), closed.basins_km2.size() + 1);
     // (About 200 nodes, most on the coast: the size fit is not this test's point.)
-    expect_verified(closed_mesh, "straits.nc", "0.5", "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
+    expect_verified(closed_mesh, "straits.nc", "0.5",
+                    "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
 
     o.keep_straits = true;
     const OceanMesh open_run = mesh_ocean(o);
-    const Mesh& open_mesh = open_run.mesh;
+    const Mesh &open_mesh = open_run.mesh;
     EXPECT_GE(open_run.mesher.land_faces_left, 1u);
     EXPECT_FALSE(open_run.straits_closing); // nothing closed, and no straits_closed attribute
     EXPECT_EQ(open_run.mesher.straits_closed, 0u);
@@ -289,8 +316,8 @@ TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     CoastData coast = load_coast(o);
     Boundary b = shape_boundary(coast, h, o);
     MesherOptions mo;
-    mo.lattice_km = 160;     // as the pipeline sets it: the field's largest value
-    mo.land = coast.land;    // and the source land (boundary nodes slide near its coast)
+    mo.lattice_km = 160;  // as the pipeline sets it: the field's largest value
+    mo.land = coast.land; // and the source land (boundary nodes slide near its coast)
     MesherReport report;
     Mesh mesh = mesh_boundary(b, h, mo, &report);
     EXPECT_GT(report.lattice_nodes, 0u);
@@ -305,12 +332,14 @@ TEST(Mesher, gulf_stream_field_grades_from_20_to_160_km) {
     // Edges near the centre are about 20 km, far away about 160 km.
     double near_sum = 0, far_sum = 0;
     std::size_t near_n = 0, far_n = 0;
-    for (const auto& f : mesh.faces)
+    for (const auto &f : mesh.faces)
         for (int i = 0; i < 3; ++i) {
             const Vec3 &a = mesh.nodes[f[i]], &c = mesh.nodes[f[(i + 1) % 3]];
             double d = arc_km(arc_midpoint(a, c), centre);
-            if (d < 1000) near_sum += arc_km(a, c), ++near_n;
-            if (d > 4000) far_sum += arc_km(a, c), ++far_n;
+            if (d < 1000)
+                near_sum += arc_km(a, c), ++near_n;
+            if (d > 4000)
+                far_sum += arc_km(a, c), ++far_n;
         }
     ASSERT_GT(near_n, 0u);
     EXPECT_NEAR(near_sum / near_n, 20, 6);
@@ -404,8 +433,9 @@ TEST(Mesher, relaxation_leaves_no_node_of_valence_4_or_8_on_a_graded_sphere) {
     MesherReport report;
     Mesh mesh = mesh_boundary(Boundary{}, latitude_size(100, 400), {}, &report);
     std::vector<int> valence(mesh.nodes.size(), 0);
-    for (const auto& f : mesh.faces)
-        for (NodeIndex v : f) ++valence[v];
+    for (const auto &f : mesh.faces)
+        for (NodeIndex v : f)
+            ++valence[v];
     std::size_t odd = 0, fives_and_sevens = 0;
     for (int v : valence) {
         odd += v <= 4 || v >= 8;
@@ -427,8 +457,9 @@ TEST(Mesher, a_mesh_the_refinement_made_is_numbered_along_the_sphere_not_in_the_
     // graded million-node mesh).
     Mesh mesh = mesh_boundary(Boundary{}, latitude_size(100, 400), {});
     std::vector<double> gaps;
-    for (const auto& f : mesh.faces)
-        for (int i = 0; i < 3; ++i) gaps.push_back(std::abs(double(f[i]) - double(f[(i + 1) % 3])));
+    for (const auto &f : mesh.faces)
+        for (int i = 0; i < 3; ++i)
+            gaps.push_back(std::abs(double(f[i]) - double(f[(i + 1) % 3])));
     std::sort(gaps.begin(), gaps.end());
     const double n = double(mesh.nodes.size());
     ASSERT_GT(n, 10000);
@@ -439,11 +470,12 @@ TEST(Mesher, a_mesh_the_refinement_made_is_numbered_along_the_sphere_not_in_the_
 // A point in a lon/lat polygon (even-odd rule on straight lon/lat sides): the land test of
 // mesh-verify, independent of the mesher's gnomonic one. The polygons here are a few km wide,
 // away from the antimeridian and the poles.
-bool in_lonlat_polygon(const LonLat& p, const std::vector<LonLat>& ring) {
+bool in_lonlat_polygon(const LonLat &p, const std::vector<LonLat> &ring) {
     bool in = false;
     for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
         if ((ring[i].lat > p.lat) != (ring[j].lat > p.lat) &&
-            p.lon < ring[j].lon + (p.lat - ring[j].lat) * (ring[i].lon - ring[j].lon) / (ring[i].lat - ring[j].lat))
+            p.lon < ring[j].lon + (p.lat - ring[j].lat) * (ring[i].lon - ring[j].lon) /
+                                      (ring[i].lat - ring[j].lat))
             in = !in;
     return in;
 }
@@ -461,15 +493,21 @@ TEST(Mesher, face_centroids_leave_the_islands_the_shaping_dropped) {
     std::vector<std::vector<LonLat>> islands;
     std::set<NodeIndex> taken;
     for (std::size_t f = 0; f < plain.faces.size() && islands.size() < 40; f += 37) {
-        const auto& fc = plain.faces[f];
-        if (taken.count(fc[0]) || taken.count(fc[1]) || taken.count(fc[2])) continue;
-        const LonLat c = vec_to_lonlat(normalized(plain.nodes[fc[0]] + plain.nodes[fc[1]] + plain.nodes[fc[2]]));
-        if (std::abs(c.lat) > 60 || std::abs(c.lon) > 170) continue;
+        const auto &fc = plain.faces[f];
+        if (taken.count(fc[0]) || taken.count(fc[1]) || taken.count(fc[2]))
+            continue;
+        const LonLat c =
+            vec_to_lonlat(normalized(plain.nodes[fc[0]] + plain.nodes[fc[1]] + plain.nodes[fc[2]]));
+        if (std::abs(c.lat) > 60 || std::abs(c.lon) > 170)
+            continue;
         const double dlat = 12.0 / 111.0, dlon = dlat / std::cos(c.lat * pi / 180);
-        std::vector<LonLat> ring = {{c.lon - dlon, c.lat - dlat}, {c.lon - dlon, c.lat + dlat},
-                                    {c.lon + dlon, c.lat + dlat}, {c.lon + dlon, c.lat - dlat}}; // clockwise
+        std::vector<LonLat> ring = {{c.lon - dlon, c.lat - dlat},
+                                    {c.lon - dlon, c.lat + dlat},
+                                    {c.lon + dlon, c.lat + dlat},
+                                    {c.lon + dlon, c.lat - dlat}}; // clockwise
         std::vector<Vec3> nodes;
-        for (const auto& ll : ring) nodes.push_back(lonlat_to_vec(ll));
+        for (const auto &ll : ring)
+            nodes.push_back(lonlat_to_vec(ll));
         b.dropped_islands.push_back(nodes);
         islands.push_back(ring);
         taken.insert(fc.begin(), fc.end());
@@ -478,9 +516,11 @@ TEST(Mesher, face_centroids_leave_the_islands_the_shaping_dropped) {
     MesherReport report;
     const Mesh mesh = mesh_boundary(b, uniform_size(400), mo, &report);
     std::size_t on = 0;
-    for (const auto& fc : mesh.faces) {
-        const LonLat c = vec_to_lonlat(normalized(mesh.nodes[fc[0]] + mesh.nodes[fc[1]] + mesh.nodes[fc[2]]));
-        for (const auto& ring : islands) on += in_lonlat_polygon(c, ring);
+    for (const auto &fc : mesh.faces) {
+        const LonLat c =
+            vec_to_lonlat(normalized(mesh.nodes[fc[0]] + mesh.nodes[fc[1]] + mesh.nodes[fc[2]]));
+        for (const auto &ring : islands)
+            on += in_lonlat_polygon(c, ring);
     }
     EXPECT_EQ(on, report.island_centroids_left);
     EXPECT_GE(report.island_centroids_moved, 40u);
@@ -507,45 +547,53 @@ TEST(Mesher, faces_centred_on_land_go_where_the_mesh_stays_a_manifold_near_the_c
     for (int i = 0; i < 30; ++i) {
         const LonLat c{-150.0 + 10.3 * i, -50.0 + 3.1 * i};
         const double dlat = 150.0 / 111.0, dlon = dlat / std::cos(c.lat * pi / 180);
-        std::vector<LonLat> ring = {{c.lon - dlon, c.lat - dlat}, {c.lon - dlon, c.lat + dlat},
-                                    {c.lon + dlon, c.lat + dlat}, {c.lon + dlon, c.lat - dlat}}; // clockwise
+        std::vector<LonLat> ring = {{c.lon - dlon, c.lat - dlat},
+                                    {c.lon - dlon, c.lat + dlat},
+                                    {c.lon + dlon, c.lat + dlat},
+                                    {c.lon + dlon, c.lat - dlat}}; // clockwise
         std::vector<Vec3> nodes, points;
         for (std::size_t k = 0; k < ring.size(); ++k) {
             nodes.push_back(lonlat_to_vec(ring[k]));
-            const LonLat& p = ring[k];
-            const LonLat& q = ring[(k + 1) % ring.size()];
+            const LonLat &p = ring[k];
+            const LonLat &q = ring[(k + 1) % ring.size()];
             for (int j = 0; j < 150; ++j)
-                points.push_back(lonlat_to_vec(p.lon + (q.lon - p.lon) * j / 150, p.lat + (q.lat - p.lat) * j / 150));
+                points.push_back(lonlat_to_vec(p.lon + (q.lon - p.lon) * j / 150,
+                                               p.lat + (q.lat - p.lat) * j / 150));
         }
         b.dropped_islands.push_back(nodes);
         islands.push_back(ring);
         outline_points.push_back(points);
     }
     struct Squares final : LandTest {
-        const std::vector<std::vector<LonLat>>& islands;
-        const std::vector<std::vector<Vec3>>& outline_points;
-        Squares(const std::vector<std::vector<LonLat>>& i, const std::vector<std::vector<Vec3>>& o)
+        const std::vector<std::vector<LonLat>> &islands;
+        const std::vector<std::vector<Vec3>> &outline_points;
+        Squares(const std::vector<std::vector<LonLat>> &i, const std::vector<std::vector<Vec3>> &o)
             : islands(i), outline_points(o) {}
-        bool contains(const Vec3& p) const override {
+        bool contains(const Vec3 &p) const override {
             const LonLat ll = vec_to_lonlat(p);
-            for (const auto& ring : islands)
-                if (in_lonlat_polygon(ll, ring)) return true;
+            for (const auto &ring : islands)
+                if (in_lonlat_polygon(ll, ring))
+                    return true;
             return false;
         }
-        double distance(const Vec3& p) const {
+        double distance(const Vec3 &p) const {
             double d = pi;
-            for (const auto& pts : outline_points)
-                for (const auto& q : pts) d = std::min(d, arc_angle(p, q));
+            for (const auto &pts : outline_points)
+                for (const auto &q : pts)
+                    d = std::min(d, arc_angle(p, q));
             return d;
         }
-        bool coast_within(const Vec3& p, double angle) const override { return distance(p) <= angle; }
+        bool coast_within(const Vec3 &p, double angle) const override {
+            return distance(p) <= angle;
+        }
     };
     const auto squares = std::make_shared<Squares>(islands, outline_points);
-    auto on_land = [&](const Vec3& p) { return squares->contains(p); };
-    auto coast_distance = [&](const Vec3& p) { return squares->distance(p); };
-    auto count_on_land = [&](const Mesh& mesh) {
+    auto on_land = [&](const Vec3 &p) { return squares->contains(p); };
+    auto coast_distance = [&](const Vec3 &p) { return squares->distance(p); };
+    auto count_on_land = [&](const Mesh &mesh) {
         std::size_t on = 0;
-        for (const auto& fc : mesh.faces) on += on_land(normalized(mesh.nodes[fc[0]] + mesh.nodes[fc[1]] + mesh.nodes[fc[2]]));
+        for (const auto &fc : mesh.faces)
+            on += on_land(normalized(mesh.nodes[fc[0]] + mesh.nodes[fc[1]] + mesh.nodes[fc[2]]));
         return on;
     };
     const Mesh before = mesh_boundary(b, uniform_size(400), mo);
@@ -558,17 +606,20 @@ TEST(Mesher, faces_centred_on_land_go_where_the_mesh_stays_a_manifold_near_the_c
     const std::size_t on = count_on_land(mesh);
     EXPECT_EQ(on, report.land_faces_left);
     ASSERT_EQ(report.land_faces_at.size(), on); // where they are: each on a square
-    for (const Vec3& c : report.land_faces_at) EXPECT_TRUE(on_land(c));
+    for (const Vec3 &c : report.land_faces_at)
+        EXPECT_TRUE(on_land(c));
     EXPECT_LT(on, on_before / 4);
     // The same faces until this last step, each removed, moved off by a corner, or left.
     EXPECT_EQ(report.land_faces_removed + report.land_faces_nudged + on, on_before);
-    EXPECT_EQ(mesh.faces.size(), before.faces.size() - report.land_faces_removed - report.water_faces_removed);
+    EXPECT_EQ(mesh.faces.size(),
+              before.faces.size() - report.land_faces_removed - report.water_faces_removed);
     // Each hole is one boundary loop (an aqua-planet has no other), and every boundary node is
     // within h/2 of an outline.
     const MeshStats s = compute_stats(mesh);
     EXPECT_GE(report.land_holes, 10u);
     EXPECT_EQ(s.boundary_loops, report.land_holes);
-    for (const auto& e : mesh.boundary) EXPECT_LE(rad_to_km(coast_distance(mesh.nodes[e.a])), 200.0 + 1e-6);
+    for (const auto &e : mesh.boundary)
+        EXPECT_LE(rad_to_km(coast_distance(mesh.nodes[e.a])), 200.0 + 1e-6);
     expect_verified(mesh, "holes.nc"); // a manifold, oriented, constrained Delaunay
 }
 
@@ -594,14 +645,15 @@ TEST(Mesher, regional_box_has_open_boundary_edges) {
     MeshOptions o = land_110m(150);
     o.region = std::array<double, 4>{-70, 10, -10, 55};
     const OceanMesh run = mesh_ocean(o);
-    const Mesh& mesh = run.mesh;
+    const Mesh &mesh = run.mesh;
     // The lattice is walked in a cap around the box only (over the whole sphere it would be 19
     // times the box's nodes, and skipped), and fills the open sea in the box.
-    EXPECT_GT(run.mesher.lattice_nodes, mesh.nodes.size() / 4) << run.mesher.lattice_nodes << " of " << mesh.nodes.size();
+    EXPECT_GT(run.mesher.lattice_nodes, mesh.nodes.size() / 4)
+        << run.mesher.lattice_nodes << " of " << mesh.nodes.size();
     EXPECT_GT(count_tag(mesh, EdgeTag::open), 10u);
     EXPECT_GT(count_tag(mesh, EdgeTag::coast), 10u);
     expect_verified(mesh, "atl.nc", "0.9");
-    for (const Vec3& p : mesh.nodes) {
+    for (const Vec3 &p : mesh.nodes) {
         LonLat ll = vec_to_lonlat(p);
         EXPECT_GE(ll.lat, 10 - 1e-6);
         EXPECT_LE(ll.lat, 56.5); // great-circle edges between box corners bulge poleward
@@ -618,8 +670,11 @@ TEST(Mesher, a_size_wider_than_the_region_is_refused_naming_hmax) {
     EXPECT_GE(mesh.faces.size(), 2u);
     expect_verified(mesh, "wide_region.nc", "0"); // (the region is about one edge across)
     o.hmax_km = 3000;
-    const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); }, "a 3000 km size in a 2000 km region");
-    EXPECT_TRUE(test::regex_match(m, R"(no ocean to mesh: at hmax_km 3000 km .* [0-3] boundary nodes; lower hmax_km)")) << m;
+    const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); },
+                                                          "a 3000 km size in a 2000 km region");
+    EXPECT_TRUE(test::regex_match(
+        m, R"(no ocean to mesh: at hmax_km 3000 km .* [0-3] boundary nodes; lower hmax_km)"))
+        << m;
 }
 
 TEST(Mesher, same_input_gives_the_same_bytes) {
@@ -642,16 +697,21 @@ TEST(Mesher, a_graded_run_is_not_refused_by_a_max_nodes_above_its_count) {
     EXPECT_EQ(mesh_ocean(o).mesh.nodes.size(), nodes);
     o.max_nodes = nodes / 2;
     std::string m = test::thrown_message<DataError>(
-        [&] { mesh_ocean(o); }, "a run of " + std::to_string(nodes) + " nodes under --max-nodes " + std::to_string(o.max_nodes));
+        [&] { mesh_ocean(o); }, "a run of " + std::to_string(nodes) + " nodes under --max-nodes " +
+                                    std::to_string(o.max_nodes));
     EXPECT_NE(m.find("max_nodes"), std::string::npos) << m;
     // The pipeline's first count of the coast's band (before the size field): a straight coast's
     // band, so no fewer than the mesher makes (bays share their bands), and under twice that,
     // which its check relies on (it refuses at twice --max-nodes).
     o.max_nodes = 3000; // above the ocean's count at --hmax alone (about 2,600)
     m = test::thrown_message<DataError>([&] { mesh_ocean(o); },
-                                        "a run of " + std::to_string(nodes) + " nodes under --max-nodes 3000");
+                                        "a run of " + std::to_string(nodes) +
+                                            " nodes under --max-nodes 3000");
     std::vector<std::string> g;
-    ASSERT_TRUE(test::regex_search(m, R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at coast_size_km 25 km)", &g))
+    ASSERT_TRUE(test::regex_search(
+        m,
+        R"(^the water along the coast \(\d+ km\) takes about (\d+) nodes at coast_size_km 25 km)",
+        &g))
         << m;
     const double estimate = std::stod(g[1]);
     EXPECT_GE(estimate, double(nodes));
@@ -667,14 +727,18 @@ TEST(Mesher, a_coast_size_of_metres_is_refused_before_the_size_field) {
     const std::string m = test::thrown_message<DataError>(
         [&] {
             mesh_ocean(o, [&](double, std::string_view stage) {
-                if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+                if (stages.empty() || stages.back() != stage)
+                    stages.emplace_back(stage);
                 return true;
             });
         },
         "a 10 m coast size on the 1:110m land (under --max-nodes 2e7)");
-    EXPECT_TRUE(test::regex_search(m, R"(at coast_size_km 0\.01 km \(0\.1 km: sizes stop at hmin_km.*raise coast_size_km and hmin_km or max_nodes$)"))
+    EXPECT_TRUE(test::regex_search(
+        m,
+        R"(at coast_size_km 0\.01 km \(0\.1 km: sizes stop at hmin_km.*raise coast_size_km and hmin_km or max_nodes$)"))
         << m;
-    EXPECT_EQ(std::count(stages.begin(), stages.end(), "size field"), 0) << "reached the size field";
+    EXPECT_EQ(std::count(stages.begin(), stages.end(), "size field"), 0)
+        << "reached the size field";
 }
 
 TEST(Mesher, too_many_nodes_are_refused_before_refining) {
@@ -684,7 +748,8 @@ TEST(Mesher, too_many_nodes_are_refused_before_refining) {
     EXPECT_NE(m.find("max_nodes"), std::string::npos) << m;
 }
 
-TEST(Mesher, without_the_source_land_every_ring_node_stays_in_place_and_sharp_corners_match_the_faces) {
+TEST(Mesher,
+     without_the_source_land_every_ring_node_stays_in_place_and_sharp_corners_match_the_faces) {
     MeshOptions o = land_110m(200);
     CoastData coast = load_coast(o);
     Boundary b = shape_boundary(coast, uniform_size(200), o);
@@ -695,10 +760,12 @@ TEST(Mesher, without_the_source_land_every_ring_node_stays_in_place_and_sharp_co
     // With no MesherOptions::land there is no coast to slide along: every ring node is an output
     // node with the very same coordinates.
     std::set<std::tuple<double, double, double>> nodes;
-    for (const Vec3& p : mesh.nodes) nodes.insert({p.x, p.y, p.z});
+    for (const Vec3 &p : mesh.nodes)
+        nodes.insert({p.x, p.y, p.z});
     std::size_t missing = 0;
-    for (const Ring& r : b.rings)
-        for (const Vec3& p : r.nodes) missing += nodes.count({p.x, p.y, p.z}) == 0;
+    for (const Ring &r : b.rings)
+        for (const Vec3 &p : r.nodes)
+            missing += nodes.count({p.x, p.y, p.z}) == 0;
     EXPECT_EQ(missing, 0u);
     // Faces at sharp corners, recounted from the faces alone (ocean angle below 60 degrees).
     EXPECT_EQ(report.sharp_corner_faces, quality(mesh).corner_faces);
@@ -716,8 +783,10 @@ TEST(Mesher, boundary_nodes_slide_only_near_the_source_coast_and_make_no_corner_
     struct CoastOnly final : LandTest {
         std::shared_ptr<const LandMask> mask;
         explicit CoastOnly(std::shared_ptr<const LandMask> m) : mask(std::move(m)) {}
-        bool contains(const Vec3&) const override { return false; }
-        bool coast_within(const Vec3& p, double angle) const override { return mask->coast_within(p, angle); }
+        bool contains(const Vec3 &) const override { return false; }
+        bool coast_within(const Vec3 &p, double angle) const override {
+            return mask->coast_within(p, angle);
+        }
     };
     MesherOptions mo;
     mo.inlet_width = 0;
@@ -733,20 +802,22 @@ TEST(Mesher, boundary_nodes_slide_only_near_the_source_coast_and_make_no_corner_
     // land test and mesh-verify as great-circle arcs: hence 1 km more (the three farthest nodes
     // measured 39.8, 40.5, 40.6 km here, and 39.8, 39.8, 39.9 km by the land test).
     std::set<std::tuple<double, double, double>> fixed_nodes;
-    for (const auto& e : fixed.boundary) {
-        const Vec3& p = fixed.nodes[e.a];
+    for (const auto &e : fixed.boundary) {
+        const Vec3 &p = fixed.nodes[e.a];
         fixed_nodes.insert({p.x, p.y, p.z});
     }
     std::set<NodeIndex> on_boundary;
-    for (const auto& e : slid.boundary) on_boundary.insert(e.a);
+    for (const auto &e : slid.boundary)
+        on_boundary.insert(e.a);
     std::size_t moved = 0;
     double farthest = 0;
     for (NodeIndex v : on_boundary) {
-        const Vec3& p = slid.nodes[v];
-        if (fixed_nodes.count({p.x, p.y, p.z})) continue;
+        const Vec3 &p = slid.nodes[v];
+        if (fixed_nodes.count({p.x, p.y, p.z}))
+            continue;
         ++moved;
         double d = pi;
-        for (const Ring& r : coast.rings.rings)
+        for (const Ring &r : coast.rings.rings)
             for (std::size_t i = 0; i < r.nodes.size(); ++i)
                 d = std::min(d, arc_distance(r.nodes[i], r.nodes[(i + 1) % r.nodes.size()], p));
         farthest = std::max(farthest, rad_to_km(d));
@@ -767,22 +838,23 @@ namespace {
 
 // A ring through lon/lat corners, land on its right (ocean on the left), each side cut into
 // pieces of at most `step` degrees.
-Ring ring_through(const std::vector<LonLat>& corners, double step = 0.8) {
+Ring ring_through(const std::vector<LonLat> &corners, double step = 0.8) {
     Ring r;
     for (std::size_t i = 0; i < corners.size(); ++i) {
         const LonLat a = corners[i], b = corners[(i + 1) % corners.size()];
         const int n = std::max(1, int(std::ceil(std::hypot(b.lon - a.lon, b.lat - a.lat) / step)));
         for (int k = 0; k < n; ++k)
-            r.nodes.push_back(lonlat_to_vec(a.lon + (b.lon - a.lon) * k / n, a.lat + (b.lat - a.lat) * k / n));
+            r.nodes.push_back(
+                lonlat_to_vec(a.lon + (b.lon - a.lon) * k / n, a.lat + (b.lat - a.lat) * k / n));
     }
     r.kinds.assign(r.nodes.size(), SegmentKind::coast);
     return r;
 }
 
 // Faces whose centroid lies in the lon/lat box.
-std::size_t faces_in(const Mesh& m, double w, double s, double e, double n) {
+std::size_t faces_in(const Mesh &m, double w, double s, double e, double n) {
     std::size_t count = 0;
-    for (const auto& f : m.faces) {
+    for (const auto &f : m.faces) {
         const LonLat c = vec_to_lonlat(normalized(m.nodes[f[0]] + m.nodes[f[1]] + m.nodes[f[2]]));
         count += c.lon > w && c.lon < e && c.lat > s && c.lat < n;
     }
@@ -796,10 +868,10 @@ std::size_t faces_in(const Mesh& m, double w, double s, double e, double n) {
 // as narrow; a bay 4 degrees wide at its mouth; an island 0.2 degrees off its west coast.
 TEST(Mesher, narrow_inlets_close_while_wide_bays_large_lagoons_and_straits_stay) {
     Boundary b;
-    b.rings.push_back(ring_through({{0, -10}, {0, 10}, {8, 10}, {8, 7}, {12, 7}, {12, 10}, {20, 10},
-                                    {20, 5.1}, {17, 5.1}, {17, 4.9}, {20, 4.9},
-                                    {20, -4.9}, {17, -4.9}, {17, -3}, {13, -3}, {13, -7}, {17, -7},
-                                    {17, -5.1}, {20, -5.1}, {20, -10}}));
+    b.rings.push_back(
+        ring_through({{0, -10},  {0, 10},   {8, 10},   {8, 7},     {12, 7},    {12, 10},   {20, 10},
+                      {20, 5.1}, {17, 5.1}, {17, 4.9}, {20, 4.9},  {20, -4.9}, {17, -4.9}, {17, -3},
+                      {13, -3},  {13, -7},  {17, -7},  {17, -5.1}, {20, -5.1}, {20, -10}}));
     b.rings.push_back(ring_through({{-2.2, -1}, {-2.2, 1}, {-0.2, 1}, {-0.2, -1}}));
     const SizeFn h = uniform_size(100);
     MesherReport report;
@@ -835,9 +907,22 @@ TEST(Mesher, narrow_inlets_close_while_wide_bays_large_lagoons_and_straits_stay)
 TEST(Mesher, a_river_with_a_narrow_lake_closes_and_a_wide_lake_stays) {
     auto continent = [](double lake) {
         Boundary b;
-        b.rings.push_back(ring_through({{0, -10}, {0, 10}, {20, 10}, {20, 0.15}, {14, 0.15}, {14, lake}, {11, lake},
-                                        {11, 0.15}, {9, 0.15}, {9, -0.15}, {11, -0.15}, {11, -lake},
-                                        {14, -lake}, {14, -0.15}, {20, -0.15}, {20, -10}}));
+        b.rings.push_back(ring_through({{0, -10},
+                                        {0, 10},
+                                        {20, 10},
+                                        {20, 0.15},
+                                        {14, 0.15},
+                                        {14, lake},
+                                        {11, lake},
+                                        {11, 0.15},
+                                        {9, 0.15},
+                                        {9, -0.15},
+                                        {11, -0.15},
+                                        {11, -lake},
+                                        {14, -lake},
+                                        {14, -0.15},
+                                        {20, -0.15},
+                                        {20, -10}}));
         return b;
     };
     const SizeFn h = uniform_size(100);
@@ -853,7 +938,7 @@ TEST(Mesher, a_river_with_a_narrow_lake_closes_and_a_wide_lake_stays) {
     test::expect_mesh_verify(dir / "narrow.nc");
 
     const Mesh wide = mesh_boundary(continent(1.5), h, {}, &report);
-    EXPECT_GT(faces_in(wide, 11, -1.5, 14, 1.5), 15u); // the lake is meshed (about 30 faces)
+    EXPECT_GT(faces_in(wide, 11, -1.5, 14, 1.5), 15u);  // the lake is meshed (about 30 faces)
     EXPECT_GT(faces_in(wide, 14, -0.15, 20, 0.15), 0u); // and so is the river to it
     EXPECT_EQ(faces_in(wide, 9, -0.15, 11, 0.15), 0u);  // the dead end beyond it closes
     write_ugrid(wide, dir / "wide.nc");
@@ -864,7 +949,8 @@ TEST(Mesher, inlet_width_out_of_range_is_a_usage_error_naming_it) {
     for (double w : {-0.1, 2.5, std::nan("")}) {
         MeshOptions o = land_110m(300);
         o.inlet_width = w;
-        const std::string m = test::thrown_message<UsageError>([&] { mesh_ocean(o); }, "inlet_width " + std::to_string(w));
+        const std::string m = test::thrown_message<UsageError>([&] { mesh_ocean(o); },
+                                                               "inlet_width " + std::to_string(w));
         EXPECT_EQ(m.rfind("inlet_width must be in 0..2", 0), 0u) << m;
     }
 }

@@ -3,17 +3,17 @@
 // perturbed points (radial factor 1 + 2^-(A k), coordinate offsets 2^-(B 2^(3r+c))), with A and B
 // chosen so large that the concrete sign equals the symbolic one. The oracle never looks at the
 // library's derivation (cofactor order, masks, parity); it only builds the perturbed points.
-#include <gtest/gtest.h>
 #include <gmpxx.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <string>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "globemesh/predicates.hpp"
@@ -31,19 +31,19 @@ namespace {
 struct Q3 {
     mpq_class x, y, z;
 };
-Q3 q3(const Vec3& v) { return {mpq_class(v.x), mpq_class(v.y), mpq_class(v.z)}; }
+Q3 q3(const Vec3 &v) {
+    return {mpq_class(v.x), mpq_class(v.y), mpq_class(v.z)};
+}
 
-int gmp_orient(const Vec3& a, const Vec3& b, const Vec3& c) {
+int gmp_orient(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     Q3 A = q3(a), B = q3(b), C = q3(c);
     mpq_class det = A.x * (B.y * C.z - B.z * C.y) + A.y * (B.z * C.x - B.x * C.z) +
                     A.z * (B.x * C.y - B.y * C.x);
     return sgn(det);
 }
 
-template <class T> struct V3 {
-    T x, y, z;
-};
-template <class T> int orient3d_of(const V3<T>& a, const V3<T>& b, const V3<T>& c, const V3<T>& d) {
+template <class T> struct V3 { T x, y, z; };
+template <class T> int orient3d_of(const V3<T> &a, const V3<T> &b, const V3<T> &c, const V3<T> &d) {
     T bx = b.x - a.x, by = b.y - a.y, bz = b.z - a.z;
     T cx = c.x - a.x, cy = c.y - a.y, cz = c.z - a.z;
     T dx = d.x - a.x, dy = d.y - a.y, dz = d.z - a.z;
@@ -51,28 +51,29 @@ template <class T> int orient3d_of(const V3<T>& a, const V3<T>& b, const V3<T>& 
     return sgn(det);
 }
 
-int gmp_orient3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-    auto v = [](const Vec3& p) { return V3<mpq_class>{p.x, p.y, p.z}; };
+int gmp_orient3d(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
+    auto v = [](const Vec3 &p) { return V3<mpq_class>{p.x, p.y, p.z}; };
     return orient3d_of(v(a), v(b), v(c), v(d));
 }
 
-bool lex_less(const Vec3& p, const Vec3& q) {
+bool lex_less(const Vec3 &p, const Vec3 &q) {
     return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
 }
 
 /// Exact integers proportional (by one common power of two) to the coordinates of the points.
-std::vector<std::array<mpz_class, 3>> to_integers(const std::vector<Vec3>& pts, long& bits) {
+std::vector<std::array<mpz_class, 3>> to_integers(const std::vector<Vec3> &pts, long &bits) {
     long emin = 1L << 20;
-    for (const Vec3& p : pts)
+    for (const Vec3 &p : pts)
         for (double v : {p.x, p.y, p.z})
             if (v != 0) {
                 int e;
                 const auto m = static_cast<std::int64_t>(std::ldexp(std::frexp(v, &e), 53));
-                emin = std::min<long>(emin, e - 53 + std::countr_zero(static_cast<std::uint64_t>(m)));
+                emin =
+                    std::min<long>(emin, e - 53 + std::countr_zero(static_cast<std::uint64_t>(m)));
             }
     std::vector<std::array<mpz_class, 3>> out;
     bits = 1;
-    for (const Vec3& p : pts) {
+    for (const Vec3 &p : pts) {
         std::array<mpz_class, 3> row;
         int k = 0;
         for (double v : {p.x, p.y, p.z}) {
@@ -98,14 +99,15 @@ std::vector<std::array<mpz_class, 3>> to_integers(const std::vector<Vec3>& pts, 
 ///   (1 + eps^g_i) (p_i + (eta^(2^(3(g_i-1))), eta^(2^(3(g_i-1)+1)), eta^(2^(3(g_i-1)+2)))),
 /// eps = 2^-A, eta = 2^-B, or without the eta term when with_eta is false. With `pts` larger
 /// than the query this is one perturbation of the whole set (global ranks).
-int perturbed_oracle(const std::vector<Vec3>& pts, int qa, int qb, int qc, int qd, bool with_eta) {
+int perturbed_oracle(const std::vector<Vec3> &pts, int qa, int qb, int qc, int qd, bool with_eta) {
     const std::size_t n = pts.size();
     long L;
     auto X = to_integers(pts, L);
     std::vector<int> rank(n, 1);
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t j = 0; j < n; ++j)
-            if (lex_less(pts[j], pts[i])) ++rank[i];
+            if (lex_less(pts[j], pts[i]))
+                ++rank[i];
     const long A = 3 * L + 24 + 8;
     const long B = static_cast<long>(n) * A + 3 * L + 32;
     const long W = with_eta ? B * (1L << (3 * n - 1)) : 0;
@@ -118,7 +120,8 @@ int perturbed_oracle(const std::vector<Vec3>& pts, int qa, int qb, int qc, int q
         mpz_class c[3];
         for (int k = 0; k < 3; ++k) {
             c[k] = X[i][k] << static_cast<mp_bitcnt_t>(W);
-            if (with_eta) c[k] += mpz_class(1) << static_cast<mp_bitcnt_t>(W - B * (1L << (3 * (g - 1) + k)));
+            if (with_eta)
+                c[k] += mpz_class(1) << static_cast<mp_bitcnt_t>(W - B * (1L << (3 * (g - 1) + k)));
             c[k] *= radial;
         }
         P[i] = {c[0], c[1], c[2]};
@@ -126,19 +129,21 @@ int perturbed_oracle(const std::vector<Vec3>& pts, int qa, int qb, int qc, int q
     return orient3d_of(P[qa], P[qb], P[qc], P[qd]);
 }
 
-bool on_one_plane_through_origin(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+bool on_one_plane_through_origin(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
     return gmp_orient(a, b, c) == 0 && gmp_orient(a, b, d) == 0 && gmp_orient(a, c, d) == 0 &&
            gmp_orient(b, c, d) == 0;
 }
 
 /// The oracle's in_circle: exact sign if non-zero, 0 for equal points, else the perturbed sign
 /// (eta only needed, and only used, when the four points span a plane through the origin).
-int oracle_in_circle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-    if (int s = gmp_orient3d(a, b, c, d); s != 0) return s;
+int oracle_in_circle(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &d) {
+    if (int s = gmp_orient3d(a, b, c, d); s != 0)
+        return s;
     const std::vector<Vec3> pts{a, b, c, d};
     for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
-            if (pts[i] == pts[j]) return 0;
+            if (pts[i] == pts[j])
+                return 0;
     return perturbed_oracle(pts, 0, 1, 2, 3, on_one_plane_through_origin(a, b, c, d));
 }
 
@@ -157,18 +162,20 @@ struct Gen {
     /// x moved by k ulps (k in [-3, 3]).
     double nudge(double x) {
         int k = pick(7) - 3;
-        for (; k > 0; --k) x = std::nextafter(x, INFINITY);
-        for (; k < 0; ++k) x = std::nextafter(x, -INFINITY);
+        for (; k > 0; --k)
+            x = std::nextafter(x, INFINITY);
+        for (; k < 0; ++k)
+            x = std::nextafter(x, -INFINITY);
         return x;
     }
-    Vec3 nudge(const Vec3& v) { return {nudge(v.x), nudge(v.y), nudge(v.z)}; }
+    Vec3 nudge(const Vec3 &v) { return {nudge(v.x), nudge(v.y), nudge(v.z)}; }
     /// A point on the rounded great circle through a and b, nudged by a few ulps.
-    Vec3 near_great_circle(const Vec3& a, const Vec3& b) {
+    Vec3 near_great_circle(const Vec3 &a, const Vec3 &b) {
         const double s = normal(rng), t = normal(rng);
         return nudge(normalized(s * a + t * b));
     }
     /// A point near the rounded circle through a, b, c (on the sphere), nudged by a few ulps.
-    Vec3 near_circle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    Vec3 near_circle(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
         // centre direction n of the circle and its plane offset; rotate a about n.
         const Vec3 n = normalized(cross(b - a, c - a));
         const double h = dot(n, a);
@@ -181,33 +188,46 @@ struct Gen {
 };
 
 /// The points as hexadecimal floats, for failure messages that reproduce the case exactly.
-std::string describe(const std::array<Vec3, 4>& q) {
+std::string describe(const std::array<Vec3, 4> &q) {
     std::string out;
     char buf[128];
-    for (const Vec3& p : q) {
+    for (const Vec3 &p : q) {
         std::snprintf(buf, sizeof buf, "{%a, %a, %a} ", p.x, p.y, p.z);
         out += buf;
     }
     return out;
 }
 
-Vec3 scaled(const Vec3& v, int e) { return {std::ldexp(v.x, e), std::ldexp(v.y, e), std::ldexp(v.z, e)}; }
+Vec3 scaled(const Vec3 &v, int e) {
+    return {std::ldexp(v.x, e), std::ldexp(v.y, e), std::ldexp(v.z, e)};
+}
 
 /// Triples and quadruples that stress the filter: random, a few ulps apart, near one great
 /// circle, nearly antipodal, scaled far from 1, with tiny coordinates.
-std::vector<std::array<Vec3, 4>> adversarial_quadruples(Gen& g, int count) {
+std::vector<std::array<Vec3, 4>> adversarial_quadruples(Gen &g, int count) {
     std::vector<std::array<Vec3, 4>> out;
     for (int i = 0; i < count; ++i) {
         const Vec3 a = g.unit(), b = g.unit(), c = g.unit();
         switch (i % 9) {
-        case 0: out.push_back({a, b, c, g.unit()}); break;
-        case 1: out.push_back({a, g.nudge(a), g.nudge(a), g.nudge(a)}); break;
-        case 2: out.push_back({a, b, g.near_great_circle(a, b), g.near_great_circle(a, b)}); break;
-        case 3: out.push_back({a, b, c, g.near_circle(a, b, c)}); break;
-        case 4: out.push_back({a, g.nudge(-a), b, g.nudge(-b)}); break;
+        case 0:
+            out.push_back({a, b, c, g.unit()});
+            break;
+        case 1:
+            out.push_back({a, g.nudge(a), g.nudge(a), g.nudge(a)});
+            break;
+        case 2:
+            out.push_back({a, b, g.near_great_circle(a, b), g.near_great_circle(a, b)});
+            break;
+        case 3:
+            out.push_back({a, b, c, g.near_circle(a, b, c)});
+            break;
+        case 4:
+            out.push_back({a, g.nudge(-a), b, g.nudge(-b)});
+            break;
         case 5: {
             const int e = (i % 2 ? 1 : -1) * (200 + g.pick(400));
-            out.push_back({scaled(a, e), scaled(b, e), scaled(c, e), scaled(g.near_circle(a, b, c), e)});
+            out.push_back(
+                {scaled(a, e), scaled(b, e), scaled(c, e), scaled(g.near_circle(a, b, c), e)});
             break;
         }
         case 6: {
@@ -239,30 +259,33 @@ std::vector<std::array<Vec3, 4>> adversarial_quadruples(Gen& g, int count) {
 std::vector<Vec3> lattice_sphere_points() {
     std::vector<Vec3> out;
     const double base[2][3] = {{5, 0, 0}, {3, 4, 0}};
-    for (const auto& b : base) {
+    for (const auto &b : base) {
         std::array<int, 3> perm{0, 1, 2};
         do {
             for (int s = 0; s < 8; ++s) {
                 double v[3];
-                for (int k = 0; k < 3; ++k) v[k] = b[perm[k]] * ((s >> k & 1) ? -1 : 1) / 8.0;
+                for (int k = 0; k < 3; ++k)
+                    v[k] = b[perm[k]] * ((s >> k & 1) ? -1 : 1) / 8.0;
                 Vec3 p{v[0] + 0.0, v[1] + 0.0, v[2] + 0.0};
-                if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+                if (std::find(out.begin(), out.end(), p) == out.end())
+                    out.push_back(p);
             }
         } while (std::next_permutation(perm.begin(), perm.end()));
     }
     return out;
 }
 
-int permutation_sign(const std::array<int, 4>& p) {
+int permutation_sign(const std::array<int, 4> &p) {
     int s = 1;
     for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
-            if (p[i] > p[j]) s = -s;
+            if (p[i] > p[j])
+                s = -s;
     return s;
 }
 
 /// Every permutation of the arguments gives sign(permutation) * in_circle(a, b, c, d).
-void expect_antisymmetric(const std::array<Vec3, 4>& q) {
+void expect_antisymmetric(const std::array<Vec3, 4> &q) {
     const int base = in_circle(q[0], q[1], q[2], q[3]);
     std::array<int, 4> p{0, 1, 2, 3};
     do {
@@ -278,7 +301,7 @@ void expect_antisymmetric(const std::array<Vec3, 4>& q) {
 TEST(Predicates, orient_matches_gmp_on_random_and_adversarial_triples) {
     Gen g;
     int zeros = 0;
-    for (const auto& q : adversarial_quadruples(g, 36000)) {
+    for (const auto &q : adversarial_quadruples(g, 36000)) {
         ASSERT_EQ(orient(q[0], q[1], q[2]), gmp_orient(q[0], q[1], q[2]));
         ASSERT_EQ(orient(q[0], q[1], q[3]), gmp_orient(q[0], q[1], q[3]));
         zeros += gmp_orient(q[0], q[1], q[3]) == 0;
@@ -297,7 +320,7 @@ TEST(Predicates, orient_against_a_kept_edge_matches_gmp) {
     // signs must be the exact ones, through the filter and the exact stage alike.
     Gen g;
     int zeros = 0;
-    for (const auto& q : adversarial_quadruples(g, 36000)) {
+    for (const auto &q : adversarial_quadruples(g, 36000)) {
         const predicates::OrientEdge e(q[1], q[2]);
         ASSERT_EQ(orient(q[0], e), gmp_orient(q[0], q[1], q[2])) << describe(q);
         ASSERT_EQ(orient(q[3], e), gmp_orient(q[3], q[1], q[2])) << describe(q);
@@ -314,7 +337,7 @@ TEST(Predicates, orient_against_a_kept_edge_matches_gmp) {
 TEST(Predicates, orient3d_matches_gmp_on_random_and_adversarial_quadruples) {
     Gen g;
     int zeros = 0;
-    for (const auto& q : adversarial_quadruples(g, 36000)) {
+    for (const auto &q : adversarial_quadruples(g, 36000)) {
         const int expected = gmp_orient3d(q[0], q[1], q[2], q[3]);
         ASSERT_EQ(orient3d(q[0], q[1], q[2], q[3]), expected) << describe(q);
         zeros += expected == 0;
@@ -344,7 +367,7 @@ TEST(Predicates, orient_and_orient3d_exact_far_from_unit_scale) {
 TEST(Predicates, in_circle_equals_exact_sign_whenever_it_is_not_zero) {
     Gen g;
     int checked = 0;
-    for (const auto& q : adversarial_quadruples(g, 36000)) {
+    for (const auto &q : adversarial_quadruples(g, 36000)) {
         const int exact = gmp_orient3d(q[0], q[1], q[2], q[3]);
         const int s = in_circle(q[0], q[1], q[2], q[3]);
         if (exact != 0) {
@@ -411,10 +434,12 @@ TEST(Predicates, in_circle_on_cocircular_lonlat_grid_matches_oracle) {
         for (double lon = -180; lon < 180; lon += 37)
             for (double lat = -80; lat < 80; lat += 23) {
                 const std::array<Vec3, 4> q{lonlat_to_vec(lon, lat), lonlat_to_vec(lon + s, lat),
-                                            lonlat_to_vec(lon + s, lat + s), lonlat_to_vec(lon, lat + s)};
+                                            lonlat_to_vec(lon + s, lat + s),
+                                            lonlat_to_vec(lon, lat + s)};
                 const int expected = oracle_in_circle(q[0], q[1], q[2], q[3]);
                 ASSERT_NE(expected, 0);
-                ASSERT_EQ(in_circle(q[0], q[1], q[2], q[3]), expected) << lon << " " << lat << " " << s;
+                ASSERT_EQ(in_circle(q[0], q[1], q[2], q[3]), expected)
+                    << lon << " " << lat << " " << s;
                 exact_zero += gmp_orient3d(q[0], q[1], q[2], q[3]) == 0;
                 expect_antisymmetric(q);
             }
@@ -425,7 +450,7 @@ TEST(Predicates, in_circle_on_cocircular_lonlat_grid_matches_oracle) {
     const std::array<Vec3, 4> octant2{Vec3{3, 0, 0}, Vec3{2, -1, 2}, Vec3{0, 3, 0}, Vec3{2, 2, -1}};
     const std::array<Vec3, 4> small{Vec3{0.6, 0.8, 0}, Vec3{0, 0.6, 0.8}, Vec3{0.8, 0, 0.6},
                                     Vec3{0.8, 0.6, 0}};
-    for (const auto& q : {octant, octant2, small}) {
+    for (const auto &q : {octant, octant2, small}) {
         ASSERT_EQ(gmp_orient3d(q[0], q[1], q[2], q[3]), 0);
         ASSERT_EQ(in_circle(q[0], q[1], q[2], q[3]), oracle_in_circle(q[0], q[1], q[2], q[3]));
         expect_antisymmetric(q);
@@ -444,14 +469,16 @@ TEST(Predicates, in_circle_on_one_great_circle_matches_oracle) {
     while (cases < 60) {
         const Vec3 u{small(), small(), small()}, v{small(), small(), small()};
         std::array<Vec3, 4> q;
-        for (Vec3& p : q) {
+        for (Vec3 &p : q) {
             const double i = small(), j = small();
             p = i * u + j * v; // exact: small integers
         }
         bool distinct = true;
         for (int a = 0; a < 4; ++a)
-            for (int b = a + 1; b < 4; ++b) distinct = distinct && !(q[a] == q[b]);
-        if (!distinct) continue;
+            for (int b = a + 1; b < 4; ++b)
+                distinct = distinct && !(q[a] == q[b]);
+        if (!distinct)
+            continue;
         ASSERT_TRUE(on_one_plane_through_origin(q[0], q[1], q[2], q[3]));
         const int s = in_circle(q[0], q[1], q[2], q[3]);
         ASSERT_NE(s, 0);
@@ -465,10 +492,11 @@ TEST(Predicates, in_circle_on_one_great_circle_matches_oracle) {
     const std::array<std::array<Vec3, 4>, 4> circles{{
         {lonlat_to_vec(0, 0), lonlat_to_vec(10, 0), lonlat_to_vec(100, 0), lonlat_to_vec(-170, 0)},
         {lonlat_to_vec(0, 10), lonlat_to_vec(0, 20), lonlat_to_vec(0, 35), lonlat_to_vec(180, 40)},
-        {lonlat_to_vec(90, -5), lonlat_to_vec(90, 5), lonlat_to_vec(-90, 60), lonlat_to_vec(90, 60)},
+        {lonlat_to_vec(90, -5), lonlat_to_vec(90, 5), lonlat_to_vec(-90, 60),
+         lonlat_to_vec(90, 60)},
         {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{-1, 0, 0}, Vec3{0, -1, 0}},
     }};
-    for (const auto& q : circles) {
+    for (const auto &q : circles) {
         ASSERT_TRUE(on_one_plane_through_origin(q[0], q[1], q[2], q[3]));
         const int s = in_circle(q[0], q[1], q[2], q[3]);
         ASSERT_NE(s, 0);
@@ -479,7 +507,8 @@ TEST(Predicates, in_circle_on_one_great_circle_matches_oracle) {
 
 TEST(Predicates, in_circle_is_antisymmetric_under_all_24_permutations) {
     Gen g;
-    for (const auto& q : adversarial_quadruples(g, 900)) expect_antisymmetric(q);
+    for (const auto &q : adversarial_quadruples(g, 900))
+        expect_antisymmetric(q);
     // points a few ulps apart with an exact degeneracy: three copies of one point nudged
     for (int i = 0; i < 200; ++i) {
         const Vec3 a = g.unit();
@@ -504,7 +533,8 @@ TEST(Predicates, in_circle_is_zero_only_for_equal_points) {
         }
     }
     // four points on a line through the origin (antipodes, both levels degenerate)
-    const std::array<Vec3, 4> line{Vec3{1, 1, 1}, Vec3{-1, -1, -1}, Vec3{2, 2, 2}, Vec3{0.5, 0.5, 0.5}};
+    const std::array<Vec3, 4> line{Vec3{1, 1, 1}, Vec3{-1, -1, -1}, Vec3{2, 2, 2},
+                                   Vec3{0.5, 0.5, 0.5}};
     EXPECT_NE(in_circle(line[0], line[1], line[2], line[3]), 0);
     EXPECT_EQ(in_circle(line[0], line[1], line[2], line[3]),
               oracle_in_circle(line[0], line[1], line[2], line[3]));

@@ -26,11 +26,12 @@ namespace {
 
 /// A Float32 lon/lat raster held in memory (no file needed for the size field).
 Raster lonlat_raster(double west, double south, double d, std::size_t nx, std::size_t ny,
-                     const std::function<double(double, double)>& elevation) {
+                     const std::function<double(double, double)> &elevation) {
     std::vector<float> v(nx * ny);
     for (std::size_t j = 0; j < ny; ++j)
         for (std::size_t i = 0; i < nx; ++i)
-            v[j * nx + i] = static_cast<float>(elevation(west + (i + 0.5) * d, south + (j + 0.5) * d));
+            v[j * nx + i] =
+                static_cast<float>(elevation(west + (i + 0.5) * d, south + (j + 0.5) * d));
     return Raster(west + 0.5 * d, south + 0.5 * d, d, d, nx, ny, std::move(v));
 }
 
@@ -44,7 +45,7 @@ MeshOptions regional(double w, double s, double e, double n, double hmin, double
 }
 
 /// Great-circle distance (km) from p to the arc a-b, by its own formula (not the library's).
-double distance_to_arc_km(const Vec3& p, const Vec3& a, const Vec3& b) {
+double distance_to_arc_km(const Vec3 &p, const Vec3 &a, const Vec3 &b) {
     Vec3 n = normalized(cross(a, b));
     Vec3 q = p - dot(p, n) * n; // projection on the great circle
     if (norm(q) > 0) {
@@ -52,20 +53,23 @@ double distance_to_arc_km(const Vec3& p, const Vec3& a, const Vec3& b) {
         if (dot(cross(a, q), n) >= 0 && dot(cross(q, b), n) >= 0)
             return std::asin(std::min(1.0, std::abs(dot(p, n)))) * earth_radius_km;
     }
-    return std::min(std::acos(std::clamp(dot(p, a), -1.0, 1.0)), std::acos(std::clamp(dot(p, b), -1.0, 1.0))) * earth_radius_km;
+    return std::min(std::acos(std::clamp(dot(p, a), -1.0, 1.0)),
+                    std::acos(std::clamp(dot(p, b), -1.0, 1.0))) *
+           earth_radius_km;
 }
 
-double distance_to_boundary_km(const Vec3& p, const Boundary& b) {
+double distance_to_boundary_km(const Vec3 &p, const Boundary &b) {
     double best = std::numeric_limits<double>::infinity();
-    for (const Ring& r : b.rings)
+    for (const Ring &r : b.rings)
         for (std::size_t k = 0; k < r.nodes.size(); ++k)
-            best = std::min(best, distance_to_arc_km(p, r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]));
+            best = std::min(best,
+                            distance_to_arc_km(p, r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]));
     return best;
 }
 
 Boundary ring_of(std::initializer_list<LonLat> corners) {
     Ring r;
-    for (const LonLat& c : corners) {
+    for (const LonLat &c : corners) {
         r.nodes.push_back(lonlat_to_vec(c));
         r.kinds.push_back(SegmentKind::coast);
     }
@@ -76,20 +80,24 @@ Boundary ring_of(std::initializer_list<LonLat> corners) {
 
 /// Largest ratio |h(a) - h(b)| / (grade * |ab|) over every row and column edge of the grid,
 /// including the +-180 seam and the pairs across the poles.
-double worst_edge_gradient_ratio(const SizeField& f, double grade) {
-    const Raster& g = f.grid();
+double worst_edge_gradient_ratio(const SizeField &f, double grade) {
+    const Raster &g = f.grid();
     const std::size_t nx = g.nlon(), ny = g.nlat();
     double worst = 0;
     auto check = [&](std::size_t i0, std::size_t j0, std::size_t i1, std::size_t j1) {
-        double d = arc_km(lonlat_to_vec(g.lon_deg(i0), g.lat_deg(j0)), lonlat_to_vec(g.lon_deg(i1), g.lat_deg(j1)));
+        double d = arc_km(lonlat_to_vec(g.lon_deg(i0), g.lat_deg(j0)),
+                          lonlat_to_vec(g.lon_deg(i1), g.lat_deg(j1)));
         double dh = std::abs(static_cast<double>(g.value(i0, j0)) - g.value(i1, j1));
         worst = std::max(worst, dh / (grade * d));
     };
     for (std::size_t j = 0; j < ny; ++j)
         for (std::size_t i = 0; i < nx; ++i) {
-            if (i + 1 < nx) check(i, j, i + 1, j);
-            else if (g.global()) check(i, j, 0, j);
-            if (j + 1 < ny) check(i, j, i, j + 1);
+            if (i + 1 < nx)
+                check(i, j, i + 1, j);
+            else if (g.global())
+                check(i, j, 0, j);
+            if (j + 1 < ny)
+                check(i, j, i, j + 1);
         }
     if (g.global())
         for (std::size_t i = 0; i < nx / 2; ++i) {
@@ -115,7 +123,8 @@ TEST(SizeField, hmax_alone_gives_a_uniform_field) {
     EXPECT_EQ(f.max_km(), 80);
     std::mt19937 rng(3);
     std::normal_distribution<double> n;
-    for (int k = 0; k < 100; ++k) EXPECT_NEAR(f.size_km(normalized({n(rng), n(rng), n(rng)})), 80, 1e-12);
+    for (int k = 0; k < 100; ++k)
+        EXPECT_NEAR(f.size_km(normalized({n(rng), n(rng), n(rng)})), 80, 1e-12);
     EXPECT_NEAR(f.size_km(lonlat_to_vec(0, 90)), 80, 1e-12);
 }
 
@@ -135,18 +144,21 @@ TEST(SizeField, a_component_on_makes_a_grid) {
 
 TEST(SizeField, wavelength_component_matches_its_formula_and_depth_floor) {
     // Depth 10..4000 m rising eastwards; land (elevation > 0) in the westmost degree.
-    auto elevation = [](double lon, double) { return lon < 1 ? 50.0 : -std::round(400.0 * (lon - 1.0)); };
+    auto elevation = [](double lon, double) {
+        return lon < 1 ? 50.0 : -std::round(400.0 * (lon - 1.0));
+    };
     Raster bathy = lonlat_raster(0, 0, 0.05, 240, 120, elevation);
     MeshOptions o = regional(0.5, 1, 11.5, 5, 2, 500);
     o.wavelength = 40;
     SizeField f = build_size_field(o, &bathy, nullptr, {}, 1 << 18);
-    const Raster& g = f.grid();
+    const Raster &g = f.grid();
     int checked = 0;
     for (std::size_t j = 0; j < g.nlat(); j += 5)
         for (std::size_t i = 0; i < g.nlon(); i += 3) {
             double lon = g.lon_deg(i), lat = g.lat_deg(j);
             double depth = -bathy.elevation_m(lon, lat);
-            if (std::isnan(depth)) continue;
+            if (std::isnan(depth))
+                continue;
             // T sqrt(g D) / n with D floored at 5 m (land and very shallow water).
             double expect = 12.42 * 3600 * std::sqrt(9.80665 * std::max(depth, 5.0)) / 40 / 1000;
             expect = std::clamp(expect, 2.0, 500.0);
@@ -162,25 +174,28 @@ TEST(SizeField, slope_component_matches_its_formula_over_a_seamount) {
     auto depth = [](double lon, double lat) {
         return 4000.0 - 3000.0 * std::exp(-((lon - 5) * (lon - 5) + (lat - 5) * (lat - 5)) / 2.0);
     };
-    Raster bathy = lonlat_raster(0, 0, 0.02, 500, 500, [&](double lon, double lat) { return -depth(lon, lat); });
+    Raster bathy = lonlat_raster(0, 0, 0.02, 500, 500,
+                                 [&](double lon, double lat) { return -depth(lon, lat); });
     MeshOptions o = regional(2, 2, 8, 8, 4, 5000);
     o.slope = 20;
     SizeField f = build_size_field(o, &bathy, nullptr, {}, 1 << 18);
-    const Raster& g = f.grid();
+    const Raster &g = f.grid();
     double worst = 0;
     int checked = 0;
     for (std::size_t j = 2; j + 2 < g.nlat(); j += 4)
         for (std::size_t i = 2; i + 2 < g.nlon(); i += 4) {
             double lon = g.lon_deg(i), lat = g.lat_deg(j);
             double r2 = (lon - 5) * (lon - 5) + (lat - 5) * (lat - 5);
-            if (r2 < 0.1 || r2 > 6) continue; // away from the flat top and the flat far field
+            if (r2 < 0.1 || r2 > 6)
+                continue; // away from the flat top and the flat far field
             // Analytic gradient, m/km: dD/dlon / (R cos(lat) rad/deg), dD/dlat / (R rad/deg).
             double e = 3000.0 * std::exp(-r2 / 2.0);
             double ddlon = e * (lon - 5), ddlat = e * (lat - 5);
             double gx = ddlon / (earth_radius_km * std::cos(lat * deg_to_rad) * deg_to_rad);
             double gy = ddlat / (earth_radius_km * deg_to_rad);
             double expect = 2 * pi * depth(lon, lat) / (20 * std::hypot(gx, gy));
-            if (expect > 4900) continue;
+            if (expect > 4900)
+                continue;
             worst = std::max(worst, std::abs(g.value(i, j) - expect) / expect);
             ++checked;
         }
@@ -195,7 +210,7 @@ TEST(SizeField, coast_component_matches_great_circle_distance_to_the_rings) {
     o.coast_size_km = 10;
     o.coast_rate = 0.1;
     SizeField f = build_size_field(o, nullptr, &island, {}, 1 << 18);
-    const Raster& g = f.grid();
+    const Raster &g = f.grid();
     const double spacing = g.dlat_deg() * deg_to_rad * earth_radius_km;
     double worst = 0;
     for (std::size_t j = 0; j < g.nlat(); j += 3)
@@ -227,15 +242,16 @@ TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles
     // 0.15-Lipschitz on the sphere and <= h0 at the nodes is <= h0(m) + 0.15 |xm| for every node m,
     // so it never exceeds the exact gradient-limited field min_m h0(m) + 0.15 |xm| (up to the coast
     // distance the library seeds with, which differs from d by at most rate * step^2 / (8 d), about
-    // 2 km here). Below: the field graded at 0.15 / sqrt(2) along every grid edge meets every corner
-    // condition of the solver, and the solver keeps at least that much.
-    const Raster& g = f.grid();
+    // 2 km here). Below: the field graded at 0.15 / sqrt(2) along every grid edge meets every
+    // corner condition of the solver, and the solver keeps at least that much.
+    const Raster &g = f.grid();
     std::vector<std::pair<Vec3, double>> seeds;
     for (std::size_t j = 0; j < g.nlat(); ++j)
         for (std::size_t i = 0; i < g.nlon(); ++i) {
             Vec3 p = lonlat_to_vec(g.lon_deg(i), g.lat_deg(j));
             double h0 = 5 + 2 * distance_to_boundary_km(p, b);
-            if (h0 < 400) seeds.emplace_back(p, h0);
+            if (h0 < 400)
+                seeds.emplace_back(p, h0);
         }
     const double dy = g.dlat_deg() * deg_to_rad * earth_radius_km;
     double worst_over = 0, worst_under = 0;
@@ -243,7 +259,7 @@ TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles
         for (std::size_t i = 0; i < g.nlon(); i += 13) {
             Vec3 p = lonlat_to_vec(g.lon_deg(i), g.lat_deg(j));
             double exact = 400, slow = 400;
-            for (const auto& [q, h0] : seeds) {
+            for (const auto &[q, h0] : seeds) {
                 exact = std::min(exact, h0 + 0.15 * arc_km(p, q));
                 slow = std::min(slow, h0 + 0.15 / std::sqrt(2.0) * arc_km(p, q));
             }
@@ -261,10 +277,11 @@ TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles
 
 /// A one-layer polygon file for --size-regions: one feature of WKT `polygon` (in `srs`, none
 /// when null) with size_km = `size`.
-void write_size_region(const std::string& path, const char* driver, OGRSpatialReferenceH srs, const char* polygon,
-                       double size) {
+void write_size_region(const std::string &path, const char *driver, OGRSpatialReferenceH srs,
+                       const char *polygon, double size) {
     GDALAllRegister();
-    GDALDatasetH ds = GDALCreate(GDALGetDriverByName(driver), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    GDALDatasetH ds =
+        GDALCreate(GDALGetDriverByName(driver), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
     ASSERT_NE(ds, nullptr);
     OGRLayerH layer = GDALDatasetCreateLayer(ds, "regions", srs, wkbPolygon, nullptr);
     OGRFieldDefnH fd = OGR_Fld_Create("size_km", OFTReal);
@@ -274,7 +291,7 @@ void write_size_region(const std::string& path, const char* driver, OGRSpatialRe
     OGR_F_SetFieldDouble(f, 0, size);
     OGRGeometryH g = nullptr;
     std::string wkt = polygon;
-    char* p = wkt.data();
+    char *p = wkt.data();
     OGR_G_CreateFromWkt(&p, nullptr, &g);
     OGR_F_SetGeometryDirectly(f, g);
     ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
@@ -288,7 +305,8 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     OGRSpatialReferenceH mercator = OSRNewSpatialReference(nullptr);
     OSRImportFromEPSG(mercator, 3857);
     // A Mercator square from 0 to 2 degrees east, 0 to ~2 degrees north: 7 km inside.
-    write_size_region(path, "GPKG", mercator, "POLYGON ((0 0, 222639 0, 222639 222684, 0 222684, 0 0))", 7.0);
+    write_size_region(path, "GPKG", mercator,
+                      "POLYGON ((0 0, 222639 0, 222639 222684, 0 222684, 0 0))", 7.0);
     OSRRelease(mercator);
     MeshOptions o = regional(-5, -5, 5, 5, 2, 100);
     o.size_regions = path;
@@ -300,28 +318,34 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     EXPECT_GT(f.size_km(2.5, 1), 50);
     // A file without a size_km field is refused.
     const std::string bare = (dir / "bare.gpkg").string();
-    GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GPKG"), bare.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    GDALDatasetH ds =
+        GDALCreate(GDALGetDriverByName("GPKG"), bare.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
     GDALDatasetCreateLayer(ds, "nothing", nullptr, wkbPolygon, nullptr);
     GDALClose(ds);
     o.size_regions = bare;
     EXPECT_THROW(build_size_field(o, nullptr, nullptr, {}, 1 << 16), DataError);
     // A shapefile whose .prj is LOCAL_CS (unknown units) has no CRS to place it by.
     const std::string local = (dir / "local.shp").string();
-    OGRSpatialReferenceH local_cs = OSRNewSpatialReference("LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]");
-    write_size_region(local, "ESRI Shapefile", local_cs, "POLYGON ((0 0, 2 0, 2 2, 0 2, 0 0))", 7.0);
+    OGRSpatialReferenceH local_cs =
+        OSRNewSpatialReference("LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]");
+    write_size_region(local, "ESRI Shapefile", local_cs, "POLYGON ((0 0, 2 0, 2 2, 0 2, 0 0))",
+                      7.0);
     OSRRelease(local_cs);
     o.size_regions = local;
-    const std::string m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); },
-                                                          "a LOCAL_CS layer");
+    const std::string m = test::thrown_message<DataError>(
+        [&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); }, "a LOCAL_CS layer");
     EXPECT_NE(m.find("has no CRS (only a local one, of unknown units)"), std::string::npos) << m;
 }
 
 /// Adds a layer `name` (EPSG:4326, with a size_km field when `size` > 0) holding the square
 /// [x0, x0 + 2] x [y0, y0 + 2] degrees to the GeoPackage `path` (created when missing).
-void add_square_layer(const std::string& path, const char* name, double x0, double y0, double size) {
+void add_square_layer(const std::string &path, const char *name, double x0, double y0,
+                      double size) {
     GDALAllRegister();
-    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
-    if (!ds) ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+    GDALDatasetH ds =
+        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE, nullptr, nullptr, nullptr);
+    if (!ds)
+        ds = GDALCreate(GDALGetDriverByName("GPKG"), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
     ASSERT_NE(ds, nullptr);
     OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
     OSRImportFromEPSG(wgs84, 4326);
@@ -333,8 +357,10 @@ void add_square_layer(const std::string& path, const char* name, double x0, doub
     OGR_Fld_Destroy(fd);
     OGRFeatureH f = OGR_F_Create(OGR_L_GetLayerDefn(layer));
     OGR_F_SetFieldDouble(f, 0, size);
-    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing), polygon = OGR_G_CreateGeometry(wkbPolygon);
-    for (auto [dx, dy] : {std::pair{0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}}) OGR_G_AddPoint_2D(ring, x0 + dx, y0 + dy);
+    OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing),
+                 polygon = OGR_G_CreateGeometry(wkbPolygon);
+    for (auto [dx, dy] : {std::pair{0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}})
+        OGR_G_AddPoint_2D(ring, x0 + dx, y0 + dy);
     OGR_G_AddGeometryDirectly(polygon, ring);
     OGR_F_SetGeometryDirectly(f, polygon);
     ASSERT_EQ(OGR_L_CreateFeature(layer, f), OGRERR_NONE);
@@ -346,9 +372,9 @@ TEST(SizeField, size_regions_layer_reads_that_layer_alone) {
     TempDir dir;
     const std::string path = (dir / "two_layers.gpkg").string();
     // Squares far apart beside the grading (9.9 km/km: 100 km within 10 km of each).
-    add_square_layer(path, "fine", 2, 2, 7);       // 7 km over [2, 4] x [2, 4]
-    add_square_layer(path, "medium", -4, -4, 30);  // 30 km over [-4, -2] x [-4, -2]
-    add_square_layer(path, "unsized", -4, 2, 0);   // no size_km field
+    add_square_layer(path, "fine", 2, 2, 7);      // 7 km over [2, 4] x [2, 4]
+    add_square_layer(path, "medium", -4, -4, 30); // 30 km over [-4, -2] x [-4, -2]
+    add_square_layer(path, "unsized", -4, 2, 0);  // no size_km field
     MeshOptions o = regional(-5, -5, 5, 5, 2, 100);
     o.size_regions = path;
     // Without a layer: every layer with a size_km field.
@@ -365,11 +391,14 @@ TEST(SizeField, size_regions_layer_reads_that_layer_alone) {
     EXPECT_NEAR(fine.size_km(-3, -3), 100, 1e-5);
     // A layer that is not there is named with the layers there are; one without size_km is refused.
     o.size_regions_layer = "coarse";
-    std::string m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
+    std::string m = test::thrown_message<DataError>(
+        [&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
     EXPECT_NE(m.find("no layer named 'coarse' (size_regions_layer); layers: fine, medium, unsized"),
-              std::string::npos) << m;
+              std::string::npos)
+        << m;
     o.size_regions_layer = "unsized";
-    m = test::thrown_message<DataError>([&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
+    m = test::thrown_message<DataError>(
+        [&] { build_size_field(o, nullptr, nullptr, {}, 1 << 16); });
     EXPECT_NE(m.find("layer 'unsized' has no size_km field"), std::string::npos) << m;
 }
 
@@ -391,12 +420,14 @@ TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
     EXPECT_GT(f.size_km(-140, 10), 140);
     // Shelves (0..200 m deep) are resolved much finer than the abyss (> 4000 m) on the whole.
     std::vector<double> shelf, abyss;
-    const Raster& g = f.grid();
+    const Raster &g = f.grid();
     for (std::size_t j = 0; j < g.nlat(); j += 3)
         for (std::size_t i = 0; i < g.nlon(); i += 3) {
             double z = bathy.elevation_m(g.lon_deg(i), g.lat_deg(j));
-            if (z < 0 && z > -200) shelf.push_back(g.value(i, j));
-            if (z < -4000) abyss.push_back(g.value(i, j));
+            if (z < 0 && z > -200)
+                shelf.push_back(g.value(i, j));
+            if (z < -4000)
+                abyss.push_back(g.value(i, j));
         }
     auto median = [](std::vector<double> v) {
         std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -416,23 +447,28 @@ TEST(SizeField, evaluation_is_linear_on_the_two_triangles_of_each_grid_cell) {
     o.coast_rate = 0.1;
     Boundary b = ring_of({{-5, -5}, {5, -5}, {5, 5}, {-5, 5}});
     SizeField f = build_size_field(o, nullptr, &b, {}, 1 << 16);
-    const Raster& g = f.grid();
+    const Raster &g = f.grid();
     for (std::size_t j = 0; j + 1 < g.nlat(); j += 13)
         for (std::size_t i = 0; i < g.nlon(); i += 11) {
             const std::size_t i1 = (i + 1) % g.nlon();
-            const double h00 = g.value(i, j), h10 = g.value(i1, j), h01 = g.value(i, j + 1), h11 = g.value(i1, j + 1);
-            const double lon = g.lon_deg(i), lat = g.lat_deg(j), dl = g.dlon_deg(), dp = g.dlat_deg();
+            const double h00 = g.value(i, j), h10 = g.value(i1, j), h01 = g.value(i, j + 1),
+                         h11 = g.value(i1, j + 1);
+            const double lon = g.lon_deg(i), lat = g.lat_deg(j), dl = g.dlon_deg(),
+                         dp = g.dlat_deg();
             EXPECT_NEAR(f.size_km(lonlat_to_vec(lon, lat)), h00, 1e-9);
             // South-west triangle, its diagonal, the north-east triangle.
-            EXPECT_NEAR(f.size_km(lon + 0.25 * dl, lat + 0.5 * dp), h00 + 0.25 * (h10 - h00) + 0.5 * (h01 - h00), 1e-9);
+            EXPECT_NEAR(f.size_km(lon + 0.25 * dl, lat + 0.5 * dp),
+                        h00 + 0.25 * (h10 - h00) + 0.5 * (h01 - h00), 1e-9);
             EXPECT_NEAR(f.size_km(lon + 0.5 * dl, lat + 0.5 * dp), 0.5 * (h10 + h01), 1e-9);
-            EXPECT_NEAR(f.size_km(lon + 0.75 * dl, lat + 0.5 * dp), h11 + 0.25 * (h01 - h11) + 0.5 * (h10 - h11), 1e-9);
+            EXPECT_NEAR(f.size_km(lon + 0.75 * dl, lat + 0.5 * dp),
+                        h11 + 0.25 * (h01 - h11) + 0.5 * (h10 - h11), 1e-9);
         }
     // The polar caps: linear in latitude from the last row to the pole value.
     ASSERT_TRUE(std::isfinite(f.north_pole_km()));
     const std::size_t top = g.nlat() - 1;
     const double cap_lat = 0.5 * (g.lat_deg(top) + 90);
-    EXPECT_NEAR(f.size_km(g.lon_deg(3), cap_lat), 0.5 * (g.value(3, top) + f.north_pole_km()), 1e-9);
+    EXPECT_NEAR(f.size_km(g.lon_deg(3), cap_lat), 0.5 * (g.value(3, top) + f.north_pole_km()),
+                1e-9);
     EXPECT_NEAR(f.size_km(lonlat_to_vec(0, 90)), f.north_pole_km(), 1e-9);
     EXPECT_NEAR(f.size_km(lonlat_to_vec(0, -90)), f.south_pole_km(), 1e-9);
     SizeFn fn = f.function();
@@ -443,22 +479,27 @@ namespace {
 
 /// Largest |h(a) - h(b)| / (grade * arc(a, b)) over random pairs: a uniform on the sphere (or in
 /// the polar caps and at the seam for a third of them), b at a random distance up to max_km.
-double worst_pair_gradient_ratio(const SizeField& f, double grade, double max_km, int pairs, unsigned seed) {
+double worst_pair_gradient_ratio(const SizeField &f, double grade, double max_km, int pairs,
+                                 unsigned seed) {
     std::mt19937 rng(seed);
     std::normal_distribution<double> normal;
     std::uniform_real_distribution<double> unit(0, 1);
     double worst = 0;
     for (int k = 0; k < pairs; ++k) {
         Vec3 a;
-        if (k % 3 == 0) a = normalized({normal(rng), normal(rng), normal(rng)});
-        else if (k % 3 == 1) a = lonlat_to_vec(360 * unit(rng), (unit(rng) < 0.5 ? -1 : 1) * (89 + unit(rng)));
-        else a = lonlat_to_vec(180 + 0.5 * (unit(rng) - 0.5), 180 * unit(rng) - 90);
+        if (k % 3 == 0)
+            a = normalized({normal(rng), normal(rng), normal(rng)});
+        else if (k % 3 == 1)
+            a = lonlat_to_vec(360 * unit(rng), (unit(rng) < 0.5 ? -1 : 1) * (89 + unit(rng)));
+        else
+            a = lonlat_to_vec(180 + 0.5 * (unit(rng) - 0.5), 180 * unit(rng) - 90);
         // b: a step of length s (0.01 km .. max_km, log-uniform) in a random direction.
         const double s = 0.01 * std::pow(max_km / 0.01, unit(rng)) / earth_radius_km;
         Vec3 t = normalized(cross(a, normalized({normal(rng), normal(rng), normal(rng)})));
         Vec3 b = normalized(std::cos(s) * a + std::sin(s) * t);
         const double d = arc_km(a, b);
-        if (d <= 0) continue;
+        if (d <= 0)
+            continue;
         worst = std::max(worst, std::abs(f.size_km(a) - f.size_km(b)) / (grade * d));
     }
     return worst;
@@ -507,11 +548,11 @@ TEST(SizeField, gradation_holds_along_the_edges_of_a_real_mesh) {
     o.slope = 20;
     o.grade = 0.15;
     Mesh mesh = mesh_ocean(o).mesh;
-    const Field* size = mesh.node_field("target_size");
+    const Field *size = mesh.node_field("target_size");
     ASSERT_NE(size, nullptr);
     ASSERT_GT(mesh.faces.size(), 1000u);
     double worst = 0, lo = 1e300, hi = 0;
-    for (const auto& face : mesh.faces)
+    for (const auto &face : mesh.faces)
         for (int k = 0; k < 3; ++k) {
             const auto a = face[k], b = face[(k + 1) % 3];
             const double d = arc_km(mesh.nodes[a], mesh.nodes[b]);
@@ -543,8 +584,9 @@ TEST(SizeField, analytic_fields_match_their_definitions) {
 
 TEST(SizeField, bad_options_give_one_line_errors_naming_the_option) {
     // The library names MeshOptions' fields (a library user never saw the command line's flags).
-    auto message = [](const MeshOptions& o, const Raster* bathy) {
-        return test::thrown_message<UsageError>([&] { build_size_field(o, bathy, nullptr, {}, 1 << 12); });
+    auto message = [](const MeshOptions &o, const Raster *bathy) {
+        return test::thrown_message<UsageError>(
+            [&] { build_size_field(o, bathy, nullptr, {}, 1 << 12); });
     };
     MeshOptions o;
     o.hmin_km = 200;

@@ -27,7 +27,8 @@ TEST(Sphere, arc_angle_matches_haversine_and_is_accurate_when_tiny) {
     EXPECT_NEAR(arc_angle(a, b), pi / 2, 1e-15);
     Vec3 c = lonlat_to_vec(1e-9, 0);
     EXPECT_NEAR(arc_angle(a, c), 1e-9 * deg_to_rad, 1e-24);
-    EXPECT_NEAR(arc_km(lonlat_to_vec(0, 0), lonlat_to_vec(0, 1)), earth_radius_km * deg_to_rad, 1e-9);
+    EXPECT_NEAR(arc_km(lonlat_to_vec(0, 0), lonlat_to_vec(0, 1)), earth_radius_km * deg_to_rad,
+                1e-9);
 }
 
 // Along the equator from lon 0 to 40: a point at latitude phi above the arc is phi away (the
@@ -57,7 +58,8 @@ TEST(Sphere, turn_angle_is_the_angle_between_the_two_great_circles) {
     // The meridian lon 10 from the pole, then the small-circle-free turn onto lon 10 + 30: at
     // the pole two meridians meet at their longitude difference.
     const Vec3 pole{0, 0, 1};
-    EXPECT_NEAR(turn_angle(lonlat_to_vec(10, 40), pole, lonlat_to_vec(190 + 30, 40)), 30 * deg_to_rad, 1e-12);
+    EXPECT_NEAR(turn_angle(lonlat_to_vec(10, 40), pole, lonlat_to_vec(190 + 30, 40)),
+                30 * deg_to_rad, 1e-12);
     EXPECT_EQ(turn_angle(a, a, b), 0);
 }
 

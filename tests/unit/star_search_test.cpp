@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <string>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "star_search.hpp"
@@ -31,8 +31,8 @@ class ForcedBuild {
 public:
     explicit ForcedBuild(StarScorer s) : ran_(force_star_scorer(s)) {}
     ~ForcedBuild() { star_scorer_in_use() = host_; }
-    ForcedBuild(const ForcedBuild&) = delete;
-    ForcedBuild& operator=(const ForcedBuild&) = delete;
+    ForcedBuild(const ForcedBuild &) = delete;
+    ForcedBuild &operator=(const ForcedBuild &) = delete;
     bool ran() const { return ran_; }
 
 private:
@@ -44,23 +44,27 @@ private:
 class StarSearch : public ::testing::TestWithParam<StarScorer> {
 protected:
     void SetUp() override {
-        if (!forced_.ran()) GTEST_SKIP() << "this processor cannot run the " << build_name(GetParam()) << " build";
+        if (!forced_.ran())
+            GTEST_SKIP() << "this processor cannot run the " << build_name(GetParam()) << " build";
     }
     ForcedBuild forced_{GetParam()};
 };
 
 /// What the quality rounds accepted before the lanes: star_count_score of each point in turn,
 /// against best + 1e-12, after the `left_of` orientations.
-unsigned count_accepts_one_by_one(const Points8& p, const std::vector<FarEdge>& far, double floor, double& best,
-                                  const std::vector<FarEdge>* left_of = nullptr) {
+unsigned count_accepts_one_by_one(const Points8 &p, const std::vector<FarEdge> &far, double floor,
+                                  double &best, const std::vector<FarEdge> *left_of = nullptr) {
     unsigned accepted = 0;
     for (int k = 0; k < 8; ++k) {
         bool left = true;
         if (left_of)
-            for (const FarEdge& e : *left_of) left = left && predicates::orient(p[k], e) > 0;
-        if (!left) continue;
+            for (const FarEdge &e : *left_of)
+                left = left && predicates::orient(p[k], e) > 0;
+        if (!left)
+            continue;
         const double score = star_count_score(p[k], far, rule, floor, best + 1e-12);
-        if (score <= best + 1e-12) continue;
+        if (score <= best + 1e-12)
+            continue;
         best = score;
         accepted |= 1u << k;
     }
@@ -68,11 +72,12 @@ unsigned count_accepts_one_by_one(const Points8& p, const std::vector<FarEdge>& 
 }
 
 /// The search rounds' the same way: star_worst_quality against best + 1e-9.
-unsigned worst_accepts_one_by_one(const Points8& p, const std::vector<FarEdge>& far, double& best) {
+unsigned worst_accepts_one_by_one(const Points8 &p, const std::vector<FarEdge> &far, double &best) {
     unsigned accepted = 0;
     for (int k = 0; k < 8; ++k) {
         const double w = star_worst_quality(p[k], far, best + 1e-9);
-        if (w <= best + 1e-9) continue;
+        if (w <= best + 1e-9)
+            continue;
         best = w;
         accepted |= 1u << k;
     }
@@ -80,9 +85,10 @@ unsigned worst_accepts_one_by_one(const Points8& p, const std::vector<FarEdge>& 
 }
 
 /// A star around `centre`: n ring points at about `radius`, counter-clockwise, jittered.
-std::vector<FarEdge> random_star(const Vec3& centre, int n, double radius, std::mt19937_64& rng) {
+std::vector<FarEdge> random_star(const Vec3 &centre, int n, double radius, std::mt19937_64 &rng) {
     std::uniform_real_distribution<double> u(-1, 1);
-    const Vec3 e1 = normalized(cross(centre, std::abs(centre.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+    const Vec3 e1 =
+        normalized(cross(centre, std::abs(centre.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
     const Vec3 e2 = cross(centre, e1);
     std::vector<Vec3> ring;
     for (int i = 0; i < n; ++i) {
@@ -91,15 +97,16 @@ std::vector<FarEdge> random_star(const Vec3& centre, int n, double radius, std::
         ring.push_back(normalized(centre + r * (std::cos(a) * e1 + std::sin(a) * e2)));
     }
     std::vector<FarEdge> far;
-    for (int i = 0; i < n; ++i) far.emplace_back(ring[std::size_t(i)], ring[std::size_t((i + 1) % n)]);
+    for (int i = 0; i < n; ++i)
+        far.emplace_back(ring[std::size_t(i)], ring[std::size_t((i + 1) % n)]);
     return far;
 }
 
 /// The eight points of a pattern-search step around `to` (pattern_search's own arithmetic).
-Points8 step_points(const Vec3& to, double step) {
+Points8 step_points(const Vec3 &to, double step) {
     Points8 points{};
     Vec3 first = to;
-    pattern_search(to, step, 0.75 * step, [&](const Points8& p) {
+    pattern_search(to, step, 0.75 * step, [&](const Points8 &p) {
         points = p;
         first = p[0];
         return 0u; // none accepted: the search halves the step and ends
@@ -120,22 +127,27 @@ TEST_P(StarSearch, eight_lanes_accept_what_eight_calls_in_turn_accepted) {
         // radius (small moves) to twice it (folds).
         const Vec3 p0 = normalized(centre + 0.3 * radius * Vec3{u(rng), u(rng), u(rng)});
         const double worst0 = star_worst_quality(p0, far);
-        if (worst0 <= 0) continue; // p0 itself folds the star
+        if (worst0 <= 0)
+            continue; // p0 itself folds the star
         const double floor = std::min(worst0, rule.worst_goal);
         with_floor += floor < rule.worst_goal;
         const Points8 points = step_points(p0, radius * (0.1 + 1.9 * (trial % 16) / 15.0));
-        const std::vector<FarEdge> land(far.begin(), far.begin() + 2); // stands for slide_node's land edges
-        for (const std::vector<FarEdge>* left_of : {static_cast<const std::vector<FarEdge>*>(nullptr), &land}) {
+        const std::vector<FarEdge> land(far.begin(),
+                                        far.begin() + 2); // stands for slide_node's land edges
+        for (const std::vector<FarEdge> *left_of :
+             {static_cast<const std::vector<FarEdge> *>(nullptr), &land}) {
             double best_one = star_count_score(p0, far, rule, floor), best_lanes = best_one;
             const unsigned one = count_accepts_one_by_one(points, far, floor, best_one, left_of);
-            const unsigned lanes = star_count_accepts(points, far, rule, floor, best_lanes, left_of);
+            const unsigned lanes =
+                star_count_accepts(points, far, rule, floor, best_lanes, left_of);
             ASSERT_EQ(lanes, one) << "trial " << trial;
             ASSERT_EQ(best_lanes, best_one) << "trial " << trial;
             accepted_any += one != 0;
             rejected_some += one != 0xffu;
         }
         double worst_one = worst0, worst_lanes = worst0;
-        ASSERT_EQ(star_worst_accepts(points, far, worst_lanes), worst_accepts_one_by_one(points, far, worst_one))
+        ASSERT_EQ(star_worst_accepts(points, far, worst_lanes),
+                  worst_accepts_one_by_one(points, far, worst_one))
             << "trial " << trial;
         ASSERT_EQ(worst_lanes, worst_one);
         ++trials;
@@ -159,7 +171,8 @@ TEST_P(StarSearch, points_on_an_edge_circle_and_zero_coordinates_are_decided_exa
                             normalized(Vec3{1, 0, 0.005}),    normalized(Vec3{1, 0, -0.005}),
                             normalized(Vec3{1, 0.001, 1e-9}), normalized(Vec3{1, -0.001, 1e-300}),
                             normalized(Vec3{1, 0, 0.01}),     normalized(Vec3{1, 0.002, 0.006})};
-    for (int k = 0; k < 8; ++k) p.x[k] = points[k].x, p.y[k] = points[k].y, p.z[k] = points[k].z;
+    for (int k = 0; k < 8; ++k)
+        p.x[k] = points[k].x, p.y[k] = points[k].y, p.z[k] = points[k].z;
     for (double floor : {-2.0, 0.0, 0.3}) {
         double best_one = -0.5, best_lanes = -0.5;
         const unsigned one = count_accepts_one_by_one(p, far, floor, best_one);
@@ -178,22 +191,25 @@ TEST_P(StarSearch, points_the_filter_cannot_decide_are_decided_exactly) {
     // The same star turned so that no coordinate is 0 (the lanes' filter applies), with
     // candidates on the great circle of b -> c up to rounding: the filter leaves them to exact
     // arithmetic, which folds some of them.
-    auto turn = [](const Vec3& v) {
+    auto turn = [](const Vec3 &v) {
         const Vec3 a = normalized(Vec3{0.3, -0.5, 0.8});
         const double t = 0.7; // about the axis a
-        return normalized(std::cos(t) * v + std::sin(t) * cross(a, v) + (1 - std::cos(t)) * dot(a, v) * a);
+        return normalized(std::cos(t) * v + std::sin(t) * cross(a, v) +
+                          (1 - std::cos(t)) * dot(a, v) * a);
     };
     const Vec3 b = turn(normalized(Vec3{1, -0.01, 0})), c = turn(normalized(Vec3{1, 0.01, 0}));
     const Vec3 d = turn(normalized(Vec3{1, 0, 0.02}));
     const std::vector<FarEdge> far = {FarEdge(b, c), FarEdge(c, d), FarEdge(d, b)};
     Points8 p{};
     for (int k = 0; k < 8; ++k) {
-        const Vec3 q = k < 7 ? normalized(b + (0.2 + 0.1 * k) * (c - b)) : turn(normalized(Vec3{1, 0, 0.005}));
+        const Vec3 q =
+            k < 7 ? normalized(b + (0.2 + 0.1 * k) * (c - b)) : turn(normalized(Vec3{1, 0, 0.005}));
         p.x[k] = q.x, p.y[k] = q.y, p.z[k] = q.z;
     }
     unsigned folded = 0;
     for (int k = 0; k < 7; ++k) {
-        ASSERT_EQ(predicates::detail::orient_filter(p[k], b, c), 0) << "lane " << k << " is not a case for exact arithmetic";
+        ASSERT_EQ(predicates::detail::orient_filter(p[k], b, c), 0)
+            << "lane " << k << " is not a case for exact arithmetic";
         folded |= unsigned(predicates::orient(p[k], far[0]) <= 0) << k;
     }
     ASSERT_NE(folded, 0u) << "no lane on the circle folds: the exact stage is not exercised";
@@ -208,7 +224,9 @@ TEST_P(StarSearch, points_the_filter_cannot_decide_are_decided_exactly) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Builds, StarSearch, ::testing::ValuesIn(builds),
-                         [](const ::testing::TestParamInfo<StarScorer>& info) { return build_name(info.param); });
+                         [](const ::testing::TestParamInfo<StarScorer> &info) {
+                             return build_name(info.param);
+                         });
 
 // The builds differ in vector width only (none uses FMA), so the improve stage must move every
 // node to the same double in each. The program itself (not this file's copies of the inline
@@ -220,30 +238,34 @@ TEST(StarSearchBuilds, every_build_the_processor_runs_gives_the_same_mesh) {
     std::vector<std::string> ran;
     std::string first;
     for (StarScorer s : builds) {
-        if (!star_scorer_supported(s)) continue;
+        if (!star_scorer_supported(s))
+            continue;
         const std::string name = s == StarScorer::baseline ? "default" : build_name(s);
         const auto nc = dir / (name + ".nc");
         std::string out;
-        ASSERT_EQ(test::run_command("GLOBEMESH_STAR_SCORER=" + name + " " GLOBEMESH_EXE " mesh -q --coast " +
+        ASSERT_EQ(test::run_command("GLOBEMESH_STAR_SCORER=" + name +
+                                        " " GLOBEMESH_EXE " mesh -q --coast " +
                                         test::fixture("coast/ne_110m_land.gpkg").string() +
                                         " --coast-layer land --hmin 150km --hmax 400km --bathy " +
-                                        test::fixture("bathy/etopo5_global_10min.nc").string() + " -o " + nc.string(),
+                                        test::fixture("bathy/etopo5_global_10min.nc").string() +
+                                        " -o " + nc.string(),
                                     out),
                   0)
             << out;
-        ASSERT_EQ(test::run_command("ncdump -p 17,17 " + nc.string() +
-                                        " | sed -n '/^data:/,$p'",
-                                    out),
-                  0)
+        ASSERT_EQ(
+            test::run_command("ncdump -p 17,17 " + nc.string() + " | sed -n '/^data:/,$p'", out), 0)
             << out;
         ASSERT_GT(out.size(), 100000u) << out.substr(0, 500);
-        if (ran.empty()) first = out;
-        else EXPECT_TRUE(out == first) << name << " gives another mesh than " << ran.front();
+        if (ran.empty())
+            first = out;
+        else
+            EXPECT_TRUE(out == first) << name << " gives another mesh than " << ran.front();
         ran.push_back(name);
     }
     // The baseline runs everywhere; on x86-64, AVX2 too on any processor of the last decade.
     ASSERT_FALSE(ran.empty());
-    if (ran.size() < 2) GTEST_SKIP() << "only the " << ran.front() << " build runs here: nothing to compare";
+    if (ran.size() < 2)
+        GTEST_SKIP() << "only the " << ran.front() << " build runs here: nothing to compare";
 }
 
 } // namespace

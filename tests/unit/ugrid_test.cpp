@@ -14,17 +14,17 @@
 
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <set>
 #include <sstream>
-#include <iostream>
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
-#include "write_hooks.hpp"
 #include "io_test_meshes.hpp"
 #include "support.hpp"
+#include "write_hooks.hpp"
 
 using namespace globemesh;
 using namespace globemesh::test;
@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The face areas of a UGRID file (its variable "area"), n of them.
-std::vector<double> file_areas(const fs::path& file, std::size_t n) {
+std::vector<double> file_areas(const fs::path &file, std::size_t n) {
     std::vector<double> area(n);
     int nc, v;
     EXPECT_EQ(nc_open(file.c_str(), NC_NOWRITE, &nc), NC_NOERR);
@@ -43,27 +43,29 @@ std::vector<double> file_areas(const fs::path& file, std::size_t n) {
     return area;
 }
 
-std::vector<std::string> folder_listing(const fs::path& dir) {
+std::vector<std::string> folder_listing(const fs::path &dir) {
     std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    for (const auto &e : fs::directory_iterator(dir))
+        names.push_back(e.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
 }
 
-std::string file_bytes(const fs::path& p) {
+std::string file_bytes(const fs::path &p) {
     std::ifstream f(p, std::ios::binary);
     return {std::istreambuf_iterator<char>(f), {}};
 }
 
-std::string text_att(int nc, int var, const char* name) {
+std::string text_att(int nc, int var, const char *name) {
     std::size_t len = 0;
-    if (nc_inq_attlen(nc, var, name, &len) != NC_NOERR) return "<missing>";
+    if (nc_inq_attlen(nc, var, name, &len) != NC_NOERR)
+        return "<missing>";
     std::string s(len, '\0');
     nc_get_att_text(nc, var, name, s.data());
     return s;
 }
 
-void expect_same_stats(const MeshStats& a, const MeshStats& b) {
+void expect_same_stats(const MeshStats &a, const MeshStats &b) {
     EXPECT_EQ(a.nodes, b.nodes);
     EXPECT_EQ(a.faces, b.faces);
     EXPECT_EQ(a.edges, b.edges);
@@ -83,7 +85,8 @@ void expect_same_stats(const MeshStats& a, const MeshStats& b) {
 }
 
 /// Writes a small UGRID file the way another tool might, with the netCDF-C API directly.
-void write_foreign(const fs::path& path, const Mesh& m, bool transposed, int start, bool four_columns) {
+void write_foreign(const fs::path &path, const Mesh &m, bool transposed, int start,
+                   bool four_columns) {
     int nc, d_node, d_face, d_col, vx, vy, vf, topo;
     ASSERT_EQ(nc_create(path.c_str(), NC_CLOBBER, &nc), NC_NOERR);
     nc_def_dim(nc, "nodes", m.nodes.size(), &d_node);
@@ -91,7 +94,9 @@ void write_foreign(const fs::path& path, const Mesh& m, bool transposed, int sta
     const int cols = four_columns ? 4 : 3;
     nc_def_dim(nc, "corners", cols, &d_col);
     nc_def_var(nc, "Mesh2", NC_INT, 0, nullptr, &topo);
-    auto text = [&](int v, const char* n, const std::string& s) { nc_put_att_text(nc, v, n, s.size(), s.c_str()); };
+    auto text = [&](int v, const char *n, const std::string &s) {
+        nc_put_att_text(nc, v, n, s.size(), s.c_str());
+    };
     text(topo, "cf_role", "mesh_topology");
     int two = 2;
     nc_put_att_int(nc, topo, "topology_dimension", NC_INT, 1, &two);
@@ -103,19 +108,21 @@ void write_foreign(const fs::path& path, const Mesh& m, bool transposed, int sta
     text(vx, "standard_name", "longitude"), text(vx, "units", "degrees_east");
     text(vy, "standard_name", "latitude"), text(vy, "units", "degrees_north");
     int dims[2] = {d_face, d_col};
-    if (transposed) std::swap(dims[0], dims[1]);
+    if (transposed)
+        std::swap(dims[0], dims[1]);
     nc_def_var(nc, "Mesh2_face_nodes", NC_INT, 2, dims, &vf);
     text(vf, "cf_role", "face_node_connectivity");
     nc_put_att_int(nc, vf, "start_index", NC_INT, 1, &start);
     int fill = -999;
-    if (four_columns) nc_put_att_int(nc, vf, "_FillValue", NC_INT, 1, &fill);
+    if (four_columns)
+        nc_put_att_int(nc, vf, "_FillValue", NC_INT, 1, &fill);
     int vd;
     nc_def_var(nc, "bathymetry", NC_FLOAT, 1, &d_node, &vd);
     text(vd, "mesh", "Mesh2"), text(vd, "location", "node"), text(vd, "units", "m");
     nc_enddef(nc);
     std::vector<double> x, y;
     std::vector<float> depth;
-    for (const auto& v : m.nodes) {
+    for (const auto &v : m.nodes) {
         LonLat p = vec_to_lonlat(v);
         x.push_back(p.lon + 360.0 * (p.lon < 0)); // another tool may use [0, 360)
         y.push_back(p.lat);
@@ -128,8 +135,10 @@ void write_foreign(const fs::path& path, const Mesh& m, bool transposed, int sta
     for (std::size_t f = 0; f < m.faces.size(); ++f)
         for (int k = 0; k < cols; ++k) {
             int value = k < 3 ? int(m.faces[f][k]) + start : fill;
-            if (transposed) conn[k * m.faces.size() + f] = value;
-            else conn[f * cols + k] = value;
+            if (transposed)
+                conn[k * m.faces.size() + f] = value;
+            else
+                conn[f * cols + k] = value;
         }
     nc_put_var_int(nc, vf, conn.data());
     ASSERT_EQ(nc_close(nc), NC_NOERR);
@@ -156,7 +165,8 @@ TEST(Ugrid, closed_icosphere_passes_mesh_verify_and_round_trips_its_statistics) 
 
     Mesh back = read_ugrid(dir / "ico.nc");
     ASSERT_EQ(back.nodes.size(), m.nodes.size());
-    for (std::size_t i = 0; i < m.nodes.size(); ++i) EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-14);
+    for (std::size_t i = 0; i < m.nodes.size(); ++i)
+        EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-14);
     EXPECT_EQ(back.faces, m.faces);
     ASSERT_NE(back.node_field("depth"), nullptr);
     EXPECT_EQ(back.node_field("depth")->values, m.node_field("depth")->values);
@@ -168,19 +178,21 @@ TEST(Ugrid, closed_icosphere_passes_mesh_verify_and_round_trips_its_statistics) 
 TEST(Ugrid, size_ratio_median_is_the_median_of_all_edge_ratios) {
     // compute_stats finds the median from bin counts and the values of the middle bins only:
     // check it against sorting every ratio, for sizes putting ratios far below 1 and beyond the
-    // last bin (4), for an even count and, with the edges at a pole left out (a negative target), an
-    // odd one.
+    // last bin (4), for an even count and, with the edges at a pole left out (a negative target),
+    // an odd one.
     Mesh m = icosphere(3);
     add_fields(m);
-    Field& size = m.node_fields[1];
+    Field &size = m.node_fields[1];
     auto sorted_median = [&] {
         std::set<std::pair<NodeIndex, NodeIndex>> edges;
-        for (const auto& f : m.faces)
-            for (int k = 0; k < 3; ++k) edges.insert(std::minmax(f[k], f[(k + 1) % 3]));
+        for (const auto &f : m.faces)
+            for (int k = 0; k < 3; ++k)
+                edges.insert(std::minmax(f[k], f[(k + 1) % 3]));
         std::vector<double> ratios;
         for (auto [a, b] : edges) {
             const double target = 0.5 * (size.values[a] + size.values[b]);
-            if (target > 0) ratios.push_back(arc_km(m.nodes[a], m.nodes[b]) / target);
+            if (target > 0)
+                ratios.push_back(arc_km(m.nodes[a], m.nodes[b]) / target);
         }
         std::sort(ratios.begin(), ratios.end());
         const std::size_t n = ratios.size();
@@ -188,12 +200,15 @@ TEST(Ugrid, size_ratio_median_is_the_median_of_all_edge_ratios) {
     };
     for (int spread : {0, 1, 2}) {
         for (std::size_t i = 0; i < m.nodes.size(); ++i)
-            size.values[i] = spread == 0 ? 500.0 + 100.0 * m.nodes[i].y : 10.0 + 3000.0 * double(i % 7) / spread;
+            size.values[i] =
+                spread == 0 ? 500.0 + 100.0 * m.nodes[i].y : 10.0 + 3000.0 * double(i % 7) / spread;
         for (bool odd : {false, true}) {
-            if (odd) size.values[0] = -1e9; // node 0, the north pole, has 5 edges
+            if (odd)
+                size.values[0] = -1e9; // node 0, the north pole, has 5 edges
             const auto [count, median] = sorted_median();
             EXPECT_EQ(count % 2, odd ? 1u : 0u);
-            EXPECT_EQ(compute_stats(m).size_ratio_median, median) << "spread " << spread << " odd " << odd;
+            EXPECT_EQ(compute_stats(m).size_ratio_median, median)
+                << "spread " << spread << " odd " << odd;
         }
     }
 }
@@ -202,12 +217,14 @@ TEST(Ugrid, statistics_passed_in_the_options_are_written_as_given) {
     TempDir dir;
     Mesh m = icosphere(2);
     MeshStats s = compute_stats(m);
-    s.quality_min = 0.125; // not this mesh's: shows the writer took them instead of computing its own
+    s.quality_min =
+        0.125; // not this mesh's: shows the writer took them instead of computing its own
     UgridOptions options;
     options.stats = &s;
     write_ugrid(m, dir / "given.nc", options);
     write_ugrid(m, dir / "own.nc");
-    for (const auto& [name, expected] : {std::pair{"given.nc", 0.125}, std::pair{"own.nc", compute_stats(m).quality_min}}) {
+    for (const auto &[name, expected] :
+         {std::pair{"given.nc", 0.125}, std::pair{"own.nc", compute_stats(m).quality_min}}) {
         int nc;
         ASSERT_EQ(nc_open((dir / name).c_str(), NC_NOWRITE, &nc), NC_NOERR);
         double q = -1;
@@ -232,13 +249,15 @@ TEST(Ugrid, mesh_with_holes_keeps_tagged_boundary_loops_and_passes_mesh_verify) 
     expect_same_stats(compute_stats(back), s);
     auto sorted = [](std::vector<BoundaryEdge> b) {
         std::vector<std::tuple<NodeIndex, NodeIndex, int>> t;
-        for (auto e : b) t.emplace_back(e.a, e.b, int(e.tag));
+        for (auto e : b)
+            t.emplace_back(e.a, e.b, int(e.tag));
         std::sort(t.begin(), t.end());
         return t;
     };
     EXPECT_EQ(sorted(back.boundary), sorted(m.boundary)); // same edges, orientation and tags
     int open = 0;
-    for (auto e : back.boundary) open += e.tag == EdgeTag::open;
+    for (auto e : back.boundary)
+        open += e.tag == EdgeTag::open;
     EXPECT_GT(open, 0);
     EXPECT_LT(open, int(back.boundary.size()));
 }
@@ -250,7 +269,7 @@ TEST(Ugrid, antimeridian_cap_passes_mesh_verify_with_longitudes_in_range) {
     expect_mesh_verify(dir / "pacific.nc", "--size-var target_size");
     int nc, v;
     ASSERT_EQ(nc_open((dir / "pacific.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
-    for (const char* name : {"mesh_node_lon", "mesh_face_lon", "mesh_edge_lon"}) {
+    for (const char *name : {"mesh_node_lon", "mesh_face_lon", "mesh_edge_lon"}) {
         ASSERT_EQ(nc_inq_varid(nc, name, &v), NC_NOERR);
         std::size_t n;
         int dim;
@@ -283,8 +302,9 @@ TEST(Ugrid, file_carries_every_connectivity_start_index_crs_and_only_int_float_d
     ASSERT_EQ(nc_inq_varid(nc, "mesh", &topo), NC_NOERR);
     EXPECT_EQ(text_att(nc, topo, "cf_role"), "mesh_topology");
     EXPECT_EQ(text_att(nc, topo, "node_coordinates"), "mesh_node_lon mesh_node_lat");
-    for (const char* role : {"face_node_connectivity", "edge_node_connectivity", "face_edge_connectivity",
-                             "face_face_connectivity", "edge_face_connectivity", "boundary_node_connectivity"}) {
+    for (const char *role :
+         {"face_node_connectivity", "edge_node_connectivity", "face_edge_connectivity",
+          "face_face_connectivity", "edge_face_connectivity", "boundary_node_connectivity"}) {
         std::string name = text_att(nc, topo, role);
         int v;
         ASSERT_EQ(nc_inq_varid(nc, name.c_str(), &v), NC_NOERR) << role;
@@ -315,8 +335,10 @@ TEST(Ugrid, file_carries_every_connectivity_start_index_crs_and_only_int_float_d
     for (int v = 0; v < nvars; ++v) {
         nc_type t;
         nc_inq_vartype(nc, v, &t);
-        EXPECT_TRUE(t == NC_INT || t == NC_FLOAT || t == NC_DOUBLE) << "variable " << v << " type " << t;
-        if (text_att(nc, v, "mesh") == "mesh") ++data_vars;
+        EXPECT_TRUE(t == NC_INT || t == NC_FLOAT || t == NC_DOUBLE)
+            << "variable " << v << " type " << t;
+        if (text_att(nc, v, "mesh") == "mesh")
+            ++data_vars;
     }
     EXPECT_EQ(data_vars, 5); // depth, target_size, quality, area, boundary_tag
     int tag;
@@ -340,7 +362,8 @@ TEST(Ugrid, face_areas_are_geodesic_and_tile_the_wgs84_ellipsoid) {
     nc_get_var_double(nc, v, area.data());
     nc_close(nc);
     double total = 0;
-    for (double a : area) total += a;
+    for (double a : area)
+        total += a;
     EXPECT_NEAR(total, GeographicLib::Geodesic::WGS84().EllipsoidArea(), 1e-8 * total);
 }
 
@@ -350,7 +373,7 @@ TEST(Ugrid, face_areas_are_geodesic_and_tile_the_wgs84_ellipsoid) {
 TEST(Ugrid, each_face_area_is_polygonarea_of_its_corners) {
     // Each mesh with the number of its faces that go round a pole without a corner on it.
     const std::pair<Mesh, int> meshes[] = {{icosphere(3), 0}, {icosphere_without_pole_nodes(3), 2}};
-    for (const auto& [m, round_pole_expected] : meshes) {
+    for (const auto &[m, round_pole_expected] : meshes) {
         TempDir dir;
         write_ugrid(m, dir / "ico.nc");
         const std::vector<double> area = file_areas(dir / "ico.nc", m.faces.size());
@@ -366,9 +389,11 @@ TEST(Ugrid, each_face_area_is_polygonarea_of_its_corners) {
             // Only the rounding of the edges' S12 terms (each up to a quarter of the ellipsoid,
             // 1.3e14 m2, so a few 0.01 m2) may differ.
             EXPECT_NEAR(area[f], std::fabs(expected), 0.1) << "face " << f;
-            const Vec3 &a = m.nodes[m.faces[f][0]], &b = m.nodes[m.faces[f][1]], &c = m.nodes[m.faces[f][2]];
+            const Vec3 &a = m.nodes[m.faces[f][0]], &b = m.nodes[m.faces[f][1]],
+                       &c = m.nodes[m.faces[f][2]];
             for (const Vec3 pole : {Vec3{0, 0, 1}, Vec3{0, 0, -1}})
-                round_pole += dot(pole, cross(a, b)) > 0 && dot(pole, cross(b, c)) > 0 && dot(pole, cross(c, a)) > 0;
+                round_pole += dot(pole, cross(a, b)) > 0 && dot(pole, cross(b, c)) > 0 &&
+                              dot(pole, cross(c, a)) > 0;
         }
         EXPECT_EQ(round_pole, round_pole_expected);
     }
@@ -431,13 +456,15 @@ TEST(Ugrid, netcdf4_chunks_written_on_every_core_read_back_as_the_classic_file) 
             std::size_t len;
             nc_inq_dimlen(a, dims[k], &len);
             values *= len;
-            if (k == 0) rows = len;
+            if (k == 0)
+                rows = len;
         }
         std::vector<double> from_a(values), from_c(values);
         ASSERT_EQ(nc_get_var_double(a, v, from_a.data()), NC_NOERR);
         ASSERT_EQ(nc_get_var_double(c, vc, from_c.data()), NC_NOERR);
         EXPECT_EQ(std::memcmp(from_a.data(), from_c.data(), values * sizeof(double)), 0);
-        if (ndims == 0) continue;
+        if (ndims == 0)
+            continue;
         int shuffle, deflate, level, storage;
         std::size_t chunk[NC_MAX_VAR_DIMS];
         ASSERT_EQ(nc_inq_var_deflate(a, v, &shuffle, &deflate, &level), NC_NOERR);
@@ -458,13 +485,15 @@ TEST(Ugrid, netcdf4_chunks_written_on_every_core_read_back_as_the_classic_file) 
 TEST(Ugrid, fields_named_as_dimensions_or_variables_are_written_under_suffixed_names) {
     TempDir dir;
     Mesh m = icosphere(2);
-    for (const char* name : {"Two", "nMesh_node", "quality"}) {
+    for (const char *name : {"Two", "nMesh_node", "quality"}) {
         Field f{name, name, "1", "", {}};
-        for (const Vec3& p : m.nodes) f.values.push_back(p.x + 2 * p.y + 3 * p.z);
+        for (const Vec3 &p : m.nodes)
+            f.values.push_back(p.x + 2 * p.y + 3 * p.z);
         m.node_fields.push_back(f);
     }
     Field f{"nMesh_face", "faces", "1", "", {}};
-    for (std::size_t i = 0; i < m.faces.size(); ++i) f.values.push_back(double(i));
+    for (std::size_t i = 0; i < m.faces.size(); ++i)
+        f.values.push_back(double(i));
     m.face_fields.push_back(f);
     for (const bool classic : {false, true}) {
         SCOPED_TRACE(classic ? "classic" : "netcdf4");
@@ -473,12 +502,13 @@ TEST(Ugrid, fields_named_as_dimensions_or_variables_are_written_under_suffixed_n
         write_ugrid(m, dir / "o.nc", o);
         int nc;
         ASSERT_EQ(nc_open((dir / "o.nc").c_str(), NC_NOWRITE, &nc), NC_NOERR);
-        auto values = [&](const char* name) {
+        auto values = [&](const char *name) {
             int v;
             std::size_t len = 0;
             int dim;
             std::vector<double> out;
-            if (nc_inq_varid(nc, name, &v) != NC_NOERR || nc_inq_vardimid(nc, v, &dim) != NC_NOERR) return out;
+            if (nc_inq_varid(nc, name, &v) != NC_NOERR || nc_inq_vardimid(nc, v, &dim) != NC_NOERR)
+                return out;
             nc_inq_dimlen(nc, dim, &len);
             out.resize(len);
             EXPECT_EQ(nc_get_var_double(nc, v, out.data()), NC_NOERR);
@@ -518,7 +548,8 @@ TEST(Ugrid, reads_one_based_four_column_file_with_fill_value_from_another_tool) 
     Mesh back = read_ugrid(dir / "other.nc");
     EXPECT_EQ(back.faces, m.faces);
     ASSERT_EQ(back.nodes.size(), m.nodes.size());
-    for (std::size_t i = 0; i < m.nodes.size(); ++i) EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-13);
+    for (std::size_t i = 0; i < m.nodes.size(); ++i)
+        EXPECT_LT(norm(back.nodes[i] - m.nodes[i]), 1e-13);
     ASSERT_NE(back.node_field("bathymetry"), nullptr);
     expect_same_stats(compute_stats(back), compute_stats(m));
 }
@@ -536,7 +567,8 @@ TEST(Ugrid, out_of_range_index_and_non_ugrid_files_are_errors_not_read) {
     Mesh m = icosphere(1);
     m.nodes.pop_back(); // the faces now reference a node that is not in the file
     write_foreign(dir / "bad.nc", m, false, 1, false);
-    const std::string message = test::thrown_message<DataError>([&] { read_ugrid(dir / "bad.nc"); });
+    const std::string message =
+        test::thrown_message<DataError>([&] { read_ugrid(dir / "bad.nc"); });
     EXPECT_NE(message.find("outside [1, 41]"), std::string::npos) << message;
     std::ofstream(dir / "text.nc") << "not netcdf";
     EXPECT_THROW(read_ugrid(dir / "text.nc"), IoError);
@@ -606,7 +638,8 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
-        if (unshare(CLONE_NEWNS) != 0 || mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+        if (unshare(CLONE_NEWNS) != 0 ||
+            mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
             mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=1m") != 0)
             _exit(cannot_mount);
         std::ofstream out(log);
@@ -619,7 +652,7 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
                     write_ugrid(icosphere(level), disk / "o.nc", o);
                     out << "written";
                     fs::remove(disk / "o.nc");
-                } catch (const IoError& e) {
+                } catch (const IoError &e) {
                     out << "error " << e.what();
                 }
                 out << (fs::is_empty(disk) ? "" : " FILES LEFT") << "\n";
@@ -638,7 +671,7 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
                 write_ugrid(m, disk / "o.nc", {});
                 out << "written";
                 fs::remove(disk / "o.nc");
-            } catch (const IoError& e) {
+            } catch (const IoError &e) {
                 out << "error " << e.what();
             }
             fs::remove(disk / "filler");
@@ -653,7 +686,9 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
     if (WIFEXITED(status) && WEXITSTATUS(status) == cannot_mount)
         GTEST_SKIP() << "cannot mount a small tmpfs here (needs root and a mount namespace)";
     const std::string text = file_bytes(log);
-    ASSERT_TRUE(WIFEXITED(status)) << "the process died of signal " << WTERMSIG(status) << " after:\n" << text;
+    ASSERT_TRUE(WIFEXITED(status))
+        << "the process died of signal " << WTERMSIG(status) << " after:\n"
+        << text;
     EXPECT_EQ(WEXITSTATUS(status), 0) << text;
     int full = 0, short_written = 0;
     std::set<std::string> short_failed_at; // the steps where the one file failed
@@ -667,12 +702,16 @@ TEST(Ugrid, a_full_disk_is_an_io_error_with_no_file_left_and_a_clean_exit) {
         }
         ++full;
         EXPECT_TRUE(line.find("(the disk is full)") != std::string::npos ||
-                    line.find("No space left on device") != std::string::npos) << line;
-        if (short_run) short_failed_at.insert(line.substr(line.rfind(": ", line.find(": HDF error") - 1)));
+                    line.find("No space left on device") != std::string::npos)
+            << line;
+        if (short_run)
+            short_failed_at.insert(line.substr(line.rfind(": ", line.find(": HDF error") - 1)));
     }
     EXPECT_GE(full, 4) << "too few of the files filled the disk:\n" << text;
     EXPECT_GE(short_written, 1) << "the file never fitted:\n" << text;
-    EXPECT_GE(short_failed_at.size(), 3u) << "the fillers did not stop the file at different steps:\n" << text;
+    EXPECT_GE(short_failed_at.size(), 3u)
+        << "the fillers did not stop the file at different steps:\n"
+        << text;
 }
 
 // The writer reports the share of its rows written, and a callback that returns false stops it
@@ -725,8 +764,9 @@ TEST(OutputFile, a_device_takes_text_and_is_refused_as_a_file) {
     ASSERT_TRUE(OutputFile::is_stream("/dev/null"));
     OutputFile::write_text("/dev/null", "{}\n", false);
     for (bool overwrite : {false, true}) {
-        const std::string m = test::thrown_message<IoError>([&] { OutputFile out("/dev/null", overwrite, "UGRID output"); },
-                                                            "a device as a file output");
+        const std::string m = test::thrown_message<IoError>(
+            [&] { OutputFile out("/dev/null", overwrite, "UGRID output"); },
+            "a device as a file output");
         EXPECT_NE(m.find("/dev/null is not a regular file"), std::string::npos) << m;
     }
     EXPECT_EQ(fs::status("/dev/null").type(), fs::file_type::character);
