@@ -11,7 +11,7 @@ GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libs
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
 # its runtime (libFuzzer) for tools/fuzz.
 GLOBEMESH_TEST_PACKAGES="libgmp-dev mandoc man-db python3-numpy python3-scipy python3-netcdf4
-  python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev"
+  python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev clang-format"
 
 install_missing() {
     local missing=()
