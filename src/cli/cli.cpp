@@ -609,7 +609,8 @@ int run_mesh(std::span<const std::string> args, std::ostream& out, std::ostream&
     };
     out << "coast             " << attribute("boundary_rings") << " rings kept, islands dropped "
         << attribute("islands_removed") << ", lakes dropped " << attribute("lakes_removed")
-        << ", inlets closed " << attribute("inlets_closed") << "\n"
+        << ", inlets closed " << attribute("inlets_closed") << ", corners blunted " << attribute("corners_blunted")
+        << "\n"
         << "coast repairs     " << attribute("coast_repairs") << "\n"
         << "faces on land     " << attribute("faces_on_land") << "\n";
     // The first six places (lon lat) of a list attribute; all of them, up to 50, are the attribute.

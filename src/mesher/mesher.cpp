@@ -18,6 +18,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/predicates.hpp"
 #include "../delaunay/hilbert.hpp"
+#include "corners.hpp"
 #include "star_search.hpp"
 
 namespace globemesh {
@@ -2733,6 +2734,21 @@ Mesh mesh_boundary(const Boundary& boundary, const std::function<double(const Ve
         }
         report.land_faces_left = report.land_faces_at.size();
         if (timings) timings->add("land", seconds_since(t0));
+    }
+    {
+        // Last, the coast's corners too sharp for the faces there (corners.cpp).
+        detail::CornerMesh cm{dt, ocean, land, size_km,
+                              [&](VertexId a, VertexId b) {
+                                  const auto it = m.segments.find(key(a, b));
+                                  return it != m.segments.end() ? it->second : SegmentKind::coast;
+                              },
+                              [&](VertexId a, VertexId b, SegmentKind k) { m.add_segment(a, b, k); },
+                              [&](HalfEdge h) { return m.split_segment(h); }, m.pinched, m.cut_sides};
+        detail::CornerReport corners = detail::blunt_corners(cm, options.close_straits);
+        report.corners_blunted = corners.blunted;
+        report.encroached_splits += corners.splits;
+        report.straits_closed += corners.straits_at.size();
+        for (const Vec3& p : corners.straits_at) report.straits_closed_at.push_back(p);
     }
 
     // ---- output ------------------------------------------------------------------------------

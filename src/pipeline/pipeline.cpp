@@ -316,6 +316,7 @@ Mesh mesh_ocean(const MeshOptions& o, const Progress& run_progress, StageTimings
     a.emplace_back("inlets_closed", std::to_string(report.inlets_closed) + " (" +
                                         number(report.inlet_area_km2) + " km2)");
     a.emplace_back("lattice_nodes", std::to_string(report.lattice_nodes));
+    a.emplace_back("corners_blunted", std::to_string(report.corners_blunted));
     a.emplace_back("sharp_coast_corners", std::to_string(report.sharp_corners));
     a.emplace_back("faces_at_sharp_corners", std::to_string(report.sharp_corner_faces));
     std::ostringstream comps;
