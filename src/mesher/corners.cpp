@@ -12,6 +12,8 @@ constexpr int next3(int i) {
 constexpr int prev3(int i) {
     return i == 0 ? 2 : i - 1;
 }
+// The most faces of a coast node's fan that go to give a face below the floor a coast side.
+constexpr std::size_t fan_reach = 2;
 
 // The removal of ocean faces below the floor, one at a time, the faces behind looked at again.
 // A face below the floor with two boundary sides is an ear of the coast at a corner too sharp
@@ -68,6 +70,11 @@ private:
         } while (h != start);
         return count;
     }
+    // The half-edge leaving origin(h) before h, clockwise around it (next_around_origin's inverse).
+    HalfEdge previous_around_origin(HalfEdge h) const {
+        const HalfEdge back = dt_.twin(h);
+        return half_edge(triangle_of(back), next3(edge_of(back)));
+    }
     bool on_boundary(VertexId v, TriangleId t) const {
         const HalfEdge from = dt_.leaving(v, t);
         HalfEdge h = from;
@@ -110,7 +117,46 @@ private:
         } else if (straits_ && spans_narrow_water(t, sides, outer)) {
             remove(t, SegmentKind::coast);
             report_.straits_at.push_back(centroid(t));
+        } else if (sides == 0) {
+            open_to_coast(t);
         }
+    }
+
+    // A face without a boundary side but with a corner b on the coast: the faces of b's fan
+    // between it and the coast (on the side with fewer, at most fan_reach, each within reach of
+    // b) go, so that t gets a boundary side and is looked at again.
+    void open_to_coast(TriangleId t) {
+        int corner = -1;
+        for (int i = 0; i < 3; ++i)
+            if (on_boundary(dt_.vertex(t, i), t))
+                corner = corner < 0 ? i : 3;
+        if (corner < 0 || corner == 3)
+            return;
+        const VertexId b = dt_.vertex(t, corner);
+        const HalfEdge at = dt_.leaving(b, t);
+        std::vector<TriangleId> runs[2];
+        for (int way = 0; way < 2; ++way) {
+            HalfEdge h = at;
+            for (;;) {
+                h = way == 0 ? dt_.next_around_origin(h) : previous_around_origin(h);
+                if (!is_ocean(triangle_of(h)) || runs[way].size() > fan_reach)
+                    break;
+                runs[way].push_back(triangle_of(h));
+            }
+        }
+        std::vector<TriangleId> &run = runs[0].size() <= runs[1].size() ? runs[0] : runs[1];
+        if (run.size() > fan_reach)
+            return;
+        const double reach = blunt_reach * km_to_rad(m_.size_km(point(b)));
+        for (const TriangleId f : run)
+            for (int i = 0; i < 3; ++i)
+                if (arc_angle(point(b), point(dt_.vertex(f, i))) > reach)
+                    return;
+        for (auto it = run.rbegin(); it != run.rend(); ++it) {
+            remove(*it, SegmentKind::coast);
+            ++report_.blunted;
+        }
+        todo_.push_back(t);
     }
 
     // An ear (two boundary sides meeting at corner c, ocean behind the third).
