@@ -79,6 +79,17 @@ TEST(CoastReal, a_coast_corner_sharper_than_the_mesh_can_hold_is_blunted) {
     expect_valid_mesh(mesh, o, "maracaibo.nc");
 }
 
+// GSHHG intermediate around the Danube delta at 25 km, the region its own box: two faces of q
+// 0.217 at 29.0E 44.68N without a coast side, each with one corner on the coast (an interior
+// node 0.3 km from a coast node beside a sharp corner). The faces between them and the coast
+// at that corner go first, then the faces themselves.
+TEST(CoastReal, a_face_below_the_floor_with_one_coast_corner_goes_with_the_faces_beside_it) {
+    const MeshOptions o = region_run("coast/hostile/gshhg_i_danube.geojson", {28, 43.5, 30.5, 46}, 25);
+    const Mesh mesh = mesh_ocean(o);
+    EXPECT_GE(corners_blunted(mesh), 2u);
+    expect_valid_mesh(mesh, o, "danube.nc");
+}
+
 // GSHHG intermediate around Seram and Misool (128.5..131.5E, 4.5..1.5S): in the global run at
 // 100 km a face there below 0.3 had no coast side (its corners on the coast across water), and
 // the first blunting step read its corner index as -1, pinched a node of another triangle and
