@@ -19,12 +19,15 @@ constexpr std::size_t fan_reach = 2;
 // A face below the floor with two boundary sides is an ear of the coast at a corner too sharp
 // for the faces its segments allow (a narrow inlet's mouth closed beside a long segment, a spike
 // of water thinner than a face): it goes when its corner lies within blunt_reach h of its third
-// side, which becomes coast; a longer ear first gets its longer boundary side split. A face
+// side, which becomes coast; a longer ear first gets its longer boundary side split. A sliver
+// with one boundary side goes when its third corner, off the coast, is within reach. A face
 // below the floor whose corners are on the boundary across water (one boundary side and the
 // corner opposite on the boundary, or no boundary side and two corners on it) spans water
-// narrower than itself: with close_straits, it goes as a closing at those corners. Removing a
-// face keeps every other face and edge, so the mesh stays constrained Delaunay; each of its
-// corners that it leaves between two fans of ocean is pinched (split apart on output).
+// narrower than itself: with close_straits, it goes as a closing at those corners. A face with
+// one corner on the coast and no boundary side first loses the faces between it and the coast
+// at that corner (at most fan_reach, within reach of it). Removing a face keeps every other
+// face and edge, so the mesh stays constrained Delaunay; each of its corners that it leaves
+// between two fans of ocean is pinched (split apart on output).
 class Blunter {
 public:
     Blunter(CornerMesh &m, bool straits) : m_(m), dt_(m.dt), straits_(straits) {}
@@ -94,8 +97,8 @@ private:
     }
 
     void look_at(TriangleId t) {
-        int inner = -1, outer = -1,
-            sides = 0; // a side with ocean behind, one without; the latter's count
+        // A side with ocean behind, one without, and how many are without.
+        int inner = -1, outer = -1, sides = 0;
         for (int i = 0; i < 3; ++i) {
             if (is_ocean(triangle_of(dt_.twin(half_edge(t, i)))))
                 inner = i;
