@@ -2,6 +2,7 @@
 // them and holds the state they share).
 #include "globemesh/mesher.hpp"
 
+#include "corners.hpp"
 #include "mesher_state.hpp"
 
 namespace globemesh {
@@ -63,6 +64,9 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
         clear_land(m, options, std::move(island_faces));
         timed("land");
     }
+
+    // Last, the coast's corners too sharp for the faces there (corners.cpp).
+    blunt_sharp_corners(m, options);
 
     // Conversion to Mesh (output.cpp).
     Mesh mesh = to_mesh(m);

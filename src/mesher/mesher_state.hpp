@@ -501,6 +501,10 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
 void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId> &faces,
                    const MesherOptions &options, BoundaryLoops &loops, MesherReport &report);
 
+// corners.cpp: the last step, the ocean faces below q 0.3 that the coast's sharp corners leave
+// removed (counted in report.corners_blunted; closings across narrow water with the straits).
+void blunt_sharp_corners(Mesher &m, const MesherOptions &options);
+
 // output.cpp: the ocean triangles as a Mesh (nodes a closed strait pinched split, the seas it cut
 // off, sharp corners and the target size per node in the report and the mesh).
 Mesh to_mesh(Mesher &m);
