@@ -43,6 +43,12 @@ std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds) {
     for (const auto &r : boundary.rings)
         rings.push_back(&r.nodes);
     ArcGrid grid(rings);
+    // Splitting converges when arcs stray by their bulge; arcs that fold back on each other
+    // (a spike of zero width) conflict at every split and would double each round: the nodes
+    // added are bounded by the ring nodes (at least 1000), and what is left is refused later.
+    std::size_t budget = 1000;
+    for (const auto &r : boundary.rings)
+        budget += r.nodes.size();
     std::size_t added = 0;
     for (int round = 0; round < max_rounds; ++round) {
         const std::vector<ArcPair> pairs = grid.conflicts();
@@ -55,6 +61,8 @@ std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds) {
         }
         std::sort(arcs.begin(), arcs.end());
         arcs.erase(std::unique(arcs.begin(), arcs.end()), arcs.end());
+        if (added + arcs.size() > budget)
+            break;
         for (std::size_t k = 0; k < arcs.size();) {
             const std::uint32_t r = arcs[k].first;
             Ring &ring = boundary.rings[r];

@@ -538,3 +538,20 @@ TEST(CoastHostile, closed_coastline_lines_are_polygonized) {
     EXPECT_EQ(d.rings.rings.size(), 3u);
     expect_valid_both_stages(d, 20);
 }
+
+// Found by fuzz_coast (tests/fuzz/corpus/fuzz_coast/regression-pole-to-pole-fold): a ring from
+// lon 200, lat 89.64 to the south pole and back folds onto itself over 180 degrees. Its arcs
+// overlap at every split, so the splitting of straying arcs doubled them each round and did not
+// return; now it stops at its bound and the ring is refused with its place, as broken data.
+TEST(CoastHostile, a_ring_folded_back_from_pole_to_pole_is_refused_not_split_forever) {
+    TempDir dir;
+    auto path = write(dir, "fold.geojson",
+                      geojson({polygon("[[200.00000100937544,89.6429443359375],"
+                                       "[199.9999991833981,89.642943742641506],"
+                                       "[200.00000031191416,89.642945295910593],[-180,-90],"
+                                       "[-180,-90],[200.00000100937544,89.6429443359375]]")}));
+    const std::string m = message_of<DataError>(options_for(path));
+    EXPECT_TRUE(
+        test::regex_match(m, R"(.*arcs touch or cross near lon -?[0-9.]+, lat -?[0-9.]+.*)"))
+        << m;
+}
