@@ -7,7 +7,7 @@ namespace globemesh::cli {
 
 namespace {
 
-/// Every MeshOptions field that a flag of `globemesh mesh` sets (cli.cpp's MeshCommand).
+/// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
 constexpr std::array<std::pair<std::string_view, std::string_view>, 31> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},

@@ -179,10 +179,8 @@ std::vector<std::string> split_words(const std::string &s) {
     return words;
 }
 
-} // namespace
-
-Mesh read_ugrid(const std::filesystem::path &path) {
-    io::NcHandle nc;
+/// Opens `path` into `nc`; IoError when it is no NetCDF file (a GeoPackage named as such).
+void open_ugrid(io::NcHandle &nc, const std::filesystem::path &path) {
     int status = nc_open(path.c_str(), NC_NOWRITE, nc.out());
     if (status != NC_NOERR) {
         // A GeoPackage (what --gpkg writes) starts with SQLite's header: say so rather than
@@ -197,24 +195,27 @@ Mesh read_ugrid(const std::filesystem::path &path) {
         throw IoError("UGRID file " + path.string() + ": cannot open (" + nc_strerror(status) +
                       "); give an existing NetCDF file");
     }
-    Reader r(nc.id(), path);
+}
 
-    int nvars;
-    io::nc_check(nc_inq_nvars(nc.id(), &nvars), path, "listing variables");
+/// The first variable with cf_role = "mesh_topology", which must be 2-D.
+int find_topology(const Reader &r, int nvars) {
     int topo = -1;
     for (int v = 0; v < nvars && topo < 0; ++v)
         if (r.text(v, "cf_role") == std::optional<std::string>("mesh_topology"))
             topo = v;
     if (topo < 0)
         r.fail("no variable with cf_role = \"mesh_topology\": not a UGRID mesh");
-    const std::string topo_name = r.name(topo);
     if (r.integer(topo, "topology_dimension").value_or(0) != 2)
-        r.fail("mesh " + topo_name + " has no topology_dimension = 2; only 2-D meshes are read");
+        r.fail("mesh " + r.name(topo) + " has no topology_dimension = 2; only 2-D meshes are read");
+    return topo;
+}
 
-    // Nodes: longitude and latitude, told apart by standard_name or units, else in x y order.
+/// Reads the nodes into mesh.nodes; returns their dimension.
+int read_nodes(const Reader &r, int topo, Mesh &mesh) {
+    // Longitude and latitude, told apart by standard_name or units, else in x y order.
     auto coord_names = split_words(r.text(topo, "node_coordinates").value_or(""));
     if (coord_names.size() != 2)
-        r.fail("mesh " + topo_name + ": node_coordinates must name two variables");
+        r.fail("mesh " + r.name(topo) + ": node_coordinates must name two variables");
     int cx = r.var_id(coord_names[0], "node_coordinates"),
         cy = r.var_id(coord_names[1], "node_coordinates");
     auto is_lat = [&](int v) {
@@ -230,8 +231,6 @@ Mesh read_ugrid(const std::filesystem::path &path) {
     const int node_dim = node_dims[0];
     const std::size_t nn = r.dim_len(node_dim);
     auto lon = r.doubles(cx, nn), lat = r.doubles(cy, nn);
-
-    Mesh mesh;
     mesh.nodes.resize(nn);
     for (std::size_t i = 0; i < nn; ++i) {
         if (!std::isfinite(lon[i]) || !std::isfinite(lat[i]) || std::fabs(lat[i]) > 90.0)
@@ -239,17 +238,21 @@ Mesh read_ugrid(const std::filesystem::path &path) {
                    std::to_string(lon[i]) + ", " + std::to_string(lat[i]) + ")");
         mesh.nodes[i] = lonlat_to_vec(lon[i], lat[i]);
     }
+    return node_dim;
+}
 
-    // Faces.
+/// Reads the triangles into mesh.faces (after the nodes); returns their dimension.
+int read_faces(const Reader &r, int topo, Mesh &mesh) {
     auto face_name = r.text(topo, "face_node_connectivity");
     if (!face_name)
-        r.fail("mesh " + topo_name + " has no face_node_connectivity");
+        r.fail("mesh " + r.name(topo) + " has no face_node_connectivity");
     int face_dim = -1;
     if (auto fd = r.text(topo, "face_dimension"))
         face_dim = r.dim_id(*fd);
     else
         face_dim = r.dims(r.var_id(*face_name, "face_node_connectivity")).at(0);
-    Table faces = read_connectivity(r, *face_name, "face_node_connectivity", face_dim, nn);
+    Table faces =
+        read_connectivity(r, *face_name, "face_node_connectivity", face_dim, mesh.nodes.size());
     mesh.faces.resize(faces.rows);
     for (std::size_t f = 0; f < faces.rows; ++f) {
         std::size_t count = 0;
@@ -270,14 +273,42 @@ Mesh read_ugrid(const std::filesystem::path &path) {
             r.fail("face " + std::to_string(f) + " has " + std::to_string(count) +
                    " nodes; only triangle meshes are read");
     }
-    const std::size_t nf = faces.rows;
+    return face_dim;
+}
 
-    // Data variables on nodes and faces, and boundary tags on edges.
+/// Boundary tags (1 or 2) by edge key (smaller node << 32 | larger node), unsorted.
+using EdgeTags = std::vector<std::pair<std::uint64_t, int>>;
+
+/// Adds the tags of the edge variable `v` (boundary_tag on dimensions `d`) to `edge_tags`.
+void read_edge_tags(const Reader &r, int v, const std::vector<int> &d, const std::string &edge_name,
+                    int &edge_dim, std::size_t nn, EdgeTags &edge_tags) {
+    int ev = r.var_id(edge_name, "edge_node_connectivity");
+    if (edge_dim < 0)
+        edge_dim = r.dims(ev).at(0);
+    if (d[0] != edge_dim)
+        return;
+    Table edges = read_connectivity(r, edge_name, "edge_node_connectivity", edge_dim, nn);
+    auto tags = r.longs(v, edges.rows);
+    for (std::size_t e = 0; e < edges.rows; ++e) {
+        long long a = edges.values[2 * e], b = edges.values[2 * e + 1];
+        if (a < 0 || b < 0 || tags[e] <= 0 || tags[e] > 2)
+            continue;
+        if (a > b)
+            std::swap(a, b);
+        edge_tags.emplace_back((std::uint64_t(a) << 32) | std::uint64_t(b), int(tags[e]));
+    }
+}
+
+/// Data variables on nodes and faces into the mesh's fields; returns the boundary tags on edges.
+EdgeTags read_variables(const Reader &r, int nvars, int topo, int node_dim, int face_dim,
+                        Mesh &mesh) {
+    const std::string topo_name = r.name(topo);
+    const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size();
     int edge_dim = -1;
     if (auto ed = r.text(topo, "edge_dimension"))
         edge_dim = r.dim_id(*ed);
     auto edge_name = r.text(topo, "edge_node_connectivity");
-    std::vector<std::pair<std::uint64_t, int>> edge_tags;
+    EdgeTags edge_tags;
     for (int v = 0; v < nvars; ++v) {
         if (r.text(v, "mesh") != std::optional<std::string>(topo_name))
             continue;
@@ -287,21 +318,7 @@ Mesh read_ugrid(const std::filesystem::path &path) {
         if (d.size() != 1 || t == NC_CHAR || t == NC_STRING)
             continue;
         if (location == "edge" && r.name(v) == "boundary_tag" && edge_name) {
-            int ev = r.var_id(*edge_name, "edge_node_connectivity");
-            if (edge_dim < 0)
-                edge_dim = r.dims(ev).at(0);
-            if (d[0] != edge_dim)
-                continue;
-            Table edges = read_connectivity(r, *edge_name, "edge_node_connectivity", edge_dim, nn);
-            auto tags = r.longs(v, edges.rows);
-            for (std::size_t e = 0; e < edges.rows; ++e) {
-                long long a = edges.values[2 * e], b = edges.values[2 * e + 1];
-                if (a < 0 || b < 0 || tags[e] <= 0 || tags[e] > 2)
-                    continue;
-                if (a > b)
-                    std::swap(a, b);
-                edge_tags.emplace_back((std::uint64_t(a) << 32) | std::uint64_t(b), int(tags[e]));
-            }
+            read_edge_tags(r, v, d, *edge_name, edge_dim, nn, edge_tags);
             continue;
         }
         bool on_nodes = location == "node" && d[0] == node_dim;
@@ -315,14 +332,18 @@ Mesh read_ugrid(const std::filesystem::path &path) {
         f.standard_name = r.text(v, "standard_name").value_or("");
         f.values = r.doubles(v, on_nodes ? nn : nf);
         double fill;
-        if (nc_get_att_double(nc.id(), v, "_FillValue", &fill) == NC_NOERR)
+        if (nc_get_att_double(r.id(), v, "_FillValue", &fill) == NC_NOERR)
             for (auto &x : f.values)
                 if (x == fill)
                     x = std::nan("");
         (on_nodes ? mesh.node_fields : mesh.face_fields).push_back(std::move(f));
     }
+    return edge_tags;
+}
 
-    // Boundary edges from the faces (oriented with the mesh on the left), tagged from the file.
+/// Boundary edges from the faces (oriented with the mesh on the left), tagged from the file
+/// (coast where it says nothing).
+void add_boundary(const Reader &r, EdgeTags edge_tags, Mesh &mesh) {
     std::sort(edge_tags.begin(), edge_tags.end());
     const io::MeshTopology topology = [&] {
         try {
@@ -340,18 +361,36 @@ Mesh read_ugrid(const std::filesystem::path &path) {
             (it != edge_tags.end() && it->first == key) ? EdgeTag(it->second) : EdgeTag::coast;
         mesh.boundary.push_back({a, b, tag});
     }
+}
 
-    // Text global attributes other than the ones a writer regenerates.
+/// Text global attributes other than the ones a writer regenerates.
+void read_global_attributes(const Reader &r, const std::filesystem::path &path, Mesh &mesh) {
     static const std::set<std::string> regenerated = {"Conventions", "title", "source", "history"};
     int natts;
-    io::nc_check(nc_inq_natts(nc.id(), &natts), path, "listing global attributes");
+    io::nc_check(nc_inq_natts(r.id(), &natts), path, "listing global attributes");
     for (int i = 0; i < natts; ++i) {
         char name[NC_MAX_NAME + 1];
-        if (nc_inq_attname(nc.id(), NC_GLOBAL, i, name) != NC_NOERR || regenerated.count(name))
+        if (nc_inq_attname(r.id(), NC_GLOBAL, i, name) != NC_NOERR || regenerated.count(name))
             continue;
         if (auto value = r.text(NC_GLOBAL, name))
             mesh.attributes.emplace_back(name, *value);
     }
+}
+
+} // namespace
+
+Mesh read_ugrid(const std::filesystem::path &path) {
+    io::NcHandle nc;
+    open_ugrid(nc, path);
+    Reader r(nc.id(), path);
+    int nvars;
+    io::nc_check(nc_inq_nvars(nc.id(), &nvars), path, "listing variables");
+    const int topo = find_topology(r, nvars);
+    Mesh mesh;
+    const int node_dim = read_nodes(r, topo, mesh);
+    const int face_dim = read_faces(r, topo, mesh);
+    add_boundary(r, read_variables(r, nvars, topo, node_dim, face_dim, mesh), mesh);
+    read_global_attributes(r, path, mesh);
     return mesh;
 }
 

@@ -1,0 +1,122 @@
+// The summary and the --report JSON of a `mesh` run (mesh_summary.hpp).
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "globemesh/writers.hpp"
+#include "mesh_summary.hpp"
+
+namespace globemesh::cli {
+
+namespace {
+
+/// A whole number with thousands separators: 33251 -> "33,251", -2505 -> "-2,505".
+std::string grouped(long long v) {
+    std::string digits = std::to_string(v < 0 ? -v : v), r;
+    for (std::size_t i = 0; i < digits.size(); ++i) {
+        if (i > 0 && (digits.size() - i) % 3 == 0)
+            r += ',';
+        r += digits[i];
+    }
+    return (v < 0 ? "-" : "") + r;
+}
+
+/// The depth counts (nodes above sea level as sampled, those --min-depth raised) as a JSON object.
+std::string depth_json(const DepthReport &d) {
+    auto number_or_null = [](bool set, double v) {
+        return set ? report_number(v) : std::string("null");
+    };
+    return "{\"nodes_above_sea_level\": " + std::to_string(d.above_sea_level) +
+           ", \"min_sampled_depth_m\": " + number_or_null(d.above_sea_level > 0, d.shallowest_m) +
+           ", \"min_depth_m\": " +
+           number_or_null(d.min_depth_m.has_value(), d.min_depth_m.value_or(0)) +
+           ", \"nodes_raised_to_min_depth\": " + std::to_string(d.min_depth_m ? d.raised : 0) + "}";
+}
+
+/// The summary's depth line, and unless `quiet` the warning on `err` when nodes above sea level
+/// are written with negative depth (no --min-depth).
+void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, bool quiet) {
+    const auto count = static_cast<long long>(d.above_sea_level);
+    std::string down_to;
+    if (d.above_sea_level > 0)
+        down_to = " (down to " + grouped(std::llround(d.shallowest_m)) + " m)";
+    out << "depth             " << count << " nodes above sea level" << down_to;
+    if (d.min_depth_m)
+        out << ", " << d.raised << " raised to --min-depth " << report_number(*d.min_depth_m)
+            << " m";
+    out << "\n";
+    if (count > 0 && !d.min_depth_m && !quiet)
+        err << "globemesh: warning: " << grouped(count)
+            << (count == 1 ? " node lies" : " nodes lie") << " above sea level" << down_to
+            << (count == 1 ? " and is" : " and are")
+            << " written with negative depth; --min-depth 5 would raise them to 5 m\n";
+}
+
+/// What the run changed of the coast and the land: the summary's lines from the typed reports.
+void print_coast(std::ostream &out, const OceanMesh &run) {
+    const MesherReport &m = run.mesher;
+    out << "coast             " << run.coast.rings << " rings kept, islands dropped "
+        << run.coast.islands_removed << ", lakes dropped " << run.coast.lakes_removed
+        << ", inlets closed " << inlets_closed_text(m) << ", corners blunted " << m.corners_blunted
+        << "\n"
+        << "coast repairs     " << coast_repairs_text(run.coast_repairs) << "\n"
+        << "faces on land     " << land_faces_text(m) << "\n";
+    // The first six places (lon lat); all of them, up to 50, are in the file's attribute `key`.
+    auto places = [&](const std::vector<Vec3> &at, const char *key) {
+        constexpr std::size_t shown = 6;
+        if (at.empty())
+            return;
+        out << "                  at " << places_text(at, shown)
+            << (at.size() > shown ? std::string(" (") + key + ")" : "") << "\n";
+    };
+    places(m.land_faces_at, "faces_on_land_at");
+    if (run.straits_closing && m.straits_closed > 0) {
+        out << "straits closed    " << straits_closed_text(m) << "\n";
+        places(m.straits_closed_at, "straits_closed_at");
+    }
+    out << "ocean components  " << ocean_components_text(m) << "\n";
+}
+
+} // namespace
+
+std::string report_json(const MeshRunSummary &s) {
+    const Mesh &mesh = s.run.mesh;
+    std::ostringstream r;
+    r << "{\n  \"globemesh\": " << json_string(GLOBEMESH_VERSION) << ",\n"
+      << "  \"history\": " << json_string(s.history) << ",\n"
+      << "  \"outputs\": " << outputs_json(s.planned);
+    r << ",\n  \"mesh\": " << stats_json(s.stats, "  ") << ",\n";
+    if (s.run.depth)
+        r << "  \"depth\": " << depth_json(*s.run.depth) << ",\n";
+    // What the run did to the coast and the land, as the NetCDF file's global attributes say.
+    r << "  \"attributes\": {";
+    for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
+        r << (i ? ", " : "") << json_string(mesh.attributes[i].first) << ": "
+          << json_string(mesh.attributes[i].second);
+    r << "},\n"
+      << "  \"stages\": " << stages_json(s.timings) << ",\n"
+      << "  \"total_seconds\": " << json_number(s.total_s) << ",\n"
+      << "  \"peak_memory_bytes\": " << s.peak << "\n}\n";
+    return r.str();
+}
+
+void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSummary &s) {
+    const CliOptions &o = s.options;
+    print_stats(out, s.stats, false);
+    print_coast(out, s.run);
+    if (s.run.depth)
+        print_depth(out, err, *s.run.depth, o.quiet);
+    print_timings(out, s.timings);
+    out << "total time        " << exact_text(std::round(s.total_s * 1000) / 1000) << " s\n"
+        << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
+        << "wrote             " << outputs_text(s.planned);
+    for (const auto *p : {&o.timings, &o.report})
+        if (!p->empty())
+            out << ", " << *p;
+    out << "\n";
+}
+
+} // namespace globemesh::cli

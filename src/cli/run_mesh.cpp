@@ -1,0 +1,146 @@
+// `globemesh mesh`: checks before anything is opened, the run, its outputs and its summary.
+#include <chrono>
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_common.hpp"
+#include "cli_outputs.hpp"
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "globemesh/error.hpp"
+#include "globemesh/options.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/pipeline.hpp"
+#include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
+#include "mesh_summary.hpp"
+
+namespace globemesh::cli {
+
+namespace {
+
+/// The checks run_cli makes before anything is opened: library validation, then the outputs'
+/// formats and paths. Returns the outputs to write.
+std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const Writer> table) {
+    validate(o.mesh);
+    if (o.mesh.coast.empty())
+        throw UsageError(
+            "--coast is required: land polygons or coast lines, e.g. --coast land.gpkg");
+    if (o.output.empty())
+        throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o ocean.nc");
+    const OutputChoices choices{o.output,
+                                o.output_format,
+                                o.creation_options,
+                                {{"--gpkg", "GPKG", o.gpkg}, {"--preview", "PNG", o.preview}}};
+    std::vector<std::pair<std::string, std::string>> netcdf_format;
+    if (o.format == "classic")
+        netcdf_format.emplace_back("--format classic", "FORMAT=NC2");
+    const auto planned = plan_outputs(choices, table, netcdf_format, !o.mesh.bathy.empty());
+    const auto files = output_files(planned, o.timings, o.report, table);
+    const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
+                                                          {"--bathy", o.mesh.bathy},
+                                                          {"--region-file", o.mesh.region_file},
+                                                          {"--size-regions", o.mesh.size_regions},
+                                                          {"--config", o.config}};
+    for (const auto &[name, path] : inputs)
+        check_input_path(path, name); // (--config was read)
+    check_output_files(files, inputs, o.overwrite);
+    return planned;
+}
+
+/// Adds the `mesh` key of issue 4 (everything from rings and size field to the final mesh,
+/// I/O excluded) when the pipeline did not report it: the sum of the stages not named read*.
+void add_mesh_total(StageTimings &timings) {
+    for (const auto &[name, s] : timings.stages)
+        if (name == "mesh")
+            return;
+    double total = 0;
+    for (const auto &[name, s] : timings.stages)
+        if (name.rfind("read", 0) != 0)
+            total += s;
+    timings.add("mesh", total);
+}
+
+} // namespace
+
+int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream &err,
+             TerminalProgress &terminal, const CliLibrary &lib) {
+    auto command = std::make_unique<MeshCommand>(lib.writers);
+    try {
+        command->parse(args);
+    } catch (const CLI::CallForHelp &) {
+        out << command->app.help();
+        return 0;
+    } catch (const CLI::CallForAllHelp &) {
+        out << command->app.help();
+        return 0;
+    } catch (const CLI::CallForVersion &) {
+        out << version_text() << "\n";
+        return 0;
+    }
+    const CliOptions &o = command->o;
+    if (o.print_config) {
+        validate(o.mesh);
+        out << command->app.config_to_str(true, true);
+        return 0;
+    }
+    const std::vector<PlannedOutput> planned = check_mesh_run(o, lib.writers);
+
+    InterruptGuard interrupt;
+    GdalMessages gdal_messages(err, o.verbose);
+    const auto t0 = std::chrono::steady_clock::now();
+    StageTimings timings;
+    terminal.configure(o.quiet, o.verbose);
+    OceanMesh run =
+        lib.mesh_ocean(o.mesh, sub_progress(terminal.callback(), 0, mesh_share(planned)), &timings);
+    Mesh &mesh = run.mesh;
+    throw_if_interrupted();
+    add_mesh_total(timings);
+    // The effective configuration travels with the mesh, so the file itself says how to remake it.
+    mesh.attributes.emplace_back("globemesh_configuration",
+                                 command->app.config_to_str(true, false));
+
+    if (o.check) {
+        auto problems = check_mesh(mesh);
+        if (!problems.empty())
+            throw DataError("--check: the mesh breaks " + std::to_string(problems.size()) +
+                            (problems.size() >= 20 ? "+" : "") + " invariants, first: " +
+                            problems.front() + "; please report this with the command line");
+    }
+
+    // Computed once for the report and the writers (each would otherwise build the topology
+    // again for it).
+    const MeshStats stats = lib.compute_stats(mesh);
+    // Every output of the run waits under its temporary name until all are complete.
+    OutputBatch batch;
+    const auto tw = std::chrono::steady_clock::now();
+    WriteOptions write;
+    write.overwrite = o.overwrite;
+    write.history = history_text("mesh", args);
+    write.stats = &stats;
+    write.land = o.mesh.coast;
+    write.extent_deg = o.mesh.region;
+    write_run_outputs(mesh, planned, write, terminal);
+    timings.add("write", seconds_since(tw));
+    terminal.finish(); // close the progress line if a stage stopped short of its share's end
+
+    MeshRunSummary summary{o, planned, stats, run, timings, write.history};
+    summary.total_s = seconds_since(t0);
+    summary.peak = peak_memory_bytes();
+    if (!o.timings.empty()) {
+        OutputFile::write_text(o.timings, timings_json(timings), o.overwrite, "--timings");
+    }
+    if (!o.report.empty())
+        OutputFile::write_text(o.report, report_json(summary), o.overwrite, "--report");
+    batch.commit(InterruptGuard::interrupted);
+    InterruptGuard::finished();
+    print_mesh_summary(out, err, summary);
+    return 0;
+}
+
+} // namespace globemesh::cli
