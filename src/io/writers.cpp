@@ -104,8 +104,9 @@ void check_creation_options(const Writer &writer, CreationOptions &options,
                             const std::string &what) {
     for (auto &[key, value] : options) {
         key = upper(key);
+        const std::string &name = key; // (clang 14 cannot capture a structured binding)
         auto known = std::find_if(writer.creation_options.begin(), writer.creation_options.end(),
-                                  [&](const CreationOption &c) { return c.name == key; });
+                                  [&](const CreationOption &c) { return c.name == name; });
         if (known == writer.creation_options.end()) {
             std::vector<std::string> names;
             for (const auto &c : writer.creation_options)
