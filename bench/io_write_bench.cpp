@@ -1,5 +1,6 @@
 // Write speed and size of the io outputs on a 1,310,720-face icosphere (level 8) with depth and
-// target_size fields: UGRID NetCDF-4 (deflate), UGRID classic, GeoPackage, preview PNG, read-back.
+// target_size fields: UGRID NetCDF-4 (deflate), UGRID classic, GeoPackage, preview PNG, gmsh MSH
+// 4.1 and 2.2 (through the writers table), read-back.
 // Run: io_write_bench --benchmark_counters_tabular=true (file sizes are reported as counters).
 #include <benchmark/benchmark.h>
 
@@ -9,6 +10,7 @@
 #include "globemesh/gpkg.hpp"
 #include "globemesh/preview.hpp"
 #include "globemesh/ugrid.hpp"
+#include "globemesh/writers.hpp"
 
 namespace {
 
@@ -53,6 +55,17 @@ void BM_write_gpkg(benchmark::State &s) {
 void BM_write_preview_png(benchmark::State &s) {
     run(s, "p.png", [](const auto &m, const auto &p) { globemesh::write_preview_png(m, p); });
 }
+void write_gmsh(const globemesh::Mesh &m, const std::filesystem::path &p, const char *version) {
+    globemesh::WriteOptions o;
+    o.creation_options = {{"MSH_VERSION", version}};
+    globemesh::find_writer(globemesh::writers(), "GMSH")->write(m, p, o);
+}
+void BM_write_gmsh_41(benchmark::State &s) {
+    run(s, "m41.msh", [](const auto &m, const auto &p) { write_gmsh(m, p, "4.1"); });
+}
+void BM_write_gmsh_22(benchmark::State &s) {
+    run(s, "m22.msh", [](const auto &m, const auto &p) { write_gmsh(m, p, "2.2"); });
+}
 void BM_read_ugrid_and_stats(benchmark::State &s) {
     auto path = out_path("r.nc");
     std::filesystem::remove(path);
@@ -68,5 +81,7 @@ BENCHMARK(BM_write_ugrid_netcdf4)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_ugrid_classic)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_gpkg)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_preview_png)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_write_gmsh_41)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_write_gmsh_22)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_read_ugrid_and_stats)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK_MAIN();

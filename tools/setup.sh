@@ -9,9 +9,10 @@ GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libs
   libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
-# its runtime (libFuzzer) for tools/fuzz.
+# its runtime (libFuzzer) for tools/fuzz, gmsh's and meshio's readers of the .msh output.
 GLOBEMESH_TEST_PACKAGES="libgmp-dev mandoc man-db python3-numpy python3-scipy python3-netcdf4
-  python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev clang-format"
+  python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev clang-format
+  python3-gmsh python3-meshio"
 
 install_missing() {
     local missing=()

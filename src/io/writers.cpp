@@ -19,6 +19,8 @@ void write_as_gpkg(const Mesh &mesh, const fs::path &path,
                    const WriteOptions &options); // gpkg_write.cpp
 void write_as_png(const Mesh &mesh, const fs::path &path,
                   const WriteOptions &options); // preview_png.cpp
+void write_as_gmsh(const Mesh &mesh, const fs::path &path,
+                   const WriteOptions &options); // gmsh_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -47,6 +49,18 @@ const std::vector<Writer> &writers() {
          .report_key = "preview",
          .progress_weight = 1.1,
          .write = write_as_png},
+        {.name = "GMSH",
+         .long_name = "gmsh MSH",
+         .extensions = {".msh"},
+         .report_key = "gmsh",
+         .progress_weight = 1.5,
+         .creation_options =
+             {{"MSH_VERSION", {"4.1", "2.2"}, "4.1 (default) or 2.2 of the MSH format"},
+              {"COORDS",
+               {"LONLAT", "SPHERE"},
+               "LONLAT: lon/lat degrees (default); SPHERE: x y z in metres on a sphere"},
+              {"RADIUS", {}, "the sphere's radius in metres for COORDS=SPHERE (6371000)"}},
+         .write = write_as_gmsh},
     };
     return table;
 }

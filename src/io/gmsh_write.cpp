@@ -1,0 +1,327 @@
+// The gmsh MSH writer (the GMSH row of writers.cpp): MSH 4.1 ASCII, or 2.2 by MSH_VERSION=2.2.
+//
+// The file holds the nodes, the faces as triangles of the physical group "ocean" (2-D) and the
+// boundary edges as lines of the groups "coast" and "open" (1-D), with the boundary tags of the
+// topology the UGRID writer uses; a group without elements is left out (a global mesh has no
+// "open"). Physical tags are fixed so that model scripts can use the numbers: coast 1, open 2,
+// ocean 3. In 4.1 the entities are the discrete curves 1 (coast) and 2 (open) and the surface 1
+// (ocean), which holds every node. The depth, when the mesh has one, follows as $NodeData
+// "depth" (metres, positive down). Coordinates: lon/lat degrees (z = 0) or, with COORDS=SPHERE,
+// x y z in metres on the sphere of RADIUS. Written as it goes through a buffer of 1 MiB.
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/writers.hpp"
+#include "mesh_topology.hpp"
+
+namespace globemesh {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int coast_group = 1, open_group = 2, ocean_group = 3;
+constexpr int ocean_surface = 1;
+constexpr std::size_t report_every = 1 << 16;
+
+/// The creation options as the writer uses them.
+struct MshChoices {
+    bool v22 = false;
+    bool sphere = false;
+    double radius = 6371000;
+};
+
+MshChoices msh_choices(const CreationOptions &options, const fs::path &path) {
+    MshChoices c;
+    c.v22 = creation_option(options, "MSH_VERSION", "4.1") == "2.2";
+    c.sphere = creation_option(options, "COORDS", "LONLAT") == "SPHERE";
+    const std::string radius = creation_option(options, "RADIUS");
+    if (radius.empty())
+        return c;
+    const char *end = radius.data() + radius.size();
+    auto [at, ec] = std::from_chars(radius.data(), end, c.radius);
+    if (ec != std::errc() || at != end || !std::isfinite(c.radius) || c.radius <= 0)
+        throw UsageError(path.string() + ": GMSH creation option RADIUS=" + radius +
+                         ": give the sphere's radius in metres, e.g. RADIUS=6371000");
+    if (!c.sphere)
+        throw UsageError(path.string() + ": GMSH creation option RADIUS=" + radius +
+                         " is for COORDS=SPHERE (lon/lat output has no radius)");
+    return c;
+}
+
+/// Text written to a FILE through a buffer, numbers formatted with to_chars (shortest text that
+/// reads back to the same double).
+class MshStream {
+public:
+    MshStream(const fs::path &temp, const fs::path &target) : target_(target) {
+        file_ = std::fopen(temp.c_str(), "wbx");
+        if (file_ == nullptr)
+            throw IoError("gmsh output " + target.string() + ": cannot create (" +
+                          std::strerror(errno) + ")");
+        buffer_.reserve(capacity + 64);
+    }
+    ~MshStream() {
+        if (file_ != nullptr)
+            std::fclose(file_);
+    }
+    MshStream(const MshStream &) = delete;
+    MshStream &operator=(const MshStream &) = delete;
+
+    MshStream &operator<<(std::string_view s) {
+        buffer_ += s;
+        return flush_if_full();
+    }
+    MshStream &operator<<(char c) {
+        buffer_ += c;
+        return flush_if_full();
+    }
+    MshStream &operator<<(double v) { return number(v); }
+    MshStream &operator<<(std::size_t v) { return number(v); }
+    MshStream &operator<<(int v) { return number(v); }
+
+    /// Writes what is left and closes the file; throws IoError on a failed write.
+    void close() {
+        flush();
+        FILE *f = std::exchange(file_, nullptr);
+        if (std::fclose(f) != 0)
+            fail();
+    }
+
+private:
+    static constexpr std::size_t capacity = 1 << 20;
+
+    template <class T> MshStream &number(T v) {
+        char text[32];
+        auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+        buffer_.append(text, end);
+        return flush_if_full();
+    }
+    MshStream &flush_if_full() {
+        if (buffer_.size() >= capacity)
+            flush();
+        return *this;
+    }
+    void flush() {
+        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+            fail();
+        buffer_.clear();
+    }
+    [[noreturn]] void fail() {
+        throw IoError("gmsh output " + target_.string() + ": writing failed (" +
+                      std::strerror(errno) + ")" + OutputFile::full_disk_note(target_));
+    }
+
+    FILE *file_ = nullptr;
+    std::string buffer_;
+    fs::path target_;
+};
+
+/// What the writer writes of one mesh, in order.
+class MshWriter {
+public:
+    MshWriter(const Mesh &mesh, const io::MeshTopology &topo, MshChoices choices, MshStream &out,
+              const Progress &progress)
+        : mesh_(mesh), topo_(topo), c_(choices), out_(out), progress_(progress) {
+        for (int tag : topo.boundary_tags)
+            ++(tag == int(EdgeTag::open) ? open_count_ : coast_count_);
+        depth_ = mesh.node_field("depth");
+        total_ = double(mesh.nodes.size()) * (depth_ ? 2 : 1) + double(mesh.faces.size()) +
+                 double(topo.boundary_edges.size()) + 1;
+    }
+
+    void write() {
+        out_ << "$MeshFormat\n" << (c_.v22 ? "2.2" : "4.1") << " 0 8\n$EndMeshFormat\n";
+        physical_names();
+        if (!c_.v22)
+            entities();
+        nodes();
+        elements();
+        if (depth_)
+            node_data();
+        report(progress_, 1.0, "write_gmsh");
+    }
+
+private:
+    std::array<double, 3> point(std::size_t i) const {
+        const Vec3 &v = mesh_.nodes[i];
+        if (c_.sphere)
+            return {c_.radius * v.x, c_.radius * v.y, c_.radius * v.z};
+        const LonLat p = vec_to_lonlat(v);
+        return {p.lon, p.lat, 0.0};
+    }
+
+    void tick() {
+        if (++done_ % report_every == 0)
+            report(progress_, double(done_) / total_, "write_gmsh");
+    }
+
+    void physical_names() {
+        const int groups = 1 + (coast_count_ > 0) + (open_count_ > 0);
+        out_ << "$PhysicalNames\n" << groups << '\n';
+        if (coast_count_ > 0)
+            out_ << "1 " << coast_group << " \"coast\"\n";
+        if (open_count_ > 0)
+            out_ << "1 " << open_group << " \"open\"\n";
+        out_ << "2 " << ocean_group << " \"ocean\"\n$EndPhysicalNames\n";
+    }
+
+    /// Writes the bounding box of the nodes for which keep(i) holds.
+    template <class Keep> void box(Keep keep) {
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        std::array<double, 3> lo{inf, inf, inf}, hi{-inf, -inf, -inf};
+        auto add = [&](std::size_t i) {
+            const auto p = point(i);
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], p[k]);
+                hi[k] = std::max(hi[k], p[k]);
+            }
+        };
+        keep(add);
+        for (double v : lo)
+            out_ << v << ' ';
+        for (double v : hi)
+            out_ << v << ' ';
+    }
+
+    /// Calls add(node) for both nodes of each boundary edge tagged `open` (or not).
+    template <class Add> void boundary_nodes(bool open, Add add) const {
+        for (std::size_t b = 0; b < topo_.boundary_edges.size(); ++b)
+            if ((topo_.boundary_tags[b] == int(EdgeTag::open)) == open)
+                for (auto n : topo_.edge_nodes(std::size_t(topo_.boundary_edges[b])))
+                    add(std::size_t(n));
+    }
+
+    void entities() {
+        const int curves = (coast_count_ > 0) + (open_count_ > 0);
+        out_ << "$Entities\n0 " << curves << " 1 0\n";
+        for (const bool open : {false, true}) {
+            if ((open ? open_count_ : coast_count_) == 0)
+                continue;
+            out_ << (open ? open_group : coast_group) << ' ';
+            box([&](auto add) { boundary_nodes(open, add); });
+            out_ << "1 " << (open ? open_group : coast_group) << " 0\n";
+        }
+        out_ << ocean_surface << ' ';
+        box([&](auto add) {
+            for (std::size_t i = 0; i < mesh_.nodes.size(); ++i)
+                add(i);
+        });
+        out_ << "1 " << ocean_group << ' ' << curves;
+        if (coast_count_ > 0)
+            out_ << ' ' << coast_group;
+        if (open_count_ > 0)
+            out_ << ' ' << open_group;
+        out_ << "\n$EndEntities\n";
+    }
+
+    void nodes() {
+        const std::size_t n = mesh_.nodes.size();
+        out_ << "$Nodes\n";
+        if (c_.v22) {
+            out_ << n << '\n';
+        } else {
+            // One block, the ocean surface's, holding every node.
+            out_ << "1 " << n << " 1 " << n << '\n';
+            out_ << "2 " << ocean_surface << " 0 " << n << '\n';
+            for (std::size_t i = 1; i <= n; ++i)
+                out_ << i << '\n';
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto p = point(i);
+            if (c_.v22)
+                out_ << i + 1 << ' ';
+            out_ << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+            tick();
+        }
+        out_ << "$EndNodes\n";
+    }
+
+    void elements() {
+        const std::size_t nf = mesh_.faces.size();
+        const std::size_t total = nf + coast_count_ + open_count_;
+        const int blocks = 1 + (coast_count_ > 0) + (open_count_ > 0);
+        out_ << "$Elements\n";
+        if (c_.v22)
+            out_ << total << '\n';
+        else
+            out_ << blocks << ' ' << total << " 1 " << total << '\n'
+                 << "2 " << ocean_surface << " 2 " << nf << '\n';
+        std::size_t tag = 0;
+        for (const auto &face : mesh_.faces) {
+            out_ << ++tag;
+            if (c_.v22)
+                out_ << " 2 2 " << ocean_group << ' ' << ocean_surface;
+            for (NodeIndex v : face)
+                out_ << ' ' << std::size_t(v) + 1;
+            out_ << '\n';
+            tick();
+        }
+        for (const bool open : {false, true}) {
+            const std::size_t count = open ? open_count_ : coast_count_;
+            const int group = open ? open_group : coast_group;
+            if (count == 0)
+                continue;
+            if (!c_.v22)
+                out_ << "1 " << group << " 1 " << count << '\n';
+            for (std::size_t b = 0; b < topo_.boundary_edges.size(); ++b) {
+                if ((topo_.boundary_tags[b] == int(EdgeTag::open)) != open)
+                    continue;
+                const auto ends = topo_.edge_nodes(std::size_t(topo_.boundary_edges[b]));
+                out_ << ++tag;
+                if (c_.v22)
+                    out_ << " 1 2 " << group << ' ' << group;
+                out_ << ' ' << std::size_t(ends[0]) + 1 << ' ' << std::size_t(ends[1]) + 1 << '\n';
+                tick();
+            }
+        }
+        out_ << "$EndElements\n";
+    }
+
+    void node_data() {
+        const std::size_t n = mesh_.nodes.size();
+        out_ << "$NodeData\n1\n\"depth\"\n1\n0\n3\n0\n1\n" << n << '\n';
+        for (std::size_t i = 0; i < n; ++i) {
+            out_ << i + 1 << ' ' << depth_->values[i] << '\n';
+            tick();
+        }
+        out_ << "$EndNodeData\n";
+    }
+
+    const Mesh &mesh_;
+    const io::MeshTopology &topo_;
+    MshChoices c_;
+    MshStream &out_;
+    const Progress &progress_;
+    const Field *depth_ = nullptr;
+    std::size_t coast_count_ = 0, open_count_ = 0;
+    double total_ = 1;
+    std::size_t done_ = 0;
+};
+
+} // namespace
+
+void write_as_gmsh(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
+    const MshChoices choices = msh_choices(options.creation_options, path);
+    OutputFile out(path, options.overwrite, "gmsh output");
+    const io::MeshTopology topo = io::build_topology(mesh);
+    {
+        MshStream stream(out.temp_path(), path);
+        MshWriter(mesh, topo, choices, stream, options.progress).write();
+        stream.close();
+    }
+    out.commit();
+}
+
+} // namespace globemesh

@@ -1,0 +1,235 @@
+// The gmsh .msh output through the globemesh executable, read back by gmsh's own Python API
+// (python3-gmsh) and by meshio (python3-meshio), and compared with the UGRID file of the same run
+// read by netCDF4: node and triangle counts, coordinates, the boundary lines (node pairs) per
+// physical group, and the depth. Skipped where a reader is absent (a failure under CI=true).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "support.hpp"
+
+namespace fs = std::filesystem;
+using namespace globemesh::test;
+
+namespace {
+
+const std::string exe = GLOBEMESH_EXE;
+const std::string land110 = fixture("coast/ne_110m_land.gpkg").string();
+const std::string land50 = fixture("coast/ne_50m_land.gpkg").string();
+const std::string shelf_dem = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+
+std::string quote(const std::string &s) {
+    return "'" + s + "'";
+}
+
+/// Runs the executable; `err` gets stderr.
+int run_exe(const std::vector<std::string> &args, std::string &err, const fs::path &dir) {
+    std::string command = quote(exe);
+    for (const auto &a : args) {
+        command += ' ';
+        command += quote(a);
+    }
+    std::string out;
+    const int status =
+        run_command("( " + command + " >/dev/null 2>" + quote((dir / ".err").string()) + " )", out);
+    std::ifstream e(dir / ".err");
+    err.assign(std::istreambuf_iterator<char>(e), {});
+    fs::remove(dir / ".err");
+    return status;
+}
+
+bool readers_available() {
+    std::string out;
+    if (run_command("/usr/bin/python3 -c 'import gmsh, meshio, netCDF4, numpy'", out) == 0)
+        return true;
+    tool_missing("gmsh's and meshio's Python modules (python3-gmsh, python3-meshio)");
+    return false;
+}
+
+// Compares MSH (argv[1]) with UGRID (argv[2]); argv[3] is "lonlat" or the sphere's radius.
+// Prints "OK coast=N open=M" or fails with the difference.
+const char *const check_script = R"(
+import sys, gmsh, meshio, netCDF4, numpy as np
+msh, nc, coords = sys.argv[1], sys.argv[2], sys.argv[3]
+ds = netCDF4.Dataset(nc)
+ds.set_auto_mask(False)
+lon, lat = ds['mesh_node_lon'][:], ds['mesh_node_lat'][:]
+faces = ds['mesh_face_nodes']
+nfaces = faces.shape[0]
+edges = ds['mesh_edge_nodes'][:] - int(getattr(ds['mesh_edge_nodes'], 'start_index', 0))
+tag = ds['boundary_tag'][:]
+want = {name: set(map(tuple, np.sort(edges[tag == t], axis=1))) for name, t in (('coast', 1), ('open', 2))}
+depth = ds['depth'][:] if 'depth' in ds.variables else None
+
+def check_points(xyz):
+    if coords == 'lonlat':
+        assert np.allclose(xyz[:, 0], lon, atol=1e-9) and np.allclose(xyz[:, 1], lat, atol=1e-9), 'lon/lat'
+        assert np.all(xyz[:, 2] == 0), 'z'
+    else:
+        r = float(coords)
+        assert np.allclose(np.linalg.norm(xyz, axis=1), r, rtol=1e-12), 'radius'
+        assert np.allclose(np.degrees(np.arcsin(xyz[:, 2] / r)), lat, atol=1e-7), 'lat'
+        d = (np.degrees(np.arctan2(xyz[:, 1], xyz[:, 0])) - lon + 180) % 360 - 180
+        assert np.allclose(d[np.abs(lat) < 89.9], 0, atol=1e-7), 'lon'
+
+# gmsh's own reader
+gmsh.initialize()
+gmsh.option.setNumber('General.Terminal', 0)
+gmsh.open(msh)
+tags, xyz, _ = gmsh.model.mesh.getNodes()
+order = np.argsort(tags)
+assert len(tags) == len(lon), ('gmsh nodes', len(tags), len(lon))
+check_points(xyz.reshape(-1, 3)[order])
+groups = {}
+for dim, ptag in gmsh.model.getPhysicalGroups():
+    name = gmsh.model.getPhysicalName(dim, ptag)
+    elems = []
+    for e in gmsh.model.getEntitiesForPhysicalGroup(dim, ptag):
+        types, _, nodes = gmsh.model.mesh.getElements(dim, e)
+        for t, n in zip(types, nodes):
+            k = 3 if t == 2 else 2
+            assert t == (2 if dim == 2 else 1), ('element type', name, t)
+            elems.append(np.asarray(n, dtype=np.int64).reshape(-1, k) - 1)
+    groups[name] = (dim, np.concatenate(elems))
+assert groups['ocean'][0] == 2 and len(groups['ocean'][1]) == nfaces, ('ocean', nfaces)
+for name, pairs in want.items():
+    got = set(map(tuple, np.sort(groups[name][1], axis=1))) if name in groups else set()
+    assert (name not in groups) == (len(pairs) == 0), ('group present', name)
+    assert name not in groups or groups[name][0] == 1, ('dim', name)
+    assert got == pairs, (name, len(got), len(pairs))
+assert set(groups) <= {'ocean', 'coast', 'open'}, groups.keys()
+views = gmsh.view.getTags()
+if depth is None:
+    assert len(views) == 0, 'depth without a bathymetry'
+else:
+    assert gmsh.option.getString('View[0].Name') == 'depth', 'view name'
+    _, ntags, data, _, ncomp = gmsh.view.getModelData(views[0], 0)
+    got = np.zeros(len(lon))
+    got[np.asarray(ntags) - 1] = np.asarray(data).ravel()
+    assert ncomp == 1 and len(ntags) == len(lon) and np.allclose(got, depth), 'gmsh depth'
+gmsh.finalize()
+
+# meshio
+m = meshio.read(msh)
+check_points(np.asarray(m.points))
+assert len(m.points) == len(lon)
+count = {}
+for block, phys in zip(m.cells, m.cell_data['gmsh:physical']):
+    for p in np.unique(phys):
+        count[(block.type, int(p))] = count.get((block.type, int(p)), 0) + int(np.sum(phys == p))
+names = {name: int(v[0]) for name, v in m.field_data.items()}
+assert count.get(('triangle', names['ocean'])) == nfaces, count
+for name, pairs in want.items():
+    assert count.get(('line', names.get(name, -1)), 0) == len(pairs), (name, count)
+assert sum(len(b.data) for b in m.cells if b.type == 'line') == int(np.sum(tag != 0)), 'lines'
+if depth is not None:
+    assert np.allclose(m.point_data['depth'], depth), 'meshio depth'
+print('OK coast=%d open=%d' % (len(want['coast']), len(want['open'])))
+)";
+
+/// Runs the check on `msh` against `nc`; returns its one line.
+std::string check(const fs::path &msh, const fs::path &nc, const std::string &coords,
+                  const fs::path &dir) {
+    std::ofstream(dir / "check.py") << check_script;
+    std::string out;
+    const int status =
+        run_command("/usr/bin/python3 " + quote((dir / "check.py").string()) + " " +
+                        quote(msh.string()) + " " + quote(nc.string()) + " " + coords,
+                    out);
+    EXPECT_EQ(status, 0) << out;
+    return out;
+}
+
+const std::vector<std::string> regional = {
+    "mesh",     "--coast",      land50,    "--coast-layer", "land",
+    "--region", "-12,46,13,62", "--bathy", shelf_dem,       "--hmax",
+    "60km",     "--hmin",       "10km",    "--coast-size",  "15km"};
+
+std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string> &more) {
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+}
+
+} // namespace
+
+TEST(GmshE2e, regional_41_and_22_read_back_as_the_ugrid_file_says) {
+    if (!readers_available())
+        return;
+    TempDir dir;
+    std::string err;
+    ASSERT_EQ(
+        run_exe(with(regional, {"-o", (dir / "r.nc").string(), "-o", (dir / "r.msh").string()}),
+                err, dir.path()),
+        0)
+        << err;
+    expect_mesh_verify(dir / "r.nc");
+    std::ifstream head(dir / "r.msh");
+    std::string line;
+    std::getline(head, line);
+    std::getline(head, line);
+    EXPECT_EQ(line, "4.1 0 8");
+    const std::string out = check(dir / "r.msh", dir / "r.nc", "lonlat", dir.path());
+    EXPECT_NE(out.find("OK coast="), std::string::npos) << out;
+    EXPECT_EQ(out.find("open=0"), std::string::npos) << out; // a region has open edges
+
+    ASSERT_EQ(run_exe(with(regional, {"-o", (dir / "s.nc").string(), "-o", (dir / "s.msh").string(),
+                                      "--co", "MSH_VERSION=2.2"}),
+                      err, dir.path()),
+              0)
+        << err;
+    std::ifstream head22(dir / "s.msh");
+    std::getline(head22, line);
+    std::getline(head22, line);
+    EXPECT_EQ(line, "2.2 0 8");
+    EXPECT_EQ(check(dir / "s.msh", dir / "s.nc", "lonlat", dir.path()), out);
+}
+
+TEST(GmshE2e, global_on_the_sphere_has_no_open_group_in_either_version) {
+    if (!readers_available())
+        return;
+    TempDir dir;
+    const std::vector<std::string> global = {"mesh",   "--coast", land110,  "--coast-layer", "land",
+                                             "--hmax", "400km",   "--hmin", "100km"};
+    for (const std::string version : {"4.1", "2.2"}) {
+        const fs::path nc = dir / ("g" + version + ".nc"), msh = dir / ("g" + version + ".msh");
+        std::string err;
+        ASSERT_EQ(run_exe(with(global, {"-o", nc.string(), "-o", msh.string(), "--co",
+                                        "MSH_VERSION=" + version, "--co", "coords=sphere", "--co",
+                                        "RADIUS=6371000"}),
+                          err, dir.path()),
+                  0)
+            << err;
+        expect_mesh_verify(nc);
+        const std::string out = check(msh, nc, "6371000", dir.path());
+        EXPECT_NE(out.find("OK coast="), std::string::npos) << version << ": " << out;
+        EXPECT_NE(out.find(" open=0"), std::string::npos) << version << ": " << out;
+    }
+}
+
+TEST(GmshE2e, refusals_are_one_line_and_leave_no_file) {
+    TempDir dir;
+    struct Case {
+        std::vector<std::string> extra;
+        int status;
+        std::string says;
+    };
+    const std::vector<Case> cases = {
+        {{"-o", (dir / "no" / "x.msh").string()}, 1, "x.msh"},
+        {{"-o", (dir / "x.msh").string(), "--co", "MSH_VERSION=3"}, 2, "MSH_VERSION=4.1 or 2.2"},
+        {{"-o", (dir / "x.msh").string(), "--co", "COORDS=SPHERE", "--co", "RADIUS=-1"},
+         2,
+         "RADIUS=-1"},
+        {{"-o", (dir / "x.msh").string(), "--co", "RADIUS=6371000"}, 2, "COORDS=SPHERE"},
+    };
+    for (const auto &c : cases) {
+        std::string err;
+        EXPECT_EQ(run_exe(with(regional, with(c.extra, {"--quiet"})), err, dir.path()), c.status)
+            << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+        EXPECT_NE(err.find(c.says), std::string::npos) << err;
+        EXPECT_TRUE(fs::is_empty(dir.path())) << err;
+    }
+}
