@@ -480,6 +480,9 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made, std::vector<std
 // when options.land is given), pattern searches raise the worst triangles, and triangles with
 // two or three boundary corners are mended.
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
+// The same search for the free nodes of the faces below q 0.3 that the land and corner stages
+// leave (their nodes moved or their neighbours removed after improve_quality).
+void raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
 
 // islands.cpp: face centroids moved off the islands the coast shaping dropped.
 std::size_t clear_dropped_islands(Mesher &m, const Boundary &boundary, MesherReport &report,

@@ -2,6 +2,7 @@
 // to the coast, or at valence defects) move where their star scores best, boundary nodes slide
 // near the coast, pattern searches raise the worst triangles, and triangles with two or three
 // boundary corners are mended.
+#include "corners.hpp"
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
@@ -35,6 +36,7 @@ public:
     void run_count_rounds();
     void run_search_rounds();
     void mend_corners();
+    void raise_floor();
 
 private:
     Mesher &m;
@@ -386,7 +388,26 @@ void QualityRounds::mend_corners() {
     }
 }
 
+void QualityRounds::raise_floor() {
+    // After the land and corner clean-up, which move and remove faces after the rounds above:
+    // the free nodes of the faces still below the floor (sharp corners included) get the
+    // search that raises their star's worst, a few rounds; a move never lowers a star's worst.
+    as_made.resize(dt.vertex_count(), 0);
+    dirty.resize(dt.vertex_count(), 0);
+    for (int round = 0; round < search_rounds; ++round) {
+        collect(detail::blunt_floor, false);
+        if (todo.empty())
+            break;
+        for (auto &[v, hint] : todo)
+            improve_node(v, hint);
+    }
+}
+
 } // namespace
+
+void raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made) {
+    QualityRounds(m, options, as_made).raise_floor();
+}
 
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made) {
     QualityRounds rounds(m, options, as_made);
