@@ -112,8 +112,9 @@ struct Chain {
 std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, bool keep_inland_seas,
                                CoastData &out);
 /// The ocean of a region (--region box or --region-file polygons): the region less the land.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const MeshOptions &options,
-                                const std::string &where, CoastData &out);
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+                                std::uint64_t max_memory_bytes, const std::string &where,
+                                CoastData &out);
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
 Ring to_sphere(const Chain &c);
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in

@@ -329,10 +329,10 @@ GeomPtr box_domain(Geos &geos, const std::array<double, 4> &region, Clip &clip) 
 
 /// The --region-file polygons, valid, dissolved and clipped to the globe; `clip` gets their
 /// prepared outline (held in `outline` and `prepared_outline`).
-GeomPtr file_domain(Geos &geos, const MeshOptions &options, Clip &clip, GeomPtr &outline,
-                    PreparedPtr &prepared_outline) {
+GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_memory_bytes,
+                    Clip &clip, GeomPtr &outline, PreparedPtr &prepared_outline) {
     Source region = read_source(options.region_file, options.region_layer, "", "", "--region-file",
-                                options.max_memory_bytes);
+                                max_memory_bytes);
     std::vector<GeomPtr> rparts;
     for (const auto &poly : region.polygons)
         rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
@@ -526,8 +526,9 @@ std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, boo
 
 /// The ocean of a region (--region box, two boxes across +-180, or --region-file polygons):
 /// region minus land with GEOS, its rings with region edges tagged open.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const MeshOptions &options,
-                                const std::string &where, CoastData &out) {
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+                                std::uint64_t max_memory_bytes, const std::string &where,
+                                CoastData &out) {
     Clip clip;
     GeomPtr domain;
     PreparedPtr prepared_outline(nullptr, GeosDeleter{geos.get()});
@@ -537,7 +538,7 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Me
     if (options.region) {
         domain = box_domain(geos, *options.region, clip);
     } else {
-        domain = file_domain(geos, options, clip, outline, prepared_outline);
+        domain = file_domain(geos, options, max_memory_bytes, clip, outline, prepared_outline);
     }
     // Only the land near the region matters: cut it to the region's extent first (fast).
     double x0, y0, x1, y1;
