@@ -279,9 +279,9 @@ std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
         shaped.push_back(std::move(s));
     }
     if (shaped.empty() && dropped_water)
-        throw DataError("the ocean of --coast " + options.coast +
-                        " is smaller than a few triangles of the target size: lower the size or "
-                        "--min-island-triangles");
+        throw DataError("the ocean of " + option("coast") + " " + options.coast +
+                        " is smaller than a few triangles of the target size: lower the size or " +
+                        option("min_island_triangles"));
     return shaped;
 }
 
@@ -389,8 +389,9 @@ void check_node_count(const std::vector<ShapedRing> &shaped, std::uint64_t max_n
     if (coast_nodes > static_cast<double>(max_nodes))
         throw DataError("the coast alone asks for about " +
                         std::to_string(std::llround(coast_nodes)) +
-                        " nodes at the target size, more than --max-nodes " +
-                        std::to_string(max_nodes) + ": raise --hmin/--hmax or --max-nodes");
+                        " nodes at the target size, more than " + option("max_nodes") + " " +
+                        std::to_string(max_nodes) + ": raise " + option("hmin_km") + "/" +
+                        option("hmax_km") + " or " + option("max_nodes"));
 }
 
 /// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
