@@ -26,10 +26,15 @@ using Clock = std::chrono::steady_clock;
 class StageClock {
 public:
     explicit StageClock(StageTimings *t) : timings_(t) {}
-    void lap(const std::string &name) {
+    /// Adds the seconds since the last lap as stage `name`, one that reads input files when
+    /// `input` (StageTimings::add_input).
+    void lap(const std::string &name, bool input = false) {
         auto now = Clock::now();
-        if (timings_)
-            timings_->add(name, std::chrono::duration<double>(now - last_).count());
+        const double seconds = std::chrono::duration<double>(now - last_).count();
+        if (timings_ && input)
+            timings_->add_input(name, seconds);
+        else if (timings_)
+            timings_->add(name, seconds);
         last_ = now;
     }
     /// Starts the next lap now, for a stage timed elsewhere.
@@ -195,7 +200,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
         load_coast(coast_options(o), o.max_memory_bytes, sub_progress(progress, 0.0, 0.1));
     for (const Ring &r : coast.rings.rings)
         budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
-    clock.lap("read_coast");
+    clock.lap("read_coast", true);
     refuse_too_many_nodes(o, coast);
 
     std::optional<Raster> bathy;
@@ -205,7 +210,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
                                 &coast.rings); // covering the ocean cut
         budget.hold(static_cast<double>(bathy->values().size() * sizeof(float)));
     }
-    clock.lap("read_bathy");
+    clock.lap("read_bathy", true);
 
     // The background grid, when the field needs one, is held against the budget before it is made.
     auto reserve_grid = [&] {
