@@ -7,6 +7,7 @@
 // Prints "SKIPPED" and exits 0 when PATH does not exist (the 1:10m file is not a fixture).
 #include <benchmark/benchmark.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -17,7 +18,8 @@
 
 namespace {
 
-globemesh::MeshOptions options;
+globemesh::CoastOptions options;
+const std::uint64_t max_nodes = globemesh::MeshingOptions{}.max_nodes;
 double size_km = 10;
 
 void load(benchmark::State &state) {
@@ -37,7 +39,7 @@ void shape(benchmark::State &state) {
     globemesh::CoastReport report;
     for (auto _ : state) {
         auto b = globemesh::shape_boundary(
-            d, [](const globemesh::Vec3 &) { return size_km; }, options, &report);
+            d, [](const globemesh::Vec3 &) { return size_km; }, options, max_nodes, &report);
         benchmark::DoNotOptimize(b);
     }
     state.counters["rings"] = static_cast<double>(report.rings);
@@ -48,7 +50,7 @@ void load_and_shape(benchmark::State &state) {
     for (auto _ : state) {
         globemesh::CoastData d = globemesh::load_coast(options);
         auto b = globemesh::shape_boundary(
-            d, [](const globemesh::Vec3 &) { return size_km; }, options);
+            d, [](const globemesh::Vec3 &) { return size_km; }, options, max_nodes);
         benchmark::DoNotOptimize(b);
     }
 }

@@ -3,6 +3,7 @@
 // Run: build/<dir>/bench/sizefield_bench
 #include <benchmark/benchmark.h>
 
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -12,8 +13,8 @@ using namespace globemesh;
 
 namespace {
 
-MeshOptions issue5_options() {
-    MeshOptions o;
+SizeFieldOptions issue5_options() {
+    SizeFieldOptions o;
     o.hmin_km = 10;
     o.hmax_km = 150;
     o.wavelength = 40;
@@ -37,7 +38,7 @@ BENCHMARK(BM_read_etopo5_global)->Unit(benchmark::kMillisecond);
 void BM_build_global_size_field(benchmark::State &state) {
     const Raster &r = etopo5();
     for (auto _ : state) {
-        SizeField f = build_size_field(issue5_options(), &r, nullptr);
+        SizeField f = build_size_field(issue5_options(), std::nullopt, &r, nullptr);
         state.counters["grid_nodes"] = static_cast<double>(f.grid().values().size());
         benchmark::DoNotOptimize(f);
     }
@@ -45,7 +46,7 @@ void BM_build_global_size_field(benchmark::State &state) {
 BENCHMARK(BM_build_global_size_field)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_size_km(benchmark::State &state) {
-    static const SizeField f = build_size_field(issue5_options(), &etopo5(), nullptr);
+    static const SizeField f = build_size_field(issue5_options(), std::nullopt, &etopo5(), nullptr);
     std::mt19937 rng(1);
     std::normal_distribution<double> n;
     std::vector<Vec3> points(1 << 16);

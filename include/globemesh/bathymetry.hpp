@@ -50,6 +50,7 @@
 // part).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -171,22 +172,48 @@ std::optional<LonLatBounds> ocean_extent(const Boundary &ocean);
 /// pole are left out (that pole is on the outline).
 int ocean_pole_winding(const Boundary &ocean);
 
-/// The limits read_bathymetry applies for `options`: cells no finer than hfloor / 2 (hfloor =
-/// hmin_km, or max(hmax / 1000, 0.01 km) when it is 0), at most half of max_memory_bytes, and a
-/// window widened by 1% of its larger side (the size field's grid reaches a cell beyond the
-/// region): region's box, or with region_file the ocean_extent of `ocean` (the coast stage's
-/// rings) when given.
-RasterLimits bathymetry_limits(const MeshOptions &options, const Boundary *ocean = nullptr);
+/// What reading the bathymetry takes from the other modules' options: the region the raster
+/// must cover (CoastOptions), the finest size the mesh asks for (SizeFieldOptions) and the
+/// memory budget (MeshingOptions). Default: the whole globe, the default sizes, no budget.
+struct BathymetryContext {
+    std::optional<std::array<double, 4>> region; ///< CoastOptions::region (W,S,E,N degrees)
+    std::string region_file; ///< CoastOptions::region_file (its ocean is the region; named)
+    double hfloor_km = size_floor_km(SizeFieldOptions{}); ///< size_floor_km(SizeFieldOptions)
+    std::uint64_t max_memory_bytes = 0; ///< MeshingOptions::max_memory_bytes; 0: no limit
+};
+
+/// The BathymetryContext of a whole run's options.
+inline BathymetryContext bathymetry_context(const MeshOptions &options) {
+    return {options.region, options.region_file, size_floor_km(options), options.max_memory_bytes};
+}
+
+/// The limits read_bathymetry applies in `context`: cells no finer than hfloor_km / 2, at most
+/// half of max_memory_bytes, and a window widened by 1% of its larger side (the size field's
+/// grid reaches a cell beyond the region): region's box, or with region_file the ocean_extent of
+/// `ocean` (the coast stage's rings) when given.
+RasterLimits bathymetry_limits(const BathymetryContext &context, const Boundary *ocean = nullptr);
+
+/// bathymetry_limits in the context of a whole run's options.
+inline RasterLimits bathymetry_limits(const MeshOptions &options, const Boundary *ocean = nullptr) {
+    return bathymetry_limits(bathymetry_context(options), ocean);
+}
 
 /// Reads options.bathy (band options.bathy_band, options.depth_positive, options.bathy_srs), sets
 /// the fill to -options.bathy_fill_m when given, and checks the raster covers the region, within
-/// bathymetry_limits(options, ocean). With `ocean` (the rings the coast stage cut for region
+/// bathymetry_limits(context, ocean). With `ocean` (the rings the coast stage cut for region
 /// or region_file) the region is that ocean: the raster must hold every point of its outline
 /// (a point a quarter of a cell apart along the great-circle segments) and a pole inside it;
 /// land in the region needs no raster. Without: region's box, or the whole globe.
 /// Throws as read_raster, and DataError (naming a point not covered) when the raster covers
-/// only part of the region and no bathy_fill_m is set.
-Raster read_bathymetry(const MeshOptions &options, const Progress &progress = {},
-                       const Boundary *ocean = nullptr);
+/// only part of the region and no bathy_fill_m is set. Messages name options by field.
+Raster read_bathymetry(const BathymetryOptions &options, const BathymetryContext &context,
+                       const Progress &progress = {}, const Boundary *ocean = nullptr);
+
+/// read_bathymetry with the bathymetry's part and the context of a whole run's options.
+inline Raster read_bathymetry(const MeshOptions &options, const Progress &progress = {},
+                              const Boundary *ocean = nullptr) {
+    return read_bathymetry(bathymetry_options(options), bathymetry_context(options), progress,
+                           ocean);
+}
 
 } // namespace globemesh

@@ -61,6 +61,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -125,13 +126,20 @@ struct CoastData {
 };
 
 /// Reads, reprojects, cleans and clips the coast of options.coast (and options.region /
-/// options.region_file) into full-resolution rings. Reads the CoastOptions part of `options`
-/// (coast, coast_layer, coast_where, coast_srs, region, region_file, min_island_area_km2,
-/// keep_inland_seas) and, to refuse a run early, max_nodes and max_memory_bytes.
-/// Throws UsageError (no --coast, bad --coast-where or --coast-srs), IoError (file missing or
+/// options.region_file) into full-resolution rings. Reads `options` (coast, coast_layer,
+/// coast_where, coast_srs, region, region_file, region_layer, min_island_area_km2,
+/// keep_inland_seas) and, to refuse a layer too large to read, max_memory_bytes (the run's
+/// MeshingOptions::max_memory_bytes; 0: no limit).
+/// Throws UsageError (no coast, bad coast_where or coast_srs), IoError (file missing or
 /// unreadable), DataError (no usable layer, layer list in the message; no CRS; no ocean in the
-/// region; rings that cannot be repaired), Cancelled.
-CoastData load_coast(const MeshOptions &options, const Progress &progress = {});
+/// region; rings that cannot be repaired), Cancelled. Messages name options by field (error.hpp).
+CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes = 0,
+                     const Progress &progress = {});
+
+/// load_coast with the coast's part and the memory budget of a whole run's options.
+inline CoastData load_coast(const MeshOptions &options, const Progress &progress = {}) {
+    return load_coast(coast_options(options), options.max_memory_bytes, progress);
+}
 
 struct CoastReport {
     std::size_t rings = 0;              ///< rings in the shaped boundary
@@ -147,9 +155,19 @@ struct CoastReport {
 /// Stage 2: drops rings smaller than options.min_island_triangles triangles of the local size,
 /// simplifies to the local size with topology preserved and resamples every ring evenly between
 /// its corners so consecutive nodes are about size_km(x) apart along great-circle arcs. Throws
-/// DataError when the shaped rings cannot be made to satisfy boundary.hpp, Cancelled.
-Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const MeshOptions &options,
-                        CoastReport *report = nullptr, const Progress &progress = {});
+/// DataError when the shaped rings cannot be made to satisfy boundary.hpp or need more than
+/// max_nodes nodes (the run's MeshingOptions::max_nodes), Cancelled.
+Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const CoastOptions &options,
+                        std::uint64_t max_nodes, CoastReport *report = nullptr,
+                        const Progress &progress = {});
+
+/// shape_boundary with the coast's part and the node limit of a whole run's options.
+inline Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km,
+                               const MeshOptions &options, CoastReport *report = nullptr,
+                               const Progress &progress = {}) {
+    return shape_boundary(coast, size_km, coast_options(options), options.max_nodes, report,
+                          progress);
+}
 
 /// One violated invariant of a Boundary: a message and where (ring, segment), -1 when none.
 struct BoundaryIssue {

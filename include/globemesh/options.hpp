@@ -77,9 +77,26 @@ struct MeshingOptions {
 };
 
 /// Every choice of a meshing run: the four modules' options together. Each field keeps its
-/// module's name (o.hmax_km); a module's function takes its own part (a MeshOptions converts).
+/// module's name (o.hmax_km); a module's function takes its own part (a MeshOptions converts)
+/// and, as separate parameters, the few values it needs of another module's (load_coast the
+/// memory budget, read_bathymetry a BathymetryContext, build_size_field the region); each
+/// module's header also keeps a MeshOptions overload that passes them from the whole.
 /// The command line's flags and config keys are the fields' names in its words (--hmax).
 struct MeshOptions : CoastOptions, BathymetryOptions, SizeFieldOptions, MeshingOptions {};
+
+/// Each module's part of a run's options.
+inline const CoastOptions &coast_options(const MeshOptions &o) {
+    return o;
+}
+inline const BathymetryOptions &bathymetry_options(const MeshOptions &o) {
+    return o;
+}
+inline const SizeFieldOptions &size_field_options(const MeshOptions &o) {
+    return o;
+}
+inline const MeshingOptions &meshing_options(const MeshOptions &o) {
+    return o;
+}
 
 /// The size field's floor hfloor (sizefield.hpp) for `options`: hmin_km, or when it is 0 the
 /// sane floor max(hmax_km / 1000, 10 m).
@@ -91,6 +108,12 @@ inline double size_floor_km(const SizeFieldOptions &options) {
 /// another); throws UsageError naming the option's field (e.g. "hmax_km must be a positive
 /// length"). Opens no file. The one place the options are checked: mesh_ocean calls it first.
 void validate(const MeshOptions &options);
+
+/// validate for one module's options alone (a module's entry point checks its own part).
+void validate(const CoastOptions &options);
+void validate(const BathymetryOptions &options);
+void validate(const SizeFieldOptions &options);
+void validate(const MeshingOptions &options);
 
 /// Bytes with an SI unit, as --max-memory takes them: memory_text(1.2e9) == "1.2 GB".
 std::string memory_text(double bytes);

@@ -32,15 +32,24 @@ inline void report(const Progress &p, double f, std::string_view stage) {
         throw Cancelled();
 }
 
-/// Seconds per named stage, in the order the stages ran. `after_stage`, when set, is called as
-/// each stage is added, while nothing of the next has run (a benchmark samples memory there).
+/// Seconds per named stage, in the order the stages ran.
 struct StageTimings {
     std::vector<std::pair<std::string, double>> stages;
-    std::function<void(const std::string &stage)> after_stage;
-    void add(const std::string &name, double seconds) {
-        stages.emplace_back(name, seconds);
-        if (after_stage)
-            after_stage(name);
+    /// Seconds of the stages that read the run's input files (added with add_input; they are
+    /// in `stages` too): the rest is the computing.
+    double input_seconds = 0;
+    void add(const std::string &name, double seconds) { stages.emplace_back(name, seconds); }
+    /// A stage that reads input files (the coast, the bathymetry, the points).
+    void add_input(const std::string &name, double seconds) {
+        add(name, seconds);
+        input_seconds += seconds;
+    }
+    /// Seconds of every stage that is not reading the inputs.
+    double compute_seconds() const {
+        double total = 0;
+        for (const auto &stage : stages)
+            total += stage.second;
+        return total - input_seconds;
     }
 };
 

@@ -45,10 +45,12 @@
 // wavelength and slope components.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/boundary.hpp"
@@ -113,18 +115,29 @@ private:
     double south_ = 0, north_ = 0;
 };
 
-/// Builds the size field the options ask for (see the file comment). bathy: the bathymetry
+/// Builds the size field the options ask for (see the file comment), over `region` (the run's
+/// CoastOptions::region, W,S,E,N degrees; nullopt: the whole globe). bathy: the bathymetry
 /// (required when wavelength or slope is on, else may be null); coast: the boundary rings at
 /// full resolution (required when coast_size_km is on). max_nodes caps the background grid.
 /// When no component is on the field is uniform (max(hmax_km, hmin_km), SizeField::is_uniform)
 /// and no grid is built; otherwise before_grid, when set, is called once before the grid is
 /// allocated (to refuse the run by throwing).
-/// Throws UsageError (bad sizes, a component without its input, naming the option), DataError
-/// (a size_regions file without a size_km field) or IoError (size_regions unreadable).
-SizeField build_size_field(const MeshOptions &options, const Raster *bathy, const Boundary *coast,
-                           const Progress &progress = {},
+/// Throws UsageError (bad sizes or region, a component without its input, naming the option),
+/// DataError (a size_regions file without a size_km field) or IoError (size_regions unreadable).
+SizeField build_size_field(const SizeFieldOptions &options,
+                           const std::optional<std::array<double, 4>> &region, const Raster *bathy,
+                           const Boundary *coast, const Progress &progress = {},
                            std::size_t max_nodes = std::size_t{1} << 24,
                            const std::function<void()> &before_grid = {});
+
+/// build_size_field with the size field's part and the region of a whole run's options.
+inline SizeField build_size_field(const MeshOptions &options, const Raster *bathy,
+                                  const Boundary *coast, const Progress &progress = {},
+                                  std::size_t max_nodes = std::size_t{1} << 24,
+                                  const std::function<void()> &before_grid = {}) {
+    return build_size_field(size_field_options(options), options.region, bathy, coast, progress,
+                            max_nodes, before_grid);
+}
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.
 SizeFn uniform_size(double h_km);

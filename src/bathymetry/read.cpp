@@ -553,10 +553,10 @@ void validate_bathy_srs(const std::string &srs) {
         parse_bathy_srs(srs);
 }
 
-RasterLimits bathymetry_limits(const MeshOptions &o, const Boundary *ocean) {
+RasterLimits bathymetry_limits(const BathymetryContext &o, const Boundary *ocean) {
     // The mesh samples the raster at its nodes and on the size field's grid (spacing hfloor / 2):
     // finer cells only alias there, so they are averaged to that size.
-    const double hfloor_km = size_floor_km(o);
+    const double hfloor_km = o.hfloor_km;
     RasterLimits limits;
     limits.min_cell_deg = 0.5 * hfloor_km / (earth_radius_km * deg_to_rad);
     limits.max_bytes = o.max_memory_bytes / 2; // the other half: the size field and the mesh
@@ -630,13 +630,14 @@ std::optional<LonLat> uncovered_point(const Raster &r, const Boundary &ocean) {
 
 } // namespace
 
-Raster read_bathymetry(const MeshOptions &o, const Progress &progress, const Boundary *ocean) {
+Raster read_bathymetry(const BathymetryOptions &o, const BathymetryContext &context,
+                       const Progress &progress, const Boundary *ocean) {
     if (o.bathy.empty())
         throw UsageError(option("bathy") + ": no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
         throw UsageError(option("bathy_fill_m") + " must be a depth in metres");
     Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress,
-                           bathymetry_limits(o, ocean), o.bathy_srs);
+                           bathymetry_limits(context, ocean), o.bathy_srs);
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
         return r;
@@ -649,21 +650,22 @@ Raster read_bathymetry(const MeshOptions &o, const Progress &progress, const Bou
                              option("region") + " or " + option("region_file") +
                              " inside the raster";
     // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
-    if (ocean && !ocean->rings.empty() && (o.region || !o.region_file.empty())) {
+    if (ocean && !ocean->rings.empty() && (context.region || !context.region_file.empty())) {
         if (const auto p = uncovered_point(r, *ocean))
-            throw DataError(
-                covers + " but the ocean of " +
-                (o.region ? option("region") : option("region_file") + " " + o.region_file) +
-                " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) + remedy);
+            throw DataError(covers + " but the ocean of " +
+                            (context.region ? option("region")
+                                            : option("region_file") + " " + context.region_file) +
+                            " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) +
+                            remedy);
         return r;
     }
     // Coverage of the region (the whole globe without --region), on a dense set of points.
     double w = -180, s = -90, e = 180, n = 90;
-    if (o.region) {
-        w = (*o.region)[0];
-        s = (*o.region)[1];
-        e = (*o.region)[2];
-        n = (*o.region)[3];
+    if (context.region) {
+        w = (*context.region)[0];
+        s = (*context.region)[1];
+        e = (*context.region)[2];
+        n = (*context.region)[3];
         if (e <= w)
             e += 360;
     }
@@ -677,8 +679,8 @@ Raster read_bathymetry(const MeshOptions &o, const Progress &progress, const Bou
     }
     if (!covered)
         throw DataError(covers +
-                        (o.region ? " but not all of " + option("region")
-                                  : ErrorText(" but the region is the whole globe")) +
+                        (context.region ? " but not all of " + option("region")
+                                        : ErrorText(" but the region is the whole globe")) +
                         remedy);
     return r;
 }

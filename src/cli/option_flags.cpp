@@ -8,7 +8,7 @@ namespace globemesh::cli {
 namespace {
 
 /// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 31> flags{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 32> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},
     {"coast_where", "--coast-where"},
@@ -17,6 +17,8 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 31> flags{{
     {"region_file", "--region-file"},
     {"region_layer", "--region-layer"},
     {"min_island_area_km2", "--min-island-area"},
+    // No flag sets it (the default, 4, always applies); the coast's message has named it so.
+    {"min_island_triangles", "--min-island-triangles"},
     {"keep_inland_seas", "--keep-inland-seas"},
     {"keep_straits", "--keep-straits"},
     {"bathy", "--bathy"},

@@ -184,8 +184,7 @@ PointList ring_points(Geos &geos, const GEOSGeometry *ring) {
     return pts;
 }
 
-GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines,
-                         const std::string &where) {
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where) {
     std::vector<GeomPtr> linestrings;
     for (const auto &l : lines) {
         std::vector<double> xy;

@@ -38,17 +38,18 @@ bool touches_pole(const PointList &ring) {
 
 } // namespace
 
-CoastData load_coast(const MeshOptions &options, const Progress &progress) {
+CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes,
+                     const Progress &progress) {
     if (options.coast.empty())
-        throw UsageError("--coast is required: give a coastline file (land polygons or coastlines, "
+        throw UsageError(option("coast") +
+                         " is required: give a coastline file (land polygons or coastlines, "
                          "any OGR format)");
     report(progress, 0.0, "reading coast");
     CoastData out;
-    Source src =
-        read_source(options.coast, options.coast_layer, options.coast_where, options.coast_srs,
-                    "--coast", options.max_memory_bytes, options.region);
+    Source src = read_source(options.coast, options.coast_layer, options.coast_where,
+                             options.coast_srs, "coast", max_memory_bytes, options.region);
     out.layer = src.layer;
-    const std::string where = "--coast " + options.coast + " layer '" + src.layer + "'";
+    const ErrorText where = option("coast") + " " + options.coast + " layer '" + src.layer + "'";
     report(progress, 0.25, "cleaning coast");
 
     Geos geos;
@@ -104,7 +105,7 @@ CoastData load_coast(const MeshOptions &options, const Progress &progress) {
     if (!options.region && options.region_file.empty()) {
         rings = world_rings(geos, land, options.keep_inland_seas, out);
     } else {
-        rings = region_rings(geos, land, options, where, out);
+        rings = region_rings(geos, land, options, max_memory_bytes, where, out);
     }
     report(progress, 0.85, "checking rings");
     {
@@ -141,11 +142,11 @@ CoastData load_coast(const MeshOptions &options, const Progress &progress) {
             return std::size_t(segment) < kinds.size() && kinds[segment] == SegmentKind::open;
         };
         if (open(is.ring, is.segment) || open(is.other_ring, is.other_segment))
-            throw DataError(
-                std::string(options.region ? "--region" : "--region-file " + options.region_file) +
-                ": its outline runs along the coast of " + where + near +
-                ", leaving slivers of ocean between them (" + is.what +
-                "); draw the outline across open water, clear of the coast");
+            throw DataError((options.region ? option("region")
+                                            : option("region_file") + " " + options.region_file) +
+                            ": its outline runs along the coast of " + where + near +
+                            ", leaving slivers of ocean between them (" + is.what +
+                            "); draw the outline across open water, clear of the coast");
         throw DataError(where + ": in the cleaned coast " + is.what + near +
                         "; repair the data there");
     }

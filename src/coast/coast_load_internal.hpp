@@ -13,6 +13,7 @@
 #include "geos_handles.hpp"
 #include "globemesh/boundary.hpp"
 #include "globemesh/coast.hpp"
+#include "globemesh/error.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh::coast_detail {
@@ -39,7 +40,8 @@ constexpr double snap_grid_deg = 1.0 / (1 << 20);
 // ----------------------------------------------------------------------------- OGR source
 
 /// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
-/// `what` names the option for messages (--coast or --region-file). With `near` (a --region
+/// `field` is the option whose file it is, named in messages ("coast" or "region_file"; its
+/// layer option is "coast_layer" or "region_layer"). With `near` (a region
 /// W,S,E,N) a polygon layer is read through OGR's spatial filter: only the features whose
 /// envelope meets the box widened by 1% of its larger side (its latitude band when it crosses
 /// +-180), in the layer's CRS; the land elsewhere plays no part in a region (region_rings cuts
@@ -49,9 +51,9 @@ constexpr double snap_grid_deg = 1.0 / (1 << 20);
 /// max_bytes (0: no limit): the layer's vertices are counted while they are read; once they
 /// pass max_bytes / coast_bytes_per_vertex nothing more is kept (memory stays bounded by one
 /// feature), the rest is only counted, and a DataError names the layer, the count and
-/// --max-memory.
+/// max_memory_bytes.
 Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
-                   const std::string &srs_override, const char *what, std::uint64_t max_bytes = 0,
+                   const std::string &srs_override, const char *field, std::uint64_t max_bytes = 0,
                    const std::optional<std::array<double, 4>> &near = std::nullopt);
 
 // ----------------------------------------------------------------------------- GEOS operations
@@ -70,7 +72,7 @@ PointList ring_points(Geos &geos, const GEOSGeometry *ring);
 /// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
 /// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the
 /// orientation of the lines does not matter and islands in lakes come out right.
-GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const std::string &where);
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where);
 
 /// What snap rounding did to the land (CoastData reports it).
 struct SnapCount {
@@ -112,8 +114,9 @@ struct Chain {
 std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, bool keep_inland_seas,
                                CoastData &out);
 /// The ocean of a region (--region box or --region-file polygons): the region less the land.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const MeshOptions &options,
-                                const std::string &where, CoastData &out);
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+                                std::uint64_t max_memory_bytes, const ErrorText &where,
+                                CoastData &out);
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
 Ring to_sphere(const Chain &c);
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in

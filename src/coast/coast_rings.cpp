@@ -305,7 +305,8 @@ struct Bbox {
 GeomPtr box_domain(Geos &geos, const std::array<double, 4> &region, Clip &clip) {
     auto [w, s, e, n] = region;
     if (!(s < n) || s < -90 || n > 90 || w < -180 || w > 180 || e < -180 || e > 180 || w == e)
-        throw UsageError("--region W,S,E,N: need -180 <= W, E <= 180, W != E, -90 <= S < N <= 90");
+        throw UsageError(option("region") +
+                         " W,S,E,N: need -180 <= W, E <= 180, W != E, -90 <= S < N <= 90");
     // The box's sides on the land's snap grid, so that land clipped to the same box (data
     // downloaded for the area) meets them exactly instead of leaving slivers of ocean.
     auto on_grid = [](double v) { return std::nearbyint(v / snap_grid_deg) * snap_grid_deg; };
@@ -329,15 +330,15 @@ GeomPtr box_domain(Geos &geos, const std::array<double, 4> &region, Clip &clip) 
 
 /// The --region-file polygons, valid, dissolved and clipped to the globe; `clip` gets their
 /// prepared outline (held in `outline` and `prepared_outline`).
-GeomPtr file_domain(Geos &geos, const MeshOptions &options, Clip &clip, GeomPtr &outline,
-                    PreparedPtr &prepared_outline) {
-    Source region = read_source(options.region_file, options.region_layer, "", "", "--region-file",
-                                options.max_memory_bytes);
+GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_memory_bytes,
+                    Clip &clip, GeomPtr &outline, PreparedPtr &prepared_outline) {
+    Source region = read_source(options.region_file, options.region_layer, "", "", "region_file",
+                                max_memory_bytes);
     std::vector<GeomPtr> rparts;
     for (const auto &poly : region.polygons)
         rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
     if (rparts.empty())
-        throw DataError("--region-file " + options.region_file + " holds no polygons");
+        throw DataError(option("region_file") + " " + options.region_file + " holds no polygons");
     GeomPtr all = make_collection(geos, rparts);
     GeomPtr domain = own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), snap_grid_deg),
                          "dissolve the region");
@@ -526,18 +527,20 @@ std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, boo
 
 /// The ocean of a region (--region box, two boxes across +-180, or --region-file polygons):
 /// region minus land with GEOS, its rings with region edges tagged open.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const MeshOptions &options,
-                                const std::string &where, CoastData &out) {
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+                                std::uint64_t max_memory_bytes, const ErrorText &where,
+                                CoastData &out) {
     Clip clip;
     GeomPtr domain;
     PreparedPtr prepared_outline(nullptr, GeosDeleter{geos.get()});
     GeomPtr outline;
     if (options.region && !options.region_file.empty())
-        throw UsageError("--region and --region-file exclude each other: give one");
+        throw UsageError(option("region") + " and " + option("region_file") +
+                         " exclude each other: give one");
     if (options.region) {
         domain = box_domain(geos, *options.region, clip);
     } else {
-        domain = file_domain(geos, options, clip, outline, prepared_outline);
+        domain = file_domain(geos, options, max_memory_bytes, clip, outline, prepared_outline);
     }
     // Only the land near the region matters: cut it to the region's extent first (fast).
     double x0, y0, x1, y1;

@@ -226,7 +226,7 @@ void resample(const ShapedRing &s, const H &h_at, Resampled &last,
 /// dropped are counted in `rep` and the islands among them added to `dropped_islands`.
 template <class H>
 std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
-                                         const MeshOptions &options, CoastReport &rep,
+                                         const CoastOptions &options, CoastReport &rep,
                                          std::vector<std::vector<Vec3>> &dropped_islands) {
     // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
     //    water bodies (ocean on the left that small, also a pocket of water that land cuts off
@@ -279,9 +279,9 @@ std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
         shaped.push_back(std::move(s));
     }
     if (shaped.empty() && dropped_water)
-        throw DataError("the ocean of --coast " + options.coast +
-                        " is smaller than a few triangles of the target size: lower the size or "
-                        "--min-island-triangles");
+        throw DataError("the ocean of " + option("coast") + " " + options.coast +
+                        " is smaller than a few triangles of the target size: lower the size or " +
+                        option("min_island_triangles"));
     return shaped;
 }
 
@@ -378,7 +378,7 @@ void simplify_ring(ShapedRing &s) {
 /// The coast's nodes at the local size, at least (each arc over the larger size at its
 /// ends): a size of metres asks a global coast for billions, refused here as the mesher
 /// would refuse them, before the resampling spends the time and memory to make them.
-void check_node_count(const std::vector<ShapedRing> &shaped, const MeshOptions &options) {
+void check_node_count(const std::vector<ShapedRing> &shaped, std::uint64_t max_nodes) {
     double coast_nodes = 0;
     for (const ShapedRing &s : shaped)
         for (std::size_t k = 0; k < s.kept.size(); ++k) {
@@ -386,11 +386,12 @@ void check_node_count(const std::vector<ShapedRing> &shaped, const MeshOptions &
             coast_nodes +=
                 arc_angle(s.ring->nodes[a], s.ring->nodes[b]) / std::max(s.h_rad[a], s.h_rad[b]);
         }
-    if (coast_nodes > static_cast<double>(options.max_nodes))
+    if (coast_nodes > static_cast<double>(max_nodes))
         throw DataError("the coast alone asks for about " +
                         std::to_string(std::llround(coast_nodes)) +
-                        " nodes at the target size, more than --max-nodes " +
-                        std::to_string(options.max_nodes) + ": raise --hmin/--hmax or --max-nodes");
+                        " nodes at the target size, more than " + option("max_nodes") + " " +
+                        std::to_string(max_nodes) + ": raise " + option("hmin_km") + "/" +
+                        option("hmax_km") + " or " + option("max_nodes"));
 }
 
 /// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
@@ -494,8 +495,9 @@ std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &
 
 } // namespace
 
-Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const MeshOptions &options,
-                        CoastReport *report_out, const Progress &progress) {
+Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const CoastOptions &options,
+                        std::uint64_t max_nodes, CoastReport *report_out,
+                        const Progress &progress) {
     if (!size_km)
         throw UsageError("shape_boundary: no size function given");
     CoastReport rep;
@@ -519,7 +521,7 @@ Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const Mes
     for (auto &s : shaped)
         simplify_ring(s);
     report(progress, 0.5, "resampling coast");
-    check_node_count(shaped, options);
+    check_node_count(shaped, max_nodes);
 
     const std::vector<Resampled> resampled = resample_clear(shaped, h_at, rep, progress);
 

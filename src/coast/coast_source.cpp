@@ -140,9 +140,9 @@ PointList read_points(OGRGeometryH g, bool transformed) {
             std::snprintf(
                 text, sizeof text,
                 "coast: a vertex has longitude %.6g, beyond +-%.0f degrees: is the layer in "
-                "lon/lat? (--coast-srs names its CRS)",
+                "lon/lat? (",
                 p.lon, max_abs_lon_deg);
-            throw DataError(text);
+            throw DataError(text + option("coast_srs") + " names its CRS)");
         }
     }
     snap_coordinates(pts, transformed);
@@ -239,12 +239,12 @@ std::string layer_list(GDALDatasetH ds) {
 
 /// The layer named `layer_name`, or else the one polygon or line layer of the data set.
 OGRLayerH choose_layer(GDALDatasetH h, const std::string &path, const std::string &layer_name,
-                       const char *what) {
+                       const std::string &field) {
     OGRLayerH layer = nullptr;
     if (!layer_name.empty()) {
         layer = GDALDatasetGetLayerByName(h, layer_name.c_str());
         if (!layer)
-            throw DataError(std::string(what) + " " + path + ": no layer named '" + layer_name +
+            throw DataError(option(field) + " " + path + ": no layer named '" + layer_name +
                             "'; layers: " + layer_list(h));
     } else {
         std::vector<OGRLayerH> candidates, unknown;
@@ -259,21 +259,21 @@ OGRLayerH choose_layer(GDALDatasetH h, const std::string &path, const std::strin
         if (candidates.empty())
             candidates = unknown;
         if (candidates.size() != 1)
-            throw DataError(std::string(what) + " " + path + ": " +
-                            (candidates.empty()
-                                 ? "no polygon or line layer"
-                                 : std::string("several polygon or line layers, choose one with ") +
-                                       (std::string(what) == "--region-file" ? "--region-layer"
-                                                                             : "--coast-layer")) +
-                            "; layers: " + layer_list(h));
+            throw DataError(
+                option(field) + " " + path + ": " +
+                (candidates.empty()
+                     ? ErrorText("no polygon or line layer")
+                     : "several polygon or line layers, choose one with " +
+                           option(field == "region_file" ? "region_layer" : "coast_layer")) +
+                "; layers: " + layer_list(h));
         layer = candidates.front();
     }
     return layer;
 }
 
 /// The layer's CRS, or the override for a layer that declares none, in GIS axis order.
-SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const std::string &where_msg,
-                  const char *what) {
+SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const ErrorText &where_msg,
+                  const std::string &field) {
     // Coordinate reference system: the layer's, or the override; lon/lat WGS84 as target. A
     // local (engineering) CRS of unknown units, as a .prj with LOCAL_CS, counts as none.
     OGRSpatialReferenceH declared = OGR_L_GetSpatialRef(layer);
@@ -283,7 +283,7 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const std::s
     if (!srs_override.empty()) {
         source_srs.reset(OSRNewSpatialReference(nullptr));
         if (OSRSetFromUserInput(source_srs.get(), srs_override.c_str()) != OGRERR_NONE)
-            throw UsageError("--coast-srs '" + srs_override +
+            throw UsageError(option("coast_srs") + " '" + srs_override +
                              "' is not a CRS GDAL/PROJ understands");
         // A layer's own CRS is not overridden: degrees read as EPSG:3857 metres put the whole
         // coast within a kilometre of 0,0, and the mesh is silently an aqua-planet.
@@ -298,10 +298,11 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const std::s
                 const std::string declared_name =
                     std::string(name ? name : "a CRS") +
                     (auth && code ? std::string(" (") + auth + ":" + code + ")" : "");
-                throw DataError(
-                    where_msg + " declares " + declared_name + ", not --coast-srs " + srs_override +
-                    "; --coast-srs is for a layer that declares none (leave it out, or replace a "
-                    "wrong CRS with ogr2ogr -a_srs)");
+                throw DataError(where_msg + " declares " + declared_name + ", not " +
+                                option("coast_srs") + " " + srs_override + "; " +
+                                option("coast_srs") +
+                                " is for a layer that declares none (leave it out, or replace a "
+                                "wrong CRS with ogr2ogr -a_srs)");
             }
         }
     } else if (declared) {
@@ -310,8 +311,8 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const std::s
         throw DataError(
             where_msg + " declares no coordinate reference system" +
             (OGR_L_GetSpatialRef(layer) ? " (only a local one, of unknown units)" : "") +
-            (std::string(what) == "--coast" ? "; give it with --coast-srs (e.g. EPSG:4326)"
-                                            : "; assign one, e.g. ogr2ogr -a_srs EPSG:4326"));
+            (field == "coast" ? "; give it with " + option("coast_srs") + " (e.g. EPSG:4326)"
+                              : ErrorText("; assign one, e.g. ogr2ogr -a_srs EPSG:4326")));
     }
     OSRSetAxisMappingStrategy(source_srs.get(), OAMS_TRADITIONAL_GIS_ORDER);
     return source_srs;
@@ -345,7 +346,7 @@ bool filter_near(OGRLayerH layer, const std::array<double, 4> &near,
 } // namespace
 
 Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
-                   const std::string &srs_override, const char *what, std::uint64_t max_bytes,
+                   const std::string &srs_override, const char *field, std::uint64_t max_bytes,
                    const std::optional<std::array<double, 4>> &near) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
@@ -353,19 +354,19 @@ Source read_source(const std::string &path, const std::string &layer_name, const
         GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) {
         std::string msg = CPLGetLastErrorMsg();
-        throw IoError(std::string(what) + " " + path + ": cannot open as a vector data set" +
+        throw IoError(option(field) + " " + path + ": cannot open as a vector data set" +
                       (msg.empty() ? "" : " (" + msg + ")") + "; check the path and format");
     }
     GDALDatasetH h = ds.get();
-    OGRLayerH layer = choose_layer(h, path, layer_name, what);
+    OGRLayerH layer = choose_layer(h, path, layer_name, field);
     Source src;
     src.layer = OGR_L_GetName(layer);
-    std::string where_msg = std::string(what) + " " + path + " layer '" + src.layer + "'";
+    const ErrorText where_msg = option(field) + " " + path + " layer '" + src.layer + "'";
     if (!where.empty() && OGR_L_SetAttributeFilter(layer, where.c_str()) != OGRERR_NONE)
-        throw UsageError("--coast-where '" + where + "' is not a valid filter for " + where_msg +
-                         ": " + CPLGetLastErrorMsg());
+        throw UsageError(option("coast_where") + " '" + where + "' is not a valid filter for " +
+                         where_msg + ": " + CPLGetLastErrorMsg());
 
-    SrsPtr source_srs = source_crs(layer, srs_override, where_msg, what);
+    SrsPtr source_srs = source_crs(layer, srs_override, where_msg, field);
     SrsPtr wgs84(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(wgs84.get(), 4326);
     OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);
@@ -420,17 +421,19 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     }
     if (too_many)
         throw DataError(where_msg + " has " + std::to_string(vertices) +
-                        " vertices, more than the " + std::to_string(max_vertices) +
-                        " that --max-memory " + memory_text(static_cast<double>(max_bytes)) +
-                        " allows (about " + std::to_string(coast_bytes_per_vertex) +
-                        " bytes each); raise --max-memory, or simplify the layer first (e.g. "
+                        " vertices, more than the " + std::to_string(max_vertices) + " that " +
+                        option("max_memory_bytes") + " " +
+                        memory_text(static_cast<double>(max_bytes)) + " allows (about " +
+                        std::to_string(coast_bytes_per_vertex) + " bytes each); raise " +
+                        option("max_memory_bytes") +
+                        ", or simplify the layer first (e.g. "
                         "ogr2ogr -simplify 0.001)");
     if (src.features == 0 && !where.empty() && CPLGetLastErrorType() >= CE_Failure)
-        throw UsageError("--coast-where '" + where + "' failed on " + where_msg + ": " +
+        throw UsageError(option("coast_where") + " '" + where + "' failed on " + where_msg + ": " +
                          CPLGetLastErrorMsg());
     if (src.features == 0)
         throw DataError(where_msg + " has no features" +
-                        (where.empty() ? "" : " matching --coast-where") +
+                        (where.empty() ? ErrorText("") : " matching " + option("coast_where")) +
                         "; give a layer of land polygons or coastlines");
     if (src.polygons.empty() && src.lines.empty())
         throw DataError(where_msg + " holds no polygons or lines" +

@@ -310,11 +310,14 @@ void estimate_nodes(Mesher &m, const MesherOptions &options) {
     if (estimate > stop) {
         const std::string nodes = "more than " + std::to_string(limit) + " nodes";
         if (limit == options.max_nodes)
-            throw DataError("the size field asks for " + nodes +
-                            " (--max-nodes): raise --hmin/--hmax or --max-nodes");
-        throw DataError(
-            "the size field asks for " + nodes + ", which need more than --max-memory " +
-            std::to_string(options.max_memory >> 20) + " MiB: raise --hmin/--hmax or --max-memory");
+            throw DataError("the size field asks for " + nodes + " (" + option("max_nodes") +
+                            "): raise " + option("hmin_km") + "/" + option("hmax_km") + " or " +
+                            option("max_nodes"));
+        throw DataError("the size field asks for " + nodes + ", which need more than " +
+                        option("max_memory_bytes") + " " +
+                        std::to_string(options.max_memory >> 20) + " MiB: raise " +
+                        option("hmin_km") + "/" + option("hmax_km") + " or " +
+                        option("max_memory_bytes"));
     }
     // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
     // per cent of the nodes made), instead of doubling through the lattice and the refinement:

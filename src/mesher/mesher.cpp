@@ -4,6 +4,7 @@
 
 #include "corners.hpp"
 #include "mesher_state.hpp"
+#include "stage_hook.hpp"
 
 namespace globemesh {
 
@@ -21,6 +22,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     auto timed = [&](const char *stage) {
         if (timings)
             timings->add(stage, seconds_since(t0));
+        if (after_stage)
+            after_stage(stage);
         t0 = Clock::now();
     };
 

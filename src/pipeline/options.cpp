@@ -111,6 +111,22 @@ void validate_bathymetry(const BathymetryOptions &o) {
 
 } // namespace
 
+void validate(const CoastOptions &o) {
+    validate_coast(o);
+}
+
+void validate(const BathymetryOptions &o) {
+    validate_bathymetry(o);
+}
+
+void validate(const SizeFieldOptions &o) {
+    validate_size(o);
+}
+
+void validate(const MeshingOptions &o) {
+    validate_meshing(o);
+}
+
 void validate(const MeshOptions &o) {
     validate_size(o);
     validate_coast(o);

@@ -26,10 +26,15 @@ using Clock = std::chrono::steady_clock;
 class StageClock {
 public:
     explicit StageClock(StageTimings *t) : timings_(t) {}
-    void lap(const std::string &name) {
+    /// Adds the seconds since the last lap as stage `name`, one that reads input files when
+    /// `input` (StageTimings::add_input).
+    void lap(const std::string &name, bool input = false) {
         auto now = Clock::now();
-        if (timings_)
-            timings_->add(name, std::chrono::duration<double>(now - last_).count());
+        const double seconds = std::chrono::duration<double>(now - last_).count();
+        if (timings_ && input)
+            timings_->add_input(name, seconds);
+        else if (timings_)
+            timings_->add(name, seconds);
         last_ = now;
     }
     /// Starts the next lap now, for a stage timed elsewhere.
@@ -191,19 +196,21 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     // load_coast and read_bathymetry check their own reads against --max-memory (the coast
     // counts its vertices while reading, the raster is read no finer than the mesh needs).
     MemoryBudget budget(o.max_memory_bytes);
-    CoastData coast = load_coast(o, sub_progress(progress, 0.0, 0.1));
+    CoastData coast =
+        load_coast(coast_options(o), o.max_memory_bytes, sub_progress(progress, 0.0, 0.1));
     for (const Ring &r : coast.rings.rings)
         budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
-    clock.lap("read_coast");
+    clock.lap("read_coast", true);
     refuse_too_many_nodes(o, coast);
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
-        bathy = read_bathymetry(o, sub_progress(progress, 0.1, 0.15),
+        bathy = read_bathymetry(bathymetry_options(o), bathymetry_context(o),
+                                sub_progress(progress, 0.1, 0.15),
                                 &coast.rings); // covering the ocean cut
         budget.hold(static_cast<double>(bathy->values().size() * sizeof(float)));
     }
-    clock.lap("read_bathy");
+    clock.lap("read_bathy", true);
 
     // The background grid, when the field needs one, is held against the budget before it is made.
     auto reserve_grid = [&] {
@@ -215,7 +222,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     };
     // Uniform when no component of the field is on: then no background grid is built.
     const SizeField field =
-        build_size_field(o, bathy ? &*bathy : nullptr, &coast.rings,
+        build_size_field(size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
                          sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
@@ -226,8 +233,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     clock.lap("size_field");
 
     CoastReport coast_report;
-    Boundary boundary =
-        shape_boundary(coast, size, o, &coast_report, sub_progress(progress, 0.25, 0.3));
+    Boundary boundary = shape_boundary(coast, size, coast_options(o), o.max_nodes, &coast_report,
+                                       sub_progress(progress, 0.25, 0.3));
     clock.lap("boundary");
     // A size wider than the region leaves too little of its outline for a triangle: say so, and
     // which option to change, rather than the mesher's "fewer than 4 nodes".

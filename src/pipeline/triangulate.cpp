@@ -148,7 +148,7 @@ Mesh triangulate_file(const TriangulateOptions &options, const Progress &progres
     PointSource src = read_point_source(options, sub_progress(progress, 0.0, 0.3));
     const std::size_t n = src.points.size();
     if (timings)
-        timings->add("read", seconds_since(t0));
+        timings->add_input("read", seconds_since(t0));
 
     report(progress, 0.3, "sort");
     t0 = std::chrono::steady_clock::now();

@@ -73,14 +73,15 @@ void BackgroundGrid::column_neighbours(std::size_t n, std::size_t out[2]) const 
     out[1] = j + 1 < nlat ? n + nlon : (global ? (nlat - 1) * nlon + across : npos);
 }
 
-BackgroundGrid make_background_grid(const MeshOptions &o, double hfloor_km, std::size_t max_nodes) {
+BackgroundGrid make_background_grid(const std::optional<std::array<double, 4>> &region,
+                                    double hfloor_km, std::size_t max_nodes) {
     max_nodes = std::max<std::size_t>(max_nodes, 64);
     const double spacing = std::max(1e-6, 0.5 * hfloor_km / earth_radius_km * rad_to_deg);
     double w = -180, s = -90, e = 180, n = 90;
     bool global = true;
-    if (o.region) {
-        w = (*o.region)[0];
-        e = (*o.region)[2];
+    if (region) {
+        w = (*region)[0];
+        e = (*region)[2];
         if (e <= w)
             e += 360;
         // One cell of margin beyond the great circles through the region's corners (they bulge
@@ -91,8 +92,8 @@ BackgroundGrid make_background_grid(const MeshOptions &o, double hfloor_km, std:
                 return lat;
             return std::atan(std::tan(lat * deg_to_rad) / std::cos(half * deg_to_rad)) * rad_to_deg;
         };
-        s = std::max(-90.0, std::min((*o.region)[1], bulge((*o.region)[1])) - spacing);
-        n = std::min(90.0, std::max((*o.region)[3], bulge((*o.region)[3])) + spacing);
+        s = std::max(-90.0, std::min((*region)[1], bulge((*region)[1])) - spacing);
+        n = std::min(90.0, std::max((*region)[3], bulge((*region)[3])) + spacing);
         global = e - w >= 360 - 2 * spacing;
         if (global) {
             w = -180;

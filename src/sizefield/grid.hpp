@@ -1,9 +1,11 @@
 // Internal to sizefield/: the background grid's geometry and the two grid solvers.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,7 +51,9 @@ struct BackgroundGrid {
 };
 
 /// The grid build_size_field uses for these options: see sizefield.hpp.
-BackgroundGrid make_background_grid(const MeshOptions &o, double hfloor_km, std::size_t max_nodes);
+/// region: W,S,E,N degrees, nullopt for the whole globe.
+BackgroundGrid make_background_grid(const std::optional<std::array<double, 4>> &region,
+                                    double hfloor_km, std::size_t max_nodes);
 
 /// Great-circle distance (km) from every node to the nearest point of the boundary rings, up to
 /// max_km (nodes farther get +infinity).

@@ -174,7 +174,7 @@ namespace {
 
 /// Lowers h (the grid's values, km) to the wavelength and slope components of the depth on
 /// the grid (see sizefield.hpp), where the options turn them on.
-void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const MeshOptions &o,
+void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const SizeFieldOptions &o,
                     std::vector<float> &h, const Progress &progress) {
     auto lower = [&](std::size_t n, double v) {
         if (v < h[n])
@@ -224,10 +224,16 @@ void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const 
 
 } // namespace
 
-SizeField build_size_field(const MeshOptions &o, const Raster *bathy, const Boundary *coast,
-                           const Progress &progress, std::size_t max_nodes,
+SizeField build_size_field(const SizeFieldOptions &o,
+                           const std::optional<std::array<double, 4>> &region, const Raster *bathy,
+                           const Boundary *coast, const Progress &progress, std::size_t max_nodes,
                            const std::function<void()> &before_grid) {
     validate(o);
+    if (region) { // checked as the coast checks it
+        CoastOptions with_region;
+        with_region.region = region;
+        validate(with_region);
+    }
     if (!(o.hmax_km > 0))
         throw UsageError(option("hmax_km") + " must be a positive length, e.g. 100km");
     if ((o.wavelength > 0 || o.slope > 0) && !bathy)
@@ -251,7 +257,7 @@ SizeField build_size_field(const MeshOptions &o, const Raster *bathy, const Boun
         if (before_grid)
             before_grid();
         report(progress, 0.0, "size field");
-        grid = detail::make_background_grid(o, hfloor, max_nodes);
+        grid = detail::make_background_grid(region, hfloor, max_nodes);
         h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
         h.assign(grid->size(), static_cast<float>(hmax));
         return *grid;

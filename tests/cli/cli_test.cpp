@@ -1080,7 +1080,7 @@ struct FakeRun {
         l.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &p,
                           globemesh::StageTimings *t) {
             globemesh::report(p, 0.5, "refine");
-            t->add("read_coast", 0.5);
+            t->add_input("read_coast", 0.5); // a stage that reads an input
             t->add("refine", 1.25);
             t->add("improve", 0.25);
             globemesh::Mesh m;

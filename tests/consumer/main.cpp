@@ -1,6 +1,7 @@
 // A program outside globemesh: meshes the ocean of a land layer through the installed library
 // (mesh_ocean) at a coarse uniform size and checks the mesh with its own geometry.
 // Usage: ocean_consumer LAND_GPKG  (Natural Earth 1:110m land, layer "land"); exit 0 when it holds.
+#include <globemesh/coast.hpp>
 #include <globemesh/pipeline.hpp>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <map>
 #include <numbers>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -100,5 +102,26 @@ int main(int argc, char **argv) {
         std::printf("ocean_consumer: missing input: %s\n", e.what());
     }
     check(typed_error, "a missing coast file throws a globemesh::Error");
+
+    // One module alone, with its own options struct: the coast of a region, no MeshOptions.
+    globemesh::CoastOptions coast;
+    coast.coast = argv[1];
+    coast.coast_layer = "land";
+    coast.region = {{-12, 48, 12, 64}}; // the North Sea and the Channel: ocean and land
+    const globemesh::CoastData region = globemesh::load_coast(coast);
+    check(!region.rings.empty() && region.ocean_area_km2 > 1e5 && region.ocean_area_km2 < 5e6,
+          "load_coast(CoastOptions) cuts the region's ocean");
+    // A library user reads the option's field, never a command-line flag: with no layer named,
+    // the two polygon layers of Natural Earth's file (land, ocean) ask for coast_layer.
+    coast.coast_layer = "";
+    std::string message;
+    try {
+        globemesh::load_coast(coast);
+    } catch (const globemesh::DataError &e) {
+        message = e.what();
+    }
+    check(message.find("coast_layer") != std::string::npos &&
+              message.find("--") == std::string::npos,
+          "a message asking for a layer names the coast_layer field, not a flag");
     return failures == 0 ? 0 : 1;
 }

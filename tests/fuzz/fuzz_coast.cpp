@@ -258,7 +258,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
     json += "]}";
     g_json = json;
 
-    MeshOptions options;
+    CoastOptions options; // the coast stage's own options, with no memory budget
     options.coast = "/vsimem/fuzz_coast.geojson";
     // A region one input in four; not on an input that has run out (its bytes then read as 0,
     // which would ask for a region of all minimums, W = E, refused before the coast is read).
@@ -287,7 +287,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
     try {
         const CoastData coast = load_coast(options);
         const SizeFn size = [h](const Vec3 &) { return h; };
-        const Boundary boundary = shape_boundary(coast, size, options);
+        const Boundary boundary = shape_boundary(coast, size, options, MeshingOptions{}.max_nodes);
         const auto issues = check_boundary(boundary);
         if (!issues.empty())
             fail("shape_boundary returned an invalid boundary: " + issues.front().what);

@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <string>
+#include <string_view>
 
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -83,7 +85,21 @@ void expect_valid_both_stages(const CoastData &d, double h_km = 50) {
 template <class E> std::string message_of(const MeshOptions &o) {
     std::string m = test::thrown_message<E>([&] { load_coast(o); }, "load_coast");
     EXPECT_EQ(m.find('\n'), std::string::npos) << "not one line: " << m;
+    EXPECT_EQ(m.find("--"), std::string::npos) << "a flag, not a field, for a library user: " << m;
     return m;
+}
+
+/// What load_coast(options, max_memory_bytes) throws as an E, each option it names as <field>:
+/// the parts a caller with other names for the options (the command line) says its own way.
+template <class E>
+std::string marked_message_of(const CoastOptions &options, std::uint64_t max_memory_bytes = 0) {
+    try {
+        load_coast(options, max_memory_bytes);
+    } catch (const E &e) {
+        return e.message([](std::string_view field) { return "<" + std::string(field) + ">"; });
+    }
+    ADD_FAILURE() << "load_coast threw nothing";
+    return "";
 }
 
 } // namespace
@@ -392,14 +408,14 @@ TEST(CoastHostile, layer_without_crs_needs_coast_srs) {
     TempDir dir;
     auto path = write(dir, "nocrs.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
     auto m = message_of<DataError>(options_for(path));
-    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+    EXPECT_NE(m.find("give it with coast_srs"), std::string::npos) << m;
     MeshOptions o = options_for(path);
     o.coast_srs = "EPSG:4326";
     CoastData d = load_coast(o);
     EXPECT_EQ(d.rings.rings.size(), 1u);
     o.coast_srs = "not a crs";
     m = message_of<UsageError>(o);
-    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+    EXPECT_EQ(m, "coast_srs 'not a crs' is not a CRS GDAL/PROJ understands");
 }
 
 TEST(CoastHostile, a_local_crs_counts_as_none) {
@@ -425,7 +441,7 @@ TEST(CoastHostile, a_local_crs_counts_as_none) {
     MeshOptions o = options_for(shp);
     auto m = message_of<DataError>(o);
     EXPECT_NE(m.find("declares no coordinate reference system (only a local one, of unknown "
-                     "units); give it with --coast-srs"),
+                     "units); give it with coast_srs"),
               std::string::npos)
         << m;
     o.coast_srs = "EPSG:4326";
@@ -435,7 +451,7 @@ TEST(CoastHostile, a_local_crs_counts_as_none) {
     o.coast_layer = "land";
     o.region_file = shp;
     m = message_of<DataError>(o);
-    EXPECT_NE(m.find("--region-file"), std::string::npos) << m;
+    EXPECT_EQ(m.rfind("region_file " + shp, 0), 0u) << m;
     EXPECT_NE(m.find("ogr2ogr -a_srs EPSG:4326"), std::string::npos) << m;
 }
 
@@ -446,7 +462,7 @@ TEST(CoastHostile, coast_srs_does_not_override_a_declared_crs) {
     o.coast_layer = "land";
     o.coast_srs = "EPSG:3857";
     auto m = message_of<DataError>(o);
-    EXPECT_NE(m.find("declares WGS 84 (EPSG:4326), not --coast-srs EPSG:3857"), std::string::npos)
+    EXPECT_NE(m.find("declares WGS 84 (EPSG:4326), not coast_srs EPSG:3857"), std::string::npos)
         << m;
     // The same CRS in another spelling is no contradiction (OGC:CRS84 is lon/lat WGS 84).
     for (const char *same : {"EPSG:4326", "OGC:CRS84", "WGS84"}) {
@@ -462,12 +478,47 @@ TEST(CoastHostile, coast_srs_does_not_override_a_declared_crs) {
     EXPECT_GT(load_coast(o).rings.rings.size(), 50u);
 }
 
+// The coast's messages name options by their field (a library user never saw the command
+// line), as parts a caller renames: the command line prints the flags (cli_test checks those).
+TEST(CoastHostile, messages_name_options_by_field_for_the_caller_to_rename) {
+    const std::string land = globemesh::test::fixture("coast/ne_110m_land.gpkg").string();
+    const std::string layers = "; layers: land (Multi Polygon), ocean (Multi Polygon)";
+    CoastOptions o;
+    o.coast = land;
+    EXPECT_EQ(marked_message_of<DataError>(o),
+              "<coast> " + land + ": several polygon or line layers, choose one with " +
+                  "<coast_layer>" + layers);
+    o.coast_layer = "lnad";
+    EXPECT_EQ(marked_message_of<DataError>(o),
+              "<coast> " + land + ": no layer named 'lnad'" + layers);
+    o.coast_layer = "land";
+    o.coast_where = "scalerank = 99";
+    EXPECT_EQ(marked_message_of<DataError>(o),
+              "<coast> " + land + " layer 'land' has no features matching <coast_where>; " +
+                  "give a layer of land polygons or coastlines");
+    o.coast_where = "";
+    o.region = {{20, 0, 30, 10}}; // inside Africa
+    EXPECT_EQ(marked_message_of<DataError>(o),
+              "<coast> " + land + " layer 'land': no ocean is left in the region (it is all " +
+                  "land); widen the region");
+    o.region.reset();
+    o.region_file = land; // its two layers again, now as the region's
+    EXPECT_EQ(marked_message_of<DataError>(o),
+              "<region_file> " + land + ": several polygon or line layers, choose one with " +
+                  "<region_layer>" + layers);
+    o.region_file = "";
+    o.coast = globemesh::test::fixture("coast/ne_50m_land.gpkg").string();
+    const std::string m = marked_message_of<DataError>(o, 1'000'000);
+    EXPECT_NE(m.find(" that <max_memory_bytes> 1 MB allows"), std::string::npos) << m;
+    EXPECT_NE(m.find("; raise <max_memory_bytes>, or simplify"), std::string::npos) << m;
+}
+
 TEST(CoastHostile, bad_attribute_filter_is_a_usage_error) {
     MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
     o.coast_layer = "land";
     o.coast_where = "no_such_column = 3";
     auto m = message_of<UsageError>(o);
-    EXPECT_NE(m.find("--coast-where"), std::string::npos) << m;
+    EXPECT_EQ(m.rfind("coast_where 'no_such_column = 3' failed on coast ", 0), 0u) << m;
     o.coast_where = "scalerank = 99";
     m = message_of<DataError>(o);
     EXPECT_NE(m.find("no features"), std::string::npos) << m;
@@ -484,7 +535,7 @@ TEST(CoastHostile, longitude_far_beyond_the_antimeridian_is_refused_at_once) {
             "[[-38.77,-20.07],[-38.77,-20.08],[8.872457321089761e+57,-20.08],[-38.77,-20.07]]")}));
     auto m = message_of<DataError>(options_for(path));
     EXPECT_NE(m.find("longitude 8.87246e+57"), std::string::npos) << m;
-    EXPECT_NE(m.find("--coast-srs"), std::string::npos) << m;
+    EXPECT_NE(m.find("(coast_srs names its CRS)"), std::string::npos) << m;
     // One wrap is fine: an island drawn from 170 to 190.
     path = write(dir, "wrap.geojson",
                  geojson({polygon("[[170,-10],[190,-10],[190,10],[170,10],[170,-10]]")}));

@@ -748,6 +748,27 @@ TEST(Mesher, too_many_nodes_are_refused_before_refining) {
     EXPECT_NE(m.find("max_nodes"), std::string::npos) << m;
 }
 
+// The mesher's own refusals name the options by field, as a library user set them (the command
+// line prints its flags for them: cli_test).
+TEST(Mesher, its_refusals_name_the_options_fields) {
+    MeshOptions o = land_110m(200);
+    const CoastData coast = load_coast(o);
+    const Boundary b = shape_boundary(coast, uniform_size(200), o);
+    MesherOptions mo;
+    mo.max_nodes = 1000; // the world ocean at 200 km takes about 10000
+    std::string m =
+        test::thrown_message<DataError>([&] { mesh_boundary(b, uniform_size(200), mo); });
+    EXPECT_EQ(m, "the size field asks for more than 1000 nodes (max_nodes): raise hmin_km/hmax_km "
+                 "or max_nodes");
+    mo.max_nodes = 20'000'000;
+    mo.max_memory = std::uint64_t{1} << 20;
+    m = test::thrown_message<DataError>([&] { mesh_boundary(b, uniform_size(200), mo); });
+    EXPECT_NE(m.find(" nodes, which need more than max_memory_bytes 1 MiB: raise hmin_km/hmax_km "
+                     "or max_memory_bytes"),
+              std::string::npos)
+        << m;
+}
+
 TEST(Mesher,
      without_the_source_land_every_ring_node_stays_in_place_and_sharp_corners_match_the_faces) {
     MeshOptions o = land_110m(200);

@@ -7,6 +7,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/pipeline.hpp"
+#include "globemesh/progress.hpp"
 #include "support.hpp"
 
 namespace globemesh {
@@ -47,6 +48,18 @@ TEST(Options, an_error_names_its_options_as_its_reader_calls_them) {
     const DataError plain("no ocean in the region");
     EXPECT_EQ(plain.message(flags), "no ocean in the region");
     EXPECT_EQ(plain.text().leading_option(), "");
+}
+
+TEST(StageTimings, the_stages_that_read_inputs_are_told_apart_from_the_computing) {
+    StageTimings t;
+    t.add_input("read_coast", 2);
+    t.add("size_field", 0.5);
+    t.add_input("read_bathy", 1);
+    t.add("refine", 3);
+    ASSERT_EQ(t.stages.size(), 4u); // all of them, in order
+    EXPECT_EQ(t.stages[2].first, "read_bathy");
+    EXPECT_DOUBLE_EQ(t.input_seconds, 3);
+    EXPECT_DOUBLE_EQ(t.compute_seconds(), 3.5);
 }
 
 TEST(OceanMesh, the_file_metadata_is_formatted_from_the_typed_reports) {
