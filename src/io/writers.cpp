@@ -19,6 +19,10 @@ void write_as_gpkg(const Mesh &mesh, const fs::path &path,
                    const WriteOptions &options); // gpkg_write.cpp
 void write_as_png(const Mesh &mesh, const fs::path &path,
                   const WriteOptions &options); // preview_png.cpp
+void write_as_adcirc(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options); // adcirc_write.cpp
+void write_as_schism(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options); // adcirc_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -47,6 +51,18 @@ const std::vector<Writer> &writers() {
          .report_key = "preview",
          .progress_weight = 1.1,
          .write = write_as_png},
+        {.name = "ADCIRC",
+         .long_name = "ADCIRC fort.14",
+         .extensions = {".14"},
+         .report_key = "adcirc",
+         .progress_weight = 1.5,
+         .write = write_as_adcirc},
+        {.name = "SCHISM",
+         .long_name = "SCHISM hgrid.gr3",
+         .extensions = {".gr3", ".ll"},
+         .report_key = "schism",
+         .progress_weight = 1.5,
+         .write = write_as_schism},
     };
     return table;
 }
