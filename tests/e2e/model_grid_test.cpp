@@ -12,7 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "globemesh/error.hpp"
+#include "globemesh/writers.hpp"
 #include "support.hpp"
+#include "unit/io_test_meshes.hpp"
 
 namespace fs = std::filesystem;
 using globemesh::test::expect_mesh_verify;
@@ -139,7 +142,68 @@ std::string check_grids(const TempDir &dir, const std::string &kind,
     return out;
 }
 
+/// The whitespace-separated leading numbers of each line of a file (what follows "!" dropped).
+std::vector<std::vector<double>> number_lines(const fs::path &file) {
+    std::ifstream in(file);
+    std::string line;
+    std::getline(in, line); // the title
+    std::vector<std::vector<double>> rows;
+    while (std::getline(in, line)) {
+        std::istringstream s(line.substr(0, line.find('!')));
+        rows.emplace_back();
+        for (double v; s >> v;)
+            rows.back().push_back(v);
+    }
+    return rows;
+}
+
+void write_adcirc(const globemesh::Mesh &mesh, const fs::path &file) {
+    const globemesh::OutputRequest request{
+        globemesh::find_writer(globemesh::writers(), "ADCIRC"), file, {}};
+    globemesh::write_outputs(mesh, {&request, 1}, {});
+}
+
 } // namespace
+
+// A cap across the antimeridian, all open: longitudes in [0, 360) so that no element is cut,
+// every element counter-clockwise there, one open string closed on itself and no land.
+TEST(ModelGrid, a_region_across_the_antimeridian_is_written_in_0_to_360) {
+    TempDir dir;
+    const globemesh::Mesh cap = globemesh::test::icosphere_cap(4, 180, 10, 15);
+    write_adcirc(cap, dir / "cap.14");
+    const auto rows = number_lines(dir / "cap.14");
+    const std::size_t ne = std::size_t(rows.at(0).at(0)), np = std::size_t(rows.at(0).at(1));
+    ASSERT_EQ(np, cap.nodes.size());
+    ASSERT_EQ(ne, cap.faces.size());
+    for (std::size_t i = 1; i <= np; ++i)
+        EXPECT_TRUE(rows[i][1] > 160 && rows[i][1] < 200) << rows[i][1];
+    for (std::size_t i = np + 1; i <= np + ne; ++i) {
+        const auto &e = rows[i];
+        const auto &a = rows[std::size_t(e[2])], &b = rows[std::size_t(e[3])],
+                   &c = rows[std::size_t(e[4])];
+        EXPECT_GT((b[1] - a[1]) * (c[2] - a[2]) - (c[1] - a[1]) * (b[2] - a[2]), 0) << i;
+    }
+    std::size_t at = np + ne + 1;
+    EXPECT_EQ(rows.at(at)[0], 1);                          // NOPE
+    const std::size_t n = std::size_t(rows.at(at + 2)[0]); // NVDLL
+    EXPECT_EQ(rows.at(at + 1)[0], n);                      // NETA
+    EXPECT_EQ(rows.at(at + 3)[0], rows.at(at + 2 + n)[0]); // closed on itself
+    EXPECT_EQ(rows.at(at + 3 + n)[0], 0);                  // NBOU
+    EXPECT_EQ(rows.at(at + 4 + n)[0], 0);                  // NVEL
+    EXPECT_EQ(rows.size(), at + 5 + n);
+}
+
+// A node without a depth (NaN) has no value a model can run on: refused, no file.
+TEST(ModelGrid, a_node_without_depth_is_refused_and_nothing_is_written) {
+    TempDir dir;
+    globemesh::Mesh cap = globemesh::test::icosphere_cap(3, 0, 0, 20);
+    cap.node_fields.front().values[1] = std::nan("");
+    ASSERT_EQ(cap.node_fields.front().name, "depth");
+    const std::string message = globemesh::test::thrown_message<globemesh::DataError>(
+        [&] { write_adcirc(cap, dir / "cap.14"); });
+    EXPECT_NE(message.find("1 nodes have no depth"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
 
 TEST(ModelGrid, a_regional_fort14_gr3_and_ll_have_the_open_and_land_strings_of_the_ugrid_file) {
     TempDir dir;
