@@ -125,38 +125,30 @@ double ring_area(const std::vector<std::uint32_t> &ring, const std::vector<LonLa
     return area;
 }
 
-BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p) {
-    const io::MeshTopology topo = io::build_topology(mesh);
-    const bool regional = std::find(topo.boundary_tags.begin(), topo.boundary_tags.end(),
-                                    int(EdgeTag::open)) != topo.boundary_tags.end();
-    const auto start_of = [&](std::size_t e) {
-        return topo.edge_nodes(std::size_t(topo.boundary_edges[e]))[0] + 1;
+/// Splits a loop with open edges into its runs of one tag, from the start of a run (a loop of open
+/// edges only is one run from any edge); each run ends on the node that starts the next.
+void split_loop(const io::MeshTopology &topo, const std::vector<std::size_t> &loop,
+                BoundaryStrings &s) {
+    const auto tag = [&](std::size_t i) { return topo.boundary_tags[loop[i % loop.size()]]; };
+    const auto node = [&](std::size_t i) {
+        return topo.edge_nodes(std::size_t(topo.boundary_edges[loop[i % loop.size()]]))[0] + 1;
     };
-    BoundaryStrings s;
-    std::vector<NodeString> rings;
-    for (auto &loop : boundary_loops(topo, mesh.nodes.size())) {
-        const auto tag = [&](std::size_t i) { return topo.boundary_tags[loop[i % loop.size()]]; };
-        std::size_t first_run = 0;
-        while (first_run < loop.size() && tag(first_run) == tag(first_run + loop.size() - 1))
-            ++first_run;
-        if (first_run == loop.size() && tag(0) != int(EdgeTag::open)) {
-            NodeString ring;
-            for (auto e : loop)
-                ring.nodes.push_back(start_of(e));
-            ring.nodes.push_back(ring.nodes.front()); // an island's string is closed
-            rings.push_back(std::move(ring));
-            continue;
-        }
-        first_run %= loop.size(); // a loop of open edges only is one run from any edge
-        for (std::size_t i = 0; i < loop.size();) {
-            NodeString run;
-            const int t = tag(first_run + i);
-            for (; i < loop.size() && (run.nodes.empty() || tag(first_run + i) == t); ++i)
-                run.nodes.push_back(start_of(loop[(first_run + i) % loop.size()]));
-            run.nodes.push_back(start_of(loop[(first_run + i) % loop.size()]));
-            (t == int(EdgeTag::open) ? s.open : s.land).push_back(std::move(run));
-        }
+    std::size_t first = 0;
+    while (first < loop.size() && tag(first) == tag(first + loop.size() - 1))
+        ++first;
+    first %= loop.size();
+    for (std::size_t i = 0; i < loop.size();) {
+        NodeString run;
+        const int t = tag(first + i);
+        for (; i < loop.size() && (run.nodes.empty() || tag(first + i) == t); ++i)
+            run.nodes.push_back(node(first + i));
+        run.nodes.push_back(node(first + i));
+        (t == int(EdgeTag::open) ? s.open : s.land).push_back(std::move(run));
     }
+}
+
+/// IBTYPE of the closed coast strings: 0 for an outer boundary (see the top of the file), else 1.
+void ring_types(std::vector<NodeString> &rings, bool regional, const std::vector<LonLat> &p) {
     std::size_t longest = 0;
     for (std::size_t i = 0; i < rings.size(); ++i) {
         rings[i].ibtype = regional && ring_area(rings[i].nodes, p) > 0 ? 0 : 1;
@@ -165,6 +157,27 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
     }
     if (!regional && !rings.empty())
         rings[longest].ibtype = 0;
+}
+
+BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p) {
+    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto is_open = [&](std::size_t e) { return topo.boundary_tags[e] == int(EdgeTag::open); };
+    BoundaryStrings s;
+    std::vector<NodeString> rings;
+    bool regional = false;
+    for (auto &loop : boundary_loops(topo, mesh.nodes.size())) {
+        if (std::any_of(loop.begin(), loop.end(), is_open)) {
+            regional = true;
+            split_loop(topo, loop, s);
+            continue;
+        }
+        NodeString ring;
+        for (auto e : loop)
+            ring.nodes.push_back(topo.edge_nodes(std::size_t(topo.boundary_edges[e]))[0] + 1);
+        ring.nodes.push_back(ring.nodes.front()); // a closed coast string ends where it starts
+        rings.push_back(std::move(ring));
+    }
+    ring_types(rings, regional, p);
     s.land.insert(s.land.end(), std::make_move_iterator(rings.begin()),
                   std::make_move_iterator(rings.end()));
     for (const auto &r : s.open)
