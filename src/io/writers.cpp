@@ -21,6 +21,10 @@ void write_as_png(const Mesh &mesh, const fs::path &path,
                   const WriteOptions &options); // preview_png.cpp
 void write_as_gmsh(const Mesh &mesh, const fs::path &path,
                    const WriteOptions &options); // gmsh_write.cpp
+void write_as_adcirc(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options); // adcirc_write.cpp
+void write_as_schism(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options); // adcirc_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -61,6 +65,18 @@ const std::vector<Writer> &writers() {
                "LONLAT: lon/lat degrees (default); SPHERE: x y z in metres on a sphere"},
               {"RADIUS", {}, "the sphere's radius in metres for COORDS=SPHERE (6371000)"}},
          .write = write_as_gmsh},
+        {.name = "ADCIRC",
+         .long_name = "ADCIRC fort.14",
+         .extensions = {".14"},
+         .report_key = "adcirc",
+         .progress_weight = 0.4, // 0.6 to 0.9 s at 1.08e6 nodes, as above
+         .write = write_as_adcirc},
+        {.name = "SCHISM",
+         .long_name = "SCHISM hgrid.gr3",
+         .extensions = {".gr3", ".ll"},
+         .report_key = "schism",
+         .progress_weight = 0.4, // 0.6 to 0.9 s at 1.08e6 nodes, as above
+         .write = write_as_schism},
     };
     return table;
 }

@@ -1,0 +1,321 @@
+// ADCIRC fort.14 and SCHISM hgrid.gr3 / hgrid.ll writers (one layout, the writers table's rows
+// ADCIRC and SCHISM).
+//
+// Layout (ADCIRC's "grid and boundary information file", which SCHISM's hgrid.gr3 follows): a
+// title line; "NE NP"; NP lines "id lon lat depth" (1-based, depth positive down); NE lines
+// "id 3 n1 n2 n3" (counter-clockwise); then NOPE, NETA and one node string per open run
+// ("count 0", then a node a line); NBOU, NVEL and one string per land run ("count IBTYPE", then a
+// node a line). Each line's counts come first; the rest after "!" is a comment.
+//
+// Boundary strings follow the boundary loops, walked with the mesh on their left (ADCIRC's order:
+// outer boundaries counter-clockwise, islands clockwise). A loop with open edges splits into
+// alternating open and land runs (IBTYPE 0), the node where two runs meet ending one and starting
+// the next. A loop of coast edges only is one closed string, its first node repeated at its end:
+// IBTYPE 0 (mainland) when it is an outer boundary, 1 (island) otherwise. Outer: in a mesh with
+// open edges (a region) a loop whose lon/lat area is positive; in a mesh without (global) the
+// loop of most nodes, there being no outside.
+//
+// Coordinates are lon/lat degrees, in [-180, 180), or [0, 360) for a mesh that crosses the
+// antimeridian and fits there without a face cut. Without a depth field every depth is 0 (a grid
+// for tools that interpolate the bathymetry afterwards); a node without a depth (NaN: the
+// bathymetry does not cover it) is refused, as no model runs on it.
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "globemesh/error.hpp"
+#include "globemesh/output_file.hpp"
+#include "globemesh/writers.hpp"
+#include "mesh_topology.hpp"
+
+namespace globemesh {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A node string of the boundary section: its 1-based nodes and its type.
+struct NodeString {
+    std::vector<std::uint32_t> nodes;
+    int ibtype = 0;
+};
+
+struct BoundaryStrings {
+    std::vector<NodeString> open, land;
+    std::size_t open_nodes = 0, land_nodes = 0;
+};
+
+/// Longitudes of the nodes in [-180, 180), or in [0, 360) when that spares every face a cut.
+std::vector<LonLat> node_lonlats(const Mesh &mesh) {
+    std::vector<LonLat> p(mesh.nodes.size());
+    for (std::size_t i = 0; i < p.size(); ++i)
+        p[i] = vec_to_lonlat(mesh.nodes[i]);
+    const auto cuts = [&](double shift) {
+        for (const auto &f : mesh.faces) {
+            double lo = 1e9, hi = -1e9;
+            for (NodeIndex n : f) {
+                const double lon = p[n].lon < 0 ? p[n].lon + shift : p[n].lon;
+                lo = std::min(lo, lon);
+                hi = std::max(hi, lon);
+            }
+            if (hi - lo > 180)
+                return true;
+        }
+        return false;
+    };
+    if (cuts(0) && !cuts(360))
+        for (auto &q : p)
+            q.lon += q.lon < 0 ? 360 : 0;
+    return p;
+}
+
+/// The boundary loops as edge index lists (into topo.boundary_edges), each walked with the mesh on
+/// its left; at a node where two loops touch, either continuation closes a loop.
+std::vector<std::vector<std::size_t>> boundary_loops(const io::MeshTopology &topo,
+                                                     std::size_t node_count) {
+    const auto &edges = topo.boundary_edges;
+    // Edges starting at each node: first[v] .. first[v + 1] - 1 of by_start.
+    std::vector<std::uint32_t> first(node_count + 1, 0), by_start(edges.size());
+    for (auto e : edges)
+        ++first[topo.edge_nodes(std::size_t(e))[0] + 1];
+    for (std::size_t v = 0; v < node_count; ++v)
+        first[v + 1] += first[v];
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (std::size_t i = 0; i < edges.size(); ++i)
+        by_start[fill[topo.edge_nodes(std::size_t(edges[i]))[0]]++] = std::uint32_t(i);
+    std::vector<bool> used(edges.size(), false);
+    std::vector<std::vector<std::size_t>> loops;
+    for (std::size_t start = 0; start < edges.size(); ++start) {
+        if (used[start])
+            continue;
+        std::vector<std::size_t> loop;
+        for (std::size_t e = start;;) {
+            used[e] = true;
+            loop.push_back(e);
+            const auto b = topo.edge_nodes(std::size_t(edges[e]))[1];
+            std::size_t next = edges.size();
+            for (auto k = first[b]; k < first[b + 1] && next == edges.size(); ++k)
+                if (!used[by_start[k]])
+                    next = by_start[k];
+            if (next == edges.size())
+                break; // back at the start: every node has as many edges in as out
+            e = next;
+        }
+        loops.push_back(std::move(loop));
+    }
+    return loops;
+}
+
+/// The signed area of a closed ring of 1-based nodes in lon/lat (positive counter-clockwise), each
+/// longitude step taken the shorter way round.
+double ring_area(const std::vector<std::uint32_t> &ring, const std::vector<LonLat> &p) {
+    double area = 0;
+    for (std::size_t i = 0; i + 1 < ring.size(); ++i) {
+        const LonLat &a = p[ring[i] - 1], &b = p[ring[i + 1] - 1];
+        double step = b.lon - a.lon;
+        step -= 360 * std::round(step / 360);
+        area -= step * (a.lat + b.lat) / 2; // the trapezoid under the step
+    }
+    return area;
+}
+
+/// Splits a loop with open edges into its runs of one tag, from the start of a run (a loop of open
+/// edges only is one run from any edge); each run ends on the node that starts the next.
+void split_loop(const io::MeshTopology &topo, const std::vector<std::size_t> &loop,
+                BoundaryStrings &s) {
+    const auto tag = [&](std::size_t i) { return topo.boundary_tags[loop[i % loop.size()]]; };
+    const auto node = [&](std::size_t i) {
+        return topo.edge_nodes(std::size_t(topo.boundary_edges[loop[i % loop.size()]]))[0] + 1;
+    };
+    std::size_t first = 0;
+    while (first < loop.size() && tag(first) == tag(first + loop.size() - 1))
+        ++first;
+    first %= loop.size();
+    for (std::size_t i = 0; i < loop.size();) {
+        NodeString run;
+        const int t = tag(first + i);
+        for (; i < loop.size() && (run.nodes.empty() || tag(first + i) == t); ++i)
+            run.nodes.push_back(node(first + i));
+        run.nodes.push_back(node(first + i));
+        (t == int(EdgeTag::open) ? s.open : s.land).push_back(std::move(run));
+    }
+}
+
+/// IBTYPE of the closed coast strings: 0 for an outer boundary (see the top of the file), else 1.
+void ring_types(std::vector<NodeString> &rings, bool regional, const std::vector<LonLat> &p) {
+    std::size_t longest = 0;
+    for (std::size_t i = 0; i < rings.size(); ++i) {
+        rings[i].ibtype = regional && ring_area(rings[i].nodes, p) > 0 ? 0 : 1;
+        if (rings[i].nodes.size() > rings[longest].nodes.size())
+            longest = i;
+    }
+    if (!regional && !rings.empty())
+        rings[longest].ibtype = 0;
+}
+
+BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p) {
+    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto is_open = [&](std::size_t e) { return topo.boundary_tags[e] == int(EdgeTag::open); };
+    BoundaryStrings s;
+    std::vector<NodeString> rings;
+    bool regional = false;
+    for (auto &loop : boundary_loops(topo, mesh.nodes.size())) {
+        if (std::any_of(loop.begin(), loop.end(), is_open)) {
+            regional = true;
+            split_loop(topo, loop, s);
+            continue;
+        }
+        NodeString ring;
+        for (auto e : loop)
+            ring.nodes.push_back(topo.edge_nodes(std::size_t(topo.boundary_edges[e]))[0] + 1);
+        ring.nodes.push_back(ring.nodes.front()); // a closed coast string ends where it starts
+        rings.push_back(std::move(ring));
+    }
+    ring_types(rings, regional, p);
+    s.land.insert(s.land.end(), std::make_move_iterator(rings.begin()),
+                  std::make_move_iterator(rings.end()));
+    for (const auto &r : s.open)
+        s.open_nodes += r.nodes.size();
+    for (const auto &r : s.land)
+        s.land_nodes += r.nodes.size();
+    return s;
+}
+
+/// Buffered text output to a FILE, numbers formatted with to_chars (shortest exact decimals).
+class TextOut {
+public:
+    TextOut(const fs::path &temp, const fs::path &target, std::string what)
+        : file_(std::fopen(temp.c_str(), "wb")), temp_(temp), target_(target),
+          what_(std::move(what)) {
+        if (!file_)
+            fail("cannot create it");
+        buffer_.reserve(capacity + 256);
+    }
+    ~TextOut() {
+        if (file_)
+            std::fclose(file_);
+    }
+    TextOut &text(std::string_view s) {
+        buffer_ += s;
+        return *this;
+    }
+    TextOut &integer(std::size_t v) {
+        char b[24];
+        buffer_.append(b, std::to_chars(b, b + sizeof b, v).ptr);
+        return *this;
+    }
+    TextOut &real(double v) {
+        char b[400];
+        buffer_.append(b, std::to_chars(b, b + sizeof b, v, std::chars_format::fixed).ptr);
+        return *this;
+    }
+    /// Ends a line, writing the buffer out when it is full.
+    void line() {
+        buffer_ += '\n';
+        if (buffer_.size() >= capacity)
+            flush();
+    }
+    void close() {
+        flush();
+        const bool ok = std::fclose(file_) == 0;
+        file_ = nullptr;
+        if (!ok)
+            fail("writing failed");
+    }
+
+private:
+    static constexpr std::size_t capacity = 1 << 20;
+    void flush() {
+        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+            fail("writing failed");
+        buffer_.clear();
+    }
+    [[noreturn]] void fail(const std::string &what) {
+        throw IoError(what_ + " " + target_.string() + ": " + what + " (" + std::strerror(errno) +
+                      ")" + OutputFile::full_disk_note(temp_));
+    }
+    std::FILE *file_;
+    fs::path temp_, target_;
+    std::string what_, buffer_;
+};
+
+/// The node strings of one kind: each "count IBTYPE ! comment", then its nodes, a line each.
+void write_strings(TextOut &out, const std::vector<NodeString> &strings, const char *kind) {
+    for (std::size_t k = 0; k < strings.size(); ++k) {
+        out.integer(strings[k].nodes.size()).text(" ").integer(std::size_t(strings[k].ibtype));
+        out.text(" ! nodes of ").text(kind).text(" boundary ").integer(k + 1).line();
+        for (auto n : strings[k].nodes)
+            out.integer(n).line();
+    }
+}
+
+/// Refuses a depth field with nodes the bathymetry left without a value.
+void check_depths(const Field *depth, const fs::path &path, const std::string &what) {
+    if (!depth)
+        return;
+    const auto missing = std::count_if(depth->values.begin(), depth->values.end(),
+                                       [](double d) { return !std::isfinite(d); });
+    if (missing > 0)
+        throw DataError(what + " " + path.string() + ": " + std::to_string(missing) +
+                        " nodes have no depth (the bathymetry does not cover them), and the "
+                        "model needs one at every node: give a bathymetry that covers the mesh");
+}
+
+void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &options,
+                const std::string &what) {
+    const Field *depth = mesh.node_field("depth");
+    check_depths(depth, path, what);
+    OutputFile file(path, options.overwrite, what);
+    const std::vector<LonLat> p = node_lonlats(mesh);
+    TextOut out(file.temp_path(), path, what);
+    std::string title = options.title;
+    std::replace_if(
+        title.begin(), title.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    out.text(title).line();
+    out.integer(mesh.faces.size()).text(" ").integer(mesh.nodes.size()).text(" ! NE NP").line();
+    const double total = double(mesh.nodes.size() + mesh.faces.size()) + 1;
+    constexpr std::size_t step = 1 << 16;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        if (i % step == 0)
+            report(options.progress, double(i) / total, "write_model_grid");
+        out.integer(i + 1).text(" ").real(p[i].lon).text(" ").real(p[i].lat).text(" ");
+        out.real(depth ? depth->values[i] : 0.0).line();
+    }
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        if (f % step == 0)
+            report(options.progress, double(p.size() + f) / total, "write_model_grid");
+        const auto &face = mesh.faces[f];
+        out.integer(f + 1).text(" 3 ").integer(face[0] + 1).text(" ").integer(face[1] + 1);
+        out.text(" ").integer(face[2] + 1).line();
+    }
+    const BoundaryStrings s = boundary_strings(mesh, p);
+    out.integer(s.open.size()).text(" ! NOPE: open boundaries").line();
+    out.integer(s.open_nodes).text(" ! NETA: open boundary nodes").line();
+    write_strings(out, s.open, "open");
+    out.integer(s.land.size()).text(" ! NBOU: land boundaries").line();
+    out.integer(s.land_nodes).text(" ! NVEL: land boundary nodes").line();
+    write_strings(out, s.land, "land");
+    out.close();
+    report(options.progress, 1, "write_model_grid");
+    file.commit();
+}
+
+} // namespace
+
+/// The ADCIRC row of the writers table (writers.cpp).
+void write_as_adcirc(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
+    write_grid(mesh, path, options, "ADCIRC output");
+}
+
+/// The SCHISM row of the writers table (writers.cpp): hgrid.gr3 and hgrid.ll, both in lon/lat.
+void write_as_schism(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
+    write_grid(mesh, path, options, "SCHISM output");
+}
+
+} // namespace globemesh
