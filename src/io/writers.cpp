@@ -25,6 +25,8 @@ void write_as_adcirc(const Mesh &mesh, const fs::path &path,
                      const WriteOptions &options); // adcirc_write.cpp
 void write_as_schism(const Mesh &mesh, const fs::path &path,
                      const WriteOptions &options); // adcirc_write.cpp
+void write_as_selafin(const Mesh &mesh, const fs::path &path,
+                      const WriteOptions &options); // selafin_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -77,6 +79,12 @@ const std::vector<Writer> &writers() {
          .report_key = "schism",
          .progress_weight = 0.4, // 0.6 to 0.9 s at 1.08e6 nodes, as above
          .write = write_as_schism},
+        {.name = "SELAFIN",
+         .long_name = "TELEMAC SELAFIN and its .cli",
+         .extensions = {".slf"},
+         .report_key = "selafin",
+         .progress_weight = 0.4,
+         .write = write_as_selafin},
     };
     return table;
 }
