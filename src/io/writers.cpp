@@ -83,7 +83,7 @@ const std::vector<Writer> &writers() {
          .long_name = "TELEMAC SELAFIN and its .cli",
          .extensions = {".slf"},
          .report_key = "selafin",
-         .progress_weight = 0.4,
+         .progress_weight = 0.25, // 0.6 s at 1.08e6 nodes, as above
          .write = write_as_selafin},
     };
     return table;
