@@ -40,19 +40,24 @@ namespace {
 void name_depth(Mesh &mesh) {
     if (mesh.node_field("depth") != nullptr)
         return;
-    for (const Field &f : mesh.node_fields) {
-        const bool depth = f.standard_name.rfind("sea_floor_depth", 0) == 0;
-        if (!depth && f.standard_name != "altitude")
-            continue;
-        Field d = f;
-        d.name = "depth";
-        d.standard_name = "sea_floor_depth_below_geoid";
-        if (!depth)
-            for (double &x : d.values)
-                x = -x;
-        mesh.node_fields.push_back(std::move(d));
+    const auto named = [&](auto &&test) -> const Field * {
+        for (const Field &f : mesh.node_fields)
+            if (test(f.standard_name))
+                return &f;
+        return nullptr;
+    };
+    const Field *depth =
+        named([](const std::string &s) { return s.rfind("sea_floor_depth", 0) == 0; });
+    const Field *altitude = named([](const std::string &s) { return s == "altitude"; });
+    if (depth == nullptr && altitude == nullptr)
         return;
-    }
+    Field d = depth != nullptr ? *depth : *altitude;
+    d.name = "depth";
+    d.standard_name = "sea_floor_depth_below_geoid";
+    if (depth == nullptr)
+        for (double &x : d.values)
+            x = -x;
+    mesh.node_fields.push_back(std::move(d));
 }
 
 } // namespace
