@@ -1,4 +1,5 @@
-// `globemesh convert`: reads a UGRID mesh (ours or another tool's) and writes it through the
+// `globemesh convert`: reads a UGRID mesh (ours or another tool's) or an ADCIRC/SCHISM grid
+// (fort.14, .gr3, .ll, by its name) and writes it through the
 // writers table, as `mesh` writes its outputs (-o, -f, --co, --overwrite, all or nothing).
 #include <algorithm>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "globemesh/error.hpp"
+#include "globemesh/mesh_read.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 
@@ -22,7 +24,9 @@ namespace globemesh::cli {
 ConvertCommand::ConvertCommand(std::span<const Writer> table) {
     app.set_version_flag("--version", version_text(), "Print the version and exit");
     app.get_formatter()->column_width(36);
-    app.add_option("IN", input, "UGRID NetCDF mesh (ours or another tool's, 0- or 1-based)")
+    app.add_option("IN", input,
+                   "UGRID NetCDF mesh (ours or another tool's, 0- or 1-based), or an ADCIRC/SCHISM "
+                   "grid named fort.14, *.14, *.gr3 or *.ll")
         ->required()
         ->type_name("IN.nc");
     app.add_option("OUT", positional, "Files to write, as -o gives them (either or both)")
@@ -87,7 +91,7 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, false);
     terminal.configure(c.quiet, false);
-    Mesh mesh = lib.read_ugrid(c.input);
+    Mesh mesh = is_adcirc_name(c.input) ? lib.read_adcirc(c.input) : lib.read_ugrid(c.input);
     name_depth(mesh);
     throw_if_interrupted();
     OutputBatch batch; // every output waits under its temporary name until all are complete

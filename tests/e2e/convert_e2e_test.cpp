@@ -1,8 +1,9 @@
 // `globemesh convert` through the executable: a regional UGRID mesh of the test's run converted to
 // gmsh (read back by gmsh's Python API and meshio), to fort.14 (read by a reader written here
-// from ADCIRC's documentation) and to UGRID; another tool's 1-based layout (made here with
-// netCDF4: other names, (nodes, faces) order with a fill column, depth as altitude) with and
-// without boundary tags; and the refusals. Every comparison is with the source read by netCDF4.
+// from ADCIRC's documentation) and to UGRID, and fort.14 back to UGRID; another tool's 1-based
+// layout (made here with netCDF4: other names, (nodes, faces) order with a fill column, depth as
+// altitude) with and without boundary tags; and the refusals. Every comparison is with the source
+// read by netCDF4.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -231,6 +232,18 @@ TEST(ConvertE2e, ugrid_to_msh_fort14_and_ugrid_keep_nodes_faces_tags_and_depth) 
     EXPECT_EQ(fort.find("nope=0"), std::string::npos) << fort; // a region has open strings
     EXPECT_EQ(check("same r.nc c.nc", dir.path()), "OK\n");
     expect_mesh_verify(dir / "c.nc");
+    // Back from fort.14 (its strings as tags), and from a fort.14 without the boundary section
+    // (as oceanmesh writes it): every boundary edge coast.
+    ASSERT_EQ(run_exe({"convert", "fort.14", "back.nc", "-q"}, err, dir.path()), 0) << err;
+    EXPECT_EQ(check("same r.nc back.nc", dir.path()), "OK\n");
+    std::string out;
+    ASSERT_EQ(
+        run_command("cd " + quote(dir.path().string()) +
+                        " && awk 'NR == 2 { n = $1 + $2 + 2 } NR < 3 || NR <= n' fort.14 > bare.14",
+                    out),
+        0);
+    ASSERT_EQ(run_exe({"convert", "bare.14", "bare.nc", "-q"}, err, dir.path()), 0) << err;
+    EXPECT_EQ(check("same r.nc bare.nc coast", dir.path()), "OK\n");
     // MSH 2.2 by --co, as `mesh` takes it.
     ASSERT_EQ(run_exe({"convert", "r.nc", "-o", "v.msh", "--co", "MSH_VERSION=2.2", "-q"}, err,
                       dir.path()),
@@ -265,6 +278,7 @@ TEST(ConvertE2e, another_tools_one_based_file_converts_with_its_tags_or_all_coas
 TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
     TempDir dir;
     std::ofstream(dir / "text.nc") << "not netcdf\n";
+    std::ofstream(dir / "bad.14") << "title\n2 x\n";
     const std::string etopo = fixture("bathy/etopo5_global_10min.nc").string();
     std::string err;
     ASSERT_EQ(run_exe({"triangulate", fixture("points/stations.csv").string(), "-o", "m.nc", "-q"},
@@ -280,6 +294,7 @@ TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
         {{"convert", "missing.nc", "out.msh"}, 1, "does not exist"},
         {{"convert", "text.nc", "out.msh"}, 1, "cannot open"},
         {{"convert", etopo, "out.msh"}, 1, "not a UGRID mesh"},
+        {{"convert", "bad.14", "out.msh"}, 1, "line 2: NP 'x' is not an integer"},
         {{"convert", "m.nc", "out.xyz"}, 2, "no format has the extension .xyz"},
         {{"convert", "m.nc", "-f", "NOSUCH", "-o", "out.msh"}, 2, "no such format"},
         {{"convert", "m.nc"}, 2, "give the file to write"},
