@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/mesh_read.hpp"
 #include "globemesh/mesh_stats.hpp"
 #include "globemesh/options.hpp"
 #include "globemesh/pipeline.hpp"
@@ -45,6 +46,8 @@ struct CliLibrary {
     /// their rows' write functions write the files.
     std::vector<Writer> writers;
     std::function<Mesh(const std::filesystem::path &)> read_ugrid;
+    /// fort.14 / hgrid.gr3 (mesh_read.hpp), an input of `convert`.
+    std::function<Mesh(const std::filesystem::path &)> read_adcirc;
     std::function<MeshStats(const Mesh &)> compute_stats;
 };
 

@@ -35,6 +35,8 @@ std::unique_ptr<CLI::App> make_top_app() {
                         "Mesh the ocean: globemesh mesh --coast LAND -o OCEAN.nc [options]");
     app->add_subcommand("triangulate",
                         "Delaunay triangulation of points: globemesh triangulate POINTS -o OUT.nc");
+    app->add_subcommand(
+        "convert", "Convert a UGRID mesh: globemesh convert IN.nc OUT.msh|fort.14|... [-o OUT]");
     app->add_subcommand("info", "Statistics of a UGRID mesh file: globemesh info MESH.nc [--json]");
     app->add_subcommand("help", "Help on globemesh or one subcommand: globemesh help [SUBCOMMAND]");
     app->require_subcommand(1);
@@ -54,6 +56,9 @@ int run_help(std::span<const std::string> args, std::ostream &out) {
     } else if (args[0] == "triangulate") {
         TriangulateCommand c;
         out << c.app.help();
+    } else if (args[0] == "convert") {
+        ConvertCommand c;
+        out << c.app.help();
     } else if (args[0] == "info") {
         InfoCommand c;
         out << c.app.help();
@@ -61,7 +66,7 @@ int run_help(std::span<const std::string> args, std::ostream &out) {
         out << make_top_app()->help();
     } else {
         throw UsageError("help: unknown subcommand '" + args[0] +
-                         "' (the subcommands are mesh, triangulate, info, help)");
+                         "' (the subcommands are mesh, triangulate, convert, info, help)");
     }
     return 0;
 }
@@ -77,13 +82,15 @@ int dispatch(std::span<const std::string> args, std::ostream &out, std::ostream 
         return run_mesh(rest, out, err, terminal, lib);
     if (name == "triangulate")
         return run_triangulate(rest, out, err, terminal, lib);
+    if (name == "convert")
+        return run_convert(rest, out, err, terminal, lib);
     if (name == "info")
         return run_info(rest, out, lib);
     if (name == "help")
         return run_help(rest, out);
     if (!name.empty() && name[0] != '-')
         throw UsageError("unknown subcommand '" + name +
-                         "' (the subcommands are mesh, triangulate, info, help)");
+                         "' (the subcommands are mesh, triangulate, convert, info, help)");
     auto top = make_top_app();
     try {
         top->parse(reversed(args));
@@ -97,9 +104,9 @@ int dispatch(std::span<const std::string> args, std::ostream &out, std::ostream 
         out << version_text() << "\n";
         return 0;
     } catch (const CLI::ParseError &) {
-        throw UsageError(
-            "unknown option '" + name +
-            "' (globemesh takes --help, --version or a subcommand: mesh, triangulate, info, help)");
+        throw UsageError("unknown option '" + name +
+                         "' (globemesh takes --help, --version or a subcommand: mesh, triangulate, "
+                         "convert, info, help)");
     }
     return 0; // unreachable: a subcommand name would have been dispatched above
 }
@@ -124,8 +131,8 @@ int run_cli(std::span<const std::string> args, std::ostream &out, std::ostream &
         return dispatch(args, out, err, terminal, library);
     } catch (...) {
         terminal.end_line();
-        const bool sub =
-            !args.empty() && (args[0] == "mesh" || args[0] == "info" || args[0] == "triangulate");
+        const bool sub = !args.empty() && (args[0] == "mesh" || args[0] == "info" ||
+                                           args[0] == "triangulate" || args[0] == "convert");
         return report_error(err, sub ? args[0] : std::string());
     }
 }

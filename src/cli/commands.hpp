@@ -1,5 +1,5 @@
-// Private to src/cli: the subcommands `mesh`, `triangulate` and `info`, each a CLI11 App bound to
-// its options, and the functions that run them (run_cli's dispatch calls these).
+// Private to src/cli: the subcommands `mesh`, `triangulate`, `convert` and `info`, each a CLI11 App
+// bound to its options, and the functions that run them (run_cli's dispatch calls these).
 #pragma once
 
 #include <ostream>
@@ -69,12 +69,27 @@ struct InfoCommand {
     InfoCommand();
 };
 
+/// The `convert` subcommand's CLI11 App and options.
+struct ConvertCommand {
+    std::string input;
+    std::vector<std::string> positional, output, creation;
+    std::string format;
+    bool overwrite = false, quiet = false;
+    CLI::App app{"Convert a UGRID mesh to the output formats, keeping boundary tags and depths.",
+                 "globemesh convert"};
+
+    explicit ConvertCommand(std::span<const Writer> table = writers());
+};
+
 /// `globemesh mesh ARGS`: returns the exit status; errors propagate to run_cli.
 int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream &err,
              TerminalProgress &terminal, const CliLibrary &lib);
 /// `globemesh triangulate ARGS`, likewise.
 int run_triangulate(std::span<const std::string> args, std::ostream &out, std::ostream &err,
                     TerminalProgress &terminal, const CliLibrary &lib);
+/// `globemesh convert ARGS`, likewise.
+int run_convert(std::span<const std::string> args, std::ostream &out, std::ostream &err,
+                TerminalProgress &terminal, const CliLibrary &lib);
 /// `globemesh info ARGS`, likewise.
 int run_info(std::span<const std::string> args, std::ostream &out, const CliLibrary &lib);
 

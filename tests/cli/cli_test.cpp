@@ -975,7 +975,7 @@ TEST(Cli, help_lists_the_subcommands) {
         const Result r = run_refused(args);
         EXPECT_EQ(r.status, 0);
         EXPECT_EQ(r.err, "");
-        for (const char *sub : {"mesh", "triangulate", "info", "help"})
+        for (const char *sub : {"mesh", "triangulate", "convert", "info", "help"})
             EXPECT_TRUE(regex_search(r.out, std::string("\\n\\s+") + sub + "\\s")) << sub << " in\n"
                                                                                    << r.out;
     }
@@ -1018,7 +1018,7 @@ std::string man_text_plain() {
 TEST(Cli, every_option_in_help_is_in_the_man_page) {
     ASSERT_TRUE(fs::exists(man_page)) << man_page;
     const auto documented = long_options(man_text_plain());
-    for (const char *sub : {"mesh", "triangulate", "info"}) {
+    for (const char *sub : {"mesh", "triangulate", "convert", "info"}) {
         const Result r = run_refused({sub, "--help"});
         const auto listed = long_options(r.out);
         EXPECT_GT(listed.size(), 2u) << sub;
@@ -1029,7 +1029,7 @@ TEST(Cli, every_option_in_help_is_in_the_man_page) {
 
 TEST(Cli, every_option_in_the_man_page_is_in_help) {
     std::set<std::string> listed = long_options(run_refused({"--help"}).out);
-    for (const char *sub : {"mesh", "triangulate", "info"})
+    for (const char *sub : {"mesh", "triangulate", "convert", "info"})
         for (const auto &o : long_options(run_refused({sub, "--help"}).out))
             listed.insert(o);
     const auto documented = long_options(man_text_plain());

@@ -1,0 +1,21 @@
+// globemesh/mesh_read.hpp: readers of the model formats globemesh also writes, so that
+// `globemesh convert` converts between them (the UGRID reader is in ugrid.hpp).
+#pragma once
+
+#include <filesystem>
+
+#include "globemesh/mesh.hpp"
+
+namespace globemesh {
+
+/// Reads an ADCIRC grid file (fort.14) or a SCHISM hgrid.gr3/.ll, in lon/lat degrees: nodes,
+/// triangles, the depth (positive down) as node field "depth", and the boundary section's
+/// strings as tags (open strings open, land strings coast; boundary edges on no string, or a
+/// file without the section, coast). Throws IoError (not readable) or DataError (not the
+/// format, indices out of range, coordinates not lon/lat).
+Mesh read_adcirc(const std::filesystem::path &path);
+
+/// Whether `path` is named as an ADCIRC or SCHISM grid (fort.14, .14, .gr3, .ll).
+bool is_adcirc_name(const std::filesystem::path &path);
+
+} // namespace globemesh
