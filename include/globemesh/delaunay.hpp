@@ -171,6 +171,26 @@ public:
     /// star would not stay counter-clockwise with v at p.
     bool place_vertex_from(HalfEdge leaving_v, const Vec3 &p);
 
+    /// Removes vertex v from the triangulation: its star becomes the Delaunay triangulation of
+    /// its former neighbours' polygon, so a Delaunay triangulation stays Delaunay (and equals
+    /// the one of the remaining points, without constraints). The polygon is cut into ears (each
+    /// strictly counter-clockwise under predicates::orient, no other polygon vertex in it or on
+    /// its sides), then Lawson flips from the edges of the hole restore the Delaunay property. v
+    /// keeps its point and id as an unused vertex with no triangle (as a merged point does:
+    /// vertex_count() does not fall), two triangle slots are freed, and the triangles left take the
+    /// labels of the slots they occupy (triangles of a star with one label keep it). Returns false
+    /// and changes nothing when a spoke of v is constrained, a triangle of its star is a ghost (not
+    /// solid), no ear is found (polygon vertices on one great circle), or a Lawson flip would fold
+    /// or flatten a triangle (points closer than rounding resolves).
+    bool remove_vertex(VertexId v);
+    /// The same with a half-edge leaving v (origin == v). With `changed`, a successful removal
+    /// fills it with every triangle created or changed (sorted, live), before `accept` is called;
+    /// when `accept` returns false, everything is undone exactly (the same triangles in the same
+    /// slots, the free slots as before) and the call returns false. `accept` must not change the
+    /// triangulation.
+    bool remove_vertex_from(HalfEdge leaving_v, std::vector<TriangleId> *changed = nullptr,
+                            const std::function<bool()> &accept = {});
+
     /// Flips the unconstrained edge h; the quadrilateral around it must be strictly convex.
     void flip(HalfEdge h);
 
@@ -256,6 +276,10 @@ private:
     void set_mark(TriangleId t) { links_[3 * t] |= mark_bit; }
     void clear_mark(TriangleId t) { links_[3 * t] &= ~mark_bit; }
     void reserve_for(std::size_t points);
+    // remove_vertex_from's steps: v's star (its triangles, in star) can go (no constrained spoke,
+    // no ghost); an ear clipping of its ring (three ring positions per triangle, empty if none).
+    bool star_removable(HalfEdge from, std::vector<TriangleId> &star) const;
+    std::vector<int> clip_ears(const std::vector<VertexId> &ring) const;
     VertexId insert_vertex(const Vec3 &p, VertexId id, TriangleId hint);
     TriangleId start_triangle(TriangleId hint) const;
     TriangleId walk(const Vec3 &p, TriangleId start, bool &inside) const;

@@ -37,6 +37,7 @@ public:
     void run_search_rounds();
     void mend_corners();
     void raise_floor();
+    std::size_t remove_floor_nodes();
 
 private:
     Mesher &m;
@@ -394,13 +395,68 @@ void QualityRounds::raise_floor() {
     // search that raises their star's worst, a few rounds; a move never lowers a star's worst.
     as_made.resize(dt.vertex_count(), 0);
     dirty.resize(dt.vertex_count(), 0);
-    for (int round = 0; round < search_rounds; ++round) {
-        collect(detail::blunt_floor, false);
-        if (todo.empty())
-            break;
-        for (auto &[v, hint] : todo)
-            improve_node(v, hint);
+    auto search = [&] {
+        for (int round = 0; round < search_rounds; ++round) {
+            collect(detail::blunt_floor, false);
+            if (todo.empty())
+                break;
+            for (auto &[v, hint] : todo)
+                improve_node(v, hint);
+        }
+    };
+    search();
+    // Then the nodes no position mends go, and the search runs again around them.
+    while (remove_floor_nodes() > 0)
+        search();
+}
+
+// A free node (not sharp) of a face still below the floor, whose star is all ocean, goes when
+// every triangle its removal makes or changes is ocean and better than its star's worst: a node
+// squeezed in a thin quadrilateral between nodes of very different spacing has no position that
+// mends its faces. Returns the nodes removed (MesherReport::floor_nodes_removed).
+std::size_t QualityRounds::remove_floor_nodes() {
+    collect(detail::blunt_floor, false);
+    std::size_t removed = 0;
+    std::vector<TriangleId> star, changed;
+    auto q = [&](TriangleId t) {
+        return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                dt.point(dt.vertex(t, 2)));
+    };
+    auto cut = [&](TriangleId t) {
+        return std::find(m.cut_sides.begin(), m.cut_sides.end(), t) != m.cut_sides.end();
+    };
+    for (auto &[v, hint] : todo) {
+        const HalfEdge from = m.is_sharp(v) ? no_half_edge : leaving(v, hint);
+        if (from == no_half_edge)
+            continue;
+        double worst = 1;
+        bool ocean_star = true;
+        star.clear();
+        HalfEdge h = from;
+        do {
+            const TriangleId t = triangle_of(h);
+            ocean_star = ocean_star && dt.label(t) == ocean && !cut(t);
+            worst = std::min(worst, q(t));
+            star.push_back(dt.destination(h));
+            h = dt.next_around_origin(h);
+        } while (h != from);
+        if (!ocean_star || worst >= detail::blunt_floor)
+            continue;
+        auto better = [&] {
+            for (TriangleId t : changed)
+                if (dt.label(t) != ocean || cut(t) || q(t) <= worst)
+                    return false;
+            return true;
+        };
+        if (!dt.remove_vertex_from(from, &changed, better))
+            continue;
+        ++removed;
+        for (VertexId u : star)
+            dirty[u] = 1;
+        hint = changed.front();
     }
+    m.report.floor_nodes_removed += removed;
+    return removed;
 }
 
 } // namespace

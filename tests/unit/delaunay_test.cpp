@@ -72,7 +72,9 @@ double solid_area(const SphericalDelaunay &dt) {
 
 // Brute force, independent of the predicates: no vertex strictly inside any solid triangle's
 // circumcircle by more than `slack` in the plane-distance sense (long double).
-std::size_t brute_force_violations(const SphericalDelaunay &dt, long double slack) {
+// Vertices marked in `skip` (removed ones) are not tested.
+std::size_t brute_force_violations(const SphericalDelaunay &dt, long double slack,
+                                   const std::vector<std::uint8_t> &skip = {}) {
     std::size_t bad = 0;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || !dt.is_solid(t))
@@ -87,6 +89,8 @@ std::size_t brute_force_violations(const SphericalDelaunay &dt, long double slac
             (long double)(b.x - a.x) * (c.y - a.y) - (long double)(b.y - a.y) * (c.x - a.x);
         long double len = std::sqrt(nx * nx + ny * ny + nz * nz);
         for (VertexId v = 0; v < dt.vertex_count(); ++v) {
+            if (v < skip.size() && skip[v])
+                continue;
             const Vec3 &d = dt.point(v);
             long double h = ((d.x - a.x) * nx + (d.y - a.y) * ny + (d.z - a.z) * nz) / len;
             if (h > slack)
@@ -985,4 +989,146 @@ TEST(Delaunay, a_patch_that_does_not_fit_its_region_is_refused_and_changes_nothi
     auto edges = all_half_edges(dt);
     dt.make_delaunay(edges);
     expect_valid_closed(dt);
+}
+
+namespace {
+
+// Every slot's corners and twin links: equal snapshots mean the same triangles in the same slots.
+std::vector<std::array<VertexId, 6>> slot_snapshot(const SphericalDelaunay &dt) {
+    std::vector<std::array<VertexId, 6>> s(dt.triangle_slots());
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+        for (int i = 0; i < 3; ++i) {
+            s[t][i] = dt.vertex(t, i);
+            s[t][3 + i] = dt.is_live(t) ? dt.twin(half_edge(t, i)) : no_half_edge;
+        }
+    return s;
+}
+
+// Removes every vertex listed, then compares with the triangulation built from the points left.
+void expect_removal_gives_delaunay_of_the_rest(const std::vector<Vec3> &p, std::size_t step) {
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    std::vector<std::uint8_t> gone(dt.vertex_count(), 0);
+    std::size_t removed = 0;
+    for (std::size_t k = 0; k < p.size(); k += step) {
+        const VertexId v = ids[k];
+        if (gone[v])
+            continue;
+        ASSERT_TRUE(dt.remove_vertex(v)) << "vertex " << v;
+        gone[v] = 1;
+        ++removed;
+        EXPECT_EQ(dt.vertex_half_edges()[v], no_half_edge);
+    }
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    EXPECT_EQ(euler(dt), 2u);
+    EXPECT_EQ(brute_force_violations(dt, 1e-15L, gone), 0u);
+    std::vector<Vec3> rest;
+    for (VertexId v = 0; v < dt.vertex_count(); ++v)
+        if (!gone[v] && dt.vertex_half_edges()[v] != no_half_edge)
+            rest.push_back(dt.point(v));
+    SphericalDelaunay fresh;
+    fresh.insert_points(rest);
+    EXPECT_EQ(canonical(dt, false), canonical(fresh, false));
+    EXPECT_GT(removed, p.size() / step / 2);
+}
+
+} // namespace
+
+TEST(Delaunay, removing_half_of_2000_random_points_leaves_the_delaunay_triangulation_of_the_rest) {
+    expect_removal_gives_delaunay_of_the_rest(random_points(2000, 31), 2);
+}
+
+TEST(Delaunay, removing_points_of_a_cocircular_grid_leaves_the_delaunay_triangulation_of_the_rest) {
+    // Four points on a circle everywhere: only the perturbation decides the diagonals.
+    expect_removal_gives_delaunay_of_the_rest(grid_points(6), 3);
+}
+
+TEST(Delaunay, removal_refuses_constrained_and_ghost_stars_and_keeps_constraints) {
+    auto p = random_points(2000, 32);
+    SphericalDelaunay dt;
+    dt.insert_points(p);
+    std::vector<VertexId> ring;
+    for (int k = 0; k < 30; ++k)
+        ring.push_back(dt.insert(lonlat_to_vec(10 + 20 * std::cos(k * 2 * pi / 30),
+                                               20 + 12 * std::sin(k * 2 * pi / 30))));
+    for (int k = 0; k < 30; ++k)
+        ASSERT_TRUE(dt.insert_constraint(ring[k], ring[(k + 1) % 30]));
+    for (VertexId v : ring) {
+        const auto before = slot_snapshot(dt);
+        EXPECT_FALSE(dt.remove_vertex(v));
+        EXPECT_EQ(slot_snapshot(dt), before);
+    }
+    // Every other vertex goes; the constraints stay edges, still constrained.
+    std::size_t removed = 0;
+    for (VertexId v = 0; v < dt.vertex_count(); ++v)
+        if (std::find(ring.begin(), ring.end(), v) == ring.end())
+            removed += dt.remove_vertex(v);
+    EXPECT_GT(removed, 1900u);
+    auto problems = dt.validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    const auto star = dt.vertex_half_edges();
+    for (int k = 0; k < 30; ++k) {
+        const HalfEdge h = dt.find_edge(star[ring[k]], ring[(k + 1) % 30]);
+        ASSERT_NE(h, no_half_edge);
+        EXPECT_TRUE(dt.is_constrained(h));
+    }
+    // Points in one hemisphere: a vertex with a ghost in its star is refused.
+    std::vector<Vec3> north;
+    for (const Vec3 &q : random_points(400, 33))
+        north.push_back({q.x, q.y, std::fabs(q.z)});
+    SphericalDelaunay half;
+    half.insert_points(north);
+    std::size_t ghost_refusals = 0;
+    const auto hs = half.vertex_half_edges();
+    for (VertexId v = 0; v < half.vertex_count(); ++v) {
+        if (hs[v] == no_half_edge)
+            continue;
+        bool ghost = false;
+        HalfEdge h = hs[v];
+        do {
+            ghost = ghost || !half.is_solid(triangle_of(h));
+            h = half.next_around_origin(h);
+        } while (h != hs[v]);
+        if (!ghost)
+            continue;
+        const auto before = slot_snapshot(half);
+        EXPECT_FALSE(half.remove_vertex_from(hs[v]));
+        EXPECT_EQ(slot_snapshot(half), before);
+        ++ghost_refusals;
+    }
+    EXPECT_GE(ghost_refusals, 3u);
+    EXPECT_TRUE(half.validate().empty());
+}
+
+TEST(Delaunay, a_removal_its_caller_refuses_leaves_every_triangle_as_it_was) {
+    auto p = random_points(1000, 34);
+    SphericalDelaunay dt;
+    auto ids = dt.insert_points(p);
+    for (std::size_t k = 0; k < 100; ++k) {
+        const VertexId v = ids[k];
+        const auto before = slot_snapshot(dt);
+        const std::size_t count = dt.triangle_count();
+        std::vector<TriangleId> changed;
+        bool seen = false;
+        EXPECT_FALSE(dt.remove_vertex_from(dt.leaving(v), &changed, [&] {
+            seen = dt.validate().empty() && dt.triangle_count() == count - 2;
+            for (TriangleId t : changed)
+                for (int i = 0; i < 3; ++i)
+                    seen = seen && dt.is_live(t) && dt.vertex(t, i) != v;
+            return false;
+        }));
+        EXPECT_TRUE(seen);
+        EXPECT_EQ(slot_snapshot(dt), before);
+        EXPECT_EQ(dt.triangle_count(), count);
+        ASSERT_TRUE(dt.validate().empty());
+    }
+    // The same removals accepted, then new points fill the freed slots.
+    for (std::size_t k = 0; k < 100; ++k)
+        ASSERT_TRUE(dt.remove_vertex_from(dt.leaving(ids[k]), nullptr, [] { return true; }));
+    EXPECT_EQ(dt.triangle_count(), 2 * (1000 - 100) - 4);
+    for (const Vec3 &q : random_points(50, 35))
+        dt.insert(q);
+    EXPECT_TRUE(dt.validate().empty());
+    EXPECT_EQ(euler(dt), 2u);
 }
