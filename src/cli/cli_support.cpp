@@ -30,7 +30,7 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0; // the first cancelling signal that arrived, or 0
 volatile std::sig_atomic_t g_mid_line = 0;    // a progress line on stderr is open
-volatile std::sig_atomic_t g_finished = 0;    // the outputs are in place: nothing to cancel
+volatile std::sig_atomic_t g_completing = 0;  // the outputs are being moved in place: no cancel
 pthread_t g_main_thread;                      // the thread of the guard, which handles the signals
 sem_t g_wake;                                 // posted by the first signal and by the guard's end
 std::atomic<bool> g_guard_ending{false};
@@ -54,6 +54,8 @@ extern "C" void on_cancelling_signal(int signal) {
         pthread_kill(g_main_thread, signal);
         return;
     }
+    if (g_completing)
+        return; // the run ends with its outputs (InterruptGuard::completing)
     if (!g_interrupted) {
         g_interrupted = signal;
         sem_post(&g_wake); // the watchdog's clock starts
@@ -61,11 +63,6 @@ extern "C" void on_cancelling_signal(int signal) {
     }
     if (OutputFile::committing())
         return;
-    if (g_finished) {
-        std::signal(signal, SIG_DFL);
-        std::raise(signal);
-        return;
-    }
     OutputFile::remove_temporaries();
     if (g_mid_line)
         write_stderr("\n");
@@ -101,7 +98,7 @@ void watchdog() {
 
 InterruptGuard::InterruptGuard() {
     g_interrupted = 0;
-    g_finished = 0;
+    g_completing = 0;
     g_main_thread = pthread_self();
     g_guard_ending = false;
     sem_init(&g_wake, 0, 0);
@@ -136,8 +133,8 @@ void InterruptGuard::forget() {
     g_interrupted = 0;
 }
 
-void InterruptGuard::finished() {
-    g_finished = 1;
+void InterruptGuard::completing() {
+    g_completing = 1;
 }
 
 bool TerminalProgress::update(double fraction, std::string_view stage) {

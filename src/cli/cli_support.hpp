@@ -25,10 +25,10 @@ namespace globemesh::cli {
 /// ones after). The first signal is only recorded (interrupted() reads it; the run stops at its
 /// next progress report and removes its files). A second one removes the temporary output files
 /// (OutputFile::remove_temporaries), says "cancelled" on stderr and ends the process by that
-/// signal, unless the outputs are being moved in place. A run still going stop_grace after the
-/// first signal (in a long call that does not report) gets it again from a watchdog thread, and
-/// so ends as on a second one. One guard at a time, on the thread that runs (run_cli is not
-/// re-entrant); a signal delivered to another thread is passed to it.
+/// signal, unless the run is moving its outputs in place (completing()). A run still going
+/// stop_grace after the first signal (in a long call that does not report) gets it again from a
+/// watchdog thread, and so ends as on a second one. One guard at a time, on the thread that runs
+/// (run_cli is not re-entrant); a signal delivered to another thread is passed to it.
 class InterruptGuard {
 public:
     InterruptGuard();
@@ -40,9 +40,10 @@ public:
     static int signal();
     /// Clears signal() before a new run.
     static void forget();
-    /// The outputs are in place: a second signal now ends the process without a word (the run
-    /// is complete), a first one changes nothing.
-    static void finished();
+    /// The run is about to move its outputs in place (OutputBatch::commit, which still stops on
+    /// a signal that came before): from now on every signal is ignored, so that the run ends
+    /// either with all its outputs and status 0 or, when the commit fails, with none.
+    static void completing();
     /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
     /// and leave the temporary output files behind.

@@ -102,8 +102,8 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
     write.history = history_text("convert", args);
     write_run_outputs(mesh, planned, write, terminal);
     terminal.finish();
+    InterruptGuard::completing();
     batch.commit(InterruptGuard::interrupted);
-    InterruptGuard::finished();
     const auto coast = std::count_if(mesh.boundary.begin(), mesh.boundary.end(),
                                      [](const BoundaryEdge &e) { return e.tag == EdgeTag::coast; });
     out << "nodes             " << mesh.nodes.size() << "\n"

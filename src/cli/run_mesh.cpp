@@ -133,8 +133,8 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     }
     if (!o.report.empty())
         OutputFile::write_text(o.report, report_json(summary), o.overwrite, "--report");
+    InterruptGuard::completing();
     batch.commit(InterruptGuard::interrupted);
-    InterruptGuard::finished();
     print_mesh_summary(out, err, summary);
     return 0;
 }

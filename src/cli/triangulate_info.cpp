@@ -83,8 +83,8 @@ int run_triangulate(std::span<const std::string> args, std::ostream &out, std::o
     if (!c.timings.empty()) {
         OutputFile::write_text(c.timings, timings_json(timings), c.overwrite, "--timings");
     }
+    InterruptGuard::completing();
     batch.commit(InterruptGuard::interrupted);
-    InterruptGuard::finished();
     out << "nodes             " << mesh.nodes.size() << "\n"
         << "faces             " << mesh.faces.size() << "\n";
     print_timings(out, timings);
