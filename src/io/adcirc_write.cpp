@@ -51,30 +51,6 @@ struct BoundaryStrings {
     std::size_t open_nodes = 0, land_nodes = 0;
 };
 
-/// Longitudes of the nodes in [-180, 180), or in [0, 360) when that spares every face a cut.
-std::vector<LonLat> node_lonlats(const Mesh &mesh) {
-    std::vector<LonLat> p(mesh.nodes.size());
-    for (std::size_t i = 0; i < p.size(); ++i)
-        p[i] = vec_to_lonlat(mesh.nodes[i]);
-    const auto cuts = [&](double shift) {
-        for (const auto &f : mesh.faces) {
-            double lo = 1e9, hi = -1e9;
-            for (NodeIndex n : f) {
-                const double lon = p[n].lon < 0 ? p[n].lon + shift : p[n].lon;
-                lo = std::min(lo, lon);
-                hi = std::max(hi, lon);
-            }
-            if (hi - lo > 180)
-                return true;
-        }
-        return false;
-    };
-    if (cuts(0) && !cuts(360))
-        for (auto &q : p)
-            q.lon += q.lon < 0 ? 360 : 0;
-    return p;
-}
-
 /// The boundary loops as edge index lists (into topo.boundary_edges), each walked with the mesh on
 /// its left; at a node where two loops touch, either continuation closes a loop.
 std::vector<std::vector<std::size_t>> boundary_loops(const io::MeshTopology &topo,
@@ -272,7 +248,7 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
     const Field *depth = mesh.node_field("depth");
     check_depths(depth, path, what);
     OutputFile file(path, options.overwrite, what);
-    const std::vector<LonLat> p = node_lonlats(mesh);
+    const std::vector<LonLat> p = io::node_lonlats(mesh);
     TextOut out(file.temp_path(), path, what);
     std::string title = options.title;
     std::replace_if(

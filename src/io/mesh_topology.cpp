@@ -167,4 +167,27 @@ std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_coun
     return loops;
 }
 
+std::vector<LonLat> node_lonlats(const Mesh &mesh) {
+    std::vector<LonLat> p(mesh.nodes.size());
+    for (std::size_t i = 0; i < p.size(); ++i)
+        p[i] = vec_to_lonlat(mesh.nodes[i]);
+    const auto cuts = [&](double shift) {
+        for (const auto &f : mesh.faces) {
+            double lo = 1e9, hi = -1e9;
+            for (NodeIndex n : f) {
+                const double lon = p[n].lon < 0 ? p[n].lon + shift : p[n].lon;
+                lo = std::min(lo, lon);
+                hi = std::max(hi, lon);
+            }
+            if (hi - lo > 180)
+                return true;
+        }
+        return false;
+    };
+    if (cuts(0) && !cuts(360))
+        for (auto &q : p)
+            q.lon += q.lon < 0 ? 360 : 0;
+    return p;
+}
+
 } // namespace globemesh::io

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/sphere.hpp"
 #include "globemesh/ugrid.hpp"
 
 namespace globemesh::io {
@@ -66,5 +67,9 @@ std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_coun
 
 /// compute_stats on an already built topology (the writer has one).
 MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo);
+
+/// The nodes in lon/lat for the model formats that store degrees (ADCIRC, SCHISM, SELAFIN):
+/// longitudes in [-180, 180), or in [0, 360) when that spares every face a cut at the seam.
+std::vector<LonLat> node_lonlats(const Mesh &mesh);
 
 } // namespace globemesh::io

@@ -165,30 +165,6 @@ std::vector<BoundaryNode> boundary_numbering(const io::MeshTopology &topo, std::
     return numbering;
 }
 
-/// Longitudes in [-180, 180), or in [0, 360) when that spares every face a cut.
-std::vector<LonLat> node_lonlats(const Mesh &mesh) {
-    std::vector<LonLat> p(mesh.nodes.size());
-    for (std::size_t i = 0; i < p.size(); ++i)
-        p[i] = vec_to_lonlat(mesh.nodes[i]);
-    const auto cuts = [&](double shift) {
-        for (const auto &f : mesh.faces) {
-            double lo = 1e9, hi = -1e9;
-            for (NodeIndex n : f) {
-                const double lon = p[n].lon < 0 ? p[n].lon + shift : p[n].lon;
-                lo = std::min(lo, lon);
-                hi = std::max(hi, lon);
-            }
-            if (hi - lo > 180)
-                return true;
-        }
-        return false;
-    };
-    if (cuts(0) && !cuts(360))
-        for (auto &q : p)
-            q.lon += q.lon < 0 ? 360 : 0;
-    return p;
-}
-
 /// Refuses what SELAFIN cannot hold: nodes without a depth, counts past its 32-bit records.
 void check_mesh(const Mesh &mesh, const Field *depth, const fs::path &path) {
     if (3 * mesh.faces.size() * 4 >= std::size_t(INT32_MAX))
@@ -233,7 +209,7 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary, Reco
     for (auto k : ipobo)
         out.integer(k);
     out.marker(4 * np);
-    const std::vector<LonLat> p = node_lonlats(mesh);
+    const std::vector<LonLat> p = io::node_lonlats(mesh);
     const Field *depth = mesh.node_field("depth");
     for (int part = 0; part < 3; ++part) { // X, Y, BOTTOM
         report(options.progress, double(ne + (part + 1) * np) / total, "write_selafin");
