@@ -32,6 +32,24 @@ CLI::Validator count_transform();
 /// CLI11 wants the arguments in reverse order.
 std::vector<std::string> reversed(std::span<const std::string> args);
 
+/// Calls parse() for a subcommand's `app`; when it asks for --help (or --help-all) or --version,
+/// prints that on `out` and returns true: the command is done, with status 0.
+template <class Parse> bool printed_help(CLI::App &app, std::ostream &out, Parse &&parse) {
+    try {
+        parse();
+    } catch (const CLI::CallForHelp &) {
+        out << app.help();
+        return true;
+    } catch (const CLI::CallForAllHelp &) {
+        out << app.help();
+        return true;
+    } catch (const CLI::CallForVersion &) {
+        out << version_text() << "\n";
+        return true;
+    }
+    return false;
+}
+
 /// One line: newlines of multi-line messages (CLI11's) become "; ".
 std::string one_line(std::string message);
 

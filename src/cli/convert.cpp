@@ -69,15 +69,8 @@ void name_depth(Mesh &mesh) {
 int run_convert(std::span<const std::string> args, std::ostream &out, std::ostream &err,
                 TerminalProgress &terminal, const CliLibrary &lib) {
     auto command = std::make_unique<ConvertCommand>(lib.writers);
-    try {
-        command->app.parse(reversed(args));
-    } catch (const CLI::CallForHelp &) {
-        out << command->app.help();
+    if (printed_help(command->app, out, [&] { command->app.parse(reversed(args)); }))
         return 0;
-    } catch (const CLI::CallForVersion &) {
-        out << version_text() << "\n";
-        return 0;
-    }
     auto &c = *command;
     c.output.insert(c.output.end(), c.positional.begin(), c.positional.end());
     if (c.output.empty())

@@ -67,18 +67,8 @@ void add_mesh_total(StageTimings &timings) {
 int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream &err,
              TerminalProgress &terminal, const CliLibrary &lib) {
     auto command = std::make_unique<MeshCommand>(lib.writers);
-    try {
-        command->parse(args);
-    } catch (const CLI::CallForHelp &) {
-        out << command->app.help();
+    if (printed_help(command->app, out, [&] { command->parse(args); }))
         return 0;
-    } catch (const CLI::CallForAllHelp &) {
-        out << command->app.help();
-        return 0;
-    } catch (const CLI::CallForVersion &) {
-        out << version_text() << "\n";
-        return 0;
-    }
     const CliOptions &o = command->o;
     if (o.print_config) {
         validate(o.mesh);

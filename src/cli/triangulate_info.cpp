@@ -44,15 +44,8 @@ TriangulateCommand::TriangulateCommand(std::span<const Writer> table) {
 int run_triangulate(std::span<const std::string> args, std::ostream &out, std::ostream &err,
                     TerminalProgress &terminal, const CliLibrary &lib) {
     auto command = std::make_unique<TriangulateCommand>(lib.writers);
-    try {
-        command->app.parse(reversed(args));
-    } catch (const CLI::CallForHelp &) {
-        out << command->app.help();
+    if (printed_help(command->app, out, [&] { command->app.parse(reversed(args)); }))
         return 0;
-    } catch (const CLI::CallForVersion &) {
-        out << version_text() << "\n";
-        return 0;
-    }
     const auto &c = *command;
     if (c.quiet && c.verbose)
         throw UsageError("--quiet and --verbose exclude each other");
@@ -105,15 +98,8 @@ InfoCommand::InfoCommand() {
 
 int run_info(std::span<const std::string> args, std::ostream &out, const CliLibrary &lib) {
     InfoCommand command;
-    try {
-        command.app.parse(reversed(args));
-    } catch (const CLI::CallForHelp &) {
-        out << command.app.help();
+    if (printed_help(command.app, out, [&] { command.app.parse(reversed(args)); }))
         return 0;
-    } catch (const CLI::CallForVersion &) {
-        out << version_text() << "\n";
-        return 0;
-    }
     check_input_path(command.path, "MESH");
     const MeshStats stats = lib.compute_stats(lib.read_ugrid(command.path));
     if (command.json)
