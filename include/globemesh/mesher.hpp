@@ -148,6 +148,7 @@ struct MesherReport {
         0; ///< triangles of two or three boundary nodes split after smoothing
     std::size_t corners_blunted = 0;     ///< faces below q 0.3 at sharp coast corners removed last
     std::size_t floor_nodes_removed = 0; ///< free nodes of faces below q 0.3 removed to mend them
+    std::size_t floor_nodes_added = 0;   ///< nodes added on the shortest side of faces below q 0.3
     std::size_t land_faces_removed = 0;  ///< faces removed because their centroid lies on land
     std::size_t land_faces_left =
         0; ///< faces centred on land that could not go (MesherOptions::land)

@@ -61,7 +61,8 @@ void print_coast(std::ostream &out, const OceanMesh &run) {
     out << "coast             " << run.coast.rings << " rings kept, islands dropped "
         << run.coast.islands_removed << ", lakes dropped " << run.coast.lakes_removed
         << ", inlets closed " << inlets_closed_text(m) << ", corners blunted " << m.corners_blunted
-        << ", floor nodes removed " << m.floor_nodes_removed << "\n"
+        << ", floor nodes removed " << m.floor_nodes_removed << " / added " << m.floor_nodes_added
+        << "\n"
         << "coast repairs     " << coast_repairs_text(run.coast_repairs) << "\n"
         << "faces on land     " << land_faces_text(m) << "\n";
     // The first six places (lon lat); all of them, up to 50, are in the file's attribute `key`.

@@ -17,6 +17,9 @@ constexpr int mend_passes = 3;
 // Rounds of the last, quality-driven smoothing of the nodes of triangles below q count_cap:
 // past 6, a round gains under 0.02% of faces above q 0.8.
 constexpr int improve_rounds = 6;
+// The faces below the floor that get a node's trial (each copies the triangulation and scans its
+// faces): the last few a run leaves; a mesh with more has another problem to find.
+constexpr std::size_t max_floor_trials = 64;
 // Those rounds move each node where its star has the most triangles above count_quality (the
 // issue's q 0.8), ties broken by the sum of the qualities capped at count_cap, with no triangle
 // below min(the star's worst, worst_goal) (star_count_score): the count and the capped sum at
@@ -38,6 +41,15 @@ public:
     void mend_corners();
     void raise_floor();
     std::size_t remove_floor_nodes();
+    std::size_t insert_floor_nodes();
+    std::pair<std::size_t, double> floor_faces(std::vector<TriangleId> *low) const;
+    double face_quality(TriangleId t) const {
+        return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
+                                dt.point(dt.vertex(t, 2)));
+    }
+    bool is_cut(TriangleId t) const {
+        return std::find(m.cut_sides.begin(), m.cut_sides.end(), t) != m.cut_sides.end();
+    }
 
 private:
     Mesher &m;
@@ -405,9 +417,15 @@ void QualityRounds::raise_floor() {
         }
     };
     search();
-    // Then the nodes no position mends go, and the search runs again around them.
+    // Then the nodes no position mends go, and the search runs again around them; last, a face
+    // that neither mends gets a node on its shortest side, and the same again.
     while (remove_floor_nodes() > 0)
         search();
+    if (insert_floor_nodes() > 0) {
+        search();
+        while (remove_floor_nodes() > 0)
+            search();
+    }
 }
 
 // A free node (not sharp) of a face still below the floor, whose star is all ocean, goes when
@@ -457,6 +475,87 @@ std::size_t QualityRounds::remove_floor_nodes() {
     }
     m.report.floor_nodes_removed += removed;
     return removed;
+}
+
+// The faces below the floor: how many, and the worst.
+std::pair<std::size_t, double> QualityRounds::floor_faces(std::vector<TriangleId> *low) const {
+    std::size_t count = 0;
+    double worst = 1;
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean)
+            continue;
+        const double q = face_quality(t);
+        if (q >= detail::blunt_floor)
+            continue;
+        ++count;
+        worst = std::min(worst, q);
+        if (low)
+            low->push_back(t);
+    }
+    return {count, worst};
+}
+
+// A face still below the floor (a short side, often a coast segment, beside nodes of a much
+// coarser spacing) gets a node at the apex of the equilateral triangle on its shortest side, on
+// the face's side (Ungor's off-centre at its most regular), and the search runs on the node and
+// its free neighbours. The trial stays when it leaves fewer faces below the floor and none worse
+// than before; else the triangulation is restored from a copy. Returns the nodes added
+// (MesherReport::floor_nodes_added).
+std::size_t QualityRounds::insert_floor_nodes() {
+    std::vector<TriangleId> low;
+    auto before = floor_faces(&low);
+    if (low.size() > max_floor_trials)
+        low.resize(max_floor_trials);
+    std::size_t added = 0;
+    std::vector<std::pair<VertexId, TriangleId>> around;
+    for (TriangleId t : low) {
+        if (!dt.is_live(t) || dt.label(t) != ocean || face_quality(t) >= detail::blunt_floor)
+            continue; // mended by an earlier node
+        int k = 0;
+        for (int i = 1; i < 3; ++i)
+            if (arc_angle(dt.point(dt.vertex(t, i)), dt.point(dt.vertex(t, next3(i)))) <
+                arc_angle(dt.point(dt.vertex(t, k)), dt.point(dt.vertex(t, next3(k)))))
+                k = i;
+        const Vec3 &a = dt.point(dt.vertex(t, k)), &b = dt.point(dt.vertex(t, next3(k)));
+        const double height = 0.5 * std::sqrt(3.0) * arc_angle(a, b);
+        const Vec3 p = normalized(std::cos(height) * arc_midpoint(a, b) +
+                                  std::sin(height) * normalized(cross(a, b)));
+        HalfEdge blocked;
+        const TriangleId in = m.walk_towards(t, p, blocked);
+        if (blocked != no_half_edge || dt.label(in) != ocean || is_cut(in))
+            continue;
+        const SphericalDelaunay saved = dt; // the trial is undone exactly by restoring it
+        const std::size_t vertices = dt.vertex_count();
+        const VertexId v = dt.insert_in_triangle(p, in);
+        if (dt.vertex_count() == vertices)
+            continue;
+        as_made.resize(dt.vertex_count(), 0);
+        dirty.resize(dt.vertex_count(), 0);
+        const HalfEdge from = dt.leaving(v, dt.last_triangle());
+        bool ocean_star = true;
+        around.assign(1, {v, triangle_of(from)});
+        HalfEdge h = from;
+        do {
+            ocean_star = ocean_star && dt.label(triangle_of(h)) == ocean && !is_cut(triangle_of(h));
+            if (!m.is_fixed(dt.destination(h)))
+                around.emplace_back(dt.destination(h), triangle_of(h));
+            h = dt.next_around_origin(h);
+        } while (h != from);
+        for (int round = 0; ocean_star && round < 2; ++round)
+            for (auto &[u, hint] : around)
+                improve_node(u, hint);
+        const auto after = floor_faces(nullptr);
+        if (!ocean_star || after.first >= before.first || after.second < before.second) {
+            dt = saved;
+            continue;
+        }
+        before = after;
+        ++added;
+        for (const auto &[u, hint] : around)
+            dirty[u] = 1;
+    }
+    m.report.floor_nodes_added += added;
+    return added;
 }
 
 } // namespace

@@ -101,6 +101,7 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
     a.emplace_back("lattice_nodes", std::to_string(m.lattice_nodes));
     a.emplace_back("corners_blunted", std::to_string(m.corners_blunted));
     a.emplace_back("floor_nodes_removed", std::to_string(m.floor_nodes_removed));
+    a.emplace_back("floor_nodes_added", std::to_string(m.floor_nodes_added));
     a.emplace_back("sharp_coast_corners", std::to_string(m.sharp_corners));
     a.emplace_back("faces_at_sharp_corners", std::to_string(m.sharp_corner_faces));
     a.emplace_back("ocean_components", ocean_components_text(m));

@@ -32,12 +32,16 @@ void expect_valid_mesh(const Mesh &mesh, const MeshOptions &o, const std::string
                              "--coast " + o.coast + " --max-land-faces 0 --min-quality 0.3");
 }
 
-std::size_t corners_blunted(const Mesh &mesh) {
+std::size_t count_attribute(const Mesh &mesh, const std::string &name) {
     for (const auto &[key, value] : mesh.attributes)
-        if (key == "corners_blunted")
+        if (key == name)
             return std::stoul(value);
-    ADD_FAILURE() << "no corners_blunted attribute";
+    ADD_FAILURE() << "no " << name << " attribute";
     return 0;
+}
+
+std::size_t corners_blunted(const Mesh &mesh) {
+    return count_attribute(mesh, "corners_blunted");
 }
 
 // GSHHG intermediate around the Great Sandy Strait (Queensland): an islet's vertex 0.4 m from
@@ -95,6 +99,19 @@ TEST(CoastReal, a_face_below_the_floor_with_one_coast_corner_goes_with_the_faces
     const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GE(corners_blunted(mesh), 2u);
     expect_valid_mesh(mesh, o, "danube.nc");
+}
+
+// GSHHG high around the Yangtze mouth (land clipped to 120..124E, 30..33N, meshed in a wider
+// region) at 50 km: a face of q 0.202 between a free node and two coast nodes 0.6 km apart, whose
+// neighbours lie 3 to 7 km off, where no position of the node and no removal of it mends the face
+// (the same as the last face below the floor of the global GSHHG h run at 50 km). A node at the
+// apex of the equilateral triangle on the short side mends it.
+TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_that_side) {
+    const MeshOptions o =
+        region_run("coast/hostile/gshhg_h_yangtze.geojson", {119, 29, 125, 34}, 50);
+    const Mesh mesh = mesh_ocean(o).mesh;
+    EXPECT_GE(count_attribute(mesh, "floor_nodes_added"), 1u);
+    expect_valid_mesh(mesh, o, "yangtze.nc");
 }
 
 // GSHHG intermediate around Seram and Misool (128.5..131.5E, 4.5..1.5S): in the global run at
