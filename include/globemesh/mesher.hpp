@@ -162,7 +162,13 @@ struct MesherReport {
     std::size_t straits_closed =
         0; ///< of the faces removed, those that closed a strait (MesherOptions::close_straits)
     std::vector<Vec3> straits_closed_at; ///< their centroids
-    std::vector<double> seas_cut_off;    ///< km2 of each basin those closings cut off (kept)
+    /// Each closed strait's water width (km) near its place in straits_closed_at: the narrowest
+    /// passage joining two stretches of water within 0.6 h of it (0: narrower than the sampling).
+    std::vector<double> straits_closed_width_km;
+    /// Where the width is 0: the sampling's finest spacing (km), which the passage is narrower
+    /// than.
+    std::vector<double> straits_closed_width_below_km;
+    std::vector<double> seas_cut_off; ///< km2 of each basin those closings cut off (kept)
     double straits_water_km2 = 0; ///< water cut off with them and closed (inlet_area, inlet_width)
     std::size_t nodes_split =
         0; ///< nodes added where a strait closed at a node between two fans of water

@@ -55,6 +55,61 @@ void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, boo
             << " written with negative depth; --min-depth 5 would raise them to 5 m\n";
 }
 
+/// The cells a strait needs across to stay open (the size it needs: its width over this).
+constexpr double strait_cells = 2;
+
+/// The summary's lines of the closed straits: each place, its width and the size it needs.
+void print_straits(std::ostream &out, const MesherReport &m) {
+    constexpr std::size_t shown = 6;
+    for (std::size_t i = 0; i < m.straits_closed_at.size() && i < shown; ++i) {
+        const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
+        char line[160];
+        const double w = m.straits_closed_width_km[i];
+        if (w == 0) {
+            const std::string below = report_number(m.straits_closed_width_below_km[i]);
+            std::snprintf(line, sizeof line,
+                          "                  at %.2f %.2f, under %s km wide: needs h < %s km\n",
+                          ll.lon, ll.lat, below.c_str(),
+                          report_number(m.straits_closed_width_below_km[i] / strait_cells).c_str());
+            out << line;
+            continue;
+        }
+        std::snprintf(line, sizeof line,
+                      "                  at %.2f %.2f, %s km wide: needs h <= %s km\n", ll.lon,
+                      ll.lat, report_number(w).c_str(), report_number(w / strait_cells).c_str());
+        out << line;
+    }
+    if (m.straits_closed_at.size() > shown)
+        out << "                  ... " << m.straits_closed_at.size() - shown
+            << " more (straits_closed_at, straits_closed_width_km; --report)\n";
+}
+
+/// The warning on `err` that straits were closed, and how to keep them.
+void warn_straits(std::ostream &err, const MesherReport &m) {
+    err << "globemesh: warning: " << m.straits_closed
+        << (m.straits_closed == 1 ? " strait narrower than its faces was closed"
+                                  : " straits narrower than their faces were closed")
+        << " (listed in the summary); keep one open with --size-regions (h at most half its width "
+           "there), or all with --keep-straits\n";
+}
+
+/// The closed straits in the --report JSON: place, width and the size each needs.
+std::string straits_json(const MesherReport &m) {
+    std::string r = "[";
+    for (std::size_t i = 0; i < m.straits_closed_at.size(); ++i) {
+        const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
+        // A passage narrower than the sampling: its width is null, under width_below_km.
+        const double w = m.straits_closed_width_km[i], below = m.straits_closed_width_below_km[i];
+        const double bound = w > 0 ? w : below;
+        r += std::string(i ? ", " : "") + "{\"lon\": " + json_number(ll.lon) +
+             ", \"lat\": " + json_number(ll.lat) +
+             ", \"width_km\": " + (w > 0 ? json_number(w) : std::string("null")) +
+             (w > 0 ? "" : ", \"width_below_km\": " + json_number(below)) +
+             ", \"size_needed_km\": " + json_number(bound / strait_cells) + "}";
+    }
+    return r + "]";
+}
+
 /// What the run changed of the coast and the land: the summary's lines from the typed reports.
 void print_coast(std::ostream &out, const OceanMesh &run) {
     const MesherReport &m = run.mesher;
@@ -76,7 +131,7 @@ void print_coast(std::ostream &out, const OceanMesh &run) {
     places(m.land_faces_at, "faces_on_land_at");
     if (run.straits_closing && m.straits_closed > 0) {
         out << "straits closed    " << straits_closed_text(m) << "\n";
-        places(m.straits_closed_at, "straits_closed_at");
+        print_straits(out, m);
     }
     out << "ocean components  " << ocean_components_text(m) << "\n";
 }
@@ -92,6 +147,8 @@ std::string report_json(const MeshRunSummary &s) {
     r << ",\n  \"mesh\": " << stats_json(s.stats, "  ") << ",\n";
     if (s.run.depth)
         r << "  \"depth\": " << depth_json(*s.run.depth) << ",\n";
+    if (s.run.straits_closing)
+        r << "  \"straits_closed\": " << straits_json(s.run.mesher) << ",\n";
     // What the run did to the coast and the land, as the NetCDF file's global attributes say.
     r << "  \"attributes\": {";
     for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
@@ -110,6 +167,8 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
     print_coast(out, s.run);
     if (s.run.depth)
         print_depth(out, err, *s.run.depth, o.quiet);
+    if (s.run.straits_closing && s.run.mesher.straits_closed > 0 && !o.quiet)
+        warn_straits(err, s.run.mesher);
     print_timings(out, s.timings);
     out << "total time        " << exact_text(std::round(s.total_s * 1000) / 1000) << " s\n"
         << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"

@@ -71,6 +71,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     // Last, the coast's corners too sharp for the faces there (corners.cpp).
     blunt_sharp_corners(m, options);
     raise_quality_floor(m, options, as_made);
+    if (options.land)
+        measure_closed_straits(m, *options.land, report);
 
     // Conversion to Mesh (output.cpp).
     Mesh mesh = to_mesh(m);

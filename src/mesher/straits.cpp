@@ -1,4 +1,6 @@
 // Straits narrower than a face closed.
+#include <numeric>
+
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
@@ -106,6 +108,119 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
     for (const TriangleId t : left)
         if (is_ocean(t))
             faces.push_back(t);
+}
+
+namespace {
+
+constexpr int passage_rings = 16; // passage_width's grid: rings of samples out to its reach
+
+// The distance (radians) from p to the coast, to within reach / 2^12; `reach` when farther.
+double coast_distance(const LandTest &land, const Vec3 &p, double reach) {
+    if (!land.coast_within(p, reach))
+        return reach;
+    double lo = 0, hi = reach;
+    for (int i = 0; i < 12; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (land.coast_within(p, mid) ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// The width (radians) of the narrowest passage of the water around p, within `reach`: twice the
+// bottleneck distance to the coast on the water path, sampled on a polar grid, that joins two
+// separate stretches of water on the grid's rim (the widest such path: a maximin, samples added
+// from the farthest from the coast). 0 when the rim has one stretch of water or none, or when the
+// water there is narrower than the grid.
+double passage_width(const LandTest &land, const Vec3 &p, double reach) {
+    constexpr int rings = passage_rings, spokes = 48;
+    const Vec3 east =
+        normalized(std::abs(p.z) < 0.9 ? cross(Vec3{0, 0, 1}, p) : cross(Vec3{1, 0, 0}, p));
+    const Vec3 north = cross(p, east);
+    const int n = 1 + rings * spokes; // sample 0 is p; ring r, spoke k is 1 + (r - 1) * spokes + k
+    auto index = [&](int r, int k) {
+        return r == 0 ? 0 : 1 + (r - 1) * spokes + (k + spokes) % spokes;
+    };
+    std::vector<double> clearance(n, -1); // -1: land
+    for (int r = 0; r <= rings; ++r)
+        for (int k = 0; k < (r ? spokes : 1); ++k) {
+            const double d = reach * r / rings, a = 2 * M_PI * k / spokes;
+            const Vec3 q = normalized(std::cos(d) * p +
+                                      std::sin(d) * (std::cos(a) * east + std::sin(a) * north));
+            if (!land.contains(q))
+                clearance[index(r, k)] = coast_distance(land, q, reach);
+        }
+    // The rim's stretches of water: each rim sample's stretch (-1 on land).
+    std::vector<int> stretch(spokes, -1);
+    int stretches = 0;
+    for (int k = 0, start = -1; k < spokes; ++k)
+        if (clearance[index(rings, k)] >= 0 && clearance[index(rings, k - 1)] < 0)
+            start = k, ++stretches, stretch[k] = stretches - 1;
+    if (stretches < 2)
+        return 0; // (a rim all water is one stretch: no passage to measure)
+    for (int k = 0; k < 2 * spokes; ++k)
+        if (stretch[k % spokes] < 0 && clearance[index(rings, k)] >= 0)
+            stretch[k % spokes] = stretch[(k + spokes - 1) % spokes];
+    std::vector<int> order, parent(n), reached(n, -1); // reached: a stretch the component touches
+    for (int i = 0; i < n; ++i)
+        if (clearance[i] >= 0)
+            order.push_back(i);
+    std::sort(order.begin(), order.end(),
+              [&](int x, int y) { return clearance[x] > clearance[y]; });
+    std::iota(parent.begin(), parent.end(), 0);
+    auto root = [&](int x) {
+        while (parent[x] != x)
+            x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    std::vector<char> added(n, 0);
+    for (const int i : order) {
+        added[i] = 1;
+        const int r = i == 0 ? 0 : 1 + (i - 1) / spokes, k = i == 0 ? 0 : (i - 1) % spokes;
+        if (r == rings)
+            reached[i] = stretch[k];
+        std::vector<int> next;
+        if (r == 0)
+            for (int j = 0; j < spokes; ++j)
+                next.push_back(index(1, j));
+        else
+            next = {index(r - 1, k), index(r, k - 1), index(r, k + 1)};
+        if (r > 0 && r < rings)
+            next.push_back(index(r + 1, k));
+        for (const int j : next) {
+            if (!added[j])
+                continue;
+            const int a = root(i), b = root(j);
+            if (a == b)
+                continue;
+            if (reached[a] >= 0 && reached[b] >= 0 && reached[a] != reached[b])
+                return 2 * clearance[i];
+            parent[b] = a;
+            if (reached[a] < 0)
+                reached[a] = reached[b];
+        }
+    }
+    return 0;
+}
+
+} // namespace
+
+void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport &report) {
+    // From 0.6 h (about the closed face's circumradius) in to 0.6 h / 64: the narrowest passage
+    // found at any of these scales (at the widest, the rim may cross one sea twice around a cape,
+    // joined by open water; closer in, only the strait joins the two sides). A passage found at
+    // none is narrower than the finest grid's spacing, which bounds it.
+    constexpr int zooms = 4;
+    report.straits_closed_width_km.clear();
+    report.straits_closed_width_below_km.clear();
+    for (const Vec3 &p : report.straits_closed_at) {
+        double reach = 0.6 * km_to_rad(m.size_km(p)), width = 0;
+        for (int zoom = 0; zoom < zooms; ++zoom, reach /= 4)
+            if (const double w = passage_width(land, p, reach); w > 0 && (width == 0 || w < width))
+                width = w;
+        report.straits_closed_width_km.push_back(width * earth_radius_km);
+        report.straits_closed_width_below_km.push_back(
+            width > 0 ? 0 : 4 * reach / passage_rings * earth_radius_km);
+    }
 }
 
 void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces) {

@@ -94,6 +94,15 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
         a.emplace_back("straits_closed", straits_closed_text(m));
         if (!m.straits_closed_at.empty())
             a.emplace_back("straits_closed_at", places_text(m.straits_closed_at, max_places));
+        if (!m.straits_closed_width_km.empty()) {
+            std::string widths;
+            for (std::size_t i = 0; i < m.straits_closed_width_km.size() && i < max_places; ++i)
+                widths += (i ? ", " : "") +
+                          (m.straits_closed_width_km[i] > 0
+                               ? report_number(m.straits_closed_width_km[i])
+                               : "<" + report_number(m.straits_closed_width_below_km[i]));
+            a.emplace_back("straits_closed_width_km", widths);
+        }
     }
     a.emplace_back("ocean_area_km2", report_number(c.ocean_area_km2));
     a.emplace_back("segments_split", std::to_string(m.segments_split + m.encroached_splits));
