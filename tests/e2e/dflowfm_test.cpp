@@ -124,6 +124,24 @@ print('SAME %d %d' % (dp.vertexCount(), dp.faceCount()), flush=True)
 os._exit(0)
 )";
 
+/// A UGRID file against the one it was converted from through a net file (argv 1, 2): the same
+/// nodes, faces, depths and boundary tags, and no coordinate read as a field; prints "ROUND".
+const std::string round_trip = R"(
+import sys, netCDF4, numpy as np
+a, b = netCDF4.Dataset(sys.argv[1]), netCDF4.Dataset(sys.argv[2])
+assert np.array_equal(a['mesh_face_nodes'][:], b['mesh_face_nodes'][:])
+for k in ('lon', 'lat'):
+    d = a['mesh_node_' + k][:] - b['mesh_node_' + k][:]
+    assert np.abs((d + 180) % 360 - 180).max() < 1e-9, k
+da, db = (np.ma.filled(f['depth'][:].astype(float), np.nan) for f in (a, b))
+assert np.array_equal(da, db, equal_nan=True), 'depth'
+assert np.array_equal(a['mesh_edge_nodes'][:], b['mesh_edge_nodes'][:])
+assert np.array_equal(a['boundary_tag'][:], b['boundary_tag'][:]), 'boundary tags'
+fields = [v for v in b.variables if getattr(b[v], 'location', '') in ('node', 'face')]
+assert not [v for v in fields if v.endswith(('_x', '_y'))], fields
+print('ROUND %d' % (b['boundary_tag'][:] == 2).sum())
+)";
+
 std::string run_python(const TempDir &dir, const std::string &name, const std::string &script,
                        const std::vector<fs::path> &args) {
     std::ofstream(dir / name) << script;
@@ -231,4 +249,18 @@ TEST(DflowFM, an_unwritable_net_file_is_one_line_and_leaves_no_file) {
     EXPECT_NE(err.find(missing.string()), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
     EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(DflowFM, a_net_file_converts_back_to_the_same_ugrid_mesh_with_its_open_boundary) {
+    TempDir dir;
+    mesh_and_check(dir, regional_run());
+    std::string err;
+    ASSERT_EQ(run_exe({"convert", "-q", (dir / "m_net.nc").string(), (dir / "back.nc").string()},
+                      err, dir.path()),
+              0)
+        << err;
+    const std::string same =
+        run_python(dir, "round.py", round_trip, {dir / "m.nc", dir / "back.nc"});
+    EXPECT_EQ(same.rfind("ROUND ", 0), 0u) << same;
+    EXPECT_EQ(same.find("ROUND 0\n"), std::string::npos) << same;
 }
