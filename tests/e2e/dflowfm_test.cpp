@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,24 +23,19 @@ namespace {
 
 const std::string exe = GLOBEMESH_EXE;
 
-std::string quote(const std::string &s) {
-    return "'" + s + "'";
+/// Runs the words (each quoted) through the shell, `redirect` applied; `out` gets what it shows
+/// (run_command: its standard output and error).
+int run(const std::vector<std::string> &words, std::string &out, const char *redirect = "") {
+    std::string command;
+    for (const auto &w : words)
+        command += "'" + w + "' ";
+    return run_command("( " + command + redirect + " )", out);
 }
 
-/// Runs the executable; `err` gets its stderr.
-int run_exe(const std::vector<std::string> &args, std::string &err, const fs::path &dir) {
-    std::string command = quote(exe);
-    for (const auto &a : args)
-        command += " " + quote(a);
-    const fs::path err_file = dir / ".stderr";
-    std::string out;
-    const int status = run_command("( " + command + " 2>" + quote(err_file.string()) + " )", out);
-    std::ifstream e(err_file);
-    std::stringstream s;
-    s << e.rdbuf();
-    err = s.str();
-    fs::remove(err_file);
-    return status;
+/// Runs the executable with `args`; `err` gets its standard error.
+int run_globemesh(std::vector<std::string> args, std::string &err) {
+    args.insert(args.begin(), exe);
+    return run(args, err, ">/dev/null");
 }
 
 /// The net file against the UGRID file (argv 1, 2); prints "OK nodes faces edges open coast".
@@ -142,27 +136,28 @@ assert not [v for v in fields if v.endswith(('_x', '_y'))], fields
 print('ROUND %d' % (b['boundary_tag'][:] == 2).sum())
 )";
 
-std::string run_python(const TempDir &dir, const std::string &name, const std::string &script,
-                       const std::vector<fs::path> &args) {
+/// Runs `script` (saved as dir/name) with `args`; returns what it printed, failing on an error.
+std::string python(const TempDir &dir, const std::string &name, const std::string &script,
+                   const std::vector<fs::path> &args) {
     std::ofstream(dir / name) << script;
-    std::string command = "/usr/bin/python3 " + quote((dir / name).string());
+    std::vector<std::string> words = {"/usr/bin/python3", (dir / name).string()};
     for (const auto &a : args)
-        command += " " + quote(a.string());
+        words.push_back(a.string());
     std::string out;
-    EXPECT_EQ(run_command(command + " 2>&1", out), 0) << out;
+    EXPECT_EQ(run(words, out), 0) << out;
     return out;
 }
 
 bool qgis_available() {
     std::string out;
-    return run_command("/usr/bin/python3 -c 'import qgis.core' 2>&1", out) == 0;
+    return run({"/usr/bin/python3", "-c", "import qgis.core"}, out) == 0;
 }
 
 /// Checks dir/net against the UGRID file dir/ugrid with both readers; returns the checker's
 /// counts: nodes, faces, edges, open edges, coast edges.
 std::vector<int> check(const TempDir &dir, const std::string &ugrid, const std::string &net) {
     expect_mesh_verify(dir / net);
-    const std::string verdict = run_python(dir, "check.py", checker, {dir / ugrid, dir / net});
+    const std::string verdict = python(dir, "check.py", checker, {dir / ugrid, dir / net});
     std::vector<std::string> groups;
     EXPECT_TRUE(
         globemesh::test::regex_search(verdict, "OK (\\d+) (\\d+) (\\d+) (\\d+) (\\d+)\n", &groups))
@@ -171,7 +166,7 @@ std::vector<int> check(const TempDir &dir, const std::string &ugrid, const std::
         globemesh::test::tool_missing("QGIS (python3-qgis)");
     } else {
         const std::string seen =
-            run_python(dir, "read_in_qgis.py", qgis_reader, {dir / ugrid, dir / net});
+            python(dir, "read_in_qgis.py", qgis_reader, {dir / ugrid, dir / net});
         EXPECT_NE(seen.find("SAME "), std::string::npos) << seen;
     }
     std::vector<int> counts;
@@ -187,7 +182,7 @@ std::vector<int> mesh_and_check(const TempDir &dir, std::vector<std::string> arg
         args.insert(args.end(), {"-o", (dir / out).string()});
     args.push_back("-q");
     std::string err;
-    EXPECT_EQ(run_exe(args, err, dir.path()), 0) << err;
+    EXPECT_EQ(run_globemesh(args, err), 0) << err;
     expect_mesh_verify(dir / "m.nc");
     return check(dir, "m.nc", "m_net.nc");
 }
@@ -227,10 +222,10 @@ TEST(DflowFM, convert_writes_a_ugrid_file_as_a_net_file_chosen_by_its_name_in_an
     args.insert(args.begin(), "mesh");
     args.insert(args.end(), {"-o", (dir / "m.nc").string(), "-q"});
     std::string err;
-    ASSERT_EQ(run_exe(args, err, dir.path()), 0) << err;
-    ASSERT_EQ(run_exe({"convert", "-q", (dir / "m.nc").string(), (dir / "c_NET.nc").string()}, err,
-                      dir.path()),
-              0)
+    ASSERT_EQ(run_globemesh(args, err), 0) << err;
+    ASSERT_EQ(
+        run_globemesh({"convert", "-q", (dir / "m.nc").string(), (dir / "c_NET.nc").string()}, err),
+        0)
         << err;
     const std::vector<int> counts = check(dir, "m.nc", "c_NET.nc");
     ASSERT_EQ(counts.size(), 5u);
@@ -241,10 +236,10 @@ TEST(DflowFM, an_unwritable_net_file_is_one_line_and_leaves_no_file) {
     TempDir dir;
     std::string err;
     const fs::path missing = dir / "no-such-folder" / "m_net.nc";
-    const int status = run_exe({"mesh", "--coast", fixture("coast/ne_110m_land.gpkg").string(),
-                                "--coast-layer", "land", "--hmax", "800km", "-o",
-                                (dir / "m.nc").string(), "-o", missing.string(), "-q"},
-                               err, dir.path());
+    const int status = run_globemesh(
+        {"mesh", "--coast", fixture("coast/ne_110m_land.gpkg").string(), "--coast-layer", "land",
+         "--hmax", "800km", "-o", (dir / "m.nc").string(), "-o", missing.string(), "-q"},
+        err);
     EXPECT_EQ(status, 1);
     EXPECT_NE(err.find(missing.string()), std::string::npos) << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
@@ -255,12 +250,11 @@ TEST(DflowFM, a_net_file_converts_back_to_the_same_ugrid_mesh_with_its_open_boun
     TempDir dir;
     mesh_and_check(dir, regional_run());
     std::string err;
-    ASSERT_EQ(run_exe({"convert", "-q", (dir / "m_net.nc").string(), (dir / "back.nc").string()},
-                      err, dir.path()),
+    ASSERT_EQ(run_globemesh(
+                  {"convert", "-q", (dir / "m_net.nc").string(), (dir / "back.nc").string()}, err),
               0)
         << err;
-    const std::string same =
-        run_python(dir, "round.py", round_trip, {dir / "m.nc", dir / "back.nc"});
+    const std::string same = python(dir, "round.py", round_trip, {dir / "m.nc", dir / "back.nc"});
     EXPECT_EQ(same.rfind("ROUND ", 0), 0u) << same;
     EXPECT_EQ(same.find("ROUND 0\n"), std::string::npos) << same;
 }
