@@ -1,6 +1,6 @@
 // Write speed and size of the io outputs on a 1,310,720-face icosphere (level 8) with depth and
 // target_size fields: UGRID NetCDF-4 (deflate), UGRID classic, GeoPackage, preview PNG, gmsh MSH
-// 4.1 and 2.2 (through the writers table), read-back.
+// 4.1 and 2.2 and D-Flow FM _net.nc (through the writers table), read-back.
 // Run: io_write_bench --benchmark_counters_tabular=true (file sizes are reported as counters).
 #include <benchmark/benchmark.h>
 
@@ -66,6 +66,11 @@ void BM_write_gmsh_41(benchmark::State &s) {
 void BM_write_gmsh_22(benchmark::State &s) {
     run(s, "m22.msh", [](const auto &m, const auto &p) { write_gmsh(m, p, "2.2"); });
 }
+void BM_write_dflowfm(benchmark::State &s) {
+    run(s, "m_net.nc", [](const auto &m, const auto &p) {
+        globemesh::find_writer(globemesh::writers(), "DFLOWFM")->write(m, p, {});
+    });
+}
 void BM_read_ugrid_and_stats(benchmark::State &s) {
     auto path = out_path("r.nc");
     std::filesystem::remove(path);
@@ -83,5 +88,6 @@ BENCHMARK(BM_write_gpkg)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_preview_png)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_gmsh_41)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_write_gmsh_22)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_write_dflowfm)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK(BM_read_ugrid_and_stats)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK_MAIN();

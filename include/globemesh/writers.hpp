@@ -66,7 +66,7 @@ struct CreationOption {
 struct Writer {
     std::string name;                    ///< as GDAL/OGR name a driver: "UGRID", "GPKG", "PNG"
     std::string long_name;               ///< in messages: "UGRID NetCDF", "GeoPackage"
-    std::vector<std::string> extensions; ///< lower case with the dot; the first is the usual one
+    std::vector<std::string> extensions; ///< name suffixes (".nc", "_net.nc"); first: usual
     std::string report_key;              ///< its key in the run report's "outputs"
     unsigned needs = needs_mesh_only;    ///< WriterNeeds bits
     /// Computes or takes each face's geodesic area (WriteOptions::face_areas_m2).
@@ -82,7 +82,8 @@ const std::vector<Writer> &writers();
 
 /// The row named `name` (any case), or null.
 const Writer *find_writer(std::span<const Writer> table, std::string_view name);
-/// The row whose extensions include `path`'s (any case), or null (also for no extension).
+/// The row with the longest of the table's extensions (suffixes: ".nc", "_net.nc") that `path`'s
+/// file name ends with (any case), or null (also for no extension).
 const Writer *writer_for_extension(std::span<const Writer> table,
                                    const std::filesystem::path &path);
 /// "UGRID (.nc, .nc4), GPKG (.gpkg), PNG (.png)": the formats, for messages.

@@ -3,7 +3,8 @@
 // Reads the first variable with cf_role = "mesh_topology": node coordinates (longitude/latitude,
 // in degrees), face_node_connectivity in either dimension order (face_dimension decides), any
 // start_index (0 or 1) and _FillValue, node and face data variables as fields, and boundary tags
-// from an edge variable "boundary_tag" when present. Nothing is trusted: every index is checked.
+// from an edge variable "boundary_tag" or D-Flow FM's "<mesh>_edge_type" when present. Nothing is
+// trusted: every index is checked.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -279,9 +280,18 @@ int read_faces(const Reader &r, int topo, Mesh &mesh) {
 /// Boundary tags (1 or 2) by edge key (smaller node << 32 | larger node), unsorted.
 using EdgeTags = std::vector<std::pair<std::uint64_t, int>>;
 
-/// Adds the tags of the edge variable `v` (boundary_tag on dimensions `d`) to `edge_tags`.
+/// The boundary tag (1 coast, 2 open; 0 none) of each value of an edge variable: ours
+/// (boundary_tag: 1 coast, 2 open) or D-Flow FM's edge type (2 boundary, 3 boundary_closed).
+int edge_tag_of(long long value, bool dflowfm) {
+    if (dflowfm)
+        return value == 2 ? 2 : value == 3 ? 1 : 0;
+    return value == 1 || value == 2 ? int(value) : 0;
+}
+
+/// Adds the tags of the edge variable `v` (boundary_tag or D-Flow FM's <mesh>_edge_type, on
+/// dimensions `d`) to `edge_tags`.
 void read_edge_tags(const Reader &r, int v, const std::vector<int> &d, const std::string &edge_name,
-                    int &edge_dim, std::size_t nn, EdgeTags &edge_tags) {
+                    int &edge_dim, std::size_t nn, EdgeTags &edge_tags, bool dflowfm) {
     int ev = r.var_id(edge_name, "edge_node_connectivity");
     if (edge_dim < 0)
         edge_dim = r.dims(ev).at(0);
@@ -291,11 +301,12 @@ void read_edge_tags(const Reader &r, int v, const std::vector<int> &d, const std
     auto tags = r.longs(v, edges.rows);
     for (std::size_t e = 0; e < edges.rows; ++e) {
         long long a = edges.values[2 * e], b = edges.values[2 * e + 1];
-        if (a < 0 || b < 0 || tags[e] <= 0 || tags[e] > 2)
+        const int tag = edge_tag_of(tags[e], dflowfm);
+        if (a < 0 || b < 0 || tag == 0)
             continue;
         if (a > b)
             std::swap(a, b);
-        edge_tags.emplace_back((std::uint64_t(a) << 32) | std::uint64_t(b), int(tags[e]));
+        edge_tags.emplace_back((std::uint64_t(a) << 32) | std::uint64_t(b), tag);
     }
 }
 
@@ -308,17 +319,26 @@ EdgeTags read_variables(const Reader &r, int nvars, int topo, int node_dim, int 
     if (auto ed = r.text(topo, "edge_dimension"))
         edge_dim = r.dim_id(*ed);
     auto edge_name = r.text(topo, "edge_node_connectivity");
+    // The coordinates are no data, though some files (D-Flow FM's) give them a mesh and location.
+    std::set<std::string> coordinates;
+    for (const char *c : {"node_coordinates", "face_coordinates", "edge_coordinates"}) {
+        std::istringstream names(r.text(topo, c).value_or(""));
+        for (std::string name; names >> name;)
+            coordinates.insert(name);
+    }
     EdgeTags edge_tags;
     for (int v = 0; v < nvars; ++v) {
-        if (r.text(v, "mesh") != std::optional<std::string>(topo_name))
+        if (r.text(v, "mesh") != std::optional<std::string>(topo_name) ||
+            coordinates.count(r.name(v)))
             continue;
         auto location = r.text(v, "location").value_or("");
         auto d = r.dims(v);
         nc_type t = r.type(v);
         if (d.size() != 1 || t == NC_CHAR || t == NC_STRING)
             continue;
-        if (location == "edge" && r.name(v) == "boundary_tag" && edge_name) {
-            read_edge_tags(r, v, d, *edge_name, edge_dim, nn, edge_tags);
+        const bool dflowfm = r.name(v) == topo_name + "_edge_type";
+        if (location == "edge" && (r.name(v) == "boundary_tag" || dflowfm) && edge_name) {
+            read_edge_tags(r, v, d, *edge_name, edge_dim, nn, edge_tags, dflowfm);
             continue;
         }
         bool on_nodes = location == "node" && d[0] == node_dim;

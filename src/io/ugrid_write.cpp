@@ -23,8 +23,8 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
-#include "hdf5_chunks.hpp"
 #include "mesh_topology.hpp"
+#include "nc_block_writer.hpp"
 #include "netcdf_handle.hpp"
 #include "ordered_blocks.hpp"
 #include "write_hooks.hpp"
@@ -37,235 +37,8 @@ namespace globemesh {
 
 namespace {
 
-constexpr const char *wgs84_wkt =
-    "GEOGCRS[\"WGS 84\",DATUM[\"World Geodetic System 1984\",ELLIPSOID[\"WGS "
-    "84\",6378137,298.257223563,"
-    "LENGTHUNIT[\"metre\",1]]],PRIMEM[\"Greenwich\",0,ANGLEUNIT[\"degree\",0.0174532925199433]],"
-    "CS[ellipsoidal,2],AXIS[\"geodetic latitude "
-    "(Lat)\",north,ORDER[1],ANGLEUNIT[\"degree\",0.0174532925199433]],"
-    "AXIS[\"geodetic longitude (Lon)\",east,ORDER[2],ANGLEUNIT[\"degree\",0.0174532925199433]],"
-    "ID[\"EPSG\",4326]]";
-
-/// Writes the variables of one file; every call checks its status.
-///
-/// The variables' data are computed and written a block of block_rows rows (one chunk) at a
-/// time (in_blocks), on every core (ordered_blocks.hpp). A netCDF-4 file is defined and closed
-/// in netCDF-C first (start_data), then each block's rows are shuffled and deflated on the
-/// thread that computed them and stored from this one as whole chunks (hdf5_chunks.hpp); a
-/// classic file's rows go through netCDF-C as they are.
-class UgridWriter {
-public:
-    UgridWriter(io::NcHandle &nc, const std::filesystem::path &temp,
-                const std::filesystem::path &file, bool compress, const Progress &progress)
-        : nc_(nc), temp_(temp), file_(file), compress_(compress), progress_(progress) {}
-
-    int dim(const char *name, std::size_t len) {
-        int d;
-        io::nc_check(nc_def_dim(nc_.id(), name, len, &d), file_,
-                     std::string("defining dimension ") + name);
-        return d;
-    }
-    int var(const char *name, nc_type type, std::vector<int> dims) {
-        int v;
-        io::nc_check(nc_def_var(nc_.id(), name, type, int(dims.size()), dims.data(), &v), file_,
-                     std::string("defining variable ") + name);
-        if (dims.empty())
-            return v;
-        Shape shape{name, 0, 1, 0};
-        std::vector<std::size_t> lengths(dims.size());
-        for (std::size_t k = 0; k < dims.size(); ++k) {
-            io::nc_check(nc_inq_dimlen(nc_.id(), dims[k], &lengths[k]), file_,
-                         std::string("sizing ") + name);
-            if (k > 0)
-                shape.row_values *= lengths[k];
-        }
-        shape.rows = lengths[0];
-        rows_total_ += shape.rows; // every variable with dimensions is written whole, once
-        if (compress_) {
-            // Chunks of at most block_rows rows, whole rows each: the blocks in_blocks computes.
-            // (netCDF's default chunking makes one chunk of a whole variable.)
-            shape.chunk_rows = std::max<std::size_t>(1, std::min(shape.rows, block_rows));
-            std::vector<std::size_t> chunk = lengths;
-            chunk[0] = shape.chunk_rows;
-            io::nc_check(nc_def_var_chunking(nc_.id(), v, NC_CHUNKED, chunk.data()), file_,
-                         std::string("chunking ") + name);
-            io::nc_check(nc_def_var_deflate(nc_.id(), v, 1, 1, 1), file_,
-                         std::string("compressing ") + name);
-        }
-        if (shapes_.size() <= std::size_t(v))
-            shapes_.resize(std::size_t(v) + 1);
-        shapes_[std::size_t(v)] = shape;
-        return v;
-    }
-    void text(int v, const char *name, const std::string &value) {
-        io::nc_check(nc_put_att_text(nc_.id(), v, name, value.size(), value.c_str()), file_,
-                     std::string("writing attribute ") + name);
-    }
-    void ints(int v, const char *name, std::vector<int> values) {
-        io::nc_check(nc_put_att_int(nc_.id(), v, name, NC_INT, values.size(), values.data()), file_,
-                     std::string("writing attribute ") + name);
-    }
-    void dbl(int v, const char *name, double value) {
-        io::nc_check(nc_put_att_double(nc_.id(), v, name, NC_DOUBLE, 1, &value), file_,
-                     std::string("writing attribute ") + name);
-    }
-    bool has_att(int v, const char *name) const {
-        return nc_inq_attid(nc_.id(), v, name, nullptr) == NC_NOERR;
-    }
-
-    /// After the definitions and the variables without dimensions: a netCDF-4 file is closed
-    /// and reopened for its chunks.
-    void start_data() {
-        if (!compress_)
-            return;
-        nc_.close(file_, "UGRID output");
-        chunks_.emplace(temp_, file_, "UGRID output");
-    }
-    /// After the last block: closes the file (throws IoError).
-    void finish() {
-        if (chunks_)
-            chunks_->close();
-        else
-            nc_.close(file_, "UGRID output");
-    }
-
-    /// One block's rows of each variable it holds, as compute gives them (in_blocks).
-    class Block {
-    public:
-        /// Rows `first` .. `first + count - 1` (the block's) of variable v, row_values values of
-        /// type T (double or int, as the variable) a row; `data` must live until the block is
-        /// stored (it is the caller's Buffers).
-        template <class T> void put(int v, const T *data, std::size_t count) {
-            static_assert(std::is_same_v<T, double> || std::is_same_v<T, int>);
-            if (used_ == pieces_.size())
-                pieces_.emplace_back();
-            Piece &p = pieces_[used_++];
-            p.var = v;
-            p.rows = count;
-            p.is_double = std::is_same_v<T, double>;
-            p.data = data;
-            if (encoder_) {
-                const Shape &s = writer_->shapes_[std::size_t(v)];
-                encoder_->encode(data, count, s.chunk_rows, s.row_values * sizeof(T), sizeof(T),
-                                 p.chunk);
-            }
-        }
-
-    private:
-        friend class UgridWriter;
-        struct Piece {
-            int var = -1;
-            std::size_t rows = 0;
-            bool is_double = false;
-            const void *data = nullptr;
-            std::vector<unsigned char> chunk; ///< encoded (netCDF-4)
-        };
-        const UgridWriter *writer_ = nullptr;
-        io::ChunkEncoder *encoder_ = nullptr;
-        std::vector<Piece>
-            pieces_; ///< the first used_ are this block's (the rest: buffers to reuse)
-        std::size_t used_ = 0;
-    };
-
-    /// Computes and stores the blocks of block_rows rows of n (compute_in_order). compute(first,
-    /// count, buffers, block) fills `buffers` (its scratch, a Buffers kept from block to block)
-    /// and puts each variable's rows into `block`; it runs on every core, for several blocks at
-    /// once in any order, so it must only read shared data. The blocks are stored in order.
-    template <class Buffers, class Compute> void in_blocks(std::size_t n, const Compute &compute) {
-        struct Slot {
-            Buffers buffers{};
-            Block block;
-        };
-        io::compute_in_order<Slot, std::optional<io::ChunkEncoder>>(
-            (n + block_rows - 1) / block_rows,
-            [&](std::size_t k, Slot &slot, std::optional<io::ChunkEncoder> &encoder) {
-                if (compress_ && !encoder)
-                    encoder.emplace();
-                slot.block.writer_ = this;
-                slot.block.encoder_ = encoder ? &*encoder : nullptr;
-                slot.block.used_ = 0;
-                const std::size_t first = k * block_rows;
-                compute(first, std::min(block_rows, n - first), slot.buffers, slot.block);
-            },
-            [&](std::size_t k, const Slot &slot) { store(k * block_rows, slot.block); });
-    }
-
-    /// in_blocks for one variable of N values of type T (double or int, as the variable) a row:
-    /// row(i) returns row i as std::array<T, N>.
-    template <class T, std::size_t N, class Row>
-    void put_rows(int v, std::size_t n, const Row &row) {
-        in_blocks<std::vector<T>>(
-            n, [&](std::size_t first, std::size_t count, std::vector<T> &rows, Block &block) {
-                rows.resize(count * N);
-                for (std::size_t i = 0; i < count; ++i) {
-                    const std::array<T, N> r = row(first + i);
-                    std::copy(r.begin(), r.end(), rows.begin() + std::ptrdiff_t(i * N));
-                }
-                block.put(v, rows.data(), count);
-            });
-    }
-    /// put_rows for a variable of one value per row: value(i) returns row i's value.
-    template <class T, class Value> void put_values(int v, std::size_t n, const Value &value) {
-        put_rows<T, 1>(v, n, [&](std::size_t i) { return std::array<T, 1>{value(i)}; });
-    }
-
-    /// Writes the lon and lat of n points to variables v_lon and v_lat, point(i) giving point i
-    /// (a unit vector), each converted once.
-    template <class Point>
-    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point) {
-        using LonLats = std::array<std::vector<double>, 2>;
-        in_blocks<LonLats>(n, [&](std::size_t first, std::size_t count, LonLats &b, Block &block) {
-            b[0].resize(count);
-            b[1].resize(count);
-            for (std::size_t i = 0; i < count; ++i) {
-                const LonLat p = vec_to_lonlat(point(first + i));
-                b[0][i] = p.lon;
-                b[1][i] = p.lat;
-            }
-            block.put(v_lon, b[0].data(), count);
-            block.put(v_lat, b[1].data(), count);
-        });
-    }
-
-    static constexpr std::size_t block_rows = 65536; ///< rows a block, as the chunks
-
-private:
-    struct Shape {
-        std::string name;
-        std::size_t rows = 0, row_values = 1, chunk_rows = 0;
-    };
-
-    /// Stores a computed block whose rows start at `first`, and reports the progress.
-    void store(std::size_t first, const Block &block) {
-        for (std::size_t i = 0; i < block.used_; ++i) {
-            const Block::Piece &p = block.pieces_[i];
-            const Shape &s = shapes_[std::size_t(p.var)];
-            if (chunks_) {
-                chunks_->write(s.name, first, p.chunk);
-            } else {
-                const std::size_t start[2] = {first, 0}, count[2] = {p.rows, s.row_values};
-                const int status = p.is_double
-                                       ? nc_put_vara_double(nc_.id(), p.var, start, count,
-                                                            static_cast<const double *>(p.data))
-                                       : nc_put_vara_int(nc_.id(), p.var, start, count,
-                                                         static_cast<const int *>(p.data));
-                io::nc_check(status, file_, "writing " + s.name);
-            }
-            rows_done_ += p.rows;
-            report(progress_, double(rows_done_) / double(std::max<std::size_t>(rows_total_, 1)),
-                   "write_ugrid");
-        }
-    }
-
-    io::NcHandle &nc_;
-    const std::filesystem::path &temp_;
-    const std::filesystem::path &file_;
-    bool compress_;
-    const Progress &progress_;
-    std::vector<Shape> shapes_;                  ///< by variable id (those with dimensions)
-    std::optional<io::Hdf5ChunkFile> chunks_;    ///< a netCDF-4 file's, from start_data
-    std::size_t rows_total_ = 0, rows_done_ = 0; ///< rows of all the variables, and written
-};
+using io::NcBlockWriter;
+using io::wgs84_wkt;
 
 /// A netCDF attribute name from a free-form key (letters, digits, underscore).
 std::string attribute_name(const std::string &key) {
@@ -277,7 +50,7 @@ std::string attribute_name(const std::string &key) {
     return s;
 }
 
-void field_attributes(UgridWriter &w, int v, const Field &f, const char *location,
+void field_attributes(NcBlockWriter &w, int v, const Field &f, const char *location,
                       const char *coords) {
     w.text(v, "mesh", "mesh");
     w.text(v, "location", location);
@@ -327,7 +100,7 @@ struct Dims {
     int node, face, edge, two, three, bnd;
 };
 
-Dims define_dimensions(UgridWriter &w, const Counts &c) {
+Dims define_dimensions(NcBlockWriter &w, const Counts &c) {
     Dims d;
     d.node = w.dim("nMesh_node", c.nn);
     d.face = w.dim("nMesh_face", c.nf);
@@ -347,21 +120,17 @@ struct TopologyVars {
         bnd = -1;
 };
 
-int define_crs(UgridWriter &w) {
+int define_crs(NcBlockWriter &w) {
     // CRS, read by CF tools (grid_mapping_name, crs_wkt) and by MDAL (EPSG_code, epsg).
     int crs = w.var("crs", NC_INT, {});
-    w.text(crs, "grid_mapping_name", "latitude_longitude");
-    w.dbl(crs, "longitude_of_prime_meridian", 0.0);
-    w.dbl(crs, "semi_major_axis", 6378137.0);
-    w.dbl(crs, "inverse_flattening", 298.257223563);
-    w.text(crs, "crs_wkt", wgs84_wkt);
+    io::wgs84_grid_mapping(w, crs);
     w.text(crs, "wkt", wgs84_wkt);
     w.ints(crs, "epsg", {4326});
     w.text(crs, "EPSG_code", "EPSG:4326");
     return crs;
 }
 
-int define_topology(UgridWriter &w, bool has_boundary) {
+int define_topology(NcBlockWriter &w, bool has_boundary) {
     int topo_var = w.var("mesh", NC_INT, {});
     w.text(topo_var, "cf_role", "mesh_topology");
     w.text(topo_var, "long_name", "Topology of the 2-D unstructured ocean mesh");
@@ -381,7 +150,7 @@ int define_topology(UgridWriter &w, bool has_boundary) {
     return topo_var;
 }
 
-void define_coordinates(UgridWriter &w, const Dims &d, TopologyVars &t) {
+void define_coordinates(NcBlockWriter &w, const Dims &d, TopologyVars &t) {
     struct Coord {
         const char *name;
         int dim;
@@ -404,7 +173,7 @@ void define_coordinates(UgridWriter &w, const Dims &d, TopologyVars &t) {
     }
 }
 
-void define_connectivity(UgridWriter &w, const Dims &d, TopologyVars &t) {
+void define_connectivity(NcBlockWriter &w, const Dims &d, TopologyVars &t) {
     auto connectivity = [&](const char *name, const char *role, int d_elem, int d_cols,
                             const char *long_name, bool fill) {
         int v = w.var(name, NC_INT, {d_elem, d_cols});
@@ -438,7 +207,7 @@ struct FieldVars {
     int quality = -1, area = -1, tag = -1;
 };
 
-FieldVars define_fields(UgridWriter &w, const Mesh &mesh, const Dims &d) {
+FieldVars define_fields(NcBlockWriter &w, const Mesh &mesh, const Dims &d) {
     FieldVars v;
     const char *node_coords = "mesh_node_lon mesh_node_lat";
     const char *face_coords = "mesh_face_lon mesh_face_lat";
@@ -505,7 +274,7 @@ FieldVars define_fields(UgridWriter &w, const Mesh &mesh, const Dims &d) {
 }
 
 /// Global attributes: conventions, provenance, the mesh's run metadata, summary statistics.
-void define_global_attributes(UgridWriter &w, const Mesh &mesh, const UgridOptions &options,
+void define_global_attributes(NcBlockWriter &w, const Mesh &mesh, const UgridOptions &options,
                               const MeshStats &stats, const Counts &c) {
     w.text(NC_GLOBAL, "Conventions", "CF-1.8 UGRID-1.0");
     w.text(NC_GLOBAL, "title", options.title);
@@ -532,10 +301,10 @@ void define_global_attributes(UgridWriter &w, const Mesh &mesh, const UgridOptio
 }
 
 /// Writes every variable with dimensions, in the order of the file's layout.
-void write_data(UgridWriter &w, const Mesh &mesh, const io::MeshTopology &topo, const Counts &c,
+void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo, const Counts &c,
                 const TopologyVars &t, const FieldVars &fv, const UgridOptions &options) {
     const std::size_t nn = c.nn, nf = c.nf, ne = c.ne, nb = c.nb;
-    // Every variable is computed block by block while it is written (UgridWriter::in_blocks):
+    // Every variable is computed block by block while it is written (NcBlockWriter::in_blocks):
     // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
     // table: the edges' area terms (GeodesicFaceAreas, 24 bytes a node).
     auto centre = [&](std::size_t f) {
@@ -581,23 +350,23 @@ void write_data(UgridWriter &w, const Mesh &mesh, const io::MeshTopology &topo, 
             std::vector<int> links;
             std::vector<double> area;
         };
-        w.in_blocks<FaceRows>(
-            nf, [&](std::size_t first, std::size_t count, FaceRows &b, UgridWriter::Block &block) {
-                io::face_edges(topo, first, count, b.edges);
-                b.links.resize(3 * count);
-                b.area.resize(count);
-                for (std::size_t i = 0; i < count; ++i) {
-                    const auto nb = io::face_faces(topo, &b.edges[3 * i], first + i);
-                    std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
-                    b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
-                }
-                block.put(t.face_edges, b.edges.data(), count);
-                block.put(t.face_links, b.links.data(), count);
-                block.put(fv.area, b.area.data(), count);
-                if (options.face_areas_m2)
-                    std::copy(b.area.begin(), b.area.end(),
-                              options.face_areas_m2->begin() + std::ptrdiff_t(first));
-            });
+        w.in_blocks<FaceRows>(nf, [&](std::size_t first, std::size_t count, FaceRows &b,
+                                      NcBlockWriter::Block &block) {
+            io::face_edges(topo, first, count, b.edges);
+            b.links.resize(3 * count);
+            b.area.resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const auto nb = io::face_faces(topo, &b.edges[3 * i], first + i);
+                std::copy(nb.begin(), nb.end(), b.links.begin() + std::ptrdiff_t(3 * i));
+                b.area[i] = areas.face_m2(first + i, &b.edges[3 * i]);
+            }
+            block.put(t.face_edges, b.edges.data(), count);
+            block.put(t.face_links, b.links.data(), count);
+            block.put(fv.area, b.area.data(), count);
+            if (options.face_areas_m2)
+                std::copy(b.area.begin(), b.area.end(),
+                          options.face_areas_m2->begin() + std::ptrdiff_t(first));
+        });
     }
     w.put_rows<int, 2>(t.edge_faces, ne, [&](std::size_t e) { return topo.edge_faces(e); });
     if (nb)
@@ -617,7 +386,7 @@ void write_data(UgridWriter &w, const Mesh &mesh, const io::MeshTopology &topo, 
         w.put_values<double>(fv.face[i], nf, [&](std::size_t k) { return f.values[k]; });
     }
     w.in_blocks<std::vector<int>>(ne, [&](std::size_t first, std::size_t count,
-                                          std::vector<int> &tags, UgridWriter::Block &block) {
+                                          std::vector<int> &tags, NcBlockWriter::Block &block) {
         tags.assign(count, int(EdgeTag::interior));
         // boundary_edges ascend: those of this block follow the first at or after `first`.
         auto b = std::lower_bound(topo.boundary_edges.begin(), topo.boundary_edges.end(),
@@ -649,7 +418,7 @@ void write_ugrid(const Mesh &mesh, const std::filesystem::path &path, const Ugri
     nc.create(out.temp_path(), mode, path, "UGRID output");
     int old_fill;
     nc_set_fill(nc.id(), NC_NOFILL, &old_fill);
-    UgridWriter w(nc, out.temp_path(), path, !options.classic, options.progress);
+    NcBlockWriter w(nc, out.temp_path(), path, !options.classic, options.progress);
 
     const Dims dims = define_dimensions(w, counts);
     TopologyVars t;

@@ -86,7 +86,9 @@ TEST(Writers, each_name_extension_and_report_key_names_one_row) {
         EXPECT_FALSE(w.long_name.empty());
         EXPECT_FALSE(w.extensions.empty());
         for (const auto &e : w.extensions) {
-            EXPECT_TRUE(e.size() > 1 && e[0] == '.') << e;
+            EXPECT_TRUE(e.size() > 1 && e.find('.') != std::string::npos) << e;
+            // A name ending so is this row's, even where a shorter suffix is another's.
+            EXPECT_EQ(globemesh::writer_for_extension(globemesh::writers(), "x" + e), &w) << e;
             for (unsigned char c : e)
                 EXPECT_FALSE(std::isupper(c)) << e;
             EXPECT_TRUE(extensions.insert(e).second) << e << " is the extension of two formats";
@@ -113,6 +115,19 @@ TEST(Writers, names_and_extensions_are_found_in_any_case) {
     EXPECT_EQ(globemesh::writer_for_extension(table, "x.png")->name, "PNG");
     EXPECT_EQ(globemesh::writer_for_extension(table, "x.gpkg.dat"), nullptr);
     EXPECT_EQ(globemesh::writer_for_extension(table, "noextension"), nullptr);
+}
+
+TEST(Writers, the_longest_suffix_a_name_ends_with_chooses) {
+    const auto &table = globemesh::writers();
+    EXPECT_EQ(globemesh::writer_for_extension(table, "a/North_Sea_NET.nc")->name, "DFLOWFM");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "a_net/b.nc")->name, "UGRID");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "x.net.nc")->name, "UGRID");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "xnet.nc")->name, "UGRID");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "run/fort.14")->name, "ADCIRC");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "hgrid.ll")->name, "SCHISM");
+    EXPECT_EQ(globemesh::writer_for_extension(table, "x_net.nc.bak"), nullptr);
+    // A name that is only a suffix is a hidden file without extension, as before.
+    EXPECT_EQ(globemesh::writer_for_extension(table, "d/.nc"), nullptr);
 }
 
 TEST(Writers, creation_options_are_checked_against_the_row) {
