@@ -245,6 +245,25 @@ TEST(OutputSrs, a_global_mesh_in_a_projection_that_cannot_hold_it_is_refused_lea
         EXPECT_TRUE(regex_search(err, "^globemesh: .*" + c.message + "[^\n]*\n$")) << err;
         EXPECT_TRUE(fs::is_empty(dir.path())) << "a refused run leaves no file";
     }
+    // The sphere whole (the Delaunay triangulation of stations round the globe) fits no plane,
+    // not even the polar stereographic projection that holds the global ocean (its one singular
+    // point, the South Pole, lies in Antarctica).
+    std::string err;
+    ASSERT_EQ(run_exe({"triangulate", "-q", fixture("points/stations.csv").string(), "-o",
+                       (dir / "s.nc").string()},
+                      err, dir.path()),
+              0)
+        << err;
+    EXPECT_EQ(run_exe({"convert", "-q", (dir / "s.nc").string(), (dir / "s.msh").string(),
+                       "--output-srs", "EPSG:3995"},
+                      err, dir.path()),
+              1);
+    EXPECT_TRUE(regex_search(err, "^globemesh: [^\n]*cannot hold this mesh[^\n]*\n$")) << err;
+    EXPECT_FALSE(fs::exists(dir / "s.msh"));
+    EXPECT_EQ(run_exe(with(global, {"-o", (dir / "g.14").string(), "--output-srs", "EPSG:3995"}),
+                      err, dir.path()),
+              0)
+        << err;
 }
 
 TEST(OutputSrs, usage_errors_are_one_line_and_exit_2_before_meshing) {
