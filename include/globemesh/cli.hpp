@@ -68,6 +68,9 @@ struct CliOptions {
     std::vector<std::string> creation_options; ///< --co KEY=VALUE: creation options of the outputs
     std::string gpkg;                          ///< --gpkg: also write a GeoPackage
     std::string preview;                       ///< --preview: also draw a PNG picture of the mesh
+    std::string
+        output_srs; ///< --output-srs: CRS of the model formats' coordinates (empty: lon/lat)
+    std::string msh_version; ///< --msh-version: MSH_VERSION of .msh outputs (empty: the default)
     std::string format =
         "netcdf4";          ///< --format: netcdf4 (deflate) or classic (netCDF-3), UGRID's FORMAT
     std::string timings;    ///< --timings: JSON file of seconds per stage

@@ -46,6 +46,10 @@ struct WriteOptions {
     std::string land; ///< OGR land polygons a picture draws under the mesh; empty: none
     std::optional<std::array<double, 4>> extent_deg; ///< W,S,E,N of a picture; unset: the mesh's
     CreationOptions creation_options;                ///< this output's, checked against its row
+    /// --output-srs: the CRS (as GDAL's SetFromUserInput takes it: EPSG:32631, a PROJ string,
+    /// WKT) of the node coordinates of the formats that take planar ones; empty: lon/lat.
+    /// write_outputs clears it for an output that does not take it (Writer::takes_output_srs).
+    std::string output_srs;
 };
 
 /// What a format requires of the mesh (bits of Writer::needs).
@@ -74,6 +78,10 @@ struct Writer {
     /// Its writing time relative to meshing the same mesh, for the shares of one progress line.
     double progress_weight = 1;
     std::vector<CreationOption> creation_options{};
+    /// Writes its node coordinates in WriteOptions::output_srs, except in the files of
+    /// lonlat_extensions (SCHISM's hgrid.ll), which hold lon/lat by definition.
+    bool takes_output_srs = false;
+    std::vector<std::string> lonlat_extensions{};
     std::function<void(const Mesh &, const std::filesystem::path &, const WriteOptions &)> write{};
 };
 
@@ -104,6 +112,16 @@ struct OutputRequest {
     std::filesystem::path path;
     CreationOptions creation_options;
 };
+
+/// Whether `output` writes its node coordinates in an --output-srs (see Writer).
+bool takes_output_srs(const OutputRequest &output);
+
+/// Checks --output-srs `srs` against the outputs before anything runs: UsageError (naming
+/// `option`) for a CRS that does not parse, one that is neither projected nor geographic WGS 84,
+/// no output that takes it, or an output whose creation options ask for other coordinates
+/// (gmsh COORDS=SPHERE). Nothing for an empty `srs`.
+void check_output_srs(const std::string &srs, std::span<const OutputRequest> outputs,
+                      const std::string &option = "--output-srs");
 
 /// Writes each output in the order given, each with `common` plus its own creation options and
 /// its share of common.progress (by progress_weight). Throws what a writer throws (IoError,

@@ -141,6 +141,52 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
         ->run_callback_for_default(false);
 }
 
+void add_model_flags(CLI::App &app, std::string &output_srs, std::string &msh_version,
+                     std::span<const Writer> table, const std::string &group) {
+    std::string planar;
+    for (const Writer &w : table)
+        for (const auto &e : w.extensions)
+            if (w.takes_output_srs &&
+                std::find(w.lonlat_extensions.begin(), w.lonlat_extensions.end(), e) ==
+                    w.lonlat_extensions.end())
+                planar += (planar.empty() ? "" : ", ") + e;
+    // Not given, --print-config leaves them out, as -f and --co.
+    app.add_option("--output-srs", output_srs,
+                   "CRS of the node coordinates of " + planar +
+                       " outputs (EPSG:32631, a PROJ string, WKT); the others, and by default "
+                       "all, hold lon/lat")
+        ->group(group)
+        ->type_name("CRS")
+        ->always_capture_default(false)
+        ->default_str("")
+        ->run_callback_for_default(false);
+    app.add_option("--msh-version", msh_version,
+                   "MSH version of .msh outputs: 4.1 (default) or 2.2 (= --co MSH_VERSION=...)")
+        ->group(group)
+        ->type_name("VERSION")
+        ->always_capture_default(false)
+        ->default_str("")
+        ->run_callback_for_default(false);
+}
+
+std::vector<std::pair<std::string, std::string>>
+msh_version_creation(const std::string &msh_version, const std::vector<std::string> &creation) {
+    if (msh_version.empty())
+        return {};
+    if (msh_version != "4.1" && msh_version != "2.2")
+        throw UsageError("--msh-version " + msh_version + ": use 4.1 or 2.2");
+    for (const auto &text : creation) {
+        const auto eq = text.find('=');
+        std::string key = text.substr(0, eq);
+        std::transform(key.begin(), key.end(), key.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+        if (key == "MSH_VERSION" && text.substr(eq + 1) != msh_version)
+            throw UsageError("--msh-version " + msh_version + " and --co " + text +
+                             " ask for two MSH versions: give one");
+    }
+    return {{"--msh-version", "MSH_VERSION=" + msh_version}};
+}
+
 std::vector<PlannedOutput>
 plan_outputs(const OutputChoices &c, std::span<const Writer> table,
              std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth) {

@@ -34,6 +34,16 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
                       std::vector<std::string> &creation, std::span<const Writer> table,
                       const std::string &group);
 
+/// Adds --output-srs and --msh-version to `app` in `group` (mesh and convert).
+void add_model_flags(CLI::App &app, std::string &output_srs, std::string &msh_version,
+                     std::span<const Writer> table, const std::string &group);
+
+/// The creation option --msh-version stands for, as plan_outputs' extra_creation ("--msh-version",
+/// "MSH_VERSION=2.2"); none when not given. UsageError when a --co MSH_VERSION of `creation`
+/// says otherwise.
+std::vector<std::pair<std::string, std::string>>
+msh_version_creation(const std::string &msh_version, const std::vector<std::string> &creation);
+
 /// One output of the run with the option that named it (for messages).
 struct PlannedOutput {
     std::string option;

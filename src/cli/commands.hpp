@@ -73,7 +73,7 @@ struct InfoCommand {
 struct ConvertCommand {
     std::string input;
     std::vector<std::string> positional, output, creation;
-    std::string format;
+    std::string format, output_srs, msh_version;
     bool overwrite = false, quiet = false;
     CLI::App app{"Convert a UGRID mesh to the output formats, keeping boundary tags and depths.",
                  "globemesh convert"};

@@ -32,6 +32,7 @@ ConvertCommand::ConvertCommand(std::span<const Writer> table) {
     app.add_option("OUT", positional, "Files to write, as -o gives them (either or both)")
         ->type_name("OUT");
     add_output_flags(app, output, format, creation, table, "Options");
+    add_model_flags(app, output_srs, msh_version, table, "Options");
     app.add_flag("--overwrite", overwrite, "Replace existing output files");
     app.add_flag("-q,--quiet", quiet, "No progress on stderr");
 }
@@ -77,7 +78,9 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
         throw UsageError("convert: give the file to write, e.g. globemesh convert in.nc fort.14");
     check_input_path(c.input, "IN");
     const OutputChoices choices{c.output, c.format, c.creation, {}};
-    const auto planned = plan_outputs(choices, lib.writers, {}, false);
+    const auto planned =
+        plan_outputs(choices, lib.writers, msh_version_creation(c.msh_version, c.creation), false);
+    check_output_srs(c.output_srs, requests(planned));
     const std::pair<std::string, std::string> inputs[] = {{"IN", c.input}};
     check_output_files(output_files(planned, "", "", lib.writers), inputs, c.overwrite);
 
@@ -93,6 +96,7 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
     write.title =
         "globemesh mesh converted from " + std::filesystem::path(c.input).filename().string();
     write.history = history_text("convert", args);
+    write.output_srs = c.output_srs;
     write_run_outputs(mesh, planned, write, terminal);
     terminal.finish();
     InterruptGuard::completing();

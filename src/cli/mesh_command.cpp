@@ -206,6 +206,7 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
 
 void MeshCommand::add_output_options(std::span<const Writer> table, const std::string &output) {
     add_output_flags(app, o.output, o.output_format, o.creation_options, table, output);
+    add_model_flags(app, o.output_srs, o.msh_version, table, output);
     app.add_option("--gpkg", o.gpkg, "Also write a GeoPackage (faces, nodes, boundary, mesh_info)")
         ->group(output)
         ->type_name("OUT.gpkg");

@@ -37,10 +37,11 @@ std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const W
                                 o.output_format,
                                 o.creation_options,
                                 {{"--gpkg", "GPKG", o.gpkg}, {"--preview", "PNG", o.preview}}};
-    std::vector<std::pair<std::string, std::string>> netcdf_format;
+    auto extra_creation = msh_version_creation(o.msh_version, o.creation_options);
     if (o.format == "classic")
-        netcdf_format.emplace_back("--format classic", "FORMAT=NC2");
-    const auto planned = plan_outputs(choices, table, netcdf_format, !o.mesh.bathy.empty());
+        extra_creation.emplace_back("--format classic", "FORMAT=NC2");
+    const auto planned = plan_outputs(choices, table, extra_creation, !o.mesh.bathy.empty());
+    check_output_srs(o.output_srs, requests(planned));
     const auto files = output_files(planned, o.timings, o.report, table);
     const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
                                                           {"--bathy", o.mesh.bathy},
@@ -111,6 +112,7 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     write.stats = &stats;
     write.land = o.mesh.coast;
     write.extent_deg = o.mesh.region;
+    write.output_srs = o.output_srs;
     write_run_outputs(mesh, planned, write, terminal);
     timings.add("write", seconds_since(tw));
     terminal.finish(); // close the progress line if a stage stopped short of its share's end

@@ -16,7 +16,9 @@
 // loop of most nodes, there being no outside.
 //
 // Coordinates are lon/lat degrees, in [-180, 180), or [0, 360) for a mesh that crosses the
-// antimeridian and fits there without a face cut. Without a depth field every depth is 0 (a grid
+// antimeridian and fits there without a face cut; or, with an --output-srs (WriteOptions), x y in
+// that CRS (SCHISM's hgrid.ll excepted: write_outputs gives it none). The format has no place for
+// the CRS. Without a depth field every depth is 0 (a grid
 // for tools that interpolate the bathymetry afterwards); a node without a depth (NaN: the
 // bathymetry does not cover it) is refused, as no model runs on it.
 #include <algorithm>
@@ -33,6 +35,7 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
+#include "model_coordinates.hpp"
 
 namespace globemesh {
 
@@ -51,43 +54,6 @@ struct BoundaryStrings {
     std::size_t open_nodes = 0, land_nodes = 0;
 };
 
-/// The boundary loops as edge index lists (into topo.boundary_edges), each walked with the mesh on
-/// its left; at a node where two loops touch, either continuation closes a loop.
-std::vector<std::vector<std::size_t>> boundary_loops(const io::MeshTopology &topo,
-                                                     std::size_t node_count) {
-    const auto &edges = topo.boundary_edges;
-    // Edges starting at each node: first[v] .. first[v + 1] - 1 of by_start.
-    std::vector<std::uint32_t> first(node_count + 1, 0), by_start(edges.size());
-    for (auto e : edges)
-        ++first[topo.edge_nodes(std::size_t(e))[0] + 1];
-    for (std::size_t v = 0; v < node_count; ++v)
-        first[v + 1] += first[v];
-    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-    for (std::size_t i = 0; i < edges.size(); ++i)
-        by_start[fill[topo.edge_nodes(std::size_t(edges[i]))[0]]++] = std::uint32_t(i);
-    std::vector<bool> used(edges.size(), false);
-    std::vector<std::vector<std::size_t>> loops;
-    for (std::size_t start = 0; start < edges.size(); ++start) {
-        if (used[start])
-            continue;
-        std::vector<std::size_t> loop;
-        for (std::size_t e = start;;) {
-            used[e] = true;
-            loop.push_back(e);
-            const auto b = topo.edge_nodes(std::size_t(edges[e]))[1];
-            std::size_t next = edges.size();
-            for (auto k = first[b]; k < first[b + 1] && next == edges.size(); ++k)
-                if (!used[by_start[k]])
-                    next = by_start[k];
-            if (next == edges.size())
-                break; // back at the start: every node has as many edges in as out
-            e = next;
-        }
-        loops.push_back(std::move(loop));
-    }
-    return loops;
-}
-
 /// The signed area of a closed ring of 1-based nodes in lon/lat (positive counter-clockwise), each
 /// longitude step taken the shorter way round.
 double ring_area(const std::vector<std::uint32_t> &ring, const std::vector<LonLat> &p) {
@@ -101,25 +67,18 @@ double ring_area(const std::vector<std::uint32_t> &ring, const std::vector<LonLa
     return area;
 }
 
-/// Splits a loop with open edges into its runs of one tag, from the start of a run (a loop of open
-/// edges only is one run from any edge); each run ends on the node that starts the next.
+/// The node strings of a loop with open edges: one per run of one tag, each ending on the node
+/// that starts the next.
 void split_loop(const io::MeshTopology &topo, const std::vector<std::size_t> &loop,
                 BoundaryStrings &s) {
-    const auto tag = [&](std::size_t i) { return topo.boundary_tags[loop[i % loop.size()]]; };
     const auto node = [&](std::size_t i) {
         return topo.edge_nodes(std::size_t(topo.boundary_edges[loop[i % loop.size()]]))[0] + 1;
     };
-    std::size_t first = 0;
-    while (first < loop.size() && tag(first) == tag(first + loop.size() - 1))
-        ++first;
-    first %= loop.size();
-    for (std::size_t i = 0; i < loop.size();) {
-        NodeString run;
-        const int t = tag(first + i);
-        for (; i < loop.size() && (run.nodes.empty() || tag(first + i) == t); ++i)
-            run.nodes.push_back(node(first + i));
-        run.nodes.push_back(node(first + i));
-        (t == int(EdgeTag::open) ? s.open : s.land).push_back(std::move(run));
+    for (const io::BoundaryRun &run : io::loop_runs(topo, loop)) {
+        NodeString string;
+        for (std::size_t k = 0; k <= run.count; ++k)
+            string.nodes.push_back(node(run.first + k));
+        (run.tag == int(EdgeTag::open) ? s.open : s.land).push_back(std::move(string));
     }
 }
 
@@ -141,7 +100,7 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
     BoundaryStrings s;
     std::vector<NodeString> rings;
     bool regional = false;
-    for (auto &loop : boundary_loops(topo, mesh.nodes.size())) {
+    for (auto &loop : io::boundary_loops(topo, mesh.nodes.size())) {
         if (std::any_of(loop.begin(), loop.end(), is_open)) {
             regional = true;
             split_loop(topo, loop, s);
@@ -247,6 +206,8 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
                 const std::string &what) {
     const Field *depth = mesh.node_field("depth");
     check_depths(depth, path, what);
+    const io::ModelCoordinates xy =
+        io::model_coordinates(mesh, options.output_srs, what + " " + path.string());
     OutputFile file(path, options.overwrite, what);
     const std::vector<LonLat> p = io::node_lonlats(mesh);
     TextOut out(file.temp_path(), path, what);
@@ -260,7 +221,7 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
     for (std::size_t i = 0; i < p.size(); ++i) {
         if (i % step == 0)
             report(options.progress, double(i) / total, "write_model_grid");
-        out.integer(i + 1).text(" ").real(p[i].lon).text(" ").real(p[i].lat).text(" ");
+        out.integer(i + 1).text(" ").real(xy.x[i]).text(" ").real(xy.y[i]).text(" ");
         out.real(depth ? depth->values[i] : 0.0).line();
     }
     for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
@@ -289,7 +250,7 @@ void write_as_adcirc(const Mesh &mesh, const fs::path &path, const WriteOptions 
     write_grid(mesh, path, options, "ADCIRC output");
 }
 
-/// The SCHISM row of the writers table (writers.cpp): hgrid.gr3 and hgrid.ll, both in lon/lat.
+/// The SCHISM row of the writers table (writers.cpp): hgrid.gr3 and hgrid.ll (always lon/lat).
 void write_as_schism(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     write_grid(mesh, path, options, "SCHISM output");
 }

@@ -4,10 +4,14 @@
 // boundary edges as lines of the groups "coast" and "open" (1-D), with the boundary tags of the
 // topology the UGRID writer uses; a group without elements is left out (a global mesh has no
 // "open"). Physical tags are fixed so that model scripts can use the numbers: coast 1, open 2,
-// ocean 3. In 4.1 the entities are the discrete curves 1 (coast) and 2 (open) and the surface 1
-// (ocean), which holds every node. The depth, when the mesh has one, follows as $NodeData
-// "depth" (metres, positive down). Coordinates: lon/lat degrees (z = 0) or, with COORDS=SPHERE,
-// x y z in metres on the sphere of RADIUS. Written as it goes through a buffer of 1 MiB.
+// ocean 3. With OPEN_GROUPS=YES each open boundary is its own group instead of "open": open_1,
+// open_2... (tags 4, 5...), in the order of the ADCIRC writer's open strings. In 4.1 the entities
+// are the discrete curves 1 (coast) and 2 (open; open_k: 1 + k) and the surface 1 (ocean), which
+// holds every node. The depth, when the mesh has one, follows as $NodeData "depth" (metres,
+// positive down). Coordinates: lon/lat degrees (z = 0); with COORDS=SPHERE, x y z in metres on the
+// sphere of RADIUS; with an --output-srs (WriteOptions), x y in that CRS (z = 0), whose WKT ends
+// the file as seamsh writes it, a section "$Projection" of two lines, "WKT" and the WKT, which
+// gmsh keeps as the model attribute "Projection". Written as it goes through a buffer of 1 MiB.
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -17,14 +21,17 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
+#include "model_coordinates.hpp"
 
 namespace globemesh {
 
@@ -40,6 +47,7 @@ constexpr std::size_t report_every = 1 << 16;
 struct MshChoices {
     bool v22 = false;
     bool sphere = false;
+    bool open_groups = false;
     double radius = 6371000;
 };
 
@@ -47,6 +55,7 @@ MshChoices msh_choices(const CreationOptions &options, const fs::path &path) {
     MshChoices c;
     c.v22 = creation_option(options, "MSH_VERSION", "4.1") == "2.2";
     c.sphere = creation_option(options, "COORDS", "LONLAT") == "SPHERE";
+    c.open_groups = creation_option(options, "OPEN_GROUPS", "NO") == "YES";
     const std::string radius = creation_option(options, "RADIUS");
     if (radius.empty())
         return c;
@@ -128,14 +137,51 @@ private:
     fs::path target_;
 };
 
+/// A discrete curve of the file: its entity and physical tags, its group name and its boundary
+/// edges (indices into topology's boundary_edges).
+struct Curve {
+    int entity = 0, physical = 0;
+    std::string name;
+    std::vector<std::size_t> edges;
+};
+
+/// The curves with edges: coast (entity 1), then open (entity 2) or, with open_groups, each open
+/// boundary (entities 2, 3...; physical tags 4, 5...: after ocean's) in the order of the ADCIRC
+/// open strings, its edges in walking order.
+std::vector<Curve> boundary_curves(const io::MeshTopology &topo, std::size_t node_count,
+                                   bool open_groups) {
+    Curve coast{1, coast_group, "coast", {}}, open{2, open_group, "open", {}};
+    for (std::size_t b = 0; b < topo.boundary_edges.size(); ++b)
+        (topo.boundary_tags[b] == int(EdgeTag::open) ? open : coast).edges.push_back(b);
+    std::vector<Curve> curves;
+    if (!coast.edges.empty())
+        curves.push_back(std::move(coast));
+    if (!open_groups) {
+        if (!open.edges.empty())
+            curves.push_back(std::move(open));
+        return curves;
+    }
+    int k = 0;
+    for (const auto &loop : io::boundary_loops(topo, node_count))
+        for (const io::BoundaryRun &run : io::loop_runs(topo, loop)) {
+            if (run.tag != int(EdgeTag::open))
+                continue;
+            ++k;
+            Curve c{1 + k, ocean_group + k, "open_" + std::to_string(k), {}};
+            for (std::size_t i = 0; i < run.count; ++i)
+                c.edges.push_back(loop[(run.first + i) % loop.size()]);
+            curves.push_back(std::move(c));
+        }
+    return curves;
+}
+
 /// What the writer writes of one mesh, in order.
 class MshWriter {
 public:
-    MshWriter(const Mesh &mesh, const io::MeshTopology &topo, MshChoices choices, MshStream &out,
-              const Progress &progress)
-        : mesh_(mesh), topo_(topo), c_(choices), out_(out), progress_(progress) {
-        for (int tag : topo.boundary_tags)
-            ++(tag == int(EdgeTag::open) ? open_count_ : coast_count_);
+    MshWriter(const Mesh &mesh, const io::MeshTopology &topo, MshChoices choices,
+              const io::ModelCoordinates *xy, MshStream &out, const Progress &progress)
+        : mesh_(mesh), topo_(topo), c_(choices), xy_(xy), out_(out), progress_(progress) {
+        curves_ = boundary_curves(topo, mesh.nodes.size(), choices.open_groups);
         depth_ = mesh.node_field("depth");
         total_ = double(mesh.nodes.size()) * (depth_ ? 2 : 1) + double(mesh.faces.size()) +
                  double(topo.boundary_edges.size()) + 1;
@@ -150,6 +196,8 @@ public:
         elements();
         if (depth_)
             node_data();
+        if (xy_ && xy_->crs) // as seamsh writes it: gmsh keeps the section as a model attribute
+            out_ << "$Projection\nWKT\n" << xy_->crs->wkt << "\n$EndProjection\n";
         report(progress_, 1.0, "write_gmsh");
     }
 
@@ -158,6 +206,8 @@ private:
         const Vec3 &v = mesh_.nodes[i];
         if (c_.sphere)
             return {c_.radius * v.x, c_.radius * v.y, c_.radius * v.z};
+        if (xy_)
+            return {xy_->x[i], xy_->y[i], 0.0};
         const LonLat p = vec_to_lonlat(v);
         return {p.lon, p.lat, 0.0};
     }
@@ -168,12 +218,9 @@ private:
     }
 
     void physical_names() {
-        const int groups = 1 + (coast_count_ > 0) + (open_count_ > 0);
-        out_ << "$PhysicalNames\n" << groups << '\n';
-        if (coast_count_ > 0)
-            out_ << "1 " << coast_group << " \"coast\"\n";
-        if (open_count_ > 0)
-            out_ << "1 " << open_group << " \"open\"\n";
+        out_ << "$PhysicalNames\n" << curves_.size() + 1 << '\n';
+        for (const Curve &c : curves_)
+            out_ << "1 " << c.physical << " \"" << c.name << "\"\n";
         out_ << "2 " << ocean_group << " \"ocean\"\n$EndPhysicalNames\n";
     }
 
@@ -195,34 +242,25 @@ private:
             out_ << v << ' ';
     }
 
-    /// Calls add(node) for both nodes of each boundary edge tagged `open` (or not).
-    template <class Add> void boundary_nodes(bool open, Add add) const {
-        for (std::size_t b = 0; b < topo_.boundary_edges.size(); ++b)
-            if ((topo_.boundary_tags[b] == int(EdgeTag::open)) == open)
-                for (auto n : topo_.edge_nodes(std::size_t(topo_.boundary_edges[b])))
-                    add(std::size_t(n));
-    }
-
     void entities() {
-        const int curves = (coast_count_ > 0) + (open_count_ > 0);
-        out_ << "$Entities\n0 " << curves << " 1 0\n";
-        for (const bool open : {false, true}) {
-            if ((open ? open_count_ : coast_count_) == 0)
-                continue;
-            out_ << (open ? open_group : coast_group) << ' ';
-            box([&](auto add) { boundary_nodes(open, add); });
-            out_ << "1 " << (open ? open_group : coast_group) << " 0\n";
+        out_ << "$Entities\n0 " << curves_.size() << " 1 0\n";
+        for (const Curve &c : curves_) {
+            out_ << c.entity << ' ';
+            box([&](auto add) {
+                for (auto b : c.edges)
+                    for (auto n : topo_.edge_nodes(std::size_t(topo_.boundary_edges[b])))
+                        add(std::size_t(n));
+            });
+            out_ << "1 " << c.physical << " 0\n";
         }
         out_ << ocean_surface << ' ';
         box([&](auto add) {
             for (std::size_t i = 0; i < mesh_.nodes.size(); ++i)
                 add(i);
         });
-        out_ << "1 " << ocean_group << ' ' << curves;
-        if (coast_count_ > 0)
-            out_ << ' ' << coast_group;
-        if (open_count_ > 0)
-            out_ << ' ' << open_group;
+        out_ << "1 " << ocean_group << ' ' << curves_.size();
+        for (const Curve &c : curves_)
+            out_ << ' ' << c.entity;
         out_ << "\n$EndEntities\n";
     }
 
@@ -250,8 +288,8 @@ private:
 
     void elements() {
         const std::size_t nf = mesh_.faces.size();
-        const std::size_t total = nf + coast_count_ + open_count_;
-        const int blocks = 1 + (coast_count_ > 0) + (open_count_ > 0);
+        const std::size_t total = nf + topo_.boundary_edges.size();
+        const std::size_t blocks = 1 + curves_.size();
         out_ << "$Elements\n";
         if (c_.v22)
             out_ << total << '\n';
@@ -268,20 +306,14 @@ private:
             out_ << '\n';
             tick();
         }
-        for (const bool open : {false, true}) {
-            const std::size_t count = open ? open_count_ : coast_count_;
-            const int group = open ? open_group : coast_group;
-            if (count == 0)
-                continue;
+        for (const Curve &c : curves_) {
             if (!c_.v22)
-                out_ << "1 " << group << " 1 " << count << '\n';
-            for (std::size_t b = 0; b < topo_.boundary_edges.size(); ++b) {
-                if ((topo_.boundary_tags[b] == int(EdgeTag::open)) != open)
-                    continue;
+                out_ << "1 " << c.entity << " 1 " << c.edges.size() << '\n';
+            for (auto b : c.edges) {
                 const auto ends = topo_.edge_nodes(std::size_t(topo_.boundary_edges[b]));
                 out_ << ++tag;
                 if (c_.v22)
-                    out_ << " 1 2 " << group << ' ' << group;
+                    out_ << " 1 2 " << c.physical << ' ' << c.entity;
                 out_ << ' ' << std::size_t(ends[0]) + 1 << ' ' << std::size_t(ends[1]) + 1 << '\n';
                 tick();
             }
@@ -302,10 +334,11 @@ private:
     const Mesh &mesh_;
     const io::MeshTopology &topo_;
     MshChoices c_;
+    const io::ModelCoordinates *xy_;
     MshStream &out_;
     const Progress &progress_;
     const Field *depth_ = nullptr;
-    std::size_t coast_count_ = 0, open_count_ = 0;
+    std::vector<Curve> curves_;
     double total_ = 1;
     std::size_t done_ = 0;
 };
@@ -314,11 +347,14 @@ private:
 
 void write_as_gmsh(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     const MshChoices choices = msh_choices(options.creation_options, path);
+    std::optional<io::ModelCoordinates> xy;
+    if (!options.output_srs.empty())
+        xy = io::model_coordinates(mesh, options.output_srs, "gmsh output " + path.string());
     OutputFile out(path, options.overwrite, "gmsh output");
     const io::MeshTopology topo = io::build_topology(mesh);
     {
         MshStream stream(out.temp_path(), path);
-        MshWriter(mesh, topo, choices, stream, options.progress).write();
+        MshWriter(mesh, topo, choices, xy ? &*xy : nullptr, stream, options.progress).write();
         stream.close();
     }
     out.commit();

@@ -167,6 +167,58 @@ std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_coun
     return loops;
 }
 
+std::vector<std::vector<std::size_t>> boundary_loops(const MeshTopology &topo,
+                                                     std::size_t node_count) {
+    const auto &edges = topo.boundary_edges;
+    // Edges starting at each node: first[v] .. first[v + 1] - 1 of by_start.
+    std::vector<std::uint32_t> first(node_count + 1, 0), by_start(edges.size());
+    for (auto e : edges)
+        ++first[topo.edge_nodes(std::size_t(e))[0] + 1];
+    for (std::size_t v = 0; v < node_count; ++v)
+        first[v + 1] += first[v];
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (std::size_t i = 0; i < edges.size(); ++i)
+        by_start[fill[topo.edge_nodes(std::size_t(edges[i]))[0]]++] = std::uint32_t(i);
+    std::vector<bool> used(edges.size(), false);
+    std::vector<std::vector<std::size_t>> loops;
+    for (std::size_t start = 0; start < edges.size(); ++start) {
+        if (used[start])
+            continue;
+        std::vector<std::size_t> loop;
+        for (std::size_t e = start;;) {
+            used[e] = true;
+            loop.push_back(e);
+            const auto b = topo.edge_nodes(std::size_t(edges[e]))[1];
+            std::size_t next = edges.size();
+            for (auto k = first[b]; k < first[b + 1] && next == edges.size(); ++k)
+                if (!used[by_start[k]])
+                    next = by_start[k];
+            if (next == edges.size())
+                break; // back at the start: every node has as many edges in as out
+            e = next;
+        }
+        loops.push_back(std::move(loop));
+    }
+    return loops;
+}
+
+std::vector<BoundaryRun> loop_runs(const MeshTopology &topo, const std::vector<std::size_t> &loop) {
+    const std::size_t n = loop.size();
+    const auto tag = [&](std::size_t i) { return topo.boundary_tags[loop[i % n]]; };
+    std::size_t first = 0;
+    while (first < n && tag(first) == tag(first + n - 1))
+        ++first;
+    first %= std::max<std::size_t>(n, 1);
+    std::vector<BoundaryRun> runs;
+    for (std::size_t i = 0; i < n;) {
+        BoundaryRun run{first + i, 0, tag(first + i)};
+        for (; i < n && (run.count == 0 || tag(first + i) == run.tag); ++i)
+            ++run.count;
+        runs.push_back(run);
+    }
+    return runs;
+}
+
 std::vector<LonLat> node_lonlats(const Mesh &mesh) {
     std::vector<LonLat> p(mesh.nodes.size());
     for (std::size_t i = 0; i < p.size(); ++i)

@@ -65,6 +65,22 @@ std::array<std::int32_t, 3> face_faces(const MeshTopology &topo, const std::int3
 /// Number of boundary loops: connected groups of boundary edges (joined at shared nodes).
 std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_count);
 
+/// The boundary loops as lists of indices into topo.boundary_edges, each walked with the mesh on
+/// its left from its lowest index; at a node where two loops touch, either continuation closes a
+/// loop. The ADCIRC/SCHISM boundary strings and the gmsh open groups follow this order.
+std::vector<std::vector<std::size_t>> boundary_loops(const MeshTopology &topo,
+                                                     std::size_t node_count);
+
+/// A run of boundary edges of one tag along a loop: loop[(first + k) % size], k < count.
+struct BoundaryRun {
+    std::size_t first = 0, count = 0;
+    int tag = 0;
+};
+
+/// The runs of a loop, in its order from the start of a run (a loop of one tag is one run from its
+/// first edge).
+std::vector<BoundaryRun> loop_runs(const MeshTopology &topo, const std::vector<std::size_t> &loop);
+
 /// compute_stats on an already built topology (the writer has one).
 MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo);
 

@@ -7,8 +7,10 @@
 // IPARAM (10 integers, IPARAM(1) = 1, IPARAM(10) = 0: no date record); NELEM NPOIN NDP(3) 1;
 // IKLE (1-based nodes of each triangle, counter-clockwise); IPOBO (0 for an interior node, k for
 // the k-th boundary node); X; Y (float32 lon/lat degrees, for TELEMAC's SPATIAL PROJECTION TYPE
-// 3); then one time step: the time (0) and BOTTOM at every node, the bottom elevation (metres,
-// positive up: minus the depth; 0 without a depth field).
+// 3; or, with an --output-srs, x y in that CRS less the origin IPARAM(3), IPARAM(4), which
+// TELEMAC and MDAL add back: the centre of the mesh's extent, so that float32 keeps about 3 cm
+// over 1000 km; SELAFIN has no place for the CRS); then one time step: the time (0) and BOTTOM at
+// every node, the bottom elevation (metres, positive up: minus the depth; 0 without a depth field).
 //
 // .cli: one line per boundary node in the boundary numbering, "LIHBOR LIUBOR LIVBOR HBOR UBOR
 // VBOR AUBOR LITBOR TBOR ATBOR BTBOR N K": solid (coast) 2 2 2 ... 2, open (prescribed elevation,
@@ -30,6 +32,7 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
+#include "model_coordinates.hpp"
 
 namespace globemesh {
 
@@ -181,8 +184,18 @@ void check_mesh(const Mesh &mesh, const Field *depth, const fs::path &path) {
                         "model needs one at every node: give a bathymetry that covers the mesh");
 }
 
-void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary, RecordOut &out,
-               const WriteOptions &options) {
+/// The integer origin SELAFIN's IPARAM(3) and IPARAM(4) give planar coordinates (the centre of
+/// their extent), so that the float32 X and Y keep centimetres; 0 for lon/lat.
+std::array<double, 2> origin(const io::ModelCoordinates &xy) {
+    if (!xy.crs || !xy.crs->projected || xy.x.empty())
+        return {0, 0};
+    const auto [x0, x1] = std::minmax_element(xy.x.begin(), xy.x.end());
+    const auto [y0, y1] = std::minmax_element(xy.y.begin(), xy.y.end());
+    return {std::round((*x0 + *x1) / 2), std::round((*y0 + *y1) / 2)};
+}
+
+void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary,
+               const io::ModelCoordinates &xy, RecordOut &out, const WriteOptions &options) {
     const std::size_t np = mesh.nodes.size(), ne = mesh.faces.size();
     std::string title = options.title;
     std::replace_if(
@@ -191,7 +204,8 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary, Reco
     out.text_record(title + "SERAFIN ", 80);
     out.integer_record({1, 0});
     out.text_record("BOTTOM          M               ", 32);
-    out.integer_record({1, 0, 0, 0, 0, 0, 0, 0, 0, 0});
+    const auto at = origin(xy);
+    out.integer_record({1, 0, std::int64_t(at[0]), std::int64_t(at[1]), 0, 0, 0, 0, 0, 0});
     out.integer_record({std::int64_t(ne), std::int64_t(np), 3, 1});
     const double total = double(ne + 4 * np) + 1;
     out.marker(12 * ne);
@@ -209,7 +223,6 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary, Reco
     for (auto k : ipobo)
         out.integer(k);
     out.marker(4 * np);
-    const std::vector<LonLat> p = io::node_lonlats(mesh);
     const Field *depth = mesh.node_field("depth");
     for (int part = 0; part < 3; ++part) { // X, Y, BOTTOM
         report(options.progress, double(ne + (part + 1) * np) / total, "write_selafin");
@@ -217,7 +230,10 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary, Reco
             out.marker(4), out.real(0), out.marker(4); // the time step's time: 0
         out.marker(4 * np);
         for (std::size_t i = 0; i < np; ++i)
-            out.real(part == 0 ? p[i].lon : part == 1 ? p[i].lat : depth ? -depth->values[i] : 0.0);
+            out.real(part == 0   ? xy.x[i] - at[0]
+                     : part == 1 ? xy.y[i] - at[1]
+                     : depth     ? -depth->values[i]
+                                 : 0.0);
         out.marker(4 * np);
     }
 }
@@ -244,6 +260,8 @@ void write_cli(const std::vector<BoundaryNode> &boundary, const fs::path &temp,
 void write_as_selafin(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     const Field *depth = mesh.node_field("depth");
     check_mesh(mesh, depth, path);
+    const io::ModelCoordinates xy =
+        io::model_coordinates(mesh, options.output_srs, "SELAFIN output " + path.string());
     fs::path cli_path = path;
     cli_path.replace_extension(".cli");
     OutputFile slf(path, options.overwrite, "SELAFIN output");
@@ -251,7 +269,7 @@ void write_as_selafin(const Mesh &mesh, const fs::path &path, const WriteOptions
     const std::vector<BoundaryNode> boundary =
         boundary_numbering(io::build_topology(mesh), mesh.nodes.size());
     RecordOut out(slf.temp_path(), path);
-    write_slf(mesh, boundary, out, options);
+    write_slf(mesh, boundary, xy, out, options);
     out.close();
     write_cli(boundary, cli.temp_path(), cli_path);
     report(options.progress, 1, "write_selafin");

@@ -67,25 +67,34 @@ const std::vector<Writer> &writers() {
               {"COORDS",
                {"LONLAT", "SPHERE"},
                "LONLAT: lon/lat degrees (default); SPHERE: x y z in metres on a sphere"},
-              {"RADIUS", {}, "the sphere's radius in metres for COORDS=SPHERE (6371000)"}},
+              {"RADIUS", {}, "the sphere's radius in metres for COORDS=SPHERE (6371000)"},
+              {"OPEN_GROUPS",
+               {"NO", "YES"},
+               "YES: each open boundary its own physical group open_1, open_2... (tags 4, 5...) "
+               "instead of open"}},
+         .takes_output_srs = true,
          .write = write_as_gmsh},
         {.name = "ADCIRC",
          .long_name = "ADCIRC fort.14",
          .extensions = {".14"},
          .report_key = "adcirc",
          .progress_weight = 0.4, // 0.6 to 0.9 s at 1.08e6 nodes, as above
+         .takes_output_srs = true,
          .write = write_as_adcirc},
         {.name = "SCHISM",
          .long_name = "SCHISM hgrid.gr3",
          .extensions = {".gr3", ".ll"},
          .report_key = "schism",
          .progress_weight = 0.4, // 0.6 to 0.9 s at 1.08e6 nodes, as above
+         .takes_output_srs = true,
+         .lonlat_extensions = {".ll"},
          .write = write_as_schism},
         {.name = "SELAFIN",
          .long_name = "TELEMAC SELAFIN and its .cli",
          .extensions = {".slf"},
          .report_key = "selafin",
          .progress_weight = 0.25, // 0.6 s at 1.08e6 nodes, as above
+         .takes_output_srs = true,
          .write = write_as_selafin},
         {.name = "DFLOWFM",
          .long_name = "D-Flow FM net file",
@@ -188,6 +197,13 @@ std::string creation_option(const CreationOptions &options, std::string_view key
     return fallback;
 }
 
+bool takes_output_srs(const OutputRequest &output) {
+    const auto &lonlat = output.writer->lonlat_extensions;
+    return output.writer->takes_output_srs &&
+           std::find(lonlat.begin(), lonlat.end(), lower(output.path.extension().string())) ==
+               lonlat.end();
+}
+
 double progress_weight(std::span<const OutputRequest> outputs) {
     double total = 0;
     for (const auto &o : outputs)
@@ -211,10 +227,15 @@ void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
         OutputBatch::active() ? nullptr : std::make_unique<OutputBatch>();
     const double total = progress_weight(outputs);
     double at = 0;
-    for (const auto &o : outputs) {
+    std::vector<OutputRequest> checked(outputs.begin(), outputs.end());
+    for (auto &o : checked)
+        check_creation_options(*o.writer, o.creation_options, o.path.string());
+    check_output_srs(common.output_srs, checked);
+    for (const auto &o : checked) {
         WriteOptions options = common;
         options.creation_options = o.creation_options;
-        check_creation_options(*o.writer, options.creation_options, o.path.string());
+        if (!takes_output_srs(o))
+            options.output_srs.clear();
         if (sharing > 1 && o.writer->shares_face_areas)
             options.face_areas_m2 = &face_areas;
         options.progress =

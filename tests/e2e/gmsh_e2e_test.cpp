@@ -233,3 +233,78 @@ TEST(GmshE2e, refusals_are_one_line_and_leave_no_file) {
         EXPECT_TRUE(fs::is_empty(dir.path())) << err;
     }
 }
+
+// argv: MSH written with OPEN_GROUPS=YES, the fort.14 and the UGRID file of the same run. Each
+// group open_k holds the edges of the k-th open string of the fort.14 (read here from ADCIRC's
+// documentation of the boundary section), per gmsh's API and per meshio; no group "open"; the
+// groups together are the UGRID file's open edges. Prints "OK groups=K".
+const char *const open_groups_script = R"(
+import sys, gmsh, meshio, netCDF4, numpy as np
+msh, f14, nc = sys.argv[1:4]
+lines = [l.split('!')[0].split() for l in open(f14).read().splitlines()]
+ne, np_ = map(int, lines[1][:2])
+at = 2 + ne + np_
+nope = int(lines[at][0]); at += 2
+strings = []
+for _ in range(nope):
+    count = int(lines[at][0])
+    nodes = [int(lines[at + 1 + i][0]) - 1 for i in range(count)]
+    strings.append({tuple(sorted(p)) for p in zip(nodes[:-1], nodes[1:])})
+    at += 1 + count
+ds = netCDF4.Dataset(nc)
+edges = ds['mesh_edge_nodes'][:] - int(getattr(ds['mesh_edge_nodes'], 'start_index', 0))
+open_edges = set(map(tuple, np.sort(edges[ds['boundary_tag'][:] == 2], axis=1)))
+assert set().union(*strings) == open_edges and sum(map(len, strings)) == len(open_edges), 'fort.14'
+
+gmsh.initialize()
+gmsh.option.setNumber('General.Terminal', 0)
+gmsh.open(msh)
+groups = {}
+for dim, ptag in gmsh.model.getPhysicalGroups(1):
+    pairs = set()
+    for e in gmsh.model.getEntitiesForPhysicalGroup(dim, ptag):
+        for t, n in zip(*gmsh.model.mesh.getElements(dim, e)[::2]):
+            pairs |= set(map(tuple, np.sort(np.asarray(n, dtype=np.int64).reshape(-1, 2) - 1, axis=1)))
+    groups[gmsh.model.getPhysicalName(dim, ptag)] = (ptag, pairs)
+gmsh.finalize()
+assert 'open' not in groups, groups.keys()
+assert sorted(k for k in groups if k != 'coast') == sorted('open_%d' % (k + 1) for k in range(nope))
+for k, pairs in enumerate(strings):
+    assert groups['open_%d' % (k + 1)] == (4 + k, pairs), ('gmsh', k + 1)
+
+m = meshio.read(msh)
+names = {name: int(v[0]) for name, v in m.field_data.items()}
+for k, pairs in enumerate(strings):
+    got = set()
+    for block, phys in zip(m.cells, m.cell_data['gmsh:physical']):
+        if block.type == 'line':
+            got |= set(map(tuple, np.sort(block.data[phys == names['open_%d' % (k + 1)]], axis=1)))
+    assert got == pairs, ('meshio', k + 1)
+print('OK groups=%d' % nope)
+)";
+
+TEST(GmshE2e, open_groups_are_the_adcirc_open_strings_in_both_versions) {
+    if (!readers_available())
+        return;
+    TempDir dir;
+    std::ofstream(dir / "groups.py") << open_groups_script;
+    for (const std::string version : {"4.1", "2.2"}) {
+        const fs::path nc = dir / (version + ".nc"), msh = dir / (version + ".msh"),
+                       f14 = dir / (version + ".14");
+        std::string err, out;
+        ASSERT_EQ(run_exe(with(regional, {"-o", nc.string(), "-o", msh.string(), "-o", f14.string(),
+                                          "--co", "OPEN_GROUPS=YES", "--msh-version", version}),
+                          err, dir.path()),
+                  0)
+            << err;
+        EXPECT_EQ(run_command("/usr/bin/python3 " + quote((dir / "groups.py").string()) + " " +
+                                  quote(msh.string()) + " " + quote(f14.string()) + " " +
+                                  quote(nc.string()) + " 2>&1",
+                              out),
+                  0)
+            << out;
+        std::vector<std::string> groups;
+        ASSERT_TRUE(regex_search(out, "OK groups=([0-9]+)", &groups)) << out;
+        EXPECT_GE(std::stoi(groups[1]), 2) << "the region has several open boundaries";
+    }
+}
