@@ -67,8 +67,11 @@ struct Writer {
     std::string name;                    ///< as GDAL/OGR name a driver: "UGRID", "GPKG", "PNG"
     std::string long_name;               ///< in messages: "UGRID NetCDF", "GeoPackage"
     std::vector<std::string> extensions; ///< lower case with the dot; the first is the usual one
-    std::string report_key;              ///< its key in the run report's "outputs"
-    unsigned needs = needs_mesh_only;    ///< WriterNeeds bits
+    /// The files it writes into the folder the output names (created when missing); empty for
+    /// a format that writes the file the output names. A folder format has no extension.
+    std::vector<std::string> folder_files{};
+    std::string report_key;           ///< its key in the run report's "outputs"
+    unsigned needs = needs_mesh_only; ///< WriterNeeds bits
     /// Computes or takes each face's geodesic area (WriteOptions::face_areas_m2).
     bool shares_face_areas = false;
     /// Its writing time relative to meshing the same mesh, for the shares of one progress line.

@@ -27,6 +27,8 @@ void write_as_schism(const Mesh &mesh, const fs::path &path,
                      const WriteOptions &options); // adcirc_write.cpp
 void write_as_selafin(const Mesh &mesh, const fs::path &path,
                       const WriteOptions &options); // selafin_write.cpp
+void write_as_fesom2(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options); // fesom2_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -85,6 +87,18 @@ const std::vector<Writer> &writers() {
          .report_key = "selafin",
          .progress_weight = 0.25, // 0.6 s at 1.08e6 nodes, as above
          .write = write_as_selafin},
+        {.name = "FESOM2",
+         .long_name = "FESOM2 mesh folder",
+         .extensions = {},
+         .folder_files = {"nod2d.out", "elem2d.out", "aux3d.out"},
+         .report_key = "fesom2",
+         .needs = needs_depth,
+         .progress_weight = 0.4,
+         .creation_options = {{"LEVELS",
+                               {},
+                               "the model levels in metres, from 0 down, comma-separated "
+                               "(default: the 48 of FESOM2's CORE2 mesh)"}},
+         .write = write_as_fesom2},
     };
     return table;
 }
@@ -134,7 +148,10 @@ const Writer *writer_for_extension(std::span<const Writer> table, const fs::path
 std::string formats_text(std::span<const Writer> table) {
     std::string r;
     for (const Writer &w : table)
-        r += (r.empty() ? "" : ", ") + w.name + " (" + joined(w.extensions) + ")";
+        r += (r.empty() ? "" : ", ") + w.name + " (" +
+             (w.extensions.empty() ? std::string("a folder, with -f ") + w.name
+                                   : joined(w.extensions)) +
+             ")";
     return r;
 }
 
