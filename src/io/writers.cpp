@@ -93,7 +93,7 @@ const std::vector<Writer> &writers() {
          .folder_files = {"nod2d.out", "elem2d.out", "aux3d.out"},
          .report_key = "fesom2",
          .needs = needs_depth,
-         .progress_weight = 0.4,
+         .progress_weight = 0.4, // 1.4 s at 1.08e6 nodes, as ADCIRC (bench/RESULTS-fesom2.md)
          .creation_options = {{"LEVELS",
                                {},
                                "the model levels in metres, from 0 down, comma-separated "
