@@ -60,6 +60,8 @@ struct CreationOption {
     std::string name;
     std::vector<std::string> values;
     std::string description;
+    /// For a free value (no list): what is wrong with it, or "" (unset: any value).
+    std::function<std::string(const std::string &value)> problem{};
 };
 
 /// One output format.
@@ -90,8 +92,9 @@ const Writer *writer_for_extension(std::span<const Writer> table,
                                    const std::filesystem::path &path);
 /// "UGRID (.nc, .nc4), GPKG (.gpkg), PNG (.png)": the formats, for messages.
 std::string formats_text(std::span<const Writer> table);
-/// Throws UsageError naming `what` (e.g. "-o x.nc") for a key the writer does not take or a
-/// value outside its list; upper-cases keys and listed values in place.
+/// Throws UsageError naming `what` (e.g. "-o x.nc") for a key the writer does not take, a
+/// value outside its list or one its `problem` finds wrong; upper-cases keys and listed values
+/// in place.
 void check_creation_options(const Writer &writer, CreationOptions &options,
                             const std::string &what);
 

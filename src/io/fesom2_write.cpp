@@ -19,6 +19,7 @@
 // OutputBatch, which removes it again if the run fails; the three files appear together.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -31,6 +32,8 @@
 #include "text_out.hpp"
 
 namespace globemesh {
+
+std::string fesom2_levels_problem(const std::string &levels);
 
 namespace {
 
@@ -45,31 +48,36 @@ const std::vector<double> core2_levels = {
     230,  280,  340,  410,  490,  580,  680,  790,  910,  1040, 1180, 1330, 1500, 1700, 1920, 2150,
     2400, 2650, 2900, 3150, 3400, 3650, 3900, 4150, 4400, 4650, 4900, 5150, 5400, 5650, 6000, 6250};
 
-/// The LEVELS creation option ("0,10,25,..."), or the CORE2 levels: at least 3 (read_mesh stops
-/// with fewer), from 0 and increasing. Throws UsageError.
-std::vector<double> levels(const WriteOptions &options, const fs::path &path) {
-    const std::string text = creation_option(options.creation_options, "LEVELS");
-    if (text.empty())
-        return core2_levels;
+/// The levels of a LEVELS value ("0,10,25,..."), empty when it is not at least 3 (read_mesh
+/// stops with fewer) depths from 0 and increasing.
+std::vector<double> parse_levels(const std::string &text) {
     std::vector<double> r;
     std::istringstream in(text);
     std::string item;
-    bool ok = true;
-    while (ok && std::getline(in, item, ',')) {
+    while (std::getline(in, item, ',')) {
         std::size_t used = 0;
         try {
             r.push_back(std::fabs(std::stod(item, &used)));
         } catch (const std::exception &) {
-            ok = false;
+            return {};
         }
-        ok = ok && item.find_first_not_of(" ", used) == std::string::npos;
+        if (item.find_first_not_of(" ", used) != std::string::npos || !std::isfinite(r.back()))
+            return {};
     }
-    ok = ok && r.size() >= 3 && r.front() == 0 && std::is_sorted(r.begin(), r.end()) &&
-         std::adjacent_find(r.begin(), r.end()) == r.end();
-    if (!ok)
-        throw UsageError("FESOM2 output " + path.string() + ": LEVELS=" + text +
-                         ": give at least 3 level depths in metres, from 0 and increasing, e.g. "
-                         "LEVELS=0,10,25,50,100");
+    const bool ok = r.size() >= 3 && r.front() == 0 &&
+                    std::adjacent_find(r.begin(), r.end(), std::greater_equal<>()) == r.end();
+    return ok ? r : std::vector<double>{};
+}
+
+/// The LEVELS creation option's levels (checked when the run was planned), or the CORE2 ones.
+std::vector<double> levels(const WriteOptions &options, const fs::path &path) {
+    const std::string text = creation_option(options.creation_options, "LEVELS");
+    if (text.empty())
+        return core2_levels;
+    std::vector<double> r = parse_levels(text);
+    if (r.empty())
+        throw UsageError("FESOM2 output " + path.string() + ": LEVELS=" + text + ": " +
+                         fesom2_levels_problem(text));
     return r;
 }
 
@@ -158,6 +166,13 @@ void write_depths(const Field &depth, const std::vector<double> &levels, const f
 }
 
 } // namespace
+
+/// What is wrong with a LEVELS creation option, or "" (the FESOM2 row's check, writers.cpp).
+std::string fesom2_levels_problem(const std::string &levels) {
+    return parse_levels(levels).empty() ? "give at least 3 level depths in metres, from 0 and "
+                                          "increasing, e.g. LEVELS=0,10,25,50,100"
+                                        : "";
+}
 
 /// The FESOM2 row of the writers table (writers.cpp): nod2d.out, elem2d.out and aux3d.out in the
 /// folder `path`.

@@ -28,7 +28,8 @@ void write_as_schism(const Mesh &mesh, const fs::path &path,
 void write_as_selafin(const Mesh &mesh, const fs::path &path,
                       const WriteOptions &options); // selafin_write.cpp
 void write_as_fesom2(const Mesh &mesh, const fs::path &path,
-                     const WriteOptions &options); // fesom2_write.cpp
+                     const WriteOptions &options);            // fesom2_write.cpp
+std::string fesom2_levels_problem(const std::string &levels); // fesom2_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -97,7 +98,8 @@ const std::vector<Writer> &writers() {
          .creation_options = {{"LEVELS",
                                {},
                                "the model levels in metres, from 0 down, comma-separated "
-                               "(default: the 48 of FESOM2's CORE2 mesh)"}},
+                               "(default: the 48 of FESOM2's CORE2 mesh)",
+                               fesom2_levels_problem}},
          .write = write_as_fesom2},
     };
     return table;
@@ -170,8 +172,13 @@ void check_creation_options(const Writer &writer, CreationOptions &options,
                 what + ": " + writer.name + " takes no creation option " + key +
                 (names.empty() ? " (it takes none)" : " (it takes " + joined(names) + ")"));
         }
-        if (known->values.empty())
+        if (known->values.empty()) {
+            const std::string problem = known->problem ? known->problem(value) : "";
+            if (!problem.empty())
+                throw UsageError(what + ": " + writer.name + " creation option " + key + "=" +
+                                 value + ": " + problem);
             continue;
+        }
         if (std::find(known->values.begin(), known->values.end(), upper(value)) ==
             known->values.end()) {
             std::string choices = known->values.front();
