@@ -157,8 +157,9 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
         ->default_str("")
         ->run_callback_for_default();
     app.add_option("-f,--output-format", format,
-                   "Format of the -o file, as GDAL names it: " + names +
-                       "; default: from its extension")
+                   "Format of the -o file (with several, of the one without an extension), as "
+                   "GDAL names it: " +
+                       names + "; default: from its extension")
         ->group(group)
         ->type_name("NAME")
         ->always_capture_default(false)
@@ -178,13 +179,19 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
 std::vector<PlannedOutput>
 plan_outputs(const OutputChoices &c, std::span<const Writer> table,
              std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth) {
-    if (!c.format.empty() && c.output.size() > 1)
+    // -f names the format of the one -o, or, with several, of the one without an extension (a
+    // FESOM2 folder beside the UGRID file); the others take theirs from their extensions.
+    const auto bare = [](const std::string &path) { return fs::path(path).extension().empty(); };
+    if (!c.format.empty() && c.output.size() > 1 &&
+        std::count_if(c.output.begin(), c.output.end(), bare) != 1)
         throw UsageError(
-            "-f/--output-format names the format of one -o file; with several, each takes its "
-            "format from its extension");
+            "-f/--output-format names the format of one -o file; with several, of the one "
+            "without an extension, each other taking its format from its extension");
     std::vector<PlannedOutput> planned;
-    for (const auto &path : c.output)
-        planned.push_back({"--output", {&output_format(path, c.format, table), path, {}}});
+    for (const auto &path : c.output) {
+        const std::string format = c.output.size() == 1 || bare(path) ? c.format : "";
+        planned.push_back({"--output", {&output_format(path, format, table), path, {}}});
+    }
     for (const auto &f : c.fixed)
         if (!f.path.empty())
             planned.push_back({f.option, {&fixed_format(f, table), f.path, {}}});

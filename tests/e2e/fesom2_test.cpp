@@ -166,25 +166,39 @@ void write_fesom2(const globemesh::Mesh &mesh, const fs::path &folder,
 
 } // namespace
 
-// A regional mesh of real data (Natural Earth 1:50m, ETOPO5 north-west shelf): mesh to UGRID,
-// then `convert` to FESOM2, with open nodes flagged 2.
-TEST(Fesom2, a_regional_mesh_converted_from_ugrid_has_its_open_nodes_flagged_2) {
+// A regional mesh of real data (Natural Earth 1:50m, ETOPO5 north-west shelf) written with its
+// UGRID file in one run (-f names the -o without an extension), with open nodes flagged 2.
+TEST(Fesom2, a_regional_mesh_has_its_open_nodes_flagged_2) {
     TempDir dir;
     std::string err;
-    ASSERT_EQ(
-        run_exe({"mesh", "--coast", fixture("coast/ne_50m_land.gpkg").string(), "--coast-layer",
-                 "land", "--region", "-12,46,13,62", "--bathy",
-                 fixture("bathy/etopo5_nwshelf_5min.tif").string(), "--hmax", "60km", "--hmin",
-                 "10km", "--coast-size", "15km", "-q", "-o", (dir / "m.nc").string()},
-                err, dir.path()),
-        0)
-        << err;
-    expect_mesh_verify(dir / "m.nc");
-    ASSERT_EQ(run_exe({"convert", "-q", (dir / "m.nc").string(), (dir / "fesom").string(), "-f",
-                       "fesom2", "--co", "LEVELS=0,10,25,50,100,200,500"},
+    ASSERT_EQ(run_exe({"mesh",
+                       "--coast",
+                       fixture("coast/ne_50m_land.gpkg").string(),
+                       "--coast-layer",
+                       "land",
+                       "--region",
+                       "-12,46,13,62",
+                       "--bathy",
+                       fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+                       "--hmax",
+                       "60km",
+                       "--hmin",
+                       "10km",
+                       "--coast-size",
+                       "15km",
+                       "-q",
+                       "-o",
+                       (dir / "m.nc").string(),
+                       "-o",
+                       (dir / "fesom").string(),
+                       "-f",
+                       "fesom2",
+                       "--co",
+                       "LEVELS=0,10,25,50,100,200,500"},
                       err, dir.path()),
               0)
         << err;
+    expect_mesh_verify(dir / "m.nc");
     const std::string verdict =
         check_folder(dir, dir / "fesom", dir / "m.nc", "regional", "0,10,25,50,100,200,500");
     std::vector<std::string> n;
@@ -194,19 +208,35 @@ TEST(Fesom2, a_regional_mesh_converted_from_ugrid_has_its_open_nodes_flagged_2) 
     EXPECT_GT(std::stoi(n[4]), 0) << "open nodes";
 }
 
-// A global mesh written directly (-o DIR -f fesom2) and the UGRID file of the same options: the
-// same mesh, coast nodes only, the CORE2 levels.
-TEST(Fesom2, a_global_mesh_has_coast_nodes_and_no_open_ones) {
+// A global mesh (Natural Earth 1:110m, ETOPO5) converted from its UGRID file: coast nodes only,
+// the CORE2 levels.
+TEST(Fesom2, a_global_mesh_converted_from_ugrid_has_coast_nodes_and_no_open_ones) {
     TempDir dir;
     std::string err;
-    ASSERT_EQ(run_exe(global_run(dir / "g", "fesom2"), err, dir.path()), 0) << err;
     ASSERT_EQ(run_exe(global_run(dir / "g.nc"), err, dir.path()), 0) << err;
     expect_mesh_verify(dir / "g.nc");
+    ASSERT_EQ(
+        run_exe({"convert", "-q", (dir / "g.nc").string(), (dir / "g").string(), "-f", "FESOM2"},
+                err, dir.path()),
+        0)
+        << err;
     const std::string verdict = check_folder(dir, dir / "g", dir / "g.nc", "global");
     std::vector<std::string> n;
     ASSERT_TRUE(globemesh::test::regex_match(verdict, "OK (\\d+) (\\d+) (\\d+) 0\n", &n))
         << verdict;
     EXPECT_GT(std::stoi(n[3]), 0);
+}
+
+// Bad levels are a usage error before the mesh is made: nothing is written.
+TEST(Fesom2, bad_levels_are_refused_before_meshing) {
+    TempDir dir;
+    std::string err;
+    auto args = global_run(dir / "fesom", "fesom2");
+    args.insert(args.end(), {"--co", "LEVELS=0,50,20"});
+    EXPECT_EQ(run_exe(args, err, dir.path()), 2);
+    EXPECT_NE(err.find("LEVELS=0,50,20: give at least 3 level depths"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
 TEST(Fesom2, a_missing_parent_is_one_line_and_creates_nothing) {
@@ -277,6 +307,20 @@ TEST(Fesom2, a_failing_run_leaves_no_folder) {
         open += flag == 2;
     }
     EXPECT_GT(open, 0u);
+}
+
+// What a second signal runs (remove_temporaries) removes an adopted folder when it is empty.
+TEST(Fesom2, the_signal_cleanup_removes_the_folder_a_writer_made_when_empty) {
+    TempDir dir;
+    fs::create_directory(dir / "made");
+    fs::create_directory(dir / "filled");
+    globemesh::OutputBatch batch;
+    ASSERT_TRUE(globemesh::OutputBatch::adopt_folder(dir / "made"));
+    ASSERT_TRUE(globemesh::OutputBatch::adopt_folder(dir / "filled"));
+    std::ofstream(dir / "filled" / "mine.txt") << "a file the user put there\n";
+    globemesh::OutputFile::remove_temporaries();
+    EXPECT_FALSE(fs::exists(dir / "made"));
+    EXPECT_TRUE(fs::exists(dir / "filled" / "mine.txt"));
 }
 
 TEST(Fesom2, bad_levels_and_a_mesh_without_depths_are_refused_before_the_folder) {
