@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace globemesh {
@@ -56,8 +57,9 @@ public:
     static bool is_stream(const std::filesystem::path &target);
 
     /// Unlinks every temporary file (and sidecar) of the OutputFiles and OutputBatches alive in
-    /// the process. Async-signal-safe: for a handler that then ends the process. Does nothing
-    /// while an OutputBatch moves its files in place (committing()), so that all of them arrive.
+    /// the process, then removes the folders the batches adopted (adopt_folder) when empty.
+    /// Async-signal-safe: for a handler that then ends the process. Does nothing while an
+    /// OutputBatch moves its files in place (committing()), so that all of them arrive.
     static void remove_temporaries() noexcept;
     /// True while an OutputBatch::commit() moves files to their targets (async-signal-safe).
     static bool committing() noexcept;
@@ -83,7 +85,8 @@ private:
 /// The outputs of one run, made to appear together or not at all. While a batch is alive (one
 /// per thread), OutputFile::commit() keeps the finished file under its temporary name and hands
 /// it to the batch; commit() then moves every file to its target, after checking them all. A
-/// batch destroyed before commit() (an error, a cancelled run) removes all the files handed to it.
+/// batch destroyed before commit() (an error, a cancelled run) removes all the files handed to it,
+/// and the folders handed to it that it leaves empty.
 class OutputBatch {
 public:
     OutputBatch();
@@ -99,9 +102,15 @@ public:
     /// True while a batch is alive on this thread (files committed now join it).
     static bool active();
 
+    /// Hands a folder a writer created for its files to this thread's batch, which removes it
+    /// (when empty) if the batch ends without commit(), as remove_temporaries() does. False when
+    /// no batch is alive: the caller keeps it.
+    static bool adopt_folder(const std::filesystem::path &folder);
+
 private:
     friend class OutputFile;
     std::vector<OutputFile::Finished> files_;
+    std::vector<std::pair<std::filesystem::path, int>> folders_; ///< created, with their slots
     OutputBatch *outer_ = nullptr;
     bool committed_ = false;
 };

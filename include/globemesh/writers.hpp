@@ -64,6 +64,8 @@ struct CreationOption {
     std::string name;
     std::vector<std::string> values;
     std::string description;
+    /// For a free value (no list): what is wrong with it, or "" (unset: any value).
+    std::function<std::string(const std::string &value)> problem{};
 };
 
 /// One output format.
@@ -71,8 +73,11 @@ struct Writer {
     std::string name;                    ///< as GDAL/OGR name a driver: "UGRID", "GPKG", "PNG"
     std::string long_name;               ///< in messages: "UGRID NetCDF", "GeoPackage"
     std::vector<std::string> extensions; ///< name suffixes (".nc", "_net.nc"); first: usual
-    std::string report_key;              ///< its key in the run report's "outputs"
-    unsigned needs = needs_mesh_only;    ///< WriterNeeds bits
+    /// The files it writes into the folder the output names (created when missing); empty for
+    /// a format that writes the file the output names. A folder format has no extension.
+    std::vector<std::string> folder_files{};
+    std::string report_key;           ///< its key in the run report's "outputs"
+    unsigned needs = needs_mesh_only; ///< WriterNeeds bits
     /// Computes or takes each face's geodesic area (WriteOptions::face_areas_m2).
     bool shares_face_areas = false;
     /// Its writing time relative to meshing the same mesh, for the shares of one progress line.
@@ -96,8 +101,9 @@ const Writer *writer_for_extension(std::span<const Writer> table,
                                    const std::filesystem::path &path);
 /// "UGRID (.nc, .nc4), GPKG (.gpkg), PNG (.png)": the formats, for messages.
 std::string formats_text(std::span<const Writer> table);
-/// Throws UsageError naming `what` (e.g. "-o x.nc") for a key the writer does not take or a
-/// value outside its list; upper-cases keys and listed values in place.
+/// Throws UsageError naming `what` (e.g. "-o x.nc") for a key the writer does not take, a
+/// value outside its list or one its `problem` finds wrong; upper-cases keys and listed values
+/// in place.
 void check_creation_options(const Writer &writer, CreationOptions &options,
                             const std::string &what);
 

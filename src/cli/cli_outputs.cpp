@@ -21,6 +21,15 @@ std::string lower(std::string s) {
     return s;
 }
 
+/// ", or -f FESOM2 to write a FESOM2 mesh folder into it": the formats that write folders.
+std::string folder_formats(std::span<const Writer> table) {
+    std::string r;
+    for (const Writer &w : table)
+        if (!w.folder_files.empty())
+            r += ", or -f " + w.name + " to write a " + w.long_name + " into it";
+    return r;
+}
+
 /// The format of -o `path`: -f's when given, else its extension's; the table's first row for a
 /// name without extension (as before the table, when -o wrote UGRID only).
 const Writer &output_format(const std::string &path, const std::string &format,
@@ -35,6 +44,10 @@ const Writer &output_format(const std::string &path, const std::string &format,
     if (const Writer *w = writer_for_extension(table, path))
         return *w;
     const std::string extension = fs::path(path).extension().string();
+    std::error_code ec;
+    if (extension.empty() && fs::is_directory(path, ec)) // as check_output_path says it
+        throw IoError("--output " + path + " is a folder; give a file name" +
+                      folder_formats(table));
     if (extension.empty())
         return table.front();
     if (lower(extension) == ".json")
@@ -100,6 +113,23 @@ void assign_creation_options(std::vector<PlannedOutput> &planned, std::span<cons
                                p.option + " " + p.request.path.string());
 }
 
+/// True when `folder` exists as a folder; false when it is missing and its parent is there (the
+/// writer makes it). Throws IoError for a file in its place or a missing parent.
+bool check_output_folder(const fs::path &folder, const std::string &what) {
+    std::error_code ec;
+    if (fs::is_directory(folder, ec))
+        return true;
+    if (fs::exists(folder, ec))
+        throw IoError(what + " is a file, and this format writes a folder of files: give a folder "
+                             "name");
+    const fs::path named = folder.has_filename() ? folder : folder.parent_path(); // "dir/"
+    const fs::path parent = named.parent_path().empty() ? fs::path(".") : named.parent_path();
+    if (!fs::is_directory(parent, ec))
+        throw IoError(what + ": the folder " + parent.string() +
+                      " does not exist; create it first");
+    return false;
+}
+
 } // namespace
 
 void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::string &format,
@@ -108,7 +138,11 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
     std::string names, extensions;
     for (const Writer &w : table) {
         names += (names.empty() ? "" : ", ") + w.name;
-        extensions += (extensions.empty() ? "" : ", ") + w.extensions.front() + " " + w.name;
+        if (!w.extensions.empty())
+            extensions += (extensions.empty() ? "" : ", ") + w.extensions.front() + " " + w.name;
+        else
+            extensions +=
+                (extensions.empty() ? "" : ", ") + std::string("a folder with -f ") + w.name;
     }
     // One value per -o (it may be repeated). Not given, --print-config shows -o as "" and leaves
     // out -f and --co, so a run's configuration reads as it did before they existed.
@@ -123,8 +157,9 @@ void add_output_flags(CLI::App &app, std::vector<std::string> &output, std::stri
         ->default_str("")
         ->run_callback_for_default();
     app.add_option("-f,--output-format", format,
-                   "Format of the -o file, as GDAL names it: " + names +
-                       "; default: from its extension")
+                   "Format of the -o file (with several, of the one without an extension), as "
+                   "GDAL names it: " +
+                       names + "; default: from its extension")
         ->group(group)
         ->type_name("NAME")
         ->always_capture_default(false)
@@ -190,13 +225,19 @@ msh_version_creation(const std::string &msh_version, const std::vector<std::stri
 std::vector<PlannedOutput>
 plan_outputs(const OutputChoices &c, std::span<const Writer> table,
              std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth) {
-    if (!c.format.empty() && c.output.size() > 1)
+    // -f names the format of the one -o, or, with several, of the one without an extension (a
+    // FESOM2 folder beside the UGRID file); the others take theirs from their extensions.
+    const auto bare = [](const std::string &path) { return fs::path(path).extension().empty(); };
+    if (!c.format.empty() && c.output.size() > 1 &&
+        std::count_if(c.output.begin(), c.output.end(), bare) != 1)
         throw UsageError(
-            "-f/--output-format names the format of one -o file; with several, each takes its "
-            "format from its extension");
+            "-f/--output-format names the format of one -o file; with several, of the one "
+            "without an extension, each other taking its format from its extension");
     std::vector<PlannedOutput> planned;
-    for (const auto &path : c.output)
-        planned.push_back({"--output", {&output_format(path, c.format, table), path, {}}});
+    for (const auto &path : c.output) {
+        const std::string format = c.output.size() == 1 || bare(path) ? c.format : "";
+        planned.push_back({"--output", {&output_format(path, format, table), path, {}}});
+    }
     for (const auto &f : c.fixed)
         if (!f.path.empty())
             planned.push_back({f.option, {&fixed_format(f, table), f.path, {}}});
@@ -227,8 +268,17 @@ std::vector<std::pair<std::string, std::string>>
 output_files(std::span<const PlannedOutput> planned, const std::string &timings,
              const std::string &report, std::span<const Writer> table) {
     std::vector<std::pair<std::string, std::string>> files;
-    for (const auto &p : planned)
-        files.emplace_back(p.option, p.request.path.string());
+    for (const auto &p : planned) {
+        const auto &inside = p.request.writer->folder_files;
+        if (inside.empty()) {
+            files.emplace_back(p.option, p.request.path.string());
+            continue;
+        }
+        // A folder format: its files, checked as files when the folder exists (else it makes it).
+        if (check_output_folder(p.request.path, p.option + " " + p.request.path.string()))
+            for (const auto &name : inside)
+                files.emplace_back(p.option, (p.request.path / name).string());
+    }
     for (const auto &[name, path] :
          {std::pair<std::string, std::string>{"--timings", timings}, {"--report", report}}) {
         if (path.empty())

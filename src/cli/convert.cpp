@@ -78,8 +78,10 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
         throw UsageError("convert: give the file to write, e.g. globemesh convert in.nc fort.14");
     check_input_path(c.input, "IN");
     const OutputChoices choices{c.output, c.format, c.creation, {}};
+    // Whether IN holds depths is known once it is read: write_outputs refuses a format that
+    // needs them then (DataError), before writing anything.
     const auto planned =
-        plan_outputs(choices, lib.writers, msh_version_creation(c.msh_version, c.creation), false);
+        plan_outputs(choices, lib.writers, msh_version_creation(c.msh_version, c.creation), true);
     check_output_srs(c.output_srs, requests(planned));
     const std::pair<std::string, std::string> inputs[] = {{"IN", c.input}};
     check_output_files(output_files(planned, "", "", lib.writers), inputs, c.overwrite);

@@ -22,11 +22,7 @@
 // for tools that interpolate the bathymetry afterwards); a node without a depth (NaN: the
 // bathymetry does not cover it) is refused, as no model runs on it.
 #include <algorithm>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,12 +32,14 @@
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
 #include "model_coordinates.hpp"
+#include "text_out.hpp"
 
 namespace globemesh {
 
 namespace {
 
 namespace fs = std::filesystem;
+using io::TextOut;
 
 /// A node string of the boundary section: its 1-based nodes and its type.
 struct NodeString {
@@ -121,64 +119,6 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
         s.land_nodes += r.nodes.size();
     return s;
 }
-
-/// Buffered text output to a FILE, numbers formatted with to_chars (shortest exact decimals).
-class TextOut {
-public:
-    TextOut(const fs::path &temp, const fs::path &target, std::string what)
-        : file_(std::fopen(temp.c_str(), "wb")), temp_(temp), target_(target),
-          what_(std::move(what)) {
-        if (!file_)
-            fail("cannot create it");
-        buffer_.reserve(capacity + 256);
-    }
-    ~TextOut() {
-        if (file_)
-            std::fclose(file_);
-    }
-    TextOut &text(std::string_view s) {
-        buffer_ += s;
-        return *this;
-    }
-    TextOut &integer(std::size_t v) {
-        char b[24];
-        buffer_.append(b, std::to_chars(b, b + sizeof b, v).ptr);
-        return *this;
-    }
-    TextOut &real(double v) {
-        char b[400];
-        buffer_.append(b, std::to_chars(b, b + sizeof b, v, std::chars_format::fixed).ptr);
-        return *this;
-    }
-    /// Ends a line, writing the buffer out when it is full.
-    void line() {
-        buffer_ += '\n';
-        if (buffer_.size() >= capacity)
-            flush();
-    }
-    void close() {
-        flush();
-        const bool ok = std::fclose(file_) == 0;
-        file_ = nullptr;
-        if (!ok)
-            fail("writing failed");
-    }
-
-private:
-    static constexpr std::size_t capacity = 1 << 20;
-    void flush() {
-        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-            fail("writing failed");
-        buffer_.clear();
-    }
-    [[noreturn]] void fail(const std::string &what) {
-        throw IoError(what_ + " " + target_.string() + ": " + what + " (" + std::strerror(errno) +
-                      ")" + OutputFile::full_disk_note(temp_));
-    }
-    std::FILE *file_;
-    fs::path temp_, target_;
-    std::string what_, buffer_;
-};
 
 /// The node strings of one kind: each "count IBTYPE ! comment", then its nodes, a line each.
 void write_strings(TextOut &out, const std::vector<NodeString> &strings, const char *kind) {

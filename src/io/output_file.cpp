@@ -94,6 +94,18 @@ void OutputFile::remove_temporaries() noexcept {
             ::unlink(name);
         }
     }
+    // Then the folders a writer created (rmdir fails, harmlessly, on the file names above and
+    // on a folder that is not empty).
+    for (TempSlot &slot : temp_slots) {
+        if (slot.state.load() != 2)
+            continue;
+        const unsigned generation = slot.generation.load();
+        char name[PATH_MAX];
+        std::memcpy(name, slot.path, sizeof name);
+        name[PATH_MAX - 1] = '\0';
+        if (slot.state.load() == 2 && slot.generation.load() == generation)
+            ::rmdir(name);
+    }
 }
 
 bool OutputFile::committing() noexcept {
@@ -213,12 +225,25 @@ bool OutputBatch::active() {
 
 OutputBatch::~OutputBatch() {
     active_batch = outer_;
-    if (committed_)
-        return;
-    for (const auto &f : files_) {
-        remove_with_sidecars(f.temp);
-        unregister_temp(f.slot);
+    if (!committed_)
+        for (const auto &f : files_) {
+            remove_with_sidecars(f.temp);
+            unregister_temp(f.slot);
+        }
+    for (const auto &[folder, slot] : folders_) {
+        if (!committed_) {
+            std::error_code ec;
+            fs::remove(folder, ec); // only when empty: nothing else of the user's goes
+        }
+        unregister_temp(slot);
     }
+}
+
+bool OutputBatch::adopt_folder(const fs::path &folder) {
+    if (active_batch == nullptr)
+        return false;
+    active_batch->folders_.emplace_back(folder, register_temp(folder));
+    return true;
 }
 
 void OutputBatch::commit(const std::function<bool()> &cancelled) {

@@ -29,6 +29,9 @@ void write_as_selafin(const Mesh &mesh, const fs::path &path,
                       const WriteOptions &options); // selafin_write.cpp
 void write_as_dflowfm(const Mesh &mesh, const fs::path &path,
                       const WriteOptions &options); // dflowfm_write.cpp
+void write_as_fesom2(const Mesh &mesh, const fs::path &path,
+                     const WriteOptions &options);            // fesom2_write.cpp
+std::string fesom2_levels_problem(const std::string &levels); // fesom2_write.cpp
 
 // The progress weights: seconds to write over seconds to read and mesh, at 20 km on 1:50m land
 // (1.08e6 nodes): UGRID 2.6 s, GPKG 7.9 s, PNG 1.8 s, meshing 1.7 s.
@@ -102,6 +105,19 @@ const std::vector<Writer> &writers() {
          .report_key = "dflowfm",
          .progress_weight = 0.4, // 1.2 to 1.6 s at 1.08e6 nodes (bench/RESULTS-dflowfm.md)
          .write = write_as_dflowfm},
+        {.name = "FESOM2",
+         .long_name = "FESOM2 mesh folder",
+         .extensions = {},
+         .folder_files = {"nod2d.out", "elem2d.out", "aux3d.out"},
+         .report_key = "fesom2",
+         .needs = needs_depth,
+         .progress_weight = 0.4, // 1.4 s at 1.08e6 nodes, as ADCIRC (bench/RESULTS-fesom2.md)
+         .creation_options = {{"LEVELS",
+                               {},
+                               "the model levels in metres, from 0 down, comma-separated "
+                               "(default: the 48 of FESOM2's CORE2 mesh)",
+                               fesom2_levels_problem}},
+         .write = write_as_fesom2},
     };
     return table;
 }
@@ -156,7 +172,10 @@ const Writer *writer_for_extension(std::span<const Writer> table, const fs::path
 std::string formats_text(std::span<const Writer> table) {
     std::string r;
     for (const Writer &w : table)
-        r += (r.empty() ? "" : ", ") + w.name + " (" + joined(w.extensions) + ")";
+        r += (r.empty() ? "" : ", ") + w.name + " (" +
+             (w.extensions.empty() ? std::string("a folder, with -f ") + w.name
+                                   : joined(w.extensions)) +
+             ")";
     return r;
 }
 
@@ -175,8 +194,13 @@ void check_creation_options(const Writer &writer, CreationOptions &options,
                 what + ": " + writer.name + " takes no creation option " + key +
                 (names.empty() ? " (it takes none)" : " (it takes " + joined(names) + ")"));
         }
-        if (known->values.empty())
+        if (known->values.empty()) {
+            const std::string problem = known->problem ? known->problem(value) : "";
+            if (!problem.empty())
+                throw UsageError(what + ": " + writer.name + " creation option " + key + "=" +
+                                 value + ": " + problem);
             continue;
+        }
         if (std::find(known->values.begin(), known->values.end(), upper(value)) ==
             known->values.end()) {
             std::string choices = known->values.front();

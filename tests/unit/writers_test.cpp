@@ -84,7 +84,7 @@ TEST(Writers, each_name_extension_and_report_key_names_one_row) {
         EXPECT_TRUE(names.insert(w.name).second);
         EXPECT_TRUE(keys.insert(w.report_key).second);
         EXPECT_FALSE(w.long_name.empty());
-        EXPECT_FALSE(w.extensions.empty());
+        EXPECT_NE(w.extensions.empty(), w.folder_files.empty()); // a file's or a folder's
         for (const auto &e : w.extensions) {
             EXPECT_TRUE(e.size() > 1 && e.find('.') != std::string::npos) << e;
             // A name ending so is this row's, even where a shorter suffix is another's.
