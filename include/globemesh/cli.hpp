@@ -48,6 +48,8 @@ struct CliLibrary {
     std::function<Mesh(const std::filesystem::path &)> read_ugrid;
     /// fort.14 / hgrid.gr3 (mesh_read.hpp), an input of `convert`.
     std::function<Mesh(const std::filesystem::path &)> read_adcirc;
+    /// gmsh .msh (mesh_read.hpp), an input of `convert`.
+    std::function<Mesh(const std::filesystem::path &)> read_gmsh;
     std::function<MeshStats(const Mesh &)> compute_stats;
 };
 

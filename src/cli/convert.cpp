@@ -25,8 +25,8 @@ ConvertCommand::ConvertCommand(std::span<const Writer> table) {
     app.set_version_flag("--version", version_text(), "Print the version and exit");
     app.get_formatter()->column_width(36);
     app.add_option("IN", input,
-                   "UGRID NetCDF mesh (ours or another tool's, 0- or 1-based), or an ADCIRC/SCHISM "
-                   "grid named fort.14, *.14, *.gr3 or *.ll")
+                   "UGRID NetCDF mesh (ours or another tool's, 0- or 1-based), an ADCIRC/SCHISM "
+                   "grid named fort.14, *.14, *.gr3 or *.ll, or a gmsh *.msh (ASCII 4.1 or 2.2)")
         ->required()
         ->type_name("IN.nc");
     app.add_option("OUT", positional, "Files to write, as -o gives them (either or both)")
@@ -89,7 +89,9 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, false);
     terminal.configure(c.quiet, false);
-    Mesh mesh = is_adcirc_name(c.input) ? lib.read_adcirc(c.input) : lib.read_ugrid(c.input);
+    Mesh mesh = is_adcirc_name(c.input) ? lib.read_adcirc(c.input)
+                : is_gmsh_name(c.input) ? lib.read_gmsh(c.input)
+                                        : lib.read_ugrid(c.input);
     name_depth(mesh);
     throw_if_interrupted();
     OutputBatch batch; // every output waits under its temporary name until all are complete

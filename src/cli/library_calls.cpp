@@ -16,6 +16,7 @@ CliLibrary library_calls() {
     lib.writers = writers();
     lib.read_ugrid = [](const std::filesystem::path &p) { return read_ugrid(p); };
     lib.read_adcirc = [](const std::filesystem::path &p) { return read_adcirc(p); };
+    lib.read_gmsh = [](const std::filesystem::path &p) { return read_gmsh(p); };
     lib.compute_stats = [](const Mesh &m) { return compute_stats(m); };
     return lib;
 }

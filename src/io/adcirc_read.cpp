@@ -19,83 +19,14 @@
 #include "globemesh/error.hpp"
 #include "globemesh/sphere.hpp"
 #include "mesh_topology.hpp"
+#include "text_lines.hpp"
 
 namespace globemesh {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-/// The file's lines as words, with the line number for messages.
-class Lines {
-public:
-    explicit Lines(const fs::path &path) : path_(path), in_(path) {
-        if (!in_)
-            throw IoError("ADCIRC file " + path.string() + ": cannot open; give an existing file");
-    }
-    [[noreturn]] void fail(const std::string &what) const {
-        throw DataError("ADCIRC file " + path_.string() + ": line " + std::to_string(line_) + ": " +
-                        what);
-    }
-    /// The next line's words (before any "!"); false at the end of the file.
-    bool next(std::vector<std::string_view> &words) {
-        if (!std::getline(in_, text_))
-            return false;
-        ++line_;
-        words.clear();
-        const std::string_view s(text_.data(), std::min(text_.find('!'), text_.size()));
-        for (std::size_t i = 0; i < s.size();) {
-            while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i])))
-                ++i;
-            std::size_t j = i;
-            while (j < s.size() && !std::isspace(static_cast<unsigned char>(s[j])))
-                ++j;
-            if (j > i)
-                words.push_back(s.substr(i, j - i));
-            i = j;
-        }
-        return true;
-    }
-    /// The next line's words; fails at the end of the file or when it has fewer than `n`.
-    const std::vector<std::string_view> &need(std::size_t n, const char *what) {
-        if (!next(words_))
-            fail(std::string("the file ends where ") + what + " should be");
-        if (words_.size() < n)
-            fail(std::string("expected ") + what);
-        return words_;
-    }
-    long long integer(std::string_view w, const char *what) const {
-        long long v = 0;
-        const auto r = std::from_chars(w.data(), w.data() + w.size(), v);
-        if (r.ec != std::errc() || r.ptr != w.data() + w.size())
-            fail(std::string(what) + " '" + std::string(w) + "' is not an integer");
-        return v;
-    }
-    double number(std::string_view w, const char *what) const {
-        std::string s(w); // from_chars for double is missing from some standard libraries
-        std::replace(s.begin(), s.end(), 'D', 'E');
-        std::replace(s.begin(), s.end(), 'd', 'e');
-        char *end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        if (end != s.c_str() + s.size() || !std::isfinite(v))
-            fail(std::string(what) + " '" + s + "' is not a number");
-        return v;
-    }
-    /// A count of at most `max`.
-    std::size_t count(std::string_view w, const char *what, long long max = 1LL << 31) const {
-        const long long v = integer(w, what);
-        if (v < 0 || v > max)
-            fail(std::string(what) + " " + std::to_string(v) + " is out of range");
-        return std::size_t(v);
-    }
-
-private:
-    const fs::path &path_;
-    std::ifstream in_;
-    std::string text_;
-    std::vector<std::string_view> words_;
-    std::size_t line_ = 0;
-};
+using io::Lines;
 
 /// Node index by the file's node id.
 struct NodeIds {
@@ -169,14 +100,12 @@ bool read_strings(Lines &in, const NodeIds &ids, EdgeTag tag, std::vector<Bounda
 } // namespace
 
 bool is_adcirc_name(const fs::path &path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string ext = io::lower_extension(path);
     return ext == ".14" || ext == ".gr3" || ext == ".ll";
 }
 
 Mesh read_adcirc(const fs::path &path) {
-    Lines in(path);
+    Lines in(path, "ADCIRC file", '!');
     Mesh mesh;
     in.need(0, "the title line");
     const auto &counts = in.need(2, "NE NP");
@@ -186,20 +115,7 @@ Mesh read_adcirc(const fs::path &path) {
     // The strings' edges tag the boundary edges they lie on (build_topology matches them).
     if (read_strings(in, ids, EdgeTag::open, mesh.boundary))
         read_strings(in, ids, EdgeTag::coast, mesh.boundary);
-    const io::MeshTopology topology = [&] {
-        try {
-            return io::build_topology(mesh);
-        } catch (const DataError &e) {
-            throw DataError("ADCIRC file " + path.string() + ": " + e.what());
-        }
-    }();
-    std::vector<BoundaryEdge> boundary;
-    for (std::size_t i = 0; i < topology.boundary_edges.size(); ++i) {
-        const auto nodes = topology.edge_nodes(std::size_t(topology.boundary_edges[i]));
-        boundary.push_back(
-            {NodeIndex(nodes[0]), NodeIndex(nodes[1]), EdgeTag(topology.boundary_tags[i])});
-    }
-    mesh.boundary = std::move(boundary);
+    io::tag_boundary_edges(mesh, "ADCIRC file " + path.string());
     return mesh;
 }
 

@@ -242,4 +242,21 @@ std::vector<LonLat> node_lonlats(const Mesh &mesh) {
     return p;
 }
 
+void tag_boundary_edges(Mesh &mesh, const std::string &what) {
+    const MeshTopology topology = [&] {
+        try {
+            return build_topology(mesh);
+        } catch (const DataError &e) {
+            throw DataError(what + ": " + e.what());
+        }
+    }();
+    std::vector<BoundaryEdge> boundary;
+    for (std::size_t i = 0; i < topology.boundary_edges.size(); ++i) {
+        const auto nodes = topology.edge_nodes(std::size_t(topology.boundary_edges[i]));
+        boundary.push_back(
+            {NodeIndex(nodes[0]), NodeIndex(nodes[1]), EdgeTag(topology.boundary_tags[i])});
+    }
+    mesh.boundary = std::move(boundary);
+}
+
 } // namespace globemesh::io

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "globemesh/mesh.hpp"
@@ -61,6 +62,12 @@ void face_edges(const MeshTopology &topo, std::size_t first, std::size_t count,
 /// Neighbours of face f across its edges k = 0, 1, 2 (-1 entries last), from its three edges.
 std::array<std::int32_t, 3> face_faces(const MeshTopology &topo, const std::int32_t *edges_of_f,
                                        std::size_t f);
+
+/// Replaces mesh.boundary by every boundary edge of the faces, oriented with the mesh on its
+/// left, each tagged from the edges read into mesh.boundary (any orientation; coast when not
+/// there). Throws DataError beginning with `what` when the faces do not make a mesh (an index out
+/// of range, an edge of more than two faces).
+void tag_boundary_edges(Mesh &mesh, const std::string &what);
 
 /// Number of boundary loops: connected groups of boundary edges (joined at shared nodes).
 std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_count);

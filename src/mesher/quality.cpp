@@ -42,6 +42,8 @@ public:
     void raise_floor();
     std::size_t remove_floor_nodes();
     std::size_t insert_floor_nodes();
+    bool try_floor_node(TriangleId t, VertexId a, VertexId b,
+                        std::pair<std::size_t, double> &before);
     std::pair<std::size_t, double> floor_faces(std::vector<TriangleId> *low) const;
     double face_quality(TriangleId t) const {
         return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
@@ -496,66 +498,77 @@ std::pair<std::size_t, double> QualityRounds::floor_faces(std::vector<TriangleId
 }
 
 // A face still below the floor (a short side, often a coast segment, beside nodes of a much
-// coarser spacing) gets a node at the apex of the equilateral triangle on its shortest side, on
-// the face's side (Ungor's off-centre at its most regular), and the search runs on the node and
-// its free neighbours. The trial stays when it leaves fewer faces below the floor and none worse
-// than before; else the triangulation is restored from a copy. Returns the nodes added
-// (MesherReport::floor_nodes_added).
+// coarser spacing) gets a node at the apex of the equilateral triangle on one of its sides, on
+// the face's side (Ungor's off-centre at its most regular), the shortest side first, and the
+// search runs on the node and its free neighbours. A trial stays when it leaves fewer faces below
+// the floor and none worse than before; else the triangulation is restored from a copy. Returns
+// the nodes added (MesherReport::floor_nodes_added).
 std::size_t QualityRounds::insert_floor_nodes() {
     std::vector<TriangleId> low;
     auto before = floor_faces(&low);
     if (low.size() > max_floor_trials)
         low.resize(max_floor_trials);
     std::size_t added = 0;
-    std::vector<std::pair<VertexId, TriangleId>> around;
     for (TriangleId t : low) {
         if (!dt.is_live(t) || dt.label(t) != ocean || face_quality(t) >= detail::blunt_floor)
             continue; // mended by an earlier node
-        int k = 0;
-        for (int i = 1; i < 3; ++i)
-            if (arc_angle(dt.point(dt.vertex(t, i)), dt.point(dt.vertex(t, next3(i)))) <
-                arc_angle(dt.point(dt.vertex(t, k)), dt.point(dt.vertex(t, next3(k)))))
-                k = i;
-        const Vec3 &a = dt.point(dt.vertex(t, k)), &b = dt.point(dt.vertex(t, next3(k)));
-        const double height = 0.5 * std::sqrt(3.0) * arc_angle(a, b);
-        const Vec3 p = normalized(std::cos(height) * arc_midpoint(a, b) +
-                                  std::sin(height) * normalized(cross(a, b)));
-        HalfEdge blocked;
-        const TriangleId in = m.walk_towards(t, p, blocked);
-        if (blocked != no_half_edge || dt.label(in) != ocean || is_cut(in))
-            continue;
-        const SphericalDelaunay saved = dt; // the trial is undone exactly by restoring it
-        const std::size_t vertices = dt.vertex_count();
-        const VertexId v = dt.insert_in_triangle(p, in);
-        if (dt.vertex_count() == vertices)
-            continue;
+        std::array<std::pair<double, int>, 3> sides;
+        for (int i = 0; i < 3; ++i)
+            sides[i] = {arc_angle(dt.point(dt.vertex(t, i)), dt.point(dt.vertex(t, next3(i)))), i};
+        std::sort(sides.begin(), sides.end());
+        const std::array<VertexId, 3> corners{dt.vertex(t, 0), dt.vertex(t, 1), dt.vertex(t, 2)};
+        for (const auto &side : sides)
+            if (try_floor_node(t, corners[side.second], corners[next3(side.second)], before)) {
+                ++added;
+                break;
+            }
+    }
+    m.report.floor_nodes_added += added;
+    return added;
+}
+
+// The trial of insert_floor_nodes: a node at the apex on side a-b of face t (counter-clockwise),
+// kept when the faces below the floor improve on `before` (then updated).
+bool QualityRounds::try_floor_node(TriangleId t, VertexId a, VertexId b,
+                                   std::pair<std::size_t, double> &before) {
+    const Vec3 &pa = dt.point(a), &pb = dt.point(b);
+    const double height = 0.5 * std::sqrt(3.0) * arc_angle(pa, pb);
+    const Vec3 p = normalized(std::cos(height) * arc_midpoint(pa, pb) +
+                              std::sin(height) * normalized(cross(pa, pb)));
+    HalfEdge blocked;
+    const TriangleId in = m.walk_towards(t, p, blocked);
+    if (blocked != no_half_edge || dt.label(in) != ocean || is_cut(in))
+        return false;
+    const SphericalDelaunay saved = dt; // the trial is undone exactly by restoring it
+    const std::size_t vertices = dt.vertex_count();
+    const VertexId v = dt.insert_in_triangle(p, in);
+    bool kept = dt.vertex_count() > vertices;
+    std::vector<std::pair<VertexId, TriangleId>> around;
+    if (kept) {
         as_made.resize(dt.vertex_count(), 0);
         dirty.resize(dt.vertex_count(), 0);
         const HalfEdge from = dt.leaving(v, dt.last_triangle());
-        bool ocean_star = true;
         around.assign(1, {v, triangle_of(from)});
         HalfEdge h = from;
         do {
-            ocean_star = ocean_star && dt.label(triangle_of(h)) == ocean && !is_cut(triangle_of(h));
+            kept = kept && dt.label(triangle_of(h)) == ocean && !is_cut(triangle_of(h));
             if (!m.is_fixed(dt.destination(h)))
                 around.emplace_back(dt.destination(h), triangle_of(h));
             h = dt.next_around_origin(h);
         } while (h != from);
-        for (int round = 0; ocean_star && round < 2; ++round)
-            for (auto &[u, hint] : around)
-                improve_node(u, hint);
-        const auto after = floor_faces(nullptr);
-        if (!ocean_star || after.first >= before.first || after.second < before.second) {
-            dt = saved;
-            continue;
-        }
-        before = after;
-        ++added;
-        for (const auto &[u, hint] : around)
-            dirty[u] = 1;
     }
-    m.report.floor_nodes_added += added;
-    return added;
+    for (int round = 0; kept && round < 2; ++round)
+        for (auto &[u, hint] : around)
+            improve_node(u, hint);
+    const auto after = kept ? floor_faces(nullptr) : before;
+    if (!kept || after.first >= before.first || after.second < before.second) {
+        dt = saved;
+        return false;
+    }
+    before = after;
+    for (const auto &[u, hint] : around)
+        dirty[u] = 1;
+    return true;
 }
 
 } // namespace

@@ -255,6 +255,75 @@ TEST(ConvertE2e, ugrid_to_msh_fort14_and_ugrid_keep_nodes_faces_tags_and_depth) 
     std::getline(head, line);
     EXPECT_EQ(line, "2.2 0 8");
     EXPECT_NE(check("msh r.nc v.msh", dir.path()).find("OK coast="), std::string::npos);
+    // Back from gmsh, 4.1 and 2.2, from points on a sphere (COORDS=SPHERE) and with one group per
+    // open boundary (OPEN_GROUPS=YES): the same nodes, faces, tags and depth.
+    for (const char *co : {"COORDS=SPHERE", "OPEN_GROUPS=YES"})
+        ASSERT_EQ(run_exe({"convert", "r.nc", "-o", std::string(co).substr(0, 4) + ".msh", "--co",
+                           co, "-q"},
+                          err, dir.path()),
+                  0)
+            << err;
+    for (const std::string m : {"c.msh", "v.msh", "COOR.msh", "OPEN.msh"}) {
+        ASSERT_EQ(run_exe({"convert", m, m + ".nc", "-q"}, err, dir.path()), 0) << err;
+        EXPECT_EQ(check("same r.nc " + m + ".nc", dir.path()), "OK\n") << m;
+    }
+}
+
+// A mesh gmsh itself made (its Python API: a lon/lat rectangle, physical groups "open" on its
+// west side and "coast" on the others, "ocean" on the surface), in MSH 4.1 and 2.2, converts to
+// UGRID with gmsh's node and triangle counts and its open lines as open boundary edges.
+TEST(ConvertE2e, a_mesh_gmsh_made_converts_with_its_physical_groups) {
+    if (!readers_available())
+        return;
+    TempDir dir;
+    std::ofstream(dir / "made.py") << R"(
+import sys, gmsh, netCDF4, numpy as np
+version, msh = sys.argv[1], sys.argv[2]
+gmsh.initialize(); gmsh.option.setNumber('General.Terminal', 0)
+gmsh.option.setNumber('Mesh.MshFileVersion', float(version))
+occ = gmsh.model.geo
+p = [occ.addPoint(x, y, 0, 0.4) for x, y in ((0, 50), (4, 50), (4, 53), (0, 53))]
+l = [occ.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
+s = occ.addPlaneSurface([occ.addCurveLoop(l)]); occ.synchronize()
+for dim, tags, tag, name in ((1, l[:3], 1, 'coast'), (1, [l[3]], 2, 'open'), (2, [s], 3, 'ocean')):
+    gmsh.model.addPhysicalGroup(dim, tags, tag); gmsh.model.setPhysicalName(dim, tag, name)
+gmsh.model.mesh.generate(2); gmsh.write(msh)
+nodes = len(gmsh.model.mesh.getNodes()[0])
+tris = sum(len(t) for t in gmsh.model.mesh.getElements(2, s)[1])
+opens = sum(len(t) for t in gmsh.model.mesh.getElements(1, l[3])[1])
+print(nodes, tris, opens)
+)";
+    std::ofstream(dir / "read.py") << R"(
+import sys, netCDF4, numpy as np
+ds = netCDF4.Dataset(sys.argv[1]); ds.set_auto_mask(False)
+topo = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
+x = ds[topo.node_coordinates.split()[0]][:]
+f = ds[topo.face_node_connectivity][:]
+t = ds['boundary_tag'][:]
+print(len(x), len(f), int((t == 2).sum()))
+)";
+    for (const char *version : {"4.1", "2.2"}) {
+        SCOPED_TRACE(version);
+        const std::string msh = std::string("g") + version + ".msh", nc = msh + ".nc";
+        std::string made, read, err;
+        ASSERT_EQ(run_command("cd " + quote(dir.path().string()) + " && /usr/bin/python3 made.py " +
+                                  version + " " + msh,
+                              made),
+                  0)
+            << made;
+        ASSERT_EQ(run_exe({"convert", msh, nc, "-q"}, err, dir.path()), 0) << err;
+        ASSERT_EQ(
+            run_command("cd " + quote(dir.path().string()) + " && /usr/bin/python3 read.py " + nc,
+                        read),
+            0)
+            << read;
+        // gmsh's counts (the last line it printed) equal the converted file's.
+        made = made.substr(made.rfind('\n', made.size() - 2) + 1);
+        EXPECT_EQ(read, made);
+        // gmsh's mesh is Delaunay in the lon/lat plane, not on the sphere: a few edges fail the
+        // spherical test; everything else must hold.
+        expect_mesh_verify(dir / nc, "--allow-nondelaunay 20");
+    }
 }
 
 TEST(ConvertE2e, another_tools_one_based_file_converts_with_its_tags_or_all_coast_without) {
@@ -279,6 +348,14 @@ TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
     TempDir dir;
     std::ofstream(dir / "text.nc") << "not netcdf\n";
     std::ofstream(dir / "bad.14") << "title\n2 x\n";
+    std::ofstream(dir / "binary.msh") << "$MeshFormat\n4.1 1 8\n$EndMeshFormat\n";
+    std::ofstream(dir / "text.msh") << "not a mesh\n";
+    // As globemesh and seamsh write a projected mesh: the CRS's WKT in a $Projection section.
+    std::ofstream(dir / "utm.msh") << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Projection\nWKT\n"
+                                      "PROJCS[\"WGS 84 / UTM zone 31N\"]\n$EndProjection\n";
+    std::ofstream(dir / "quads.msh") << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n"
+                                        "1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n$EndNodes\n"
+                                        "$Elements\n1\n1 3 0 1 2 3 4\n$EndElements\n";
     const std::string etopo = fixture("bathy/etopo5_global_10min.nc").string();
     std::string err;
     ASSERT_EQ(run_exe({"triangulate", fixture("points/stations.csv").string(), "-o", "m.nc", "-q"},
@@ -295,6 +372,10 @@ TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
         {{"convert", "text.nc", "out.msh"}, 1, "cannot open"},
         {{"convert", etopo, "out.msh"}, 1, "not a UGRID mesh"},
         {{"convert", "bad.14", "out.msh"}, 1, "line 2: NP 'x' is not an integer"},
+        {{"convert", "binary.msh", "out.nc"}, 1, "a binary MSH file is not read"},
+        {{"convert", "text.msh", "out.nc"}, 1, "not a gmsh MSH file"},
+        {{"convert", "quads.msh", "out.nc"}, 1, "element type 3 is not read"},
+        {{"convert", "utm.msh", "out.nc"}, 1, "projected CRS ($Projection)"},
         {{"convert", "m.nc", "out.xyz"}, 2, "no format has the extension .xyz"},
         {{"convert", "m.nc", "-f", "NOSUCH", "-o", "out.msh"}, 2, "no such format"},
         {{"convert", "m.nc"}, 2, "give the file to write"},
@@ -304,6 +385,8 @@ TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
         EXPECT_EQ(run_exe(c.args, err, dir.path()), c.status) << c.args[1] << ": " << err;
         EXPECT_NE(err.find(c.says), std::string::npos) << err;
         EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-        EXPECT_FALSE(fs::exists(dir / "out.msh") || fs::exists(dir / "out.xyz")) << c.args[1];
+        EXPECT_FALSE(fs::exists(dir / "out.msh") || fs::exists(dir / "out.xyz") ||
+                     fs::exists(dir / "out.nc"))
+            << c.args[1];
     }
 }

@@ -1,0 +1,317 @@
+// gmsh MSH reader (ASCII 4.1 and 2.2): see globemesh/mesh_read.hpp.
+//
+// Sections read, as gmsh's file format documentation lays them out: $MeshFormat (version, file
+// type 0 = ASCII), $PhysicalNames ("dim tag "name""), $Entities (4.1: each curve's physical tags),
+// $Nodes (4.1: blocks of tags then coordinates; 2.2: "id x y z"), $Elements (4.1: blocks of one
+// entity and type; 2.2: "id type ntags tags... nodes"), $NodeData "depth". Other sections are
+// skipped; $Projection (a projected mesh, as globemesh and seamsh write it) is refused.
+// Triangles (type 2) are the faces; lines (type 1) tag the boundary edges: those in a physical
+// group named "open" or "open_<k>" are open, the rest coast; points (type 15) are ignored.
+// Coordinates are lon/lat degrees when every z is 0, else points in 3-D on a sphere (any radius).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "globemesh/error.hpp"
+#include "globemesh/mesh_read.hpp"
+#include "globemesh/sphere.hpp"
+#include "mesh_topology.hpp"
+#include "text_lines.hpp"
+
+namespace globemesh {
+
+namespace {
+
+namespace fs = std::filesystem;
+using io::Lines;
+
+constexpr int line_type = 1, triangle_type = 2, point_type = 15;
+
+struct MshContent {
+    bool v4 = true;
+    std::map<int, std::string> line_groups;          ///< physical tag of dimension 1 -> name
+    std::map<int, std::vector<int>> curve_groups;    ///< 4.1: curve entity -> physical tags
+    std::vector<long long> node_tags;                ///< in the order read
+    std::vector<std::array<double, 3>> xyz;          ///< per node read
+    std::vector<std::array<long long, 3>> triangles; ///< node tags
+    std::vector<std::pair<std::array<long long, 2>, int>> lines; ///< node tags, physical (0)
+    std::map<long long, double> depth;                           ///< node tag -> $NodeData "depth"
+};
+
+std::string unquoted(std::string_view w) {
+    if (w.size() >= 2 && w.front() == '"' && w.back() == '"')
+        w = w.substr(1, w.size() - 2);
+    return std::string(w);
+}
+
+void read_format(Lines &in, MshContent &c) {
+    const auto &w = in.need(3, "version file-type data-size");
+    const std::string version(w[0]);
+    if (version.rfind("4", 0) == 0)
+        c.v4 = true;
+    else if (version.rfind("2", 0) == 0)
+        c.v4 = false;
+    else
+        in.fail("MSH version " + version + " is not read (4.1 or 2.2)");
+    if (w[1] != "0")
+        in.fail("a binary MSH file is not read; save it as ASCII (gmsh: -bin 0)");
+}
+
+void read_physical_names(Lines &in, MshContent &c) {
+    const std::size_t n = in.count(in.need(1, "the number of physical names")[0], "count");
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto &w = in.need(3, "a physical name: dim tag \"name\"");
+        if (in.integer(w[0], "dimension") == 1)
+            c.line_groups[int(in.integer(w[1], "physical tag"))] = unquoted(w[2]);
+    }
+}
+
+/// 4.1's $Entities: the physical tags of each curve (points, surfaces, volumes skipped).
+void read_entities(Lines &in, MshContent &c) {
+    const auto &counts = in.need(4, "numPoints numCurves numSurfaces numVolumes");
+    const std::size_t points = in.count(counts[0], "count"), curves = in.count(counts[1], "count"),
+                      others = in.count(counts[2], "count") + in.count(counts[3], "count");
+    for (std::size_t i = 0; i < points; ++i)
+        in.need(5, "a point entity");
+    for (std::size_t i = 0; i < curves; ++i) {
+        const auto &w = in.need(8, "a curve entity");
+        const std::size_t n = in.count(w[7], "number of physical tags");
+        if (w.size() < 8 + n)
+            in.fail("a curve entity lists fewer physical tags than it says");
+        auto &tags = c.curve_groups[int(in.integer(w[0], "entity tag"))];
+        for (std::size_t k = 0; k < n; ++k)
+            tags.push_back(int(std::abs(in.integer(w[8 + k], "physical tag"))));
+    }
+    for (std::size_t i = 0; i < others; ++i)
+        in.need(8, "a surface or volume entity");
+}
+
+void add_node(Lines &in, MshContent &c, long long tag, const std::vector<std::string_view> &w,
+              std::size_t first) {
+    c.node_tags.push_back(tag);
+    c.xyz.push_back(
+        {in.number(w[first], "x"), in.number(w[first + 1], "y"), in.number(w[first + 2], "z")});
+}
+
+void read_nodes(Lines &in, MshContent &c) {
+    if (!c.v4) {
+        const std::size_t n = in.count(in.need(1, "the number of nodes")[0], "node count");
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto &w = in.need(4, "a node: id x y z");
+            add_node(in, c, in.integer(w[0], "node id"), w, 1);
+        }
+        return;
+    }
+    const auto &head = in.need(4, "numEntityBlocks numNodes minNodeTag maxNodeTag");
+    const std::size_t blocks = in.count(head[0], "block count");
+    std::vector<long long> tags;
+    for (std::size_t b = 0; b < blocks; ++b) {
+        const auto &w = in.need(4, "a node block: entityDim entityTag parametric numNodes");
+        const bool parametric = in.integer(w[2], "parametric") != 0;
+        const std::size_t n = in.count(w[3], "node count");
+        tags.clear();
+        for (std::size_t i = 0; i < n; ++i)
+            tags.push_back(in.integer(in.need(1, "a node tag")[0], "node tag"));
+        for (std::size_t i = 0; i < n; ++i)
+            add_node(in, c, tags[i], in.need(parametric ? 4 : 3, "node coordinates x y z"), 0);
+    }
+}
+
+/// One element of `type` with the node words `nodes` and physical group `physical` (0: none).
+void add_element(Lines &in, MshContent &c, long long type, const std::vector<std::string_view> &w,
+                 std::size_t first, int physical) {
+    auto node = [&](std::size_t k) {
+        if (first + k >= w.size())
+            in.fail("an element has fewer nodes than its type");
+        return in.integer(w[first + k], "node tag");
+    };
+    if (type == triangle_type)
+        c.triangles.push_back({node(0), node(1), node(2)});
+    else if (type == line_type)
+        c.lines.push_back({{node(0), node(1)}, physical});
+    else if (type != point_type)
+        in.fail("element type " + std::to_string(type) +
+                " is not read (3-node triangles, 2-node lines and points only)");
+}
+
+void read_elements(Lines &in, MshContent &c) {
+    if (!c.v4) {
+        const std::size_t n = in.count(in.need(1, "the number of elements")[0], "element count");
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto &w = in.need(3, "an element: id type ntags ...");
+            const std::size_t tags = in.count(w[2], "tag count");
+            const int physical = tags > 0 && w.size() > 3 ? int(in.integer(w[3], "physical")) : 0;
+            add_element(in, c, in.integer(w[1], "element type"), w, 3 + tags, physical);
+        }
+        return;
+    }
+    const auto &head = in.need(4, "numEntityBlocks numElements minTag maxTag");
+    const std::size_t blocks = in.count(head[0], "block count");
+    for (std::size_t b = 0; b < blocks; ++b) {
+        const auto &w = in.need(4, "an element block: entityDim entityTag type numElements");
+        const int dim = int(in.integer(w[0], "dimension")), entity = int(in.integer(w[1], "tag"));
+        const long long type = in.integer(w[2], "element type");
+        const std::size_t n = in.count(w[3], "element count");
+        const auto groups = c.curve_groups.find(entity);
+        const int physical = dim == 1 && groups != c.curve_groups.end() && !groups->second.empty()
+                                 ? groups->second.front()
+                                 : 0;
+        for (std::size_t i = 0; i < n; ++i)
+            add_element(in, c, type, in.need(2, "an element: tag nodes..."), 1, physical);
+    }
+}
+
+/// $NodeData: kept when its name is "depth".
+void read_node_data(Lines &in, MshContent &c) {
+    std::string name;
+    const std::size_t strings = in.count(in.need(1, "the number of string tags")[0], "count");
+    for (std::size_t i = 0; i < strings; ++i)
+        name = i == 0 ? unquoted(in.need(1, "a string tag")[0]) : name;
+    const std::size_t reals = in.count(in.need(1, "the number of real tags")[0], "count");
+    for (std::size_t i = 0; i < reals; ++i)
+        in.need(1, "a real tag");
+    const std::size_t ints = in.count(in.need(1, "the number of integer tags")[0], "count");
+    std::size_t components = 1, values = 0;
+    for (std::size_t i = 0; i < ints; ++i) {
+        const std::size_t v = in.count(in.need(1, "an integer tag")[0], "integer tag");
+        if (i == 1)
+            components = v;
+        if (i == 2)
+            values = v;
+    }
+    for (std::size_t i = 0; i < values; ++i) {
+        const auto &w = in.need(1 + components, "a node value: tag value");
+        // A node without a depth is NaN (written "nan" or "-nan", as gmsh reads it back).
+        const bool nan = w[1].find("nan") != std::string_view::npos ||
+                         w[1].find("NaN") != std::string_view::npos;
+        if (name == "depth" && components == 1)
+            c.depth[in.integer(w[0], "node tag")] = nan ? NAN : in.number(w[1], "depth");
+    }
+}
+
+/// Skips to `$End<name>`.
+void skip_section(Lines &in, const std::string &name) {
+    std::vector<std::string_view> w;
+    const std::string end = "$End" + name;
+    while (in.next(w))
+        if (!w.empty() && w[0] == end)
+            return;
+    in.fail("the file ends before " + end);
+}
+
+MshContent read_content(const fs::path &path, Lines &in) {
+    MshContent c;
+    std::vector<std::string_view> w;
+    bool format = false;
+    while (in.next(w)) {
+        if (w.empty())
+            continue;
+        if (!format && w[0] != "$MeshFormat")
+            in.fail("not a gmsh MSH file (it does not begin with $MeshFormat)");
+        if (w[0][0] != '$')
+            in.fail("expected a section such as $Nodes, found '" + std::string(w[0]) + "'");
+        const std::string name(w[0].substr(1));
+        if (name == "MeshFormat")
+            read_format(in, c), format = true;
+        else if (name == "PhysicalNames")
+            read_physical_names(in, c);
+        else if (name == "Entities" && c.v4)
+            read_entities(in, c);
+        else if (name == "Nodes")
+            read_nodes(in, c);
+        else if (name == "Elements")
+            read_elements(in, c);
+        else if (name == "NodeData")
+            read_node_data(in, c);
+        else if (name == "Projection")
+            throw DataError("gmsh file " + path.string() +
+                            ": its nodes are in a projected CRS ($Projection); convert reads "
+                            "lon/lat or points on a sphere");
+        else {
+            skip_section(in, name);
+            continue;
+        }
+        skip_section(in, name);
+    }
+    if (!format)
+        in.fail("not a gmsh MSH file (no $MeshFormat)");
+    return c;
+}
+
+/// The nodes on the unit sphere: lon/lat degrees when every z is 0, else 3-D points.
+std::vector<Vec3> unit_nodes(const fs::path &path, const MshContent &c) {
+    const bool planar = std::all_of(c.xyz.begin(), c.xyz.end(),
+                                    [](const std::array<double, 3> &p) { return p[2] == 0; });
+    std::vector<Vec3> nodes;
+    nodes.reserve(c.xyz.size());
+    for (const auto &p : c.xyz) {
+        if (planar && (std::fabs(p[1]) > 90 || std::fabs(p[0]) > 540))
+            throw DataError("gmsh file " + path.string() + ": node (" + std::to_string(p[0]) +
+                            ", " + std::to_string(p[1]) +
+                            ") is not longitude and latitude in degrees (a projected mesh is not "
+                            "read)");
+        const Vec3 v{p[0], p[1], p[2]};
+        if (!planar && norm(v) == 0)
+            throw DataError("gmsh file " + path.string() +
+                            ": a node lies at the centre of the sphere");
+        nodes.push_back(planar ? lonlat_to_vec(p[0], p[1]) : normalized(v));
+    }
+    return nodes;
+}
+
+} // namespace
+
+bool is_gmsh_name(const fs::path &path) {
+    return io::lower_extension(path) == ".msh";
+}
+
+Mesh read_gmsh(const fs::path &path) {
+    Lines in(path, "gmsh file", '\0');
+    const MshContent c = read_content(path, in);
+    Mesh mesh;
+    mesh.nodes = unit_nodes(path, c);
+    std::unordered_map<long long, NodeIndex> index;
+    for (std::size_t i = 0; i < c.node_tags.size(); ++i)
+        if (!index.emplace(c.node_tags[i], NodeIndex(i)).second)
+            throw DataError("gmsh file " + path.string() + ": node tag " +
+                            std::to_string(c.node_tags[i]) + " is repeated");
+    auto node = [&](long long tag) {
+        const auto it = index.find(tag);
+        if (it == index.end())
+            throw DataError("gmsh file " + path.string() + ": an element names node " +
+                            std::to_string(tag) + ", which is not among the nodes");
+        return it->second;
+    };
+    if (c.triangles.empty())
+        throw DataError("gmsh file " + path.string() + ": no triangles to read");
+    // Counter-clockwise seen from outside the sphere, as the writers want them.
+    for (const auto &t : c.triangles) {
+        std::array<NodeIndex, 3> f{node(t[0]), node(t[1]), node(t[2])};
+        const Vec3 &a = mesh.nodes[f[0]], &b = mesh.nodes[f[1]], &d = mesh.nodes[f[2]];
+        if (dot(cross(b - a, d - a), a) < 0)
+            std::swap(f[1], f[2]);
+        mesh.faces.push_back(f);
+    }
+    for (const auto &[ends, physical] : c.lines) {
+        const auto group = c.line_groups.find(physical);
+        const bool open = group != c.line_groups.end() && group->second.rfind("open", 0) == 0;
+        mesh.boundary.push_back(
+            {node(ends[0]), node(ends[1]), open ? EdgeTag::open : EdgeTag::coast});
+    }
+    if (!c.depth.empty()) {
+        Field depth{"depth", "sea floor depth below mean sea level", "m",
+                    "sea_floor_depth_below_mean_sea_level",
+                    std::vector<double>(mesh.nodes.size(), NAN)};
+        for (const auto &[tag, value] : c.depth)
+            depth.values[node(tag)] = value;
+        mesh.node_fields.push_back(std::move(depth));
+    }
+    io::tag_boundary_edges(mesh, "gmsh file " + path.string());
+    return mesh;
+}
+
+} // namespace globemesh
