@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
+#include "model_coordinates.hpp"
 #include "nc_block_writer.hpp"
 #include "netcdf_handle.hpp"
 
@@ -39,26 +41,47 @@ constexpr const char *what = "D-Flow FM output";
 constexpr int fill_index = -999;
 constexpr double missing_z = -999.0; ///< D-Flow FM's dmiss
 
-/// The file's x/y: lon/lat degrees as io::node_lonlats places the nodes, with the wgs84 CRS
-/// variable. The one place where a projected CRS would give its x/y (then the CRS variable is
-/// projected_coordinate_system, and the units metres).
+/// The file's x/y: lon/lat degrees as io::node_lonlats places the nodes, with the CRS variable
+/// wgs84; or, with an --output-srs, the nodes in that CRS (io::model_coordinates), the edge
+/// midpoints and face centres the means of their nodes in the plane, with the CRS variable
+/// projected_coordinate_system.
 struct Placement {
-    std::vector<LonLat> nodes;
-    bool east = false; ///< longitudes in [0, 360), as node_lonlats chose for this mesh
+    std::vector<LonLat> nodes;        ///< x in lon, y in lat
+    std::optional<io::OutputCrs> crs; ///< set when projected
+    bool east = false; ///< lon/lat: longitudes in [0, 360), as node_lonlats chose for this mesh
 
-    /// A face centre's or an edge midpoint's x/y, on the nodes' side of the antimeridian.
-    LonLat place(const Vec3 &p) const {
-        LonLat q = vec_to_lonlat(p);
+    const char *crs_var() const { return crs ? "projected_coordinate_system" : "wgs84"; }
+    /// The x/y of the point p, the mean of the n nodes `of`.
+    template <std::size_t n>
+    LonLat place(const Mesh &mesh, const std::array<NodeIndex, n> &of) const {
+        if (crs) {
+            LonLat q{0, 0};
+            for (NodeIndex i : of)
+                q.lon += nodes[i].lon / n, q.lat += nodes[i].lat / n;
+            return q;
+        }
+        Vec3 p{0, 0, 0};
+        for (NodeIndex i : of)
+            p = p + mesh.nodes[i];
+        LonLat q = vec_to_lonlat(normalized(p));
         if (east && q.lon < 0)
             q.lon += 360;
         return q;
     }
 };
 
-Placement place_nodes(const Mesh &mesh) {
-    Placement p{io::node_lonlats(mesh)};
-    p.east =
-        std::any_of(p.nodes.begin(), p.nodes.end(), [](const LonLat &q) { return q.lon >= 180; });
+Placement place_nodes(const Mesh &mesh, const WriteOptions &options, const fs::path &path) {
+    io::ModelCoordinates c =
+        io::model_coordinates(mesh, options.output_srs, std::string(what) + " " + path.string());
+    Placement p;
+    p.nodes.resize(c.x.size());
+    for (std::size_t i = 0; i < c.x.size(); ++i)
+        p.nodes[i] = {c.x[i], c.y[i]};
+    if (c.crs && c.crs->projected)
+        p.crs = std::move(c.crs);
+    else
+        p.east = std::any_of(p.nodes.begin(), p.nodes.end(),
+                             [](const LonLat &q) { return q.lon >= 180; });
     return p;
 }
 
@@ -71,8 +94,19 @@ struct Vars {
     std::array<int, 2> node_xy{}, edge_xy{}, face_xy{};
 };
 
-int define_crs(io::NcBlockWriter &w) {
+int define_crs(io::NcBlockWriter &w, const Placement &at) {
     // As D-Flow FM writes it: its reader takes the EPSG code from "epsg".
+    if (at.crs) {
+        const int v = w.var(at.crs_var(), NC_INT, {});
+        w.text(v, "name", at.crs->name);
+        w.ints(v, "epsg", {at.crs->epsg});
+        w.text(v, "grid_mapping_name", "Unknown projected");
+        if (at.crs->epsg > 0)
+            w.text(v, "EPSG_code", "EPSG:" + std::to_string(at.crs->epsg));
+        w.text(v, "crs_wkt", at.crs->wkt);
+        w.text(v, "value", "value is equal to EPSG code");
+        return v;
+    }
     const int v = w.var("wgs84", NC_INT, {});
     w.text(v, "name", "WGS84");
     w.ints(v, "epsg", {4326});
@@ -114,10 +148,19 @@ int mesh_var(io::NcBlockWriter &w, const std::string &name, nc_type type, std::v
 }
 
 /// mesh2d_<location>_x and _y, of dimension dim.
-std::array<int, 2> define_xy(io::NcBlockWriter &w, const char *location, int dim, const char *of) {
+std::array<int, 2> define_xy(io::NcBlockWriter &w, const char *location, int dim, const char *of,
+                             bool projected) {
     std::array<int, 2> v{};
     for (int k = 0; k < 2; ++k) {
         const std::string name = std::string("mesh2d_") + location + (k ? "_y" : "_x");
+        if (projected) {
+            v[k] = mesh_var(w, name, NC_DOUBLE, {dim}, location,
+                            std::string(k ? "y-coordinate of " : "x-coordinate of ") + of);
+            w.text(v[k], "standard_name",
+                   k ? "projection_y_coordinate" : "projection_x_coordinate");
+            w.text(v[k], "units", "m");
+            continue;
+        }
         v[k] = mesh_var(w, name, NC_DOUBLE, {dim}, location,
                         std::string(k ? "latitude of " : "longitude of ") + of);
         w.text(v[k], "standard_name", k ? "latitude" : "longitude");
@@ -138,26 +181,27 @@ int define_connectivity(io::NcBlockWriter &w, const char *name, const char *role
     return v;
 }
 
-Vars define_variables(io::NcBlockWriter &w, const Dims &d) {
+Vars define_variables(io::NcBlockWriter &w, const Dims &d, const Placement &at) {
+    const bool projected = at.crs.has_value();
     Vars v;
-    v.crs = define_crs(w);
+    v.crs = define_crs(w, at);
     v.mesh = define_topology(w);
-    v.node_xy = define_xy(w, "node", d.node, "mesh nodes");
+    v.node_xy = define_xy(w, "node", d.node, "mesh nodes", projected);
     v.node_z = mesh_var(w, "mesh2d_node_z", NC_DOUBLE, {d.node}, "node", "bed level at mesh nodes");
     w.text(v.node_z, "coordinates", "mesh2d_node_x mesh2d_node_y");
     w.text(v.node_z, "standard_name", "altitude");
     w.text(v.node_z, "units", "m");
     w.text(v.node_z, "positive", "up");
     w.text(v.node_z, "comment", "minus the depth below mean sea level");
-    w.text(v.node_z, "grid_mapping", "wgs84");
+    w.text(v.node_z, "grid_mapping", at.crs_var());
     w.dbl(v.node_z, "_FillValue", missing_z);
-    v.edge_xy = define_xy(w, "edge", d.edge, "mesh edge midpoints");
+    v.edge_xy = define_xy(w, "edge", d.edge, "mesh edge midpoints", projected);
     v.edge_nodes = define_connectivity(w, "mesh2d_edge_nodes", "edge_node_connectivity", "edge",
                                        {d.edge, d.two}, "the two nodes of each edge");
     v.face_nodes = define_connectivity(w, "mesh2d_face_nodes", "face_node_connectivity", "face",
                                        {d.face, d.max_face_nodes},
                                        "the nodes of each face, counter-clockwise");
-    v.face_xy = define_xy(w, "face", d.face, "mesh face centres");
+    v.face_xy = define_xy(w, "face", d.face, "mesh face centres", projected);
     v.edge_type = mesh_var(w, "mesh2d_edge_type", NC_INT, {d.edge}, "edge",
                            "edge type (relation between edge and flow geometry)");
     w.text(v.edge_type, "coordinates", "mesh2d_edge_x mesh2d_edge_y");
@@ -183,9 +227,8 @@ std::vector<int> edge_types(const io::MeshTopology &topo) {
     return types;
 }
 
-void write_data(io::NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo,
-                const Vars &v) {
-    const Placement at = place_nodes(mesh);
+void write_data(io::NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo, const Vars &v,
+                const Placement &at) {
     const Field *depth = mesh.node_field("depth");
     const std::size_t nn = mesh.nodes.size(), nf = mesh.faces.size(), ne = topo.edge_count();
     w.put_xy(v.node_xy[0], v.node_xy[1], nn, [&](std::size_t i) { return at.nodes[i]; });
@@ -195,7 +238,7 @@ void write_data(io::NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &
     });
     w.put_xy(v.edge_xy[0], v.edge_xy[1], ne, [&](std::size_t e) {
         const auto ends = topo.edge_nodes(e);
-        return at.place(arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]));
+        return at.place(mesh, std::array<NodeIndex, 2>{NodeIndex(ends[0]), NodeIndex(ends[1])});
     });
     w.put_rows<int, 2>(v.edge_nodes, ne, [&](std::size_t e) {
         const auto ends = topo.edge_nodes(e);
@@ -205,10 +248,8 @@ void write_data(io::NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &
         const auto &t = mesh.faces[f];
         return std::array<int, 3>{int(t[0]) + 1, int(t[1]) + 1, int(t[2]) + 1};
     });
-    w.put_xy(v.face_xy[0], v.face_xy[1], nf, [&](std::size_t f) {
-        const auto &t = mesh.faces[f];
-        return at.place(normalized(mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]]));
-    });
+    w.put_xy(v.face_xy[0], v.face_xy[1], nf,
+             [&](std::size_t f) { return at.place(mesh, mesh.faces[f]); });
     const std::vector<int> types = edge_types(topo);
     w.put_values<int>(v.edge_type, ne, [&](std::size_t e) { return types[e]; });
 }
@@ -219,6 +260,7 @@ void write_data(io::NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &
 void write_as_dflowfm(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     if (mesh.faces.empty())
         throw DataError("mesh: no faces to write to " + path.string());
+    const Placement at = place_nodes(mesh, options, path); // its refusals before any file
     OutputFile out(path, options.overwrite, what);
     const io::MeshTopology topo = io::build_topology(mesh);
     io::NcHandle nc;
@@ -230,15 +272,15 @@ void write_as_dflowfm(const Mesh &mesh, const fs::path &path, const WriteOptions
                  w.dim("mesh2d_nEdges", topo.edge_count()),
                  w.dim("mesh2d_nFaces", mesh.faces.size()), w.dim("mesh2d_nMax_face_nodes", 3),
                  w.dim("Two", 2)};
-    const Vars v = define_variables(w, d);
+    const Vars v = define_variables(w, d, at);
     define_global_attributes(w, options);
     io::nc_check(nc_enddef(nc.id()), path, "leaving define mode", what);
     // The CRS variable holds its EPSG code, as D-Flow FM's do; NC_NOFILL leaves mesh2d's byte
     // undefined unless written.
-    const int epsg = 4326, zero = 0;
-    io::nc_check(nc_put_var_int(nc.id(), v.crs, &epsg), path, "writing wgs84", what);
+    const int epsg = at.crs ? at.crs->epsg : 4326, zero = 0;
+    io::nc_check(nc_put_var_int(nc.id(), v.crs, &epsg), path, "writing the CRS variable", what);
     io::nc_check(nc_put_var_int(nc.id(), v.mesh, &zero), path, "writing mesh2d", what);
-    write_data(w, mesh, topo, v);
+    write_data(w, mesh, topo, v, at);
     w.finish();
     out.commit();
 }

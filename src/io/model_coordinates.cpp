@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
@@ -72,6 +73,11 @@ OutputCrs parse_output_crs(const std::string &text, const std::string &option) {
                              "WGS 84 lon/lat, which the formats write without --output-srs; "
                              "give a projected CRS for planar coordinates");
     }
+    OSRAutoIdentifyEPSG(srs.get());
+    const char *authority = OSRGetAuthorityName(srs.get(), nullptr);
+    const char *code = OSRGetAuthorityCode(srs.get(), nullptr);
+    if (authority && code && std::string(authority) == "EPSG")
+        crs.epsg = std::atoi(code);
     char *wkt = nullptr;
     OSRExportToWkt(srs.get(), &wkt);
     crs.wkt = wkt ? wkt : "";

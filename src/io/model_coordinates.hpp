@@ -16,6 +16,7 @@ struct OutputCrs {
     std::string wkt;        ///< WKT1 on one line (as seamsh writes it into gmsh files)
     std::string name;       ///< as the CRS names itself, for messages
     bool projected = false; ///< false: geographic on WGS 84, the mesh's own lon/lat
+    int epsg = 0;           ///< its EPSG code when it has one (as GDAL identifies it), else 0
 };
 
 /// Parses `text`. Throws UsageError naming `option` for a text GDAL does not read as a CRS, and

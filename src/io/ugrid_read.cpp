@@ -226,6 +226,9 @@ int read_nodes(const Reader &r, int topo, Mesh &mesh) {
     };
     if (is_lat(cx) && !is_lat(cy))
         std::swap(cx, cy);
+    if (r.text(cx, "standard_name").value_or("") == "projection_x_coordinate")
+        r.fail("its nodes are in a projected CRS (" + r.name(cx) +
+               " is projection_x_coordinate); globemesh reads longitude and latitude");
     auto node_dims = r.dims(cx);
     if (node_dims.size() != 1 || r.dims(cy) != node_dims)
         r.fail("node coordinates must be 1-D on one dimension");

@@ -104,6 +104,7 @@ const std::vector<Writer> &writers() {
          .extensions = {"_net.nc"}, // before ".nc": the longest suffix a name ends with wins
          .report_key = "dflowfm",
          .progress_weight = 0.4, // 1.2 to 1.6 s at 1.08e6 nodes (bench/RESULTS-dflowfm.md)
+         .takes_output_srs = true,
          .write = write_as_dflowfm},
         {.name = "FESOM2",
          .long_name = "FESOM2 mesh folder",

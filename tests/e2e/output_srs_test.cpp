@@ -141,6 +141,44 @@ assert np.array_equal(v[:, 2], np.asarray(-depth, dtype=np.float32).astype(float
 print('OK %d %.4f' % (v.shape[0], err))
 )";
 
+// argv: UGRID, CRS, NAME_net.nc. D-Flow FM's nodes equal the transform to 1 mm, its edge
+// midpoints and face centres the means of their nodes, and its CRS variable names the CRS (read
+// by osr from crs_wkt, and by QGIS/MDAL as the layer's CRS); prints "OK n".
+const char *const dflow_check = R"(
+import os, sys, netCDF4, numpy as np
+from osgeo import osr
+ds = netCDF4.Dataset(sys.argv[1]); ds.set_auto_mask(False)
+lon, lat, depth = ds['mesh_node_lon'][:], ds['mesh_node_lat'][:], ds['depth'][:]
+src, dst = osr.SpatialReference(), osr.SpatialReference()
+src.ImportFromEPSG(4326)
+dst.SetFromUserInput(sys.argv[2])
+for s in (src, dst):
+    s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+want = np.array(osr.CoordinateTransformation(src, dst).TransformPoints(np.c_[lon, lat]))[:, :2]
+net = netCDF4.Dataset(sys.argv[3]); net.set_auto_mask(False)
+xy = np.c_[net['mesh2d_node_x'][:], net['mesh2d_node_y'][:]]
+assert np.abs(xy - want).max() < 1e-3, ('nodes', np.abs(xy - want).max())
+assert net['mesh2d_node_x'].units == 'm' and net['mesh2d_node_x'].standard_name == 'projection_x_coordinate'
+e = net['mesh2d_edge_nodes'][:] - 1
+assert np.allclose(np.c_[net['mesh2d_edge_x'][:], net['mesh2d_edge_y'][:]], xy[e].mean(axis=1), rtol=0, atol=1e-6)
+f = net['mesh2d_face_nodes'][:] - 1
+assert np.allclose(np.c_[net['mesh2d_face_x'][:], net['mesh2d_face_y'][:]], xy[f].mean(axis=1), rtol=0, atol=1e-6)
+crs = net['projected_coordinate_system']
+back = osr.SpatialReference()
+assert back.ImportFromWkt(crs.crs_wkt) == 0 and back.IsSame(dst), 'crs_wkt'
+assert net['mesh2d_node_z'].grid_mapping == 'projected_coordinate_system'
+assert np.allclose(net['mesh2d_node_z'][:], np.where(np.isnan(depth), -999, -depth))
+os.environ['QT_QPA_PLATFORM'] = 'offscreen'
+from qgis.core import QgsApplication, QgsMeshLayer
+app = QgsApplication([], False)
+app.initQgis()
+layer = QgsMeshLayer(sys.argv[3], 'm', 'mdal')
+assert layer.isValid() and layer.crs().authid() == 'EPSG:%d' % crs.epsg, layer.crs().authid()
+print('OK %d' % len(xy))
+sys.stdout.flush()
+os._exit(0)
+)";
+
 const char *const qgis_reader = R"(
 import os, sys
 os.environ['QT_QPA_PLATFORM'] = 'offscreen'
@@ -177,7 +215,7 @@ TEST(OutputSrs, regional_utm_31n_in_every_planar_format_equals_the_independent_t
     TempDir dir;
     std::string err;
     std::vector<std::string> outputs;
-    for (const char *name : {"m.nc", "fort.14", "m.gr3", "m.ll", "m.msh", "m.slf"})
+    for (const char *name : {"m.nc", "fort.14", "m.gr3", "m.ll", "m.msh", "m.slf", "m_net.nc"})
         outputs.insert(outputs.end(), {"-o", (dir / name).string()});
     ASSERT_EQ(
         run_exe(with(with(regional, outputs), {"--output-srs", "EPSG:32631"}), err, dir.path()), 0)
@@ -190,6 +228,15 @@ TEST(OutputSrs, regional_utm_31n_in_every_planar_format_equals_the_independent_t
     EXPECT_NE(out.find("OK "), std::string::npos) << out;
     if (!python_available("qgis.core", "QGIS (python3-qgis)"))
         return;
+    const std::string net = run_python(
+        dir, dflow_check, {(dir / "m.nc").string(), "EPSG:32631", (dir / "m_net.nc").string()});
+    EXPECT_NE(net.find("OK "), std::string::npos) << net;
+    // Read back, a projected net file is refused in one line (the readers take lon/lat).
+    EXPECT_EQ(run_exe({"convert", (dir / "m_net.nc").string(), (dir / "back.nc").string()}, err,
+                      dir.path()),
+              1);
+    EXPECT_NE(err.find("in a projected CRS"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir / "back.nc"));
     run_python(dir, qgis_reader, {(dir / "m.slf").string(), (dir / "qgis.txt").string()});
     const std::string slf = run_python(
         dir, slf_check, {(dir / "m.nc").string(), "EPSG:32631", (dir / "qgis.txt").string()});
