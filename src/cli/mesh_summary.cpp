@@ -92,6 +92,8 @@ std::string report_json(const MeshRunSummary &s) {
     r << ",\n  \"mesh\": " << stats_json(s.stats, "  ") << ",\n";
     if (s.run.depth)
         r << "  \"depth\": " << depth_json(*s.run.depth) << ",\n";
+    if (!s.run.passages.empty())
+        r << "  \"passages\": " << passages_json(s.run) << ",\n";
     // What the run did to the coast and the land, as the NetCDF file's global attributes say.
     r << "  \"attributes\": {";
     for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
@@ -108,6 +110,7 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
     const CliOptions &o = s.options;
     print_stats(out, s.stats, false);
     print_coast(out, s.run);
+    print_passages(out, err, s.run, o.quiet);
     if (s.run.depth)
         print_depth(out, err, *s.run.depth, o.quiet);
     print_timings(out, s.timings);
