@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "globemesh/passages.hpp"
+#include "globemesh/sizefield.hpp"
 #include "support.hpp"
 
 namespace fs = std::filesystem;
@@ -146,6 +148,59 @@ TEST(Passages, WithoutThemTheNarrowStraitsClose) {
     EXPECT_LT(cells.at("Oresund"), 2);
 }
 
+/// Land west of 10.02 and east of 10.08 degrees east: water 0.06 degrees of longitude wide.
+class Channel final : public globemesh::LandTest {
+public:
+    bool contains(const globemesh::Vec3 &p) const override {
+        const double lon = globemesh::vec_to_lonlat(p).lon;
+        return lon < 10.02 || lon > 10.08;
+    }
+    bool coast_within(const globemesh::Vec3 &, double) const override { return false; }
+};
+
+TEST(Passages, WidthIsTheLinesLengthInWater) {
+    using namespace globemesh;
+    std::vector<Passage> p{{"channel", {lonlat_to_vec(10, 0), lonlat_to_vec(10.1, 0)}, 0}};
+    const double degree_km = earth_radius_km * pi / 180;
+    measure_passages(p, nullptr);
+    EXPECT_NEAR(p[0].width_km, 0.1 * degree_km, 1e-6);
+    const Channel land;
+    measure_passages(p, &land);
+    EXPECT_NEAR(p[0].width_km, 0.06 * degree_km, 0.001 * degree_km);
+}
+
+// The field is width / cells along the line, below --hmin, and graded up to --hmax around it.
+TEST(Passages, SizeFieldGoesBelowHminAlongTheLine) {
+    using namespace globemesh;
+    MeshOptions o;
+    o.region = std::array<double, 4>{0, -10, 20, 10};
+    o.hmin_km = 10;
+    o.hmax_km = 100;
+    o.passage_cells = 2;
+    const std::vector<Passage> p{{"channel", {lonlat_to_vec(10, 0), lonlat_to_vec(10.1, 0)}, 1.0}};
+    const SizeField f = build_size_field(o, nullptr, nullptr, {}, 1 << 18, {}, p);
+    for (double lon : {10.0, 10.03, 10.05, 10.1})
+        EXPECT_NEAR(f.size_km(lon, 0), 0.5, 1e-4) << lon;
+    const double away = arc_km(lonlat_to_vec(10.05, 0), lonlat_to_vec(10.05, 1));
+    EXPECT_LE(f.size_km(10.05, 1), 0.5 + o.grade * away + 1e-3);
+    EXPECT_GE(f.size_km(10.05, 1), o.hmin_km);
+    EXPECT_NEAR(f.size_km(1, 9), 100, 1e-4);
+    // Without passages the same options give the uniform field.
+    EXPECT_TRUE(build_size_field(o, nullptr, nullptr).is_uniform());
+}
+
+TEST(Passages, LineMeetsTriangle) {
+    using namespace globemesh;
+    const Vec3 a = lonlat_to_vec(-1, -1), b = lonlat_to_vec(1, -1), c = lonlat_to_vec(0, 1);
+    auto meets = [&](std::vector<Vec3> line) { return line_meets_triangle(line, a, b, c); };
+    EXPECT_TRUE(meets({lonlat_to_vec(-2, 0), lonlat_to_vec(2, 0)}));     // across
+    EXPECT_TRUE(meets({lonlat_to_vec(-0.1, 0), lonlat_to_vec(0.1, 0)})); // inside
+    EXPECT_TRUE(meets({lonlat_to_vec(0, -3), lonlat_to_vec(0, 0)}));     // into it
+    EXPECT_FALSE(meets({lonlat_to_vec(5, 5), lonlat_to_vec(6, 6)}));
+    EXPECT_FALSE(meets({lonlat_to_vec(179, 0), lonlat_to_vec(-179, 0)})); // the antipodes
+    EXPECT_FALSE(meets({lonlat_to_vec(-2, 2), lonlat_to_vec(2, 2)}));     // above the apex
+}
+
 // A line drawn on land (no water across) ends with no cell: a warning names it, never silent.
 TEST(Passages, WarnsOfAPassageShortOfCells) {
     TempDir dir;
@@ -187,6 +242,11 @@ TEST(Passages, Errors) {
     EXPECT_TRUE(regex_search(out, R"(^globemesh: --passage-cells must be in 1\.\.100)")) << out;
     EXPECT_EQ(run_exe(base + "--passages-layer x", out), 2);
     EXPECT_TRUE(regex_search(out, R"(--passages-layer names a layer of --passages)")) << out;
+    // The passages' sizes count against --max-nodes: the run is refused, not meshed.
+    EXPECT_EQ(run_exe(base + "--hmax 100km --passages default --max-nodes 48000", out), 1);
+    EXPECT_TRUE(regex_search(out, R"(more than 48000 nodes \(--max-nodes\))")) << out;
+    EXPECT_EQ(run_exe(base + "--hmax 100km --max-nodes 48000", out), 0) << out;
+    fs::remove(dir.path() / "m.nc");
     EXPECT_FALSE(fs::exists(dir.path() / "m.nc"));
 }
 
