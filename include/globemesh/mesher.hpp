@@ -108,6 +108,8 @@ struct MesherOptions {
     /// With `land`: close the straits narrower than a face that faces centred on land are left
     /// across (step 7), rather than keep them open with those faces.
     bool close_straits = true;
+    /// Lines across straits (passages.hpp): no strait closing removes a face one of them meets.
+    std::vector<std::vector<Vec3>> passages;
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory

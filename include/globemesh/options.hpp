@@ -59,7 +59,12 @@ struct SizeFieldOptions {
     std::string size_regions;     ///< polygons with a "size_km" attribute: the edge length inside
     /// The layer of size_regions to read; default every layer with a size_km field.
     std::string size_regions_layer;
-    double grade = 0.15; ///< largest |grad h| (km/km), in (0, 10)
+    /// Lines drawn across straits from land to land (any OGR source, passages.hpp): the field is
+    /// width / passage_cells along each (below hmin_km if need be) and no strait is closed there.
+    std::string passages;
+    std::string passages_layer; ///< the layer of passages to read; default every layer
+    int passage_cells = 2;      ///< edges across each passage's water, 1..100
+    double grade = 0.15;        ///< largest |grad h| (km/km), in (0, 10)
 };
 
 /// The mesher's options as a user sets them (the pipeline turns them into mesher.hpp's

@@ -18,6 +18,7 @@
 #include "globemesh/mesh.hpp"
 #include "globemesh/mesher.hpp"
 #include "globemesh/options.hpp"
+#include "globemesh/passages.hpp"
 #include "globemesh/progress.hpp"
 
 namespace globemesh {
@@ -56,6 +57,8 @@ struct OceanMesh {
     MesherReport mesher;
     bool straits_closing = false;     ///< the mesher closed straits (a land mask and close_straits)
     std::optional<DepthReport> depth; ///< set with bathymetry
+    std::vector<PassageReport> passages; ///< MeshOptions::passages inside the region, in order
+    int passage_cells = 2;               ///< MeshOptions::passage_cells, the cells each needs
 };
 
 /// Meshes the ocean as the options say (validate(options) first). Deterministic: the same

@@ -14,6 +14,9 @@
 //   slope      h = 2 pi D / (n * |grad D|)   (n = slope, |grad D| in m/km by central
 //              differences on the grid);
 //   regions    h = size_km of every size_regions polygon holding the node (OGR, any CRS).
+// and after the clamp, so below hfloor where a passage needs it:
+//   passages   h = width / passage_cells on the grid cells each passage's line runs through
+//              (passages.hpp; the width is measured by the caller).
 // Depth floor: where the raster says land or is shallower than min_depth_m (5 m) at a point the
 // mesh treats as ocean, D = 5 m for the wavelength and slope components (a coarse raster puts
 // shallow coastal water above sea level); where the raster has no data and no fill, those two
@@ -51,10 +54,12 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
+#include "globemesh/passages.hpp"
 #include "globemesh/progress.hpp"
 #include "globemesh/size_fn.hpp"
 #include "globemesh/sphere.hpp"
@@ -121,22 +126,25 @@ private:
 /// full resolution (required when coast_size_km is on). max_nodes caps the background grid.
 /// When no component is on the field is uniform (max(hmax_km, hmin_km), SizeField::is_uniform)
 /// and no grid is built; otherwise before_grid, when set, is called once before the grid is
-/// allocated (to refuse the run by throwing).
+/// allocated (to refuse the run by throwing). passages: the lines of options.passages with their
+/// widths (read_passages, measure_passages); the field has a grid when there are any.
 /// Throws UsageError (bad sizes or region, a component without its input, naming the option),
 /// DataError (a size_regions file without a size_km field) or IoError (size_regions unreadable).
 SizeField build_size_field(const SizeFieldOptions &options,
                            const std::optional<std::array<double, 4>> &region, const Raster *bathy,
                            const Boundary *coast, const Progress &progress = {},
                            std::size_t max_nodes = std::size_t{1} << 24,
-                           const std::function<void()> &before_grid = {});
+                           const std::function<void()> &before_grid = {},
+                           std::span<const Passage> passages = {});
 
 /// build_size_field with the size field's part and the region of a whole run's options.
 inline SizeField build_size_field(const MeshOptions &options, const Raster *bathy,
                                   const Boundary *coast, const Progress &progress = {},
                                   std::size_t max_nodes = std::size_t{1} << 24,
-                                  const std::function<void()> &before_grid = {}) {
+                                  const std::function<void()> &before_grid = {},
+                                  std::span<const Passage> passages = {}) {
     return build_size_field(size_field_options(options), options.region, bathy, coast, progress,
-                            max_nodes, before_grid);
+                            max_nodes, before_grid, passages);
 }
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.

@@ -162,6 +162,18 @@ void MeshCommand::add_size_options(const std::string &size) {
                    "Layer of --size-regions; default every layer with a size_km field")
         ->group(size)
         ->type_name("NAME");
+    app.add_option("--passages", m.passages,
+                   "Lines across straits kept open (any OGR source), or 'default': the world's "
+                   "critical passages")
+        ->group(size)
+        ->type_name("SOURCE");
+    app.add_option("--passages-layer", m.passages_layer, "Layer of --passages; default every layer")
+        ->group(size)
+        ->type_name("NAME");
+    app.add_option("--passage-cells", m.passage_cells,
+                   "Edges across each passage's water (its width / N there, even below --hmin)")
+        ->group(size)
+        ->type_name("N");
     app.add_option("--grade", m.grade, "Largest |grad h|, the gradation of edge lengths (km/km)")
         ->group(size)
         ->type_name("G");

@@ -89,8 +89,9 @@ void warn_straits(std::ostream &err, const MesherReport &m) {
     err << "globemesh: warning: " << m.straits_closed
         << (m.straits_closed == 1 ? " strait narrower than its faces was closed"
                                   : " straits narrower than their faces were closed")
-        << " (listed in the summary); keep one open with --size-regions (h at most half its width "
-           "there), or all with --keep-straits\n";
+        << " (listed in the summary); keep one open with --passages (a line drawn across it, or "
+           "'default' for the world's critical passages) or --size-regions (h at most half its "
+           "width there), or all with --keep-straits\n";
 }
 
 /// The closed straits in the --report JSON: place, width and the size each needs.
@@ -149,6 +150,8 @@ std::string report_json(const MeshRunSummary &s) {
         r << "  \"depth\": " << depth_json(*s.run.depth) << ",\n";
     if (s.run.straits_closing)
         r << "  \"straits_closed\": " << straits_json(s.run.mesher) << ",\n";
+    if (!s.run.passages.empty())
+        r << "  \"passages\": " << passages_json(s.run) << ",\n";
     // What the run did to the coast and the land, as the NetCDF file's global attributes say.
     r << "  \"attributes\": {";
     for (std::size_t i = 0; i < mesh.attributes.size(); ++i)
@@ -165,6 +168,7 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
     const CliOptions &o = s.options;
     print_stats(out, s.stats, false);
     print_coast(out, s.run);
+    print_passages(out, err, s.run, o.quiet);
     if (s.run.depth)
         print_depth(out, err, *s.run.depth, o.quiet);
     if (s.run.straits_closing && s.run.mesher.straits_closed > 0 && !o.quiet)

@@ -30,4 +30,15 @@ std::string report_json(const MeshRunSummary &s);
 /// The summary lines on `out`; unless --quiet, the warning about nodes above sea level on `err`.
 void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSummary &s);
 
+/// The file --passages default names: the installed passages.geojson, else the source tree's.
+/// Throws IoError when neither is there.
+std::string default_passages_path();
+
+/// The passages' report: {"cells_needed": N, "list": [{name, width_km, size_km, cells, lon, lat}]}.
+std::string passages_json(const OceanMesh &run);
+
+/// The summary's passages line on `out`; unless `quiet`, a warning on `err` for each passage
+/// with fewer cells across than --passage-cells.
+void print_passages(std::ostream &out, std::ostream &err, const OceanMesh &run, bool quiet);
+
 } // namespace globemesh::cli

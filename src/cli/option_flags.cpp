@@ -8,7 +8,7 @@ namespace globemesh::cli {
 namespace {
 
 /// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 32> flags{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 35> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},
     {"coast_where", "--coast-where"},
@@ -36,6 +36,9 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 32> flags{{
     {"slope", "--slope"},
     {"size_regions", "--size-regions"},
     {"size_regions_layer", "--size-regions-layer"},
+    {"passages", "--passages"},
+    {"passages_layer", "--passages-layer"},
+    {"passage_cells", "--passage-cells"},
     {"grade", "--grade"},
     {"max_nodes", "--max-nodes"},
     {"max_memory_bytes", "--max-memory"},

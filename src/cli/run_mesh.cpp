@@ -47,6 +47,7 @@ std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const W
                                                           {"--bathy", o.mesh.bathy},
                                                           {"--region-file", o.mesh.region_file},
                                                           {"--size-regions", o.mesh.size_regions},
+                                                          {"--passages", o.mesh.passages},
                                                           {"--config", o.config}};
     for (const auto &[name, path] : inputs)
         check_input_path(path, name); // (--config was read)
@@ -70,6 +71,8 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     auto command = std::make_unique<MeshCommand>(lib.writers);
     if (printed_help(command->app, out, [&] { command->parse(args); }))
         return 0;
+    if (command->o.mesh.passages == "default")
+        command->o.mesh.passages = default_passages_path();
     const CliOptions &o = command->o;
     if (o.print_config) {
         validate(o.mesh);

@@ -1,9 +1,26 @@
 // Straits narrower than a face closed.
 #include <numeric>
 
+#include "globemesh/passages.hpp"
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
+
+namespace {
+
+/// True when a passage line (MesherOptions::passages) meets face t: closing it would close
+/// the passage.
+bool on_passage(const Mesher &m, const MesherOptions &options, TriangleId t) {
+    const SphericalDelaunay &dt = m.dt;
+    const Vec3 &a = dt.point(dt.vertex(t, 0)), &b = dt.point(dt.vertex(t, 1)),
+               &c = dt.point(dt.vertex(t, 2));
+    for (const std::vector<Vec3> &line : options.passages)
+        if (line_meets_triangle(line, a, b, c))
+            return true;
+    return false;
+}
+
+} // namespace
 
 // Closes the straits narrower than a face that `faces` (those still centred on land after the
 // nudge) lie across (MesherOptions::close_straits): remove_land_faces with `straits`. Of the
@@ -17,6 +34,11 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
     SphericalDelaunay &dt = m.dt;
     auto is_ocean = [&](TriangleId t) { return dt.is_live(t) && dt.label(t) == ocean; };
     std::vector<TriangleId> sides, left;
+    // The faces across a passage stay (with those left on land).
+    const auto kept = std::stable_partition(
+        faces.begin(), faces.end(), [&](TriangleId t) { return !on_passage(m, options, t); });
+    std::vector<TriangleId> passage_faces(kept, faces.end());
+    faces.erase(kept, faces.end());
     remove_land_faces(m, land_test, faces, options.inlet_area, report, left, loops, true, &sides);
     // The pieces beside the cuts, each flooded until whole or over inlet_narrow_area h^2 (then
     // it stays whatever it is: the ocean, or a sea cut off). Floods that meet are one piece
@@ -67,6 +89,15 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
             }
         }
     }
+    // A piece a passage runs through stays.
+    auto passes_through = [&](std::uint32_t k) {
+        for (std::uint32_t f = 0; f < floods.size(); ++f)
+            if (root(f) == k)
+                for (const TriangleId t : floods[f].faces)
+                    if (on_passage(m, options, t))
+                        return true;
+        return false;
+    };
     // A piece is whole when none of its floods has faces left to count. The whole ones go
     // under the inlet rule, but for the largest when no piece is left growing (every piece
     // beside the cuts small: one of them stays).
@@ -89,7 +120,7 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
         const bool small = p.area <= options.inlet_area * h * h ||
                            (p.area <= inlet_narrow_area * h * h &&
                             2 * p.area < options.inlet_width * h * p.perimeter);
-        if (p.open || !small)
+        if (p.open || !small || passes_through(k))
             continue;
         report.straits_water_km2 += p.area * earth_radius_km * earth_radius_km;
         for (std::uint32_t f = 0; f < floods.size(); ++f)
@@ -106,6 +137,9 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
             m.cut_sides.push_back(t);
     faces.clear();
     for (const TriangleId t : left)
+        if (is_ocean(t))
+            faces.push_back(t);
+    for (const TriangleId t : passage_faces)
         if (is_ocean(t))
             faces.push_back(t);
 }

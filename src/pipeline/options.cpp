@@ -64,6 +64,11 @@ void validate_size(const SizeFieldOptions &o) {
     require(o.size_regions_layer.empty() || !o.size_regions.empty(),
             option("size_regions_layer") + " names a layer of " + option("size_regions") +
                 ", which is not given");
+    require(o.passage_cells >= 1 && o.passage_cells <= 100,
+            option("passage_cells") + " must be in 1..100 (edges across each passage)");
+    require(o.passages_layer.empty() || !o.passages.empty(),
+            option("passages_layer") + " names a layer of " + option("passages") +
+                ", which is not given");
 }
 
 void validate_meshing(const MeshingOptions &o) {

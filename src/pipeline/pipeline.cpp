@@ -181,6 +181,36 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
     }
 }
 
+/// The passages of --passages that reach into the region (a point of the line inside its W,S,E,N
+/// box; all of them globally), with their widths in water on the source land.
+std::vector<Passage> region_passages(const MeshOptions &o, const LandTest *land) {
+    std::vector<Passage> all = read_passages(o.passages, o.passages_layer), kept;
+    auto inside = [&](const Vec3 &p) {
+        const LonLat ll = vec_to_lonlat(p);
+        const auto &r = *o.region;
+        double east = ll.lon - r[0];
+        east -= 360 * std::floor(east / 360);
+        const double span = r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360;
+        return ll.lat >= r[1] && ll.lat <= r[3] && east <= span;
+    };
+    for (Passage &p : all)
+        if (!o.region || std::any_of(p.line.begin(), p.line.end(), inside))
+            kept.push_back(std::move(p));
+    measure_passages(kept, land);
+    return kept;
+}
+
+/// Each passage's width, the field's size at its middle and the faces of `mesh` its line meets.
+std::vector<PassageReport> passage_reports(const std::vector<Passage> &passages,
+                                           const SizeField &field, const Mesh &mesh) {
+    std::vector<PassageReport> reports;
+    for (const Passage &p : passages) {
+        const Vec3 at = arc_midpoint(p.line.front(), p.line.back());
+        reports.push_back({p.name, p.width_km, field.size_km(at), faces_crossed(mesh, p.line), at});
+    }
+    return reports;
+}
+
 } // namespace
 
 OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTimings *timings) {
@@ -202,6 +232,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
         budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
     clock.lap("read_coast", true);
     refuse_too_many_nodes(o, coast);
+    const std::vector<Passage> passages =
+        o.passages.empty() ? std::vector<Passage>{} : region_passages(o, coast.land.get());
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {
@@ -221,9 +253,9 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
                        " or " + option("hmin_km"));
     };
     // Uniform when no component of the field is on: then no background grid is built.
-    const SizeField field =
-        build_size_field(size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
-                         sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid);
+    const SizeField field = build_size_field(
+        size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
+        sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid, passages);
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
     if (!field.is_uniform()) {
@@ -263,6 +295,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     mo.inlet_width = o.inlet_width;
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
+    for (const Passage &p : passages)
+        mo.passages.push_back(p.line);
     if (coast.land) {
         // The land test holds the land polygons (GEOS coordinates and their prepared index).
         budget.hold(static_cast<double>(coast.land->vertices() * land_bytes_per_vertex +
@@ -303,6 +337,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     run.size_field = size_report;
     run.mesher = std::move(report);
     run.straits_closing = mo.land && mo.close_straits;
+    run.passages = passage_reports(passages, field, mesh);
+    run.passage_cells = o.passage_cells;
     run.mesh = std::move(mesh);
     run.mesh.attributes = ocean_attributes(run);
     return run;

@@ -11,6 +11,7 @@
 
 #include "globemesh/boundary.hpp"
 #include "globemesh/options.hpp"
+#include "globemesh/passages.hpp"
 #include "globemesh/progress.hpp"
 #include "globemesh/sphere.hpp"
 
@@ -76,5 +77,10 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
 /// of its layer `layer_name`, or of every layer with that field when it is empty.
 void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                         const std::string &layer_name, std::vector<float> &h);
+
+/// min(h, width_km / cells) on the nodes of every grid cell each passage's line runs through,
+/// for passages of positive width.
+void apply_passages(const BackgroundGrid &g, std::span<const Passage> passages, int cells,
+                    std::vector<float> &h);
 
 } // namespace globemesh::detail

@@ -227,7 +227,8 @@ void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const 
 SizeField build_size_field(const SizeFieldOptions &o,
                            const std::optional<std::array<double, 4>> &region, const Raster *bathy,
                            const Boundary *coast, const Progress &progress, std::size_t max_nodes,
-                           const std::function<void()> &before_grid) {
+                           const std::function<void()> &before_grid,
+                           std::span<const Passage> passages) {
     validate(o);
     if (region) { // checked as the coast checks it
         CoastOptions with_region;
@@ -291,6 +292,8 @@ SizeField build_size_field(const SizeFieldOptions &o,
 
     if (!o.size_regions.empty())
         detail::apply_size_regions(background(), o.size_regions, o.size_regions_layer, h);
+    if (!passages.empty())
+        background();
     if (!grid)
         return SizeField::uniform(std::max(o.hmax_km, o.hmin_km));
     report(progress, 0.6, "size field");
@@ -298,6 +301,7 @@ SizeField build_size_field(const SizeFieldOptions &o,
     const detail::BackgroundGrid &g = *grid;
     for (float &v : h)
         v = std::clamp(v, static_cast<float>(hfloor), static_cast<float>(hmax));
+    detail::apply_passages(g, passages, o.passage_cells, h); // below hfloor where they ask
     const detail::PoleSizes poles =
         detail::limit_gradient(g, h, o.grade, sub_progress(progress, 0.6, 1.0));
     report(progress, 1.0, "size field");
