@@ -133,9 +133,14 @@ void check_output_srs(const std::string &srs, std::span<const OutputRequest> out
 /// its share of common.progress (by progress_weight). Throws what a writer throws (IoError,
 /// DataError when the mesh lacks what a format needs, Cancelled when progress or `cancelled`
 /// says so); then no output is left. Under a live OutputBatch the files join it; otherwise
-/// they appear together at the end.
+/// they appear together at the end. With `timings`, each format's seconds are a stage of their
+/// own (writer_stage_name; two outputs of one format add up).
 void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
-                   const WriteOptions &common, const std::function<bool()> &cancelled = {});
+                   const WriteOptions &common, const std::function<bool()> &cancelled = {},
+                   StageTimings *timings = nullptr);
+
+/// "write_" and the format's name in lower case: write_ugrid, write_gpkg, write_png...
+std::string writer_stage_name(const Writer &writer);
 
 /// The sum of the outputs' progress weights.
 double progress_weight(std::span<const OutputRequest> outputs);

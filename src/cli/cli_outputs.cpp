@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <filesystem>
 #include <map>
 
+#include "cli_common.hpp"
 #include "cli_support.hpp"
 #include "globemesh/error.hpp"
 
@@ -312,9 +314,12 @@ double mesh_share(std::span<const PlannedOutput> planned) {
 }
 
 void write_run_outputs(const Mesh &mesh, std::span<const PlannedOutput> planned,
-                       WriteOptions options, TerminalProgress &terminal) {
+                       WriteOptions options, TerminalProgress &terminal, StageTimings *timings) {
     options.progress = sub_progress(terminal.callback(), mesh_share(planned), 1);
-    write_outputs(mesh, requests(planned), options, InterruptGuard::interrupted);
+    const auto t0 = std::chrono::steady_clock::now();
+    write_outputs(mesh, requests(planned), options, InterruptGuard::interrupted, timings);
+    if (timings)
+        timings->add("write", seconds_since(t0));
 }
 
 std::vector<OutputRequest> requests(std::span<const PlannedOutput> planned) {

@@ -80,9 +80,12 @@ void check_output_files(std::span<const std::pair<std::string, std::string>> out
 double mesh_share(std::span<const PlannedOutput> planned);
 
 /// Writes the outputs of `mesh` (mesh and triangulate alike) into the caller's OutputBatch, on
-/// the rest of `terminal`'s line after the mesh's share; a signal stops it (Cancelled).
+/// the rest of `terminal`'s line after the mesh's share; a signal stops it (Cancelled). With
+/// `timings`, adds each format's seconds (write_ugrid, write_gpkg...) and all of them (write) to
+/// `timings`.
 void write_run_outputs(const Mesh &mesh, std::span<const PlannedOutput> planned,
-                       WriteOptions options, TerminalProgress &terminal);
+                       WriteOptions options, TerminalProgress &terminal,
+                       StageTimings *timings = nullptr);
 
 /// The requests of `planned`, in order.
 std::vector<OutputRequest> requests(std::span<const PlannedOutput> planned);

@@ -173,9 +173,8 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
         print_depth(out, err, *s.run.depth, o.quiet);
     if (s.run.straits_closing && s.run.mesher.straits_closed > 0 && !o.quiet)
         warn_straits(err, s.run.mesher);
-    print_timings(out, s.timings);
-    out << "total time        " << exact_text(std::round(s.total_s * 1000) / 1000) << " s\n"
-        << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
+    print_timings(out, s.timings); // its last line: the total
+    out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
         << "wrote             " << outputs_text(s.planned);
     for (const auto *p : {&o.timings, &o.report})
         if (!p->empty())

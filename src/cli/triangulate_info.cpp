@@ -59,20 +59,20 @@ int run_triangulate(std::span<const std::string> args, std::ostream &out, std::o
 
     InterruptGuard interrupt;
     GdalMessages gdal_messages(err, c.verbose);
+    const auto t0 = std::chrono::steady_clock::now();
     StageTimings timings;
     terminal.configure(c.quiet, c.verbose);
     Mesh mesh = lib.triangulate_file(c.t, sub_progress(terminal.callback(), 0, mesh_share(planned)),
                                      &timings);
     throw_if_interrupted();
     OutputBatch batch; // every output waits under its temporary name until all are complete
-    const auto tw = std::chrono::steady_clock::now();
     WriteOptions write;
     write.overwrite = c.overwrite;
     write.title = "globemesh spherical Delaunay triangulation";
     write.history = history_text("triangulate", args);
-    write_run_outputs(mesh, planned, write, terminal);
-    timings.add("write", seconds_since(tw));
+    write_run_outputs(mesh, planned, write, terminal, &timings);
     terminal.finish();
+    timings.add("total", seconds_since(t0));
     if (!c.timings.empty()) {
         OutputFile::write_text(c.timings, timings_json(timings), c.overwrite, "--timings");
     }

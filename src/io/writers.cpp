@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <memory>
 
 #include "globemesh/error.hpp"
@@ -236,8 +237,27 @@ double progress_weight(std::span<const OutputRequest> outputs) {
     return total;
 }
 
+std::string writer_stage_name(const Writer &writer) {
+    return "write_" + lower(writer.name);
+}
+
+namespace {
+
+/// Adds `seconds` to the stage `name`, appended when it is new.
+void add_to_stage(StageTimings &timings, const std::string &name, double seconds) {
+    for (auto &[stage, s] : timings.stages)
+        if (stage == name) {
+            s += seconds;
+            return;
+        }
+    timings.add(name, seconds);
+}
+
+} // namespace
+
 void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
-                   const WriteOptions &common, const std::function<bool()> &cancelled) {
+                   const WriteOptions &common, const std::function<bool()> &cancelled,
+                   StageTimings *timings) {
     for (const auto &o : outputs)
         if ((o.writer->needs & needs_depth) && mesh.node_field("depth") == nullptr)
             throw DataError(o.writer->name + " output " + o.path.string() +
@@ -266,7 +286,12 @@ void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
         options.progress =
             sub_progress(common.progress, at / total, (at + o.writer->progress_weight) / total);
         at += o.writer->progress_weight;
+        const auto t0 = std::chrono::steady_clock::now();
         o.writer->write(mesh, o.path, options);
+        if (timings)
+            add_to_stage(
+                *timings, writer_stage_name(*o.writer),
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         if (cancelled && cancelled())
             throw Cancelled();
     }

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gdal.h>
@@ -27,6 +29,7 @@
 
 namespace fs = std::filesystem;
 using globemesh::test::fixture;
+using globemesh::test::regex_all;
 using globemesh::test::regex_match;
 using globemesh::test::regex_replace;
 using globemesh::test::regex_search;
@@ -1075,6 +1078,7 @@ struct FakeRun {
     std::vector<std::string> written; // paths the fake writers were asked for, in order
     std::string configuration;        // the globemesh_configuration attribute given to write_ugrid
     bool fail_gpkg = false;
+    int ugrid_ms = 0, gpkg_ms = 0; // how long the fake writers take
     globemesh::CliLibrary lib() {
         globemesh::CliLibrary l;
         l.mesh_ocean = [](const globemesh::MeshOptions &, const globemesh::Progress &p,
@@ -1102,6 +1106,7 @@ struct FakeRun {
                 if (key == "globemesh_configuration")
                     configuration = value;
             globemesh::OutputFile::write_text(p, "nc", o.overwrite); // as the real writers do
+            std::this_thread::sleep_for(std::chrono::milliseconds(ugrid_ms));
             written.push_back(p.string());
         };
         row(l, "GPKG").write = [this](const globemesh::Mesh &, const fs::path &p,
@@ -1109,6 +1114,7 @@ struct FakeRun {
             if (fail_gpkg)
                 throw globemesh::IoError("cannot write " + p.string() + " (disk full)");
             globemesh::OutputFile::write_text(p, "gpkg", o.overwrite);
+            std::this_thread::sleep_for(std::chrono::milliseconds(gpkg_ms));
             written.push_back(p.string());
         };
         row(l, "PNG").write = [this](const globemesh::Mesh &, const fs::path &p,
@@ -1143,7 +1149,7 @@ TEST(Cli, timings_and_report_hold_the_stages_and_the_mesh_total) {
     // Issue 4's "mesh" key: every stage but the reading, 1.25 + 0.25 s here.
     EXPECT_TRUE(regex_search(
         t,
-        R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write": [0-9.e-]+\}\}\n$)"))
+        R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write_ugrid": [0-9.e-]+, "write": [0-9.e-]+, "total": [0-9.e-]+\}\}\n$)"))
         << t;
     const std::string report = read_text(dir / "r.json");
     EXPECT_NE(report.find("\"nodes\": 6"), std::string::npos) << report;
@@ -1156,6 +1162,37 @@ TEST(Cli, timings_and_report_hold_the_stages_and_the_mesh_total) {
     for (const auto &e : fs::directory_iterator(dir.path()))
         names.insert(e.path().filename().string());
     EXPECT_EQ(names, (std::set<std::string>{"o.nc", "t.json", "r.json"})); // no temporary files
+}
+
+TEST(Cli, timings_name_each_format_as_a_stage_and_add_the_total) {
+    TempDir dir;
+    FakeRun fake;
+    fake.ugrid_ms = 30;
+    fake.gpkg_ms = 80;
+    const Result r =
+        run({"mesh", "--coast", coast, "-o", (dir / "a.nc").string(), "-o", (dir / "b.nc").string(),
+             "--gpkg", (dir / "o.gpkg").string(), "--timings", (dir / "t.json").string(), "-q"},
+            fake.lib());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string t = read_text(dir / "t.json");
+    EXPECT_EQ(regex_all(t, R"x("([a-z_]+)": )x", 1),
+              (std::vector<std::string>{"stages", "read_coast", "refine", "improve", "mesh",
+                                        "write_ugrid", "write_gpkg", "write", "total"}))
+        << t;
+    auto seconds = [&t](const std::string &stage) {
+        const auto v = regex_all(t, "\"" + stage + R"(": ([0-9.e-]+))", 1);
+        return v.size() == 1 ? std::stod(v[0]) : -1.0;
+    };
+    // Two UGRID outputs of 30 ms add up in one stage; the GeoPackage's 80 ms are its own.
+    EXPECT_GE(seconds("write_ugrid"), 0.06) << t;
+    EXPECT_GE(seconds("write_gpkg"), 0.08) << t;
+    EXPECT_GE(seconds("write"), seconds("write_ugrid") + seconds("write_gpkg")) << t;
+    // The total is measured (the fake mesher's 2 s are only reported): at least the writing.
+    EXPECT_GE(seconds("total"), seconds("write")) << t;
+    EXPECT_LT(seconds("total"), 1.5) << t;
+    EXPECT_TRUE(regex_search(r.out, R"(\n\s+write_ugrid [0-9.]+\n\s+write_gpkg [0-9.]+\n)"))
+        << r.out;
+    EXPECT_TRUE(regex_search(r.out, R"(\n\s+total [0-9.]+\npeak memory )")) << r.out;
 }
 
 TEST(Cli, a_failing_writer_leaves_none_of_the_run_outputs) {

@@ -137,8 +137,9 @@ assert r['mesh']['faces'] == faces.shape[0], (r['mesh']['faces'], faces.shape)
 assert sum(r['mesh']['quality']['histogram']) == faces.shape[0]
 assert 0 < r['mesh']['quality']['min'] <= r['mesh']['quality']['mean'] <= 1
 assert r['peak_memory_bytes'] > 1e6
-for k in ('mesh', 'write'):
+for k in ('mesh', 'write_ugrid', 'write', 'total'):
     assert k in t['stages'], t
+assert t['stages']['write_ugrid'] <= t['stages']['write'] <= t['stages']['total'], t
 assert all(v >= 0 for v in t['stages'].values())
 assert 0.6 * 400 < r['mesh']['edge_km']['mean'] < 1.3 * 400, r['mesh']['edge_km']
 assert )" + std::to_string(loops) + R"( <= r['mesh']['boundary_loops'] <= )" +

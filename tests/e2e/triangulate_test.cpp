@@ -155,7 +155,7 @@ TEST(Triangulate, points_in_one_hemisphere_give_a_disk_with_an_open_boundary) {
     globemesh::test::expect_mesh_verify(dir / "n.nc");
 }
 
-TEST(Triangulate, timings_json_has_read_sort_triangulate_and_write) {
+TEST(Triangulate, timings_json_has_read_sort_triangulate_each_writer_and_the_total) {
     TempDir dir;
     CliRun r = triangulate({fixture("points/stations.csv").string(), "-o", (dir / "s.nc").string(),
                             "--timings", (dir / "t.json").string(), "-q"});
@@ -163,7 +163,8 @@ TEST(Triangulate, timings_json_has_read_sort_triangulate_and_write) {
     std::ifstream f(dir / "t.json");
     std::string json((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     EXPECT_EQ(json.rfind("{\"stages\": {", 0), 0u) << json;
-    for (const char *key : {"\"read\": ", "\"sort\": ", "\"triangulate\": ", "\"write\": "})
+    for (const char *key : {"\"read\": ", "\"sort\": ", "\"triangulate\": ", "\"write_ugrid\": ",
+                            "\"write\": ", "\"total\": "})
         EXPECT_NE(json.find(key), std::string::npos) << key << " missing in " << json;
 }
 
