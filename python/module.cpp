@@ -153,9 +153,11 @@ std::shared_ptr<PyMesh> triangulate_arrays(const py::array_t<double, py::array::
 /// flags), each as its Python exception.
 void register_errors(py::module_ &m) {
     static py::exception<Error> base(m, "Error", PyExc_RuntimeError);
-    static py::exception<UsageError> usage(m, "UsageError", PyExc_ValueError);
+    // globemesh.Error catches them all; ValueError and OSError as Python's own kinds.
+    static py::exception<UsageError> usage(m, "UsageError",
+                                           py::make_tuple(base, py::handle(PyExc_ValueError)));
     static py::exception<DataError> data(m, "DataError", base.ptr());
-    static py::exception<IoError> io(m, "IoError", PyExc_OSError);
+    static py::exception<IoError> io(m, "IoError", py::make_tuple(base, py::handle(PyExc_OSError)));
     static py::exception<Cancelled> cancelled(m, "Cancelled", base.ptr());
     py::register_exception_translator([](std::exception_ptr p) {
         try {

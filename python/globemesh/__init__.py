@@ -9,13 +9,14 @@
 mesh_ocean() takes the options of `globemesh mesh` (see `globemesh help mesh` and globemesh(1))
 as keywords: the long option names with "_" for "-" (coast_layer, min_island_area), with the same
 units ("20km", "5000m", a bare number is km), defaults and checks, through the command line's own
-parser. Errors are the command line's one-line messages, raised as:
+parser. Errors are the command line's one-line messages, raised as these globemesh.Error (a
+RuntimeError):
 
     UsageError (a ValueError)    a bad option value: exit status 2 at the command line
     IoError (an OSError)         a file that cannot be read or written
-    DataError (a RuntimeError)   inputs that give no mesh
-    Cancelled (a RuntimeError)   the progress callback returned False
-    KeyboardInterrupt            Ctrl-C during a run (or the exception the callback raised)
+    DataError                    inputs that give no mesh
+    Cancelled                    the progress callback returned False
+and KeyboardInterrupt for Ctrl-C during a run (or the exception the callback raised).
 
 A run releases the GIL; progress(fraction, stage) is called at most every 50 ms, and Ctrl-C stops
 the run there. A cancelled or failed write() leaves no file.

@@ -155,6 +155,14 @@ class Errors(TempDir):
         missing = self.path("nowhere.gpkg")
         self.same(OSError, ["--coast", missing], coast=missing)
 
+    def test_every_error_is_a_globemesh_error(self):
+        for kind, python_kind in ((globemesh.UsageError, ValueError), (globemesh.IoError, OSError),
+                                  (globemesh.DataError, RuntimeError),
+                                  (globemesh.Cancelled, RuntimeError)):
+            self.assertTrue(issubclass(kind, globemesh.Error) and issubclass(kind, python_kind))
+        with self.assertRaises(globemesh.Error):
+            globemesh.mesh_ocean(self.path("nowhere.gpkg"))
+
     def test_unknown_keyword_and_output_options(self):
         with self.assertRaises(TypeError):
             globemesh.mesh_ocean(LAND110, hmaxx="50km")
