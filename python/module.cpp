@@ -29,8 +29,8 @@ namespace globemesh::python {
 
 namespace {
 
-/// Options of `globemesh mesh` that mesh_ocean() does not take: the outputs (Result.write) and
-/// the terminal's.
+/// Whether mesh_ocean() takes this option of `globemesh mesh`: all but the outputs (those are
+/// Result.write's) and the terminal's.
 bool python_takes(const CLI::Option &option) {
     const std::string name = option.get_lnames().empty() ? "" : option.get_lnames().front();
     return option.get_group() != "Output" && !name.empty() && name != "help" && name != "version" &&
@@ -47,7 +47,7 @@ std::vector<std::tuple<std::string, bool, int>> mesh_keywords() {
             continue;
         std::string name = option->get_lnames().front();
         std::replace(name.begin(), name.end(), '-', '_');
-        keywords.emplace_back(name, option->get_type_size() == 0, option->get_expected_max());
+        keywords.emplace_back(name, option->get_expected_max() == 0, option->get_expected_max());
     }
     return keywords;
 }

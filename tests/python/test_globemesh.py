@@ -100,6 +100,23 @@ class SameAsCommandLine(TempDir):
         self.assertIn(2, set(r.boundary_tags.tolist()))  # open boundary along the region
         self.compare(r, self.path("cli.nc"))
 
+    def test_flags_and_configuration(self):
+        status, err = cli("mesh", "-q", "--coast", LAND110, "--coast-layer", "land", "--hmax", "800",
+                          "--keep-straits", "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax=800, keep_straits=True,
+                                 keep_inland_seas=False)
+        self.compare(r, self.path("cli.nc"))
+        config = r.attributes["globemesh_configuration"].splitlines()
+        self.assertIn("keep-straits=true", config)
+        self.assertIn("keep-inland-seas=false", config)
+        def run_options(lines):  # the same, but for the outputs and the command line's -q
+            return [l for l in lines if not l.startswith(("output=", "quiet="))]
+
+        with netCDF4.Dataset(self.path("cli.nc")) as nc:
+            cli_config = nc.getncattr("globemesh_configuration").splitlines()
+        self.assertEqual(run_options(config), run_options(cli_config))
+
     def test_write_is_the_command_lines_file(self):
         r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
         r.write([self.path("py.nc"), self.path("py.gpkg")])
