@@ -220,13 +220,14 @@ class Cancel(TempDir):
     def test_ctrl_c_stops_the_run(self):
         # SIGINT to this process while the library runs without the GIL: Python's handler
         # marks it, the next progress tick raises KeyboardInterrupt.
-        timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+        timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
         timer.start()
         t0 = time.monotonic()
         with self.assertRaises(KeyboardInterrupt):
-            globemesh.mesh_ocean(LAND50, coast_layer="land", hmax="60km")
+            # 2.1 million faces: 3.7 s on the 2-core test machine when the run goes to its end.
+            globemesh.mesh_ocean(LAND50, coast_layer="land", hmax="20km")
         timer.join()
-        self.assertLess(time.monotonic() - t0, 1.5)  # the whole run takes 3 s or more
+        self.assertLess(time.monotonic() - t0, 2)
 
     def test_cancelled_write_leaves_nothing(self):
         r = globemesh.mesh_ocean(LAND110, ETOPO, coast_layer="land", hmax="100km")
