@@ -4,15 +4,19 @@
 
 GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
-# Build and run dependencies of globemesh itself.
+# Build and run dependencies of globemesh itself; pybind11 (the binding library, headers only)
+# with the Python headers (python3-dev, which pybind11-dev does not pull in) and numpy (its arrays)
+# for the Python module.
 GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libsqlite3-dev libgeos-dev libproj-dev
-  libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin"
+  libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin
+  pybind11-dev python3-dev python3-numpy"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with
-# its runtime (libFuzzer) for tools/fuzz, gmsh's and meshio's readers of the .msh output.
+# its runtime (libFuzzer) for tools/fuzz, gmsh's and meshio's readers of the .msh output, xarray
+# for the Python module's to_xarray().
 GLOBEMESH_TEST_PACKAGES="libgmp-dev mandoc man-db python3-numpy python3-scipy python3-netcdf4
   python3-gdal python3-shapely qgis python3-qgis clang libclang-rt-14-dev clang-format
-  python3-gmsh python3-meshio"
+  python3-gmsh python3-meshio python3-xarray"
 
 install_missing() {
     local missing=()

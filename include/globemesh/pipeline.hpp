@@ -104,4 +104,11 @@ struct TriangulateOptions {
 Mesh triangulate_file(const TriangulateOptions &options, const Progress &progress = {},
                       StageTimings *timings = nullptr);
 
+/// The same triangulation of points already on the sphere (unit vectors), for callers that hold
+/// them in memory (the Python module). options.points names them in messages ("": "the
+/// points"); options.layer is unused. Stages "sort" and "triangulate". Throws DataError (too
+/// many points, no triangle) or Cancelled.
+Mesh triangulate_points(std::vector<Vec3> points, const TriangulateOptions &options,
+                        const Progress &progress = {}, StageTimings *timings = nullptr);
+
 } // namespace globemesh

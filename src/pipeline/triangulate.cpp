@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -141,33 +143,29 @@ PointSource read_point_source(const TriangulateOptions &options, const Progress 
 
 } // namespace
 
-Mesh triangulate_file(const TriangulateOptions &options, const Progress &progress,
-                      StageTimings *timings) {
+Mesh triangulate_points(std::vector<Vec3> points, const TriangulateOptions &options,
+                        const Progress &progress, StageTimings *timings) {
+    // The points' name in messages: the source file, or what the caller passed.
+    const std::string what = options.points.empty() ? "the points" : "POINTS " + options.points;
+    const std::size_t n = points.size();
+    report(progress, 0.0, "sort");
     auto t0 = std::chrono::steady_clock::now();
-    report(progress, 0.0, "read");
-    PointSource src = read_point_source(options, sub_progress(progress, 0.0, 0.3));
-    const std::size_t n = src.points.size();
-    if (timings)
-        timings->add_input("read", seconds_since(t0));
-
-    report(progress, 0.3, "sort");
-    t0 = std::chrono::steady_clock::now();
     if (n >= 0x80000000u)
-        throw DataError("POINTS " + options.points + ": more than 2^31 points");
-    std::vector<std::uint32_t> order = SphericalDelaunay::insertion_order(src.points, options.seed);
+        throw DataError(what + ": more than 2^31 points");
+    std::vector<std::uint32_t> order = SphericalDelaunay::insertion_order(points, options.seed);
     if (timings)
         timings->add("sort", seconds_since(t0));
 
-    report(progress, 0.4, "triangulate");
+    report(progress, 1.0 / 7, "triangulate");
     t0 = std::chrono::steady_clock::now();
     SphericalDelaunay dt({options.merge_tolerance_rad, options.seed});
     std::vector<VertexId> vertex_of;
     try {
-        vertex_of = dt.insert_points(std::move(src.points), std::move(order));
+        vertex_of = dt.insert_points(std::move(points), std::move(order));
     } catch (const DataError &e) {
-        throw DataError("POINTS " + options.points + ": " + e.what());
+        throw DataError(what + ": " + e.what());
     }
-    report(progress, 0.9, "triangulate");
+    report(progress, 6.0 / 7, "triangulate");
 
     // Nodes: the vertices of solid triangles, numbered in the order of the first input point that
     // became each (so node order follows the input, whatever the insertion order).
@@ -203,15 +201,27 @@ Mesh triangulate_file(const TriangulateOptions &options, const Progress &progres
             }
     }
     if (mesh.faces.empty())
-        throw DataError("POINTS " + options.points +
-                        ": the points give no triangle (all on one circle?)");
-    mesh.attributes.emplace_back("source_points", options.points);
-    mesh.attributes.emplace_back("source_layer", src.layer);
+        throw DataError(what + ": the points give no triangle (all on one circle?)");
     mesh.attributes.emplace_back("input_point_count", std::to_string(n));
     mesh.attributes.emplace_back("merged_point_count", std::to_string(dt.merged_count()));
     if (timings)
         timings->add("triangulate", seconds_since(t0));
     report(progress, 1.0, "triangulate");
+    return mesh;
+}
+
+Mesh triangulate_file(const TriangulateOptions &options, const Progress &progress,
+                      StageTimings *timings) {
+    auto t0 = std::chrono::steady_clock::now();
+    report(progress, 0.0, "read");
+    PointSource src = read_point_source(options, sub_progress(progress, 0.0, 0.3));
+    if (timings)
+        timings->add_input("read", seconds_since(t0));
+    Mesh mesh = triangulate_points(std::move(src.points), options, sub_progress(progress, 0.3, 1.0),
+                                   timings);
+    const std::pair<std::string, std::string> source[] = {{"source_points", options.points},
+                                                          {"source_layer", src.layer}};
+    mesh.attributes.insert(mesh.attributes.begin(), std::begin(source), std::end(source));
     return mesh;
 }
 

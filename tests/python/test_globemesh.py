@@ -1,0 +1,283 @@
+"""The Python module against the command line: the same arrays as its UGRID file (read with
+netCDF4), the same errors and messages, cancellation that leaves nothing, the GIL released.
+Run by ctest (tests/CMakeLists.txt) with PYTHONPATH at the build tree's python/ folder and
+GLOBEMESH_EXE, GLOBEMESH_FIXTURES_DIR set."""
+
+import os
+import signal
+import subprocess
+import tempfile
+import threading
+import time
+import unittest
+
+import netCDF4
+import numpy as np
+
+import globemesh
+
+EXE = os.environ["GLOBEMESH_EXE"]
+FIXTURES = os.environ["GLOBEMESH_FIXTURES_DIR"]
+LAND110 = os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg")
+LAND50 = os.path.join(FIXTURES, "coast", "ne_50m_land.gpkg")
+ETOPO = os.path.join(FIXTURES, "bathy", "etopo5_global_10min.nc")
+STATIONS = os.path.join(FIXTURES, "points", "stations.csv")
+
+
+def cli(*args):
+    """(exit status, stderr) of `globemesh ARGS`."""
+    p = subprocess.run([EXE, *args], capture_output=True, text=True)
+    return p.returncode, p.stderr
+
+
+def cli_error(*args):
+    """The command line's one-line error (without "globemesh: ") and its exit status."""
+    status, err = cli(*args)
+    lines = [l for l in err.splitlines() if l.startswith("globemesh: ")]
+    assert len(lines) == 1, err
+    return lines[0][len("globemesh: "):], status
+
+
+class TempDir(unittest.TestCase):
+    def setUp(self):
+        self._dir = tempfile.TemporaryDirectory(prefix="globemesh-py-")
+        self.dir = self._dir.name
+
+    def tearDown(self):
+        self._dir.cleanup()
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+
+class SameAsCommandLine(TempDir):
+    """mesh_ocean's arrays are the command line's file's, variable for variable."""
+
+    def compare(self, result, nc_path):
+        with netCDF4.Dataset(nc_path) as nc:
+            v = {name: nc[name][:].filled() if np.ma.isMaskedArray(nc[name][:]) else nc[name][:]
+                 for name in nc.variables}
+            pairs = [("node_lon", "mesh_node_lon"), ("node_lat", "mesh_node_lat"),
+                     ("faces", "mesh_face_nodes"), ("edges", "mesh_edge_nodes"),
+                     ("edge_tags", "boundary_tag"), ("quality", "quality"), ("face_area", "area")]
+            for ours, theirs in pairs:
+                np.testing.assert_array_equal(getattr(result, ours), v[theirs], err_msg=ours)
+            for name in result.node_fields:
+                np.testing.assert_array_equal(result.node_fields[name], v[name], err_msg=name)
+            if "mesh_boundary_nodes" in v:
+                np.testing.assert_array_equal(result.boundary_edges, v["mesh_boundary_nodes"])
+            else:
+                self.assertEqual(len(result.boundary_edges), 0)
+            # The boundary's tags are those of its edges in the file's per-edge boundary_tag.
+            edge_of = {tuple(e): i for i, e in enumerate(v["mesh_edge_nodes"].tolist())}
+            tags = [v["boundary_tag"][edge_of[tuple(e)]] for e in result.boundary_edges.tolist()]
+            np.testing.assert_array_equal(result.boundary_tags, tags)
+            for key, value in result.attributes.items():
+                if key not in ("globemesh_configuration", "history"):
+                    self.assertEqual(str(nc.getncattr(key)), value, key)
+            self.assertEqual(result.faces.dtype, np.int32)
+
+    def test_global_with_bathymetry(self):
+        status, err = cli("mesh", "-q", "--coast", LAND110, "--coast-layer", "land", "--bathy", ETOPO,
+                          "--hmin", "150km", "--hmax", "600", "--wavelength", "30", "--grade", "0.2",
+                          "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        r = globemesh.mesh_ocean(LAND110, ETOPO, coast_layer="land", hmin="150km", hmax=600,
+                                 wavelength=30, grade=0.2)
+        self.assertGreater(len(r.faces), 1000)
+        self.assertIsNotNone(r.depth)
+        self.compare(r, self.path("cli.nc"))
+        self.assertEqual(r.report["mesh"]["faces"], len(r.faces))
+        self.assertIn("depth", r.report)
+
+    def test_region_with_open_boundary(self):
+        status, err = cli("mesh", "-q", "--coast", LAND50, "--coast-layer", "land",
+                          "--region", "-12,48,12,64", "--hmax", "60km", "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        r = globemesh.mesh_ocean(coast=LAND50, coast_layer="land", region=(-12, 48, 12, 64),
+                                 hmax="60km")
+        self.assertIsNone(r.depth)
+        self.assertIn(2, set(r.boundary_tags.tolist()))  # open boundary along the region
+        self.compare(r, self.path("cli.nc"))
+
+    def test_flags_and_configuration(self):
+        status, err = cli("mesh", "-q", "--coast", LAND110, "--coast-layer", "land", "--hmax", "800",
+                          "--keep-straits", "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax=800, keep_straits=True,
+                                 keep_inland_seas=False)
+        self.compare(r, self.path("cli.nc"))
+        config = r.attributes["globemesh_configuration"].splitlines()
+        self.assertIn("keep-straits=true", config)
+        self.assertIn("keep-inland-seas=false", config)
+        def run_options(lines):  # the same, but for the outputs and the command line's -q
+            return [l for l in lines if not l.startswith(("output=", "quiet="))]
+
+        with netCDF4.Dataset(self.path("cli.nc")) as nc:
+            cli_config = nc.getncattr("globemesh_configuration").splitlines()
+        self.assertEqual(run_options(config), run_options(cli_config))
+
+    def test_write_is_the_command_lines_file(self):
+        r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
+        r.write([self.path("py.nc"), self.path("py.gpkg")])
+        self.compare(r, self.path("py.nc"))
+        self.assertTrue(os.path.getsize(self.path("py.gpkg")) > 0)
+        with self.assertRaises(globemesh.IoError):  # exists, no overwrite
+            r.write(self.path("py.nc"))
+        r.write(self.path("py.nc"), overwrite=True)
+
+    def test_arrays_are_read_only_views(self):
+        r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
+        faces = r.faces
+        self.assertFalse(faces.flags.writeable)
+        self.assertFalse(faces.flags.owndata)  # a view of the library's vector
+        del r  # the view keeps the mesh alive
+        self.assertTrue((faces >= 0).all())
+
+    def test_triangulate_is_the_command_lines(self):
+        status, err = cli("triangulate", "-q", STATIONS, "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        data = np.genfromtxt(STATIONS, delimiter=",", names=True, dtype=None, encoding="utf-8")
+        r = globemesh.triangulate(data["lon"], data["lat"])
+        with netCDF4.Dataset(self.path("cli.nc")) as nc:
+            np.testing.assert_array_equal(r.faces, nc["mesh_face_nodes"][:])
+            np.testing.assert_array_equal(r.node_lon, nc["mesh_node_lon"][:])
+            np.testing.assert_array_equal(r.edges, nc["mesh_edge_nodes"][:])
+
+
+class Errors(TempDir):
+    """Errors are the command line's messages, as exceptions."""
+
+    def same(self, exception, cli_args, **options):
+        message, status = cli_error("mesh", *cli_args, "-o", self.path("x.nc"))
+        with self.assertRaises(exception) as caught:
+            globemesh.mesh_ocean(**options)
+        self.assertEqual(str(caught.exception), message)
+        self.assertEqual(status, 2 if issubclass(exception, ValueError) else 1)
+        self.assertEqual(os.listdir(self.dir), [])
+
+    def test_bad_length(self):
+        self.same(globemesh.UsageError, ["--coast", LAND110, "--hmax", "50 parsecs"],
+                  coast=LAND110, hmax="50 parsecs")
+
+    def test_bad_option_value(self):
+        self.same(globemesh.UsageError, ["--coast", LAND110, "--hmax", "10km", "--hmin", "20km"],
+                  coast=LAND110, hmax="10km", hmin="20km")
+
+    def test_bad_region(self):
+        self.same(ValueError, ["--coast", LAND110, "--region", "10,50,20,40"], coast=LAND110,
+                  region=[10, 50, 20, 40])
+
+    def test_missing_file(self):
+        missing = self.path("nowhere.gpkg")
+        self.same(OSError, ["--coast", missing], coast=missing)
+
+    def test_every_error_is_a_globemesh_error(self):
+        for kind, python_kind in ((globemesh.UsageError, ValueError), (globemesh.IoError, OSError),
+                                  (globemesh.DataError, RuntimeError),
+                                  (globemesh.Cancelled, RuntimeError)):
+            self.assertTrue(issubclass(kind, globemesh.Error) and issubclass(kind, python_kind))
+        with self.assertRaises(globemesh.Error):
+            globemesh.mesh_ocean(self.path("nowhere.gpkg"))
+
+    def test_unknown_keyword_and_output_options(self):
+        with self.assertRaises(TypeError):
+            globemesh.mesh_ocean(LAND110, hmaxx="50km")
+        with self.assertRaises(TypeError):  # outputs are Result.write's
+            globemesh.mesh_ocean(LAND110, output="x.nc")
+
+    def test_write_unknown_format(self):
+        r = globemesh.triangulate([0, 90, 180, 0], [0, 0, 0, 90])
+        with self.assertRaises(globemesh.UsageError) as caught:
+            r.write(self.path("mesh.xyz"))
+        message, status = cli_error("triangulate", STATIONS, "-o", self.path("mesh.xyz"))
+        self.assertEqual(str(caught.exception), message)
+        self.assertEqual(status, 2)
+
+    def test_triangulate_bad_points(self):
+        with self.assertRaisesRegex(globemesh.UsageError, "same length"):
+            globemesh.triangulate([0, 1], [0])
+        with self.assertRaisesRegex(globemesh.UsageError, "point 1 .*lat in"):
+            globemesh.triangulate([0, 1, 2], [0, 91, 2])
+        with self.assertRaisesRegex(globemesh.DataError, "one circle"):
+            globemesh.triangulate([0, 10, 20], [0, 0, 0])
+
+
+class Cancel(TempDir):
+    """A cancelled run raises, and leaves no file."""
+
+    def test_callback_false_cancels(self):
+        calls = []
+
+        def progress(fraction, stage):
+            calls.append((fraction, stage))
+            return False
+
+        with self.assertRaisesRegex(globemesh.Cancelled, "^cancelled, no output written$"):
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="300km", progress=progress)
+        self.assertEqual(len(calls), 1)
+
+    def test_ctrl_c_stops_the_run(self):
+        # SIGINT to this process while the library runs without the GIL: Python's handler
+        # marks it, the next progress tick raises KeyboardInterrupt.
+        timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+        timer.start()
+        t0 = time.monotonic()
+        with self.assertRaises(KeyboardInterrupt):
+            # 2.1 million faces: 3.7 s on the 2-core test machine when the run goes to its end.
+            globemesh.mesh_ocean(LAND50, coast_layer="land", hmax="20km")
+        timer.join()
+        self.assertLess(time.monotonic() - t0, 2)
+
+    def test_cancelled_write_leaves_nothing(self):
+        r = globemesh.mesh_ocean(LAND110, ETOPO, coast_layer="land", hmax="100km")
+        outputs = [self.path("o.nc"), self.path("o.gpkg"), self.path("o.msh")]
+        for stop in (lambda: False, lambda: 1 / 0):
+            calls = []
+
+            def progress(fraction, stage):
+                calls.append(fraction)
+                return stop() if len(calls) == 2 else True  # midway: the first call is at 0
+
+            with self.assertRaises((globemesh.Cancelled, ZeroDivisionError)):
+                r.write(outputs, progress=progress)
+            self.assertEqual(len(calls), 2)
+            self.assertLess(calls[-1], 1)
+            self.assertEqual(os.listdir(self.dir), [])
+
+    def test_gil_is_released(self):
+        ticks = []
+        done = threading.Event()
+
+        def count():
+            while not done.is_set():
+                ticks.append(1)
+                time.sleep(0.001)
+
+        counter = threading.Thread(target=count)
+        counter.start()
+        try:
+            globemesh.mesh_ocean(LAND50, coast_layer="land", hmax="100km")
+        finally:
+            done.set()
+            counter.join()
+        # Held for the whole run, the GIL would not let the counter tick at all in between.
+        self.assertGreater(len(ticks), 20)
+
+
+class Xarray(TempDir):
+    def test_dataset_is_the_file(self):
+        try:
+            import xarray  # noqa: F401
+        except ImportError:
+            self.skipTest("xarray missing")
+        r = globemesh.mesh_ocean(LAND110, ETOPO, coast_layer="land", hmax="600km")
+        ds = r.to_xarray()
+        self.assertEqual(ds["mesh"].attrs["cf_role"], "mesh_topology")
+        np.testing.assert_array_equal(ds["mesh_face_nodes"].values, r.faces)
+        np.testing.assert_array_equal(ds["depth"].values, r.depth)
+        self.assertEqual(ds["depth"].attrs["positive"], "down")
+
+
+if __name__ == "__main__":
+    unittest.main()
