@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"

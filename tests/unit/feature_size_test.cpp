@@ -85,8 +85,9 @@ TEST(FeatureSize, FieldHoldsThreeElementsAcrossTheStrait) {
     o.hmin_km = 0.5;
     o.feature_size = 3;
     const SizeField field = build_size_field(o, co.region, nullptr, &coast.rings);
-    const SizeField off = build_size_field(SizeFieldOptions{.hmax_km = 50, .hmin_km = 0.5},
-                                           co.region, nullptr, &coast.rings);
+    SizeFieldOptions without = o;
+    without.feature_size = 0;
+    const SizeField off = build_size_field(without, co.region, nullptr, &coast.rings);
     EXPECT_TRUE(off.is_uniform());
     const double target = strait_width_km / 3; // 2 lfs / 3
     for (double lon : {-0.3, 0.0, 0.25})
@@ -242,9 +243,11 @@ TEST(FeatureSize, FjordCoastHasThreeEdgesAcrossEveryChannel) {
     // The mesher's edges spread about the target size (edge / target in [0.7, 1.4], median 1):
     // a channel near 3 hmin, where the size stops at hmin, can hold a little under 3 edges.
     EXPECT_LT(share_with, 0.02);
-    for (const Section &s : with_sections)
-        if (s.width_km > 4 * o.hmin_km)
+    for (const Section &s : with_sections) {
+        if (s.width_km > 4 * o.hmin_km) {
             EXPECT_GE(s.edges_across, 2.9) << "a channel " << s.width_km << " km wide";
+        }
+    }
     // A run the term would take over --max-nodes is refused before meshing, naming the option.
     o.max_nodes = with.mesh.nodes.size() / 3;
     const std::string m = test::thrown_message<DataError>([&] { mesh_ocean(o); }, "mesh_ocean");
