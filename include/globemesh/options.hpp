@@ -56,6 +56,7 @@ struct SizeFieldOptions {
     double wavelength = 0.0;      ///< points per wavelength of the tide; 0 = off
     double wave_period_h = 12.42; ///< period of that wave (hours; M2 by default)
     double slope = 0.0;           ///< points per topographic length scale; 0 = off
+    double feature_size = 0.0;    ///< elements across every channel (h <= 2 lfs / n); 0 = off
     std::string size_regions;     ///< polygons with a "size_km" attribute: the edge length inside
     /// The layer of size_regions to read; default every layer with a size_km field.
     std::string size_regions_layer;

@@ -13,6 +13,10 @@
 //              n = wavelength, D the depth in metres);
 //   slope      h = 2 pi D / (n * |grad D|)   (n = slope, |grad D| in m/km by central
 //              differences on the grid);
+//   feature    h = 2 lfs / n (n = feature_size) over the channels of water, lfs their half width:
+//              the circumradius of the spherical Delaunay triangles of coast samples (every grid
+//              row) that lie in water and touch two shores, their circumcentres on the medial
+//              axis (sizefield/feature_size.hpp), on the nodes within 1.5 rows of them;
 //   regions    h = size_km of every size_regions polygon holding the node (OGR, any CRS).
 // and after the clamp, so below hfloor where a passage needs it:
 //   passages   h = width / passage_cells on the grid cells each passage's line runs through
@@ -45,7 +49,7 @@
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
 // limiting", Eng. Comput. 22 (2006); Roberts et al., OceanMesh2D, GMD 12 (2019) for the
-// wavelength and slope components.
+// wavelength, slope and feature-size components.
 #pragma once
 
 #include <array>
@@ -123,7 +127,8 @@ private:
 /// Builds the size field the options ask for (see the file comment), over `region` (the run's
 /// CoastOptions::region, W,S,E,N degrees; nullopt: the whole globe). bathy: the bathymetry
 /// (required when wavelength or slope is on, else may be null); coast: the boundary rings at
-/// full resolution (required when coast_size_km is on). max_nodes caps the background grid.
+/// full resolution (required when coast_size_km or feature_size is on). max_nodes caps the
+/// background grid.
 /// When no component is on the field is uniform (max(hmax_km, hmin_km), SizeField::is_uniform)
 /// and no grid is built; otherwise before_grid, when set, is called once before the grid is
 /// allocated (to refuse the run by throwing). passages: the lines of options.passages with their

@@ -154,6 +154,11 @@ void MeshCommand::add_size_options(const std::string &size) {
     app.add_option("--slope", m.slope, "Points per topographic length scale; 0: off")
         ->group(size)
         ->type_name("N");
+    app.add_option(
+           "--feature-size", m.feature_size,
+           "Elements across every channel, from the coast's medial axis (3 as OceanMesh2D); 0: off")
+        ->group(size)
+        ->type_name("N");
     app.add_option("--size-regions", m.size_regions,
                    "Polygons with a size_km attribute: edge length inside")
         ->group(size)

@@ -91,7 +91,7 @@ void warn_straits(std::ostream &err, const MesherReport &m) {
                                   : " straits narrower than their faces were closed")
         << " (listed in the summary); keep one open with --passages (a line drawn across it, or "
            "'default' for the world's critical passages) or --size-regions (h at most half its "
-           "width there), or all with --keep-straits\n";
+           "width there), every channel with --feature-size 3, or all with --keep-straits\n";
 }
 
 /// The closed straits in the --report JSON: place, width and the size each needs.

@@ -8,7 +8,7 @@ namespace globemesh::cli {
 namespace {
 
 /// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 35> flags{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 36> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},
     {"coast_where", "--coast-where"},
@@ -34,6 +34,7 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 35> flags{{
     {"wavelength", "--wavelength"},
     {"wave_period_h", "--wave-period"},
     {"slope", "--slope"},
+    {"feature_size", "--feature-size"},
     {"size_regions", "--size-regions"},
     {"size_regions_layer", "--size-regions-layer"},
     {"passages", "--passages"},

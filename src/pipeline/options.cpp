@@ -59,6 +59,8 @@ void validate_size(const SizeFieldOptions &o) {
             option("wave_period_h") + " must be a positive number of hours");
     require(std::isfinite(o.slope) && o.slope >= 0,
             option("slope") + " must be >= 0 (points per length scale)");
+    require(std::isfinite(o.feature_size) && o.feature_size >= 0,
+            option("feature_size") + " must be >= 0 (elements across a channel)");
     require(positive(o.grade) && o.grade < 10, option("grade") + " must be in (0, 10)");
     // A layer without its file would be ignored without a word.
     require(o.size_regions_layer.empty() || !o.size_regions.empty(),

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "feature_size.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/sizefield.hpp"
 #include "grid.hpp"
@@ -240,8 +241,9 @@ SizeField build_size_field(const SizeFieldOptions &o,
     if ((o.wavelength > 0 || o.slope > 0) && !bathy)
         throw UsageError(option(o.wavelength > 0 ? "wavelength" : "slope") +
                          " needs a bathymetry raster: give " + option("bathy"));
-    if (o.coast_size_km > 0 && !coast)
-        throw UsageError(option("coast_size_km") + " needs the coastline: give " + option("coast"));
+    if ((o.coast_size_km > 0 || o.feature_size > 0) && !coast)
+        throw UsageError(option(o.coast_size_km > 0 ? "coast_size_km" : "feature_size") +
+                         " needs the coastline: give " + option("coast"));
     const double hmax = o.hmax_km;
     const double hfloor = size_floor_km(o);
     if (o.coast_size_km > 0 && o.coast_size_km > hmax)
@@ -289,6 +291,14 @@ SizeField build_size_field(const SizeFieldOptions &o,
         lower_by_depth(background(), *bathy, o, h, progress);
     if (grid)
         report(progress, 0.55, "size field");
+
+    // Feature size: elements across every channel of water.
+    if (o.feature_size > 0) {
+        const detail::BackgroundGrid &g = background();
+        if (!coast->empty())
+            detail::apply_feature_size(g, *coast, o.feature_size, hmax, h,
+                                       sub_progress(progress, 0.55, 0.6));
+    }
 
     if (!o.size_regions.empty())
         detail::apply_size_regions(background(), o.size_regions, o.size_regions_layer, h);

@@ -146,6 +146,7 @@ void expect_same_options(const globemesh::MeshOptions &a, const globemesh::MeshO
     EXPECT_EQ(a.wavelength, b.wavelength);
     EXPECT_EQ(a.wave_period_h, b.wave_period_h);
     EXPECT_EQ(a.slope, b.slope);
+    EXPECT_EQ(a.feature_size, b.feature_size);
     EXPECT_EQ(a.size_regions, b.size_regions);
     EXPECT_EQ(a.size_regions_layer, b.size_regions_layer);
     EXPECT_EQ(a.grade, b.grade);
@@ -211,6 +212,8 @@ std::vector<std::string> every_option(const std::string &out_dir) {
             "745.2min",
             "--slope",
             "12",
+            "--feature-size",
+            "2.5",
             "--size-regions",
             out_dir + "/sizes.gpkg",
             "--size-regions-layer",
