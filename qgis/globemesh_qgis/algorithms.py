@@ -63,8 +63,16 @@ class _ShowDepth(QgsProcessingLayerPostProcessorInterface):
             show_depth(layer)
 
 
-# Processing keeps only a pointer to a post-processor: the Python object must outlive the run.
-_SHOW_DEPTH = _ShowDepth()
+# The processing context deletes its post-processors with itself, but holds no Python reference:
+# each run's is kept alive here until QGIS has deleted it.
+_POST_PROCESSORS = []
+
+
+def _show_depth_post_processor():
+    from qgis.PyQt import sip
+    _POST_PROCESSORS[:] = [p for p in _POST_PROCESSORS if not sip.isdeleted(p)]
+    _POST_PROCESSORS.append(_ShowDepth())
+    return _POST_PROCESSORS[-1]
 
 
 class _Algorithm(QgsProcessingAlgorithm):
@@ -95,7 +103,7 @@ class _Algorithm(QgsProcessingAlgorithm):
         name = os.path.splitext(os.path.basename(nc))[0]
         details = QgsProcessingContext.LayerDetails(name, context.project(), self.OUTPUT,
                                                     QgsProcessingUtils.LayerHint.Mesh)
-        details.setPostProcessor(_SHOW_DEPTH)
+        details.setPostProcessor(_show_depth_post_processor())
         context.addLayerToLoadOnCompletion(nc, details)
         for layer in GPKG_LAYERS if gpkg else ():
             context.addLayerToLoadOnCompletion(

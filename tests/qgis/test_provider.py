@@ -92,5 +92,54 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
             assert layer.isValid() and layer.featureCount() > 0, path
 print("OK: %d faces" % mesh.meshFaceCount())
 del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
+
+
+def nodes_in(nc, west, south, east, north):
+    """How many nodes of the UGRID file lie in the box (read with netCDF4, not QGIS)."""
+    import netCDF4
+    with netCDF4.Dataset(nc) as file:
+        lon, lat = file["mesh_node_lon"][:], file["mesh_node_lat"][:]
+    return int(((lon >= west) & (lon <= east) & (lat >= south) & (lat <= north)).sum()), len(lon)
+
+
+# A region (as Processing writes an extent: xmin,xmax,ymin,ymax [crs]) and the selected features only:
+# with Great Britain left out of the selection, the sea covers England.
+with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
+    england = (-2.5, 52, -1, 53.2)  # the Midlands
+    for selected in (False, True):
+        if selected:
+            from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition
+            inland = QgsGeometry.fromPointXY(QgsPointXY(-1.5, 52.8))
+            coast.selectByIds([f.id() for f in coast.getFeatures() if not f.geometry().intersects(inland)])
+            assert 0 < coast.selectedFeatureCount() < coast.featureCount()
+        nc = os.path.join(folder, "region%d.nc" % selected)
+        source = QgsProcessingFeatureSourceDefinition(coast.id(), True) if selected else coast.id()
+        processing.run("globemesh:meshocean", {"COAST": source, "REGION": "-20,20,30,60 [EPSG:4326]",
+                                               "HMAX": 50, "OUTPUT": nc})
+        # The whole mesh in the region, whose edges are great circles: its north edge rises to
+        # atan(tan 60 / cos 20) = 61.5 N midway.
+        inside, total = nodes_in(nc, -20.001, 29.999, 20.001, 61.6)
+        assert inside == total > 0 and nodes_in(nc, -20.001, 29.999, 20.001, 60.001)[0] < total, (inside, total)
+        assert (nodes_in(nc, *england)[0] > 0) == selected, nodes_in(nc, *england)
+        assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+
+    # Cancelled (as the progress bar's Cancel button does): nothing written.
+    cancelled = QgsProcessingFeedback()
+    cancelled.cancel()
+    nc = os.path.join(folder, "cancelled.nc")
+    assert processing.run("globemesh:meshocean", {"COAST": coast.id(), "HMAX": 500, "OUTPUT": nc},
+                          feedback=cancelled) == {}
+    assert not os.path.exists(nc), os.listdir(folder)
+
+    # Triangulate points: 2000 points spread over the whole sphere make 2*2000-4 triangles (Euler).
+    points = QgsVectorLayer("file://%s?type=csv&xField=lon&yField=lat&crs=EPSG:4326"
+                            % os.path.join(FIXTURES, "points", "stations.csv"), "stations", "delimitedtext")
+    assert points.isValid() and points.featureCount() == 2000
+    nc = os.path.join(folder, "stations.nc")
+    processing.run("globemesh:triangulate", {"POINTS": points, "OUTPUT": nc})
+    mesh = QgsMeshLayer(nc, "stations", "mdal")
+    assert mesh.meshFaceCount() == 3996 and mesh.meshVertexCount() == 2000, mesh.meshFaceCount()
+    assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+    del mesh, points
 project.clear()
 app.exitQgis()
