@@ -44,6 +44,17 @@ def _long_name(path, variable):
         return None
 
 
+def _first_layer(path):
+    """The name of the first layer of an OGR source: the layer QGIS reads from a path that names
+    none (globemesh asks for one when there are several)."""
+    from osgeo import ogr
+    try:
+        source = ogr.Open(path)
+        return source.GetLayer(0).GetName() if source and source.GetLayerCount() else None
+    except RuntimeError:
+        return None
+
+
 def show_depth(layer):
     """Makes the mesh layer draw its dataset group of the variable depth (QGIS draws the first
     group, face area, otherwise). True when it has one."""
@@ -161,7 +172,7 @@ class MeshOcean(_Algorithm):
         """The keywords of globemesh.mesh_ocean() given by the parameters."""
         coast, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(
             parameters, self.COAST, context, ["gpkg", "shp"], "gpkg", feedback)
-        options = {"coast": coast, "coast_layer": layer or None,
+        options = {"coast": coast, "coast_layer": layer or _first_layer(coast),
                    "hmax": "%rkm" % self.parameterAsDouble(parameters, self.HMAX, context),
                    "hmin": "%rkm" % self.parameterAsDouble(parameters, self.HMIN, context)}
         bathy = self.parameterAsRasterLayer(parameters, self.BATHY, context)

@@ -24,6 +24,7 @@ def skip(why):
 
 
 os.environ["QT_QPA_PLATFORM"] = "offscreen"
+os.environ["GDAL_PAM_ENABLED"] = "NO"  # no .aux.xml beside the fixtures
 try:
     from qgis.core import (QgsApplication, QgsMeshDatasetIndex, QgsMeshLayer, QgsProcessingContext,
                            QgsProcessingFeedback, QgsProject, QgsRasterLayer, QgsVectorLayer)
@@ -122,6 +123,16 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
         assert inside == total > 0 and nodes_in(nc, -20.001, 29.999, 20.001, 60.001)[0] < total, (inside, total)
         assert (nodes_in(nc, *england)[0] > 0) == selected, nodes_in(nc, *england)
         assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+
+    # A path with several polygon layers and no layer named: the first, as QGIS reads it.
+    from osgeo import gdal
+    two = os.path.join(folder, "two_layers.gpkg")
+    for name in ("land", "land_again"):
+        gdal.VectorTranslate(two, os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg"), layers=["land"],
+                             layerName=name, accessMode="update" if os.path.exists(two) else None)
+    nc = os.path.join(folder, "two_layers.nc")
+    assert processing.run("globemesh:meshocean", {"COAST": two, "HMAX": 500, "OUTPUT": nc}) == {
+        "OUTPUT": nc, "OUTPUT_GPKG": None}
 
     # Cancelled (as the progress bar's Cancel button does): nothing written.
     cancelled = QgsProcessingFeedback()
