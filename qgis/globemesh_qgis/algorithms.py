@@ -177,6 +177,9 @@ class MeshOcean(_Algorithm):
                    "hmin": "%rkm" % self.parameterAsDouble(parameters, self.HMIN, context)}
         bathy = self.parameterAsRasterLayer(parameters, self.BATHY, context)
         if bathy is not None:
+            if bathy.providerType() != "gdal":  # globemesh reads the raster with GDAL, by its source
+                raise QgsProcessingException("bathymetry layer %s: not a GDAL raster (provider %s); save it as a "
+                                             "GeoTIFF first" % (bathy.name(), bathy.providerType()))
             options["bathy"] = bathy.source()
         if parameters.get(self.REGION):
             r = self.parameterAsExtent(parameters, self.REGION, context, WGS84)
