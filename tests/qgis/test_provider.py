@@ -1,0 +1,156 @@
+"""The QGIS Processing provider (qgis/globemesh_qgis), headless in Debian's QGIS: the provider
+loads with its two algorithms; "Mesh ocean" runs on a coastline layer and a bathymetry layer
+opened in a QGIS project, its UGRID file opens in QGIS as a mesh with faces, the checker
+../shared/tools/mesh-verify accepts it, and the outputs it asks to load are the mesh (drawn by
+depth) and the GeoPackage's layers. Exit 77 (ctest: skipped) when QGIS's Python cannot be
+imported or mesh-verify is absent (a failure under CI=true, as tests/support.hpp)."""
+
+import os
+import subprocess
+import sys
+import tempfile
+
+SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+FIXTURES = os.path.join(SOURCE, "fixtures")
+SHARED = os.environ.get("GLOBEMESH_SHARED_DIR", os.path.join(SOURCE, "..", "shared"))
+CHECKER = os.environ.get("GLOBEMESH_MESH_VERIFY", os.path.join(SHARED, "tools", "mesh-verify"))
+
+
+def skip(why):
+    if os.environ.get("CI") == "true":
+        sys.exit("%s, and CI=true requires it" % why)
+    print("SKIPPED: " + why)
+    sys.exit(77)
+
+
+os.environ["QT_QPA_PLATFORM"] = "offscreen"
+os.environ["GDAL_PAM_ENABLED"] = "NO"  # no .aux.xml beside the fixtures
+try:
+    from qgis.core import (QgsApplication, QgsMeshDatasetIndex, QgsMeshLayer, QgsProcessingContext,
+                           QgsProcessingFeedback, QgsProject, QgsRasterLayer, QgsVectorLayer)
+except ImportError as e:
+    skip("QGIS's Python (Debian: python3-qgis) cannot be imported: %s" % e)
+if not os.path.exists(CHECKER):
+    skip("mesh-verify (%s) is missing" % CHECKER)
+
+app = QgsApplication([], False)
+app.initQgis()
+sys.path.insert(0, os.path.join(SOURCE, "qgis"))
+sys.path.append("/usr/share/qgis/python/plugins")  # Debian's processing
+import processing  # noqa: E402
+from processing.core.Processing import Processing  # noqa: E402
+
+from globemesh_qgis.provider import GlobemeshProvider  # noqa: E402
+
+Processing.initialize()
+provider = GlobemeshProvider()
+assert QgsApplication.processingRegistry().addProvider(provider)
+assert provider.id() == "globemesh"
+names = sorted(a.id() for a in provider.algorithms())
+assert names == ["globemesh:meshocean", "globemesh:triangulate"], names
+
+project = QgsProject.instance()
+coast = QgsVectorLayer(os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg") + "|layername=land", "land", "ogr")
+bathy = QgsRasterLayer(os.path.join(FIXTURES, "bathy", "etopo5_global_10min.nc"), "etopo5")
+assert coast.isValid() and bathy.isValid()
+project.addMapLayers([coast, bathy])
+
+with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
+    nc, gpkg = os.path.join(folder, "ocean.nc"), os.path.join(folder, "ocean.gpkg")
+    context = QgsProcessingContext()
+    context.setProject(project)
+    feedback = QgsProcessingFeedback()
+    steps = []
+    feedback.progressChanged.connect(steps.append)
+    result = processing.run("globemesh:meshocean", {"COAST": coast.id(), "BATHY": bathy.id(), "HMAX": 500,
+                                                    "HMIN": 150, "OUTPUT": nc, "OUTPUT_GPKG": gpkg},
+                            context=context, feedback=feedback)
+    assert result == {"OUTPUT": nc, "OUTPUT_GPKG": gpkg}, result
+    assert steps and max(steps) > 50, steps  # the run moved the progress bar
+
+    mesh = QgsMeshLayer(nc, "ocean", "mdal")
+    assert mesh.isValid() and mesh.meshFaceCount() > 0, (mesh.isValid(), mesh.meshFaceCount())
+    status = subprocess.run([CHECKER, nc, "--quiet", "--size-var", "target_size"]).returncode
+    assert status == 0, "mesh-verify rejects %s" % nc
+
+    # What it loads when done: the mesh, drawn by depth once Processing post-processes it, and the
+    # GeoPackage's faces and boundary.
+    loads = context.layersToLoadOnCompletion()
+    assert sorted(loads) == sorted([nc, gpkg + "|layername=faces", gpkg + "|layername=boundary"]), sorted(loads)
+    def active(layer):
+        group = layer.rendererSettings().activeScalarDatasetGroup()
+        return layer.datasetGroupMetadata(QgsMeshDatasetIndex(group)).name()
+
+    import netCDF4  # QGIS's reader names a group by its variable's long_name
+    with netCDF4.Dataset(nc) as file:
+        depth = file["depth"].long_name
+    assert active(mesh) != depth  # what QGIS draws by itself
+    loads[nc].postProcessor().postProcessLayer(mesh, context, feedback)
+    assert active(mesh) == depth, active(mesh)
+    for path in loads:
+        if path != nc:
+            layer = QgsVectorLayer(path, "x", "ogr")
+            assert layer.isValid() and layer.featureCount() > 0, path
+print("OK: %d faces" % mesh.meshFaceCount())
+del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
+
+
+def nodes_in(nc, west, south, east, north):
+    """How many nodes of the UGRID file lie in the box (read with netCDF4, not QGIS)."""
+    import netCDF4
+    with netCDF4.Dataset(nc) as file:
+        lon, lat = file["mesh_node_lon"][:], file["mesh_node_lat"][:]
+    return int(((lon >= west) & (lon <= east) & (lat >= south) & (lat <= north)).sum()), len(lon)
+
+
+# A region (as Processing writes an extent: xmin,xmax,ymin,ymax [crs]) and the selected features only:
+# with Great Britain left out of the selection, the sea covers England.
+with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
+    england = (-2.5, 52, -1, 53.2)  # the Midlands
+    for selected in (False, True):
+        if selected:
+            from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition
+            inland = QgsGeometry.fromPointXY(QgsPointXY(-1.5, 52.8))
+            coast.selectByIds([f.id() for f in coast.getFeatures() if not f.geometry().intersects(inland)])
+            assert 0 < coast.selectedFeatureCount() < coast.featureCount()
+        nc = os.path.join(folder, "region%d.nc" % selected)
+        source = QgsProcessingFeatureSourceDefinition(coast.id(), True) if selected else coast.id()
+        processing.run("globemesh:meshocean", {"COAST": source, "REGION": "-20,20,30,60 [EPSG:4326]",
+                                               "HMAX": 50, "OUTPUT": nc})
+        # The whole mesh in the region, whose edges are great circles: its north edge rises to
+        # atan(tan 60 / cos 20) = 61.5 N midway.
+        inside, total = nodes_in(nc, -20.001, 29.999, 20.001, 61.6)
+        assert inside == total > 0 and nodes_in(nc, -20.001, 29.999, 20.001, 60.001)[0] < total, (inside, total)
+        assert (nodes_in(nc, *england)[0] > 0) == selected, nodes_in(nc, *england)
+        assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+
+    # A path with several polygon layers and no layer named: the first, as QGIS reads it.
+    from osgeo import gdal
+    two = os.path.join(folder, "two_layers.gpkg")
+    for name in ("land", "land_again"):
+        gdal.VectorTranslate(two, os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg"), layers=["land"],
+                             layerName=name, accessMode="update" if os.path.exists(two) else None)
+    nc = os.path.join(folder, "two_layers.nc")
+    assert processing.run("globemesh:meshocean", {"COAST": two, "HMAX": 500, "OUTPUT": nc}) == {
+        "OUTPUT": nc, "OUTPUT_GPKG": None}
+
+    # Cancelled (as the progress bar's Cancel button does): nothing written.
+    cancelled = QgsProcessingFeedback()
+    cancelled.cancel()
+    nc = os.path.join(folder, "cancelled.nc")
+    assert processing.run("globemesh:meshocean", {"COAST": coast.id(), "HMAX": 500, "OUTPUT": nc},
+                          feedback=cancelled) == {}
+    assert not os.path.exists(nc), os.listdir(folder)
+
+    # Triangulate points: 2000 points spread over the whole sphere make 2*2000-4 triangles (Euler).
+    points = QgsVectorLayer("file://%s?type=csv&xField=lon&yField=lat&crs=EPSG:4326"
+                            % os.path.join(FIXTURES, "points", "stations.csv"), "stations", "delimitedtext")
+    assert points.isValid() and points.featureCount() == 2000
+    nc = os.path.join(folder, "stations.nc")
+    processing.run("globemesh:triangulate", {"POINTS": points, "OUTPUT": nc})
+    mesh = QgsMeshLayer(nc, "stations", "mdal")
+    assert mesh.meshFaceCount() == 3996 and mesh.meshVertexCount() == 2000, mesh.meshFaceCount()
+    assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+    del mesh, points
+project.clear()
+app.exitQgis()
