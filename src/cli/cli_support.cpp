@@ -115,9 +115,14 @@ InterruptGuard::~InterruptGuard() {
     g_guard_ending = true;
     sem_post(&g_wake);
     watchdog_.join();
+    // A run that completed ignores the signals until the process ends: one arriving between
+    // here and exit would otherwise end it by the default action, its outputs all in place.
+    struct sigaction ignore {};
+    ignore.sa_handler = SIG_IGN;
+    sigemptyset(&ignore.sa_mask);
     for (std::size_t k = 0; k < std::size(cancelling); ++k)
         if (installed_[k])
-            sigaction(cancelling[k], &previous_[k], nullptr);
+            sigaction(cancelling[k], g_completing ? &ignore : &previous_[k], nullptr);
     sem_destroy(&g_wake);
 }
 

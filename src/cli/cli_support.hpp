@@ -41,8 +41,9 @@ public:
     /// Clears signal() before a new run.
     static void forget();
     /// The run is about to move its outputs in place (OutputBatch::commit, which still stops on
-    /// a signal that came before): from now on every signal is ignored, so that the run ends
-    /// either with all its outputs and status 0 or, when the commit fails, with none.
+    /// a signal that came before): from now on every signal is ignored, also after the guard
+    /// ends (it then leaves them ignored rather than restoring the earlier handlers), so that the
+    /// process ends either with all its outputs and status 0 or, when the commit fails, with none.
     static void completing();
     /// The signals that cancel a run: Ctrl-C, `kill` and batch schedulers at their time limit
     /// (SIGTERM), and a closed terminal (SIGHUP). Each would otherwise end the process at once
