@@ -162,6 +162,7 @@ void expect_same_cli(const globemesh::CliOptions &a, const globemesh::CliOptions
     EXPECT_EQ(a.output, b.output);
     EXPECT_EQ(a.gpkg, b.gpkg);
     EXPECT_EQ(a.preview, b.preview);
+    EXPECT_EQ(a.preview_region, b.preview_region);
     EXPECT_EQ(a.format, b.format);
     EXPECT_EQ(a.timings, b.timings);
     EXPECT_EQ(a.report, b.report);
@@ -236,6 +237,8 @@ std::vector<std::string> every_option(const std::string &out_dir) {
             out_dir + "/o.gpkg",
             "--preview",
             out_dir + "/o.png",
+            "--preview-region",
+            "170,-50,-170,-10",
             "--format",
             "classic",
             "--timings",
@@ -425,6 +428,7 @@ TEST(Cli, print_config_round_trips_every_option) {
     expect_same_cli(again, original);
     // Not vacuous: the values differ from the defaults.
     EXPECT_DOUBLE_EQ(original.mesh.hmax_km, 45.0);
+    EXPECT_EQ(original.preview_region, (std::array<double, 4>{170, -50, -170, -10}));
     EXPECT_DOUBLE_EQ(original.mesh.wave_period_h, 12.42);
     EXPECT_DOUBLE_EQ(original.mesh.min_island_area_km2, 25.0);
     EXPECT_EQ(original.mesh.coast_rate, 0.123456789012345);
