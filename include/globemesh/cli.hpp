@@ -70,6 +70,9 @@ struct CliOptions {
     std::vector<std::string> creation_options; ///< --co KEY=VALUE: creation options of the outputs
     std::string gpkg;                          ///< --gpkg: also write a GeoPackage
     std::string preview;                       ///< --preview: also draw a PNG picture of the mesh
+    /// --preview-region: W,S,E,N in degrees the PNG pictures show (W > E crosses +-180); unset:
+    /// the --region, else the mesh's extent.
+    std::optional<std::array<double, 4>> preview_region;
     std::string
         output_srs; ///< --output-srs: CRS of the model formats' coordinates (empty: lon/lat)
     std::string msh_version; ///< --msh-version: MSH_VERSION of .msh outputs (empty: the default)

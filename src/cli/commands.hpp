@@ -21,12 +21,14 @@ namespace globemesh::cli {
 struct MeshCommand {
     CliOptions o;
     std::vector<double> region;
+    std::vector<double> preview_region;
     double bathy_fill_m = 0;
     double min_depth_m = 0;
     std::string max_memory_text = "auto";
     CLI::App app{"Mesh the ocean between the coastlines, graded by the size options.",
                  "globemesh mesh"};
     CLI::Option *region_opt = nullptr;
+    CLI::Option *preview_region_opt = nullptr;
     CLI::Option *bathy_fill_opt = nullptr;
     CLI::Option *min_depth_opt = nullptr;
 

@@ -1,6 +1,7 @@
 // The `mesh` subcommand's options, one function per group of --help, and their parsing.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string>
 
@@ -16,6 +17,25 @@
 #include "option_flags.hpp"
 
 namespace globemesh::cli {
+
+namespace {
+
+/// --preview-region's W,S,E,N, checked as --region is (W > E crosses +-180); one-line
+/// UsageError otherwise.
+std::array<double, 4> checked_preview_region(const std::vector<double> &r) {
+    const std::string flag = "--preview-region: ";
+    if (!std::all_of(r.begin(), r.end(), [](double v) { return std::isfinite(v); }))
+        throw UsageError(flag + "values must be numbers: W,S,E,N in degrees");
+    if (r[0] < -180 || r[0] > 180 || r[2] < -180 || r[2] > 180)
+        throw UsageError(flag + "longitudes W and E must be in [-180, 180]");
+    if (!(r[1] >= -90 && r[3] <= 90 && r[1] < r[3]))
+        throw UsageError(flag + "needs -90 <= S < N <= 90 (W,S,E,N in degrees)");
+    if (r[0] == r[2])
+        throw UsageError(flag + "W and E must differ (W > E crosses +-180)");
+    return {r[0], r[1], r[2], r[3]};
+}
+
+} // namespace
 
 MeshCommand::MeshCommand(std::span<const Writer> table) {
     app.option_defaults()->always_capture_default();
@@ -227,9 +247,19 @@ void MeshCommand::add_output_options(std::span<const Writer> table, const std::s
     app.add_option("--gpkg", o.gpkg, "Also write a GeoPackage (faces, nodes, boundary, mesh_info)")
         ->group(output)
         ->type_name("OUT.gpkg");
-    app.add_option("--preview", o.preview, "Also draw the mesh over the land as a PNG")
+    app.add_option("--preview", o.preview,
+                   "Also draw the mesh over the land as a PNG (its edges when 4+ pixels long)")
         ->group(output)
         ->type_name("OUT.png");
+    preview_region_opt = app.add_option("--preview-region", preview_region,
+                                        "Region W,S,E,N in degrees the PNG shows (W > E crosses "
+                                        "180); default the --region, else the mesh's extent")
+                             ->group(output)
+                             ->type_name("W,S,E,N")
+                             ->delimiter(',')
+                             ->expected(4);
+    preview_region_opt->always_capture_default(false)->default_str("")->run_callback_for_default(
+        false); // no region: the mesh's extent
     app.add_option(
            "--format", o.format,
            "NetCDF flavour of UGRID outputs: netcdf4 (deflate) or classic (= --co FORMAT=NC2)")
@@ -293,6 +323,8 @@ void MeshCommand::parse(std::span<const std::string> args) {
         o.config = config->as<std::string>();
     if (region_opt->count() > 0 && region.size() == 4)
         o.mesh.region = std::array<double, 4>{region[0], region[1], region[2], region[3]};
+    if (preview_region_opt->count() > 0 && preview_region.size() == 4)
+        o.preview_region = checked_preview_region(preview_region);
     if (bathy_fill_opt->count() > 0)
         o.mesh.bathy_fill_m = bathy_fill_m;
     if (min_depth_opt->count() > 0)

@@ -1,4 +1,5 @@
 // `globemesh mesh`: checks before anything is opened, the run, its outputs and its summary.
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <span>
@@ -42,6 +43,10 @@ std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const W
         extra_creation.emplace_back("--format classic", "FORMAT=NC2");
     const auto planned = plan_outputs(choices, table, extra_creation, !o.mesh.bathy.empty());
     check_output_srs(o.output_srs, requests(planned));
+    if (o.preview_region && std::none_of(planned.begin(), planned.end(), [](const auto &p) {
+            return p.request.writer->name == "PNG";
+        }))
+        throw UsageError("--preview-region zooms the PNG picture: give --preview OUT.png too");
     const auto files = output_files(planned, o.timings, o.report, table);
     const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
                                                           {"--bathy", o.mesh.bathy},
@@ -113,7 +118,7 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     write.history = history_text("mesh", args);
     write.stats = &stats;
     write.land = o.mesh.coast;
-    write.extent_deg = o.mesh.region;
+    write.extent_deg = o.preview_region ? o.preview_region : o.mesh.region;
     write.output_srs = o.output_srs;
     write_run_outputs(mesh, planned, write, terminal, &timings);
     terminal.finish(); // close the progress line if a stage stopped short of its share's end

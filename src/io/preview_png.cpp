@@ -2,7 +2,8 @@
 //
 // Plate carree (lon/lat) picture drawn with GDAL's rasterizer into a MEM RGBA raster and written
 // by the PNG driver: background, optional land polygons, faces coloured by quality or depth
-// (cut at +-180, so nothing smears), and the face outlines when faces are at least 6 px wide.
+// (cut at +-180, so nothing smears), and the edges as thin dark lines when the mean edge of the
+// faces shown spans at least 4 pixels (min_outline_edge_px).
 // An extent that crosses the antimeridian (W > E, or E > 180) is drawn continuously.
 #include <algorithm>
 #include <cmath>
@@ -201,6 +202,51 @@ void draw_land(GDALDataset *canvas, double (&gt)[6], double w, double e,
     canvas->SetGeoTransform(gt);
 }
 
+/// The mean edge of a mesh is drawn as outlines when it spans at least this many pixels.
+constexpr double min_outline_edge_px = 4.0;
+
+/// The mean length in pixels (of geotransform gt, pixel width in longitude) of the edges of the
+/// faces whose first corner lies in the picture [west, east] x [south, north]; 0 when none does.
+/// Measured on the faces shown, so a zoom onto a region judges that region's faces.
+double mean_edge_px(const Mesh &mesh, const double (&gt)[6], double west, double east,
+                    double south) {
+    const double north = gt[3];
+    double sum_rad = 0;
+    std::size_t edges = 0;
+    for (const auto &t : mesh.faces) {
+        const LonLat p = vec_to_lonlat(mesh.nodes[t[0]]);
+        if (shifts_for(p.lon, p.lon, west, east).empty() || p.lat > north || p.lat < south)
+            continue;
+        for (int k = 0; k < 3; ++k)
+            sum_rad += arc_angle(mesh.nodes[t[k]], mesh.nodes[t[(k + 1) % 3]]);
+        edges += 3;
+    }
+    return edges == 0 ? 0.0 : sum_rad / double(edges) * rad_to_deg / gt[1];
+}
+
+/// The edges of one ring of a face (face_polygons) shifted by `shift` degrees, as lines, without
+/// the sides that are no edge of the mesh: a pole corner's side along +-90 and, for a face cut
+/// at +-180, its sides along the cut. Null when none is left.
+std::unique_ptr<OGRGeometry> face_edges(const io::LonLatPart &ring, double shift, bool cut) {
+    auto on_seam = [cut](const io::LonLatPoint &p, const io::LonLatPoint &q) {
+        return (std::fabs(p[1]) == 90 && q[1] == p[1]) ||
+               (cut && std::fabs(p[0]) == 180 && q[0] == p[0]);
+    };
+    auto lines = std::make_unique<OGRMultiLineString>();
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+        const auto &p = ring[i], &q = ring[(i + 1) % ring.size()];
+        if (on_seam(p, q))
+            continue;
+        auto line = std::make_unique<OGRLineString>();
+        line->addPoint(p[0] + shift, p[1]);
+        line->addPoint(q[0] + shift, q[1]);
+        lines->addGeometryDirectly(line.release());
+    }
+    if (lines->IsEmpty())
+        return nullptr;
+    return lines;
+}
+
 /// Burns the faces into the canvas (geotransform gt, longitudes west to east), coloured by
 /// quality (red poor .. green good) or depth (light to dark blue), with their outlines when
 /// faces are large enough; reports the progress from 0.08 to 0.97.
@@ -221,13 +267,8 @@ void draw_faces(GDALDataset *canvas, const double (&gt)[6], double west, double 
     const std::vector<std::pair<double, Rgba>> depth_ramp = {
         {0.0, {222, 235, 247, 255}}, {0.5, {66, 146, 198, 255}}, {1.0, {8, 48, 107, 255}}};
     BurnList faces, outlines;
-    // Outlines only where the mean side of a face is 6 pixels or more.
-    double sides_rad = 0;
-    for (const auto &t : mesh.faces)
-        for (int k = 0; k < 3; ++k)
-            sides_rad += arc_angle(mesh.nodes[t[k]], mesh.nodes[t[(k + 1) % 3]]);
-    const double mean_edge_deg = sides_rad / double(3 * mesh.faces.size()) * rad_to_deg;
-    const bool draw_outlines = mean_edge_deg / gt[1] >= 6.0;
+    const double south = gt[3] + gt[5] * canvas->GetRasterYSize();
+    const bool draw_outlines = mean_edge_px(mesh, gt, west, east, south) >= min_outline_edge_px;
     const Rgba outline = {40, 40, 40, 255};
     // The faces' polygons are made a block at a time on every core and added in order on this
     // thread (ordered_blocks.hpp): the same lists, so the same picture.
@@ -251,7 +292,9 @@ void draw_faces(GDALDataset *canvas, const double (&gt)[6], double west, double 
                                (depth->values[t[0]] + depth->values[t[1]] + depth->values[t[2]]) /
                                    3.0 / depth_max)
                         : ramp(quality_ramp, triangle_quality(a, b, c));
-                for (const auto &ring : io::face_polygons(a, b, c)) {
+                const auto rings = io::face_polygons(a, b, c);
+                const bool cut = rings.size() > 1; // parts of a face across +-180
+                for (const auto &ring : rings) {
                     double lo = 1e9, hi = -1e9, south = 90, north = -90;
                     for (const auto &p : ring) {
                         lo = std::min(lo, p[0]), hi = std::max(hi, p[0]);
@@ -266,7 +309,8 @@ void draw_faces(GDALDataset *canvas, const double (&gt)[6], double west, double 
                             r->addPoint(p[0] + shift, p[1]);
                         r->closeRings();
                         if (draw_outlines)
-                            shapes.outlines.emplace_back(r->clone());
+                            if (auto lines = face_edges(ring, shift, cut); lines)
+                                shapes.outlines.push_back(std::move(lines));
                         auto poly = std::make_unique<OGRPolygon>();
                         poly->addRingDirectly(r.release());
                         shapes.faces.push_back(std::move(poly));

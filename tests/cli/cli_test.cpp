@@ -162,6 +162,7 @@ void expect_same_cli(const globemesh::CliOptions &a, const globemesh::CliOptions
     EXPECT_EQ(a.output, b.output);
     EXPECT_EQ(a.gpkg, b.gpkg);
     EXPECT_EQ(a.preview, b.preview);
+    EXPECT_EQ(a.preview_region, b.preview_region);
     EXPECT_EQ(a.format, b.format);
     EXPECT_EQ(a.timings, b.timings);
     EXPECT_EQ(a.report, b.report);
@@ -236,6 +237,8 @@ std::vector<std::string> every_option(const std::string &out_dir) {
             out_dir + "/o.gpkg",
             "--preview",
             out_dir + "/o.png",
+            "--preview-region",
+            "170,-50,-170,-10",
             "--format",
             "classic",
             "--timings",
@@ -425,6 +428,7 @@ TEST(Cli, print_config_round_trips_every_option) {
     expect_same_cli(again, original);
     // Not vacuous: the values differ from the defaults.
     EXPECT_DOUBLE_EQ(original.mesh.hmax_km, 45.0);
+    EXPECT_EQ(original.preview_region, (std::array<double, 4>{170, -50, -170, -10}));
     EXPECT_DOUBLE_EQ(original.mesh.wave_period_h, 12.42);
     EXPECT_DOUBLE_EQ(original.mesh.min_island_area_km2, 25.0);
     EXPECT_EQ(original.mesh.coast_rate, 0.123456789012345);
@@ -703,6 +707,31 @@ INSTANTIATE_TEST_SUITE_P(
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.json"},
                   2,
                   "--preview"},
+        // --preview-region is checked as --region is, and zooms only a picture.
+        ErrorCase{"preview_region_south_above_north",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.png",
+                   "--preview-region=-8,56,2,49"},
+                  2,
+                  "--preview-region: needs -90 <= S < N"},
+        ErrorCase{"preview_region_longitude_out_of_range",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.png",
+                   "--preview-region=170,-10,190,10"},
+                  2,
+                  "--preview-region: longitudes"},
+        ErrorCase{"preview_region_of_width_zero",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.png",
+                   "--preview-region=5,40,5,50"},
+                  2,
+                  "--preview-region: W and E must differ"},
+        ErrorCase{"preview_region_of_three_values",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview", "{dir}/p.png",
+                   "--preview-region=5,40,6"},
+                  2,
+                  "--preview-region"},
+        ErrorCase{"preview_region_without_a_picture",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--preview-region=-8,49,2,56"},
+                  2,
+                  "give --preview"},
         ErrorCase{"report_named_png",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--report", "{dir}/r.png"},
                   2,

@@ -274,6 +274,56 @@ print('OK')
     EXPECT_EQ(verdict, "OK\n");
 }
 
+TEST(CliE2e, preview_region_zooms_the_picture_and_draws_the_edges_through_the_nodes) {
+    // Oracles: the picture's size follows the asked region; each node of the UGRID file (read by
+    // netCDF4) placed by the asked region's W,S,E,N lands on or next to a dark edge pixel of the
+    // PNG (read by GDAL); a whole-globe picture of the same mesh (faces about 2 pixels) has none.
+    TempDir dir;
+    std::string out, err;
+    for (const auto &[name, region] : {std::pair{"r", "-8,49,2,56"}, {"g", "-180,-90,180,90"}}) {
+        const int status =
+            run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-12,48,10,62",
+                     "--bathy", shelf_dem, "--hmax", "60km", "--hmin", "10km", "-o",
+                     (dir / (std::string(name) + ".nc")).string(), "--preview",
+                     (dir / (std::string(name) + ".png")).string(),
+                     "--preview-region=" + std::string(region), "--quiet"},
+                    out, err, dir.path());
+        ASSERT_EQ(status, 0) << err;
+    }
+    expect_mesh_verify(dir / "r.nc");
+    const std::string verdict = python(R"(
+import netCDF4, numpy as np
+from osgeo import gdal
+ds = netCDF4.Dataset(')" + (dir / "r.nc").string() +
+                                           R"(')
+mesh = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_topology'][0]
+lon = np.asarray(ds.variables[mesh.node_coordinates.split()[0]][:])
+lat = np.asarray(ds.variables[mesh.node_coordinates.split()[1]][:])
+def rgb(name):
+    png = gdal.Open(')" + dir.path().string() +
+                                           R"(/' + name)
+    return np.stack([png.GetRasterBand(b).ReadAsArray() for b in (1, 2, 3)], axis=-1).astype(int)
+def dark(a):  # the edges' colour (40, 40, 40): no face, land or background colour is grey
+    return (a[..., 0] == 40) & (a[..., 1] == 40) & (a[..., 2] == 40)
+zoom = rgb('r.png')
+W, S, E, N = -8, 49, 2, 56
+h, w = zoom.shape[:2]
+assert w == 1600 and abs(h - round(1600 * (N - S) / (E - W))) <= 1, (w, h)
+col = (lon - W) / (E - W) * w
+row = (N - lat) / (N - S) * h
+inside = (col >= 2) & (col < w - 2) & (row >= 2) & (row < h - 2)
+assert inside.sum() > 50, inside.sum()
+edge = dark(zoom)
+near = [edge[int(r) - 1:int(r) + 2, int(c) - 1:int(c) + 2].any() for c, r in zip(col[inside], row[inside])]
+assert np.mean(near) > 0.95, np.mean(near)
+assert edge.mean() > 0.005, edge.mean()
+assert not dark(rgb('g.png')).any()
+print('OK')
+)",
+                                       dir.path());
+    EXPECT_EQ(verdict, "OK\n");
+}
+
 TEST(CliE2e, a_config_file_run_equals_the_same_run_by_options) {
     TempDir dir;
     std::string out, err;

@@ -677,6 +677,44 @@ TEST(Preview, draws_faces_over_land_without_smearing_across_the_map) {
     EXPECT_GT(at_cap_east[1], at_cap_east[0]); // quality ~0.9: green over red
 }
 
+TEST(Preview, edges_are_drawn_across_180_without_a_line_along_the_cut) {
+    // Faces about 3.8 degrees on a picture of 20 pixels a degree (W > E: across 180): their
+    // edges are drawn, dark grey, but the cut of the faces across 180 is no edge of the mesh, so
+    // the columns at 180 are dark only where edges cross them. Drawn, the cut would darken the
+    // columns along the whole cap (about half of the picture's height).
+    TempDir dir;
+    const Mesh m = icosphere_cap(4, 180, 0, 30);
+    PreviewOptions o;
+    o.width_px = 400;
+    o.extent_deg = std::array<double, 4>{170, -10, -170, 10};
+    write_preview_png(m, dir / "seam.png", o);
+    Dataset d(dir / "seam.png", GDAL_OF_RASTER);
+    ASSERT_TRUE(d.ds);
+    const int nx = d.ds->GetRasterXSize(), ny = d.ds->GetRasterYSize();
+    ASSERT_EQ(nx, 400);
+    ASSERT_EQ(ny, 400);
+    std::vector<std::uint8_t> rgb(3 * std::size_t(nx) * std::size_t(ny));
+    int bands[3] = {1, 2, 3};
+    ASSERT_EQ(d.ds->RasterIO(GF_Read, 0, 0, nx, ny, rgb.data(), nx, ny, GDT_Byte, 3, bands, 3,
+                             3 * nx, 1, nullptr),
+              CE_None);
+    auto dark = [&](int x, int y) {
+        const std::size_t i = 3 * (std::size_t(y) * std::size_t(nx) + std::size_t(x));
+        return rgb[i] == 40 && rgb[i + 1] == 40 && rgb[i + 2] == 40;
+    };
+    std::size_t all = 0;
+    for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x)
+            all += dark(x, y);
+    EXPECT_GT(double(all) / double(nx * ny), 0.02); // the edges are drawn
+    for (int x = 198; x <= 201; ++x) {              // lon 180 is between columns 199 and 200
+        int column = 0;
+        for (int y = 0; y < ny; ++y)
+            column += dark(x, y);
+        EXPECT_LT(column, ny / 5) << "column " << x;
+    }
+}
+
 TEST(Preview, faces_smaller_than_a_pixel_leave_no_pixel_of_a_closed_sphere_unpainted) {
     // 327,680 faces, at 200 pixels about a quarter of a pixel wide: the writer skips those whose
     // box holds no pixel centre (they burn nothing); at 1,600 pixels about two pixels wide, and
