@@ -10,6 +10,8 @@ from qgis.core import (QgsCoordinateReferenceSystem, QgsFeatureRequest, QgsMeshD
                        QgsProcessingParameterFeatureSource, QgsProcessingParameterFileDestination,
                        QgsProcessingParameterNumber, QgsProcessingParameterRasterLayer, QgsProcessingUtils)
 
+from . import styles
+
 WGS84 = QgsCoordinateReferenceSystem("EPSG:4326")
 GPKG_LAYERS = ("faces", "boundary")  # the GeoPackage's layers loaded into the project
 
@@ -68,21 +70,28 @@ def show_depth(layer):
     return False
 
 
-class _ShowDepth(QgsProcessingLayerPostProcessorInterface):
+class _Style(QgsProcessingLayerPostProcessorInterface):
+    """Styles a loaded layer: the mesh by depth, a GeoPackage layer by styles.STYLES[name]."""
+    def __init__(self, gpkg_layer=None):
+        super().__init__()
+        self.gpkg_layer = gpkg_layer
+
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802 (QGIS's name)
         if isinstance(layer, QgsMeshLayer):
             show_depth(layer)
+        elif self.gpkg_layer in styles.STYLES:
+            styles.STYLES[self.gpkg_layer](layer)
 
 
 # The processing context deletes its post-processors with itself, but holds no Python reference:
-# each run's is kept alive here until QGIS has deleted it.
+# each run's are kept alive here until QGIS has deleted them.
 _POST_PROCESSORS = []
 
 
-def _show_depth_post_processor():
+def _post_processor(gpkg_layer=None):
     from qgis.PyQt import sip
     _POST_PROCESSORS[:] = [p for p in _POST_PROCESSORS if not sip.isdeleted(p)]
-    _POST_PROCESSORS.append(_ShowDepth())
+    _POST_PROCESSORS.append(_Style(gpkg_layer))
     return _POST_PROCESSORS[-1]
 
 
@@ -114,13 +123,13 @@ class _Algorithm(QgsProcessingAlgorithm):
         name = os.path.splitext(os.path.basename(nc))[0]
         details = QgsProcessingContext.LayerDetails(name, context.project(), self.OUTPUT,
                                                     QgsProcessingUtils.LayerHint.Mesh)
-        details.setPostProcessor(_show_depth_post_processor())
+        details.setPostProcessor(_post_processor())
         context.addLayerToLoadOnCompletion(nc, details)
         for layer in GPKG_LAYERS if gpkg else ():
-            context.addLayerToLoadOnCompletion(
-                "%s|layername=%s" % (gpkg, layer),
-                QgsProcessingContext.LayerDetails("%s %s" % (name, layer), context.project(), self.OUTPUT_GPKG,
-                                                  QgsProcessingUtils.LayerHint.Vector))
+            details = QgsProcessingContext.LayerDetails("%s %s" % (name, layer), context.project(), self.OUTPUT_GPKG,
+                                                        QgsProcessingUtils.LayerHint.Vector)
+            details.setPostProcessor(_post_processor(layer))
+            context.addLayerToLoadOnCompletion("%s|layername=%s" % (gpkg, layer), details)
         return {self.OUTPUT: nc, self.OUTPUT_GPKG: gpkg or None}
 
     def _run(self, run, parameters, context, feedback):

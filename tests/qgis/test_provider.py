@@ -84,13 +84,34 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     import netCDF4  # QGIS's reader names a group by its variable's long_name
     with netCDF4.Dataset(nc) as file:
         depth = file["depth"].long_name
+    assert active(mesh) == depth, active(mesh)  # by the style ocean.qml beside ocean.nc
+    os.remove(os.path.join(folder, "ocean.qml"))
+    mesh = QgsMeshLayer(nc, "ocean", "mdal")
     assert active(mesh) != depth  # what QGIS draws by itself
     loads[nc].postProcessor().postProcessLayer(mesh, context, feedback)
     assert active(mesh) == depth, active(mesh)
+    # The GeoPackage's layers: faces graduated by quality, boundary coast and open in two colours,
+    # also when QGIS did not load the faces' style stored in the GeoPackage.
+    from qgis.core import QgsCategorizedSymbolRenderer, QgsGraduatedSymbolRenderer
+    bare = QgsVectorLayer.LayerOptions()
+    bare.loadDefaultStyle = False
     for path in loads:
         if path != nc:
-            layer = QgsVectorLayer(path, "x", "ogr")
-            assert layer.isValid() and layer.featureCount() > 0, path
+            for options in (QgsVectorLayer.LayerOptions(), bare):
+                layer = QgsVectorLayer(path, "x", "ogr", options)
+                assert layer.isValid() and layer.featureCount() > 0, path
+                loads[path].postProcessor().postProcessLayer(layer, context, feedback)
+                renderer = layer.renderer()
+                if path.endswith("faces"):
+                    assert isinstance(renderer, QgsGraduatedSymbolRenderer), renderer
+                    assert renderer.classAttribute() == "quality" and len(renderer.ranges()) == 5
+                else:
+                    assert isinstance(renderer, QgsCategorizedSymbolRenderer), renderer
+                    assert renderer.classAttribute() == "tag"
+                    colours = {c.value(): c.symbol().color().name() for c in renderer.categories()}
+                    assert sorted(colours) == ["coast", "open"] and len(set(colours.values())) == 2, colours
+                    tags = {f["tag"] for f in layer.getFeatures()}
+                    assert tags <= set(colours), tags  # every feature drawn by a category
 print("OK: %d faces" % mesh.meshFaceCount())
 del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
 
