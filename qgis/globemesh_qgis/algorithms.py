@@ -10,6 +10,8 @@ from qgis.core import (QgsCoordinateReferenceSystem, QgsFeatureRequest, QgsMeshD
                        QgsProcessingParameterFeatureSource, QgsProcessingParameterFileDestination,
                        QgsProcessingParameterNumber, QgsProcessingParameterRasterLayer, QgsProcessingUtils)
 
+from . import display, styles
+
 WGS84 = QgsCoordinateReferenceSystem("EPSG:4326")
 GPKG_LAYERS = ("faces", "boundary")  # the GeoPackage's layers loaded into the project
 
@@ -68,21 +70,28 @@ def show_depth(layer):
     return False
 
 
-class _ShowDepth(QgsProcessingLayerPostProcessorInterface):
+class _Style(QgsProcessingLayerPostProcessorInterface):
+    """Styles a loaded layer: the mesh by depth, a GeoPackage layer by styles.STYLES[name]."""
+    def __init__(self, gpkg_layer=None):
+        super().__init__()
+        self.gpkg_layer = gpkg_layer
+
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802 (QGIS's name)
         if isinstance(layer, QgsMeshLayer):
             show_depth(layer)
+        elif self.gpkg_layer in styles.STYLES:
+            styles.STYLES[self.gpkg_layer](layer)
 
 
 # The processing context deletes its post-processors with itself, but holds no Python reference:
-# each run's is kept alive here until QGIS has deleted it.
+# each run's are kept alive here until QGIS has deleted them.
 _POST_PROCESSORS = []
 
 
-def _show_depth_post_processor():
+def _post_processor(gpkg_layer=None):
     from qgis.PyQt import sip
     _POST_PROCESSORS[:] = [p for p in _POST_PROCESSORS if not sip.isdeleted(p)]
-    _POST_PROCESSORS.append(_ShowDepth())
+    _POST_PROCESSORS.append(_Style(gpkg_layer))
     return _POST_PROCESSORS[-1]
 
 
@@ -112,16 +121,34 @@ class _Algorithm(QgsProcessingAlgorithm):
         paths = [nc] + ([gpkg] if gpkg else [])
         mesh.write(paths, overwrite=True, progress=_progress(feedback))
         name = os.path.splitext(os.path.basename(nc))[0]
-        details = QgsProcessingContext.LayerDetails(name, context.project(), self.OUTPUT,
-                                                    QgsProcessingUtils.LayerHint.Mesh)
-        details.setPostProcessor(_show_depth_post_processor())
-        context.addLayerToLoadOnCompletion(nc, details)
+        shown = self._display_copy(mesh, nc, feedback)
+        details = QgsProcessingContext.LayerDetails(name if shown == nc else name + " (display)", context.project(),
+                                                    self.OUTPUT, QgsProcessingUtils.LayerHint.Mesh)
+        details.setPostProcessor(_post_processor())
+        context.addLayerToLoadOnCompletion(shown, details)
         for layer in GPKG_LAYERS if gpkg else ():
-            context.addLayerToLoadOnCompletion(
-                "%s|layername=%s" % (gpkg, layer),
-                QgsProcessingContext.LayerDetails("%s %s" % (name, layer), context.project(), self.OUTPUT_GPKG,
-                                                  QgsProcessingUtils.LayerHint.Vector))
+            details = QgsProcessingContext.LayerDetails("%s %s" % (name, layer), context.project(), self.OUTPUT_GPKG,
+                                                        QgsProcessingUtils.LayerHint.Vector)
+            details.setPostProcessor(_post_processor(layer))
+            context.addLayerToLoadOnCompletion("%s|layername=%s" % (gpkg, layer), details)
         return {self.OUTPUT: nc, self.OUTPUT_GPKG: gpkg or None}
+
+    @staticmethod
+    def _display_copy(mesh, nc, feedback):
+        """The UGRID file to load: nc, or its display copy when faces cross the antimeridian
+        (display.py); without xarray, nc with a warning."""
+        try:
+            copy = display.write_display_copy(mesh, nc)
+        except ImportError as e:
+            feedback.pushWarning("%s: faces across the antimeridian are drawn smeared across the map (%s: "
+                                 "install python3-xarray for a display copy); the GeoPackage's faces draw right"
+                                 % (nc, e))
+            return nc
+        if copy is None:
+            return nc
+        feedback.pushInfo("%s: display copy of %s for QGIS: %d faces across the antimeridian unwrapped, %d round "
+                          "a pole left out (a model reads %s)" % (copy[0], nc, copy[1], copy[2], nc))
+        return copy[0]
 
     def _run(self, run, parameters, context, feedback):
         """The outputs of the mesh that run(globemesh, progress) makes, with globemesh's errors as
@@ -155,7 +182,8 @@ class MeshOcean(_Algorithm):
                 "'selected features only' is checked) on the sphere, as `globemesh mesh` does: edges of at "
                 "most hmax km, graded down to hmin km, with the depths of the bathymetry raster when given. "
                 "The region, when given, is turned into longitudes and latitudes (EPSG:4326). "
-                "The UGRID mesh is loaded showing depth.")
+                "The UGRID mesh is loaded showing depth; when faces cross the antimeridian, through a display "
+                "copy NAME_display.nc that QGIS draws without smearing them (the UGRID file is the model's).")
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.addParameter(QgsProcessingParameterFeatureSource(self.COAST, "Coastline (land polygons)",

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <future>
 #include <optional>
 #include <set>
@@ -27,6 +28,7 @@
 #include "nc_block_writer.hpp"
 #include "netcdf_handle.hpp"
 #include "ordered_blocks.hpp"
+#include "qgis_style.hpp"
 #include "write_hooks.hpp"
 
 #ifndef GLOBEMESH_VERSION
@@ -442,7 +444,46 @@ void write_ugrid(const Mesh &mesh, const std::filesystem::path &path, const Ugri
     out.commit();
 }
 
-/// The UGRID row of the writers table (writers.cpp).
+namespace {
+
+/// The QGIS style that shows depth first, or "" when the mesh has no depth. QGIS (MDAL) names a
+/// dataset group by its variable's long_name and numbers the groups in the byte order of names.
+std::string depth_style(const Mesh &mesh) {
+    auto group_name = [](const Field &f) { return f.long_name.empty() ? f.name : f.long_name; };
+    std::set<std::string> names = {"quality (2*sqrt(3)*inradius/longest edge)",
+                                   "face area (geodesic, WGS84)"};
+    const Field *depth = nullptr;
+    for (const auto &f : mesh.node_fields) {
+        names.insert(group_name(f));
+        if (f.name == "depth" && !depth)
+            depth = &f;
+    }
+    for (const auto &f : mesh.face_fields)
+        names.insert(group_name(f));
+    if (!depth)
+        return "";
+    double deepest = 0;
+    for (double d : depth->values)
+        if (std::isfinite(d))
+            deepest = std::max(deepest, d);
+    const auto group = std::distance(names.begin(), names.find(group_name(*depth)));
+    return io::qgis_depth_style(int(group), deepest > 0 ? deepest : 1.0);
+}
+
+/// Writes `text` to the temporary file of `out`.
+void write_style(const OutputFile &out, const std::string &text) {
+    std::ofstream f(out.temp_path(), std::ios::binary);
+    f << text;
+    f.flush();
+    if (!f)
+        throw IoError("QGIS style " + out.target().string() + ": write failed" +
+                      OutputFile::full_disk_note(out.target()));
+}
+
+} // namespace
+
+/// The UGRID row of the writers table (writers.cpp); with depth, NAME.qml beside NAME.nc, the
+/// style QGIS loads with the file (QgsMapLayer::loadDefaultStyle), so that it shows depth first.
 void write_as_ugrid(const Mesh &mesh, const std::filesystem::path &path,
                     const WriteOptions &options) {
     UgridOptions ugrid;
@@ -453,7 +494,16 @@ void write_as_ugrid(const Mesh &mesh, const std::filesystem::path &path,
     ugrid.stats = options.stats;
     ugrid.face_areas_m2 = options.face_areas_m2;
     ugrid.progress = options.progress;
+    const std::string style = depth_style(mesh);
+    std::optional<OutputFile> qml;
+    if (!style.empty() && path.extension() != ".qml") {
+        qml.emplace(std::filesystem::path(path).replace_extension(".qml"), options.overwrite,
+                    "QGIS style");
+        write_style(*qml, style);
+    }
     write_ugrid(mesh, path, ugrid);
+    if (qml)
+        qml->commit();
 }
 
 } // namespace globemesh

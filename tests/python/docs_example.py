@@ -16,6 +16,6 @@ with tempfile.TemporaryDirectory(prefix="globemesh-doc-") as folder:
     os.chdir(folder)
     exec(compile(blocks[0], doc, "exec"), {"__name__": "__main__"})
     written = sorted(f for f in os.listdir(folder) if f != "fixtures")
-    # ocean.msh, ocean.nc, ocean.gpkg and fort.14, as the example says.
-    assert written == ["fort.14", "ocean.gpkg", "ocean.msh", "ocean.nc"], written
+    # ocean.msh, ocean.nc (with its QGIS style ocean.qml), ocean.gpkg and fort.14, as the example says.
+    assert written == ["fort.14", "ocean.gpkg", "ocean.msh", "ocean.nc", "ocean.qml"], written
     os.chdir(root)

@@ -73,26 +73,65 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     status = subprocess.run([CHECKER, nc, "--quiet", "--size-var", "target_size"]).returncode
     assert status == 0, "mesh-verify rejects %s" % nc
 
-    # What it loads when done: the mesh, drawn by depth once Processing post-processes it, and the
-    # GeoPackage's faces and boundary.
+    # What it loads when done: the mesh (this global one through its display copy, as faces cross
+    # the antimeridian), drawn by depth, and the GeoPackage's faces and boundary.
+    display = os.path.join(folder, "ocean_display.nc")
     loads = context.layersToLoadOnCompletion()
-    assert sorted(loads) == sorted([nc, gpkg + "|layername=faces", gpkg + "|layername=boundary"]), sorted(loads)
+    assert sorted(loads) == sorted([display, gpkg + "|layername=faces", gpkg + "|layername=boundary"]), sorted(loads)
     def active(layer):
         group = layer.rendererSettings().activeScalarDatasetGroup()
         return layer.datasetGroupMetadata(QgsMeshDatasetIndex(group)).name()
 
     import netCDF4  # QGIS's reader names a group by its variable's long_name
+    import numpy
     with netCDF4.Dataset(nc) as file:
         depth = file["depth"].long_name
+        lon, faces, depths = file["mesh_node_lon"][:], file["mesh_face_nodes"][:], file["depth"][:]
+    assert (numpy.ptp(lon[faces], axis=1) > 180).sum() > 50  # the model file keeps its true topology
+    with netCDF4.Dataset(display) as file:  # the copy: the same nodes first, then western copies + 360
+        shown_lon, shown_faces, shown_depths = file["mesh_node_lon"][:], file["mesh_face_nodes"][:], file["depth"][:]
+    n = len(lon)
+    assert (shown_lon[:n] == lon).all() and (shown_depths[:n] == depths).all()
+    assert (shown_lon[n:] > 180).all() and (shown_lon[n:] <= 360).all()
+    assert (numpy.ptp(shown_lon[shown_faces], axis=1) <= 180).all()
+    assert len(faces) - 2 <= len(shown_faces) < len(faces)  # the face round the North Pole left out
+    # QGIS draws every loaded file without a face wider than 180 degrees (qgis-check --strict).
+    qgis_check = os.path.join(SHARED, "tools", "qgis-check")
+    if os.path.exists(qgis_check):
+        check = subprocess.run([qgis_check, "--strict", display, gpkg], capture_output=True, text=True)
+        assert check.returncode == 0, check.stdout + check.stderr
+    shown = QgsMeshLayer(display, "ocean (display)", "mdal")
+    assert active(shown) == depth, active(shown)  # by the style ocean_display.qml beside it
+    assert active(mesh) == depth, active(mesh)  # by the style ocean.qml beside ocean.nc
+    os.remove(os.path.join(folder, "ocean.qml"))
+    mesh = QgsMeshLayer(nc, "ocean", "mdal")
     assert active(mesh) != depth  # what QGIS draws by itself
-    loads[nc].postProcessor().postProcessLayer(mesh, context, feedback)
+    loads[display].postProcessor().postProcessLayer(mesh, context, feedback)
     assert active(mesh) == depth, active(mesh)
+    # The GeoPackage's layers: faces graduated by quality, boundary coast and open in two colours,
+    # also when QGIS did not load the faces' style stored in the GeoPackage.
+    from qgis.core import QgsCategorizedSymbolRenderer, QgsGraduatedSymbolRenderer
+    bare = QgsVectorLayer.LayerOptions()
+    bare.loadDefaultStyle = False
     for path in loads:
-        if path != nc:
-            layer = QgsVectorLayer(path, "x", "ogr")
-            assert layer.isValid() and layer.featureCount() > 0, path
+        if path != display:
+            for options in (QgsVectorLayer.LayerOptions(), bare):
+                layer = QgsVectorLayer(path, "x", "ogr", options)
+                assert layer.isValid() and layer.featureCount() > 0, path
+                loads[path].postProcessor().postProcessLayer(layer, context, feedback)
+                renderer = layer.renderer()
+                if path.endswith("faces"):
+                    assert isinstance(renderer, QgsGraduatedSymbolRenderer), renderer
+                    assert renderer.classAttribute() == "quality" and len(renderer.ranges()) == 5
+                else:
+                    assert isinstance(renderer, QgsCategorizedSymbolRenderer), renderer
+                    assert renderer.classAttribute() == "tag"
+                    colours = {c.value(): c.symbol().color().name() for c in renderer.categories()}
+                    assert sorted(colours) == ["coast", "open"] and len(set(colours.values())) == 2, colours
+                    tags = {f["tag"] for f in layer.getFeatures()}
+                    assert tags <= set(colours), tags  # every feature drawn by a category
 print("OK: %d faces" % mesh.meshFaceCount())
-del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
+del mesh, shown, layer, loads, context, feedback  # QGIS's objects go before QGIS does
 
 
 def nodes_in(nc, west, south, east, north):
@@ -123,6 +162,7 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
         assert inside == total > 0 and nodes_in(nc, -20.001, 29.999, 20.001, 60.001)[0] < total, (inside, total)
         assert (nodes_in(nc, *england)[0] > 0) == selected, nodes_in(nc, *england)
         assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+        assert not os.path.exists(nc.replace(".nc", "_display.nc"))  # no face crosses the antimeridian
 
     # A path with several polygon layers and no layer named: the first, as QGIS reads it.
     from osgeo import gdal

@@ -207,5 +207,6 @@ TEST(Writers, a_format_that_needs_depths_refuses_a_mesh_without_them_before_writ
     with_depth.node_fields.push_back(
         {"depth", "depth", "m", "", std::vector<double>(with_depth.nodes.size(), 10.0)});
     globemesh::write_outputs(with_depth, requests, {});
-    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "b.nc"}));
+    // With depth, each UGRID file has its QGIS style beside it.
+    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "a.qml", "b.nc", "b.qml"}));
 }
