@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -85,6 +86,28 @@ std::string regex_replace(const std::string &text, const std::string &pattern,
 
 /// True under CI=true (as CI services set it), where every outside tool the tests use must be
 /// installed: a missing one is a failure there, not a skip.
+/// `s` in single quotes for the shell (the tests' paths and arguments hold none).
+inline std::string shell_quote(const std::string &s) {
+    return "'" + s + "'";
+}
+
+/// Runs the executable `exe` with `args`: its standard error into `err` (through a file in
+/// `dir`), its standard output dropped. Returns the exit status as run_command does.
+inline int run_exe_in(const std::string &exe, const std::vector<std::string> &args,
+                      std::string &err, const std::filesystem::path &dir) {
+    std::string command = shell_quote(exe);
+    for (const auto &a : args)
+        command += " " + shell_quote(a);
+    const std::filesystem::path err_file = dir / ".stderr";
+    std::string out;
+    const int status =
+        run_command("( " + command + " >/dev/null 2>" + shell_quote(err_file.string()) + " )", out);
+    std::ifstream e(err_file);
+    err.assign(std::istreambuf_iterator<char>(e), {});
+    std::filesystem::remove(err_file);
+    return status;
+}
+
 inline bool in_ci() {
     const char *ci = std::getenv("CI");
     return ci && std::string(ci) == "true";

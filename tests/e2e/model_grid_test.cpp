@@ -28,25 +28,12 @@ namespace {
 const std::string exe = GLOBEMESH_EXE;
 
 std::string quote(const std::string &s) {
-    return "'" + s + "'";
+    return globemesh::test::shell_quote(s);
 }
 
-/// Runs the executable; `err` gets its stderr.
+/// Runs the executable; `err` gets its stderr (support.hpp).
 int run_exe(const std::vector<std::string> &args, std::string &err, const fs::path &dir) {
-    std::string command = quote(exe);
-    for (const auto &a : args) {
-        command += ' ';
-        command += quote(a);
-    }
-    const fs::path err_file = dir / ".stderr";
-    std::string out;
-    const int status = run_command("( " + command + " 2>" + quote(err_file.string()) + " )", out);
-    std::ifstream e(err_file);
-    std::stringstream s;
-    s << e.rdbuf();
-    err = s.str();
-    fs::remove(err_file);
-    return status;
+    return globemesh::test::run_exe_in(exe, args, err, dir);
 }
 
 /// The reader and the comparison: prints "OK nope nbou" or fails (non-zero status, the reason).

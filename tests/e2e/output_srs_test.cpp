@@ -23,21 +23,12 @@ const std::string land50 = fixture("coast/ne_50m_land.gpkg").string();
 const std::string shelf_dem = fixture("bathy/etopo5_nwshelf_5min.tif").string();
 
 std::string quote(const std::string &s) {
-    return "'" + s + "'";
+    return globemesh::test::shell_quote(s);
 }
 
-/// Runs the executable; `err` gets stderr.
+/// Runs the executable; `err` gets its stderr (support.hpp).
 int run_exe(const std::vector<std::string> &args, std::string &err, const fs::path &dir) {
-    std::string command = quote(exe);
-    for (const auto &a : args)
-        command += " " + quote(a);
-    std::string out;
-    const int status =
-        run_command("( " + command + " >/dev/null 2>" + quote((dir / ".err").string()) + " )", out);
-    std::ifstream e(dir / ".err");
-    err.assign(std::istreambuf_iterator<char>(e), {});
-    fs::remove(dir / ".err");
-    return status;
+    return globemesh::test::run_exe_in(exe, args, err, dir);
 }
 
 std::string run_python(const TempDir &dir, const std::string &script,
