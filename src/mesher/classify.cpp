@@ -309,15 +309,20 @@ void estimate_nodes(Mesher &m, const MesherOptions &options) {
     report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
     if (estimate > stop) {
         const std::string nodes = "more than " + std::to_string(limit) + " nodes";
+        // Passages refine below --hmin: raising it does not help them.
+        const ErrorText passages =
+            options.passages.empty()
+                ? ErrorText("")
+                : ", or ask less of the passages (" + option("passage_cells") + ", fewer lines)";
         if (limit == options.max_nodes)
             throw DataError("the size field asks for " + nodes + " (" + option("max_nodes") +
                             "): raise " + option("hmin_km") + "/" + option("hmax_km") + " or " +
-                            option("max_nodes"));
+                            option("max_nodes") + passages);
         throw DataError("the size field asks for " + nodes + ", which need more than " +
                         option("max_memory_bytes") + " " +
                         std::to_string(options.max_memory >> 20) + " MiB: raise " +
                         option("hmin_km") + "/" + option("hmax_km") + " or " +
-                        option("max_memory_bytes"));
+                        option("max_memory_bytes") + passages);
     }
     // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
     // per cent of the nodes made), instead of doubling through the lattice and the refinement:

@@ -245,6 +245,8 @@ TEST(Passages, Errors) {
     // The passages' sizes count against --max-nodes: the run is refused, not meshed.
     EXPECT_EQ(run_exe(base + "--hmax 100km --passages default --max-nodes 48000", out), 1);
     EXPECT_TRUE(regex_search(out, R"(more than 48000 nodes \(--max-nodes\))")) << out;
+    // ... and says that the passages ask for them (raising --hmin does not help there).
+    EXPECT_TRUE(regex_search(out, R"(ask less of the passages \(--passage-cells)")) << out;
     EXPECT_EQ(run_exe(base + "--hmax 100km --max-nodes 48000", out), 0) << out;
     fs::remove(dir.path() / "m.nc");
     EXPECT_FALSE(fs::exists(dir.path() / "m.nc"));
