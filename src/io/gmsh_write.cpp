@@ -27,6 +27,7 @@
 #include <utility>
 #include <vector>
 
+#include "buffered_file.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
@@ -70,71 +71,32 @@ MshChoices msh_choices(const CreationOptions &options, const fs::path &path) {
     return c;
 }
 
-/// Text written to a FILE through a buffer, numbers formatted with to_chars (shortest text that
-/// reads back to the same double).
+/// Text through a buffer, numbers formatted with to_chars (shortest text that reads back to the
+/// same double).
 class MshStream {
 public:
-    MshStream(const fs::path &temp, const fs::path &target) : target_(target) {
-        file_ = std::fopen(temp.c_str(), "wbx");
-        if (file_ == nullptr)
-            throw IoError("gmsh output " + target.string() + ": cannot create (" +
-                          std::strerror(errno) + ")");
-        buffer_.reserve(capacity + 64);
-    }
-    ~MshStream() {
-        if (file_ != nullptr)
-            std::fclose(file_);
-    }
-    MshStream(const MshStream &) = delete;
-    MshStream &operator=(const MshStream &) = delete;
-
+    MshStream(const fs::path &temp, const fs::path &target) : file_(temp, target, "gmsh output") {}
     MshStream &operator<<(std::string_view s) {
-        buffer_ += s;
-        return flush_if_full();
+        file_.put(s);
+        return *this;
     }
     MshStream &operator<<(char c) {
-        buffer_ += c;
-        return flush_if_full();
+        file_.put({&c, 1});
+        return *this;
     }
     MshStream &operator<<(double v) { return number(v); }
     MshStream &operator<<(std::size_t v) { return number(v); }
     MshStream &operator<<(int v) { return number(v); }
-
     /// Writes what is left and closes the file; throws IoError on a failed write.
-    void close() {
-        flush();
-        FILE *f = std::exchange(file_, nullptr);
-        if (std::fclose(f) != 0)
-            fail();
-    }
+    void close() { file_.close(); }
 
 private:
-    static constexpr std::size_t capacity = 1 << 20;
-
     template <class T> MshStream &number(T v) {
         char text[32];
-        auto [end, ec] = std::to_chars(text, text + sizeof text, v);
-        buffer_.append(text, end);
-        return flush_if_full();
-    }
-    MshStream &flush_if_full() {
-        if (buffer_.size() >= capacity)
-            flush();
+        file_.put({text, std::to_chars(text, text + sizeof text, v).ptr});
         return *this;
     }
-    void flush() {
-        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-            fail();
-        buffer_.clear();
-    }
-    [[noreturn]] void fail() {
-        throw IoError("gmsh output " + target_.string() + ": writing failed (" +
-                      std::strerror(errno) + ")" + OutputFile::full_disk_note(target_));
-    }
-
-    FILE *file_ = nullptr;
-    std::string buffer_;
-    fs::path target_;
+    io::BufferedFile file_;
 };
 
 /// A discrete curve of the file: its entity and physical tags, its group name and its boundary

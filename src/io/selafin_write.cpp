@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "buffered_file.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
@@ -42,21 +43,11 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t report_every = 1 << 16;
 
-/// Buffered big-endian Fortran records to a FILE.
+/// Big-endian Fortran records, through a buffer.
 class RecordOut {
 public:
     RecordOut(const fs::path &temp, const fs::path &target)
-        : file_(std::fopen(temp.c_str(), "wb")), temp_(temp), target_(target) {
-        if (!file_)
-            fail("cannot create it");
-        buffer_.reserve(capacity + 64);
-    }
-    ~RecordOut() {
-        if (file_)
-            std::fclose(file_);
-    }
-    RecordOut(const RecordOut &) = delete;
-    RecordOut &operator=(const RecordOut &) = delete;
+        : file_(temp, target, "SELAFIN output") {}
     /// The length marker that opens and closes a record of `bytes` bytes.
     void marker(std::size_t bytes) { word(std::uint32_t(bytes)); }
     void integer(std::int64_t v) { word(std::uint32_t(std::int32_t(v))); }
@@ -69,7 +60,7 @@ public:
     void text(const std::string &s, std::size_t width) {
         std::string padded = s.substr(0, width);
         padded.resize(width, ' ');
-        put(padded.data(), width);
+        file_.put(padded);
     }
     /// One record of whole text.
     void text_record(const std::string &s, std::size_t width) {
@@ -83,37 +74,14 @@ public:
             integer(v);
         marker(4 * values.size());
     }
-    void close() {
-        flush();
-        const bool ok = std::fclose(file_) == 0;
-        file_ = nullptr;
-        if (!ok)
-            fail("writing failed");
-    }
+    void close() { file_.close(); }
 
 private:
-    static constexpr std::size_t capacity = 1 << 20;
     void word(std::uint32_t u) {
         const char b[4] = {char(u >> 24), char(u >> 16), char(u >> 8), char(u)};
-        put(b, 4);
+        file_.put({b, 4});
     }
-    void put(const char *p, std::size_t n) {
-        buffer_.append(p, n);
-        if (buffer_.size() >= capacity)
-            flush();
-    }
-    void flush() {
-        if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-            fail("writing failed");
-        buffer_.clear();
-    }
-    [[noreturn]] void fail(const std::string &what) {
-        throw IoError("SELAFIN output " + target_.string() + ": " + what + " (" +
-                      std::strerror(errno) + ")" + OutputFile::full_disk_note(temp_));
-    }
-    std::FILE *file_;
-    fs::path temp_, target_;
-    std::string buffer_;
+    io::BufferedFile file_;
 };
 
 /// A boundary node in the boundary numbering: its 0-based node and whether it is open.
