@@ -51,6 +51,12 @@ void measure_passages(std::vector<Passage> &passages, const LandTest *land);
 /// (counter-clockwise): an arc crosses an edge, or a point of the line lies inside.
 bool line_meets_triangle(std::span<const Vec3> line, const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
+/// True when the polyline `line` reaches the ocean of `ocean` (left of its rings): an arc
+/// crosses or touches a ring's segment, or the line lies in the ocean. A line across a strait
+/// (land to land) reaches a region's ocean exactly when the strait's water lies in the region.
+/// O(line arcs x ring segments).
+bool line_meets_ocean(std::span<const Vec3> line, const Boundary &ocean);
+
 /// The faces of `mesh` (all ocean) that `line` meets.
 std::size_t faces_crossed(const Mesh &mesh, std::span<const Vec3> line);
 

@@ -1,5 +1,5 @@
 // Where a passage line meets the mesh's triangles (passages.hpp): the mesher's strait check and
-// the run's count of the cells across each passage.
+// the run's count of the cells across each passage; and whether it reaches a region's ocean.
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +26,64 @@ bool inside(const Vec3 &a, const Vec3 &b, const Vec3 &c, const Vec3 &p) {
     return side(a, b, p) >= 0 && side(b, c, p) >= 0 && side(c, a, p) >= 0 && dot(a + b + c, p) > 0;
 }
 
+/// The number of arcs of `ocean` (but ring `skip_ring`'s segment `skip`) that the short arc p-q
+/// crosses or touches, or -1 when one only touches it (an end on the arc, or the arc through a
+/// ring's node: the count's parity is then unknown).
+long arcs_crossed(const Vec3 &p, const Vec3 &q, const Boundary &ocean, std::size_t skip_ring,
+                  std::size_t skip) {
+    const Vec3 n = cross(p, q);
+    long count = 0;
+    for (std::size_t r = 0; r < ocean.rings.size(); ++r) {
+        const std::vector<Vec3> &nodes = ocean.rings[r].nodes;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            if (r == skip_ring && i == skip)
+                continue;
+            const Vec3 &a = nodes[i], &b = nodes[(i + 1) % nodes.size()];
+            if (!arcs_meet(p, q, a, b))
+                continue;
+            if (dot(n, a) == 0 || dot(n, b) == 0 || side(a, b, p) == 0 || side(a, b, q) == 0)
+                return -1;
+            ++count;
+        }
+    }
+    return count;
+}
+
+/// True when p lies in the ocean of `ocean` (left of its rings): the arc from p to the middle
+/// of a ring's segment crosses the other segments an even number of times when p lies on the
+/// segment's ocean side. A segment whose arc from p is not short enough, or only touches
+/// another, gives way to the next.
+bool in_ocean(const Vec3 &p, const Boundary &ocean) {
+    for (std::size_t r = 0; r < ocean.rings.size(); ++r) {
+        const std::vector<Vec3> &nodes = ocean.rings[r].nodes;
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            const Vec3 &a = nodes[i], &b = nodes[(i + 1) % nodes.size()];
+            const Vec3 m = arc_midpoint(a, b);
+            const double s = side(a, b, p);
+            if (s == 0 || dot(p, m) <= 0) // on the segment's great circle, or a half turn away
+                continue;
+            const long crossed = arcs_crossed(p, m, ocean, r, i);
+            if (crossed >= 0)
+                return (s > 0) == (crossed % 2 == 0);
+        }
+    }
+    return ocean.rings.empty(); // the whole sphere is ocean
+}
+
 } // namespace
+
+bool line_meets_ocean(std::span<const Vec3> line, const Boundary &ocean) {
+    if (line.empty())
+        return false;
+    for (std::size_t i = 0; i + 1 < line.size(); ++i)
+        for (const Ring &ring : ocean.rings)
+            for (std::size_t k = 0; k < ring.nodes.size(); ++k)
+                if (arcs_meet(line[i], line[i + 1], ring.nodes[k],
+                              ring.nodes[(k + 1) % ring.nodes.size()]))
+                    return true;
+    // No arc meets the outline: the line lies all in the ocean or all out of it.
+    return in_ocean(line.front(), ocean);
+}
 
 bool line_meets_triangle(std::span<const Vec3> line, const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     for (const Vec3 &p : line)

@@ -182,8 +182,10 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
 }
 
 /// The passages of --passages that reach into the region (a point of the line inside its W,S,E,N
-/// box; all of them globally), with their widths in water on the source land.
-std::vector<Passage> region_passages(const MeshOptions &o, const LandTest *land) {
+/// box; with --region-file, the line reaching the region's ocean `rings`; all of them globally),
+/// with their widths in water on the source land.
+std::vector<Passage> region_passages(const MeshOptions &o, const Boundary &rings,
+                                     const LandTest *land) {
     std::vector<Passage> all = read_passages(o.passages, o.passages_layer), kept;
     auto inside = [&](const Vec3 &p) {
         const LonLat ll = vec_to_lonlat(p);
@@ -193,8 +195,13 @@ std::vector<Passage> region_passages(const MeshOptions &o, const LandTest *land)
         const double span = r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360;
         return ll.lat >= r[1] && ll.lat <= r[3] && east <= span;
     };
+    auto in_region = [&](const Passage &p) {
+        if (o.region)
+            return std::any_of(p.line.begin(), p.line.end(), inside);
+        return o.region_file.empty() || line_meets_ocean(p.line, rings);
+    };
     for (Passage &p : all)
-        if (!o.region || std::any_of(p.line.begin(), p.line.end(), inside))
+        if (in_region(p))
             kept.push_back(std::move(p));
     measure_passages(kept, land);
     return kept;
@@ -232,8 +239,9 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
         budget.hold(static_cast<double>(r.nodes.size() * ring_bytes_per_node));
     clock.lap("read_coast", true);
     refuse_too_many_nodes(o, coast);
-    const std::vector<Passage> passages =
-        o.passages.empty() ? std::vector<Passage>{} : region_passages(o, coast.land.get());
+    const std::vector<Passage> passages = o.passages.empty()
+                                              ? std::vector<Passage>{}
+                                              : region_passages(o, coast.rings, coast.land.get());
 
     std::optional<Raster> bathy;
     if (!o.bathy.empty()) {

@@ -201,6 +201,63 @@ TEST(Passages, LineMeetsTriangle) {
     EXPECT_FALSE(meets({lonlat_to_vec(-2, 2), lonlat_to_vec(2, 2)}));     // above the apex
 }
 
+// Ring 0: the square of side 2 degrees around (0, 0), ocean inside (counter-clockwise); ring 1:
+// an island at (0.5, 0.5), ocean outside (clockwise).
+TEST(Passages, LineMeetsOcean) {
+    using namespace globemesh;
+    Boundary b;
+    b.rings.push_back(
+        {{lonlat_to_vec(-1, -1), lonlat_to_vec(1, -1), lonlat_to_vec(1, 1), lonlat_to_vec(-1, 1)},
+         std::vector<SegmentKind>(4, SegmentKind::open)});
+    b.rings.push_back({{lonlat_to_vec(0.4, 0.4), lonlat_to_vec(0.4, 0.6), lonlat_to_vec(0.6, 0.6),
+                        lonlat_to_vec(0.6, 0.4)},
+                       std::vector<SegmentKind>(4, SegmentKind::coast)});
+    auto meets = [&](double x0, double y0, double x1, double y1) {
+        const std::vector<Vec3> line{lonlat_to_vec(x0, y0), lonlat_to_vec(x1, y1)};
+        return line_meets_ocean(line, b);
+    };
+    EXPECT_TRUE(meets(-0.5, -0.5, -0.2, 0.3));  // all in the ocean, no outline crossed
+    EXPECT_TRUE(meets(-3, 0, 3, 0));            // across the region
+    EXPECT_TRUE(meets(0.5, 0.5, 0.5, 0.9));     // from the island out
+    EXPECT_FALSE(meets(0.45, 0.45, 0.55, 0.5)); // on the island
+    EXPECT_FALSE(meets(2, 2, 3, -2));           // outside, within the box of the region
+    EXPECT_FALSE(meets(178, 0, 179, 0));        // the far side
+    EXPECT_FALSE(line_meets_ocean(std::vector<Vec3>{lonlat_to_vec(5, 5), lonlat_to_vec(6, 5)}, b));
+    EXPECT_TRUE(line_meets_ocean(std::vector<Vec3>{lonlat_to_vec(5, 5), lonlat_to_vec(6, 5)},
+                                 Boundary{})); // the whole sphere is ocean
+}
+
+// With --region-file, the passages whose line does not reach the polygon's ocean are dropped:
+// Menorca's line lies inside the triangle's W,S,E,N box but outside the triangle, the
+// Bosphorus's far from both.
+TEST(Passages, RegionFileKeepsOnlyThePassagesInIt) {
+    TempDir dir;
+    const fs::path region = dir.path() / "triangle.geojson", lines = dir.path() / "lines.geojson";
+    std::ofstream(region) << R"({"type": "FeatureCollection", "features": [{"type": "Feature",)"
+                             R"( "properties": {}, "geometry": {"type": "Polygon", "coordinates":)"
+                             R"( [[[-12, 33], [4, 33], [-12, 46], [-12, 33]]]}}]})";
+    std::ofstream(lines)
+        << R"({"type": "FeatureCollection", "features": [)"
+           R"({"type": "Feature", "properties": {"name": "Gibraltar"}, "geometry": {"type":)"
+           R"( "LineString", "coordinates": [[-5.61, 36.03], [-5.47, 35.9]]}},)"
+           R"({"type": "Feature", "properties": {"name": "Menorca"}, "geometry": {"type":)"
+           R"( "LineString", "coordinates": [[3.3, 39.7], [3.95, 40.0]]}},)"
+           R"({"type": "Feature", "properties": {"name": "Bosphorus"}, "geometry": {"type":)"
+           R"( "LineString", "coordinates": [[29.0, 41.1], [29.1, 41.05]]}}]})";
+    std::string out;
+    ASSERT_EQ(run_exe("mesh --coast " + quote(land50) + " --coast-layer land --hmax 50km" +
+                          " --region-file " + quote(region.string()) + " --passages " +
+                          quote(lines.string()) + " -o " + quote((dir.path() / "m.nc").string()),
+                      out),
+              0)
+        << out;
+    EXPECT_TRUE(
+        regex_search(out, R"(passages +1, 1 with >= 2 cells across \(fewest [0-9]+: Gibraltar)"))
+        << out;
+    EXPECT_FALSE(regex_search(out, "warning: passage")) << out;
+    expect_mesh_verify(dir.path() / "m.nc", "--min-quality 0.3");
+}
+
 // A line drawn on land (no water across) ends with no cell: a warning names it, never silent.
 TEST(Passages, WarnsOfAPassageShortOfCells) {
     TempDir dir;

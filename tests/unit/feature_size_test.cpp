@@ -241,8 +241,10 @@ TEST(FeatureSize, FjordCoastHasThreeEdgesAcrossEveryChannel) {
     EXPECT_GT(wide_with, 500u);
     EXPECT_GT(share_without, 0.3) << "the run without the term is already fine: no test";
     // The mesher's edges spread about the target size (edge / target in [0.7, 1.4], median 1):
-    // a channel near 3 hmin, where the size stops at hmin, can hold a little under 3 edges.
-    EXPECT_LT(share_with, 0.02);
+    // a channel near 3 hmin, where the size stops at hmin, can hold a little under 3 edges, and
+    // near a fjord's head (the coast samples there too close along the coast to count as two
+    // shores) the field is the grading's. 15 sections of 1326 (1.1%) hold fewer than 3.
+    EXPECT_LT(share_with, 0.015);
     for (const Section &s : with_sections) {
         if (s.width_km > 4 * o.hmin_km) {
             EXPECT_GE(s.edges_across, 2.9) << "a channel " << s.width_km << " km wide";
