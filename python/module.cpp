@@ -89,6 +89,8 @@ std::shared_ptr<PyMesh> mesh_ocean_args(const std::vector<std::string> &args, py
     } catch (const CLI::ParseError &e) {
         throw UsageError(cli::usage_text(e, "mesh"));
     }
+    if (command.o.mesh.passages == "default") // as `globemesh mesh` resolves it
+        command.o.mesh.passages = cli::default_passages_path();
     const CliOptions &o = command.o;
     validate(o.mesh);
     check_inputs(o);
