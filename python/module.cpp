@@ -14,6 +14,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "gdal_warnings.hpp"
 #include "globemesh/command.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/pipeline.hpp"
@@ -111,8 +112,19 @@ PYBIND11_MODULE(_globemesh, m) {
     m.doc() = "globemesh's library: see the package globemesh";
     m.attr("__version__") = GLOBEMESH_VERSION;
     register_errors(m);
+    gdal_warning_class() = py::reinterpret_steal<py::object>(
+        PyErr_NewException("globemesh._globemesh.GdalWarning", PyExc_UserWarning, nullptr));
+    m.attr("GdalWarning") = gdal_warning_class();
     bind_result(m);
     m.def("mesh_keywords", &mesh_keywords);
+    // For the tests: a GDAL warning raised during a run, as a reader's would be.
+    m.def("_gdal_warning_in_a_run", [](const std::string &message) {
+        ProgressBridge bridge{py::none()};
+        run_without_gil(bridge, [&](const globemesh::Progress &) {
+            CPLError(CE_Warning, CPLE_AppDefined, "%s", message.c_str());
+            return true;
+        });
+    });
     m.def("mesh_ocean", &mesh_ocean_args, py::arg("args"), py::arg("progress") = py::none());
     m.def("triangulate", &triangulate_arrays, py::arg("lon"), py::arg("lat"),
           py::arg("progress") = py::none());
