@@ -210,13 +210,12 @@ class _Algorithm(QgsProcessingAlgorithm):
     @staticmethod
     def _display_copy(mesh, nc, feedback):
         """The UGRID file to load: nc, or its display copy when faces cross the antimeridian
-        (display.py); without xarray, nc with a warning."""
+        (display.py); nc with a warning when the copy cannot be written."""
         try:
             copy = display.write_display_copy(mesh, nc)
-        except ImportError as e:
-            feedback.pushWarning("%s: faces across the antimeridian are drawn smeared across the map (%s: "
-                                 "install python3-xarray for a display copy); the GeoPackage's faces draw right"
-                                 % (nc, e))
+        except (OSError, RuntimeError) as e:
+            feedback.pushWarning("%s: faces across the antimeridian are drawn smeared across the map (no display "
+                                 "copy: %s); the GeoPackage's faces draw right" % (nc, e))
             return nc
         if copy is None:
             return nc

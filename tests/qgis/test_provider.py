@@ -25,6 +25,7 @@ def skip(why):
 
 os.environ["QT_QPA_PLATFORM"] = "offscreen"
 os.environ["GDAL_PAM_ENABLED"] = "NO"  # no .aux.xml beside the fixtures
+sys.modules["xarray"] = None  # the plugin's display copy needs no xarray (an import of it fails)
 try:
     from qgis.core import (QgsApplication, QgsMeshDatasetIndex, QgsMeshLayer, QgsProcessingContext,
                            QgsProcessingFeedback, QgsProject, QgsRasterLayer, QgsVectorLayer)
@@ -130,8 +131,13 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
                     assert sorted(colours) == ["coast", "open"] and len(set(colours.values())) == 2, colours
                     tags = {f["tag"] for f in layer.getFeatures()}
                     assert tags <= set(colours), tags  # every feature drawn by a category
+    # A regional run into the same file: the display copy of the global one (and its style) goes.
+    del shown
+    processing.run("globemesh:meshocean", {"COAST": coast.id(), "REGION": "-20,20,30,60 [EPSG:4326]", "HMAX": 500,
+                                           "OUTPUT": nc})
+    assert sorted(f for f in os.listdir(folder) if f.startswith("ocean_display")) == [], os.listdir(folder)
 print("OK: %d faces" % mesh.meshFaceCount())
-del mesh, shown, layer, loads, context, feedback  # QGIS's objects go before QGIS does
+del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
 
 
 def nodes_in(nc, west, south, east, north):

@@ -65,7 +65,8 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qml-") as folder:
     converted = os.path.join(folder, "converted.nc")
     run = subprocess.run([EXE, "convert", "-q", os.path.join(folder, "shelf.nc"), converted], capture_output=True,
                          text=True)
-    assert run.returncode == 0 and "\nwritten           %s, %s\n" % (converted, converted[:-3] + ".qml") in run.stdout, run
+    written = "\nwritten           %s, %s\n" % (converted, converted[:-3] + ".qml")
+    assert run.returncode == 0 and written in run.stdout, run
     for name in ("converted.nc", "converted.qml"):
         os.remove(os.path.join(folder, name))
 
