@@ -14,14 +14,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "cli_common.hpp"
-#include "cli_support.hpp"
-#include "commands.hpp"
+#include "gdal_warnings.hpp"
+#include "globemesh/command.hpp"
 #include "globemesh/error.hpp"
-#include "globemesh/mesh_stats.hpp"
 #include "globemesh/pipeline.hpp"
-#include "mesh_summary.hpp"
-#include "option_flags.hpp"
 #include "progress_bridge.hpp"
 #include "result.hpp"
 
@@ -29,87 +25,21 @@ namespace globemesh::python {
 
 namespace {
 
-/// Whether mesh_ocean() takes this option of `globemesh mesh`: all but the outputs (those are
-/// Result.write's) and the terminal's.
-bool python_takes(const CLI::Option &option) {
-    const std::string name = option.get_lnames().empty() ? "" : option.get_lnames().front();
-    return option.get_group() != "Output" && !name.empty() && name != "help" && name != "version" &&
-           name != "quiet" && name != "verbose" && name != "print-config";
-}
-
 /// (keyword, is a flag, values it takes) of each option mesh_ocean() takes, keywords as the
 /// long option names with '_' for '-'.
 std::vector<std::tuple<std::string, bool, int>> mesh_keywords() {
-    cli::MeshCommand command;
     std::vector<std::tuple<std::string, bool, int>> keywords;
-    for (const CLI::Option *option : command.app.get_options()) {
-        if (!python_takes(*option))
-            continue;
-        std::string name = option->get_lnames().front();
-        std::replace(name.begin(), name.end(), '-', '_');
-        keywords.emplace_back(name, option->get_expected_max() == 0, option->get_expected_max());
-    }
+    for (const command::Keyword &k : command::mesh_keywords())
+        keywords.emplace_back(k.name, k.flag, k.values);
     return keywords;
-}
-
-/// The inputs that must be readable files, as `globemesh mesh` checks them before any run.
-void check_inputs(const CliOptions &o) {
-    if (o.mesh.coast.empty())
-        throw UsageError(
-            "--coast is required: land polygons or coast lines, e.g. --coast land.gpkg");
-    const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
-                                                          {"--bathy", o.mesh.bathy},
-                                                          {"--region-file", o.mesh.region_file},
-                                                          {"--size-regions", o.mesh.size_regions},
-                                                          {"--config", o.config}};
-    for (const auto &[name, path] : inputs)
-        cli::check_input_path(path, name);
-}
-
-/// The run's mesh, checked when --check asks, with its statistics in `stats`.
-OceanMesh mesh_and_check(const CliOptions &o, const Progress &progress, StageTimings &timings,
-                         MeshStats &stats) {
-    OceanMesh run = mesh_ocean(o.mesh, progress, &timings);
-    if (o.check) {
-        const auto problems = check_mesh(run.mesh);
-        if (!problems.empty())
-            throw DataError("--check: the mesh breaks " + std::to_string(problems.size()) +
-                            (problems.size() >= 20 ? "+" : "") + " invariants, first: " +
-                            problems.front() + "; please report this with the command line");
-    }
-    stats = compute_stats(run.mesh);
-    return run;
 }
 
 /// mesh_ocean(args, progress): `args` are those of `globemesh mesh` without outputs.
 std::shared_ptr<PyMesh> mesh_ocean_args(const std::vector<std::string> &args, py::object callback) {
-    cli::MeshCommand command;
-    try {
-        command.parse(args);
-    } catch (const CLI::ParseError &e) {
-        throw UsageError(cli::usage_text(e, "mesh"));
-    }
-    const CliOptions &o = command.o;
-    validate(o.mesh);
-    check_inputs(o);
     auto result = std::make_shared<PyMesh>();
-    StageTimings timings;
-    const auto t0 = std::chrono::steady_clock::now();
     ProgressBridge bridge(std::move(callback));
-    OceanMesh run = run_without_gil(bridge, [&](const Progress &progress) {
-        return mesh_and_check(o, progress, timings, result->stats);
-    });
-    // The effective configuration travels with the mesh, as the command line's files carry it.
-    run.mesh.attributes.emplace_back("globemesh_configuration",
-                                     command.app.config_to_str(true, false));
-    result->history = cli::history_text("mesh", args);
-    cli::MeshRunSummary summary{o, {}, result->stats, run, timings, result->history};
-    summary.total_s = cli::seconds_since(t0);
-    summary.peak = cli::peak_memory_bytes();
-    result->report_json = cli::report_json(summary);
-    result->land = o.mesh.coast;
-    result->extent_deg = o.mesh.region;
-    result->mesh = std::move(run.mesh);
+    result->run = run_without_gil(
+        bridge, [&](const Progress &progress) { return command::mesh(args, progress); });
     return result;
 }
 
@@ -139,13 +69,9 @@ std::shared_ptr<PyMesh> triangulate_arrays(const py::array_t<double, py::array::
     std::vector<Vec3> points = points_of(lon, lat);
     auto result = std::make_shared<PyMesh>();
     ProgressBridge bridge(std::move(callback));
-    result->mesh = run_without_gil(bridge, [&](const Progress &progress) {
-        Mesh mesh = triangulate_points(std::move(points), TriangulateOptions{}, progress);
-        result->stats = compute_stats(mesh);
-        return mesh;
+    result->run = run_without_gil(bridge, [&](const Progress &progress) {
+        return command::triangulate(std::move(points), progress);
     });
-    result->history = cli::history_text("triangulate", std::vector<std::string>{"(Python)"});
-    result->report_json = "{\"mesh\": " + cli::stats_json(result->stats, "") + "}";
     return result;
 }
 
@@ -166,13 +92,13 @@ void register_errors(py::module_ &m) {
         } catch (const Cancelled &) {
             cancelled("cancelled, no output written");
         } catch (const UsageError &e) {
-            usage(cli::one_line(e.message(cli::flag_of)).c_str());
+            usage(command::error_message(e).c_str());
         } catch (const IoError &e) {
-            io(cli::one_line(e.message(cli::flag_of)).c_str());
+            io(command::error_message(e).c_str());
         } catch (const DataError &e) {
-            data(cli::one_line(e.message(cli::flag_of)).c_str());
+            data(command::error_message(e).c_str());
         } catch (const Error &e) {
-            base(cli::one_line(e.message(cli::flag_of)).c_str());
+            base(command::error_message(e).c_str());
         }
     });
 }
@@ -186,8 +112,19 @@ PYBIND11_MODULE(_globemesh, m) {
     m.doc() = "globemesh's library: see the package globemesh";
     m.attr("__version__") = GLOBEMESH_VERSION;
     register_errors(m);
+    gdal_warning_class() = py::reinterpret_steal<py::object>(
+        PyErr_NewException("globemesh._globemesh.GdalWarning", PyExc_UserWarning, nullptr));
+    m.attr("GdalWarning") = gdal_warning_class();
     bind_result(m);
     m.def("mesh_keywords", &mesh_keywords);
+    // For the tests: a GDAL warning raised during a run, as a reader's would be.
+    m.def("_gdal_warning_in_a_run", [](const std::string &message) {
+        ProgressBridge bridge{py::none()};
+        run_without_gil(bridge, [&](const globemesh::Progress &) {
+            CPLError(CE_Warning, CPLE_AppDefined, "%s", message.c_str());
+            return true;
+        });
+    });
     m.def("mesh_ocean", &mesh_ocean_args, py::arg("args"), py::arg("progress") = py::none());
     m.def("triangulate", &triangulate_arrays, py::arg("lon"), py::arg("lat"),
           py::arg("progress") = py::none());

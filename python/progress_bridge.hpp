@@ -11,6 +11,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include "gdal_warnings.hpp"
 #include "globemesh/progress.hpp"
 
 namespace globemesh::python {
@@ -69,12 +70,13 @@ private:
     std::optional<py::error_already_set> error_;
 };
 
-/// Runs `job` with the GIL released and `bridge`'s progress; then, with the GIL, raises what
-/// stopped it from Python (before any library error a stopped run threw), or the library's
-/// error.
+/// Runs `job` with the GIL released and `bridge`'s progress; then, with the GIL, gives GDAL's
+/// warnings to Python and raises what stopped it from Python (before any library error a
+/// stopped run threw), or the library's error.
 template <class Job> auto run_without_gil(ProgressBridge &bridge, Job &&job) {
     std::exception_ptr failure;
     decltype(job(bridge.progress())) result{};
+    GdalWarnings warnings;
     {
         py::gil_scoped_release release;
         try {
@@ -84,6 +86,7 @@ template <class Job> auto run_without_gil(ProgressBridge &bridge, Job &&job) {
         }
     }
     bridge.raise_if_stopped();
+    warnings.warn();
     if (failure)
         std::rethrow_exception(failure);
     return result;

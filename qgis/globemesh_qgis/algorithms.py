@@ -4,16 +4,27 @@ user cancels, and the mesh is written by the command line's own writers (Result.
 
 import os
 
-from qgis.core import (QgsCoordinateReferenceSystem, QgsFeatureRequest, QgsMeshDatasetIndex, QgsMeshLayer,
-                       QgsProcessing, QgsProcessingAlgorithm, QgsProcessingContext, QgsProcessingException,
-                       QgsProcessingLayerPostProcessorInterface, QgsProcessingParameterExtent,
-                       QgsProcessingParameterFeatureSource, QgsProcessingParameterFileDestination,
+from qgis.core import (QgsCoordinateReferenceSystem, QgsExpression, QgsFeatureRequest, QgsMeshDatasetIndex,
+                       QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm, QgsProcessingContext,
+                       QgsProcessingException, QgsProcessingLayerPostProcessorInterface, QgsProcessingParameterBoolean,
+                       QgsProcessingParameterCrs, QgsProcessingParameterDefinition, QgsProcessingParameterExtent,
+                       QgsProcessingParameterFeatureSource, QgsProcessingParameterField,
+                       QgsProcessingParameterFileDestination, QgsProcessingParameterFolderDestination,
                        QgsProcessingParameterNumber, QgsProcessingParameterRasterLayer, QgsProcessingUtils)
 
 from . import display, styles
 
 WGS84 = QgsCoordinateReferenceSystem("EPSG:4326")
 GPKG_LAYERS = ("faces", "boundary")  # the GeoPackage's layers loaded into the project
+# The model formats, each an optional output: (parameter, description, file filter, the name's
+# ending that picks the format at the command line). QGIS loads those its reader (MDAL) opens.
+MODEL_OUTPUTS = (("OUTPUT_MSH", "gmsh mesh (MSH 4.1)", "gmsh MSH (*.msh)", ".msh"),
+                 ("OUTPUT_ADCIRC", "ADCIRC grid (fort.14)", "ADCIRC grid (*.14)", ".14"),
+                 ("OUTPUT_SCHISM", "SCHISM grid (hgrid.gr3)", "SCHISM grid (*.gr3)", ".gr3"),
+                 ("OUTPUT_SELAFIN", "TELEMAC SELAFIN (.slf, and its boundary file .cli)", "SELAFIN (*.slf)", ".slf"),
+                 ("OUTPUT_DFLOWFM", "D-Flow FM network file (_net.nc)", "D-Flow FM network (*_net.nc)", "_net.nc"))
+OUTPUT_FESOM2 = "OUTPUT_FESOM2"  # a folder (nod2d.out, elem2d.out, aux3d.out)
+OUTPUT_SRS = "OUTPUT_SRS"
 
 
 def _globemesh():
@@ -57,6 +68,25 @@ def _first_layer(path):
         return None
 
 
+def with_ending(path, ending):
+    """path, made to end with `ending` (what picks its format): NAME.nc -> NAME_net.nc, NAME -> NAME.14."""
+    if path.lower().endswith(ending):
+        return path
+    root, ext = os.path.splitext(path)
+    return (root if ext and ending.endswith(ext.lower()) else path) + ending
+
+
+def loads_in_qgis(path):
+    """Whether QGIS's mesh reader (MDAL) opens the file (it reads .slf and _net.nc, not .msh, .14, .gr3),
+    without GDAL's messages about the formats it tries."""
+    from osgeo import gdal
+    gdal.PushErrorHandler("CPLQuietErrorHandler")
+    try:
+        return QgsMeshLayer(path, "probe", "mdal").isValid()
+    finally:
+        gdal.PopErrorHandler()
+
+
 def show_depth(layer):
     """Makes the mesh layer draw its dataset group of the variable depth (QGIS draws the first
     group, face area, otherwise). True when it has one."""
@@ -71,13 +101,17 @@ def show_depth(layer):
 
 
 class _Style(QgsProcessingLayerPostProcessorInterface):
-    """Styles a loaded layer: the mesh by depth, a GeoPackage layer by styles.STYLES[name]."""
-    def __init__(self, gpkg_layer=None):
+    """Styles a loaded layer: the mesh by depth (in its CRS when given: a model file's), a
+    GeoPackage layer by styles.STYLES[name]."""
+    def __init__(self, gpkg_layer=None, crs=None):
         super().__init__()
         self.gpkg_layer = gpkg_layer
+        self.crs = crs
 
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802 (QGIS's name)
         if isinstance(layer, QgsMeshLayer):
+            if self.crs is not None and self.crs.isValid():
+                layer.setCrs(self.crs)
             show_depth(layer)
         elif self.gpkg_layer in styles.STYLES:
             styles.STYLES[self.gpkg_layer](layer)
@@ -88,10 +122,10 @@ class _Style(QgsProcessingLayerPostProcessorInterface):
 _POST_PROCESSORS = []
 
 
-def _post_processor(gpkg_layer=None):
+def _post_processor(gpkg_layer=None, crs=None):
     from qgis.PyQt import sip
     _POST_PROCESSORS[:] = [p for p in _POST_PROCESSORS if not sip.isdeleted(p)]
-    _POST_PROCESSORS.append(_Style(gpkg_layer))
+    _POST_PROCESSORS.append(_Style(gpkg_layer, crs))
     return _POST_PROCESSORS[-1]
 
 
@@ -113,36 +147,75 @@ class _Algorithm(QgsProcessingAlgorithm):
         self.addParameter(QgsProcessingParameterFileDestination(self.OUTPUT_GPKG, "GeoPackage (faces, nodes, boundary)",
                                                                 "GeoPackage (*.gpkg)", optional=True,
                                                                 createByDefault=False))
+        for name, description, filter, _ in MODEL_OUTPUTS:
+            self.addParameter(QgsProcessingParameterFileDestination(name, description, filter, optional=True,
+                                                                    createByDefault=False))
+        self.addParameter(QgsProcessingParameterFolderDestination(OUTPUT_FESOM2, "FESOM2 mesh folder", optional=True,
+                                                                  createByDefault=False))
+        srs = QgsProcessingParameterCrs(OUTPUT_SRS, "CRS of the model formats' coordinates (lon/lat when empty)",
+                                        optional=True)
+        srs.setFlags(srs.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+        self.addParameter(srs)
+
+    def _outputs(self, parameters, context):
+        """{parameter: path} of the outputs asked for (the model formats' names made to end as their
+        format asks), in the order written."""
+        outputs = {self.OUTPUT: self.parameterAsFileOutput(parameters, self.OUTPUT, context)}
+        for name, ending in [(self.OUTPUT_GPKG, ".gpkg")] + [(m[0], m[3]) for m in MODEL_OUTPUTS]:
+            path = self.parameterAsFileOutput(parameters, name, context)
+            if path:
+                outputs[name] = with_ending(path, ending)
+        folder = self.parameterAsFileOutput(parameters, OUTPUT_FESOM2, context)
+        if folder:
+            outputs[OUTPUT_FESOM2] = folder
+        return outputs
 
     def _write(self, mesh, parameters, context, feedback):
         """Writes the mesh to the outputs chosen, loads them into the project when done, returns them."""
-        nc = self.parameterAsFileOutput(parameters, self.OUTPUT, context)
-        gpkg = self.parameterAsFileOutput(parameters, self.OUTPUT_GPKG, context)
-        paths = [nc] + ([gpkg] if gpkg else [])
-        mesh.write(paths, overwrite=True, progress=_progress(feedback))
+        outputs = self._outputs(parameters, context)
+        srs = self.parameterAsCrs(parameters, OUTPUT_SRS, context) if parameters.get(OUTPUT_SRS) else None
+        mesh.write(list(outputs.values()), "FESOM2" if OUTPUT_FESOM2 in outputs else None, overwrite=True,
+                   output_srs=srs.authid() or srs.toWkt() if srs and srs.isValid() else None,
+                   progress=_progress(feedback))
+        nc = outputs[self.OUTPUT]
         name = os.path.splitext(os.path.basename(nc))[0]
         shown = self._display_copy(mesh, nc, feedback)
-        details = QgsProcessingContext.LayerDetails(name if shown == nc else name + " (display)", context.project(),
-                                                    self.OUTPUT, QgsProcessingUtils.LayerHint.Mesh)
-        details.setPostProcessor(_post_processor())
-        context.addLayerToLoadOnCompletion(shown, details)
-        for layer in GPKG_LAYERS if gpkg else ():
-            details = QgsProcessingContext.LayerDetails("%s %s" % (name, layer), context.project(), self.OUTPUT_GPKG,
-                                                        QgsProcessingUtils.LayerHint.Vector)
-            details.setPostProcessor(_post_processor(layer))
-            context.addLayerToLoadOnCompletion("%s|layername=%s" % (gpkg, layer), details)
-        return {self.OUTPUT: nc, self.OUTPUT_GPKG: gpkg or None}
+        self._load(shown, name if shown == nc else name + " (display)", self.OUTPUT, context, _post_processor())
+        for layer in GPKG_LAYERS if self.OUTPUT_GPKG in outputs else ():
+            self._load("%s|layername=%s" % (outputs[self.OUTPUT_GPKG], layer), "%s %s" % (name, layer),
+                       self.OUTPUT_GPKG, context, _post_processor(layer), QgsProcessingUtils.LayerHint.Vector)
+        self._load_models(outputs, srs, context, feedback)
+        results = {p: outputs.get(p) for p in [self.OUTPUT, self.OUTPUT_GPKG] + [m[0] for m in MODEL_OUTPUTS]}
+        results[OUTPUT_FESOM2] = outputs.get(OUTPUT_FESOM2)
+        return results
+
+    @staticmethod
+    def _load(path, name, output, context, post_processor, hint=QgsProcessingUtils.LayerHint.Mesh):
+        details = QgsProcessingContext.LayerDetails(name, context.project(), output, hint)
+        details.setPostProcessor(post_processor)
+        context.addLayerToLoadOnCompletion(path, details)
+
+    def _load_models(self, outputs, srs, context, feedback):
+        """Loads the model files QGIS reads (in their CRS: the one asked, else lon/lat); says which it does not."""
+        for name, _, _, _ in MODEL_OUTPUTS:
+            path = outputs.get(name)
+            if path is None:
+                continue
+            if loads_in_qgis(path):
+                self._load(path, os.path.basename(path), name, context, _post_processor(crs=srs or WGS84))
+            else:
+                feedback.pushInfo("%s: written; QGIS's mesh reader does not open this format, so it is not loaded"
+                                  % path)
 
     @staticmethod
     def _display_copy(mesh, nc, feedback):
         """The UGRID file to load: nc, or its display copy when faces cross the antimeridian
-        (display.py); without xarray, nc with a warning."""
+        (display.py); nc with a warning when the copy cannot be written."""
         try:
             copy = display.write_display_copy(mesh, nc)
-        except ImportError as e:
-            feedback.pushWarning("%s: faces across the antimeridian are drawn smeared across the map (%s: "
-                                 "install python3-xarray for a display copy); the GeoPackage's faces draw right"
-                                 % (nc, e))
+        except (OSError, RuntimeError) as e:
+            feedback.pushWarning("%s: faces across the antimeridian are drawn smeared across the map (no display "
+                                 "copy: %s); the GeoPackage's faces draw right" % (nc, e))
             return nc
         if copy is None:
             return nc
@@ -164,12 +237,32 @@ class _Algorithm(QgsProcessingAlgorithm):
             raise QgsProcessingException(str(e))
 
 
+# The size and coast options beside hmax and hmin: (parameter, keyword, description, default
+# (globemesh's), unit, advanced). A value other than the default is passed on.
+NUMBER_OPTIONS = (("FEATURE_SIZE", "feature_size", "Elements across every channel (3 as OceanMesh2D; 0: off)", 0, "",
+                   False),
+                  ("WAVELENGTH", "wavelength", "Points per tidal wavelength, from the bathymetry (0: off)", 0, "",
+                   False),
+                  ("SLOPE", "slope", "Points per topographic length scale, from the bathymetry (0: off)", 0, "", False),
+                  ("GRADE", "grade", "Gradation: largest growth of the edge length (km/km)", 0.15, "", False),
+                  ("COAST_SIZE", "coast_size", "Edge length at the coast (km; 0: off)", 0, "km", True),
+                  ("COAST_RATE", "coast_rate", "Growth of the edge length away from the coast (km/km)", 0.1, "", True),
+                  ("MIN_ISLAND_AREA", "min_island_area", "Drop islands and lakes smaller than (km2)", 0, "km2", True),
+                  ("PASSAGE_CELLS", "passage_cells", "Edges across each passage", 2, "", True))
+
+
 class MeshOcean(_Algorithm):
     COAST = "COAST"
     BATHY = "BATHY"
     REGION = "REGION"
+    REGION_LAYER = "REGION_LAYER"
     HMAX = "HMAX"
     HMIN = "HMIN"
+    SIZE_REGIONS = "SIZE_REGIONS"
+    SIZE_FIELD = "SIZE_FIELD"
+    PASSAGES = "PASSAGES"
+    DEFAULT_PASSAGES = "DEFAULT_PASSAGES"
+    KEEP_INLAND_SEAS = "KEEP_INLAND_SEAS"
 
     def name(self):
         return "meshocean"
@@ -181,38 +274,113 @@ class MeshOcean(_Algorithm):
         return ("Meshes the ocean between the coastlines of a polygon layer (its selected features when "
                 "'selected features only' is checked) on the sphere, as `globemesh mesh` does: edges of at "
                 "most hmax km, graded down to hmin km, with the depths of the bathymetry raster when given. "
-                "The region, when given, is turned into longitudes and latitudes (EPSG:4326). "
+                "The region is an extent (turned into longitudes and latitudes, EPSG:4326) or a polygon layer "
+                "(--region-file), not both. Size regions are polygons whose field (size_km by default) gives the "
+                "edge length in km inside (--size-regions). Passages are lines across straits kept open: a line "
+                "layer, or the world's critical passages (--passages default). Each layer's selection is "
+                "honoured. The other numbers are those of `globemesh help mesh`; 0 switches a term off. "
                 "The UGRID mesh is loaded showing depth; when faces cross the antimeridian, through a display "
-                "copy NAME_display.nc that QGIS draws without smearing them (the UGRID file is the model's).")
+                "copy NAME_display.nc that QGIS draws without smearing them (the UGRID file is the model's). "
+                "The model formats asked for are written with it; QGIS loads those it reads (SELAFIN, D-Flow FM).")
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.addParameter(QgsProcessingParameterFeatureSource(self.COAST, "Coastline (land polygons)",
                                                               [QgsProcessing.TypeVectorPolygon]))
         self.addParameter(QgsProcessingParameterRasterLayer(self.BATHY, "Bathymetry", optional=True))
         self.addParameter(QgsProcessingParameterExtent(self.REGION, "Region (whole globe when empty)", optional=True))
+        self.addParameter(QgsProcessingParameterFeatureSource(self.REGION_LAYER, "Region as polygons (instead of the "
+                                                              "extent)", [QgsProcessing.TypeVectorPolygon],
+                                                              optional=True))
         self.addParameter(QgsProcessingParameterNumber(self.HMAX, "Largest edge length (km)",
                                                        QgsProcessingParameterNumber.Double, 50.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterNumber(self.HMIN, "Smallest edge length (km; 0: max(hmax/1000, 10 m))",
                                                        QgsProcessingParameterNumber.Double, 0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterFeatureSource(self.SIZE_REGIONS, "Size regions (polygons)",
+                                                              [QgsProcessing.TypeVectorPolygon], optional=True))
+        self.addParameter(QgsProcessingParameterField(self.SIZE_FIELD, "Size regions' edge length field (km)",
+                                                      "size_km", self.SIZE_REGIONS,
+                                                      QgsProcessingParameterField.Numeric, optional=True))
+        self.addParameter(QgsProcessingParameterBoolean(self.DEFAULT_PASSAGES, "Keep the world's critical passages "
+                                                        "open (Gibraltar, Bosphorus...)", False))
+        self.addParameter(QgsProcessingParameterFeatureSource(self.PASSAGES, "Passages (lines across straits, instead "
+                                                              "of the world's)", [QgsProcessing.TypeVectorLine],
+                                                              optional=True))
+        for name, _, description, default, _, advanced in NUMBER_OPTIONS:
+            self._add(QgsProcessingParameterNumber(name, description, QgsProcessingParameterNumber.Double, default,
+                                                   minValue=0.0), advanced)
+        self._add(QgsProcessingParameterBoolean(self.KEEP_INLAND_SEAS, "Keep water bodies not connected to the "
+                                                "ocean", False), True)
         self._add_outputs()
 
-    def _options(self, parameters, context, feedback):
-        """The keywords of globemesh.mesh_ocean() given by the parameters."""
-        coast, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(
-            parameters, self.COAST, context, ["gpkg", "shp"], "gpkg", feedback)
-        options = {"coast": coast, "coast_layer": layer or _first_layer(coast),
-                   "hmax": "%rkm" % self.parameterAsDouble(parameters, self.HMAX, context),
-                   "hmin": "%rkm" % self.parameterAsDouble(parameters, self.HMIN, context)}
-        bathy = self.parameterAsRasterLayer(parameters, self.BATHY, context)
-        if bathy is not None:
-            if bathy.providerType() != "gdal":  # globemesh reads the raster with GDAL, by its source
-                raise QgsProcessingException("bathymetry layer %s: not a GDAL raster (provider %s); save it as a "
-                                             "GeoTIFF first" % (bathy.name(), bathy.providerType()))
-            options["bathy"] = bathy.source()
+    def _add(self, parameter, advanced):
+        if advanced:
+            parameter.setFlags(parameter.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+        self.addParameter(parameter)
+
+    def _layer_file(self, parameters, name, context, feedback):
+        """(path, layer name) of a vector layer parameter as globemesh reads it: its file, or a
+        temporary GeoPackage of its selected features (or of a layer OGR cannot read); None when empty."""
+        if not parameters.get(name):
+            return None, None
+        path, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(parameters, name, context, ["gpkg", "shp"],
+                                                                            "gpkg", feedback)
+        return path, layer or _first_layer(path)
+
+    def _size_regions(self, parameters, context, feedback):
+        """The size regions' (path, layer), their field copied as size_km when it is another."""
+        field = self.parameterAsString(parameters, self.SIZE_FIELD, context) or "size_km"
+        if not parameters.get(self.SIZE_REGIONS) or field == "size_km":
+            return self._layer_file(parameters, self.SIZE_REGIONS, context, feedback)
+        import processing
+        copied = processing.run("native:fieldcalculator", {
+            "INPUT": parameters[self.SIZE_REGIONS], "FIELD_NAME": "size_km", "FIELD_TYPE": 0, "FIELD_LENGTH": 0,
+            "FIELD_PRECISION": 0, "FORMULA": "to_real(%s)" % QgsExpression.quotedColumnRef(field),
+            "OUTPUT": QgsProcessingUtils.generateTempFilename("size_regions.gpkg")}, context=context,
+            feedback=feedback, is_child_algorithm=True)
+        return copied["OUTPUT"], _first_layer(copied["OUTPUT"])
+
+    def _region(self, parameters, context, feedback, options):
+        """The region: an extent in lon/lat, or a polygon layer."""
+        if parameters.get(self.REGION) and parameters.get(self.REGION_LAYER):
+            raise QgsProcessingException("give the region as an extent or as a polygon layer, not both")
         if parameters.get(self.REGION):
             r = self.parameterAsExtent(parameters, self.REGION, context, WGS84)
             options["region"] = (r.xMinimum(), r.yMinimum(), r.xMaximum(), r.yMaximum())
-        return options
+        options["region_file"], options["region_layer"] = self._layer_file(parameters, self.REGION_LAYER, context,
+                                                                           feedback)
+
+    def _passages(self, parameters, context, feedback, options):
+        if self.parameterAsBool(parameters, self.DEFAULT_PASSAGES, context):
+            if parameters.get(self.PASSAGES):
+                raise QgsProcessingException("keep the world's critical passages or a passages layer, not both")
+            options["passages"] = "default"
+        else:
+            options["passages"], options["passages_layer"] = self._layer_file(parameters, self.PASSAGES, context,
+                                                                               feedback)
+
+    def _bathy(self, parameters, context):
+        bathy = self.parameterAsRasterLayer(parameters, self.BATHY, context)
+        if bathy is not None and bathy.providerType() != "gdal":  # globemesh reads the raster with GDAL, by its source
+            raise QgsProcessingException("bathymetry layer %s: not a GDAL raster (provider %s); save it as a "
+                                         "GeoTIFF first" % (bathy.name(), bathy.providerType()))
+        return bathy.source() if bathy is not None else None
+
+    def _options(self, parameters, context, feedback):
+        """The keywords of globemesh.mesh_ocean() given by the parameters (None: globemesh's default)."""
+        coast, layer = self._layer_file(parameters, self.COAST, context, feedback)
+        options = {"coast": coast, "coast_layer": layer, "bathy": self._bathy(parameters, context),
+                   "hmax": "%rkm" % self.parameterAsDouble(parameters, self.HMAX, context),
+                   "hmin": "%rkm" % self.parameterAsDouble(parameters, self.HMIN, context)}
+        self._region(parameters, context, feedback, options)
+        options["size_regions"], options["size_regions_layer"] = self._size_regions(parameters, context, feedback)
+        self._passages(parameters, context, feedback, options)
+        for name, keyword, _, default, unit, _ in NUMBER_OPTIONS:
+            value = self.parameterAsDouble(parameters, name, context)
+            if value != default:
+                options[keyword] = "%r%s" % (value, unit)
+        if self.parameterAsBool(parameters, self.KEEP_INLAND_SEAS, context):
+            options["keep_inland_seas"] = True
+        return {k: v for k, v in options.items() if v is not None}
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         options = self._options(parameters, context, feedback)

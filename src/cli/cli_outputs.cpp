@@ -226,7 +226,8 @@ msh_version_creation(const std::string &msh_version, const std::vector<std::stri
 
 std::vector<PlannedOutput>
 plan_outputs(const OutputChoices &c, std::span<const Writer> table,
-             std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth) {
+             std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth,
+             const std::string &no_depth) {
     // -f names the format of the one -o, or, with several, of the one without an extension (a
     // FESOM2 folder beside the UGRID file); the others take theirs from their extensions.
     const auto bare = [](const std::string &path) { return fs::path(path).extension().empty(); };
@@ -251,7 +252,7 @@ plan_outputs(const OutputChoices &c, std::span<const Writer> table,
     for (const auto &p : planned)
         if ((p.request.writer->needs & needs_depth) && !has_depth)
             throw UsageError(p.option + " " + p.request.path.string() + ": " +
-                             p.request.writer->name + " needs depths; give a bathymetry (--bathy)");
+                             p.request.writer->name + " needs depths; " + no_depth);
     // The table's order is the order of writing (a writer that computes the face areas first).
     auto row = [&](const PlannedOutput &p) { return p.request.writer - table.data(); };
     std::stable_sort(planned.begin(), planned.end(),
@@ -353,10 +354,14 @@ std::string outputs_json(std::span<const PlannedOutput> planned) {
     return r + "}";
 }
 
-std::string outputs_text(std::span<const PlannedOutput> planned) {
+std::string outputs_text(std::span<const PlannedOutput> planned, const Mesh *mesh) {
+    const bool styled = mesh != nullptr && mesh->node_field("depth") != nullptr;
     std::string r;
-    for (const auto &p : planned)
+    for (const auto &p : planned) {
         r += (r.empty() ? "" : ", ") + p.request.path.string();
+        if (styled && p.request.writer->name == "UGRID" && p.request.path.extension() != ".qml")
+            r += ", " + fs::path(p.request.path).replace_extension(".qml").string();
+    }
     return r;
 }
 

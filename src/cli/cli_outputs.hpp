@@ -52,11 +52,13 @@ struct PlannedOutput {
 
 /// The outputs of `c` in the table's order (the order they are written), their formats chosen
 /// and their creation options checked. `extra_creation` (option, KEY=VALUE) are creation
-/// options given by other flags (--format classic). `has_depth`: the mesh will have depths.
+/// options given by other flags (--format classic). `has_depth`: the mesh will have depths;
+/// `no_depth`: how the message about a format that needs them goes on (what gives them).
 /// Throws UsageError (one line naming the option and listing the formats) before anything runs.
 std::vector<PlannedOutput>
 plan_outputs(const OutputChoices &c, std::span<const Writer> table,
-             std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth);
+             std::span<const std::pair<std::string, std::string>> extra_creation, bool has_depth,
+             const std::string &no_depth = "give a bathymetry (--bathy)");
 
 /// Throws UsageError when JSON output `option` (--report, --timings) is named for a mesh format.
 void check_json_output(const std::string &path, const std::string &option,
@@ -94,7 +96,8 @@ std::vector<OutputRequest> requests(std::span<const PlannedOutput> planned);
 /// when a format is written twice).
 std::string outputs_json(std::span<const PlannedOutput> planned);
 
-/// "o.nc, o.gpkg": the outputs in the order written.
-std::string outputs_text(std::span<const PlannedOutput> planned);
+/// "o.nc, o.qml, o.gpkg": the outputs in the order written, with the QGIS style NAME.qml that a
+/// UGRID output of `mesh` gets when it has depths (ugrid_write.cpp).
+std::string outputs_text(std::span<const PlannedOutput> planned, const Mesh *mesh = nullptr);
 
 } // namespace globemesh::cli

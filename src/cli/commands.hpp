@@ -2,6 +2,7 @@
 // bound to its options, and the functions that run them (run_cli's dispatch calls these).
 #pragma once
 
+#include <array>
 #include <ostream>
 #include <span>
 #include <string>
@@ -71,11 +72,17 @@ struct InfoCommand {
     InfoCommand();
 };
 
+/// --preview-region's W,S,E,N, checked as --region is (W > E crosses +-180); one-line
+/// UsageError otherwise (mesh and convert).
+std::array<double, 4> checked_preview_region(const std::vector<double> &r);
+
 /// The `convert` subcommand's CLI11 App and options.
 struct ConvertCommand {
     std::string input;
     std::vector<std::string> positional, output, creation;
     std::string format, output_srs, msh_version;
+    std::vector<double> preview_region;
+    CLI::Option *preview_region_opt = nullptr;
     bool overwrite = false, quiet = false;
     CLI::App app{"Convert a UGRID mesh to the output formats, keeping boundary tags and depths.",
                  "globemesh convert"};

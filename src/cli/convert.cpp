@@ -2,8 +2,10 @@
 // (fort.14, .gr3, .ll, by its name) and writes it through the
 // writers table, as `mesh` writes its outputs (-o, -f, --co, --overwrite, all or nothing).
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -33,6 +35,12 @@ ConvertCommand::ConvertCommand(std::span<const Writer> table) {
         ->type_name("OUT");
     add_output_flags(app, output, format, creation, table, "Options");
     add_model_flags(app, output_srs, msh_version, table, "Options");
+    preview_region_opt = app.add_option("--preview-region", preview_region,
+                                        "Region W,S,E,N in degrees a .png output shows (W > E "
+                                        "crosses 180); default the mesh's extent")
+                             ->type_name("W,S,E,N")
+                             ->delimiter(',')
+                             ->expected(4);
     app.add_flag("--overwrite", overwrite, "Replace existing output files");
     app.add_flag("-q,--quiet", quiet, "No progress on stderr");
 }
@@ -65,6 +73,18 @@ void name_depth(Mesh &mesh) {
     mesh.node_fields.push_back(std::move(d));
 }
 
+/// --preview-region's W,S,E,N when given, checked, with a PNG output to zoom.
+std::optional<std::array<double, 4>> preview_region(const ConvertCommand &c,
+                                                    std::span<const PlannedOutput> planned) {
+    if (c.preview_region_opt->count() == 0)
+        return std::nullopt;
+    const auto region = checked_preview_region(c.preview_region);
+    if (std::none_of(planned.begin(), planned.end(),
+                     [](const auto &p) { return p.request.writer->name == "PNG"; }))
+        throw UsageError("--preview-region zooms the PNG picture: give an OUT.png too");
+    return region;
+}
+
 } // namespace
 
 int run_convert(std::span<const std::string> args, std::ostream &out, std::ostream &err,
@@ -83,6 +103,7 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
     const auto planned =
         plan_outputs(choices, lib.writers, msh_version_creation(c.msh_version, c.creation), true);
     check_output_srs(c.output_srs, requests(planned));
+    const auto region = preview_region(c, planned);
     const std::pair<std::string, std::string> inputs[] = {{"IN", c.input}};
     check_output_files(output_files(planned, "", "", lib.writers), inputs, c.overwrite);
 
@@ -101,6 +122,7 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
         "globemesh mesh converted from " + std::filesystem::path(c.input).filename().string();
     write.history = history_text("convert", args);
     write.output_srs = c.output_srs;
+    write.extent_deg = region;
     write_run_outputs(mesh, planned, write, terminal);
     terminal.finish();
     InterruptGuard::completing();
@@ -111,7 +133,7 @@ int run_convert(std::span<const std::string> args, std::ostream &out, std::ostre
         << "faces             " << mesh.faces.size() << "\n"
         << "boundary edges    " << mesh.boundary.size() << " (" << coast << " coast, "
         << mesh.boundary.size() - std::size_t(coast) << " open)\n"
-        << "written           " << outputs_text(planned) << "\n";
+        << "written           " << outputs_text(planned, &mesh) << "\n";
     return 0;
 }
 

@@ -18,8 +18,6 @@
 
 namespace globemesh::cli {
 
-namespace {
-
 /// --preview-region's W,S,E,N, checked as --region is (W > E crosses +-180); one-line
 /// UsageError otherwise.
 std::array<double, 4> checked_preview_region(const std::vector<double> &r) {
@@ -34,8 +32,6 @@ std::array<double, 4> checked_preview_region(const std::vector<double> &r) {
         throw UsageError(flag + "W and E must differ (W > E crosses +-180)");
     return {r[0], r[1], r[2], r[3]};
 }
-
-} // namespace
 
 MeshCommand::MeshCommand(std::span<const Writer> table) {
     app.option_defaults()->always_capture_default();

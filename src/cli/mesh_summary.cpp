@@ -175,7 +175,7 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
         warn_straits(err, s.run.mesher);
     print_timings(out, s.timings); // its last line: the total
     out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
-        << "wrote             " << outputs_text(s.planned);
+        << "wrote             " << outputs_text(s.planned, &s.run.mesh);
     for (const auto *p : {&o.timings, &o.report})
         if (!p->empty())
             out << ", " << *p;

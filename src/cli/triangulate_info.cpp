@@ -53,7 +53,9 @@ int run_triangulate(std::span<const std::string> args, std::ostream &out, std::o
         throw UsageError("-o/--output is required: the UGRID file to write, e.g. -o out.nc");
     check_input_path(c.t.points, "POINTS");
     const OutputChoices choices{c.output, c.format, c.creation, {{"--gpkg", "GPKG", c.gpkg}}};
-    const auto planned = plan_outputs(choices, lib.writers, {}, false);
+    const auto planned = plan_outputs(choices, lib.writers, {}, false,
+                                      "points have none: mesh with a bathymetry (globemesh mesh "
+                                      "--bathy) for it");
     const std::pair<std::string, std::string> inputs[] = {{"POINTS", c.t.points}};
     check_output_files(output_files(planned, c.timings, "", lib.writers), inputs, c.overwrite);
 

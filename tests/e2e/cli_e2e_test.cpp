@@ -290,6 +290,12 @@ TEST(CliE2e, preview_region_zooms_the_picture_and_draws_the_edges_through_the_no
                     out, err, dir.path());
         ASSERT_EQ(status, 0) << err;
     }
+    // convert zooms its picture as mesh does (no land under it: convert has no coast).
+    ASSERT_EQ(run_exe({"convert", (dir / "g.nc").string(), (dir / "c.png").string(),
+                       "--preview-region=-8,49,2,56", "--quiet"},
+                      out, err, dir.path()),
+              0)
+        << err;
     expect_mesh_verify(dir / "r.nc");
     const std::string verdict = python(R"(
 import netCDF4, numpy as np
@@ -318,6 +324,11 @@ near = [edge[int(r) - 1:int(r) + 2, int(c) - 1:int(c) + 2].any() for c, r in zip
 assert np.mean(near) > 0.95, np.mean(near)
 assert edge.mean() > 0.005, edge.mean()
 assert not dark(rgb('g.png')).any()
+converted = rgb('c.png')
+assert converted.shape == zoom.shape, converted.shape
+edge = dark(converted)
+near = [edge[int(r) - 1:int(r) + 2, int(c) - 1:int(c) + 2].any() for c, r in zip(col[inside], row[inside])]
+assert np.mean(near) > 0.95, np.mean(near)
 print('OK')
 )",
                                        dir.path());

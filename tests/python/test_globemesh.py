@@ -6,6 +6,7 @@ GLOBEMESH_EXE, GLOBEMESH_FIXTURES_DIR set."""
 import os
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -193,6 +194,19 @@ class Errors(TempDir):
         message, status = cli_error("triangulate", STATIONS, "-o", self.path("mesh.xyz"))
         self.assertEqual(str(caught.exception), message)
         self.assertEqual(status, 2)
+
+    def test_gdal_warnings_are_python_warnings(self):
+        # A GDAL warning during a run (the library's readers silence those they expect) comes as
+        # a globemesh.GdalWarning, not on stderr as GDAL's default handler prints it; in a child
+        # process, to see its stderr.
+        script = ("import warnings, globemesh\n"
+                  "with warnings.catch_warnings(record=True) as caught:\n"
+                  "    warnings.simplefilter('always')\n"
+                  "    globemesh._globemesh._gdal_warning_in_a_run('odd raster')\n"
+                  "print([(w.category.__name__, str(w.message)) for w in caught])\n")
+        run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+        self.assertEqual((run.returncode, run.stdout, run.stderr), (0, "[('GdalWarning', 'GDAL: odd raster')]\n", ""))
+        self.assertTrue(issubclass(globemesh.GdalWarning, UserWarning))
 
     def test_triangulate_bad_points(self):
         with self.assertRaisesRegex(globemesh.UsageError, "same length"):

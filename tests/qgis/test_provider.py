@@ -25,6 +25,7 @@ def skip(why):
 
 os.environ["QT_QPA_PLATFORM"] = "offscreen"
 os.environ["GDAL_PAM_ENABLED"] = "NO"  # no .aux.xml beside the fixtures
+sys.modules["xarray"] = None  # the plugin's display copy needs no xarray (an import of it fails)
 try:
     from qgis.core import (QgsApplication, QgsMeshDatasetIndex, QgsMeshLayer, QgsProcessingContext,
                            QgsProcessingFeedback, QgsProject, QgsRasterLayer, QgsVectorLayer)
@@ -65,7 +66,7 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     result = processing.run("globemesh:meshocean", {"COAST": coast.id(), "BATHY": bathy.id(), "HMAX": 500,
                                                     "HMIN": 150, "OUTPUT": nc, "OUTPUT_GPKG": gpkg},
                             context=context, feedback=feedback)
-    assert result == {"OUTPUT": nc, "OUTPUT_GPKG": gpkg}, result
+    assert {k: v for k, v in result.items() if v} == {"OUTPUT": nc, "OUTPUT_GPKG": gpkg}, result
     assert steps and max(steps) > 50, steps  # the run moved the progress bar
 
     mesh = QgsMeshLayer(nc, "ocean", "mdal")
@@ -130,8 +131,13 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
                     assert sorted(colours) == ["coast", "open"] and len(set(colours.values())) == 2, colours
                     tags = {f["tag"] for f in layer.getFeatures()}
                     assert tags <= set(colours), tags  # every feature drawn by a category
+    # A regional run into the same file: the display copy of the global one (and its style) goes.
+    del shown
+    processing.run("globemesh:meshocean", {"COAST": coast.id(), "REGION": "-20,20,30,60 [EPSG:4326]", "HMAX": 500,
+                                           "OUTPUT": nc})
+    assert sorted(f for f in os.listdir(folder) if f.startswith("ocean_display")) == [], os.listdir(folder)
 print("OK: %d faces" % mesh.meshFaceCount())
-del mesh, shown, layer, loads, context, feedback  # QGIS's objects go before QGIS does
+del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
 
 
 def nodes_in(nc, west, south, east, north):
@@ -144,11 +150,11 @@ def nodes_in(nc, west, south, east, north):
 
 # A region (as Processing writes an extent: xmin,xmax,ymin,ymax [crs]) and the selected features only:
 # with Great Britain left out of the selection, the sea covers England.
+from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition  # noqa: E402
 with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     england = (-2.5, 52, -1, 53.2)  # the Midlands
     for selected in (False, True):
         if selected:
-            from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition
             inland = QgsGeometry.fromPointXY(QgsPointXY(-1.5, 52.8))
             coast.selectByIds([f.id() for f in coast.getFeatures() if not f.geometry().intersects(inland)])
             assert 0 < coast.selectedFeatureCount() < coast.featureCount()
@@ -164,6 +170,81 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
         assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
         assert not os.path.exists(nc.replace(".nc", "_display.nc"))  # no face crosses the antimeridian
 
+    # The region as a polygon layer (its selected feature: the North Sea, not the Java Sea), a
+    # size-regions layer whose edge length field is not size_km (15 km in a box off the Netherlands),
+    # the world's passages, a channel term, and every model format: QGIS loads the two its reader opens.
+    from qgis.core import QgsFeature, QgsProcessingException, QgsRectangle
+
+    def polygons(name, boxes, field=None):
+        layer = QgsVectorLayer("Polygon?crs=EPSG:4326" + ("&field=%s:double" % field if field else ""), name, "memory")
+        features = []
+        for box in boxes:
+            feature = QgsFeature(layer.fields())
+            feature.setGeometry(QgsGeometry.fromRect(QgsRectangle(*box[:4])))
+            feature.setAttributes(list(box[4:]))
+            features.append(feature)
+        assert layer.dataProvider().addFeatures(features)
+        return layer
+    regions = polygons("regions", [(-12, 46, 13, 62), (100, -10, 120, 10)])
+    sizes = polygons("sizes", [(2, 53, 5, 56, 15.0)], "h")
+    project.addMapLayers([regions, sizes])
+    regions.selectByIds([1])
+    out = {"OUTPUT": os.path.join(folder, "north_sea.nc"), "OUTPUT_MSH": os.path.join(folder, "north_sea.msh"),
+           "OUTPUT_ADCIRC": os.path.join(folder, "fort.14"), "OUTPUT_SCHISM": os.path.join(folder, "hgrid.gr3"),
+           "OUTPUT_SELAFIN": os.path.join(folder, "north_sea.slf"),
+           "OUTPUT_DFLOWFM": os.path.join(folder, "north_sea.nc"), "OUTPUT_FESOM2": os.path.join(folder, "fesom")}
+    context = QgsProcessingContext()
+    context.setProject(project)
+    result = processing.run("globemesh:meshocean", dict(out, COAST=coast.id(), BATHY=bathy.id(), HMAX=100, HMIN=10,
+                                                        REGION_LAYER=QgsProcessingFeatureSourceDefinition(regions.id(),
+                                                                                                          True),
+                                                        SIZE_REGIONS=sizes.id(), SIZE_FIELD="h",
+                                                        DEFAULT_PASSAGES=True, FEATURE_SIZE=2), context=context)
+    net = os.path.join(folder, "north_sea_net.nc")  # D-Flow FM's name ending, which picks its format
+    assert {k: v for k, v in result.items() if v} == dict(out, OUTPUT_DFLOWFM=net), result
+    nc = out["OUTPUT"]
+    inside, total = nodes_in(nc, -12.001, 45.999, 13.001, 62.5)
+    assert inside == total > 0, (inside, total)
+    assert subprocess.run([CHECKER, nc, "--quiet"]).returncode == 0, "mesh-verify rejects %s" % nc
+    import netCDF4
+    import numpy
+    with netCDF4.Dataset(nc) as file:
+        configuration = file.globemesh_configuration
+        lon, lat, faces = (numpy.asarray(file[v][:]) for v in ("mesh_node_lon", "mesh_node_lat", "mesh_face_nodes"))
+    assert 'passages="default"' in configuration  # the world's list, found (else the run fails)
+    assert "feature-size=2" in configuration and 'size-regions="' in configuration, configuration
+    # The size region: edges of about 15 km inside (km along the meridian and the parallel), over 40 km
+    # off Ireland (100 km at most, shorter near the coast).
+    def edge_km(where):
+        a, b = faces[where][:, 0], faces[where][:, 1]
+        dx = (lon[a] - lon[b]) * numpy.cos(numpy.radians(lat[a]))
+        return numpy.median(numpy.hypot(dx, lat[a] - lat[b])) * 111.2
+    corner_lon, corner_lat = lon[faces[:, 0]], lat[faces[:, 0]]
+    boxed = (corner_lon > 2.5) & (corner_lon < 4.5) & (corner_lat > 53.5) & (corner_lat < 55.5)
+    atlantic = (corner_lon < -8) & (corner_lat < 58) & (corner_lat > 47)
+    assert edge_km(boxed) < 20 and edge_km(atlantic) > 40, (edge_km(boxed), edge_km(atlantic))
+    loads = context.layersToLoadOnCompletion()
+    assert sorted(loads) == sorted([nc, out["OUTPUT_SELAFIN"], net]), sorted(loads)
+    for path in (out["OUTPUT_SELAFIN"], net):
+        model = QgsMeshLayer(path, "model", "mdal")
+        loads[path].postProcessor().postProcessLayer(model, context, QgsProcessingFeedback())
+        assert model.meshFaceCount() == len(faces) and model.crs().authid() == "EPSG:4326", path
+    with open(out["OUTPUT_ADCIRC"]) as grid:
+        grid.readline()
+        assert [int(n) for n in grid.readline().split()[:2]] == [len(faces), len(lon)]
+    assert sorted(os.listdir(out["OUTPUT_FESOM2"])) == ["aux3d.out", "elem2d.out", "nod2d.out"]
+    assert os.path.getsize(out["OUTPUT_MSH"]) > 0 and os.path.getsize(out["OUTPUT_SCHISM"]) > 0
+    del model, loads, context
+    for both, why in (({"REGION": "-20,20,30,60 [EPSG:4326]", "REGION_LAYER": regions.id()}, "not both"),
+                      ({"PASSAGES": os.path.join(FIXTURES, "passages", "passages.geojson"), "DEFAULT_PASSAGES": True},
+                       "not both")):
+        try:
+            processing.run("globemesh:meshocean", dict(both, COAST=coast.id(), HMAX=500,
+                                                       OUTPUT=os.path.join(folder, "both.nc")))
+            raise AssertionError("ran with %s" % both)
+        except QgsProcessingException as e:
+            assert why in str(e), e
+
     # A path with several polygon layers and no layer named: the first, as QGIS reads it.
     from osgeo import gdal
     two = os.path.join(folder, "two_layers.gpkg")
@@ -171,8 +252,8 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
         gdal.VectorTranslate(two, os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg"), layers=["land"],
                              layerName=name, accessMode="update" if os.path.exists(two) else None)
     nc = os.path.join(folder, "two_layers.nc")
-    assert processing.run("globemesh:meshocean", {"COAST": two, "HMAX": 500, "OUTPUT": nc}) == {
-        "OUTPUT": nc, "OUTPUT_GPKG": None}
+    result = processing.run("globemesh:meshocean", {"COAST": two, "HMAX": 500, "OUTPUT": nc})
+    assert {k: v for k, v in result.items() if v} == {"OUTPUT": nc}, result
 
     # Cancelled (as the progress bar's Cancel button does): nothing written.
     cancelled = QgsProcessingFeedback()

@@ -29,7 +29,7 @@ import numpy  # noqa: E402
 def mesh(out, *args, sizes=("--hmax", "500km", "--hmin", "150km")):
     return subprocess.run([EXE, "mesh", "-q", "--coast", os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg"),
                            "--coast-layer", "land", "-o", out] + list(sizes) + list(args),
-                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                          capture_output=True, text=True)
 
 
 app = QgsApplication([], False)
@@ -43,6 +43,7 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qml-") as folder:
         run = mesh(nc, *args, sizes=sizes)
         assert run.returncode == 0, run.stderr
         assert os.path.exists(os.path.join(folder, name + ".qml")), os.listdir(folder)
+        assert "\nwrote             %s, %s\n" % (nc, os.path.join(folder, name + ".qml")) in run.stdout, run.stdout
         with netCDF4.Dataset(nc) as file:
             long_name, deepest = file["depth"].long_name, numpy.nanmax(file["depth"][:])
             groups = sum(1 for v in file.variables.values() if getattr(v, "location", "") in ("node", "face"))
@@ -60,8 +61,18 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qml-") as folder:
         assert len(items) > 2 and items[0].color.lightness() > items[-1].color.lightness()  # deep is dark
         del layer
 
+    # convert writes the style with the depths it reads, and says so.
+    converted = os.path.join(folder, "converted.nc")
+    run = subprocess.run([EXE, "convert", "-q", os.path.join(folder, "shelf.nc"), converted], capture_output=True,
+                         text=True)
+    written = "\nwritten           %s, %s\n" % (converted, converted[:-3] + ".qml")
+    assert run.returncode == 0 and written in run.stdout, run
+    for name in ("converted.nc", "converted.qml"):
+        os.remove(os.path.join(folder, name))
+
     # No bathymetry, no depth: no style.
-    assert mesh(os.path.join(folder, "bare.nc")).returncode == 0
+    run = mesh(os.path.join(folder, "bare.nc"))
+    assert run.returncode == 0 and "\nwrote             %s\n" % os.path.join(folder, "bare.nc") in run.stdout, run
     assert sorted(f for f in os.listdir(folder) if f.startswith("bare")) == ["bare.nc"], os.listdir(folder)
 
     # A NAME.qml already there: refused without --overwrite (one line, exit 1, no .nc), replaced with it.
