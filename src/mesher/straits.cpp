@@ -186,9 +186,9 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
     // The rim's stretches of water: each rim sample's stretch (-1 on land).
     std::vector<int> stretch(spokes, -1);
     int stretches = 0;
-    for (int k = 0, start = -1; k < spokes; ++k)
+    for (int k = 0; k < spokes; ++k)
         if (clearance[index(rings, k)] >= 0 && clearance[index(rings, k - 1)] < 0)
-            start = k, ++stretches, stretch[k] = stretches - 1;
+            stretch[k] = stretches++;
     if (stretches < 2)
         return 0; // (a rim all water is one stretch: no passage to measure)
     for (int k = 0; k < 2 * spokes; ++k)

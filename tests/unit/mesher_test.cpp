@@ -294,10 +294,12 @@ TEST(Mesher, straits_narrower_than_a_face_close_unless_kept) {
         const LonLat at = vec_to_lonlat(r.straits_closed_at[i]);
         EXPECT_GT(r.straits_closed_width_km[i] + r.straits_closed_width_below_km[i], 0);
         EXPECT_LT(r.straits_closed_width_km[i], 100) << "narrower than a face";
-        if (std::abs(at.lon - 26.5) < 0.2 && std::abs(at.lat - 40.2) < 0.2)
+        if (std::abs(at.lon - 26.5) < 0.2 && std::abs(at.lat - 40.2) < 0.2) {
             EXPECT_NEAR(r.straits_closed_width_km[i], 3.5, 2.5) << "the Dardanelles";
-        if (std::abs(at.lon - 29.1) < 0.2 && std::abs(at.lat - 41.1) < 0.2)
+        }
+        if (std::abs(at.lon - 29.1) < 0.2 && std::abs(at.lat - 41.1) < 0.2) {
             EXPECT_NEAR(r.straits_closed_width_km[i], 2.2, 1.5) << "the Bosphorus";
+        }
     }
     // The largest basin cut off is the Black Sea (436,000 km2, and the Sea of Azov), each basin
     // a piece of its own beside the main one.
