@@ -55,6 +55,7 @@ std::string qgis_depth_style(int group, double max_depth) {
     x.imbue(std::locale::classic());
     const std::string g = std::to_string(group);
     x << "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>\n"
+      << qgis_style_mark << "\n"
       << "<qgis version=\"3.22\" styleCategories=\"Symbology\">\n"
       << " <mesh-renderer-settings>\n"
       << "  <active-dataset-group scalar=\"" << g << "\" vector=\"-1\"/>\n"

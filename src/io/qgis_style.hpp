@@ -9,4 +9,9 @@ namespace globemesh::io {
 /// file in the byte order of their names) with a bathymetry colour ramp from 0 to `max_depth` m.
 std::string qgis_depth_style(int group, double max_depth);
 
+/// The comment line that marks a style globemesh wrote (its second line), so that a later run
+/// with --overwrite may remove one it no longer matches, and never a user's own.
+inline constexpr const char *qgis_style_mark =
+    "<!-- globemesh: the depth style of its UGRID file -->";
+
 } // namespace globemesh::io

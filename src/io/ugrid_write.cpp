@@ -480,6 +480,18 @@ void write_style(const OutputFile &out, const std::string &text) {
                       OutputFile::full_disk_note(out.target()));
 }
 
+/// Removes the style beside a UGRID file that an earlier run wrote (marked so) and this one,
+/// without depth, does not replace: it would show another variable with the depth ramp.
+void remove_our_style(const std::filesystem::path &qml) {
+    std::ifstream f(qml, std::ios::binary);
+    std::string doctype, mark;
+    if (f && std::getline(f, doctype) && std::getline(f, mark) && mark == io::qgis_style_mark) {
+        f.close();
+        std::error_code ignored; // a style left behind is no failure of the run
+        std::filesystem::remove(qml, ignored);
+    }
+}
+
 } // namespace
 
 /// The UGRID row of the writers table (writers.cpp); with depth, NAME.qml beside NAME.nc, the
@@ -504,6 +516,8 @@ void write_as_ugrid(const Mesh &mesh, const std::filesystem::path &path,
     write_ugrid(mesh, path, ugrid);
     if (qml)
         qml->commit();
+    else if (options.overwrite && path.extension() != ".qml")
+        remove_our_style(std::filesystem::path(path).replace_extension(".qml"));
 }
 
 } // namespace globemesh

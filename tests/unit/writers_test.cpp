@@ -9,6 +9,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -209,4 +210,20 @@ TEST(Writers, a_format_that_needs_depths_refuses_a_mesh_without_them_before_writ
     globemesh::write_outputs(with_depth, requests, {});
     // With depth, each UGRID file has its QGIS style beside it.
     EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "a.qml", "b.nc", "b.qml"}));
+}
+
+TEST(Writers, a_rewrite_without_depth_removes_the_style_it_wrote_and_keeps_a_users_own) {
+    TempDir dir;
+    globemesh::Mesh with_depth = icosphere(1);
+    with_depth.node_fields.push_back(
+        {"depth", "depth", "m", "", std::vector<double>(with_depth.nodes.size(), 10.0)});
+    const globemesh::OutputRequest a[] = {{&globemesh::writers().front(), dir / "a.nc", {}}};
+    globemesh::write_outputs(with_depth, a, {});
+    { std::ofstream(dir / "b.qml") << "<!DOCTYPE qgis>\n<qgis/>\n"; } // the user's own
+    const globemesh::OutputRequest b[] = {{&globemesh::writers().front(), dir / "b.nc", {}}};
+    globemesh::WriteOptions overwrite;
+    overwrite.overwrite = true;
+    globemesh::write_outputs(icosphere(1), a, overwrite);
+    globemesh::write_outputs(icosphere(1), b, overwrite);
+    EXPECT_EQ(files_in(dir.path()), (std::set<std::string>{"a.nc", "b.nc", "b.qml"}));
 }
