@@ -250,8 +250,7 @@ void add_index(GpkgSqlite &db, const RtreeLayer &layer, Steps &steps) {
 
         Statement node(db, "INSERT OR REPLACE INTO " + quoted(rtree + "_node") +
                                "(nodeno, data) VALUES (?, ?)");
-        Statement rowid(db, "INSERT INTO " + quoted(rtree + "_rowid") +
-                                "(rowid, nodeno) VALUES (?, ?)");
+        RowInserter rowid(db, rtree + "_rowid", {"rowid", "nodeno"});
         Statement parent(db, "INSERT INTO " + quoted(rtree + "_parent") +
                                  "(nodeno, parentnode) VALUES (?, ?)");
         std::vector<unsigned char> blob(static_cast<std::size_t>(node_bytes));
@@ -284,9 +283,12 @@ void add_index(GpkgSqlite &db, const RtreeLayer &layer, Steps &steps) {
             }
         }
         for (std::size_t i = 0; i < leaf_of.size(); ++i) {
-            rowid.insert(std::int64_t(i) + 1, leaf_of[i]);
+            rowid.bind(0, std::int64_t(i) + 1);
+            rowid.bind(1, leaf_of[i]);
+            rowid.insert();
             steps.add(1);
         }
+        rowid.flush();
     }
     for (const std::string &sql : triggers(layer.table, layer.column))
         db.exec(sql);
@@ -343,9 +345,30 @@ void GpkgSqlite::commit() {
     in_transaction_ = false;
 }
 
+RowInserter::RowInserter(GpkgSqlite &db, const std::string &table,
+                         const std::vector<std::string> &columns)
+    : db_(db), table_(table), columns_(columns.size()), queued_(columns.size()) {
+    std::string names, row;
+    for (const std::string &c : columns) {
+        names += (names.empty() ? "" : ", ") + quoted(c);
+        row += row.empty() ? "(?" : ", ?";
+    }
+    row += ")";
+    const std::string insert = "INSERT INTO " + quoted(table) + " (" + names + ") VALUES ";
+    std::string rows = row;
+    for (std::size_t r = 1; r < rows_per_statement; ++r)
+        rows += ", " + row;
+    if (sqlite3_prepare_v2(db.get(), (insert + rows).c_str(), -1, &full_, nullptr) != SQLITE_OK ||
+        sqlite3_prepare_v2(db.get(), (insert + row).c_str(), -1, &one_, nullptr) != SQLITE_OK) {
+        const std::string why = sqlite3_errmsg(db.get());
+        sqlite3_finalize(full_); // the destructor does not run for a constructor that throws
+        db.fail("preparing the rows of " + table, why);
+    }
+}
+
 BulkRows::BulkRows(GpkgSqlite &db, const std::string &table,
                    const std::vector<std::string> &columns)
-    : db_(db), table_(table) {
+    : RowInserter(db, table, columns) {
     constexpr double inf = std::numeric_limits<double>::infinity();
     extent_ = {inf, -inf, inf, -inf};
     // GDAL's trigger that counts each row inserted into gpkg_ogr_contents (finish() writes the
@@ -358,38 +381,67 @@ BulkRows::BulkRows(GpkgSqlite &db, const std::string &table,
     }
     if (!triggers_.empty())
         db.exec("DROP TRIGGER " + quoted("trigger_insert_feature_count_" + table));
-    std::string names, values;
-    for (const std::string &c : columns) {
-        names += (names.empty() ? "" : ", ") + quoted(c);
-        values += values.empty() ? "?" : ", ?";
-    }
-    const std::string sql =
-        "INSERT INTO " + quoted(table) + " (" + names + ") VALUES (" + values + ")";
-    if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &insert_, nullptr) != SQLITE_OK)
-        db.fail("preparing the rows of " + table);
 }
 
-BulkRows::~BulkRows() {
-    sqlite3_finalize(insert_);
+RowInserter::~RowInserter() {
+    sqlite3_finalize(full_);
+    sqlite3_finalize(one_);
 }
 
-void BulkRows::bind(int i, std::int64_t v) {
-    sqlite3_bind_int64(insert_, i + 1, v);
+void RowInserter::bind(int i, std::int64_t v) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::integer, x.i = v;
 }
 
-void BulkRows::bind(int i, double v) {
-    sqlite3_bind_double(insert_, i + 1, v);
+void RowInserter::bind(int i, double v) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::real, x.d = v;
 }
 
-void BulkRows::bind_blob(int i, const unsigned char *data, std::size_t bytes) {
-    sqlite3_bind_blob(insert_, i + 1, data, static_cast<int>(bytes), SQLITE_STATIC);
+void RowInserter::bind_blob(int i, const unsigned char *data, std::size_t bytes) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::blob, x.data = data, x.bytes = bytes;
 }
 
-void BulkRows::insert() {
-    if (sqlite3_step(insert_) != SQLITE_DONE)
-        db_.fail("writing the rows of " + table_);
-    sqlite3_reset(insert_);
+void RowInserter::insert() {
+    ++queued_rows_;
     ++rows_;
+    if (queued_rows_ < rows_per_statement) {
+        queued_.resize((queued_rows_ + 1) * columns_);
+        return;
+    }
+    for (std::size_t r = 0; r < queued_rows_; ++r)
+        bind_row(full_, r, int(r * columns_) + 1);
+    step(full_);
+    queued_rows_ = 0;
+}
+
+void RowInserter::flush() {
+    for (std::size_t r = 0; r < queued_rows_; ++r) {
+        bind_row(one_, r, 1);
+        step(one_);
+    }
+    queued_rows_ = 0;
+}
+
+/// Binds queued row `row` to the parameters of `s` from number `first` on.
+void RowInserter::bind_row(sqlite3_stmt *s, std::size_t row, int first) {
+    for (std::size_t c = 0; c < columns_; ++c) {
+        const Value &x = queued_[row * columns_ + c];
+        const int p = first + int(c);
+        if (x.kind == Value::integer)
+            sqlite3_bind_int64(s, p, x.i);
+        else if (x.kind == Value::real)
+            sqlite3_bind_double(s, p, x.d);
+        else
+            sqlite3_bind_blob(s, p, x.data, static_cast<int>(x.bytes), SQLITE_STATIC);
+    }
+}
+
+void RowInserter::step(sqlite3_stmt *s) {
+    if (sqlite3_step(s) != SQLITE_DONE)
+        db_.fail("writing the rows of " + table_);
+    sqlite3_reset(s);
 }
 
 void BulkRows::extend(double min_x, double max_x, double min_y, double max_y) {
@@ -398,13 +450,14 @@ void BulkRows::extend(double min_x, double max_x, double min_y, double max_y) {
 }
 
 void BulkRows::finish() {
+    flush();
     const std::string what = "counting the rows of " + table_;
     Statement count(db_,
                     "UPDATE gpkg_ogr_contents SET feature_count = ? WHERE "
                     "table_name = " +
                         literal(table_),
                     what);
-    count.insert(rows_);
+    count.insert(rows());
     if (extent_[0] <= extent_[1]) {
         // As GDAL 3.6 writes it: through SQLite's printf, which keeps 16 significant digits.
         char *sql = sqlite3_mprintf("UPDATE gpkg_contents SET min_x = %.18g, min_y = %.18g, "

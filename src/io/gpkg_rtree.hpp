@@ -70,35 +70,66 @@ private:
     bool in_transaction_ = false;
 };
 
-/// The bulk rows of one feature table that GDAL created empty: `columns` in the order the
-/// values are bound (a row's fid among them). GDAL's feature-count triggers are dropped while
-/// the rows go in and put back by finish(), which writes the table's row count to
-/// gpkg_ogr_contents and its features' extent to gpkg_contents, as GDAL does at close.
-class BulkRows {
+/// Rows inserted into one table of `db`, 64 to a statement (SQLite updates an AUTOINCREMENT
+/// table's sequence once a statement: one a row cost half the insert), `columns` in the order
+/// the values are set.
+class RowInserter {
 public:
-    BulkRows(GpkgSqlite &db, const std::string &table, const std::vector<std::string> &columns);
-    ~BulkRows();
-    BulkRows(const BulkRows &) = delete;
-    BulkRows &operator=(const BulkRows &) = delete;
+    RowInserter(GpkgSqlite &db, const std::string &table, const std::vector<std::string> &columns);
+    ~RowInserter();
+    RowInserter(const RowInserter &) = delete;
+    RowInserter &operator=(const RowInserter &) = delete;
 
-    /// Binds column i (0-based in `columns`) of the next row; a blob must live until insert().
+    /// Sets column i (0-based in `columns`) of the next row; a blob must live until flush().
     void bind(int i, std::int64_t v);
     void bind(int i, double v);
     void bind_blob(int i, const unsigned char *data, std::size_t bytes);
-    /// Inserts the row bound and counts it.
+    /// Queues the row set (every column must be), inserting a full statement's rows.
     void insert();
+    /// Inserts the rows queued.
+    void flush();
+    /// The rows queued or inserted.
+    std::int64_t rows() const { return rows_; }
+
+protected:
+    GpkgSqlite &db_;
+    std::string table_;
+
+private:
+    static constexpr std::size_t rows_per_statement = 64;
+    struct Value {
+        enum { integer, real, blob } kind = integer;
+        std::int64_t i = 0;
+        double d = 0;
+        const unsigned char *data = nullptr;
+        std::size_t bytes = 0;
+    };
+    void bind_row(sqlite3_stmt *s, std::size_t row, int first);
+    void step(sqlite3_stmt *s);
+
+    std::size_t columns_;
+    sqlite3_stmt *full_ = nullptr; ///< rows_per_statement rows
+    sqlite3_stmt *one_ = nullptr;  ///< one row, for the last of a flush
+    std::vector<Value> queued_;    ///< the rows queued, then the row being set
+    std::size_t queued_rows_ = 0;
+    std::int64_t rows_ = 0;
+};
+
+/// The bulk rows of one feature table that GDAL created empty (a row's fid among `columns`).
+/// GDAL's feature-count trigger is dropped while the rows go in and put back by finish(), which
+/// writes the table's row count to gpkg_ogr_contents and its features' extent to gpkg_contents,
+/// as GDAL does at close.
+class BulkRows : public RowInserter {
+public:
+    BulkRows(GpkgSqlite &db, const std::string &table, const std::vector<std::string> &columns);
     /// Widens the layer's extent by a feature's envelope.
     void extend(double min_x, double max_x, double min_y, double max_y);
-    /// The count, the extent (none: left as GDAL wrote it) and the triggers, once the rows are in.
+    /// Flushes, then the count, the extent (none: left as GDAL wrote it) and the trigger.
     void finish();
 
 private:
-    GpkgSqlite &db_;
-    std::string table_;
-    sqlite3_stmt *insert_ = nullptr;
     std::vector<std::string> triggers_; ///< the SQL of the triggers dropped
-    std::int64_t rows_ = 0;
-    std::array<double, 4> extent_; ///< min x, max x, min y, max y
+    std::array<double, 4> extent_;      ///< min x, max x, min y, max y
 };
 
 /// Adds the spatial index of each layer (written by GDAL with SPATIAL_INDEX=NO) to the file.

@@ -427,6 +427,7 @@ void insert_block(io::BulkRows &rows, const RowBlock &b, std::size_t first, std:
         rows.extend(e[0], e[1], e[2], e[3]);
         start = b.ends[r];
     }
+    rows.flush(); // before the block's blobs go
     boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
 }
 
