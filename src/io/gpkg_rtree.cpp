@@ -1,4 +1,4 @@
-// The GeoPackage spatial index built in bulk: see gpkg_rtree.hpp.
+// The GeoPackage writer's bulk steps in SQLite: see gpkg_rtree.hpp.
 #include "gpkg_rtree.hpp"
 
 #include <algorithm>
@@ -8,6 +8,7 @@
 #include <deque>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include <sqlite3.h>
 
@@ -99,55 +100,12 @@ std::string literal(const std::string &text) {
     return q + "'";
 }
 
-class Database {
-public:
-    Database(const std::filesystem::path &file, const std::filesystem::path &output)
-        : output_(output) {
-        if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) == SQLITE_OK)
-            return;
-        const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
-        sqlite3_close(db_); // the destructor does not run for a constructor that throws
-        db_ = nullptr;
-        fail("opening it with SQLite", why);
-    }
-    ~Database() {
-        if (in_transaction_)
-            sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-        sqlite3_close(db_);
-    }
-    Database(const Database &) = delete;
-    Database &operator=(const Database &) = delete;
-
-    /// Throws the IoError of `step`, for SQLite's last error or `why`.
-    [[noreturn]] void fail(const std::string &step, std::string why = "") const {
-        if (why.empty())
-            why = sqlite3_errmsg(db_);
-        throw IoError("GeoPackage output " + output_.string() + ": spatial index: " + step + ": " +
-                      why + OutputFile::full_disk_note(output_));
-    }
-    void exec(const std::string &sql) {
-        if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK)
-            fail(sql.substr(0, sql.find('(')));
-    }
-    void begin() {
-        exec("BEGIN");
-        in_transaction_ = true;
-    }
-    void commit() {
-        exec("COMMIT");
-        in_transaction_ = false;
-    }
-    sqlite3 *get() const { return db_; }
-
-private:
-    sqlite3 *db_ = nullptr;
-    std::filesystem::path output_;
-    bool in_transaction_ = false;
-};
-
 class Statement {
 public:
-    Statement(Database &db, const std::string &sql) : db_(db) {
+    /// `what` names the step in the error of a failed insert.
+    Statement(GpkgSqlite &db, const std::string &sql,
+              std::string what = "spatial index: writing the tree")
+        : db_(db), what_(std::move(what)) {
         if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &s_, nullptr) != SQLITE_OK)
             db.fail("preparing " + sql);
     }
@@ -165,6 +123,17 @@ public:
         sqlite3_bind_blob(s_, 2, blob.data(), static_cast<int>(blob.size()), SQLITE_STATIC);
         step();
     }
+    void insert(std::int64_t a) {
+        sqlite3_bind_int64(s_, 1, a);
+        step();
+    }
+    /// The first column of the next row of a query as text, or "" past the last row.
+    std::string text() {
+        if (sqlite3_step(s_) != SQLITE_ROW)
+            return "";
+        const auto *t = sqlite3_column_text(s_, 0);
+        return t ? reinterpret_cast<const char *>(t) : "";
+    }
     /// The first column of the one row of a query, or -1 when it has none.
     std::int64_t single() {
         const std::int64_t v = sqlite3_step(s_) == SQLITE_ROW ? sqlite3_column_int64(s_, 0) : -1;
@@ -175,10 +144,11 @@ public:
 private:
     void step() {
         if (sqlite3_step(s_) != SQLITE_DONE)
-            db_.fail("writing the tree");
+            db_.fail(what_);
         sqlite3_reset(s_);
     }
-    Database &db_;
+    GpkgSqlite &db_;
+    std::string what_;
     sqlite3_stmt *s_ = nullptr;
 };
 
@@ -229,7 +199,7 @@ struct Steps {
 
 /// One layer's index: the virtual table (SQLite creates its shadow tables and an empty root),
 /// then the packed tree written into them, then the triggers and the extension's row.
-void add_index(Database &db, const RtreeLayer &layer, Steps &steps) {
+void add_index(GpkgSqlite &db, const RtreeLayer &layer, Steps &steps) {
     const std::string rtree = "rtree_" + layer.table + "_" + layer.column;
     db.exec("CREATE VIRTUAL TABLE " + quoted(rtree) + " USING rtree(id, minx, maxx, miny, maxy)");
     // The node size SQLite chose for this file's page size (its root is a node of that size).
@@ -237,7 +207,7 @@ void add_index(Database &db, const RtreeLayer &layer, Steps &steps) {
     const std::int64_t node_bytes = size.single();
     constexpr std::size_t cell_bytes = 8 + 4 * 4;
     if (node_bytes < std::int64_t(4 + 2 * cell_bytes))
-        db.fail("unexpected root node of " + rtree);
+        db.fail("spatial index: unexpected root node of " + rtree);
     const std::size_t capacity = (std::size_t(node_bytes) - 4) / cell_bytes;
 
     if (!layer.boxes.empty()) {
@@ -280,8 +250,7 @@ void add_index(Database &db, const RtreeLayer &layer, Steps &steps) {
 
         Statement node(db, "INSERT OR REPLACE INTO " + quoted(rtree + "_node") +
                                "(nodeno, data) VALUES (?, ?)");
-        Statement rowid(db, "INSERT INTO " + quoted(rtree + "_rowid") +
-                                "(rowid, nodeno) VALUES (?, ?)");
+        RowInserter rowid(db, rtree + "_rowid", {"rowid", "nodeno"});
         Statement parent(db, "INSERT INTO " + quoted(rtree + "_parent") +
                                  "(nodeno, parentnode) VALUES (?, ?)");
         std::vector<unsigned char> blob(static_cast<std::size_t>(node_bytes));
@@ -314,9 +283,12 @@ void add_index(Database &db, const RtreeLayer &layer, Steps &steps) {
             }
         }
         for (std::size_t i = 0; i < leaf_of.size(); ++i) {
-            rowid.insert(std::int64_t(i) + 1, leaf_of[i]);
+            rowid.bind(0, std::int64_t(i) + 1);
+            rowid.bind(1, leaf_of[i]);
+            rowid.insert();
             steps.add(1);
         }
+        rowid.flush();
     }
     for (const std::string &sql : triggers(layer.table, layer.column))
         db.exec(sql);
@@ -329,13 +301,184 @@ void add_index(Database &db, const RtreeLayer &layer, Steps &steps) {
 
 } // namespace
 
-void add_rtree_indexes(const std::filesystem::path &file, const std::vector<RtreeLayer> &layers,
-                       const std::filesystem::path &output, const Progress &progress) {
+GpkgSqlite::GpkgSqlite(const std::filesystem::path &file, const std::filesystem::path &output)
+    : output_(output) {
+    if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) {
+        const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+        sqlite3_close(db_); // the destructor does not run for a constructor that throws
+        db_ = nullptr;
+        fail("opening it with SQLite", why);
+    }
+    try {
+        // No rollback journal and no syncs: a failed write's temporary file is deleted, not
+        // rolled back (journal_mode is not stored in the file: the next reader has its own).
+        exec("PRAGMA journal_mode = OFF");
+        exec("PRAGMA synchronous = OFF");
+        exec("BEGIN");
+        in_transaction_ = true;
+    } catch (...) {
+        sqlite3_close(db_);
+        throw;
+    }
+}
+
+GpkgSqlite::~GpkgSqlite() {
+    if (in_transaction_)
+        sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    sqlite3_close(db_);
+}
+
+void GpkgSqlite::fail(const std::string &step, std::string why) const {
+    if (why.empty())
+        why = sqlite3_errmsg(db_);
+    throw IoError("GeoPackage output " + output_.string() + ": " + step + ": " + why +
+                  OutputFile::full_disk_note(output_));
+}
+
+void GpkgSqlite::exec(const std::string &sql) {
+    if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK)
+        fail(sql.substr(0, sql.find('(')));
+}
+
+void GpkgSqlite::commit() {
+    exec("COMMIT");
+    in_transaction_ = false;
+}
+
+RowInserter::RowInserter(GpkgSqlite &db, const std::string &table,
+                         const std::vector<std::string> &columns)
+    : db_(db), table_(table), columns_(columns.size()), queued_(columns.size()) {
+    std::string names, row;
+    for (const std::string &c : columns) {
+        names += (names.empty() ? "" : ", ") + quoted(c);
+        row += row.empty() ? "(?" : ", ?";
+    }
+    row += ")";
+    const std::string insert = "INSERT INTO " + quoted(table) + " (" + names + ") VALUES ";
+    std::string rows = row;
+    for (std::size_t r = 1; r < rows_per_statement; ++r)
+        rows += ", " + row;
+    if (sqlite3_prepare_v2(db.get(), (insert + rows).c_str(), -1, &full_, nullptr) != SQLITE_OK ||
+        sqlite3_prepare_v2(db.get(), (insert + row).c_str(), -1, &one_, nullptr) != SQLITE_OK) {
+        const std::string why = sqlite3_errmsg(db.get());
+        sqlite3_finalize(full_); // the destructor does not run for a constructor that throws
+        db.fail("preparing the rows of " + table, why);
+    }
+}
+
+BulkRows::BulkRows(GpkgSqlite &db, const std::string &table,
+                   const std::vector<std::string> &columns)
+    : RowInserter(db, table, columns) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    extent_ = {inf, -inf, inf, -inf};
+    // GDAL's trigger that counts each row inserted into gpkg_ogr_contents (finish() writes the
+    // count once, and puts the trigger back as it was).
+    {
+        Statement find(db, "SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " +
+                               literal("trigger_insert_feature_count_" + table));
+        for (std::string sql; !(sql = find.text()).empty();)
+            triggers_.push_back(sql);
+    }
+    if (!triggers_.empty())
+        db.exec("DROP TRIGGER " + quoted("trigger_insert_feature_count_" + table));
+}
+
+RowInserter::~RowInserter() {
+    sqlite3_finalize(full_);
+    sqlite3_finalize(one_);
+}
+
+void RowInserter::bind(int i, std::int64_t v) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::integer, x.i = v;
+}
+
+void RowInserter::bind(int i, double v) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::real, x.d = v;
+}
+
+void RowInserter::bind_blob(int i, const unsigned char *data, std::size_t bytes) {
+    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
+    x.kind = Value::blob, x.data = data, x.bytes = bytes;
+}
+
+void RowInserter::insert() {
+    ++queued_rows_;
+    ++rows_;
+    if (queued_rows_ < rows_per_statement) {
+        queued_.resize((queued_rows_ + 1) * columns_);
+        return;
+    }
+    for (std::size_t r = 0; r < queued_rows_; ++r)
+        bind_row(full_, r, int(r * columns_) + 1);
+    step(full_);
+    queued_rows_ = 0;
+}
+
+void RowInserter::flush() {
+    for (std::size_t r = 0; r < queued_rows_; ++r) {
+        bind_row(one_, r, 1);
+        step(one_);
+    }
+    queued_rows_ = 0;
+}
+
+/// Binds queued row `row` to the parameters of `s` from number `first` on.
+void RowInserter::bind_row(sqlite3_stmt *s, std::size_t row, int first) {
+    for (std::size_t c = 0; c < columns_; ++c) {
+        const Value &x = queued_[row * columns_ + c];
+        const int p = first + int(c);
+        if (x.kind == Value::integer)
+            sqlite3_bind_int64(s, p, x.i);
+        else if (x.kind == Value::real)
+            sqlite3_bind_double(s, p, x.d);
+        else
+            sqlite3_bind_blob(s, p, x.data, static_cast<int>(x.bytes), SQLITE_STATIC);
+    }
+}
+
+void RowInserter::step(sqlite3_stmt *s) {
+    if (sqlite3_step(s) != SQLITE_DONE)
+        db_.fail("writing the rows of " + table_);
+    sqlite3_reset(s);
+}
+
+void BulkRows::extend(double min_x, double max_x, double min_y, double max_y) {
+    extent_ = {std::min(extent_[0], min_x), std::max(extent_[1], max_x),
+               std::min(extent_[2], min_y), std::max(extent_[3], max_y)};
+}
+
+void BulkRows::finish() {
+    flush();
+    const std::string what = "counting the rows of " + table_;
+    Statement count(db_,
+                    "UPDATE gpkg_ogr_contents SET feature_count = ? WHERE "
+                    "table_name = " +
+                        literal(table_),
+                    what);
+    count.insert(rows());
+    if (extent_[0] <= extent_[1]) {
+        // As GDAL 3.6 writes it: through SQLite's printf, which keeps 16 significant digits.
+        char *sql = sqlite3_mprintf("UPDATE gpkg_contents SET min_x = %.18g, min_y = %.18g, "
+                                    "max_x = %.18g, max_y = %.18g WHERE table_name = %Q",
+                                    extent_[0], extent_[2], extent_[1], extent_[3], table_.c_str());
+        if (!sql)
+            db_.fail("the extent of " + table_, "out of memory");
+        const std::string text = sql;
+        sqlite3_free(sql);
+        db_.exec(text);
+    }
+    for (const std::string &sql : triggers_)
+        db_.exec(sql);
+    triggers_.clear();
+}
+
+void add_rtree_indexes(GpkgSqlite &db, const std::vector<RtreeLayer> &layers,
+                       const Progress &progress) {
     Steps steps{progress};
     for (const RtreeLayer &layer : layers)
         steps.total += 2.0 * double(layer.boxes.size());
-    Database db(file, output);
-    db.begin();
     // The GeoPackage's table of extensions, in the words of the standard (GDAL creates it only
     // for a file that uses one).
     db.exec("CREATE TABLE IF NOT EXISTS gpkg_extensions (table_name TEXT,column_name "
@@ -344,7 +487,6 @@ void add_rtree_indexes(const std::filesystem::path &file, const std::vector<Rtre
             "column_name, extension_name))");
     for (const RtreeLayer &layer : layers)
         add_index(db, layer, steps);
-    db.commit();
 }
 
 } // namespace globemesh::io

@@ -1,4 +1,5 @@
-// GeoPackage writer (OGR GPKG driver): see globemesh/gpkg.hpp.
+// GeoPackage writer: see globemesh/gpkg.hpp. GDAL's GPKG driver creates the file, its layers
+// and small tables; the faces' and nodes' rows go in through SQLite in bulk (gpkg_rtree.hpp).
 //
 // Layers: faces (MultiPolygon, one feature per face, FID = face index + 1, cut at +-180 and with
 // pole corners split, see face_geometry.hpp), nodes (Point, every node field), boundary (runs of
@@ -9,8 +10,10 @@
 // would pass 180 (the pieces share the cut vertex).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <map>
-#include <memory>
 #include <optional>
 #include <sstream>
 
@@ -118,6 +121,13 @@ public:
         if (l->CreateFeature(&f) != OGRERR_NONE)
             fail(std::string("writing a feature of ") + l->GetName());
     }
+    /// The named layer's table and metadata rows, created now (GDAL creates them at the first
+    /// feature or at close).
+    void create_tables(const char *name) {
+        OGRLayer *l = ds_->GetLayerByName(name);
+        if (!l || l->SyncToDisk() != OGRERR_NONE)
+            fail(std::string("creating layer ") + name);
+    }
     void begin() {
         if (ds_->StartTransaction() != OGRERR_NONE)
             fail("starting a transaction");
@@ -219,45 +229,6 @@ std::vector<io::LonLatPart> narrow_lines(const io::LonLatPart &line) {
     return parts;
 }
 
-OGRPolygon *polygon_of(const io::LonLatPart &ring) {
-    auto *r = new OGRLinearRing();
-    r->setNumPoints(int(ring.size() + 1), FALSE);
-    for (std::size_t i = 0; i <= ring.size(); ++i)
-        r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
-    auto *p = new OGRPolygon();
-    p->addRingDirectly(r);
-    return p;
-}
-
-/// Sets the feature's geometry to a multipolygon of one ring per part: in place when it holds one
-/// of as many polygons with rings of as many points, else a new one.
-void set_polygons(OGRFeature &feature, const std::vector<io::LonLatPart> &parts) {
-    if (OGRGeometry *g = feature.GetGeometryRef();
-        g && wkbFlatten(g->getGeometryType()) == wkbMultiPolygon) {
-        OGRMultiPolygon *multi = g->toMultiPolygon();
-        bool same = multi->getNumGeometries() == int(parts.size());
-        for (int p = 0; same && p < int(parts.size()); ++p) {
-            const OGRPolygon *polygon = multi->getGeometryRef(p);
-            same =
-                polygon->getNumInteriorRings() == 0 && polygon->getExteriorRing() &&
-                polygon->getExteriorRing()->getNumPoints() == int(parts[std::size_t(p)].size() + 1);
-        }
-        if (same) {
-            for (int p = 0; p < int(parts.size()); ++p) {
-                const io::LonLatPart &ring = parts[std::size_t(p)];
-                OGRLinearRing *r = multi->getGeometryRef(p)->getExteriorRing();
-                for (std::size_t i = 0; i <= ring.size(); ++i)
-                    r->setPoint(int(i), ring[i % ring.size()][0], ring[i % ring.size()][1]);
-            }
-            return;
-        }
-    }
-    auto *multi = new OGRMultiPolygon();
-    for (const auto &part : parts)
-        multi->addGeometryDirectly(polygon_of(part));
-    feature.SetGeometryDirectly(multi);
-}
-
 /// Boundary edges chained into loops, each loop split into runs of one tag.
 struct BoundaryRun {
     std::vector<NodeIndex> nodes;
@@ -314,9 +285,9 @@ std::vector<BoundaryRun> boundary_runs(const io::MeshTopology &topo) {
     return runs;
 }
 
-/// Shares of the progress, as measured at 20 km (7.6 / 7.9 s): the faces' features 47%, the
-/// nodes' 19%, and the rest (the boundary, GDAL's close and the spatial indexes) 33-34%.
-constexpr double face_share = 0.47, node_share = 0.19;
+/// Shares of the progress, as the writer's time splits at 1e6 nodes: the faces' rows, the
+/// nodes', and the rest (the spatial indexes).
+constexpr double face_share = 0.55, node_share = 0.1;
 
 /// A geometry's box, for its layer's spatial index (gpkg_rtree.hpp).
 io::RtreeBox box_of(const OGRGeometry &g) {
@@ -325,9 +296,75 @@ io::RtreeBox box_of(const OGRGeometry &g) {
     return io::rtree_box(e.MinX, e.MaxX, e.MinY, e.MaxY);
 }
 
+/// min x, max x, min y, max y, the order of a GeoPackage geometry's envelope.
+using Envelope = std::array<double, 4>;
+
+/// GeoPackage geometry blobs (GeoPackage 1.2, 2.1.3) as GDAL writes them: "GP", version 0,
+/// flags (little-endian, with an xy envelope except for a point), srs_id, then the geometry's
+/// ISO WKB, little-endian. Appended to one buffer, a block's rows one after the other.
+class BlobBytes {
+public:
+    explicit BlobBytes(std::vector<unsigned char> &out) : out_(out) {}
+    void u8(unsigned v) { out_.push_back(static_cast<unsigned char>(v)); }
+    void u32(std::uint32_t v) {
+        for (int i = 0; i < 4; ++i, v >>= 8)
+            out_.push_back(static_cast<unsigned char>(v));
+    }
+    void f64(double d) {
+        std::uint64_t v;
+        std::memcpy(&v, &d, sizeof v);
+        for (int i = 0; i < 8; ++i, v >>= 8)
+            out_.push_back(static_cast<unsigned char>(v));
+    }
+    /// The header, with `envelope` when given; `empty` flags a geometry with no points.
+    void header(const Envelope *envelope, bool empty = false) {
+        u8('G'), u8('P'), u8(0), u8((envelope ? 0x03 : 0x01) | (empty ? 0x10 : 0)),
+            u32(wgs84_srs_id);
+        if (envelope)
+            for (double d : *envelope)
+                f64(d);
+    }
+
+private:
+    static constexpr std::uint32_t wgs84_srs_id = 4326;
+    std::vector<unsigned char> &out_;
+};
+
+/// A multipolygon of one ring per part (each closed by repeating its first point) appended to
+/// `out` as a GeoPackage blob; returns its envelope, the points' extremes as OGR takes them
+/// (none, an empty envelope, for no part: a degenerate face, written as GDAL writes an empty
+/// geometry).
+Envelope append_multipolygon(std::vector<unsigned char> &out,
+                             const std::vector<io::LonLatPart> &parts) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    Envelope e = {inf, -inf, inf, -inf};
+    for (const auto &part : parts)
+        for (const auto &p : part) {
+            e[0] = p[0] < e[0] ? p[0] : e[0], e[1] = p[0] > e[1] ? p[0] : e[1];
+            e[2] = p[1] < e[2] ? p[1] : e[2], e[3] = p[1] > e[3] ? p[1] : e[3];
+        }
+    BlobBytes b(out);
+    b.header(parts.empty() ? nullptr : &e, parts.empty());
+    constexpr unsigned little_endian = 1, wkb_polygon = 3, wkb_multipolygon = 6;
+    b.u8(little_endian), b.u32(wkb_multipolygon), b.u32(std::uint32_t(parts.size()));
+    for (const auto &ring : parts) {
+        b.u8(little_endian), b.u32(wkb_polygon), b.u32(1), b.u32(std::uint32_t(ring.size() + 1));
+        for (std::size_t i = 0; i <= ring.size(); ++i)
+            b.f64(ring[i % ring.size()][0]), b.f64(ring[i % ring.size()][1]);
+    }
+    return e;
+}
+
+/// A point appended to `out` as a GeoPackage blob (no envelope, as GDAL writes points).
+void append_point(std::vector<unsigned char> &out, double x, double y) {
+    BlobBytes b(out);
+    b.header(nullptr);
+    constexpr unsigned little_endian = 1, wkb_point = 1;
+    b.u8(little_endian), b.u32(wkb_point), b.f64(x), b.f64(y);
+}
+
 /// The faces layer and the node and face fields its features carry.
 struct FacesLayer {
-    OGRLayer *layer = nullptr;
     const Field *depth = nullptr; ///< the nodes' depth, as the mean of each face's corners
     const Field *size = nullptr;  ///< the nodes' target_size, likewise
     std::vector<const Field *> face_fields; ///< the mesh's other face fields, as they are
@@ -335,7 +372,7 @@ struct FacesLayer {
 
 FacesLayer define_faces_layer(GpkgWriter &w, const Mesh &mesh) {
     FacesLayer l;
-    OGRLayer *faces = l.layer =
+    OGRLayer *faces =
         w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
     w.field(faces, "face", OFTInteger);
     w.field(faces, "quality", OFTReal);
@@ -356,10 +393,48 @@ FacesLayer define_faces_layer(GpkgWriter &w, const Mesh &mesh) {
     return l;
 }
 
-/// The faces' features, and their boxes into `indexes`.
-void write_faces(GpkgWriter &w, const FacesLayer &l, const Mesh &mesh, const io::MeshTopology &topo,
-                 const GpkgOptions &options, std::vector<io::RtreeLayer> &indexes) {
-    OGRLayer *faces = l.layer;
+/// The columns of a bulk insert: fid, geom, the integer `number`, then `reals`.
+std::vector<std::string> bulk_columns(const char *number, const std::vector<std::string> &reals) {
+    std::vector<std::string> columns = {"fid", "geom", number};
+    columns.insert(columns.end(), reals.begin(), reals.end());
+    return columns;
+}
+
+/// A block of rows made on any core (ordered_blocks.hpp): each row's blob in `bytes` up to
+/// ends[r], its real columns at values[r * reals ...], its envelope and index box.
+struct RowBlock {
+    std::vector<unsigned char> bytes;
+    std::vector<std::size_t> ends;
+    std::vector<double> values;
+    std::vector<Envelope> envelopes;
+    std::vector<io::RtreeBox> boxes;
+    void clear() { bytes.clear(), ends.clear(), values.clear(), envelopes.clear(), boxes.clear(); }
+};
+
+/// Inserts a block's rows, the first with fid (and number) first + 1 (first), and adds their
+/// boxes to `boxes`.
+void insert_block(io::BulkRows &rows, const RowBlock &b, std::size_t first, std::size_t reals,
+                  std::vector<io::RtreeBox> &boxes) {
+    std::size_t start = 0;
+    for (std::size_t r = 0; r < b.ends.size(); ++r) {
+        rows.bind(0, std::int64_t(first + r) + 1);
+        rows.bind_blob(1, b.bytes.data() + start, b.ends[r] - start);
+        rows.bind(2, std::int64_t(first + r));
+        for (std::size_t c = 0; c < reals; ++c)
+            rows.bind(int(3 + c), b.values[r * reals + c]);
+        rows.insert();
+        const Envelope &e = b.envelopes[r];
+        rows.extend(e[0], e[1], e[2], e[3]);
+        start = b.ends[r];
+    }
+    rows.flush(); // before the block's blobs go
+    boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
+}
+
+/// The faces' rows, and their boxes into `indexes`.
+void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
+                 const io::MeshTopology &topo, const GpkgOptions &options,
+                 std::vector<io::RtreeBox> &boxes) {
     const Field *depth = l.depth, *size = l.size;
     const std::vector<const Field *> &face_fields = l.face_fields;
     // The face areas as the UGRID file has them: those write_ugrid gave, else each edge's
@@ -370,50 +445,31 @@ void write_faces(GpkgWriter &w, const FacesLayer &l, const Mesh &mesh, const io:
     std::optional<io::GeodesicFaceAreas> areas;
     if (!given)
         areas.emplace(topo);
-    std::vector<io::RtreeBox> &boxes =
-        indexes.emplace_back(io::RtreeLayer{"faces", "geom", {}}).boxes;
-    boxes.reserve(mesh.faces.size());
-    // The features (fields, geometry cut at +-180, box) are made a block at a time on every
-    // core, and added in order from this thread, the one that calls GDAL
-    // (ordered_blocks.hpp): the same file, with GDAL's CreateFeature alone on this thread.
-    OGRFeatureDefn *defn = faces->GetLayerDefn();
-    const int face_field = defn->GetFieldIndex("face"),
-              quality_field = defn->GetFieldIndex("quality"),
-              area_field = defn->GetFieldIndex("area_km2");
-    const int depth_field = depth ? defn->GetFieldIndex("depth") : -1;
-    const int size_field = size ? defn->GetFieldIndex("target_size") : -1;
-    std::vector<int> face_field_index;
+    std::vector<std::string> reals = {"quality", "area_km2"};
+    if (depth)
+        reals.push_back("depth");
+    if (size)
+        reals.push_back("target_size");
     for (const Field *f : face_fields)
-        face_field_index.push_back(defn->GetFieldIndex(f->name.c_str()));
-    // A slot's features are made once and refilled for each block it holds (every field
-    // is set again; a face's polygon takes the new corners in place when it has as many
-    // parts and points as before): a feature made and freed per face cost as much as the
-    // rest of the face (allocations, and the layer definition's reference count).
-    struct FaceBlock {
-        std::vector<std::unique_ptr<OGRFeature>> features;
-        std::size_t count = 0; // the features of this block: the first count
-        std::vector<io::RtreeBox> boxes;
-    };
+        reals.push_back(f->name);
+    io::BulkRows rows(db, "faces", bulk_columns("face", reals));
+    boxes.reserve(mesh.faces.size());
+    // The rows (fields, geometry cut at +-180, box) are made a block at a time on every core,
+    // and inserted in order from this thread, the one that calls SQLite (ordered_blocks.hpp).
     struct Scratch {
         std::vector<std::int32_t> edges;
     };
     constexpr std::size_t block_faces = 4096;
-    io::compute_in_order<FaceBlock, Scratch>(
+    io::compute_in_order<RowBlock, Scratch>(
         (mesh.faces.size() + block_faces - 1) / block_faces,
-        [&](std::size_t k, FaceBlock &b, Scratch &scratch) {
+        [&](std::size_t k, RowBlock &b, Scratch &scratch) {
             const std::size_t first = k * block_faces,
                               last = std::min(mesh.faces.size(), first + block_faces);
-            b.count = last - first;
-            while (b.features.size() < b.count)
-                b.features.push_back(std::make_unique<OGRFeature>(defn));
-            b.boxes.clear();
+            b.clear();
             for (std::size_t i = first; i < last; ++i) {
                 const auto &t = mesh.faces[i];
-                OGRFeature &feature = *b.features[i - first];
-                feature.SetFID(GIntBig(i) + 1);
-                feature.SetField(face_field, int(i));
-                feature.SetField(quality_field, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]],
-                                                                 mesh.nodes[t[2]]));
+                b.values.push_back(
+                    triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
                 double area_m2;
                 if (given) {
                     area_m2 = (*given)[i];
@@ -421,75 +477,89 @@ void write_faces(GpkgWriter &w, const FacesLayer &l, const Mesh &mesh, const io:
                     io::face_edges(topo, i, 1, scratch.edges);
                     area_m2 = areas->face_m2(i, scratch.edges.data());
                 }
-                feature.SetField(area_field, area_m2 * 1e-6);
+                b.values.push_back(area_m2 * 1e-6);
                 auto mean = [&](const Field *f) {
                     return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0;
                 };
                 if (depth)
-                    feature.SetField(depth_field, mean(depth));
+                    b.values.push_back(mean(depth));
                 if (size)
-                    feature.SetField(size_field, mean(size));
-                for (std::size_t f = 0; f < face_fields.size(); ++f)
-                    feature.SetField(face_field_index[f], face_fields[f]->values[i]);
+                    b.values.push_back(mean(size));
+                for (const Field *f : face_fields)
+                    b.values.push_back(f->values[i]);
                 std::vector<io::LonLatPart> parts;
                 for (auto &ring :
                      io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
                     for (auto &part : narrow_rings(std::move(ring)))
                         parts.push_back(std::move(part));
-                set_polygons(feature, parts);
-                b.boxes.push_back(box_of(*feature.GetGeometryRef()));
+                const Envelope e = append_multipolygon(b.bytes, parts);
+                b.ends.push_back(b.bytes.size());
+                b.envelopes.push_back(e);
+                // An empty geometry's box is OGR's envelope of it, all 0.
+                b.boxes.push_back(parts.empty() ? io::rtree_box(0, 0, 0, 0)
+                                                : io::rtree_box(e[0], e[1], e[2], e[3]));
             }
         },
-        [&](std::size_t k, FaceBlock &b) {
+        [&](std::size_t k, RowBlock &b) {
             if (k % 4 == 0)
                 report(options.progress,
                        face_share * double(k * block_faces) / double(mesh.faces.size()),
                        "write_gpkg");
-            for (std::size_t f = 0; f < b.count; ++f)
-                w.add(faces, *b.features[f]);
-            boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
+            insert_block(rows, b, k * block_faces, reals.size(), boxes);
         });
+    rows.finish();
 }
 
-/// The nodes layer with every node field, and its boxes into `indexes`.
-void write_nodes(GpkgWriter &w, const Mesh &mesh, const GpkgOptions &options,
-                 std::vector<io::RtreeLayer> &indexes) {
+/// The nodes layer with every node field (the rows are write_nodes').
+void define_nodes_layer(GpkgWriter &w, const Mesh &mesh) {
     OGRLayer *nodes = w.layer("nodes", wkbPoint, "mesh nodes with their fields");
     w.field(nodes, "node", OFTInteger);
     for (const auto &f : mesh.node_fields)
         if (f.name != "node")
             w.field(nodes, f.name.c_str(), OFTReal);
-    std::vector<io::RtreeBox> &node_boxes =
-        indexes.emplace_back(io::RtreeLayer{"nodes", "geom", {}}).boxes;
-    node_boxes.reserve(mesh.nodes.size());
-    // One feature and one point, refilled for each node (as the faces' features are).
-    OGRFeature feature(nodes->GetLayerDefn());
-    const int node_field = feature.GetFieldIndex("node");
-    std::vector<std::pair<int, const Field *>> fields;
-    for (const auto &f : mesh.node_fields)
-        if (f.name != "node" && f.values.size() == mesh.nodes.size())
-            fields.emplace_back(feature.GetFieldIndex(f.name.c_str()), &f);
-    auto *point = new OGRPoint(0, 0);
-    feature.SetGeometryDirectly(point);
-    for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
-        if (i % 16384 == 0)
-            report(options.progress,
-                   face_share + node_share * double(i) / double(mesh.nodes.size()), "write_gpkg");
-        feature.SetFID(GIntBig(i) + 1);
-        feature.SetField(node_field, int(i));
-        for (const auto &[index, f] : fields)
-            feature.SetField(index, f->values[i]);
-        LonLat p = vec_to_lonlat(mesh.nodes[i]);
-        node_boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
-        point->setX(p.lon);
-        point->setY(p.lat);
-        w.add(nodes, feature);
-    }
 }
 
-/// The boundary layer, one feature per run, and its boxes into `indexes`; runs is not empty.
+/// The nodes' rows, and their boxes into `boxes`: every node field with a value per node.
+void write_nodes(io::GpkgSqlite &db, const Mesh &mesh, const GpkgOptions &options,
+                 std::vector<io::RtreeBox> &boxes) {
+    std::vector<const Field *> fields;
+    std::vector<std::string> reals;
+    for (const auto &f : mesh.node_fields)
+        if (f.name != "node" && f.values.size() == mesh.nodes.size()) {
+            fields.push_back(&f);
+            reals.push_back(f.name);
+        }
+    io::BulkRows rows(db, "nodes", bulk_columns("node", reals));
+    boxes.reserve(mesh.nodes.size());
+    constexpr std::size_t block_nodes = 16384;
+    io::compute_in_order<RowBlock, char>(
+        (mesh.nodes.size() + block_nodes - 1) / block_nodes,
+        [&](std::size_t k, RowBlock &b, char &) {
+            const std::size_t first = k * block_nodes,
+                              last = std::min(mesh.nodes.size(), first + block_nodes);
+            b.clear();
+            for (std::size_t i = first; i < last; ++i) {
+                for (const Field *f : fields)
+                    b.values.push_back(f->values[i]);
+                const LonLat p = vec_to_lonlat(mesh.nodes[i]);
+                append_point(b.bytes, p.lon, p.lat);
+                b.ends.push_back(b.bytes.size());
+                b.envelopes.push_back({p.lon, p.lon, p.lat, p.lat});
+                b.boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
+            }
+        },
+        [&](std::size_t k, RowBlock &b) {
+            report(options.progress,
+                   face_share + node_share * double(k * block_nodes) / double(mesh.nodes.size()),
+                   "write_gpkg");
+            insert_block(rows, b, k * block_nodes, reals.size(), boxes);
+        });
+    rows.finish();
+}
+
+/// The boundary layer, one feature per run, and its boxes into `run_boxes`; runs is not empty.
 void write_boundary(GpkgWriter &w, const Mesh &mesh, const std::vector<BoundaryRun> &runs,
-                    std::vector<io::RtreeLayer> &indexes) {
+                    std::vector<io::RtreeBox> &run_boxes) {
     OGRLayer *boundary =
         w.layer("boundary", wkbMultiLineString, "mesh boundary, runs of coast or open edges");
     w.field(boundary, "tag", OFTString);
@@ -497,8 +567,6 @@ void write_boundary(GpkgWriter &w, const Mesh &mesh, const std::vector<BoundaryR
     w.field(boundary, "loop", OFTInteger);
     w.field(boundary, "edges", OFTInteger);
     w.field(boundary, "length_km", OFTReal);
-    std::vector<io::RtreeBox> &run_boxes =
-        indexes.emplace_back(io::RtreeLayer{"boundary", "geom", {}}).boxes;
     for (const auto &run : runs) {
         OGRFeature feature(boundary->GetLayerDefn());
         feature.SetFID(GIntBig(run_boxes.size()) + 1);
@@ -588,6 +656,44 @@ void write_layer_styles(GpkgWriter &w) {
     w.add(styles, style);
 }
 
+/// GDAL's part of the file, created at `file` and closed: every layer and its fields, the faces
+/// and nodes without rows (write_faces and write_nodes add them in bulk), the boundary (its
+/// boxes into `run_boxes`; no layer for a closed mesh: QGIS treats an empty layer as a broken
+/// one), mesh_info and layer_styles.
+FacesLayer define_gdal_layers(const Mesh &mesh, const std::filesystem::path &path,
+                              const std::filesystem::path &file,
+                              const std::vector<BoundaryRun> &runs, const MeshStats &stats,
+                              std::vector<io::RtreeBox> &run_boxes) {
+    GDALAllRegister();
+    io::QuietGdalErrors quiet;
+    GDALDriver *driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+    if (!driver)
+        throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
+    io::GdalDatasetPtr ds(driver->Create(file.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    if (!ds)
+        throw IoError("GeoPackage output " + path.string() + ": cannot create (" +
+                      io::last_gdal_error() + ")" + OutputFile::full_disk_note(path));
+    FacesLayer faces;
+    {
+        // Destroyed before the dataset closes: it rolls back a transaction left open.
+        GpkgWriter w(ds.get(), path);
+        w.begin();
+        faces = define_faces_layer(w, mesh);
+        define_nodes_layer(w, mesh);
+        // Their tables now, not at close (GDAL defers an empty layer's): the layers' order.
+        w.create_tables("faces"), w.create_tables("nodes");
+        if (!runs.empty())
+            write_boundary(w, mesh, runs, run_boxes);
+        write_mesh_info(w, mesh, stats);
+        write_layer_styles(w);
+        w.commit();
+    }
+    if (!io::close_dataset(ds))
+        throw IoError("GeoPackage output " + path.string() + ": closing failed: " +
+                      io::last_gdal_error() + OutputFile::full_disk_note(path));
+    return faces;
+}
+
 } // namespace
 
 void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgOptions &options) {
@@ -601,46 +707,26 @@ void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgO
     const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
     const std::vector<BoundaryRun> runs = boundary_runs(topo);
 
-    GDALAllRegister();
-    io::QuietGdalErrors quiet;
-    GDALDriver *driver = GetGDALDriverManager()->GetDriverByName("GPKG");
-    if (!driver)
-        throw IoError("GeoPackage output " + path.string() + ": GDAL has no GPKG driver");
-    io::GdalDatasetPtr ds(driver->Create(out.temp_path().c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    if (!ds)
-        throw IoError("GeoPackage output " + path.string() + ": cannot create (" +
-                      io::last_gdal_error() + ")" + OutputFile::full_disk_note(path));
-    // Declared after the dataset, so that it rolls back before the dataset closes.
-    GpkgWriter w(ds.get(), path);
-
-    const FacesLayer faces = define_faces_layer(w, mesh);
     // Each spatial layer's feature boxes, for its index (gpkg_rtree.hpp).
-    std::vector<io::RtreeLayer> indexes;
-    indexes.reserve(3); // faces, nodes, boundary: the references to their boxes stay valid
-    // Every layer in one transaction, so that a failure or a cancel anywhere before the end
-    // rolls all of it back (GpkgWriter). At 20 km one transaction writes as fast as one per
-    // layer (52.1/66.1 s against 53.7/61.3 s, alternated) and gives the same file.
-    w.begin();
-    write_faces(w, faces, mesh, topo, options, indexes);
+    std::vector<io::RtreeLayer> indexes = {
+        {"faces", "geom", {}}, {"nodes", "geom", {}}, {"boundary", "geom", {}}};
+    const FacesLayer faces =
+        define_gdal_layers(mesh, path, out.temp_path(), runs, stats, indexes[2].boxes);
+    // The faces' and nodes' rows and every index in one SQLite transaction: a failure or a
+    // cancel anywhere before its end leaves a file that OutputFile deletes.
+    io::GpkgSqlite db(out.temp_path(), path);
+    write_faces(db, faces, mesh, topo, options, indexes[0].boxes);
     if (options.face_areas_m2)
         std::vector<double>().swap(*options.face_areas_m2); // not needed any more
     topo = io::MeshTopology{};
     if (detail::after_partial_write)
         detail::after_partial_write(); // tests only (write_hooks.hpp)
-    write_nodes(w, mesh, options, indexes);
-    // boundary (left out for a closed mesh: QGIS treats an empty layer as a broken one)
-    if (!runs.empty())
-        write_boundary(w, mesh, runs, indexes);
-    write_mesh_info(w, mesh, stats);
-    write_layer_styles(w);
-    w.commit();
-
-    report(options.progress, face_share + node_share, "write_gpkg");
-    if (!io::close_dataset(ds))
-        throw IoError("GeoPackage output " + path.string() + ": closing failed: " +
-                      io::last_gdal_error() + OutputFile::full_disk_note(path));
-    io::add_rtree_indexes(out.temp_path(), indexes, path,
+    write_nodes(db, mesh, options, indexes[1].boxes);
+    if (runs.empty()) // no boundary layer (closed mesh)
+        indexes.pop_back();
+    io::add_rtree_indexes(db, indexes,
                           sub_progress(options.progress, face_share + node_share, 1.0));
+    db.commit();
     report(options.progress, 1.0, "write_gpkg");
     out.commit();
 }

@@ -391,6 +391,60 @@ TEST(Gpkg, spatial_index_follows_features_edited_later_through_gdal) {
     EXPECT_EQ(box[0], (std::vector<std::string>{"10.0", "11.0", "80.0", "81.0"}));
 }
 
+// The faces' and nodes' rows go in through SQLite, not GDAL: the layer's count and extent are
+// still those GDAL keeps (gpkg_ogr_contents, gpkg_contents: the union of the features'
+// envelopes as OGR reads them, written by GDAL with 16 significant digits and read here as
+// SQLite's text, 15), and a row added later still counts (GDAL's trigger is back).
+TEST(Gpkg, bulk_layers_keep_gdal_counts_extents_and_count_triggers) {
+    TempDir dir;
+    const Mesh m = icosphere_with_holes(3);
+    write_gpkg(m, dir / "m.gpkg");
+    {
+        Dataset d(dir / "m.gpkg");
+        ASSERT_TRUE(d.ds);
+        const Sqlite db(dir / "m.gpkg");
+        for (const char *name : {"faces", "nodes"}) {
+            SCOPED_TRACE(name);
+            OGRLayer *layer = d.ds->GetLayerByName(name);
+            ASSERT_TRUE(layer);
+            OGREnvelope all;
+            for (const auto &[fid, e] : envelopes(layer))
+                all.Merge(e);
+            const auto row = db.rows(std::string("SELECT min_x, max_x, min_y, max_y FROM "
+                                                 "gpkg_contents WHERE table_name = '") +
+                                     name + "'");
+            ASSERT_EQ(row.size(), 1u);
+            const double expected[] = {all.MinX, all.MaxX, all.MinY, all.MaxY};
+            for (int i = 0; i < 4; ++i)
+                EXPECT_NEAR(std::stod(row[0][std::size_t(i)]), expected[i],
+                            1e-14 * std::max(1.0, std::fabs(expected[i])))
+                    << i;
+            EXPECT_EQ(
+                db.one(std::string("SELECT feature_count FROM gpkg_ogr_contents WHERE "
+                                   "table_name = '") +
+                       name + "'"),
+                std::to_string(name == std::string("faces") ? m.faces.size() : m.nodes.size()));
+        }
+    }
+    sqlite3 *db = nullptr;
+    ASSERT_EQ(sqlite3_open_v2((dir / "m.gpkg").c_str(), &db, SQLITE_OPEN_READWRITE, nullptr),
+              SQLITE_OK);
+    // The index's triggers name GDAL's SQL functions: stand-ins, not called for a row with no
+    // geometry.
+    for (const char *f : {"ST_IsEmpty", "ST_MinX", "ST_MaxX", "ST_MinY", "ST_MaxY"})
+        sqlite3_create_function(
+            db, f, 1, SQLITE_UTF8, nullptr,
+            [](sqlite3_context *c, int, sqlite3_value **) { sqlite3_result_null(c); }, nullptr,
+            nullptr);
+    EXPECT_EQ(sqlite3_exec(db, "INSERT INTO nodes (node) VALUES (-1)", nullptr, nullptr, nullptr),
+              SQLITE_OK)
+        << sqlite3_errmsg(db);
+    sqlite3_close(db);
+    EXPECT_EQ(Sqlite(dir / "m.gpkg")
+                  .one("SELECT feature_count FROM gpkg_ogr_contents WHERE table_name = 'nodes'"),
+              std::to_string(m.nodes.size() + 1));
+}
+
 // GDAL's own GeoPackage validator (validate_gpkg.py, with python3-gdal) finds nothing to say.
 TEST(Gpkg, gdal_validator_accepts_the_file) {
     std::string out;
