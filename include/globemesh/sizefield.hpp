@@ -133,6 +133,8 @@ private:
 /// and no grid is built; otherwise before_grid, when set, is called once before the grid is
 /// allocated (to refuse the run by throwing). passages: the lines of options.passages with their
 /// widths (read_passages, measure_passages); the field has a grid when there are any.
+/// threads: how many threads compute the per-node terms (0: one per core); the field does not
+/// depend on it (the same floats), and the gradation runs on the calling thread.
 /// Throws UsageError (bad sizes or region, a component without its input, naming the option),
 /// DataError (a size_regions file without a size_km field) or IoError (size_regions unreadable).
 SizeField build_size_field(const SizeFieldOptions &options,
@@ -140,16 +142,16 @@ SizeField build_size_field(const SizeFieldOptions &options,
                            const Boundary *coast, const Progress &progress = {},
                            std::size_t max_nodes = std::size_t{1} << 24,
                            const std::function<void()> &before_grid = {},
-                           std::span<const Passage> passages = {});
+                           std::span<const Passage> passages = {}, std::size_t threads = 0);
 
 /// build_size_field with the size field's part and the region of a whole run's options.
 inline SizeField build_size_field(const MeshOptions &options, const Raster *bathy,
                                   const Boundary *coast, const Progress &progress = {},
                                   std::size_t max_nodes = std::size_t{1} << 24,
                                   const std::function<void()> &before_grid = {},
-                                  std::span<const Passage> passages = {}) {
+                                  std::span<const Passage> passages = {}, std::size_t threads = 0) {
     return build_size_field(size_field_options(options), options.region, bathy, coast, progress,
-                            max_nodes, before_grid, passages);
+                            max_nodes, before_grid, passages, threads);
 }
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.

@@ -2,9 +2,16 @@
 // on it (ordered like fast marching, Persson 2006, with the corner conditions of the evaluated
 // piecewise-linear field in place of the upwind eikonal update).
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <cstring>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <queue>
+#include <system_error>
+#include <thread>
 
 #include "grid.hpp"
 
@@ -13,6 +20,7 @@ namespace globemesh::detail {
 namespace {
 
 constexpr float float_inf = std::numeric_limits<float>::infinity();
+constexpr double float_max = std::numeric_limits<float>::max(); // finite bounds stay finite
 
 struct HeapEntry {
     float key;
@@ -36,7 +44,81 @@ float float_down(double x) {
     return f;
 }
 
+/// Sorts entries made in increasing node order by (key, node), as the heap pops them: a stable
+/// radix sort on the key's bits (positive floats order as their bit patterns); std::sort where a
+/// key is not a positive finite float.
+void sort_seeds(std::vector<HeapEntry> &seeds) {
+    auto bits = [](float key) {
+        std::uint32_t b;
+        std::memcpy(&b, &key, sizeof b);
+        return b;
+    };
+    if (!std::all_of(seeds.begin(), seeds.end(),
+                     [](const HeapEntry &e) { return e.key > 0 && e.key < float_inf; })) {
+        std::sort(seeds.begin(), seeds.end(),
+                  [](const HeapEntry &a, const HeapEntry &b) { return b > a; });
+        return;
+    }
+    std::vector<HeapEntry> sorted(seeds.size());
+    for (int shift = 0; shift < 32; shift += 8) {
+        std::array<std::size_t, 257> start{};
+        for (const HeapEntry &e : seeds)
+            ++start[((bits(e.key) >> shift) & 255u) + 1];
+        if (std::find(start.begin(), start.end(), seeds.size()) != start.end())
+            continue; // one digit for all: this pass would not move anything
+        for (std::size_t d = 1; d < start.size(); ++d)
+            start[d] += start[d - 1];
+        for (const HeapEntry &e : seeds)
+            sorted[start[(bits(e.key) >> shift) & 255u]++] = e;
+        seeds.swap(sorted);
+    }
+}
+
 } // namespace
+
+std::size_t field_threads(std::size_t threads) {
+    return threads > 0 ? threads
+                       : std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+}
+
+void for_row_blocks(std::size_t n, std::size_t block, std::size_t threads,
+                    const std::function<void(std::size_t, std::size_t)> &rows,
+                    const std::function<void(double)> &progress) {
+    block = std::max<std::size_t>(block, 1);
+    const std::size_t blocks = (n + block - 1) / block;
+    std::atomic<std::size_t> next{0};
+    std::atomic<bool> stop{false};
+    std::mutex mutex;
+    std::exception_ptr error;
+    // Takes blocks until none is left or one failed; the first failure is kept.
+    auto work = [&](bool caller) {
+        try {
+            for (std::size_t b; !stop && (b = next++) < blocks;) {
+                rows(b * block, std::min(n, (b + 1) * block));
+                if (caller && progress)
+                    progress(static_cast<double>(std::min(next.load(), blocks)) /
+                             static_cast<double>(blocks));
+            }
+        } catch (...) {
+            std::lock_guard lock(mutex);
+            if (!error)
+                error = std::current_exception();
+            stop = true;
+        }
+    };
+    std::vector<std::thread> pool;
+    try {
+        for (std::size_t t = 1; t < std::min(threads, blocks); ++t)
+            pool.emplace_back(work, false);
+    } catch (const std::system_error &) {
+        // No more threads (a process limit): fewer share the blocks, this one among them.
+    }
+    work(true);
+    for (std::thread &t : pool)
+        t.join();
+    if (error)
+        std::rethrow_exception(error);
+}
 
 BackgroundGrid::BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_deg,
                                std::size_t nlon_, std::size_t nlat_, bool global_)
@@ -330,6 +412,13 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
                                                                                    : i);
     };
     // The two corner conditions of the cell with lower-left corner (i, j); 0 where there is none.
+    // Their slots in `bound` are 2 * cell and 2 * cell + 1.
+    auto cell_index = [&](long i, long j) {
+        return static_cast<std::size_t>(j - j_first) * g.nlon +
+               static_cast<std::size_t>(i < 0       ? i + nlon
+                                        : i >= nlon ? i - nlon
+                                                    : i);
+    };
     auto corners = [&](long i, long j, Corner out[2]) -> int {
         if (j < j_first || j > j_last)
             return 0;
@@ -361,7 +450,7 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
             const int k = corners(i, j, c);
             for (int m = 0; m < k; ++m)
                 if (c[m].involves(n))
-                    visit(c[m]);
+                    visit(c[m], 2 * cell_index(i, j) + static_cast<std::size_t>(m));
         };
         if (n >= n_grid) {
             const long j = n == south ? -1 : nlat - 1;
@@ -388,18 +477,21 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
     for (std::size_t n = 0; n < n_grid; ++n)
         if (h[n] < top_value)
             seeds.push_back({h[n], static_cast<std::uint32_t>(n)});
-    std::sort(seeds.begin(), seeds.end(),
-              [](const HeapEntry &a, const HeapEntry &b) { return b > a; });
+    sort_seeds(seeds);
     std::size_t next_seed = 0;
     MinHeap heap;
     std::vector<std::uint8_t> accepted(n_grid + 2, 0);
     std::size_t popped = 0;
-    // A node's tentative value from scratch: its bounds can rise as well as fall when another
-    // node of one of its conditions is accepted, so no running minimum is kept.
+    // Each condition's bound, rounded down to float (the same minimum: float_down is monotone),
+    // changes only when one of its nodes is accepted, so it is kept, and a node's tentative value
+    // is the minimum of its ceiling and its conditions' kept bounds. It can rise as well as fall
+    // when another node of one of its conditions is accepted: no running minimum is kept.
+    const long cell_rows = j_last - j_first + 1;
+    std::vector<float> bound(cell_rows > 0 ? 2 * static_cast<std::size_t>(cell_rows) * g.nlon : 0,
+                             float_inf);
     auto tentative = [&](std::size_t m) {
-        double t = initial[m];
-        for_each_corner(
-            m, [&](const Corner &c) { t = std::min(t, corner_bound(c, h, accepted, grade)); });
+        float t = initial[m];
+        for_each_corner(m, [&](const Corner &, std::size_t slot) { t = std::min(t, bound[slot]); });
         return t;
     };
     std::vector<std::size_t> around;
@@ -419,7 +511,8 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
                    std::min(0.99, static_cast<double>(popped) / static_cast<double>(n_grid)),
                    "gradation");
         around.clear();
-        for_each_corner(top.node, [&](const Corner &c) {
+        for_each_corner(top.node, [&](const Corner &c, std::size_t slot) {
+            bound[slot] = float_down(std::min(corner_bound(c, h, accepted, grade), float_max));
             for (std::size_t m : {c.k, c.row, c.col})
                 if (!accepted[m] && std::find(around.begin(), around.end(), m) == around.end())
                     around.push_back(m);
@@ -427,7 +520,7 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         for (std::size_t m : around) {
             // Never below the value just accepted (the conditions held with every unknown node
             // at that value); the max only absorbs rounding.
-            const float t = std::max(top.key, float_down(tentative(m)));
+            const float t = std::max(top.key, tentative(m));
             if (t != h[m]) {
                 h[m] = t;
                 heap.push({t, static_cast<std::uint32_t>(m)});
