@@ -4,6 +4,7 @@
 // real ETOPO5 field, the analytic size functions and the bad inputs.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -437,6 +438,49 @@ TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
     EXPECT_LT(median(shelf), 0.5 * median(abyss));
     // The Mid-Atlantic Ridge is finer than the abyssal plains beside it.
     EXPECT_LT(f.size_km(-29, 30), f.size_km(-50, 28));
+}
+
+TEST(SizeField, etopo5_field_is_the_same_floats_on_one_two_and_three_threads) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmin_km = 40;
+    o.hmax_km = 300;
+    o.wavelength = 30;
+    o.slope = 20;
+    o.grade = 0.2;
+    auto build = [&](std::size_t threads) {
+        return build_size_field(o, &bathy, nullptr, {}, 1 << 18, {}, {}, threads);
+    };
+    const SizeField one = build(1);
+    ASSERT_LT(one.min_km(), 0.5 * one.max_km()); // shelves and abyss: the terms vary
+    for (std::size_t threads : {2, 3}) {
+        const SizeField more = build(threads);
+        const std::vector<float> &a = one.grid().values(), &b = more.grid().values();
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << threads;
+        EXPECT_EQ(one.south_pole_km(), more.south_pole_km());
+        EXPECT_EQ(one.north_pole_km(), more.north_pole_km());
+    }
+}
+
+TEST(SizeField, a_cancel_while_the_depths_are_sampled_stops_every_thread) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmin_km = 40;
+    o.hmax_km = 300;
+    o.wavelength = 30;
+    int calls = 0;
+    double last = 0;
+    // Asks to stop in the middle of the depths (0.35 .. 0.5 of the size field).
+    Progress stop_midway = [&](double f, std::string_view) {
+        ++calls;
+        last = f;
+        return f < 0.4;
+    };
+    EXPECT_THROW(build_size_field(o, &bathy, nullptr, stop_midway, 1 << 18, {}, {}, 2), Cancelled);
+    EXPECT_GE(last, 0.4);
+    EXPECT_LT(last, 0.5);
+    EXPECT_GT(calls, 2);
 }
 
 TEST(SizeField, evaluation_is_linear_on_the_two_triangles_of_each_grid_cell) {
