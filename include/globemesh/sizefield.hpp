@@ -41,11 +41,15 @@
 // the bound holds except poleward of the grid, where a held row's east-west differences sit on
 // shorter parallels (never reached by a mesh of the region: the grid has a cell of margin).
 //
-// Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
-// nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
-// grid). Building needs about 4 more arrays of the same size at peak. No grid at all when no
-// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region
-// is set; a regional grid covers the region plus one cell and holds its edge values outside.
+// Background grid: cell centres, nlon even, spacing half the smallest size the field can take
+// but never more than max_nodes nodes (2^24 by default: 64 MiB of float in the final field, about
+// 6.5 km spacing on a global grid). That size is hfloor, or, when every component that is on has
+// a lower bound above it (coast: coast_size_km; wavelength: its value at the 5 m depth floor;
+// slope, feature size and size regions have none) and there are no passages, the least of those
+// bounds (at most hmax): the grid --hmin at that size would give, and the same field. Building
+// needs about 4 more arrays of the same size at peak. No grid at all when no component is on: the
+// field is then uniform (SizeField::is_uniform). Global unless options.region is set; a regional
+// grid covers the region plus one cell and holds its edge values outside.
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
 // limiting", Eng. Comput. 22 (2006); Roberts et al., OceanMesh2D, GMD 12 (2019) for the

@@ -244,6 +244,22 @@ void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const 
     });
 }
 
+/// The smallest size the field can take before the passages, km: hfloor, or the least of the
+/// lower bounds of the components that are on when each has one above hfloor (coast: coast_size;
+/// wavelength: its value at the depth floor), at most hmax. Slope, feature size and size regions
+/// have none. The grid's spacing is half of it: a field that cannot go below it gets the grid
+/// --hmin at that value would give, the same sizes on fewer nodes.
+double finest_size_km(const SizeFieldOptions &o, double hfloor) {
+    if (o.slope > 0 || o.feature_size > 0 || !o.size_regions.empty())
+        return hfloor;
+    double finest = o.hmax_km;
+    if (o.coast_size_km > 0)
+        finest = std::min(finest, o.coast_size_km);
+    if (o.wavelength > 0)
+        finest = std::min(finest, wavelength_size_km(min_depth_m, o.wave_period_h, o.wavelength));
+    return std::max(hfloor, finest);
+}
+
 } // namespace
 
 SizeField build_size_field(const SizeFieldOptions &o,
@@ -282,7 +298,8 @@ SizeField build_size_field(const SizeFieldOptions &o,
         if (before_grid)
             before_grid();
         report(progress, 0.0, "size field");
-        grid = detail::make_background_grid(region, hfloor, max_nodes);
+        grid = detail::make_background_grid(
+            region, passages.empty() ? finest_size_km(o, hfloor) : hfloor, max_nodes);
         h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
         h.assign(grid->size(), static_cast<float>(hmax));
         return *grid;

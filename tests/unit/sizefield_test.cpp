@@ -463,6 +463,31 @@ TEST(SizeField, etopo5_field_is_the_same_floats_on_one_two_and_three_threads) {
     }
 }
 
+TEST(SizeField, without_hmin_the_grid_is_the_one_hmin_at_the_finest_size_asked_gives) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmax_km = 600;
+    o.wavelength = 2; // at the 5 m depth floor: 44712 s * sqrt(9.80665 * 5) / 2 = 156.6 km
+    o.grade = 0.2;
+    const std::size_t cap = 1 << 18;
+    const SizeField without = build_size_field(o, &bathy, nullptr, {}, cap);
+    o.hmin_km = wavelength_size_km(min_depth_m, o.wave_period_h, o.wavelength);
+    ASSERT_NEAR(o.hmin_km, 156.6, 0.1);
+    const SizeField with = build_size_field(o, &bathy, nullptr, {}, cap);
+    // Spacing 78.3 km (0.704 degrees): 512 x 256 nodes, not the 2^18 of a 0.6 km floor (hmax /
+    // 1000).
+    EXPECT_EQ(without.grid().values().size(), 512u * 256u);
+    const std::vector<float> &a = without.grid().values(), &b = with.grid().values();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+    EXPECT_EQ(without.south_pole_km(), with.south_pole_km());
+    EXPECT_NEAR(without.min_km(), 156.6, 0.1);
+    // A slope term has no lower bound: the floor's grid, up to the cap.
+    o.hmin_km = 0;
+    o.slope = 20;
+    EXPECT_GT(build_size_field(o, &bathy, nullptr, {}, cap).grid().values().size(), cap * 9 / 10);
+}
+
 TEST(SizeField, a_cancel_while_the_depths_are_sampled_stops_every_thread) {
     Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
     MeshOptions o;
