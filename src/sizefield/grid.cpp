@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <limits>
@@ -12,6 +13,8 @@
 #include <queue>
 #include <system_error>
 #include <thread>
+
+#include <sys/mman.h>
 
 #include "grid.hpp"
 
@@ -30,6 +33,40 @@ struct HeapEntry {
     }
 };
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<HeapEntry>>;
+
+constexpr std::size_t huge_page = std::size_t{2} << 20;
+
+/// Puts blocks of 2 MiB and more on 2 MiB boundaries, advised to huge pages: the coast distance and
+/// the gradation read their arrays in the order of the values, all over the grid, where 4 KiB
+/// pages make most reads a TLB miss. Where the kernel has none the advice is ignored.
+template <class T> struct HugePages {
+    using value_type = T;
+    HugePages() = default;
+    template <class U> HugePages(const HugePages<U> &) {}
+    T *allocate(std::size_t n) {
+        const std::size_t bytes = n * sizeof(T);
+        if (bytes < huge_page)
+            return std::allocator<T>{}.allocate(n);
+        const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;
+        void *p = std::aligned_alloc(huge_page, rounded);
+        if (!p)
+            throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+        madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+        return static_cast<T *>(p);
+    }
+    void deallocate(T *p, std::size_t n) {
+        if (n * sizeof(T) < huge_page)
+            std::allocator<T>{}.deallocate(p, n);
+        else
+            std::free(p);
+    }
+    friend bool operator==(const HugePages &, const HugePages &) {
+        return true;
+    }
+};
+template <class T> using HugeVector = std::vector<T, HugePages<T>>;
 
 double chord2(const Vec3 &a, const Vec3 &b) {
     Vec3 d = a - b;
@@ -220,8 +257,8 @@ std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b,
                                              static_cast<double>(p) / static_cast<double>(pieces)));
         }
     }
-    std::vector<float> key(g.size(), float_inf); // chord^2 to the nearest source found
-    std::vector<std::uint32_t> nearest(g.size(), 0);
+    HugeVector<float> key(g.size(), float_inf); // chord^2 to the nearest source found
+    HugeVector<std::uint32_t> nearest(g.size(), 0);
     MinHeap heap;
     auto offer = [&](std::size_t node, std::uint32_t src) {
         float k = static_cast<float>(chord2(g.node(node), sources[src]));
@@ -263,7 +300,7 @@ std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b,
     const double max_angle = std::min(pi, max_km / earth_radius_km);
     const float max_key =
         static_cast<float>(4.0 * std::pow(std::sin(0.5 * max_angle), 2)) * 1.0001f;
-    std::vector<std::uint8_t> done(g.size(), 0);
+    HugeVector<std::uint8_t> done(g.size(), 0);
     std::size_t popped = 0;
     while (!heap.empty()) {
         HeapEntry top = heap.top();
@@ -353,8 +390,8 @@ struct Corner {
 
 /// Largest v >= the accepted nodes for which the condition holds when its unaccepted nodes take
 /// the value v; +inf when no edge ties an unknown node to an accepted one.
-double corner_bound(const Corner &c, const std::vector<float> &h,
-                    const std::vector<std::uint8_t> &accepted, double grade) {
+double corner_bound(const Corner &c, const HugeVector<float> &h,
+                    const HugeVector<std::uint8_t> &accepted, double grade) {
     const double inf = std::numeric_limits<double>::infinity();
     double fixed[2] = {0, 0}, partner[2] = {inf, inf};
     const std::size_t ends[2] = {c.row, c.col};
@@ -389,14 +426,18 @@ double corner_bound(const Corner &c, const std::vector<float> &h,
 
 } // namespace
 
-PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double grade,
+PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &values, double grade,
                          const Progress &progress) {
     const std::size_t n_grid = g.size();
     const std::size_t south = n_grid, north = n_grid + 1; // the pole nodes, when capped
     float top_value = 0;
-    for (float v : h)
+    for (float v : values)
         top_value = std::max(top_value, v);
-    h.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
+    // The components' values, the ceiling of every node, and the values being solved for.
+    HugeVector<float> initial(values.begin(), values.end());
+    std::vector<float>().swap(values);
+    initial.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
+    HugeVector<float> h(initial);
 
     const double rad_lon = g.dlon * deg_to_rad * earth_radius_km;
     auto row_dx = [&](long j) { return rad_lon * g.cos_lat[static_cast<std::size_t>(j)]; };
@@ -465,7 +506,6 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         cell(i, j);
     };
 
-    const std::vector<float> initial(h); // the components' values, the ceiling of every node
     // The queue: the nodes' initial values, sorted once, merged with a heap of the values the
     // solver lowers or raises them to (a band along the accepted front: small, where one heap of
     // every node takes a cache miss at each of its levels on every pop). The two pop in the one
@@ -480,15 +520,15 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
     sort_seeds(seeds);
     std::size_t next_seed = 0;
     MinHeap heap;
-    std::vector<std::uint8_t> accepted(n_grid + 2, 0);
+    HugeVector<std::uint8_t> accepted(n_grid + 2, 0);
     std::size_t popped = 0;
     // Each condition's bound, rounded down to float (the same minimum: float_down is monotone),
     // changes only when one of its nodes is accepted, so it is kept, and a node's tentative value
     // is the minimum of its ceiling and its conditions' kept bounds. It can rise as well as fall
     // when another node of one of its conditions is accepted: no running minimum is kept.
     const long cell_rows = j_last - j_first + 1;
-    std::vector<float> bound(cell_rows > 0 ? 2 * static_cast<std::size_t>(cell_rows) * g.nlon : 0,
-                             float_inf);
+    HugeVector<float> bound(cell_rows > 0 ? 2 * static_cast<std::size_t>(cell_rows) * g.nlon : 0,
+                            float_inf);
     auto tentative = [&](std::size_t m) {
         float t = initial[m];
         for_each_corner(m, [&](const Corner &, std::size_t slot) { t = std::min(t, bound[slot]); });
@@ -532,7 +572,12 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         poles.south = h[south];
     if (g.north_cap)
         poles.north = h[north];
-    h.resize(n_grid);
+    // The solver's arrays freed before the result is copied out: no higher peak than the solve.
+    HugeVector<float>().swap(initial);
+    HugeVector<float>().swap(bound);
+    HugeVector<std::uint8_t>().swap(accepted);
+    std::vector<HeapEntry>().swap(seeds);
+    values.assign(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(n_grid));
     return poles;
 }
 

@@ -300,7 +300,6 @@ SizeField build_size_field(const SizeFieldOptions &o,
         report(progress, 0.0, "size field");
         grid = detail::make_background_grid(
             region, passages.empty() ? finest_size_km(o, hfloor) : hfloor, max_nodes);
-        h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
         h.assign(grid->size(), static_cast<float>(hmax));
         return *grid;
     };
