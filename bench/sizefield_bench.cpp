@@ -73,6 +73,29 @@ BENCHMARK(BM_build_demo_size_field)
     ->UseRealTime()
     ->MeasureProcessCPUTime();
 
+// The field of the 1e6-node run with bathymetry (--hmax 20km --wavelength 30 --grade 0.2, no
+// --hmin): the pipeline's largest grid, 2^22 nodes.
+void BM_build_hmax20_size_field(benchmark::State &state) {
+    SizeFieldOptions o;
+    o.hmax_km = 20;
+    o.wavelength = 30;
+    o.grade = 0.2;
+    const Raster &r = etopo5();
+    const auto threads = static_cast<std::size_t>(state.range(0));
+    for (auto _ : state) {
+        SizeField f = build_size_field(o, std::nullopt, &r, nullptr, {}, std::size_t{1} << 22, {},
+                                       {}, threads);
+        state.counters["grid_nodes"] = static_cast<double>(f.grid().values().size());
+        benchmark::DoNotOptimize(f);
+    }
+}
+BENCHMARK(BM_build_hmax20_size_field)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+
 void BM_size_km(benchmark::State &state) {
     static const SizeField f = build_size_field(issue5_options(), std::nullopt, &etopo5(), nullptr);
     std::mt19937 rng(1);
