@@ -1,5 +1,6 @@
 // Size field: time to build the global field from the ETOPO5 fixture with the issue-5 options
-// (--hmin 10 --hmax 150 --wavelength 40 --slope 20 --grade 0.15) and the cost of one evaluation.
+// (--hmin 10 --hmax 150 --wavelength 40 --slope 20 --grade 0.15) and with the demo's (--hmin 40
+// --hmax 300 --wavelength 30 --grade 0.2) on 1 and 2 threads, and the cost of one evaluation.
 // Run: build/<dir>/bench/sizefield_bench
 #include <benchmark/benchmark.h>
 
@@ -44,6 +45,56 @@ void BM_build_global_size_field(benchmark::State &state) {
     }
 }
 BENCHMARK(BM_build_global_size_field)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+SizeFieldOptions demo_options() {
+    SizeFieldOptions o;
+    o.hmin_km = 40;
+    o.hmax_km = 300;
+    o.wavelength = 30;
+    o.grade = 0.2;
+    return o;
+}
+
+// The demo's field (tools/demo) with the per-node terms on state.range(0) threads.
+void BM_build_demo_size_field(benchmark::State &state) {
+    const Raster &r = etopo5();
+    const auto threads = static_cast<std::size_t>(state.range(0));
+    for (auto _ : state) {
+        SizeField f = build_size_field(demo_options(), std::nullopt, &r, nullptr, {},
+                                       std::size_t{1} << 22, {}, {}, threads);
+        state.counters["grid_nodes"] = static_cast<double>(f.grid().values().size());
+        benchmark::DoNotOptimize(f);
+    }
+}
+BENCHMARK(BM_build_demo_size_field)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+
+// The field of the 1e6-node run with bathymetry (--hmax 20km --wavelength 30 --grade 0.2, no
+// --hmin): the pipeline's largest grid, 2^22 nodes.
+void BM_build_hmax20_size_field(benchmark::State &state) {
+    SizeFieldOptions o;
+    o.hmax_km = 20;
+    o.wavelength = 30;
+    o.grade = 0.2;
+    const Raster &r = etopo5();
+    const auto threads = static_cast<std::size_t>(state.range(0));
+    for (auto _ : state) {
+        SizeField f = build_size_field(o, std::nullopt, &r, nullptr, {}, std::size_t{1} << 22, {},
+                                       {}, threads);
+        state.counters["grid_nodes"] = static_cast<double>(f.grid().values().size());
+        benchmark::DoNotOptimize(f);
+    }
+}
+BENCHMARK(BM_build_hmax20_size_field)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 void BM_size_km(benchmark::State &state) {
     static const SizeField f = build_size_field(issue5_options(), std::nullopt, &etopo5(), nullptr);

@@ -41,11 +41,15 @@
 // the bound holds except poleward of the grid, where a held row's east-west differences sit on
 // shorter parallels (never reached by a mesh of the region: the grid has a cell of margin).
 //
-// Background grid: cell centres, nlon even, spacing hfloor / 2 but never more than max_nodes
-// nodes (2^24 by default: 64 MiB of float in the final field, about 6.5 km spacing on a global
-// grid). Building needs about 4 more arrays of the same size at peak. No grid at all when no
-// component is on: the field is then uniform (SizeField::is_uniform). Global unless options.region
-// is set; a regional grid covers the region plus one cell and holds its edge values outside.
+// Background grid: cell centres, nlon even, spacing half the smallest size the field can take
+// but never more than max_nodes nodes (2^24 by default: 64 MiB of float in the final field, about
+// 6.5 km spacing on a global grid). That size is hfloor, or, when every component that is on has
+// a lower bound above it (coast: coast_size_km; wavelength: its value at the 5 m depth floor;
+// slope, feature size and size regions have none) and there are no passages, the least of those
+// bounds (at most hmax): the grid --hmin at that size would give, and the same field. Building
+// needs about 4 more arrays of the same size at peak. No grid at all when no component is on: the
+// field is then uniform (SizeField::is_uniform). Global unless options.region is set; a regional
+// grid covers the region plus one cell and holds its edge values outside.
 //
 // References: Persson, "Mesh size functions for implicit geometries and PDE-based gradient
 // limiting", Eng. Comput. 22 (2006); Roberts et al., OceanMesh2D, GMD 12 (2019) for the
@@ -133,6 +137,8 @@ private:
 /// and no grid is built; otherwise before_grid, when set, is called once before the grid is
 /// allocated (to refuse the run by throwing). passages: the lines of options.passages with their
 /// widths (read_passages, measure_passages); the field has a grid when there are any.
+/// threads: how many threads compute the per-node terms (0: one per core); the field does not
+/// depend on it (the same floats), and the gradation runs on the calling thread.
 /// Throws UsageError (bad sizes or region, a component without its input, naming the option),
 /// DataError (a size_regions file without a size_km field) or IoError (size_regions unreadable).
 SizeField build_size_field(const SizeFieldOptions &options,
@@ -140,16 +146,16 @@ SizeField build_size_field(const SizeFieldOptions &options,
                            const Boundary *coast, const Progress &progress = {},
                            std::size_t max_nodes = std::size_t{1} << 24,
                            const std::function<void()> &before_grid = {},
-                           std::span<const Passage> passages = {});
+                           std::span<const Passage> passages = {}, std::size_t threads = 0);
 
 /// build_size_field with the size field's part and the region of a whole run's options.
 inline SizeField build_size_field(const MeshOptions &options, const Raster *bathy,
                                   const Boundary *coast, const Progress &progress = {},
                                   std::size_t max_nodes = std::size_t{1} << 24,
                                   const std::function<void()> &before_grid = {},
-                                  std::span<const Passage> passages = {}) {
+                                  std::span<const Passage> passages = {}, std::size_t threads = 0) {
     return build_size_field(size_field_options(options), options.region, bathy, coast, progress,
-                            max_nodes, before_grid, passages);
+                            max_nodes, before_grid, passages, threads);
 }
 
 /// Uniform size h_km everywhere. Throws UsageError unless h_km > 0.

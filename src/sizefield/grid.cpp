@@ -2,9 +2,19 @@
 // on it (ordered like fast marching, Persson 2006, with the corner conditions of the evaluated
 // piecewise-linear field in place of the upwind eikonal update).
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <queue>
+#include <system_error>
+#include <thread>
+
+#include <sys/mman.h>
 
 #include "grid.hpp"
 
@@ -13,6 +23,7 @@ namespace globemesh::detail {
 namespace {
 
 constexpr float float_inf = std::numeric_limits<float>::infinity();
+constexpr double float_max = std::numeric_limits<float>::max(); // finite bounds stay finite
 
 struct HeapEntry {
     float key;
@@ -22,6 +33,40 @@ struct HeapEntry {
     }
 };
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<HeapEntry>>;
+
+constexpr std::size_t huge_page = std::size_t{2} << 20;
+
+/// Puts blocks of 2 MiB and more on 2 MiB boundaries, advised to huge pages: the coast distance and
+/// the gradation read their arrays in the order of the values, all over the grid, where 4 KiB
+/// pages make most reads a TLB miss. Where the kernel has none the advice is ignored.
+template <class T> struct HugePages {
+    using value_type = T;
+    HugePages() = default;
+    template <class U> HugePages(const HugePages<U> &) {}
+    T *allocate(std::size_t n) {
+        const std::size_t bytes = n * sizeof(T);
+        if (bytes < huge_page)
+            return std::allocator<T>{}.allocate(n);
+        const std::size_t rounded = (bytes + huge_page - 1) / huge_page * huge_page;
+        void *p = std::aligned_alloc(huge_page, rounded);
+        if (!p)
+            throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+        madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+        return static_cast<T *>(p);
+    }
+    void deallocate(T *p, std::size_t n) {
+        if (n * sizeof(T) < huge_page)
+            std::allocator<T>{}.deallocate(p, n);
+        else
+            std::free(p);
+    }
+    friend bool operator==(const HugePages &, const HugePages &) {
+        return true;
+    }
+};
+template <class T> using HugeVector = std::vector<T, HugePages<T>>;
 
 double chord2(const Vec3 &a, const Vec3 &b) {
     Vec3 d = a - b;
@@ -36,7 +81,81 @@ float float_down(double x) {
     return f;
 }
 
+/// Sorts entries made in increasing node order by (key, node), as the heap pops them: a stable
+/// radix sort on the key's bits (positive floats order as their bit patterns); std::sort where a
+/// key is not a positive finite float.
+void sort_seeds(std::vector<HeapEntry> &seeds) {
+    auto bits = [](float key) {
+        std::uint32_t b;
+        std::memcpy(&b, &key, sizeof b);
+        return b;
+    };
+    if (!std::all_of(seeds.begin(), seeds.end(),
+                     [](const HeapEntry &e) { return e.key > 0 && e.key < float_inf; })) {
+        std::sort(seeds.begin(), seeds.end(),
+                  [](const HeapEntry &a, const HeapEntry &b) { return b > a; });
+        return;
+    }
+    std::vector<HeapEntry> sorted(seeds.size());
+    for (int shift = 0; shift < 32; shift += 8) {
+        std::array<std::size_t, 257> start{};
+        for (const HeapEntry &e : seeds)
+            ++start[((bits(e.key) >> shift) & 255u) + 1];
+        if (std::find(start.begin(), start.end(), seeds.size()) != start.end())
+            continue; // one digit for all: this pass would not move anything
+        for (std::size_t d = 1; d < start.size(); ++d)
+            start[d] += start[d - 1];
+        for (const HeapEntry &e : seeds)
+            sorted[start[(bits(e.key) >> shift) & 255u]++] = e;
+        seeds.swap(sorted);
+    }
+}
+
 } // namespace
+
+std::size_t field_threads(std::size_t threads) {
+    return threads > 0 ? threads
+                       : std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+}
+
+void for_row_blocks(std::size_t n, std::size_t block, std::size_t threads,
+                    const std::function<void(std::size_t, std::size_t)> &rows,
+                    const std::function<void(double)> &progress) {
+    block = std::max<std::size_t>(block, 1);
+    const std::size_t blocks = (n + block - 1) / block;
+    std::atomic<std::size_t> next{0};
+    std::atomic<bool> stop{false};
+    std::mutex mutex;
+    std::exception_ptr error;
+    // Takes blocks until none is left or one failed; the first failure is kept.
+    auto work = [&](bool caller) {
+        try {
+            for (std::size_t b; !stop && (b = next++) < blocks;) {
+                rows(b * block, std::min(n, (b + 1) * block));
+                if (caller && progress)
+                    progress(static_cast<double>(std::min(next.load(), blocks)) /
+                             static_cast<double>(blocks));
+            }
+        } catch (...) {
+            std::lock_guard lock(mutex);
+            if (!error)
+                error = std::current_exception();
+            stop = true;
+        }
+    };
+    std::vector<std::thread> pool;
+    try {
+        for (std::size_t t = 1; t < std::min(threads, blocks); ++t)
+            pool.emplace_back(work, false);
+    } catch (const std::system_error &) {
+        // No more threads (a process limit): fewer share the blocks, this one among them.
+    }
+    work(true);
+    for (std::thread &t : pool)
+        t.join();
+    if (error)
+        std::rethrow_exception(error);
+}
 
 BackgroundGrid::BackgroundGrid(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_deg,
                                std::size_t nlon_, std::size_t nlat_, bool global_)
@@ -138,8 +257,8 @@ std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b,
                                              static_cast<double>(p) / static_cast<double>(pieces)));
         }
     }
-    std::vector<float> key(g.size(), float_inf); // chord^2 to the nearest source found
-    std::vector<std::uint32_t> nearest(g.size(), 0);
+    HugeVector<float> key(g.size(), float_inf); // chord^2 to the nearest source found
+    HugeVector<std::uint32_t> nearest(g.size(), 0);
     MinHeap heap;
     auto offer = [&](std::size_t node, std::uint32_t src) {
         float k = static_cast<float>(chord2(g.node(node), sources[src]));
@@ -181,7 +300,7 @@ std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b,
     const double max_angle = std::min(pi, max_km / earth_radius_km);
     const float max_key =
         static_cast<float>(4.0 * std::pow(std::sin(0.5 * max_angle), 2)) * 1.0001f;
-    std::vector<std::uint8_t> done(g.size(), 0);
+    HugeVector<std::uint8_t> done(g.size(), 0);
     std::size_t popped = 0;
     while (!heap.empty()) {
         HeapEntry top = heap.top();
@@ -271,8 +390,8 @@ struct Corner {
 
 /// Largest v >= the accepted nodes for which the condition holds when its unaccepted nodes take
 /// the value v; +inf when no edge ties an unknown node to an accepted one.
-double corner_bound(const Corner &c, const std::vector<float> &h,
-                    const std::vector<std::uint8_t> &accepted, double grade) {
+double corner_bound(const Corner &c, const HugeVector<float> &h,
+                    const HugeVector<std::uint8_t> &accepted, double grade) {
     const double inf = std::numeric_limits<double>::infinity();
     double fixed[2] = {0, 0}, partner[2] = {inf, inf};
     const std::size_t ends[2] = {c.row, c.col};
@@ -307,14 +426,18 @@ double corner_bound(const Corner &c, const std::vector<float> &h,
 
 } // namespace
 
-PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double grade,
+PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &values, double grade,
                          const Progress &progress) {
     const std::size_t n_grid = g.size();
     const std::size_t south = n_grid, north = n_grid + 1; // the pole nodes, when capped
     float top_value = 0;
-    for (float v : h)
+    for (float v : values)
         top_value = std::max(top_value, v);
-    h.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
+    // The components' values, the ceiling of every node, and the values being solved for.
+    HugeVector<float> initial(values.begin(), values.end());
+    std::vector<float>().swap(values);
+    initial.resize(n_grid + 2, top_value); // the poles start at the top: they are only lowered
+    HugeVector<float> h(initial);
 
     const double rad_lon = g.dlon * deg_to_rad * earth_radius_km;
     auto row_dx = [&](long j) { return rad_lon * g.cos_lat[static_cast<std::size_t>(j)]; };
@@ -330,6 +453,13 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
                                                                                    : i);
     };
     // The two corner conditions of the cell with lower-left corner (i, j); 0 where there is none.
+    // Their slots in `bound` are 2 * cell and 2 * cell + 1.
+    auto cell_index = [&](long i, long j) {
+        return static_cast<std::size_t>(j - j_first) * g.nlon +
+               static_cast<std::size_t>(i < 0       ? i + nlon
+                                        : i >= nlon ? i - nlon
+                                                    : i);
+    };
     auto corners = [&](long i, long j, Corner out[2]) -> int {
         if (j < j_first || j > j_last)
             return 0;
@@ -361,7 +491,7 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
             const int k = corners(i, j, c);
             for (int m = 0; m < k; ++m)
                 if (c[m].involves(n))
-                    visit(c[m]);
+                    visit(c[m], 2 * cell_index(i, j) + static_cast<std::size_t>(m));
         };
         if (n >= n_grid) {
             const long j = n == south ? -1 : nlat - 1;
@@ -376,7 +506,6 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         cell(i, j);
     };
 
-    const std::vector<float> initial(h); // the components' values, the ceiling of every node
     // The queue: the nodes' initial values, sorted once, merged with a heap of the values the
     // solver lowers or raises them to (a band along the accepted front: small, where one heap of
     // every node takes a cache miss at each of its levels on every pop). The two pop in the one
@@ -388,18 +517,21 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
     for (std::size_t n = 0; n < n_grid; ++n)
         if (h[n] < top_value)
             seeds.push_back({h[n], static_cast<std::uint32_t>(n)});
-    std::sort(seeds.begin(), seeds.end(),
-              [](const HeapEntry &a, const HeapEntry &b) { return b > a; });
+    sort_seeds(seeds);
     std::size_t next_seed = 0;
     MinHeap heap;
-    std::vector<std::uint8_t> accepted(n_grid + 2, 0);
+    HugeVector<std::uint8_t> accepted(n_grid + 2, 0);
     std::size_t popped = 0;
-    // A node's tentative value from scratch: its bounds can rise as well as fall when another
-    // node of one of its conditions is accepted, so no running minimum is kept.
+    // Each condition's bound, rounded down to float (the same minimum: float_down is monotone),
+    // changes only when one of its nodes is accepted, so it is kept, and a node's tentative value
+    // is the minimum of its ceiling and its conditions' kept bounds. It can rise as well as fall
+    // when another node of one of its conditions is accepted: no running minimum is kept.
+    const long cell_rows = j_last - j_first + 1;
+    HugeVector<float> bound(cell_rows > 0 ? 2 * static_cast<std::size_t>(cell_rows) * g.nlon : 0,
+                            float_inf);
     auto tentative = [&](std::size_t m) {
-        double t = initial[m];
-        for_each_corner(
-            m, [&](const Corner &c) { t = std::min(t, corner_bound(c, h, accepted, grade)); });
+        float t = initial[m];
+        for_each_corner(m, [&](const Corner &, std::size_t slot) { t = std::min(t, bound[slot]); });
         return t;
     };
     std::vector<std::size_t> around;
@@ -419,7 +551,8 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
                    std::min(0.99, static_cast<double>(popped) / static_cast<double>(n_grid)),
                    "gradation");
         around.clear();
-        for_each_corner(top.node, [&](const Corner &c) {
+        for_each_corner(top.node, [&](const Corner &c, std::size_t slot) {
+            bound[slot] = float_down(std::min(corner_bound(c, h, accepted, grade), float_max));
             for (std::size_t m : {c.k, c.row, c.col})
                 if (!accepted[m] && std::find(around.begin(), around.end(), m) == around.end())
                     around.push_back(m);
@@ -427,7 +560,7 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         for (std::size_t m : around) {
             // Never below the value just accepted (the conditions held with every unknown node
             // at that value); the max only absorbs rounding.
-            const float t = std::max(top.key, float_down(tentative(m)));
+            const float t = std::max(top.key, tentative(m));
             if (t != h[m]) {
                 h[m] = t;
                 heap.push({t, static_cast<std::uint32_t>(m)});
@@ -439,7 +572,12 @@ PoleSizes limit_gradient(const BackgroundGrid &g, std::vector<float> &h, double 
         poles.south = h[south];
     if (g.north_cap)
         poles.north = h[north];
-    h.resize(n_grid);
+    // The solver's arrays freed before the result is copied out: no higher peak than the solve.
+    HugeVector<float>().swap(initial);
+    HugeVector<float>().swap(bound);
+    HugeVector<std::uint8_t>().swap(accepted);
+    std::vector<HeapEntry>().swap(seeds);
+    values.assign(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(n_grid));
     return poles;
 }
 

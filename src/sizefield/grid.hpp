@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,18 @@ struct BackgroundGrid {
 
     static constexpr std::size_t npos = static_cast<std::size_t>(-1);
 };
+
+/// Threads for the size field's per-node terms: `threads`, or one per core when 0 (at most 16).
+std::size_t field_threads(std::size_t threads);
+
+/// Runs rows(begin, end) over the row blocks of [0, n) (`block` rows each) on up to `threads`
+/// threads, the calling one among them, which reports (fraction of the blocks done) to `progress`
+/// after each block it runs. rows must write only what its rows own, so the results do not
+/// depend on the thread count. An exception (Cancelled from progress, one from rows) stops the
+/// blocks not started and is rethrown once every thread has returned.
+void for_row_blocks(std::size_t n, std::size_t block, std::size_t threads,
+                    const std::function<void(std::size_t, std::size_t)> &rows,
+                    const std::function<void(double)> &progress = {});
 
 /// The grid build_size_field uses for these options: see sizefield.hpp.
 /// region: W,S,E,N degrees, nullopt for the whole globe.

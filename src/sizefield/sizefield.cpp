@@ -173,54 +173,91 @@ SizeFn SizeField::function() const {
 
 namespace {
 
-/// Lowers h (the grid's values, km) to the wavelength and slope components of the depth on
-/// the grid (see sizefield.hpp), where the options turn them on.
-void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const SizeFieldOptions &o,
-                    std::vector<float> &h, const Progress &progress) {
-    auto lower = [&](std::size_t n, double v) {
-        if (v < h[n])
-            h[n] = static_cast<float>(v);
-    };
+/// Depth (m, positive down; NaN where the raster has none) at every grid node, rows on every
+/// thread.
+std::vector<float> grid_depths(const detail::BackgroundGrid &g, const Raster &bathy,
+                               std::size_t threads, const Progress &progress) {
     std::vector<float> depth(g.size());
-    for (std::size_t j = 0; j < g.nlat; ++j) {
-        for (std::size_t i = 0; i < g.nlon; ++i)
-            depth[j * g.nlon + i] = static_cast<float>(-bathy.elevation_m(g.lon(i), g.lat(j)));
-        if (j % 256 == 0)
-            report(progress, 0.35 + 0.15 * static_cast<double>(j) / static_cast<double>(g.nlat),
-                   "size field");
+    detail::for_row_blocks(
+        g.nlat, 16, threads,
+        [&](std::size_t j0, std::size_t j1) {
+            for (std::size_t j = j0; j < j1; ++j)
+                for (std::size_t i = 0; i < g.nlon; ++i)
+                    depth[j * g.nlon + i] =
+                        static_cast<float>(-bathy.elevation_m(g.lon(i), g.lat(j)));
+        },
+        [&](double f) { report(progress, f, "size field"); });
+    return depth;
+}
+
+/// The smaller of the wavelength and slope components the options turn on at node n, km
+/// (+inf where neither applies).
+double depth_size_km(const detail::BackgroundGrid &g, const std::vector<float> &depth,
+                     const SizeFieldOptions &o, std::size_t n) {
+    const double dn = depth[n];
+    double v = inf;
+    if (std::isnan(dn))
+        return v;
+    if (o.wavelength > 0)
+        v = std::min(v, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
+    if (o.slope > 0) {
+        // Central differences of the floored depth (one-sided at edges and no-data).
+        auto floored = [&](std::size_t m) {
+            return std::isnan(depth[m]) ? std::numeric_limits<double>::quiet_NaN()
+                                        : std::max(static_cast<double>(depth[m]), min_depth_m);
+        };
+        auto derivative = [&](const std::size_t nb[2], double step) {
+            double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
+            double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
+            double here = std::max(dn, min_depth_m);
+            if (!std::isnan(lo) && !std::isnan(hi))
+                return (hi - lo) / (2 * step);
+            if (!std::isnan(hi))
+                return (hi - here) / step;
+            if (!std::isnan(lo))
+                return (here - lo) / step;
+            return 0.0;
+        };
+        std::size_t r[2], c[2];
+        g.row_neighbours(n, r);
+        g.column_neighbours(n, c);
+        const double gx = derivative(r, g.dx_km[n / g.nlon]);
+        const double gy = derivative(c, g.dy_km);
+        v = std::min(v, slope_size_km(dn, std::hypot(gx, gy), o.slope));
     }
-    for (std::size_t n = 0; n < g.size(); ++n) {
-        const double dn = depth[n];
-        if (std::isnan(dn))
-            continue;
-        if (o.wavelength > 0)
-            lower(n, wavelength_size_km(dn, o.wave_period_h, o.wavelength));
-        if (o.slope > 0) {
-            // Central differences of the floored depth (one-sided at edges and no-data).
-            auto floored = [&](std::size_t m) {
-                return std::isnan(depth[m]) ? std::numeric_limits<double>::quiet_NaN()
-                                            : std::max(static_cast<double>(depth[m]), min_depth_m);
-            };
-            auto derivative = [&](const std::size_t nb[2], double step) {
-                double lo = nb[0] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[0]);
-                double hi = nb[1] == detail::BackgroundGrid::npos ? std::nan("") : floored(nb[1]);
-                double here = std::max(dn, min_depth_m);
-                if (!std::isnan(lo) && !std::isnan(hi))
-                    return (hi - lo) / (2 * step);
-                if (!std::isnan(hi))
-                    return (hi - here) / step;
-                if (!std::isnan(lo))
-                    return (here - lo) / step;
-                return 0.0;
-            };
-            std::size_t r[2], c[2];
-            g.row_neighbours(n, r);
-            g.column_neighbours(n, c);
-            const double gx = derivative(r, g.dx_km[n / g.nlon]);
-            const double gy = derivative(c, g.dy_km);
-            lower(n, slope_size_km(dn, std::hypot(gx, gy), o.slope));
+    return v;
+}
+
+/// Lowers h (the grid's values, km) to the wavelength and slope components of the depth on
+/// the grid (see sizefield.hpp), where the options turn them on; each node on its own, rows on
+/// every thread.
+void lower_by_depth(const detail::BackgroundGrid &g, const Raster &bathy, const SizeFieldOptions &o,
+                    std::vector<float> &h, std::size_t threads, const Progress &progress) {
+    const std::vector<float> depth =
+        grid_depths(g, bathy, threads, sub_progress(progress, 0.35, 0.5));
+    detail::for_row_blocks(g.nlat, 16, threads, [&](std::size_t j0, std::size_t j1) {
+        for (std::size_t n = j0 * g.nlon; n < j1 * g.nlon; ++n) {
+            const double v = depth_size_km(g, depth, o, n);
+            if (v < h[n])
+                h[n] = static_cast<float>(v);
         }
-    }
+    });
+}
+
+/// The smallest size the field can take before the passages, km: hfloor, or the least of the
+/// lower bounds of the components that are on when each has one above hfloor (coast: coast_size;
+/// wavelength: its value at the depth floor), at most hmax. Slope, feature size and size regions
+/// have none. The grid's spacing is half of it: a field that cannot go below it gets the grid
+/// --hmin at that value would give, the same sizes on fewer nodes.
+double finest_size_km(const SizeFieldOptions &o, double hfloor) {
+    if (o.slope > 0 || o.feature_size > 0 || !o.size_regions.empty())
+        return hfloor;
+    double finest = o.hmax_km;
+    if (o.coast_size_km > 0)
+        finest = std::min(finest, o.coast_size_km);
+    if (o.wavelength > 0)
+        finest = std::min(finest, wavelength_size_km(min_depth_m, o.wave_period_h, o.wavelength));
+    return std::max(hfloor, finest);
 }
 
 } // namespace
@@ -229,8 +266,9 @@ SizeField build_size_field(const SizeFieldOptions &o,
                            const std::optional<std::array<double, 4>> &region, const Raster *bathy,
                            const Boundary *coast, const Progress &progress, std::size_t max_nodes,
                            const std::function<void()> &before_grid,
-                           std::span<const Passage> passages) {
+                           std::span<const Passage> passages, std::size_t threads) {
     validate(o);
+    threads = detail::field_threads(threads);
     if (region) { // checked as the coast checks it
         CoastOptions with_region;
         with_region.region = region;
@@ -260,8 +298,8 @@ SizeField build_size_field(const SizeFieldOptions &o,
         if (before_grid)
             before_grid();
         report(progress, 0.0, "size field");
-        grid = detail::make_background_grid(region, hfloor, max_nodes);
-        h.reserve(grid->size() + 2); // the gradation solver appends the two pole nodes
+        grid = detail::make_background_grid(
+            region, passages.empty() ? finest_size_km(o, hfloor) : hfloor, max_nodes);
         h.assign(grid->size(), static_cast<float>(hmax));
         return *grid;
     };
@@ -288,7 +326,7 @@ SizeField build_size_field(const SizeFieldOptions &o,
 
     // Wavelength and slope, from the depth on the grid.
     if (o.wavelength > 0 || o.slope > 0)
-        lower_by_depth(background(), *bathy, o, h, progress);
+        lower_by_depth(background(), *bathy, o, h, threads, progress);
     if (grid)
         report(progress, 0.55, "size field");
 

@@ -4,6 +4,7 @@
 // real ETOPO5 field, the analytic size functions and the bad inputs.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -437,6 +438,80 @@ TEST(SizeField, etopo5_global_field_refines_shelves_and_is_graded) {
     EXPECT_LT(median(shelf), 0.5 * median(abyss));
     // The Mid-Atlantic Ridge is finer than the abyssal plains beside it.
     EXPECT_LT(f.size_km(-29, 30), f.size_km(-50, 28));
+}
+
+TEST(SizeField, etopo5_field_is_the_same_floats_on_one_two_and_three_threads) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmin_km = 40;
+    o.hmax_km = 300;
+    o.wavelength = 30;
+    o.slope = 20;
+    o.grade = 0.2;
+    auto build = [&](std::size_t threads) {
+        return build_size_field(o, &bathy, nullptr, {}, 1 << 18, {}, {}, threads);
+    };
+    const SizeField one = build(1);
+    ASSERT_LT(one.min_km(), 0.5 * one.max_km()); // shelves and abyss: the terms vary
+    for (std::size_t threads : {2, 3}) {
+        const SizeField more = build(threads);
+        const std::vector<float> &a = one.grid().values(), &b = more.grid().values();
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << threads;
+        EXPECT_EQ(one.south_pole_km(), more.south_pole_km());
+        EXPECT_EQ(one.north_pole_km(), more.north_pole_km());
+    }
+}
+
+TEST(SizeField, without_hmin_the_grid_is_the_one_hmin_at_the_finest_size_asked_gives) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmax_km = 600;
+    o.wavelength = 2; // at the 5 m depth floor: 44712 s * sqrt(9.80665 * 5) / 2 = 156.6 km
+    o.grade = 0.2;
+    const std::size_t cap = 1 << 18;
+    const SizeField without = build_size_field(o, &bathy, nullptr, {}, cap);
+    o.hmin_km = wavelength_size_km(min_depth_m, o.wave_period_h, o.wavelength);
+    ASSERT_NEAR(o.hmin_km, 156.6, 0.1);
+    const SizeField with = build_size_field(o, &bathy, nullptr, {}, cap);
+    // Spacing 78.3 km (0.704 degrees): 512 x 256 nodes, not the 2^18 of a 0.6 km floor (hmax /
+    // 1000).
+    EXPECT_EQ(without.grid().values().size(), 512u * 256u);
+    const std::vector<float> &a = without.grid().values(), &b = with.grid().values();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+    EXPECT_EQ(without.south_pole_km(), with.south_pole_km());
+    EXPECT_NEAR(without.min_km(), 156.6, 0.1);
+    // A slope term has no lower bound: the floor's grid, up to the cap.
+    o.hmin_km = 0;
+    o.slope = 20;
+    EXPECT_GT(build_size_field(o, &bathy, nullptr, {}, cap).grid().values().size(), cap * 9 / 10);
+}
+
+TEST(SizeField, a_cancel_while_the_depths_are_sampled_stops_there) {
+    Raster bathy = read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+    MeshOptions o;
+    o.hmin_km = 40;
+    o.hmax_km = 300;
+    o.wavelength = 30;
+    int calls = 0;
+    double last = 0;
+    // Asks to stop in the middle of the depths (0.35 .. 0.5 of the size field). The calling
+    // thread reports after each block it runs: on one thread, every block.
+    Progress stop_midway = [&](double f, std::string_view) {
+        ++calls;
+        last = f;
+        return f < 0.4;
+    };
+    EXPECT_THROW(build_size_field(o, &bathy, nullptr, stop_midway, 1 << 18, {}, {}, 1), Cancelled);
+    EXPECT_GE(last, 0.4);
+    EXPECT_LT(last, 0.5); // from the depths' blocks, not the report after them (0.55)
+    EXPECT_GT(calls, 2);
+    // On two threads the other may run every block first: the run stops at the depths' last
+    // block or just after them, the other thread joined.
+    Progress stop_in_depths = [&](double f, std::string_view) { return !(f > 0.35); };
+    EXPECT_THROW(build_size_field(o, &bathy, nullptr, stop_in_depths, 1 << 18, {}, {}, 2),
+                 Cancelled);
 }
 
 TEST(SizeField, evaluation_is_linear_on_the_two_triangles_of_each_grid_cell) {
