@@ -1,126 +1,138 @@
-// Geodesic face areas with each edge's inverse problem solved once: see face_area.hpp.
+// Geodesic face areas on the authalic sphere with a term per side: see face_area.hpp.
 #include "face_area.hpp"
 
-#include <algorithm>
+#include <array>
 #include <cmath>
-#include <system_error>
-#include <thread>
-#include <vector>
 
-#include <GeographicLib/Accumulator.hpp>
 #include <GeographicLib/Geodesic.hpp>
-#include <GeographicLib/Math.hpp>
+#include <GeographicLib/PolygonArea.hpp>
 
 namespace globemesh::io {
 
 namespace {
 
-/// +1 or -1 when the shorter way from lon1 to lon2 crosses the prime meridian eastwards or
-/// westwards (longitude 0 counts as east of it), else 0: PolygonArea's rule for the crossings
-/// whose parity tells a polygon round a pole.
-int prime_meridian_transit(double lon1, double lon2) {
-    using GeographicLib::Math;
-    // Longitudes in [-180, 180] (vec_to_lonlat's) on one side of the meridian: no crossing, as
-    // the rule below gives for them, without its angle reductions.
-    if ((lon1 < 0) == (lon2 < 0) && !(lon1 > 0 && lon2 == 0))
-        return 0;
-    const double d = Math::AngDiff(lon1, lon2);
-    lon1 = Math::AngNormalize(lon1);
-    lon2 = Math::AngNormalize(lon2);
-    if (d > 0 && ((lon1 < 0 && lon2 >= 0) || (lon1 > 0 && lon2 == 0)))
-        return 1;
-    if (d < 0 && lon1 >= 0 && lon2 < 0)
-        return -1;
-    return 0;
+/// WGS84 (a, e^2, e) and its authalic sphere: q at the pole and the radius R_q (and its square).
+struct Ellipsoid {
+    double a, e2, e, qp, rq, rq2;
+};
+
+/// q(phi) of the authalic latitude (sin xi = q(phi) / q(pole)), from s = sin(phi).
+double authalic_q(const Ellipsoid &w, double s) {
+    return (1 - w.e2) * (s / (1 - w.e2 * s * s) + std::atanh(w.e * s) / w.e);
 }
 
-/// +1 or -1 when vec_to_lonlat(v).lon is surely in (0, 180) or in (-180, 0), from the sign of
-/// v.y alone (a margin keeps lon off 0 and off the 180 that rounding could give), else 0.
-int hemisphere_of_lon(const Vec3 &v) {
-    const double margin = 1e-12 * std::fabs(v.x);
-    return v.y > margin ? 1 : v.y < -margin ? -1 : 0;
+const Ellipsoid &wgs84() {
+    static const Ellipsoid w = [] {
+        const auto &g = GeographicLib::Geodesic::WGS84();
+        Ellipsoid e{g.EquatorialRadius(), 0, 0, 0, 0, 0};
+        const double f = g.Flattening();
+        e.e2 = f * (2 - f);
+        e.e = std::sqrt(e.e2);
+        e.qp = authalic_q(e, 1);
+        e.rq2 = e.a * e.a * e.qp / 2;
+        e.rq = std::sqrt(e.rq2);
+        return e;
+    }();
+    return w;
 }
 
-/// Runs slice(k, threads) for k = 0 .. threads - 1, one per core (at most 16), slice 0 on the
-/// calling thread; when the process may start no more threads, the caller runs the rest.
-/// slice must be safe to run concurrently with the others.
-template <class Slice> void on_every_core(const Slice &slice) {
-    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
-    std::vector<std::thread> pool;
-    std::size_t k = 1;
-    try {
-        for (; k < threads; ++k)
-            pool.emplace_back(slice, k, threads);
-    } catch (const std::system_error &) {
-        // No more threads (a process limit): this thread runs the slices left.
-    }
-    for (; k < threads; ++k)
-        slice(k, threads);
-    slice(0, threads);
-    for (auto &t : pool)
-        t.join();
+/// sin and cos of the authalic latitude of the point at geodetic latitude phi, from sin(phi) (z)
+/// and cos(phi) (h >= 0). q(pole) - q(phi) is taken from 1 - |sin phi| = cos^2 / (1 + |sin|) to
+/// keep the digits of cos xi near the poles.
+std::array<double, 2> authalic_sin_cos(const Ellipsoid &w, double z, double h) {
+    const double s = std::fabs(z), one_minus = h * h / (1 + s);
+    const double q = authalic_q(w, s);
+    const double to_pole = one_minus * (1 + w.e2 * s) / (1 - w.e2 * s * s) +
+                           (1 - w.e2) * std::atanh(w.e * one_minus / (1 - w.e2 * s)) / w.e;
+    return {std::copysign(q / w.qp, z), std::sqrt(to_pole * (w.qp + q)) / w.qp};
+}
+
+/// The point of the authalic sphere (unit vector) where the equal-area map takes the point v
+/// (a unit vector of geodetic latitude atan2(v.z, hypot(v.x, v.y))): its authalic latitude.
+Vec3 to_authalic(const Ellipsoid &w, const Vec3 &v) {
+    const double h = std::sqrt(v.x * v.x + v.y * v.y), r = std::sqrt(h * h + v.z * v.z);
+    if (h == 0)
+        return {0, 0, v.z > 0 ? 1.0 : -1.0};
+    const auto [sx, cx] = authalic_sin_cos(w, v.z / r, h / r);
+    return {v.x * (cx / h), v.y * (cx / h), sx};
+}
+
+/// The geodesic curvature (1/m, positive turning left) on the authalic sphere of the image of
+/// the ellipsoid's geodesic through m (unit vector, geodetic) heading along d (a chord).
+/// With k = P / p the map's scale along parallels (1 / k along meridians: equal area), the
+/// image's azimuth is atan(k^2 tan alpha); its rate of turn along the image, less that of the
+/// sphere's great circle of the same azimuth (Clairaut), is the curvature.
+double image_curvature(const Ellipsoid &w, const Vec3 &m, const Vec3 &d) {
+    const double z = m.z, h = std::sqrt(m.x * m.x + m.y * m.y);
+    const Vec3 east{-m.y / h, m.x / h, 0}, north{-z * m.x / h, -z * m.y / h, h};
+    // The ellipsoid's azimuth: tan alpha = (N / M) tan(azimuth on the unit sphere).
+    const double w2 = 1 - w.e2 * z * z;
+    double sa = w2 / (1 - w.e2) * dot(d, east), ca = dot(d, north);
+    const double r = std::hypot(sa, ca);
+    sa /= r;
+    ca /= r;
+    const double wr = std::sqrt(w2), n = w.a / wr, mr = w.a * (1 - w.e2) / (wr * w2), p = n * h;
+    const auto [sx, cx] = authalic_sin_cos(w, z, h);
+    const double big_p = w.rq * cx;
+    const double k = big_p / p, k2 = k * k;
+    const double k_lat = mr * (big_p * z / (p * p) - sx / big_p); // dk / dphi
+    const double turn = sa * z / p;                               // dalpha / ds (geodesic)
+    const double k2_s = 2 * k * k_lat * ca / mr;                  // d(k^2) / ds
+    const double den = ca * ca + k2 * k2 * sa * sa;
+    const double image_turn = (k2_s * sa * ca + k2 * turn) / den;  // dalpha' / ds
+    const double stretch = std::sqrt(ca * ca / k2 + k2 * sa * sa); // ds' / ds
+    const double sin_image = k2 * sa / std::sqrt(den);
+    return image_turn / stretch - sx * sin_image / big_p;
+}
+
+/// The area (m2) between the image of the geodesic from a to b and the authalic sphere's great
+/// circle between their images wa and wb, positive on the left of a -> b.
+double side_term(const Ellipsoid &w, const Vec3 &a, const Vec3 &b, const Vec3 &wa, const Vec3 &wb) {
+    const double l = w.rq * 2 * std::asin(norm(wb - wa) / 2);
+    return -image_curvature(w, normalized(a + b), b - a) * l * l * l / 12;
 }
 
 } // namespace
 
-GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *stop)
-    : topo_(topo), s12_(topo.edge_count()) {
-    const auto &wgs84 = GeographicLib::Geodesic::WGS84();
-    const auto &nodes = topo.mesh->nodes;
-    const std::size_t n = nodes.size();
-    // Node by node, each edge among those of its smaller node (node_edges): that node's lon/lat
-    // is converted once for its edges rather than once per edge.
-    on_every_core([&](std::size_t k, std::size_t threads) {
-        double t;
-        for (std::size_t v = n * k / threads; v < n * (k + 1) / threads; ++v) {
-            if (stop && v % 4096 == 0 && stop->load(std::memory_order_relaxed))
-                return;
-            const LonLat own = vec_to_lonlat(nodes[v]);
-            for (std::size_t e = topo.node_edges[v]; e < topo.node_edges[v + 1]; ++e) {
-                const auto ends = topo.edge_nodes(e);
-                const bool first = std::size_t(ends[0]) == v;
-                const LonLat other = vec_to_lonlat(nodes[std::size_t(ends[first ? 1 : 0])]);
-                const LonLat &a = first ? own : other, &b = first ? other : own;
-                wgs84.GenInverse(a.lat, a.lon, b.lat, b.lon, GeographicLib::Geodesic::AREA, t, t, t,
-                                 t, t, t, s12_[e]);
-            }
-        }
-    });
+double polygon_area_m2(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
+    GeographicLib::PolygonArea polygon(GeographicLib::Geodesic::WGS84());
+    for (const Vec3 *v : {&a, &b, &c}) {
+        const LonLat p = vec_to_lonlat(*v);
+        polygon.AddPoint(p.lat, p.lon);
+    }
+    double perimeter, area;
+    polygon.Compute(false, true, perimeter, area);
+    return std::fabs(area);
 }
+
+GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *)
+    : topo_(topo) {}
 
 double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f) const {
     const auto &face = topo_.mesh->faces[f];
     const auto &nodes = topo_.mesh->nodes;
-    // Corners all east or all west of the prime meridian (and off the antimeridian's 180) cross
-    // neither: their longitudes are not needed.
-    const int side = hemisphere_of_lon(nodes[face[0]]);
-    const bool one_side = side != 0 && hemisphere_of_lon(nodes[face[1]]) == side &&
-                          hemisphere_of_lon(nodes[face[2]]) == side;
-    double lon[3] = {};
-    for (int k = 0; k < 3 && !one_side; ++k)
-        lon[k] = vec_to_lonlat(nodes[face[std::size_t(k)]]).lon;
-    GeographicLib::Accumulator<> sum;
-    int crossings = 0;
+    const Vec3 v[3] = {nodes[face[0]], nodes[face[1]], nodes[face[2]]};
+    constexpr double longest_chord = short_side_km / 6371.0;
+    for (int k = 0; k < 3; ++k)
+        if (const Vec3 d = v[(k + 1) % 3] - v[k]; dot(d, d) > longest_chord * longest_chord)
+            return polygon_area_m2(v[0], v[1], v[2]);
+    const Ellipsoid &w = wgs84();
+    const Vec3 s[3] = {to_authalic(w, v[0]), to_authalic(w, v[1]), to_authalic(w, v[2])};
+    // The spherical triangle's excess, tan(E / 2) = det / (1 + a.b + b.c + c.a), the determinant
+    // from the sides (b - a, c - a) to keep its digits on small faces.
+    const double det = dot(s[0], cross(s[1] - s[0], s[2] - s[0]));
+    double area =
+        w.rq2 * 2 * std::atan2(det, 1 + dot(s[0], s[1]) + dot(s[1], s[2]) + dot(s[2], s[0]));
     for (int k = 0; k < 3; ++k) {
+        const int j = (k + 1) % 3;
         const auto e = std::size_t(edges_of_f[k]);
-        // Side k runs from corner k to corner k + 1: the edge's own direction when the face is
-        // the edge's first (edge_nodes), the opposite one on its second.
+        // Side k runs from corner k to corner j: the edge's own direction when the face is the
+        // edge's first (edge_nodes), the opposite one on its second; the term is computed in the
+        // edge's direction so that both faces get the same value.
         const bool forward = topo_.edge_halves[e][0] == 3 * f + std::size_t(k);
-        sum += forward ? s12_[e] : -s12_[e];
-        if (!one_side)
-            crossings += prime_meridian_transit(lon[k], lon[(k + 1) % 3]);
+        area +=
+            forward ? side_term(w, v[k], v[j], s[k], s[j]) : -side_term(w, v[j], v[k], s[j], s[k]);
     }
-    // PolygonArea::Compute's reduction: into (-area0/2, area0/2], then half the ellipsoid off a
-    // face that goes round a pole.
-    const double area0 = GeographicLib::Geodesic::WGS84().EllipsoidArea();
-    sum.remainder(area0);
-    if (crossings & 1)
-        sum += (sum() < 0 ? 0.5 : -0.5) * area0;
-    double area = sum();
-    if (area > area0 / 2)
-        area -= area0;
-    else if (area <= -area0 / 2)
-        area += area0;
     return std::fabs(area);
 }
 
