@@ -1,17 +1,19 @@
 // Internal to io/: the geodesic areas of a mesh's faces on the WGS84 ellipsoid, for both writers.
 //
-// GeographicLib's PolygonArea solves one inverse problem per side of a polygon and sums the
-// sides' S12 terms (the area between the geodesic and the equator). A mesh edge is a side of
-// two faces, so the inverse problem of each edge is solved here once (on every core) and its
-// S12 enters one face with its sign and the other with the opposite sign: half the geodesic
-// work of PolygonArea face by face, the same areas (to rounding), and areas that tile the
-// ellipsoid exactly, each edge's term cancelling between its faces. Each face's sum is then
-// reduced as PolygonArea::Compute does it: modulo the ellipsoid's area, and by half of it when
-// the face goes round a pole (an odd number of crossings of the prime meridian).
+// The area of a geodesic triangle is that of its image on the authalic sphere (the equal-area
+// map of the ellipsoid, radius R_q, latitude -> authalic latitude): the spherical triangle of
+// the three mapped corners, plus, for each side, the area between the image of the ellipsoid's
+// geodesic and the sphere's great circle. That curve is nearly a great circle (its geodesic
+// curvature on the sphere, kappa, is of the order of the flattening over R_q), so the area
+// between them is kappa * L^3 / 12 with kappa taken at the side's midpoint (L its length on the
+// sphere; the next terms are of relative order (L / R_q)^2). No geodesic problem is solved:
+// on faces of sides up to short_side_km the areas agree with GeographicLib's PolygonArea to
+// better than 1e-9 relative (tests/unit/face_area_test.cpp checks it face by face); a face with
+// a longer side is given PolygonArea's area itself. Each side's term is computed from the
+// edge's own direction (edge_nodes) and enters its two faces with opposite signs, so the
+// areas still tile the ellipsoid.
 //
-// Memory: one double per edge (about 24 bytes per node) while the object lives. The corners'
-// lon/lat are converted where needed rather than held: a table of them (16 bytes per node) made
-// the writer the process's peak at 20 km (204.3 MiB instead of the mesher's 194.5).
+// Memory: nothing beyond the topology; every face's area is computed when asked for.
 #pragma once
 
 #include <atomic>
@@ -25,8 +27,12 @@ namespace globemesh::io {
 
 class GeodesicFaceAreas {
 public:
-    /// Solves every edge's inverse problem, on every core. When `stop` turns true meanwhile,
-    /// returns early with the areas unfinished (for a writer that failed or was cancelled).
+    /// Faces with a side longer than this (chord, km on the unit sphere times 6371) are given
+    /// GeographicLib's PolygonArea.
+    static constexpr double short_side_km = 80;
+
+    /// The areas of topo's mesh, computed face by face in face_m2 (safe from any thread). `stop`
+    /// is not used (the callers' interface of when the edges were solved here ahead).
     explicit GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *stop = nullptr);
 
     /// The area of face f (m2), whose edges edges_of_f are those face_edges gives.
@@ -34,7 +40,11 @@ public:
 
 private:
     const MeshTopology &topo_;
-    std::vector<double> s12_; ///< per edge, from its first node to its second (edge_nodes)
 };
+
+/// The area (m2) of the geodesic triangle abc (unit vectors of geodetic lon/lat, as
+/// vec_to_lonlat reads them) on WGS84, as GeographicLib's PolygonArea gives it (its absolute
+/// value): for tests and the writers' long sides.
+double polygon_area_m2(const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
 } // namespace globemesh::io

@@ -1,7 +1,9 @@
 // Direct chunk writes of a netCDF-4 file's compressed variables: see hdf5_chunks.hpp.
 #include "hdf5_chunks.hpp"
 
+#include <algorithm>
 #include <new>
+#include <type_traits>
 
 #include <libdeflate.h>
 
@@ -11,6 +13,19 @@
 namespace globemesh::io {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// HDF5's shuffle of m elements of `size` bytes from `in` into `size` planes of n bytes at
+/// `out`; `size` a std::integral_constant for the common sizes (its loops unrolled).
+template <class Size>
+void shuffle(const unsigned char *in, std::size_t m, std::size_t n, Size size, unsigned char *out) {
+    for (std::size_t i = 0; i < m; ++i)
+        for (std::size_t j = 0; j < size; ++j)
+            out[j * n + i] = in[i * size + j];
+}
+
+} // namespace
 
 ChunkEncoder::ChunkEncoder() : compressor_(libdeflate_alloc_compressor(1)) {
     if (!compressor_)
@@ -26,14 +41,20 @@ void ChunkEncoder::encode(const void *data, std::size_t rows, std::size_t chunk_
                           std::vector<unsigned char> &out) {
     const std::size_t bytes = chunk_rows * row_bytes, used = rows * row_bytes,
                       n = bytes / element_size;
-    // HDF5's shuffle: byte j of element i goes to j * n + i (n elements in the chunk).
-    shuffled_.assign(bytes, 0);
+    // HDF5's shuffle: byte j of element i goes to j * n + i (n elements in the chunk); the
+    // elements past `used` (a last chunk's) are zeros. Not zero-filled first: every byte is set.
+    shuffled_.resize(bytes);
     const auto *in = static_cast<const unsigned char *>(data);
-    for (std::size_t j = 0; j < element_size; ++j) {
-        unsigned char *to = shuffled_.data() + j * n;
-        for (std::size_t i = j, k = 0; i < used; i += element_size, ++k)
-            to[k] = in[i];
-    }
+    const std::size_t m = used / element_size;
+    if (element_size == 8)
+        shuffle(in, m, n, std::integral_constant<std::size_t, 8>{}, shuffled_.data());
+    else if (element_size == 4)
+        shuffle(in, m, n, std::integral_constant<std::size_t, 4>{}, shuffled_.data());
+    else
+        shuffle(in, m, n, element_size, shuffled_.data());
+    for (std::size_t j = 0; j < element_size; ++j)
+        std::fill(shuffled_.begin() + std::ptrdiff_t(j * n + m),
+                  shuffled_.begin() + std::ptrdiff_t((j + 1) * n), 0);
     out.resize(libdeflate_zlib_compress_bound(compressor_, bytes));
     out.resize(
         libdeflate_zlib_compress(compressor_, shuffled_.data(), bytes, out.data(), out.size()));

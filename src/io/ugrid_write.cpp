@@ -7,11 +7,9 @@
 // mesh_boundary_nodes, all 0-based with start_index written; "crs" for CF and MDAL. Nothing in
 // the file depends on the clock: the only date is the caller's history string.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <future>
 #include <optional>
 #include <set>
 #include <string>
@@ -307,8 +305,7 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
                 const TopologyVars &t, const FieldVars &fv, const UgridOptions &options) {
     const std::size_t nn = c.nn, nf = c.nf, ne = c.ne, nb = c.nb;
     // Every variable is computed block by block while it is written (NcBlockWriter::in_blocks):
-    // no table of the file is ever whole in memory. Beside the mesh and its topology, one helper
-    // table: the edges' area terms (GeodesicFaceAreas, 24 bytes a node).
+    // no table of the file is ever whole in memory, beside the mesh and its topology.
     auto centre = [&](std::size_t f) {
         return normalized(mesh.nodes[mesh.faces[f][0]] + mesh.nodes[mesh.faces[f][1]] +
                           mesh.nodes[mesh.faces[f][2]]);
@@ -317,20 +314,6 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
         const auto ends = topo.edge_nodes(e);
         return arc_midpoint(mesh.nodes[ends[0]], mesh.nodes[ends[1]]);
     };
-    // The edges' geodesic problems (GeodesicFaceAreas), the writer's largest computation, run in
-    // the background from here, while the variables before the face areas are computed and
-    // compressed.
-    std::atomic<bool> stop_solving{false};
-    auto solve_edges = [&topo, &stop_solving] {
-        return io::GeodesicFaceAreas(topo, &stop_solving);
-    };
-    std::future<io::GeodesicFaceAreas> areas_ahead = io::start_task(solve_edges);
-    // A failure or a cancel before the areas are taken stops their computation: the future's
-    // destructor waits for it (at 1e7 nodes, a minute).
-    struct StopOnExit {
-        std::atomic<bool> &stop;
-        ~StopOnExit() { stop = true; }
-    } stop_on_exit{stop_solving};
     w.put_rows<int, 3>(t.face_nodes, nf, [&](std::size_t f) {
         const auto &tri = mesh.faces[f];
         return std::array<int, 3>{int(tri[0]), int(tri[1]), int(tri[2])};
@@ -342,7 +325,7 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
     w.put_rows<int, 2>(t.edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
     {
         w.put_lonlat(t.coords[0], t.coords[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
-        const io::GeodesicFaceAreas areas = areas_ahead.get();
+        const io::GeodesicFaceAreas areas(topo);
         if (options.face_areas_m2)
             options.face_areas_m2->assign(nf, 0.0);
         // Face edges, face neighbours and face areas a block of faces at a time (face_edges): no
