@@ -271,7 +271,11 @@ double rings_area_km2(const std::vector<std::vector<LonLat>> &rings) {
 
 } // namespace coast_detail
 
-std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t max_issues) {
+namespace {
+
+/// check_boundary; the search for arcs that touch or cross only when `conflicts`.
+std::vector<BoundaryIssue> check_rings(const Boundary &boundary, std::size_t max_issues,
+                                       bool conflicts) {
     std::vector<BoundaryIssue> issues;
     auto add = [&](std::string what, long ring, long seg, long oring = -1, long oseg = -1) {
         if (issues.size() < max_issues)
@@ -296,11 +300,22 @@ std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t 
                 add("consecutive nodes are antipodal", r, i);
         }
     }
-    if (!issues.empty())
+    if (!issues.empty() || !conflicts)
         return issues;
     for (const auto &c : coast_detail::find_conflicts(rings, max_issues))
         add("arcs touch or cross", c.ring_a, c.seg_a, c.ring_b, c.seg_b);
     return issues;
+}
+
+} // namespace
+
+std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t max_issues) {
+    return check_rings(boundary, max_issues, true);
+}
+
+std::vector<BoundaryIssue> coast_detail::check_boundary_clear(const Boundary &boundary,
+                                                              std::size_t max_issues) {
+    return check_rings(boundary, max_issues, false);
 }
 
 double boundary_area_km2(const Boundary &boundary) {

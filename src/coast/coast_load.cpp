@@ -149,8 +149,9 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     }
     separate_pinches(out.rings);
     // 30 rounds shorten an arc 2^30 times: far past any bulge that snap rounding leaves room for.
-    out.arcs_split = coast_detail::split_conflicting_arcs(out.rings, 30);
-    auto issues = check_boundary(out.rings, 5);
+    bool clear = false;
+    out.arcs_split = coast_detail::split_conflicting_arcs(out.rings, 30, &clear);
+    auto issues = clear ? check_boundary_clear(out.rings, 5) : check_boundary(out.rings, 5);
     if (!issues.empty()) {
         const auto &is = issues.front();
         LonLat at = vec_to_lonlat(out.rings.rings[is.ring].nodes[std::max(is.segment, 0L)]);
