@@ -313,15 +313,13 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
     // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
     join_near(geos, polys, grid, joined, near_only);
     // Each group goes to GEOS as one collection: a polygon alone through GEOS's precision
-    // reducer, several through a snap-rounding union. Lone polygons go in batches (a valid
-    // MultiPolygon, as they are at least 2 cells apart) of at most batch_vertices vertices and
-    // batch_polygons polygons: GEOS's hot-pixel KdTree is balanced within a ring only, so a batch
-    // of many rings in spatial order (as a source lists its islands) makes it a deep list, and
-    // each query costs as much as the batch's rings. Groups are far enough apart (2 cells:
-    // rounding moves a vertex at most 0.71 cell) that rounding them apart cannot make them meet:
-    // each polygon comes out as it does alone, and the jobs run on every core, largest first.
+    // reducer, several through a snap-rounding union. Lone polygons go in batches of about
+    // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap
+    // rounding seeds a random generator through CPUID, which a virtual machine traps. Groups are
+    // far enough apart (2 cells: rounding moves a vertex at most 0.71 cell) that rounding them
+    // apart cannot make them meet. The batches and groups are snap-rounded on every core, the
+    // largest first, and join the output in a fixed order.
     constexpr std::size_t batch_vertices = 100'000;
-    constexpr std::size_t batch_polygons = 64;
     std::vector<std::vector<std::size_t>> groups(n);
     for (std::size_t i = 0; i < n; ++i)
         groups[find(i)].push_back(i);
@@ -341,7 +339,7 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
             lone.rings_in += rings_of(geos, polys[i].get());
             lone.vertices += static_cast<std::size_t>(vertices[i]);
             lone.polygons.push_back(std::move(polys[i]));
-            if (lone.vertices >= batch_vertices || lone.polygons.size() >= batch_polygons)
+            if (lone.vertices >= batch_vertices)
                 flush_lone();
             continue;
         }

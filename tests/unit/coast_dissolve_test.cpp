@@ -55,7 +55,7 @@ GeomPtr rounded(Geos &geos, const GEOSGeometry *g) {
 TEST(CoastDissolve, lone_polygons_come_out_as_geos_rounds_each_alone_in_their_order) {
     std::mt19937_64 rng(41);
     Geos geos;
-    const auto polygons = archipelago(700, rng); // several batches, on every core
+    const auto polygons = archipelago(6000, rng); // several batches, on every core
     const auto parts = geometries(geos, polygons);
     SnapCount count;
     const auto out = dissolve(geos, parts, snap_grid_deg, count);
