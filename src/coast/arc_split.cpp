@@ -38,7 +38,7 @@ Vec3 lonlat_midpoint(const Vec3 &a, const Vec3 &b) {
 
 } // namespace
 
-std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds) {
+std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds, bool *clear) {
     std::vector<const std::vector<Vec3> *> rings;
     for (const auto &r : boundary.rings)
         rings.push_back(&r.nodes);
@@ -50,9 +50,13 @@ std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds) {
     for (const auto &r : boundary.rings)
         budget += r.nodes.size();
     std::size_t added = 0;
-    for (int round = 0; round < max_rounds; ++round) {
+    if (clear)
+        *clear = false;
+    for (int round = 0; round <= max_rounds; ++round) {
         const std::vector<ArcPair> pairs = grid.conflicts();
-        if (pairs.empty())
+        if (clear)
+            *clear = pairs.empty();
+        if (pairs.empty() || round == max_rounds)
             break;
         std::vector<std::pair<std::uint32_t, std::uint32_t>> arcs; // (ring, arc) to split
         for (const auto &p : pairs) {

@@ -11,6 +11,7 @@
 #include <GeographicLib/PolygonArea.hpp>
 
 #include "coast_internal.hpp"
+#include "coast_parallel.hpp"
 #include "globemesh/coast.hpp"
 
 namespace globemesh {
@@ -246,15 +247,18 @@ double rings_area_km2(const std::vector<std::vector<LonLat>> &rings) {
     double earth = wgs.EllipsoidArea() * 1e-6;
     if (rings.empty())
         return earth;
-    double sum = 0;
-    for (const auto &ring : rings) {
+    // The rings on every core, summed in their order (the same sum on any number of threads).
+    std::vector<double> areas(rings.size());
+    parallel_for_each(rings.size(), [&](std::size_t r) {
         GeographicLib::PolygonArea poly(wgs, false);
-        for (const auto &p : ring)
+        for (const auto &p : rings[r])
             poly.AddPoint(p.lat, p.lon);
-        double perimeter, area;
-        poly.Compute(false, true, perimeter, area);
+        double perimeter;
+        poly.Compute(false, true, perimeter, areas[r]);
+    });
+    double sum = 0;
+    for (double area : areas)
         sum += area * 1e-6;
-    }
     double r = std::fmod(sum, earth);
     if (r < 0)
         r += earth;
@@ -267,7 +271,11 @@ double rings_area_km2(const std::vector<std::vector<LonLat>> &rings) {
 
 } // namespace coast_detail
 
-std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t max_issues) {
+namespace {
+
+/// check_boundary; the search for arcs that touch or cross only when `conflicts`.
+std::vector<BoundaryIssue> check_rings(const Boundary &boundary, std::size_t max_issues,
+                                       bool conflicts) {
     std::vector<BoundaryIssue> issues;
     auto add = [&](std::string what, long ring, long seg, long oring = -1, long oseg = -1) {
         if (issues.size() < max_issues)
@@ -292,22 +300,31 @@ std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t 
                 add("consecutive nodes are antipodal", r, i);
         }
     }
-    if (!issues.empty())
+    if (!issues.empty() || !conflicts)
         return issues;
     for (const auto &c : coast_detail::find_conflicts(rings, max_issues))
         add("arcs touch or cross", c.ring_a, c.seg_a, c.ring_b, c.seg_b);
     return issues;
 }
 
+} // namespace
+
+std::vector<BoundaryIssue> check_boundary(const Boundary &boundary, std::size_t max_issues) {
+    return check_rings(boundary, max_issues, true);
+}
+
+std::vector<BoundaryIssue> coast_detail::check_boundary_clear(const Boundary &boundary,
+                                                              std::size_t max_issues) {
+    return check_rings(boundary, max_issues, false);
+}
+
 double boundary_area_km2(const Boundary &boundary) {
-    std::vector<std::vector<LonLat>> rings;
-    for (const auto &ring : boundary.rings) {
-        std::vector<LonLat> ll;
-        ll.reserve(ring.nodes.size());
-        for (const auto &v : ring.nodes)
-            ll.push_back(vec_to_lonlat(v));
-        rings.push_back(std::move(ll));
-    }
+    std::vector<std::vector<LonLat>> rings(boundary.rings.size());
+    coast_detail::parallel_for_each(rings.size(), [&](std::size_t r) {
+        rings[r].reserve(boundary.rings[r].nodes.size());
+        for (const auto &v : boundary.rings[r].nodes)
+            rings[r].push_back(vec_to_lonlat(v));
+    });
     return coast_detail::rings_area_km2(rings);
 }
 

@@ -13,6 +13,7 @@
 
 #include "coast_internal.hpp"
 #include "coast_load_internal.hpp"
+#include "coast_parallel.hpp"
 #include "globemesh/error.hpp"
 
 namespace globemesh::coast_detail {
@@ -110,6 +111,43 @@ void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Group
             continue;
         near_only[j] = 1;
         parent[find(j)] = find(i);
+    }
+}
+
+std::size_t rings_of(Geos &geos, const GEOSGeometry *polygon) {
+    return std::size_t(1 + GEOSGetNumInteriorRings_r(geos.get(), polygon));
+}
+
+/// Polygons snap-rounded together: a group (one snap-rounding union) or a batch of lone ones
+/// (GEOS's precision reducer on their MultiPolygon).
+struct SnapJob {
+    bool group = false;
+    std::vector<GeomPtr> polygons; ///< taken by snap_job
+    std::size_t vertices = 0, rings_in = 0, rings_out = 0;
+    std::vector<GeomPtr> out; ///< the polygons it gave, owned in the caller's context
+};
+
+/// Runs a job in `geos` (a worker's context, or the caller's `owner`).
+void snap_job(Geos &geos, SnapJob &job, double grid, GEOSContextHandle_t owner) {
+    std::vector<GEOSGeometry *> raw;
+    for (auto &p : job.polygons)
+        raw.push_back(p.release());
+    job.polygons.clear();
+    GeomPtr all = own(geos,
+                      GEOSGeom_createCollection_r(
+                          geos.get(), job.group ? GEOS_GEOMETRYCOLLECTION : GEOS_MULTIPOLYGON,
+                          raw.data(), static_cast<unsigned>(raw.size())),
+                      "collect polygons");
+    GeomPtr snapped = job.group ? own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid),
+                                      "dissolve the land polygons")
+                                : own(geos, GEOSGeom_setPrecision_r(geos.get(), all.get(), grid, 0),
+                                      "snap-round the land");
+    std::vector<const GEOSGeometry *> ps;
+    polygons_of(geos, snapped.get(), ps);
+    for (const auto *p : ps) {
+        job.rings_out += rings_of(geos, p);
+        GeomPtr copy = own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon");
+        job.out.emplace_back(copy.release(), GeosDeleter{owner});
     }
 }
 
@@ -279,64 +317,57 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
     // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap
     // rounding seeds a random generator through CPUID, which a virtual machine traps. Groups are
     // far enough apart (2 cells: rounding moves a vertex at most 0.71 cell) that rounding them
-    // apart cannot make them meet.
+    // apart cannot make them meet. The batches and groups are snap-rounded on every core, the
+    // largest first, and join the output in a fixed order.
     constexpr std::size_t batch_vertices = 100'000;
     std::vector<std::vector<std::size_t>> groups(n);
     for (std::size_t i = 0; i < n; ++i)
         groups[find(i)].push_back(i);
-    std::vector<GeomPtr> out;
-    auto rings_of = [&](const GEOSGeometry *p) {
-        return std::size_t(1 + GEOSGetNumInteriorRings_r(geos.get(), p));
-    };
-    auto add_snapped = [&](GeomPtr snapped, std::size_t rings_in) {
-        std::vector<const GEOSGeometry *> ps;
-        polygons_of(geos, snapped.get(), ps);
-        std::size_t rings_out = 0;
-        for (const auto *p : ps) {
-            rings_out += rings_of(p);
-            out.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
-        }
-        count.changed += rings_out > rings_in ? rings_out - rings_in : rings_in - rings_out;
-    };
-    std::vector<GEOSGeometry *> lone;
-    std::size_t lone_vertices = 0, lone_rings = 0;
+    // Jobs in the order their results join the output: a group where it stands, a batch of lone
+    // polygons where it fills up (and the last one at the end).
+    std::vector<SnapJob> jobs;
+    SnapJob lone;
     auto flush_lone = [&] {
-        if (lone.empty())
-            return;
-        GeomPtr multi = own(geos,
-                            GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, lone.data(),
-                                                        static_cast<unsigned>(lone.size())),
-                            "collect polygons");
-        add_snapped(own(geos, GEOSGeom_setPrecision_r(geos.get(), multi.get(), grid, 0),
-                        "snap-round the land"),
-                    lone_rings);
-        lone.clear();
-        lone_vertices = lone_rings = 0;
+        if (!lone.polygons.empty())
+            jobs.push_back(std::move(lone));
+        lone = SnapJob{};
     };
     for (std::size_t i = 0; i < n; ++i) {
         if (groups[i].empty())
             continue;
         if (groups[i].size() == 1) {
-            lone_rings += rings_of(polys[i].get());
-            lone_vertices += static_cast<std::size_t>(vertices[i]);
-            lone.push_back(polys[i].release());
-            if (lone_vertices >= batch_vertices)
+            lone.rings_in += rings_of(geos, polys[i].get());
+            lone.vertices += static_cast<std::size_t>(vertices[i]);
+            lone.polygons.push_back(std::move(polys[i]));
+            if (lone.vertices >= batch_vertices)
                 flush_lone();
             continue;
         }
-        std::vector<GeomPtr> members;
-        std::size_t rings_in = 0;
+        SnapJob group;
+        group.group = true;
         for (std::size_t j : groups[i]) {
             count.joined += near_only[j];
-            rings_in += rings_of(polys[j].get());
-            members.push_back(std::move(polys[j]));
+            group.rings_in += rings_of(geos, polys[j].get());
+            group.vertices += static_cast<std::size_t>(vertices[j]);
+            group.polygons.push_back(std::move(polys[j]));
         }
-        GeomPtr all = make_collection(geos, members);
-        add_snapped(own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid),
-                        "dissolve the land polygons"),
-                    rings_in);
+        jobs.push_back(std::move(group));
     }
     flush_lone();
+    std::vector<std::size_t> sizes;
+    for (const auto &job : jobs)
+        sizes.push_back(job.vertices);
+    const std::vector<std::size_t> first = largest_first(sizes);
+    parallel_for_each_geos(
+        geos, jobs.size(), [&](Geos &g, std::size_t k) { snap_job(g, jobs[k], grid, geos.get()); },
+        &first);
+    std::vector<GeomPtr> out;
+    for (auto &job : jobs) {
+        count.changed += job.rings_out > job.rings_in ? job.rings_out - job.rings_in
+                                                      : job.rings_in - job.rings_out;
+        for (auto &p : job.out)
+            out.push_back(std::move(p));
+    }
     return out;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "globemesh/boundary.hpp"
+#include "globemesh/coast.hpp"
 #include "globemesh/sphere.hpp"
 
 namespace globemesh::coast_detail {
@@ -74,7 +75,12 @@ near_pairs(const std::vector<std::vector<std::vector<LonLat>>> &polygons, double
 /// Splits every arc that touches or crosses another at the midpoint of its lon/lat edge, and
 /// again for the halves that still do, for at most max_rounds rounds (arc_split.cpp). Returns
 /// the nodes added; conflicts that remain are the data's own (check_boundary reports them).
-std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds);
+/// `clear` (when given) is set to whether no arc touches or crosses another at the end.
+std::size_t split_conflicting_arcs(Boundary &boundary, int max_rounds, bool *clear = nullptr);
+
+/// check_boundary without its search for arcs that touch or cross, for a boundary that
+/// split_conflicting_arcs left clear: the same issues, without indexing every arc again.
+std::vector<BoundaryIssue> check_boundary_clear(const Boundary &boundary, std::size_t max_issues);
 
 /// Geodesic area (WGS84) to the left of all the closed lon/lat rings, km2 (sum of signed
 /// GeographicLib areas modulo the Earth's area); the whole Earth when there is no ring.

@@ -14,6 +14,7 @@
 
 #include "coast_internal.hpp"
 #include "coast_load_internal.hpp"
+#include "coast_parallel.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 
@@ -36,6 +37,33 @@ bool touches_pole(const PointList &ring) {
                        [](const LonLat &p) { return std::abs(p.lat) == 90.0; });
 }
 
+/// The source's polygons made valid and wrapped into +-180 (add_wrapped), on every core, in
+/// their order.
+std::vector<GeomPtr> valid_parts(Geos &geos, const std::vector<PolygonRings> &polygons) {
+    std::vector<std::vector<GeomPtr>> parts_of(polygons.size());
+    std::vector<std::size_t> sizes;
+    for (const auto &p : polygons)
+        sizes.push_back(p.front().size());
+    const std::vector<std::size_t> first = largest_first(sizes);
+    parallel_for_each_geos(
+        geos, polygons.size(),
+        [&](Geos &g, std::size_t i) {
+            GeomPtr p = make_polygon(g, polygons[i]);
+            if (GEOSisValid_r(g.get(), p.get()) != 1)
+                p = make_valid(g, p.get());
+            std::vector<GeomPtr> pieces;
+            add_wrapped(g, std::move(p), pieces);
+            for (auto &piece : pieces)
+                parts_of[i].emplace_back(piece.release(), GeosDeleter{geos.get()});
+        },
+        &first);
+    std::vector<GeomPtr> parts;
+    for (auto &pieces : parts_of)
+        for (auto &piece : pieces)
+            parts.push_back(std::move(piece));
+    return parts;
+}
+
 } // namespace
 
 CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes,
@@ -54,13 +82,7 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
 
     Geos geos;
     // Land: valid polygons, dissolved.
-    std::vector<GeomPtr> parts;
-    for (const auto &poly : src.polygons) {
-        GeomPtr g = make_polygon(geos, poly);
-        if (GEOSisValid_r(geos.get(), g.get()) != 1)
-            g = make_valid(geos, g.get());
-        add_wrapped(geos, std::move(g), parts);
-    }
+    std::vector<GeomPtr> parts = valid_parts(geos, src.polygons);
     if (!src.lines.empty())
         add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
     SnapCount snapped;
@@ -127,8 +149,9 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     }
     separate_pinches(out.rings);
     // 30 rounds shorten an arc 2^30 times: far past any bulge that snap rounding leaves room for.
-    out.arcs_split = coast_detail::split_conflicting_arcs(out.rings, 30);
-    auto issues = check_boundary(out.rings, 5);
+    bool clear = false;
+    out.arcs_split = coast_detail::split_conflicting_arcs(out.rings, 30, &clear);
+    auto issues = clear ? check_boundary_clear(out.rings, 5) : check_boundary(out.rings, 5);
     if (!issues.empty()) {
         const auto &is = issues.front();
         LonLat at = vec_to_lonlat(out.rings.rings[is.ring].nodes[std::max(is.segment, 0L)]);
