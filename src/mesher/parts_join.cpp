@@ -19,6 +19,18 @@ namespace {
 /// to rounding (1e-16), every other node is a boundary segment's length away.
 constexpr double on_border_tolerance = 1e-12;
 
+/// A node the parts' meshers split off a border node (0.64 m, a pinched strait) is this close
+/// to the border (radians): 6 m.
+constexpr double near_border_tolerance = 1e-6;
+
+/// Rounds of smoothing and flips over the nodes near the borders after the join (the parts'
+/// own improve stage runs four sweeps).
+constexpr int smoothing_rounds = 4;
+
+/// How far a node is moved into the second fan of faces at a border node (radians; 0.64 m, the
+/// mesher's own offset at a pinched strait): apart beyond mesh-verify's 1e-9 duplicates.
+constexpr double pinch_offset = 1e-7;
+
 using Edge = std::pair<NodeIndex, NodeIndex>;
 
 /// Appends part `m` to `out`: nodes of its boundary equal to one already there are that node.
@@ -54,8 +66,9 @@ void append_part(Mesh &m, std::map<std::array<double, 3>, NodeIndex> &border, Me
 }
 
 /// The nodes on each border, by latitude (z): of the open boundary edges, or all (`all`).
-std::vector<std::vector<std::pair<double, NodeIndex>>> border_nodes(const Mesh &mesh, int parts,
-                                                                    bool all = false) {
+std::vector<std::vector<std::pair<double, NodeIndex>>>
+border_nodes(const Mesh &mesh, int parts, bool all = false,
+             double tolerance = on_border_tolerance) {
     std::vector<std::vector<std::pair<double, NodeIndex>>> on(static_cast<std::size_t>(parts));
     std::vector<char> seen(mesh.nodes.size(), 0);
     auto add = [&](NodeIndex v) {
@@ -65,8 +78,8 @@ std::vector<std::vector<std::pair<double, NodeIndex>>> border_nodes(const Mesh &
         const Vec3 &p = mesh.nodes[v];
         for (int k = 0; k < parts; ++k) {
             const double lon = part_border_lon(k, parts) * deg_to_rad;
-            if (std::abs(-std::sin(lon) * p.x + std::cos(lon) * p.y) < on_border_tolerance &&
-                std::cos(lon) * p.x + std::sin(lon) * p.y > -on_border_tolerance)
+            if (std::abs(-std::sin(lon) * p.x + std::cos(lon) * p.y) < tolerance &&
+                std::cos(lon) * p.x + std::sin(lon) * p.y > -tolerance)
                 on[static_cast<std::size_t>(k)].push_back({p.z, v});
         }
     };
@@ -156,15 +169,7 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 /// Lawson flips of the edges near the borders whose opposite node lies inside the circumcircle
 /// (the borders were constrained in their parts, and a fan split leaves such edges): the faces of
 /// the border nodes' stars and of their neighbours', the joined mesh Delaunay there as inside.
-void flip_near_borders(Mesh &mesh, int parts) {
-    std::vector<char> zone(mesh.nodes.size(), 0); // 1: on a border, 2: a neighbour of one
-    for (const auto &list : border_nodes(mesh, parts, true))
-        for (const auto &x : list)
-            zone[x.second] = 1;
-    for (const auto &f : mesh.faces)
-        if (zone[f[0]] == 1 || zone[f[1]] == 1 || zone[f[2]] == 1)
-            for (NodeIndex v : f)
-                zone[v] = std::max<char>(zone[v], 2);
+void flip_near_borders(Mesh &mesh, const std::vector<char> &zone) {
     auto key = [](NodeIndex a, NodeIndex b) { return (std::uint64_t(a) << 32) | b; };
     std::unordered_map<std::uint64_t, std::uint32_t> face_of;
     std::vector<std::pair<NodeIndex, NodeIndex>> stack;
@@ -208,10 +213,122 @@ void flip_near_borders(Mesh &mesh, int parts) {
     }
 }
 
+/// Nodes near the borders: 1 on a border, 2 a neighbour of one, 0 elsewhere.
+std::vector<char> border_zone(const Mesh &mesh, int parts) {
+    std::vector<char> zone(mesh.nodes.size(), 0);
+    for (const auto &list : border_nodes(mesh, parts, true))
+        for (const auto &x : list)
+            zone[x.second] = 1;
+    for (const auto &f : mesh.faces)
+        if (zone[f[0]] == 1 || zone[f[1]] == 1 || zone[f[2]] == 1)
+            for (NodeIndex v : f)
+                zone[v] = zone[v] == 1 ? char{1} : char{2};
+    return zone;
+}
+
+/// Smoothing that crosses the borders (each part smoothed only its inside): sweeps over the
+/// free nodes near the borders, in index order, each moved to the mean of its neighbours where
+/// its star's worst quality rises and no face folds.
+void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone, int sweeps) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    std::map<NodeIndex, std::vector<std::uint32_t>> star; // ordered: the same sweep every run
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                star[v].push_back(f);
+    auto worst = [&](const std::vector<std::uint32_t> &faces) {
+        double q = 1;
+        for (std::uint32_t f : faces) {
+            const auto &t = mesh.faces[f];
+            const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+            q = predicates::orient(a, b, c) <= 0 ? -1 : std::min(q, triangle_quality(a, b, c));
+            if (q < 0)
+                break;
+        }
+        return q;
+    };
+    for (int sweep = 0; sweep < sweeps; ++sweep)
+        for (const auto &[v, faces] : star) {
+            Vec3 sum{0, 0, 0};
+            for (std::uint32_t f : faces)
+                for (NodeIndex u : mesh.faces[f])
+                    if (u != v)
+                        sum = sum + mesh.nodes[u];
+            const Vec3 old = mesh.nodes[v];
+            const double before = worst(faces);
+            mesh.nodes[v] = normalized(sum);
+            if (worst(faces) <= before)
+                mesh.nodes[v] = old;
+        }
+}
+
+/// Gives each fan of faces at a border node after the first a node of its own, moved
+/// pinch_offset into its fan (as the mesher's output does where a closed strait pinches the
+/// water): where the parts removed land on both sides of a border node, its faces form two fans.
+void split_pinched(Mesh &mesh, const std::vector<char> &zone) {
+    std::map<NodeIndex, std::vector<std::uint32_t>> star;
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] == 1)
+                star[v].push_back(f);
+    for (const auto &[v, faces] : star) {
+        // Faces sharing an edge at v are one fan (union-find over the star).
+        std::vector<std::size_t> root(faces.size());
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            root[i] = i;
+        auto find = [&](std::size_t i) {
+            while (root[i] != i)
+                i = root[i] = root[root[i]];
+            return i;
+        };
+        std::map<NodeIndex, std::size_t> by_neighbour;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            for (NodeIndex u : mesh.faces[faces[i]])
+                if (u != v) {
+                    const auto [it, added] = by_neighbour.emplace(u, i);
+                    if (!added)
+                        root[find(i)] = find(it->second);
+                }
+        std::map<std::size_t, std::vector<std::uint32_t>> fans;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            fans[find(i)].push_back(faces[i]);
+        if (fans.size() < 2)
+            continue;
+        for (auto it = std::next(fans.begin()); it != fans.end(); ++it) {
+            Vec3 toward{0, 0, 0};
+            for (std::uint32_t f : it->second)
+                for (NodeIndex u : mesh.faces[f])
+                    if (u != v)
+                        toward = toward + mesh.nodes[u];
+            const Vec3 &p = mesh.nodes[v];
+            const Vec3 step = normalized(normalized(toward) - p);
+            const auto copy = static_cast<NodeIndex>(mesh.nodes.size());
+            mesh.nodes.push_back(normalized(p + pinch_offset * step));
+            for (Field &field : mesh.node_fields)
+                field.values.push_back(field.values[v]);
+            std::set<Edge> fan_edges;
+            for (std::uint32_t f : it->second)
+                for (int i = 0; i < 3; ++i) {
+                    auto &t = mesh.faces[f];
+                    fan_edges.insert({t[i], t[(i + 1) % 3]});
+                }
+            for (BoundaryEdge &e : mesh.boundary)
+                if ((e.a == v || e.b == v) && fan_edges.count({e.a, e.b}))
+                    (e.a == v ? e.a : e.b) = copy;
+            for (std::uint32_t f : it->second)
+                for (NodeIndex &u : mesh.faces[f])
+                    if (u == v)
+                        u = copy;
+        }
+    }
+}
+
 /// The open edges left on a border (the other side's faces there were removed as land) are
-/// coast.
+/// coast; their nodes may lie up to near_border_tolerance off it (a node the mesher split).
 void tag_border_coast(Mesh &mesh, int parts) {
-    const auto on = border_nodes(mesh, parts);
+    const auto on = border_nodes(mesh, parts, false, near_border_tolerance);
     std::vector<int> border_of(mesh.nodes.size(), -1);
     for (std::size_t k = 0; k < on.size(); ++k)
         for (const auto &x : on[k])
@@ -250,8 +367,14 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
         if (!edges.count({e.b, e.a}))
             boundary.push_back(e);
     out.boundary.swap(boundary);
-    flip_near_borders(out, parts);
+    const std::vector<char> zone = border_zone(out, parts);
+    flip_near_borders(out, zone);
+    for (int round = 0; round < smoothing_rounds; ++round) {
+        smooth_near_borders(out, zone, 1);
+        flip_near_borders(out, zone);
+    }
     tag_border_coast(out, parts);
+    split_pinched(out, zone);
     return out;
 }
 
