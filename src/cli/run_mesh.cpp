@@ -25,22 +25,6 @@ namespace globemesh::cli {
 
 namespace {
 
-/// The configuration as the file keeps it: without the thread count, which never changes the
-/// mesh (the same bytes on any machine), and without the default single part (the files of
-/// before --parts).
-std::string file_configuration(const std::string &config) {
-    std::string out;
-    std::size_t start = 0;
-    while (start < config.size()) {
-        const std::size_t end = std::min(config.find('\n', start), config.size());
-        const std::string line = config.substr(start, end - start);
-        if (line.rfind("threads=", 0) != 0 && line != "parts=1")
-            out += line + (end < config.size() ? "\n" : "");
-        start = end + 1;
-    }
-    return out;
-}
-
 /// The checks run_cli makes before anything is opened: library validation, then the outputs'
 /// formats and paths. Returns the outputs to write.
 std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const Writer> table) {

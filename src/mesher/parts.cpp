@@ -41,7 +41,8 @@ private:
 
 /// The rings that bound some of the ocean mesh_boundary keeps (the largest component, or all
 /// with keep_inland_seas), told on the triangulation of the boundary nodes alone, as
-/// classify_ocean does; the components (of the whole ocean) go to report.components.
+/// classify_ocean does; the components (of the whole ocean) go to report.components. Throws
+/// DataError as mesh_boundary does when the node estimate passes max_nodes or max_memory.
 Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
                           const MesherOptions &options, MesherReport &report) {
     MesherReport local;
@@ -49,7 +50,9 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     const std::vector<VertexId> ids = insert_boundary(m, boundary);
     recover_segments(m, boundary, ids);
     classify_ocean(m, boundary, options);
+    estimate_nodes(m, options, false); // refused here as one part would be, before any part
     report.components = local.components;
+    report.estimated_nodes = local.estimated_nodes;
     Boundary kept;
     kept.dropped_islands = boundary.dropped_islands;
     std::size_t offset = 0;
@@ -186,8 +189,10 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
                                       shared.part(k), &times[k]);
     });
     t0 = Clock::now();
+    const std::size_t estimated = report.estimated_nodes;
     for (const MesherReport &r : reports)
         add_report(report, r);
+    report.estimated_nodes = estimated; // the whole ocean's, as one part counts it
     // Each stage's seconds summed over the parts (the parts ran at once: more than its wall time).
     if (timings) {
         StageTimings summed;
