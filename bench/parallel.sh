@@ -17,7 +17,7 @@ cat >"$work/aqua.geojson" <<'JSON'
 {"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[-150,0],[-148,0],[-148,2],[-150,2],[-150,0]]]}}]}
 JSON
 printf '%-7s %5s %-9s %9s %6s %7s %6s %5s %6s %7s %6s %7s %6s %s\n' case round run nodes mesh wall cpu \
-    load q_min q_mean q>0.8 fit_med fit_in verify
+    load q_min q_mean "q>0.8" fit_med fit_in verify
 for r in $(seq "$rounds"); do
     for c in aqua gshhg_l; do
         if [ $c = aqua ]; then args=(--coast "$work/aqua.geojson" --hmax 24km); else
