@@ -80,6 +80,10 @@ struct MeshingOptions {
     /// water is under the local size squared, 0..2; 0 keeps every inlet.
     double inlet_width = 0.5;
     std::uint64_t seed = 1; ///< seed of every pseudo-random choice
+    /// Parts meshed apart and joined (docs/parallel.md), 1..6: the mesh depends on it.
+    int parts = 1;
+    /// Threads meshing the parts at once, 0: one per core; the mesh never depends on it.
+    int threads = 0;
 };
 
 /// Every choice of a meshing run: the four modules' options together. Each field keeps its

@@ -1,4 +1,5 @@
 // The helpers of cli_common.hpp: CLI11 transforms and error wording, the history line.
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -127,6 +128,19 @@ std::string usage_text(const CLI::ParseError &e, const std::string &command) {
     if (dynamic_cast<const CLI::RequiredError *>(&e))
         return what + " (" + help + ")";
     return what;
+}
+
+std::string file_configuration(const std::string &config) {
+    std::string out;
+    std::size_t start = 0;
+    while (start < config.size()) {
+        const std::size_t end = std::min(config.find('\n', start), config.size());
+        const std::string line = config.substr(start, end - start);
+        if (line.rfind("threads=", 0) != 0 && line != "parts=1")
+            out += line + (end < config.size() ? "\n" : "");
+        start = end + 1;
+    }
+    return out;
 }
 
 /// The command line for the `history` attribute, with the date (UTC).

@@ -115,8 +115,8 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
     const auto t0 = std::chrono::steady_clock::now();
     OceanMesh run = mesh_and_check(o, progress, timings, result.stats);
     // The effective configuration travels with the mesh, as the command line's files carry it.
-    run.mesh.attributes.emplace_back("globemesh_configuration",
-                                     command.app.config_to_str(true, false));
+    run.mesh.attributes.emplace_back(
+        "globemesh_configuration", cli::file_configuration(command.app.config_to_str(true, false)));
     result.history = cli::history_text("mesh", args);
     cli::MeshRunSummary summary{o, {}, result.stats, run, timings, result.history};
     summary.total_s = cli::seconds_since(t0);

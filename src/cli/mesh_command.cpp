@@ -235,6 +235,14 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
     app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")
         ->group(mesher)
         ->type_name("N");
+    app.add_option("--parts", m.parts,
+                   "Mesh N lunes apart and join them (1..6; the mesh depends on N)")
+        ->group(mesher)
+        ->type_name("N");
+    app.add_option("--threads", m.threads,
+                   "Threads meshing the parts (0: one per core; never changes the mesh)")
+        ->group(mesher)
+        ->type_name("N");
 }
 
 void MeshCommand::add_output_options(std::span<const Writer> table, const std::string &output) {

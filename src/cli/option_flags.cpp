@@ -8,7 +8,7 @@ namespace globemesh::cli {
 namespace {
 
 /// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 36> flags{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 38> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},
     {"coast_where", "--coast-where"},
@@ -46,6 +46,8 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 36> flags{{
     {"inlet_width", "--inlet-width"},
     {"smooth_iterations", "--smooth"},
     {"seed", "--seed"},
+    {"parts", "--parts"},
+    {"threads", "--threads"},
 }};
 
 } // namespace

@@ -98,7 +98,7 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     add_mesh_total(timings);
     // The effective configuration travels with the mesh, so the file itself says how to remake it.
     mesh.attributes.emplace_back("globemesh_configuration",
-                                 command->app.config_to_str(true, false));
+                                 file_configuration(command->app.config_to_str(true, false)));
 
     if (o.check) {
         auto problems = check_mesh(mesh);

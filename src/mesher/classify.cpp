@@ -294,7 +294,7 @@ void mark_sharp_corners(Mesher &m) {
     }
 }
 
-void estimate_nodes(Mesher &m, const MesherOptions &options) {
+void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve) {
     SphericalDelaunay &dt = m.dt;
     MesherReport &report = m.report;
     std::size_t limit = options.max_nodes;
@@ -327,7 +327,8 @@ void estimate_nodes(Mesher &m, const MesherOptions &options) {
     // The triangulation's arrays sized once for the nodes to come (the estimate is within a few
     // per cent of the nodes made), instead of doubling through the lattice and the refinement:
     // each doubling copied them into new blocks and touched their pages again.
-    dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
+    if (reserve)
+        dt.reserve(report.estimated_nodes + report.estimated_nodes / 4);
 }
 
 } // namespace globemesh::mesher_internal

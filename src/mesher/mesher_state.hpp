@@ -458,7 +458,8 @@ void recover_segments(Mesher &m, const Boundary &boundary, const std::vector<Ver
 void classify_ocean(Mesher &m, const Boundary &boundary, const MesherOptions &options);
 void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report);
 void mark_sharp_corners(Mesher &m);
-void estimate_nodes(Mesher &m, const MesherOptions &options);
+// reserve: size the triangulation for them (not for a triangulation only counted, parts.cpp).
+void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve = true);
 void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const Vec3 &a,
                        const Vec3 &b, const Vec3 &c, double stop, double &sum);
 

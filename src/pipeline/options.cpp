@@ -5,6 +5,7 @@
 
 #include "globemesh/error.hpp"
 #include "globemesh/options.hpp"
+#include "globemesh/parts.hpp"
 
 namespace globemesh {
 
@@ -79,6 +80,11 @@ void validate_meshing(const MeshingOptions &o) {
             option("max_memory_bytes") + " must be 0 (no limit) or at least 1MB, e.g. 4GB");
     require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000,
             option("smooth_iterations") + " must be in 0..1000");
+    require(o.parts >= 1 && o.parts <= max_parts,
+            option("parts") + " must be in 1.." + std::to_string(max_parts) +
+                " (lunes meeting at the poles at 360 / N degrees)");
+    require(o.threads >= 0 && o.threads <= 1024,
+            option("threads") + " must be in 0..1024 (0: one per core)");
     require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,
             option("inlet_width") +
                 " must be in 0..2 (a fraction of the local edge length; 0 keeps every inlet)");

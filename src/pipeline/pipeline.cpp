@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "coast/geos_interrupt.hpp"
@@ -15,6 +16,7 @@
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/mesher.hpp"
+#include "globemesh/parts.hpp"
 #include "globemesh/sizefield.hpp"
 
 namespace globemesh {
@@ -263,7 +265,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     // Uniform when no component of the field is on: then no background grid is built.
     const SizeField field = build_size_field(
         size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
-        sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid, passages);
+        sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid, passages,
+        static_cast<std::size_t>(std::max(0, o.threads)));
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
     if (!field.is_uniform()) {
@@ -314,8 +317,10 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     MesherReport report;
     StageTimings mesher_times;
     auto mesh_start = Clock::now();
-    Mesh mesh = mesh_boundary(boundary, size, mo, &report, sub_progress(progress, 0.3, 0.97),
-                              &mesher_times);
+    const unsigned threads = o.threads > 0 ? static_cast<unsigned>(o.threads)
+                                           : std::max(1u, std::thread::hardware_concurrency());
+    Mesh mesh = mesh_parts(boundary, size, mo, o.parts, threads, &report,
+                           sub_progress(progress, 0.3, 0.97), &mesher_times);
     double mesh_seconds = std::chrono::duration<double>(Clock::now() - mesh_start).count();
     clock.restart();
     if (timings) {

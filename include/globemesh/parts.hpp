@@ -1,0 +1,50 @@
+// Parallel meshing (docs/parallel.md): the sphere split into `parts` lunes between meridians,
+// each border discretised first from the size field (the same nodes for both sides), every part
+// meshed by mesh_boundary on a thread of its own, and the parts joined in part order. The result
+// depends on the part count and the inputs, never on the thread count. One part is mesh_boundary
+// itself. Standard library only.
+#pragma once
+
+#include <vector>
+
+#include "globemesh/mesher.hpp"
+
+namespace globemesh {
+
+/// Most parts: the lunes meet at the poles at 360 / parts degrees, 60 (an equilateral
+/// triangle's corner) at 6.
+inline constexpr int max_parts = 6;
+
+/// The longitude (degrees) of border k of n parts: off the meridians where source data has
+/// vertices by construction (0, +-90, +-180).
+double part_border_lon(int k, int parts);
+
+/// The lune (0 .. parts - 1) holding p: between part_border_lon(k) and part_border_lon(k + 1).
+int part_of(const Vec3 &p, int parts);
+
+/// `boundary` cut into the rings of each part: each ring piece inside a part, joined along the
+/// part's borders by nodes spaced by size_km (open segments), a deterministic function of the
+/// border, the coast crossing it and the size field. An empty boundary (aqua-planet) gives each
+/// part its outline. `land` (may be null) tells whether a border no ring crosses is land. A part
+/// without ocean gets no rings and `has_ocean` false. Throws DataError when the rings do not
+/// alternate along a border (they do not close the ocean).
+struct PartBoundary {
+    Boundary boundary;
+    bool has_ocean = false;
+};
+std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km, int parts,
+                                         const LandTest *land);
+
+/// The part meshes joined: nodes equal on a border are one node, a border segment one side
+/// split is split on the other (a fan), boundary edges with their reverse become interior.
+Mesh join_parts(std::vector<Mesh> &parts_meshes, int parts);
+
+/// mesh_boundary over `parts` parts, meshed on up to `threads` threads (0: one) and joined;
+/// the inland seas are told on the whole boundary first (MesherOptions::keep_inland_seas), the
+/// rest per part. Reports and stage times are summed over the parts. Throws what mesh_boundary
+/// throws, the first in part order.
+Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOptions &options,
+                int parts, unsigned threads, MesherReport *report = nullptr,
+                const Progress &progress = {}, StageTimings *timings = nullptr);
+
+} // namespace globemesh

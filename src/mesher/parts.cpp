@@ -1,0 +1,217 @@
+// mesh_parts (docs/parallel.md, sections 4-8): the inland seas told on the whole boundary, the
+// parts meshed on threads (each part's mesh independent of the schedule, stored by part index),
+// then joined in part order (join_parts).
+#include "globemesh/parts.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "globemesh/error.hpp"
+#include "mesher_state.hpp"
+
+namespace globemesh {
+
+using namespace mesher_internal;
+
+namespace {
+
+/// The land test under a lock: LandMask caches its answers and shares one GEOS context, neither
+/// safe from two threads; its answers do not depend on the order of the calls.
+class LockedLand : public LandTest {
+public:
+    explicit LockedLand(std::shared_ptr<const LandTest> land) : land_(std::move(land)) {}
+    bool contains(const Vec3 &p) const override {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return land_->contains(p);
+    }
+    bool coast_within(const Vec3 &p, double angle) const override {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return land_->coast_within(p, angle);
+    }
+
+private:
+    std::shared_ptr<const LandTest> land_;
+    mutable std::mutex mutex_;
+};
+
+/// The rings that bound some of the ocean mesh_boundary keeps (the largest component, or all
+/// with keep_inland_seas), told on the triangulation of the boundary nodes alone, as
+/// classify_ocean does; the components (of the whole ocean) go to report.components. Throws
+/// DataError as mesh_boundary does when the node estimate passes max_nodes or max_memory.
+Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
+                          const MesherOptions &options, MesherReport &report) {
+    MesherReport local;
+    Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, local);
+    const std::vector<VertexId> ids = insert_boundary(m, boundary);
+    recover_segments(m, boundary, ids);
+    classify_ocean(m, boundary, options);
+    estimate_nodes(m, options, false); // refused here as one part would be, before any part
+    report.components = local.components;
+    report.estimated_nodes = local.estimated_nodes;
+    Boundary kept;
+    kept.dropped_islands = boundary.dropped_islands;
+    std::size_t offset = 0;
+    for (const Ring &r : boundary.rings) {
+        bool ocean = false, found = false;
+        for (std::size_t i = 0; i < r.nodes.size() && !found; ++i) {
+            const VertexId a = ids[offset + i], b = ids[offset + (i + 1) % r.nodes.size()];
+            const HalfEdge h = a == b ? no_half_edge : m.dt.find_edge(m.dt.leaving(a), b);
+            found = h != no_half_edge;
+            ocean = found && m.dt.label(triangle_of(h)) == mesher_internal::ocean;
+        }
+        if (ocean || !found)
+            kept.rings.push_back(r);
+        offset += r.nodes.size();
+    }
+    return kept;
+}
+
+/// Adds a part's report to the run's (counts summed, lists concatenated; not the components).
+void add_report(MesherReport &run, const MesherReport &part) {
+    auto append = [](auto &to, const auto &from) { to.insert(to.end(), from.begin(), from.end()); };
+    run.boundary_nodes += part.boundary_nodes;
+    run.segments_split += part.segments_split;
+    run.encroached_splits += part.encroached_splits;
+    run.estimated_nodes += part.estimated_nodes;
+    run.sharp_corners += part.sharp_corners;
+    run.sharp_corner_faces += part.sharp_corner_faces;
+    run.inlets_closed += part.inlets_closed;
+    run.inlet_area_km2 += part.inlet_area_km2;
+    run.lattice_nodes += part.lattice_nodes;
+    run.lattice_patched += part.lattice_patched;
+    run.island_centroids_moved += part.island_centroids_moved;
+    run.island_centroids_left += part.island_centroids_left;
+    run.valence_flips += part.valence_flips;
+    run.corners_mended += part.corners_mended;
+    run.corners_blunted += part.corners_blunted;
+    run.floor_nodes_removed += part.floor_nodes_removed;
+    run.floor_nodes_added += part.floor_nodes_added;
+    run.land_faces_removed += part.land_faces_removed;
+    run.land_faces_left += part.land_faces_left;
+    run.land_faces_nudged += part.land_faces_nudged;
+    append(run.land_faces_at, part.land_faces_at);
+    run.water_faces_removed += part.water_faces_removed;
+    run.land_holes += part.land_holes;
+    run.land_loops_joined += part.land_loops_joined;
+    run.straits_closed += part.straits_closed;
+    append(run.straits_closed_at, part.straits_closed_at);
+    append(run.straits_closed_width_km, part.straits_closed_width_km);
+    append(run.straits_closed_width_below_km, part.straits_closed_width_below_km);
+    append(run.seas_cut_off, part.seas_cut_off);
+    run.straits_water_km2 += part.straits_water_km2;
+    run.nodes_split += part.nodes_split;
+}
+
+/// The parts' progress as one: their mean fraction, reported under a lock (the caller's
+/// callback need not be thread-safe); once it asks to stop, every part stops.
+class SharedProgress {
+public:
+    SharedProgress(const Progress &parent, std::size_t parts)
+        : parent_(parent), fractions_(parts, 0.0) {}
+    Progress part(std::size_t k) {
+        return [this, k](double f, std::string_view stage) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            fractions_[k] = f;
+            double sum = 0;
+            for (double x : fractions_)
+                sum += x;
+            if (parent_ && !stop_ && !parent_(sum / double(fractions_.size()), stage))
+                stop_ = true;
+            return !stop_;
+        };
+    }
+
+private:
+    const Progress &parent_;
+    std::vector<double> fractions_;
+    std::mutex mutex_;
+    bool stop_ = false;
+};
+
+/// Runs work(k) for k in [0, count) on `threads` threads, each taking the next k; rethrows the
+/// first exception in k order once all have ended.
+template <class Work> void run_parts(std::size_t count, unsigned threads, Work work) {
+    std::vector<std::exception_ptr> errors(count);
+    std::atomic<std::size_t> next{0};
+    auto loop = [&] {
+        for (std::size_t k; (k = next++) < count;) {
+            try {
+                work(k);
+            } catch (...) {
+                errors[k] = std::current_exception();
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < std::min<std::size_t>(threads, count); ++t)
+        pool.emplace_back(loop);
+    loop();
+    for (auto &t : pool)
+        t.join();
+    for (auto &e : errors)
+        if (e)
+            std::rethrow_exception(e);
+}
+
+} // namespace
+
+Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOptions &options,
+                int parts, unsigned threads, MesherReport *report_out, const Progress &progress,
+                StageTimings *timings) {
+    if (parts <= 1)
+        return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
+    MesherReport local_report;
+    MesherReport &report = report_out ? *report_out : local_report;
+    report = MesherReport{};
+    auto t0 = Clock::now();
+    const Boundary kept = drop_inland_seas(boundary, size_km, options, report);
+    MesherOptions part_options = options;
+    part_options.keep_inland_seas = true; // a sea cut by a border is two components
+    if (options.land)
+        part_options.land = std::make_shared<LockedLand>(options.land);
+    const std::vector<PartBoundary> split =
+        split_boundary(kept, size_km, parts, options.land.get());
+    if (timings)
+        timings->add("split", seconds_since(t0));
+
+    std::vector<Mesh> meshes(split.size());
+    std::vector<MesherReport> reports(split.size());
+    std::vector<StageTimings> times(split.size());
+    SharedProgress shared(progress, split.size());
+    run_parts(split.size(), std::max(1u, threads), [&](std::size_t k) {
+        if (split[k].has_ocean)
+            meshes[k] = mesh_boundary(split[k].boundary, size_km, part_options, &reports[k],
+                                      shared.part(k), &times[k]);
+    });
+    t0 = Clock::now();
+    const std::size_t estimated = report.estimated_nodes;
+    for (const MesherReport &r : reports)
+        add_report(report, r);
+    report.estimated_nodes = estimated; // the whole ocean's, as one part counts it
+    // Each stage's seconds summed over the parts (the parts ran at once: more than its wall time).
+    if (timings) {
+        StageTimings summed;
+        for (const StageTimings &t : times)
+            for (const auto &stage : t.stages) {
+                auto it = std::find_if(summed.stages.begin(), summed.stages.end(),
+                                       [&](const auto &s) { return s.first == stage.first; });
+                if (it == summed.stages.end())
+                    summed.add(stage.first, stage.second);
+                else
+                    it->second += stage.second;
+            }
+        for (const auto &s : summed.stages)
+            timings->stages.push_back(s);
+    }
+    Mesh mesh = join_parts(meshes, parts);
+    if (timings)
+        timings->add("join", seconds_since(t0));
+    return mesh;
+}
+
+} // namespace globemesh

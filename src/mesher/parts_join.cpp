@@ -1,0 +1,381 @@
+// join_parts (docs/parallel.md, section 5): the part meshes as one mesh, border nodes merged,
+// border segments split on one side only split on the other, border edges made interior.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+#include "globemesh/error.hpp"
+#include "globemesh/parts.hpp"
+#include "globemesh/predicates.hpp"
+
+namespace globemesh {
+
+namespace {
+
+/// A node this close to a border's plane (radians) lies on the border: border nodes are on it
+/// to rounding (1e-16), every other node is a boundary segment's length away.
+constexpr double on_border_tolerance = 1e-12;
+
+/// A node the parts' meshers split off a border node (0.64 m, a pinched strait) is this close
+/// to the border (radians): 6 m.
+constexpr double near_border_tolerance = 1e-6;
+
+/// Rounds of smoothing and flips over the nodes near the borders after the join (the parts'
+/// own improve stage runs four sweeps).
+constexpr int smoothing_rounds = 4;
+
+/// How far a node is moved into the second fan of faces at a border node (radians; 0.64 m, the
+/// mesher's own offset at a pinched strait): apart beyond mesh-verify's 1e-9 duplicates.
+constexpr double pinch_offset = 1e-7;
+
+using Edge = std::pair<NodeIndex, NodeIndex>;
+
+/// Appends part `m` to `out`: nodes of its boundary equal to one already there are that node.
+void append_part(Mesh &m, std::map<std::array<double, 3>, NodeIndex> &border, Mesh &out) {
+    std::vector<char> open(m.nodes.size(), 0); // on the boundary: maybe on a border
+    for (const BoundaryEdge &e : m.boundary)
+        open[e.a] = open[e.b] = 1;
+    std::vector<NodeIndex> global_of(m.nodes.size());
+    for (std::size_t v = 0; v < m.nodes.size(); ++v) {
+        const Vec3 &p = m.nodes[v];
+        const auto index = static_cast<NodeIndex>(out.nodes.size());
+        if (open[v]) {
+            const auto [it, added] = border.emplace(std::array<double, 3>{p.x, p.y, p.z}, index);
+            if (!added) {
+                global_of[v] = it->second;
+                continue;
+            }
+        }
+        global_of[v] = index;
+        out.nodes.push_back(p);
+        for (std::size_t i = 0; i < out.node_fields.size(); ++i)
+            out.node_fields[i].values.push_back(m.node_fields[i].values[v]);
+    }
+    for (const auto &f : m.faces)
+        out.faces.push_back({global_of[f[0]], global_of[f[1]], global_of[f[2]]});
+    for (std::size_t i = 0; i < out.face_fields.size(); ++i)
+        out.face_fields[i].values.insert(out.face_fields[i].values.end(),
+                                         m.face_fields[i].values.begin(),
+                                         m.face_fields[i].values.end());
+    for (const BoundaryEdge &e : m.boundary)
+        out.boundary.push_back({global_of[e.a], global_of[e.b], e.tag});
+    m = Mesh{}; // its memory back before the next part is copied
+}
+
+/// The nodes on each border, by latitude (z): of the open boundary edges, or all (`all`).
+std::vector<std::vector<std::pair<double, NodeIndex>>>
+border_nodes(const Mesh &mesh, int parts, bool all = false,
+             double tolerance = on_border_tolerance) {
+    std::vector<std::vector<std::pair<double, NodeIndex>>> on(static_cast<std::size_t>(parts));
+    std::vector<char> seen(mesh.nodes.size(), 0);
+    auto add = [&](NodeIndex v) {
+        if (seen[v])
+            return;
+        seen[v] = 1;
+        const Vec3 &p = mesh.nodes[v];
+        for (int k = 0; k < parts; ++k) {
+            const double lon = part_border_lon(k, parts) * deg_to_rad;
+            if (std::abs(-std::sin(lon) * p.x + std::cos(lon) * p.y) < tolerance &&
+                std::cos(lon) * p.x + std::sin(lon) * p.y > -tolerance)
+                on[static_cast<std::size_t>(k)].push_back({p.z, v});
+        }
+    };
+    if (all)
+        for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
+            add(v);
+    else
+        for (const BoundaryEdge &e : mesh.boundary)
+            if (e.tag == EdgeTag::open)
+                add(e.a), add(e.b);
+    for (auto &list : on)
+        std::sort(list.begin(), list.end());
+    return on;
+}
+
+/// The nodes of the other side strictly inside each open edge on a border whose reverse is not
+/// in the mesh, in order from its start.
+std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, int parts) {
+    std::set<Edge> edges;
+    for (const BoundaryEdge &e : mesh.boundary)
+        edges.insert({e.a, e.b});
+    const auto on = border_nodes(mesh, parts);
+    std::map<Edge, std::vector<NodeIndex>> splits;
+    for (const BoundaryEdge &e : mesh.boundary) {
+        if (e.tag != EdgeTag::open || edges.count({e.b, e.a}))
+            continue;
+        for (const auto &list : on) {
+            auto has = [&](NodeIndex v) {
+                return std::any_of(list.begin(), list.end(),
+                                   [v](const auto &x) { return x.second == v; });
+            };
+            if (!has(e.a) || !has(e.b))
+                continue;
+            const double za = mesh.nodes[e.a].z, zb = mesh.nodes[e.b].z;
+            std::vector<NodeIndex> inside;
+            for (const auto &x : list)
+                if (x.first > std::min(za, zb) && x.first < std::max(za, zb))
+                    inside.push_back(x.second);
+            if (za > zb)
+                std::reverse(inside.begin(), inside.end());
+            if (!inside.empty())
+                splits[{e.a, e.b}] = inside;
+            break;
+        }
+    }
+    return splits;
+}
+
+/// Splits each face on an edge of `splits` into a fan at the edge's nodes, and the edge too.
+void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &splits) {
+    const std::size_t faces = mesh.faces.size();
+    for (std::size_t f = 0; f < faces; ++f)
+        for (int i = 0; i < 3; ++i) {
+            const auto face = mesh.faces[f];
+            const auto it = splits.find({face[i], face[(i + 1) % 3]});
+            if (it == splits.end())
+                continue;
+            const NodeIndex apex = face[(i + 2) % 3];
+            NodeIndex from = face[i];
+            std::vector<std::array<NodeIndex, 3>> fan;
+            for (NodeIndex v : it->second)
+                fan.push_back({from, v, apex}), from = v;
+            fan.push_back({from, face[(i + 1) % 3], apex});
+            mesh.faces[f] = fan[0];
+            for (std::size_t j = 1; j < fan.size(); ++j) {
+                mesh.faces.push_back(fan[j]);
+                for (Field &field : mesh.face_fields)
+                    field.values.push_back(field.values[f]);
+            }
+            break;
+        }
+    std::vector<BoundaryEdge> boundary;
+    for (const BoundaryEdge &e : mesh.boundary) {
+        const auto it = splits.find({e.a, e.b});
+        if (it == splits.end()) {
+            boundary.push_back(e);
+            continue;
+        }
+        NodeIndex from = e.a;
+        for (NodeIndex v : it->second)
+            boundary.push_back({from, v, e.tag}), from = v;
+        boundary.push_back({from, e.b, e.tag});
+    }
+    mesh.boundary.swap(boundary);
+}
+
+/// Lawson flips of the edges near the borders whose opposite node lies inside the circumcircle
+/// (the borders were constrained in their parts, and a fan split leaves such edges): the faces of
+/// the border nodes' stars and of their neighbours', the joined mesh Delaunay there as inside.
+void flip_near_borders(Mesh &mesh, const std::vector<char> &zone) {
+    auto key = [](NodeIndex a, NodeIndex b) { return (std::uint64_t(a) << 32) | b; };
+    std::unordered_map<std::uint64_t, std::uint32_t> face_of;
+    std::vector<std::pair<NodeIndex, NodeIndex>> stack;
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
+        const auto &t = mesh.faces[f];
+        if (!zone[t[0]] && !zone[t[1]] && !zone[t[2]])
+            continue;
+        for (int i = 0; i < 3; ++i) {
+            face_of[key(t[i], t[(i + 1) % 3])] = f;
+            stack.push_back({t[i], t[(i + 1) % 3]});
+        }
+    }
+    auto third = [&](std::uint32_t f, NodeIndex a, NodeIndex b) {
+        for (NodeIndex v : mesh.faces[f])
+            if (v != a && v != b)
+                return v;
+        return a;
+    };
+    using predicates::orient;
+    for (std::size_t budget = 20 * stack.size() + 100; !stack.empty() && budget > 0; --budget) {
+        const auto [a, b] = stack.back();
+        stack.pop_back();
+        const auto i1 = face_of.find(key(a, b)), i2 = face_of.find(key(b, a));
+        if (i1 == face_of.end() || i2 == face_of.end())
+            continue;
+        const std::uint32_t f1 = i1->second, f2 = i2->second;
+        const NodeIndex c = third(f1, a, b), d = third(f2, b, a);
+        const Vec3 &pa = mesh.nodes[a], &pb = mesh.nodes[b], &pc = mesh.nodes[c],
+                   &pd = mesh.nodes[d];
+        if (predicates::orient3d(pa, pb, pc, pd) <= 0 || orient(pa, pd, pc) <= 0 ||
+            orient(pd, pb, pc) <= 0)
+            continue;
+        mesh.faces[f1] = {a, d, c};
+        mesh.faces[f2] = {d, b, c};
+        face_of.erase(i1);
+        face_of.erase(key(b, a));
+        face_of[key(a, d)] = f1, face_of[key(d, c)] = f1, face_of[key(c, a)] = f1;
+        face_of[key(d, b)] = f2, face_of[key(b, c)] = f2, face_of[key(c, d)] = f2;
+        for (auto e : {std::pair{a, d}, std::pair{d, b}, std::pair{b, c}, std::pair{c, a}})
+            stack.push_back(e);
+    }
+}
+
+/// Nodes near the borders: 1 on a border, 2 a neighbour of one, 0 elsewhere.
+std::vector<char> border_zone(const Mesh &mesh, int parts) {
+    std::vector<char> zone(mesh.nodes.size(), 0);
+    for (const auto &list : border_nodes(mesh, parts, true))
+        for (const auto &x : list)
+            zone[x.second] = 1;
+    for (const auto &f : mesh.faces)
+        if (zone[f[0]] == 1 || zone[f[1]] == 1 || zone[f[2]] == 1)
+            for (NodeIndex v : f)
+                zone[v] = zone[v] == 1 ? char{1} : char{2};
+    return zone;
+}
+
+/// Smoothing that crosses the borders (each part smoothed only its inside): sweeps over the
+/// free nodes near the borders, in index order, each moved to the mean of its neighbours where
+/// its star's worst quality rises and no face folds.
+void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone, int sweeps) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    std::map<NodeIndex, std::vector<std::uint32_t>> star; // ordered: the same sweep every run
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                star[v].push_back(f);
+    auto worst = [&](const std::vector<std::uint32_t> &faces) {
+        double q = 1;
+        for (std::uint32_t f : faces) {
+            const auto &t = mesh.faces[f];
+            const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+            q = predicates::orient(a, b, c) <= 0 ? -1 : std::min(q, triangle_quality(a, b, c));
+            if (q < 0)
+                break;
+        }
+        return q;
+    };
+    for (int sweep = 0; sweep < sweeps; ++sweep)
+        for (const auto &[v, faces] : star) {
+            Vec3 sum{0, 0, 0};
+            for (std::uint32_t f : faces)
+                for (NodeIndex u : mesh.faces[f])
+                    if (u != v)
+                        sum = sum + mesh.nodes[u];
+            const Vec3 old = mesh.nodes[v];
+            const double before = worst(faces);
+            mesh.nodes[v] = normalized(sum);
+            if (worst(faces) <= before)
+                mesh.nodes[v] = old;
+        }
+}
+
+/// Gives each fan of faces at a border node after the first a node of its own, moved
+/// pinch_offset into its fan (as the mesher's output does where a closed strait pinches the
+/// water): where the parts removed land on both sides of a border node, its faces form two fans.
+void split_pinched(Mesh &mesh, const std::vector<char> &zone) {
+    std::map<NodeIndex, std::vector<std::uint32_t>> star;
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] == 1)
+                star[v].push_back(f);
+    for (const auto &[v, faces] : star) {
+        // Faces sharing an edge at v are one fan (union-find over the star).
+        std::vector<std::size_t> root(faces.size());
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            root[i] = i;
+        auto find = [&](std::size_t i) {
+            while (root[i] != i)
+                i = root[i] = root[root[i]];
+            return i;
+        };
+        std::map<NodeIndex, std::size_t> by_neighbour;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            for (NodeIndex u : mesh.faces[faces[i]])
+                if (u != v) {
+                    const auto [it, added] = by_neighbour.emplace(u, i);
+                    if (!added)
+                        root[find(i)] = find(it->second);
+                }
+        std::map<std::size_t, std::vector<std::uint32_t>> fans;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            fans[find(i)].push_back(faces[i]);
+        if (fans.size() < 2)
+            continue;
+        for (auto it = std::next(fans.begin()); it != fans.end(); ++it) {
+            Vec3 toward{0, 0, 0};
+            for (std::uint32_t f : it->second)
+                for (NodeIndex u : mesh.faces[f])
+                    if (u != v)
+                        toward = toward + mesh.nodes[u];
+            const Vec3 &p = mesh.nodes[v];
+            const Vec3 step = normalized(normalized(toward) - p);
+            const auto copy = static_cast<NodeIndex>(mesh.nodes.size());
+            mesh.nodes.push_back(normalized(p + pinch_offset * step));
+            for (Field &field : mesh.node_fields)
+                field.values.push_back(field.values[v]);
+            std::set<Edge> fan_edges;
+            for (std::uint32_t f : it->second)
+                for (int i = 0; i < 3; ++i) {
+                    auto &t = mesh.faces[f];
+                    fan_edges.insert({t[i], t[(i + 1) % 3]});
+                }
+            for (BoundaryEdge &e : mesh.boundary)
+                if ((e.a == v || e.b == v) && fan_edges.count({e.a, e.b}))
+                    (e.a == v ? e.a : e.b) = copy;
+            for (std::uint32_t f : it->second)
+                for (NodeIndex &u : mesh.faces[f])
+                    if (u == v)
+                        u = copy;
+        }
+    }
+}
+
+/// The open edges left on a border (the other side's faces there were removed as land) are
+/// coast; their nodes may lie up to near_border_tolerance off it (a node the mesher split).
+void tag_border_coast(Mesh &mesh, int parts) {
+    const auto on = border_nodes(mesh, parts, false, near_border_tolerance);
+    std::vector<int> border_of(mesh.nodes.size(), -1);
+    for (std::size_t k = 0; k < on.size(); ++k)
+        for (const auto &x : on[k])
+            border_of[x.second] = border_of[x.second] == -1 ? int(k) : -2; // -2: a pole
+    for (BoundaryEdge &e : mesh.boundary) {
+        const int ka = border_of[e.a], kb = border_of[e.b];
+        if (e.tag == EdgeTag::open && ka != -1 && kb != -1 && (ka == kb || ka == -2 || kb == -2))
+            e.tag = EdgeTag::coast;
+    }
+}
+
+} // namespace
+
+Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
+    Mesh out;
+    const auto first =
+        std::find_if(meshes.begin(), meshes.end(), [](const Mesh &m) { return !m.faces.empty(); });
+    if (first == meshes.end())
+        throw DataError("no ocean is left to mesh in any part");
+    for (const Field &f : first->node_fields)
+        out.node_fields.push_back({f.name, f.long_name, f.units, f.standard_name, {}});
+    for (const Field &f : first->face_fields)
+        out.face_fields.push_back({f.name, f.long_name, f.units, f.standard_name, {}});
+    out.attributes = first->attributes;
+    std::map<std::array<double, 3>, NodeIndex> border;
+    for (Mesh &m : meshes)
+        if (!m.faces.empty())
+            append_part(m, border, out);
+    split_faces(out, border_splits(out, parts));
+    // A boundary edge whose reverse is there too lies between two parts: interior now.
+    std::set<Edge> edges;
+    for (const BoundaryEdge &e : out.boundary)
+        edges.insert({e.a, e.b});
+    std::vector<BoundaryEdge> boundary;
+    for (const BoundaryEdge &e : out.boundary)
+        if (!edges.count({e.b, e.a}))
+            boundary.push_back(e);
+    out.boundary.swap(boundary);
+    const std::vector<char> zone = border_zone(out, parts);
+    flip_near_borders(out, zone);
+    for (int round = 0; round < smoothing_rounds; ++round) {
+        smooth_near_borders(out, zone, 1);
+        flip_near_borders(out, zone);
+    }
+    tag_border_coast(out, parts);
+    split_pinched(out, zone);
+    return out;
+}
+
+} // namespace globemesh

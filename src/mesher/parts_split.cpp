@@ -1,0 +1,330 @@
+// The boundary cut into lunes (docs/parallel.md, sections 1-3): crossings of the rings with the
+// border meridians, the borders' ocean stretches discretised from the size field, and each
+// part's rings joined from its ring pieces and border nodes (Weiler-Atherton on the sphere).
+#include "globemesh/parts.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "globemesh/error.hpp"
+
+namespace globemesh {
+
+namespace {
+
+/// A crossing within this fraction of h of a ring node replaces the node: no segment shorter.
+constexpr double snap_fraction = 0.1;
+/// The border's size-field integral is summed in steps of this fraction of h.
+constexpr double border_step_fraction = 0.125;
+/// A segment crossing two borders (near a pole) is halved at most this many times.
+constexpr int max_halvings = 40;
+
+Vec3 border_normal(int k, int n) { // east of the border: dot > 0
+    const double lon = part_border_lon(k, n) * deg_to_rad;
+    return {-std::sin(lon), std::cos(lon), 0};
+}
+
+Vec3 border_direction(int k, int n) { // the border's meridian at the equator
+    const double lon = part_border_lon(k, n) * deg_to_rad;
+    return {std::cos(lon), std::sin(lon), 0};
+}
+
+struct Crossing {
+    Vec3 p;
+    int border = 0;
+    bool east = false; // the ring goes east across the border (ocean to the north)
+};
+
+struct Node {
+    Vec3 p;
+    SegmentKind kind; // of the segment from this node
+    int crossing = -1;
+};
+
+struct Splitter {
+    int n;
+    const SizeFn &size_km;
+    std::vector<Crossing> crossings;
+
+    /// Where arc a-b crosses border k's meridian, if it does.
+    bool cross_border(const Vec3 &a, const Vec3 &b, int k, Vec3 &p) const {
+        const Vec3 normal = border_normal(k, n);
+        if ((dot(normal, a) > 0) == (dot(normal, b) > 0))
+            return false;
+        p = normalized(cross(cross(a, b), normal));
+        if (dot(p, a + b) < 0)
+            p = Vec3{-p.x, -p.y, -p.z};
+        return dot(p, border_direction(k, n)) > 0;
+    }
+
+    /// Appends to `out` the crossings of arc a-b (kind `kind`), halving it where it crosses
+    /// more than one border.
+    void split_segment(const Vec3 &a, const Vec3 &b, SegmentKind kind, int depth,
+                       std::vector<Node> &out) {
+        const int la = part_of(a, n), lb = part_of(b, n);
+        if (la == lb)
+            return;
+        const int east = (la + 1) % n, west = (la + n - 1) % n;
+        Vec3 p;
+        if (lb == east && cross_border(a, b, east, p)) {
+            crossings.push_back({p, east, true});
+        } else if (lb == west && cross_border(a, b, la, p)) {
+            crossings.push_back({p, la, false});
+        } else {
+            if (depth >= max_halvings)
+                throw DataError("parts: a coast segment near " +
+                                std::to_string(vec_to_lonlat(a).lon) + "," +
+                                std::to_string(vec_to_lonlat(a).lat) +
+                                " cannot be cut at a part border; use --parts 1");
+            const Vec3 mid = arc_midpoint(a, b);
+            split_segment(a, mid, kind, depth + 1, out);
+            out.push_back({mid, kind, -1});
+            split_segment(mid, b, kind, depth + 1, out);
+            return;
+        }
+        out.push_back({p, kind, static_cast<int>(crossings.size() - 1)});
+    }
+
+    /// The ring's nodes with its crossings inserted; ring nodes within snap_fraction * h of a
+    /// crossing dropped.
+    std::vector<Node> cut_ring(const Ring &r) {
+        std::vector<Node> nodes;
+        const std::size_t m = r.nodes.size();
+        for (std::size_t i = 0; i < m; ++i) {
+            nodes.push_back({r.nodes[i], r.kinds[i], -1});
+            split_segment(r.nodes[i], r.nodes[(i + 1) % m], r.kinds[i], 0, nodes);
+        }
+        std::vector<char> drop(nodes.size(), 0);
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            if (nodes[i].crossing < 0)
+                continue;
+            const double near = snap_fraction * km_to_rad(size_km(nodes[i].p));
+            const std::size_t m = nodes.size();
+            for (std::size_t step : {m - 1, std::size_t{1}}) {
+                // Only from a piece of three nodes or more: each piece keeps a node inside.
+                std::size_t run = 0;
+                while (run < 3 && nodes[(i + (run + 1) * step) % m].crossing < 0)
+                    ++run;
+                const std::size_t j = (i + step) % m;
+                if (run == 3 && arc_angle(nodes[i].p, nodes[j].p) < near)
+                    drop[j] = 1;
+            }
+        }
+        const bool too_few = nodes.size() - std::count(drop.begin(), drop.end(), 1) < 3;
+        std::vector<Node> kept;
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+            if (!drop[i] || too_few)
+                kept.push_back(nodes[i]);
+        return kept;
+    }
+
+    /// The nodes strictly between p and q (p south of q, both on border k's meridian), spaced
+    /// by equal shares of the integral of ds / h.
+    std::vector<Vec3> stretch_nodes(const Vec3 &p, const Vec3 &q, int k) const {
+        const double lon = part_border_lon(k, n) * deg_to_rad;
+        auto at = [&](double lat) {
+            return Vec3{std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon),
+                        std::sin(lat)};
+        };
+        const double lat0 = std::asin(std::clamp(p.z, -1.0, 1.0));
+        const double lat1 = std::asin(std::clamp(q.z, -1.0, 1.0));
+        std::vector<double> lats{lat0}, sums{0};
+        double inv = 1 / km_to_rad(size_km(p));
+        while (lats.back() < lat1) {
+            const double step = std::max(1e-9, border_step_fraction / inv); // radians of latitude
+            const double next = std::min(lat1, lats.back() + step);
+            const double inv_next = 1 / km_to_rad(size_km(next == lat1 ? q : at(next)));
+            sums.push_back(sums.back() + 0.5 * (inv + inv_next) * (next - lats.back()));
+            lats.push_back(next);
+            inv = inv_next;
+        }
+        const long pieces = std::max(1L, std::lround(sums.back()));
+        std::vector<Vec3> out;
+        std::size_t j = 1;
+        for (long i = 1; i < pieces; ++i) {
+            const double target = sums.back() * double(i) / double(pieces);
+            while (sums[j] < target)
+                ++j;
+            const double f = (target - sums[j - 1]) / (sums[j] - sums[j - 1]);
+            out.push_back(at(lats[j - 1] + f * (lats[j] - lats[j - 1])));
+        }
+        return out;
+    }
+
+    /// Border k's nodes from the south pole to the north: crossings, and the ocean stretches'
+    /// nodes with the poles where they are ocean.
+    std::vector<Node> border_nodes(int k, const LandTest *land) const {
+        std::vector<int> on;
+        for (std::size_t c = 0; c < crossings.size(); ++c)
+            if (crossings[c].border == k)
+                on.push_back(static_cast<int>(c));
+        std::sort(on.begin(), on.end(), [&](int a, int b) {
+            return crossings[a].p.z != crossings[b].p.z ? crossings[a].p.z < crossings[b].p.z
+                                                        : a < b;
+        });
+        const Vec3 south{0, 0, -1}, north{0, 0, 1};
+        bool ocean = on.empty() ? !(land && land->contains(border_direction(k, n)))
+                                : !crossings[on.front()].east;
+        std::vector<Node> out;
+        Vec3 from = south;
+        if (ocean)
+            out.push_back({south, SegmentKind::open, -1});
+        for (std::size_t i = 0; i <= on.size(); ++i) {
+            const Vec3 to = i < on.size() ? crossings[on[i]].p : north;
+            if (ocean)
+                for (const Vec3 &v : stretch_nodes(from, to, k))
+                    out.push_back({v, SegmentKind::open, -1});
+            if (i == on.size()) {
+                if (ocean)
+                    out.push_back({north, SegmentKind::open, -1});
+                break;
+            }
+            if (crossings[on[i]].east == ocean)
+                throw DataError("parts: the coast does not alternate between land and ocean along "
+                                "the part border at longitude " +
+                                std::to_string(part_border_lon(k, n)) +
+                                " (rings crossing); use --parts 1");
+            out.push_back({to, SegmentKind::open, on[i]});
+            ocean = crossings[on[i]].east;
+            from = to;
+        }
+        return out;
+    }
+};
+
+/// A ring's stretch inside one part, from an entry crossing to (not including) the exit.
+struct Piece {
+    int part = 0;
+    int exit = -1;
+    std::vector<Node> nodes;
+};
+
+/// The pieces of a ring cut at its crossings (at least one), each with its part.
+void cut_pieces(const std::vector<Node> &ring, int n, std::vector<Piece> &pieces,
+                std::vector<int> &piece_of_entry) {
+    std::size_t start = 0;
+    while (ring[start].crossing < 0)
+        ++start;
+    const std::size_t m = ring.size();
+    Piece piece;
+    for (std::size_t s = 0; s <= m; ++s) {
+        const Node &v = ring[(start + s) % m];
+        if (s > 0 && v.crossing >= 0) {
+            piece.exit = v.crossing;
+            const Vec3 inside =
+                piece.nodes.size() > 1 ? piece.nodes[1].p : arc_midpoint(piece.nodes[0].p, v.p);
+            piece.part = part_of(inside, n);
+            piece_of_entry[piece.nodes[0].crossing] = static_cast<int>(pieces.size());
+            pieces.push_back(std::move(piece));
+            piece = Piece{};
+        }
+        if (s < m)
+            piece.nodes.push_back(v);
+    }
+}
+
+/// Part k's outline with the part on its left: its east border south to north, its west border
+/// north to south (the poles once).
+std::vector<Node> part_outline(const std::vector<std::vector<Node>> &borders, int k, int n) {
+    std::vector<Node> loop = borders[(k + 1) % n];
+    auto is_pole = [](const Node &v) { return v.crossing < 0 && std::abs(v.p.z) == 1.0; };
+    const auto &west = borders[k];
+    for (auto it = west.rbegin(); it != west.rend(); ++it) {
+        const bool seen = !loop.empty() && ((is_pole(loop.back()) && loop.back().p.z == it->p.z) ||
+                                            (is_pole(loop.front()) && loop.front().p.z == it->p.z));
+        if (!(is_pole(*it) && seen))
+            loop.push_back(*it);
+    }
+    return loop;
+}
+
+/// Part k's rings from its pieces, each exit joined to the next entry along its outline.
+void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces,
+                 const std::vector<int> &piece_of_entry, int k, std::size_t crossing_count,
+                 Boundary &out) {
+    std::vector<int> position(crossing_count, -1);
+    for (std::size_t i = 0; i < loop.size(); ++i)
+        if (loop[i].crossing >= 0)
+            position[loop[i].crossing] = static_cast<int>(i);
+    std::vector<char> used(pieces.size(), 0);
+    for (std::size_t first = 0; first < pieces.size(); ++first) {
+        if (pieces[first].part != k || used[first])
+            continue;
+        Ring ring;
+        for (std::size_t p = first, guard = 0; !used[p]; ++guard) {
+            if (guard > pieces.size() || position[pieces[p].exit] < 0)
+                throw DataError("parts: a coast piece leaves its part where no border is; use "
+                                "--parts 1");
+            used[p] = 1;
+            for (const Node &v : pieces[p].nodes)
+                ring.nodes.push_back(v.p), ring.kinds.push_back(v.kind);
+            std::size_t i = static_cast<std::size_t>(position[pieces[p].exit]);
+            ring.nodes.push_back(loop[i].p), ring.kinds.push_back(SegmentKind::open);
+            for (i = (i + 1) % loop.size(); loop[i].crossing < 0; i = (i + 1) % loop.size())
+                ring.nodes.push_back(loop[i].p), ring.kinds.push_back(SegmentKind::open);
+            p = static_cast<std::size_t>(piece_of_entry[loop[i].crossing]);
+            if (pieces[p].part != k)
+                throw DataError("parts: the coast enters a part across a border it leaves; use "
+                                "--parts 1");
+        }
+        out.rings.push_back(std::move(ring));
+    }
+}
+
+} // namespace
+
+double part_border_lon(int k, int parts) {
+    return -90 + 0.0123456789 + 360.0 * k / parts;
+}
+
+int part_of(const Vec3 &p, int parts) {
+    double east = std::atan2(p.y, p.x) * rad_to_deg - part_border_lon(0, parts);
+    east -= 360 * std::floor(east / 360);
+    return std::min(parts - 1, static_cast<int>(east / (360.0 / parts)));
+}
+
+std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km, int parts,
+                                         const LandTest *land) {
+    Splitter s{parts, size_km, {}};
+    std::vector<PartBoundary> out(static_cast<std::size_t>(parts));
+    std::vector<std::vector<Node>> cut;
+    for (const Ring &r : boundary.rings) {
+        std::vector<Node> nodes = s.cut_ring(r);
+        if (std::none_of(nodes.begin(), nodes.end(),
+                         [](const Node &v) { return v.crossing >= 0; })) {
+            auto &b = out[static_cast<std::size_t>(part_of(nodes[0].p, parts))];
+            b.boundary.rings.push_back(r);
+            b.has_ocean = true;
+        } else {
+            cut.push_back(std::move(nodes));
+        }
+    }
+    std::vector<Piece> pieces;
+    std::vector<int> piece_of_entry(s.crossings.size(), -1);
+    for (const auto &nodes : cut)
+        cut_pieces(nodes, parts, pieces, piece_of_entry);
+    std::vector<std::vector<Node>> borders;
+    for (int k = 0; k < parts; ++k)
+        borders.push_back(s.border_nodes(k, land));
+    for (int k = 0; k < parts; ++k) {
+        const std::vector<Node> loop = part_outline(borders, k, parts);
+        auto &b = out[static_cast<std::size_t>(k)];
+        const bool crossed =
+            std::any_of(loop.begin(), loop.end(), [](const Node &v) { return v.crossing >= 0; });
+        if (crossed) {
+            join_pieces(loop, pieces, piece_of_entry, k, s.crossings.size(), b.boundary);
+        } else if (!loop.empty()) { // the whole outline is ocean
+            Ring ring;
+            for (const Node &v : loop)
+                ring.nodes.push_back(v.p), ring.kinds.push_back(SegmentKind::open);
+            b.boundary.rings.push_back(std::move(ring));
+        }
+        b.has_ocean = b.has_ocean || !loop.empty();
+    }
+    for (const auto &island : boundary.dropped_islands)
+        out[static_cast<std::size_t>(part_of(island[0], parts))].boundary.dropped_islands.push_back(
+            island);
+    return out;
+}
+
+} // namespace globemesh

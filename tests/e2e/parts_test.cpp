@@ -1,0 +1,131 @@
+// --parts and --threads (issue 41, docs/parallel.md): the sphere meshed in lunes and joined. The
+// joined mesh is one valid mesh (mesh-verify), the same bytes whatever the thread count, and
+// close to the single-part mesh of the same input; borders cut by the coast (Natural Earth)
+// and an aqua-planet (no ring crosses a border).
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "globemesh/error.hpp"
+#include "globemesh/parts.hpp"
+#include "globemesh/pipeline.hpp"
+#include "globemesh/ugrid.hpp"
+#include "support.hpp"
+
+namespace fs = std::filesystem;
+using namespace globemesh;
+using globemesh::test::expect_mesh_verify;
+using globemesh::test::fixture;
+using globemesh::test::TempDir;
+
+namespace {
+
+std::string bytes_of(const fs::path &p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+/// The run meshed and written to dir/name with a fixed history line (the CLI's holds the date).
+Mesh mesh_and_write(MeshOptions o, int parts, int threads, const fs::path &path) {
+    o.parts = parts;
+    o.threads = threads;
+    OceanMesh run = mesh_ocean(o);
+    UgridOptions w;
+    w.history = "parts_test";
+    w.overwrite = true;
+    write_ugrid(run.mesh, path, w);
+    return std::move(run.mesh);
+}
+
+/// Every edge between two faces once each way, every other edge a boundary edge (not open on a
+/// global run): the parts are one mesh with no border left.
+void expect_joined(const Mesh &mesh) {
+    std::set<std::pair<NodeIndex, NodeIndex>> edges;
+    for (const auto &f : mesh.faces)
+        for (int i = 0; i < 3; ++i)
+            EXPECT_TRUE(edges.insert({f[i], f[(i + 1) % 3]}).second) << "an edge twice";
+    std::size_t boundary = 0;
+    for (const auto &[a, b] : edges)
+        boundary += edges.count({b, a}) == 0;
+    EXPECT_EQ(boundary, mesh.boundary.size());
+    for (const BoundaryEdge &e : mesh.boundary)
+        EXPECT_NE(e.tag, EdgeTag::open) << "a border left as open boundary";
+}
+
+TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
+    const SizeFn h = [](const Vec3 &) { return 500.0; };
+    for (int parts : {2, 3, 6}) {
+        const auto split = split_boundary(Boundary{}, h, parts, nullptr);
+        ASSERT_EQ(split.size(), std::size_t(parts));
+        std::multiset<std::tuple<double, double, double>> nodes;
+        for (const auto &p : split) {
+            EXPECT_TRUE(p.has_ocean);
+            ASSERT_EQ(p.boundary.rings.size(), 1u);
+            for (const Vec3 &v : p.boundary.rings[0].nodes)
+                nodes.insert({v.x, v.y, v.z});
+        }
+        // Each border node (20000 km / 500 km: 40 pieces) in two outlines, the poles in all.
+        for (const auto &v : nodes) {
+            const bool pole = std::abs(std::get<2>(v)) == 1.0;
+            EXPECT_EQ(nodes.count(v), pole ? std::size_t(parts) : 2u);
+        }
+        EXPECT_EQ(nodes.size(), std::size_t(parts) * (2 * 39 + 2)) << parts;
+    }
+}
+
+TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
+    TempDir dir;
+    {
+        std::ofstream(dir / "island.geojson")
+            << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+               R"("geometry":{"type":"Polygon","coordinates":[[[-150,0],[-140,0],[-140,8],)"
+               R"([-150,8],[-150,0]]]}}]})";
+    }
+    MeshOptions o;
+    o.coast = (dir / "island.geojson").string();
+    o.hmax_km = 250;
+    const Mesh one = mesh_and_write(o, 1, 1, dir / "one.nc");
+    const Mesh a = mesh_and_write(o, 2, 1, dir / "a.nc");
+    mesh_and_write(o, 2, 2, dir / "b.nc");
+    EXPECT_EQ(bytes_of(dir / "a.nc"), bytes_of(dir / "b.nc"));
+    expect_mesh_verify(dir / "a.nc");
+    expect_joined(a);
+    EXPECT_NEAR(double(a.nodes.size()), double(one.nodes.size()), 0.03 * double(one.nodes.size()));
+}
+
+TEST(Parts, threads_give_the_same_bytes_natural_earth) {
+    TempDir dir;
+    MeshOptions o;
+    o.coast = fixture("coast/ne_110m_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = 150; // 2 parts: a border node in the Canadian Arctic with land on both sides
+    const Mesh one = mesh_and_write(o, 1, 1, dir / "one.nc");
+    for (int parts : {2, 5}) {
+        const Mesh a = mesh_and_write(o, parts, 1, dir / "a.nc");
+        mesh_and_write(o, parts, 3, dir / "b.nc");
+        EXPECT_EQ(bytes_of(dir / "a.nc"), bytes_of(dir / "b.nc")) << parts;
+        expect_mesh_verify(dir / "a.nc");
+        expect_joined(a);
+        EXPECT_NEAR(double(a.nodes.size()), double(one.nodes.size()),
+                    0.05 * double(one.nodes.size()))
+            << parts;
+    }
+}
+
+TEST(Parts, refuses_more_parts_than_the_poles_allow) {
+    MeshOptions o;
+    o.coast = fixture("coast/ne_110m_land.gpkg").string();
+    o.parts = 7;
+    EXPECT_THROW(validate(o), UsageError);
+    o.parts = 0;
+    EXPECT_THROW(validate(o), UsageError);
+    o.parts = 2;
+    o.threads = -1;
+    EXPECT_THROW(validate(o), UsageError);
+}
+
+} // namespace
