@@ -27,6 +27,15 @@ constexpr double near_border_tolerance = 1e-6;
 /// own improve stage runs four sweeps).
 constexpr int smoothing_rounds = 4;
 
+/// The rings of nodes around a border that the join smooths and flips (the border's own
+/// included): the parts' faces against a border reach two rings in.
+constexpr char zone_rings = 3;
+
+/// A node near a border whose star's worst face is below this quality gets a pattern search
+/// (search_node) of search_steps steps.
+constexpr double search_below = 0.9;
+constexpr int search_steps = 16;
+
 /// How far a node is moved into the second fan of faces at a border node (radians; 0.64 m, the
 /// mesher's own offset at a pinched strait): apart beyond mesh-verify's 1e-9 duplicates.
 constexpr double pinch_offset = 1e-7;
@@ -213,22 +222,66 @@ void flip_near_borders(Mesh &mesh, const std::vector<char> &zone) {
     }
 }
 
-/// Nodes near the borders: 1 on a border, 2 a neighbour of one, 0 elsewhere.
+/// Nodes near the borders: 1 on a border, k + 1 k rings of faces away (k < zone_rings), 0
+/// elsewhere.
 std::vector<char> border_zone(const Mesh &mesh, int parts) {
     std::vector<char> zone(mesh.nodes.size(), 0);
     for (const auto &list : border_nodes(mesh, parts, true))
         for (const auto &x : list)
             zone[x.second] = 1;
-    for (const auto &f : mesh.faces)
-        if (zone[f[0]] == 1 || zone[f[1]] == 1 || zone[f[2]] == 1)
-            for (NodeIndex v : f)
-                zone[v] = zone[v] == 1 ? char{1} : char{2};
+    for (char ring = 1; ring < zone_rings; ++ring)
+        for (const auto &f : mesh.faces)
+            if (zone[f[0]] == ring || zone[f[1]] == ring || zone[f[2]] == ring)
+                for (NodeIndex v : f)
+                    if (!zone[v])
+                        zone[v] = static_cast<char>(ring + 1);
     return zone;
+}
+
+/// The worst quality of `faces`, -1 when one of them is folded.
+double worst_quality(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
+    double q = 1;
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+        if (predicates::orient(a, b, c) <= 0)
+            return -1;
+        q = std::min(q, triangle_quality(a, b, c));
+    }
+    return q;
+}
+
+/// A pattern search for the place of v where its star's worst face is best (as the mesher's
+/// quality rounds do inside a part): steps along two tangent directions from a fifth of the
+/// mean edge, halved whenever none of the four raises the worst face.
+void search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &faces) {
+    double length = 0;
+    for (std::uint32_t f : faces)
+        for (NodeIndex u : mesh.faces[f])
+            length += norm(mesh.nodes[u] - mesh.nodes[v]);
+    double step = 0.2 * length / (2.0 * static_cast<double>(faces.size()));
+    double best = worst_quality(mesh, faces);
+    for (int k = 0; k < search_steps; ++k) {
+        const Vec3 base = mesh.nodes[v];
+        const Vec3 t1 = normalized(
+            cross(base, std::abs(base.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+        const Vec3 t2 = cross(base, t1);
+        Vec3 best_place = base;
+        for (const Vec3 &d : {t1, -t1, t2, -t2}) {
+            mesh.nodes[v] = normalized(base + step * d);
+            if (const double q = worst_quality(mesh, faces); q > best)
+                best = q, best_place = mesh.nodes[v];
+        }
+        mesh.nodes[v] = best_place;
+        if (best_place == base)
+            step *= 0.5;
+    }
 }
 
 /// Smoothing that crosses the borders (each part smoothed only its inside): sweeps over the
 /// free nodes near the borders, in index order, each moved to the mean of its neighbours where
-/// its star's worst quality rises and no face folds.
+/// its star's worst quality rises and no face folds, then searched for a better place where its
+/// star's worst face is still below search_below.
 void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone, int sweeps) {
     std::vector<char> fixed(mesh.nodes.size(), 0);
     for (const BoundaryEdge &e : mesh.boundary)
@@ -238,17 +291,6 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone, int sweeps) 
         for (NodeIndex v : mesh.faces[f])
             if (zone[v] && !fixed[v])
                 star[v].push_back(f);
-    auto worst = [&](const std::vector<std::uint32_t> &faces) {
-        double q = 1;
-        for (std::uint32_t f : faces) {
-            const auto &t = mesh.faces[f];
-            const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
-            q = predicates::orient(a, b, c) <= 0 ? -1 : std::min(q, triangle_quality(a, b, c));
-            if (q < 0)
-                break;
-        }
-        return q;
-    };
     for (int sweep = 0; sweep < sweeps; ++sweep)
         for (const auto &[v, faces] : star) {
             Vec3 sum{0, 0, 0};
@@ -257,10 +299,12 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone, int sweeps) 
                     if (u != v)
                         sum = sum + mesh.nodes[u];
             const Vec3 old = mesh.nodes[v];
-            const double before = worst(faces);
+            const double before = worst_quality(mesh, faces);
             mesh.nodes[v] = normalized(sum);
-            if (worst(faces) <= before)
+            if (worst_quality(mesh, faces) <= before)
                 mesh.nodes[v] = old;
+            if (worst_quality(mesh, faces) < search_below)
+                search_node(mesh, v, faces);
         }
 }
 
