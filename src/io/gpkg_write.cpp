@@ -437,8 +437,8 @@ void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
                  std::vector<io::RtreeBox> &boxes) {
     const Field *depth = l.depth, *size = l.size;
     const std::vector<const Field *> &face_fields = l.face_fields;
-    // The face areas as the UGRID file has them: those write_ugrid gave, else each edge's
-    // geodesic problem solved once here, on every core (freed before the nodes).
+    // The face areas as the UGRID file has them: those write_ugrid gave, else computed face by
+    // face as it does (face_area.hpp: the authalic sphere and a term per side).
     const std::vector<double> *given = options.face_areas_m2;
     if (given && given->size() != mesh.faces.size())
         given = nullptr;
