@@ -20,6 +20,7 @@
 #include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_summary.hpp"
+#include "mesh_topology.hpp"
 
 namespace globemesh::cli {
 
@@ -109,7 +110,8 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     }
 
     // Computed once for the report and the writers (each would otherwise build the topology
-    // again for it).
+    // again for it), on the topology the writers then share.
+    const io::SharedTopology shared(mesh);
     const MeshStats stats = lib.compute_stats(mesh);
     // Every output of the run waits under its temporary name until all are complete.
     OutputBatch batch;

@@ -93,7 +93,8 @@ void ring_types(std::vector<NodeString> &rings, bool regional, const std::vector
 }
 
 BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p) {
-    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto topology = io::topology_of(mesh);
+    const io::MeshTopology &topo = *topology;
     const auto is_open = [&](std::size_t e) { return topo.boundary_tags[e] == int(EdgeTag::open); };
     BoundaryStrings s;
     std::vector<NodeString> rings;

@@ -262,7 +262,8 @@ void write_as_dflowfm(const Mesh &mesh, const fs::path &path, const WriteOptions
         throw DataError("mesh: no faces to write to " + path.string());
     const Placement at = place_nodes(mesh, options, path); // its refusals before any file
     OutputFile out(path, options.overwrite, what);
-    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto topology = io::topology_of(mesh);
+    const io::MeshTopology &topo = *topology;
     io::NcHandle nc;
     nc.create(out.temp_path(), NC_NOCLOBBER | NC_64BIT_OFFSET, path, what);
     int old_fill;

@@ -111,7 +111,8 @@ bool make_folder(const fs::path &folder) {
 
 /// 0 interior, 1 coast, 2 open: the FESOM2 flag of each node, from the boundary edges' tags.
 std::vector<unsigned char> node_flags(const Mesh &mesh) {
-    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto topology = io::topology_of(mesh);
+    const io::MeshTopology &topo = *topology;
     std::vector<unsigned char> flags(mesh.nodes.size(), 0);
     for (std::size_t i = 0; i < topo.boundary_edges.size(); ++i) {
         const unsigned char flag = topo.boundary_tags[i] == int(EdgeTag::open) ? 2 : 1;

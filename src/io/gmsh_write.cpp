@@ -313,7 +313,8 @@ void write_as_gmsh(const Mesh &mesh, const fs::path &path, const WriteOptions &o
     if (!options.output_srs.empty())
         xy = io::model_coordinates(mesh, options.output_srs, "gmsh output " + path.string());
     OutputFile out(path, options.overwrite, "gmsh output");
-    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto topology = io::topology_of(mesh);
+    const io::MeshTopology &topo = *topology;
     {
         MshStream stream(out.temp_path(), path);
         MshWriter(mesh, topo, choices, xy ? &*xy : nullptr, stream, options.progress).write();

@@ -701,11 +701,12 @@ void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgO
         throw DataError("mesh: no faces to write to " + path.string());
     OutputFile out(path, options.overwrite, "GeoPackage output");
     // The topology (about 50 bytes a node) serves the statistics, the boundary's runs and the
-    // faces' areas and edges, and goes once the faces are written: held to the end, it made the
+    // faces' areas and edges, and goes once the faces are written (write_outputs lets the last
+    // writer hold it alone): held to the end, it made the
     // spatial indexes' step the process's peak at 20 km (242.7 MiB, 218.5 without).
-    io::MeshTopology topo = io::build_topology(mesh);
-    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
-    const std::vector<BoundaryRun> runs = boundary_runs(topo);
+    std::shared_ptr<const io::MeshTopology> topo = io::topology_of(mesh);
+    const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, *topo);
+    const std::vector<BoundaryRun> runs = boundary_runs(*topo);
 
     // Each spatial layer's feature boxes, for its index (gpkg_rtree.hpp).
     std::vector<io::RtreeLayer> indexes = {
@@ -715,10 +716,10 @@ void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgO
     // The faces' and nodes' rows and every index in one SQLite transaction: a failure or a
     // cancel anywhere before its end leaves a file that OutputFile deletes.
     io::GpkgSqlite db(out.temp_path(), path);
-    write_faces(db, faces, mesh, topo, options, indexes[0].boxes);
+    write_faces(db, faces, mesh, *topo, options, indexes[0].boxes);
     if (options.face_areas_m2)
         std::vector<double>().swap(*options.face_areas_m2); // not needed any more
-    topo = io::MeshTopology{};
+    topo.reset(); // freed here unless an earlier stage still shares it (SharedTopology)
     if (detail::after_partial_write)
         detail::after_partial_write(); // tests only (write_hooks.hpp)
     write_nodes(db, mesh, options, indexes[1].boxes);

@@ -163,7 +163,7 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
 } // namespace io
 
 MeshStats compute_stats(const Mesh &mesh) {
-    return io::compute_stats(mesh, io::build_topology(mesh));
+    return io::compute_stats(mesh, *io::topology_of(mesh));
 }
 
 } // namespace globemesh

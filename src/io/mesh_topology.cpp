@@ -2,6 +2,7 @@
 #include "mesh_topology.hpp"
 
 #include <algorithm>
+#include <mutex>
 #include <numeric>
 #include <string>
 
@@ -16,6 +17,67 @@ std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
     return (std::uint64_t(a) << 32) | b;
 }
 } // namespace
+
+namespace {
+// The one topology a SharedTopology scope shares: its mesh, the topology kept (or, after
+// let_go, only watched).
+struct TopologySlot {
+    std::mutex mutex;
+    const Mesh *mesh = nullptr;
+    std::shared_ptr<const MeshTopology> kept;
+    std::weak_ptr<const MeshTopology> watched;
+    bool holding = true;
+};
+TopologySlot &slot() {
+    static TopologySlot s;
+    return s;
+}
+} // namespace
+
+std::shared_ptr<const MeshTopology> topology_of(const Mesh &mesh) {
+    TopologySlot &s = slot();
+    const std::lock_guard<std::mutex> lock(s.mutex);
+    if (s.mesh != &mesh)
+        return std::make_shared<const MeshTopology>(build_topology(mesh));
+    if (auto alive = s.watched.lock()) {
+        if (!s.holding)
+            s.kept.reset(); // let go: this caller holds it alone now
+        return alive;
+    }
+    auto built = std::make_shared<const MeshTopology>(build_topology(mesh));
+    s.watched = built;
+    if (s.holding)
+        s.kept = built;
+    return built;
+}
+
+SharedTopology::SharedTopology(const Mesh &mesh) {
+    TopologySlot &s = slot();
+    const std::lock_guard<std::mutex> lock(s.mutex);
+    if (s.mesh)
+        return; // an outer scope (of this mesh or another) has the slot
+    s.mesh = &mesh;
+    s.holding = true;
+    owner_ = true;
+}
+
+SharedTopology::~SharedTopology() {
+    if (!owner_)
+        return;
+    TopologySlot &s = slot();
+    const std::lock_guard<std::mutex> lock(s.mutex);
+    s.mesh = nullptr;
+    s.kept.reset();
+    s.watched.reset();
+}
+
+void SharedTopology::let_go(const Mesh &mesh) {
+    TopologySlot &s = slot();
+    const std::lock_guard<std::mutex> lock(s.mutex);
+    if (s.mesh != &mesh)
+        return;
+    s.holding = false; // the next topology_of takes the slot's pointer over
+}
 
 MeshTopology build_topology(const Mesh &mesh) {
     const std::size_t nf = mesh.faces.size(), nn = mesh.nodes.size();

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,29 @@ struct MeshTopology {
 /// edge shared by more than two faces. Boundary edges take their tag from mesh.boundary (matched
 /// by node pair); untagged boundary edges are coast.
 MeshTopology build_topology(const Mesh &mesh);
+
+/// The topology of `mesh` for a writer or the statistics: while a SharedTopology of this same
+/// mesh is alive, the one it keeps (built at the first call), otherwise built anew. The caller
+/// may drop its pointer early to free the memory when nothing else holds it.
+std::shared_ptr<const MeshTopology> topology_of(const Mesh &mesh);
+
+/// While alive, every topology_of(mesh) of the mesh it names returns one topology, built once:
+/// the CLI's statistics and each writer of a run share it (one at a time per process; an inner
+/// scope of the same mesh joins the outer one). The mesh must not change while it lives.
+class SharedTopology {
+public:
+    explicit SharedTopology(const Mesh &mesh);
+    ~SharedTopology();
+    SharedTopology(const SharedTopology &) = delete;
+    SharedTopology &operator=(const SharedTopology &) = delete;
+    /// Keeps the topology of `mesh` (when a scope shares it) only until the next topology_of,
+    /// whose caller then holds it alone (called before the last writer, which can then free it
+    /// early).
+    static void let_go(const Mesh &mesh);
+
+private:
+    bool owner_ = false; // this scope made the process's slot (an inner one did not)
+};
 
 /// The edges of faces first .. first + count - 1: out[3 * i + k] is the edge joining nodes k and
 /// k+1 of face first + i, found among the edges of the side's smaller node.

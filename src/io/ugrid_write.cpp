@@ -388,7 +388,8 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
 void write_ugrid(const Mesh &mesh, const std::filesystem::path &path, const UgridOptions &options) {
     check_fields(mesh, path);
     OutputFile out(path, options.overwrite, "UGRID output");
-    const io::MeshTopology topo = io::build_topology(mesh);
+    const auto topology = io::topology_of(mesh);
+    const io::MeshTopology &topo = *topology;
     const MeshStats stats = options.stats ? *options.stats : io::compute_stats(mesh, topo);
     const Counts counts{mesh.nodes.size(), mesh.faces.size(), topo.edge_count(),
                         topo.boundary_edges.size()};

@@ -8,6 +8,7 @@
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
+#include "mesh_topology.hpp"
 
 namespace globemesh {
 
@@ -276,7 +277,12 @@ void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
     for (auto &o : checked)
         check_creation_options(*o.writer, o.creation_options, o.path.string());
     check_output_srs(common.output_srs, checked);
+    // The writers share one topology (and the caller's statistics, when it made them in a scope
+    // of its own); the last writer holds it alone, so it can free it early.
+    const io::SharedTopology shared(mesh);
     for (const auto &o : checked) {
+        if (&o == &checked.back())
+            io::SharedTopology::let_go(mesh);
         WriteOptions options = common;
         options.creation_options = o.creation_options;
         if (!takes_output_srs(o))
