@@ -112,7 +112,9 @@ int run_mesh(std::span<const std::string> args, std::ostream &out, std::ostream 
     // Computed once for the report and the writers (each would otherwise build the topology
     // again for it), on the topology the writers then share.
     const io::SharedTopology shared(mesh);
+    const auto stats_start = std::chrono::steady_clock::now();
     const MeshStats stats = lib.compute_stats(mesh);
+    timings.add("statistics", seconds_since(stats_start));
     // Every output of the run waits under its temporary name until all are complete.
     OutputBatch batch;
     WriteOptions write;

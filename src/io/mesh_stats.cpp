@@ -55,6 +55,9 @@ private:
     std::size_t count_ = 0;
 };
 
+/// Faces or edges per block of compute_stats' loops (two doubles each: 2 MB a block).
+constexpr std::size_t stats_block = std::size_t(1) << 17;
+
 } // namespace
 
 MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
@@ -64,9 +67,8 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
     s.edges = topo.edge_count();
     s.boundary_edges = topo.boundary_edges.size();
     s.boundary_loops = count_boundary_loops(topo, mesh.nodes.size());
-    // The nodes' extent and the faces' quality and area are computed on other threads while
-    // this one does the edges: each task sets members of `s` of its own, with the same loops as
-    // in turn (the same sums), so the statistics do not depend on the timing.
+    // The nodes' extent is computed on another thread meanwhile: it sets members of `s` of its
+    // own, so the statistics do not depend on the timing.
     auto node_extent = [&] {
         if (mesh.nodes.empty())
             return;
@@ -78,29 +80,46 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
             s.lat_min = std::min(s.lat_min, p.lat), s.lat_max = std::max(s.lat_max, p.lat);
         }
     };
-    auto face_quality_and_area = [&] {
-        if (mesh.faces.empty())
-            return;
+    // Joined before `s` is returned, or by its destructor should the faces or edges throw.
+    std::future<void> nodes_done = start_task(node_extent);
+    // The faces' quality and area, then the edges' lengths, computed a block at a time on every
+    // core and summed here in face and edge order: the sums of the loop in turn, bit for bit.
+    struct Values {
+        std::vector<double> a, b;
+    };
+    auto blocks_of = [](std::size_t n) { return (n + stats_block - 1) / stats_block; };
+    if (!mesh.faces.empty()) {
         s.quality_min = 1e300;
         double qsum = 0, area = 0;
         std::size_t above = 0;
-        for (const auto &f : mesh.faces) {
-            const Vec3 &a = mesh.nodes[f[0]], &b = mesh.nodes[f[1]], &c = mesh.nodes[f[2]];
-            double q = triangle_quality(a, b, c);
-            s.quality_min = std::min(s.quality_min, q);
-            qsum += q;
-            if (q > 0.8)
-                ++above;
-            s.quality_histogram[std::clamp(int(q * 10.0), 0, 9)]++;
-            area += std::fabs(spherical_triangle_area(a, b, c));
-        }
+        compute_in_order<Values, char>(
+            blocks_of(mesh.faces.size()),
+            [&](std::size_t k, Values &v, char &) {
+                const std::size_t first = k * stats_block,
+                                  last = std::min(mesh.faces.size(), first + stats_block);
+                v.a.resize(last - first), v.b.resize(last - first);
+                for (std::size_t i = first; i < last; ++i) {
+                    const auto &f = mesh.faces[i];
+                    const Vec3 &a = mesh.nodes[f[0]], &b = mesh.nodes[f[1]], &c = mesh.nodes[f[2]];
+                    v.a[i - first] = triangle_quality(a, b, c);
+                    v.b[i - first] = std::fabs(spherical_triangle_area(a, b, c));
+                }
+            },
+            [&](std::size_t, const Values &v) {
+                for (std::size_t i = 0; i < v.a.size(); ++i) {
+                    const double q = v.a[i];
+                    s.quality_min = std::min(s.quality_min, q);
+                    qsum += q;
+                    if (q > 0.8)
+                        ++above;
+                    s.quality_histogram[std::clamp(int(q * 10.0), 0, 9)]++;
+                    area += v.b[i];
+                }
+            });
         s.quality_mean = qsum / double(mesh.faces.size());
         s.quality_above_0_8 = double(above) / double(mesh.faces.size());
         s.area_km2 = area * earth_radius_km * earth_radius_km;
-    };
-    // Joined before `s` is returned, or by their destructors should the edges throw.
-    std::future<void> nodes_done = start_task(node_extent),
-                      faces_done = start_task(face_quality_and_area);
+    }
     const Field *size = mesh.node_field("target_size");
     s.has_size = size && size->values.size() == mesh.nodes.size();
     if (topo.edge_count() > 0) {
@@ -122,20 +141,32 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
         // middle bins (2 bytes an edge).
         std::vector<std::uint16_t> edge_bin(s.has_size ? topo.edge_count() : 0, RatioBins::no_bin);
         std::size_t in = 0;
-        for (std::size_t e = 0; e < topo.edge_count(); ++e) {
-            const double km = edge_km(e);
-            s.edge_km_min = std::min(s.edge_km_min, km);
-            s.edge_km_max = std::max(s.edge_km_max, km);
-            sum += km;
-            if (s.has_size) {
-                const double r = ratio(e, km);
-                if (std::isnan(r))
-                    continue;
-                edge_bin[e] = bins.add(r);
-                if (r >= 0.7 && r <= 1.4)
-                    ++in;
-            }
-        }
+        compute_in_order<Values, char>(
+            blocks_of(topo.edge_count()),
+            [&](std::size_t k, Values &v, char &) {
+                const std::size_t first = k * stats_block,
+                                  last = std::min(topo.edge_count(), first + stats_block);
+                v.a.resize(last - first), v.b.resize(s.has_size ? last - first : 0);
+                for (std::size_t e = first; e < last; ++e) {
+                    v.a[e - first] = edge_km(e);
+                    if (s.has_size)
+                        v.b[e - first] = ratio(e, v.a[e - first]);
+                }
+            },
+            [&](std::size_t k, const Values &v) {
+                for (std::size_t i = 0; i < v.a.size(); ++i) {
+                    const double km = v.a[i];
+                    s.edge_km_min = std::min(s.edge_km_min, km);
+                    s.edge_km_max = std::max(s.edge_km_max, km);
+                    sum += km;
+                    if (!s.has_size || std::isnan(v.b[i]))
+                        continue;
+                    const double r = v.b[i];
+                    edge_bin[k * stats_block + i] = bins.add(r);
+                    if (r >= 0.7 && r <= 1.4)
+                        ++in;
+                }
+            });
         s.edge_km_mean = sum / double(topo.edge_count());
         if (bins.count() > 0) {
             s.size_ratio_in_range = double(in) / double(bins.count());
@@ -156,7 +187,6 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
         }
     }
     nodes_done.get();
-    faces_done.get();
     return s;
 }
 

@@ -7,10 +7,14 @@
 #include <string>
 
 #include "globemesh/error.hpp"
+#include "ordered_blocks.hpp"
 
 namespace globemesh::io {
 
 namespace {
+// Below this many half-edges the buckets are sorted on the calling thread alone.
+constexpr std::size_t sort_alone = std::size_t(1) << 16;
+
 std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
     if (a > b)
         std::swap(a, b);
@@ -116,8 +120,27 @@ MeshTopology build_topology(const Mesh &mesh) {
     auto by_larger_node = [&](std::uint32_t a, std::uint32_t b) {
         return std::pair{ends(a).second, a} < std::pair{ends(b).second, b};
     };
-    for (std::size_t v = 0; v < nn; ++v)
-        std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
+    // The buckets sorted on every core, each thread a range of nodes with about an equal share
+    // of the half-edges (the keys are distinct: the same order on any number of threads).
+    auto sort_nodes = [&](std::size_t v0, std::size_t v1) {
+        for (std::size_t v = v0; v < v1; ++v)
+            std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
+    };
+    const std::size_t parts = nh < sort_alone ? 1 : block_threads();
+    std::vector<std::size_t> cut{0};
+    for (std::size_t k = 1; k < parts; ++k)
+        cut.push_back(std::size_t(
+            std::upper_bound(start.begin(), start.end() - 1, std::uint32_t(nh * k / parts)) -
+            start.begin()));
+    cut.push_back(nn);
+    {
+        std::vector<std::future<void>> sorted;
+        for (std::size_t k = 1; k < parts; ++k)
+            sorted.push_back(start_task([&, k] { sort_nodes(cut[k], cut[k + 1]); }));
+        sort_nodes(cut[0], cut[1]);
+        for (auto &done : sorted)
+            done.get();
+    }
 
     // Calls edge(i, j, v) for each edge in order: its half-edges are bucket[i..j), one or two,
     // and v is its smaller node.

@@ -1199,7 +1199,7 @@ TEST(Cli, timings_and_report_hold_the_stages_and_the_mesh_total) {
     // Issue 4's "mesh" key: every stage but the reading, 1.25 + 0.25 s here.
     EXPECT_TRUE(regex_search(
         t,
-        R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "write_ugrid": [0-9.e-]+, "write": [0-9.e-]+, "total": [0-9.e-]+\}\}\n$)"))
+        R"(^\{"stages": \{"read_coast": 0\.5, "refine": 1\.25, "improve": 0\.25, "mesh": 1\.5, "statistics": [0-9.e-]+, "write_ugrid": [0-9.e-]+, "write": [0-9.e-]+, "total": [0-9.e-]+\}\}\n$)"))
         << t;
     const std::string report = read_text(dir / "r.json");
     EXPECT_NE(report.find("\"nodes\": 6"), std::string::npos) << report;
@@ -1225,9 +1225,10 @@ TEST(Cli, timings_name_each_format_as_a_stage_and_add_the_total) {
             fake.lib());
     ASSERT_EQ(r.status, 0) << r.err;
     const std::string t = read_text(dir / "t.json");
-    EXPECT_EQ(regex_all(t, R"x("([a-z_]+)": )x", 1),
-              (std::vector<std::string>{"stages", "read_coast", "refine", "improve", "mesh",
-                                        "write_ugrid", "write_gpkg", "write", "total"}))
+    EXPECT_EQ(
+        regex_all(t, R"x("([a-z_]+)": )x", 1),
+        (std::vector<std::string>{"stages", "read_coast", "refine", "improve", "mesh", "statistics",
+                                  "write_ugrid", "write_gpkg", "write", "total"}))
         << t;
     auto seconds = [&t](const std::string &stage) {
         const auto v = regex_all(t, "\"" + stage + R"(": ([0-9.e-]+))", 1);
