@@ -263,10 +263,10 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
                        " or " + option("hmin_km"));
     };
     // Uniform when no component of the field is on: then no background grid is built.
-    const SizeField field = build_size_field(
-        size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
-        sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid, passages,
-        static_cast<std::size_t>(std::max(0, o.threads)));
+    const SizeField field =
+        build_size_field(size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
+                         sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid,
+                         passages, static_cast<std::size_t>(std::max(0, o.threads)));
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
     if (!field.is_uniform()) {
