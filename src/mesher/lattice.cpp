@@ -430,13 +430,14 @@ private:
 // Only the lattice's points in a cap around the ocean are walked (a region's), and none when
 // those are more than `max_points` (about 10 n^2 times the cap's share of the sphere). Returns
 // the number of nodes added.
-std::size_t fill_lattice(Mesher &m, double s_km, double max_points) {
+std::size_t fill_lattice(Mesher &m, double s_km, double max_points,
+                         const std::function<bool(const Vec3 &)> &within, double share) {
     SphericalDelaunay &dt = m.dt;
     const double s = km_to_rad(s_km);
     const double n = std::max(1.0, std::round(lattice_edge_scale / s));
     const Cap cap = ocean_cap(dt, s);
-    const double cap_points =
-        (10 * n * n + 2) * 0.5 * (1 - cap.cos_r); // the lattice's points in the cap, about
+    const double cap_points = (10 * n * n + 2) * 0.5 * (1 - cap.cos_r) *
+                              (cap.cos_r > -1 ? 1 : share); // the lattice's points there, about
     if (cap_points > max_points)
         return 0;
     const std::array<Vec3, 12> corner = ico_corners();
@@ -480,8 +481,8 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points) {
                 const Vec3 p =
                     normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
                                (lattice_jitter * s) * lattice_shift(f, i, j));
-                if (m.size_km(p) < lattice_level * s_km)
-                    continue;
+                if ((within && !within(p)) || m.size_km(p) < lattice_level * s_km)
+                    continue; // outside a part's lune: outside its ocean, not located
                 hint = dt.locate(p, hint);
                 if (dt.label(hint) != ocean || !clearance.clear(p, hint))
                     continue;

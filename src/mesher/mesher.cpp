@@ -50,7 +50,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
         static_cast<VertexId>(m.dt.vertex_count()); // the lattice nodes follow
     if (options.lattice_km > 0)
         report.lattice_nodes =
-            fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000);
+            fill_lattice(m, options.lattice_km, 4.0 * double(report.estimated_nodes) + 1000,
+                         options.lattice_within, options.lattice_share);
     refine(m, progress);
     timed("refine");
 

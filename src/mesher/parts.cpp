@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -69,6 +71,18 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
         offset += r.nodes.size();
     }
     return kept;
+}
+
+/// Whether a point lies inside lune k of `parts` (east of border k, west of border k + 1): the
+/// part's ocean lies there, its borders being arcs of those meridians' planes.
+std::function<bool(const Vec3 &)> within_lune(int k, int parts) {
+    auto normal = [parts](int b) { // east of border b: dot > 0
+        const double lon = part_border_lon(b, parts) * deg_to_rad;
+        return Vec3{-std::sin(lon), std::cos(lon), 0};
+    };
+    return [west = normal(k), east = normal(k + 1)](const Vec3 &p) {
+        return dot(p, west) > 0 && dot(p, east) < 0;
+    };
 }
 
 /// Adds a part's report to the run's (counts summed, lists concatenated; not the components).
@@ -184,9 +198,13 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     std::vector<StageTimings> times(split.size());
     SharedProgress shared(progress, split.size());
     run_parts(split.size(), std::max(1u, threads), [&](std::size_t k) {
-        if (split[k].has_ocean)
-            meshes[k] = mesh_boundary(split[k].boundary, size_km, part_options, &reports[k],
-                                      shared.part(k), &times[k]);
+        if (!split[k].has_ocean)
+            return;
+        MesherOptions lune = part_options;
+        lune.lattice_within = within_lune(static_cast<int>(k), parts);
+        lune.lattice_share = 1.0 / parts;
+        meshes[k] =
+            mesh_boundary(split[k].boundary, size_km, lune, &reports[k], shared.part(k), &times[k]);
     });
     t0 = Clock::now();
     const std::size_t estimated = report.estimated_nodes;
