@@ -116,6 +116,24 @@ TEST(Parts, threads_give_the_same_bytes_natural_earth) {
     }
 }
 
+TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
+    // Each part's lattice is its lune's share of the sphere's: with 3 or more parts it had been
+    // weighed whole against one part's node estimate, and skipped.
+    MeshOptions o;
+    o.coast = fixture("coast/ne_110m_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = 250;
+    const std::size_t one = mesh_ocean(o).mesher.lattice_nodes;
+    ASSERT_GT(one, 2000u);
+    for (int parts = 2; parts <= 6; ++parts) {
+        o.parts = parts;
+        const OceanMesh run = mesh_ocean(o);
+        // The bands along the borders (1.5 lattice spacings each side) are refined instead.
+        EXPECT_GT(double(run.mesher.lattice_nodes), 0.6 * double(one)) << parts;
+        EXPECT_LE(run.mesher.lattice_nodes, one) << parts;
+    }
+}
+
 TEST(Parts, refuses_more_parts_than_the_poles_allow) {
     MeshOptions o;
     o.coast = fixture("coast/ne_110m_land.gpkg").string();
