@@ -100,10 +100,11 @@ struct MesherOptions {
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
     double lattice_km = 0;
-    /// Where the ocean may lie (a part's lune, parts.hpp): the lattice's points outside it are
-    /// not looked for in the triangulation, and `lattice_share` (the share of the sphere it
-    /// covers) scales the lattice's points against the node estimate. Null: the whole sphere.
-    std::function<bool(const Vec3 &)> lattice_within;
+    /// Where the ocean may lie (a part's lune, parts.hpp): where dot(p, n) > 0 for each normal
+    /// n. The lattice's points elsewhere are not looked for in the triangulation, and
+    /// `lattice_share` (the share of the sphere that covers) scales the lattice's points
+    /// against the node estimate. Empty: the whole sphere.
+    std::vector<Vec3> lattice_within;
     double lattice_share = 1;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
     /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where

@@ -1,7 +1,10 @@
 // The icosahedral lattice: the open ocean filled with near-equilateral triangles.
 #include "mesher_state.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <vector>
 
 namespace globemesh::mesher_internal {
 
@@ -316,6 +319,33 @@ bool row_in_cap(const Cap &cap, const Vec3 &a, const Vec3 &b, const Vec3 &c, int
     return true;
 }
 
+// Narrows row i's [lo, hi] (weights j on b, len - j on c) to the points where dot(p, n) > 0 for
+// each normal n, with one point of margin each side (the jitter, the rounding): dot is linear in
+// j before the point is normalized. False when no point is left.
+bool row_within(const std::vector<Vec3> &normals, const Vec3 &a, const Vec3 &b, const Vec3 &c,
+                int i, int len, int &lo, int &hi) {
+    for (const Vec3 &n : normals) {
+        const double at0 = double(i) * dot(a, n) + double(len) * dot(c, n);
+        const double slope = dot(b, n) - dot(c, n);
+        // at0 + j * slope > 0: j above or below -at0 / slope.
+        if (std::fabs(slope) < 1e-300) {
+            if (at0 <= 0)
+                return false;
+            continue;
+        }
+        const double j0 = -at0 / slope;
+        if (slope > 0)
+            lo = std::max(
+                lo, static_cast<int>(std::max(-1.0, std::min(double(len), std::floor(j0)))) - 1);
+        else
+            hi = std::min(
+                hi, static_cast<int>(std::max(-1.0, std::min(double(len) + 1, std::ceil(j0)))) + 1);
+    }
+    lo = std::max(lo, 0);
+    hi = std::min(hi, len);
+    return lo <= hi;
+}
+
 // The pseudo-random shift of lattice point (f, i, j), each coordinate in [-0.5, 0.5) (its index
 // hashed, splitmix64): the lattice's mirror symmetries make many four points exactly
 // cocircular, each an in-circle test that only exact arithmetic decides.
@@ -430,8 +460,12 @@ private:
 // Only the lattice's points in a cap around the ocean are walked (a region's), and none when
 // those are more than `max_points` (about 10 n^2 times the cap's share of the sphere). Returns
 // the number of nodes added.
-std::size_t fill_lattice(Mesher &m, double s_km, double max_points,
-                         const std::function<bool(const Vec3 &)> &within, double share) {
+std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::vector<Vec3> &within,
+                         double share) {
+    auto inside = [&](const Vec3 &p) {
+        return std::all_of(within.begin(), within.end(),
+                           [&](const Vec3 &n) { return dot(p, n) > 0; });
+    };
     SphericalDelaunay &dt = m.dt;
     const double s = km_to_rad(s_km);
     const double n = std::max(1.0, std::round(lattice_edge_scale / s));
@@ -467,7 +501,8 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points,
         for (int i = 0; i <= rows; ++i) {
             const int len = rows - i;
             int lo = 0, hi = len;
-            if (cap.cos_r > -1 && !row_in_cap(cap, a, b, c, i, len, lo, hi))
+            if ((cap.cos_r > -1 && !row_in_cap(cap, a, b, c, i, len, lo, hi)) ||
+                !row_within(within, a, b, c, i, len, lo, hi))
                 continue;
             LatticeCells::Row &row = grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
             row = {lo, hi, cell.size()};
@@ -481,7 +516,7 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points,
                 const Vec3 p =
                     normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
                                (lattice_jitter * s) * lattice_shift(f, i, j));
-                if ((within && !within(p)) || m.size_km(p) < lattice_level * s_km)
+                if (!inside(p) || m.size_km(p) < lattice_level * s_km)
                     continue; // outside a part's lune: outside its ocean, not located
                 hint = dt.locate(p, hint);
                 if (dt.label(hint) != ocean || !clearance.clear(p, hint))

@@ -464,9 +464,9 @@ void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const
                        const Vec3 &b, const Vec3 &c, double stop, double &sum);
 
 // lattice.cpp: the open ocean filled with an icosahedral lattice; returns the nodes added.
-// within (may be null): where the ocean may lie, covering `share` of the sphere.
+// within (MesherOptions::lattice_within): where the ocean may lie, covering `share` of the sphere.
 std::size_t fill_lattice(Mesher &m, double s_km, double max_points,
-                         const std::function<bool(const Vec3 &)> &within = {}, double share = 1);
+                         const std::vector<Vec3> &within = {}, double share = 1);
 
 // refine.cpp: refinement until every ocean triangle fits the size field and the shape bounds.
 void refine(Mesher &m, const Progress &progress);

@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
-#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -73,16 +72,14 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     return kept;
 }
 
-/// Whether a point lies inside lune k of `parts` (east of border k, west of border k + 1): the
-/// part's ocean lies there, its borders being arcs of those meridians' planes.
-std::function<bool(const Vec3 &)> within_lune(int k, int parts) {
-    auto normal = [parts](int b) { // east of border b: dot > 0
+/// Lune k of `parts` as MesherOptions::lattice_within takes it: east of border k, west of
+/// border k + 1 (the part's ocean lies there, its borders being arcs of those meridians' planes).
+std::vector<Vec3> lune_normals(int k, int parts) {
+    auto east_of = [parts](int b) { // dot > 0 east of border b
         const double lon = part_border_lon(b, parts) * deg_to_rad;
         return Vec3{-std::sin(lon), std::cos(lon), 0};
     };
-    return [west = normal(k), east = normal(k + 1)](const Vec3 &p) {
-        return dot(p, west) > 0 && dot(p, east) < 0;
-    };
+    return {east_of(k), -east_of(k + 1)};
 }
 
 /// Adds a part's report to the run's (counts summed, lists concatenated; not the components).
@@ -201,7 +198,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
         if (!split[k].has_ocean)
             return;
         MesherOptions lune = part_options;
-        lune.lattice_within = within_lune(static_cast<int>(k), parts);
+        lune.lattice_within = lune_normals(static_cast<int>(k), parts);
         lune.lattice_share = 1.0 / parts;
         meshes[k] =
             mesh_boundary(split[k].boundary, size_km, lune, &reports[k], shared.part(k), &times[k]);
