@@ -328,6 +328,123 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
     }
 }
 
+/// Removes the free nodes near the borders with four faces (a lattice's valence defect that a
+/// border leaves: its faces near q 0.72, which no move of one node mends): the quadrilateral of
+/// their neighbours becomes two faces (the diagonal that keeps both positive; the flips that
+/// follow make it Delaunay), and the nodes and faces are compacted away. Returns how many.
+std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
+                                const std::vector<std::uint32_t> &zone_face_list) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
+    for (std::uint32_t f : zone_face_list)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                at.push_back({v, f});
+    std::sort(at.begin(), at.end());
+    std::vector<char> dead_node(mesh.nodes.size(), 0), dead_face(mesh.faces.size(), 0),
+        touched(mesh.nodes.size(), 0);
+    std::size_t removed = 0;
+    using predicates::orient;
+    for (std::size_t i = 0; i < at.size();) {
+        const NodeIndex v = at[i].first;
+        std::size_t j = i;
+        while (j < at.size() && at[j].first == v)
+            ++j;
+        const std::size_t count = j - i;
+        const std::size_t first = i;
+        i = j;
+        if (count != 4 || touched[v])
+            continue;
+        // The star's faces as (v, x, y), counter-clockwise; the ring x0 -> x1 -> x2 -> x3.
+        std::array<std::pair<NodeIndex, NodeIndex>, 4> side;
+        for (std::size_t k = 0; k < 4; ++k) {
+            const auto &t = mesh.faces[at[first + k].second];
+            const int r = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+            side[k] = {t[(r + 1) % 3], t[(r + 2) % 3]};
+        }
+        std::array<NodeIndex, 4> ring{side[0].first, side[0].second, 0, 0};
+        bool closed = true;
+        for (std::size_t k = 2; k < 4 && closed; ++k) {
+            const auto next = std::find_if(side.begin(), side.end(),
+                                           [&](const auto &e) { return e.first == ring[k - 1]; });
+            closed = next != side.end();
+            if (closed)
+                ring[k] = next->second;
+        }
+        if (!closed || std::none_of(side.begin(), side.end(), [&](const auto &e) {
+                return e.first == ring[3] && e.second == ring[0];
+            }))
+            continue;
+        if (std::any_of(ring.begin(), ring.end(), [&](NodeIndex u) { return touched[u]; }))
+            continue;
+        const auto &p = mesh.nodes;
+        // The diagonal between the two neighbours with the fewer faces first (it adds one to
+        // each): valences nearer six. The smoothing and flips that follow settle it.
+        auto faces_at = [&](NodeIndex u) {
+            return std::count_if(at.begin(), at.end(), [u](const auto &x) { return x.first == u; });
+        };
+        const bool first_diagonal =
+            faces_at(ring[0]) + faces_at(ring[2]) <= faces_at(ring[1]) + faces_at(ring[3]);
+        auto fits = [&](int s) {
+            return orient(p[ring[s]], p[ring[s + 1]], p[ring[(s + 2) % 4]]) > 0 &&
+                   orient(p[ring[s]], p[ring[(s + 2) % 4]], p[ring[(s + 3) % 4]]) > 0;
+        };
+        int s = first_diagonal ? 0 : 1;
+        if (!fits(s))
+            s = 1 - s;
+        if (!fits(s))
+            continue;
+        const std::array<std::array<NodeIndex, 3>, 2> two = {
+            {{ring[s], ring[s + 1], ring[(s + 2) % 4]},
+             {ring[s], ring[(s + 2) % 4], ring[(s + 3) % 4]}}};
+        mesh.faces[at[first].second] = two[0];
+        mesh.faces[at[first + 1].second] = two[1];
+        dead_face[at[first + 2].second] = dead_face[at[first + 3].second] = 1;
+        dead_node[v] = touched[v] = 1;
+        for (NodeIndex u : ring)
+            touched[u] = 1;
+        ++removed;
+    }
+    if (removed == 0)
+        return 0;
+    // Compaction: the nodes and faces left, in their order.
+    std::vector<NodeIndex> new_index(mesh.nodes.size());
+    std::size_t kept = 0;
+    for (std::size_t v = 0; v < mesh.nodes.size(); ++v) {
+        new_index[v] = static_cast<NodeIndex>(kept);
+        if (!dead_node[v]) {
+            mesh.nodes[kept] = mesh.nodes[v];
+            zone[kept] = zone[v];
+            for (Field &field : mesh.node_fields)
+                field.values[kept] = field.values[v];
+            ++kept;
+        }
+    }
+    mesh.nodes.resize(kept);
+    zone.resize(kept);
+    for (Field &field : mesh.node_fields)
+        field.values.resize(kept);
+    std::size_t faces_kept = 0;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        if (!dead_face[f]) {
+            auto t = mesh.faces[f];
+            for (NodeIndex &u : t)
+                u = new_index[u];
+            mesh.faces[faces_kept] = t;
+            for (Field &field : mesh.face_fields)
+                field.values[faces_kept] = field.values[f];
+            ++faces_kept;
+        }
+    mesh.faces.resize(faces_kept);
+    for (Field &field : mesh.face_fields)
+        field.values.resize(faces_kept);
+    for (BoundaryEdge &e : mesh.boundary)
+        e.a = new_index[e.a], e.b = new_index[e.b];
+    return removed;
+}
+
 /// Gives each fan of faces at a border node after the first a node of its own, moved
 /// pinch_offset into its fan (as the mesher's output does where a closed strait pinches the
 /// water): where the parts removed land on both sides of a border node, its faces form two fans.
@@ -431,11 +548,19 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
         if (!edges.count({e.b, e.a}))
             boundary.push_back(e);
     out.boundary.swap(boundary);
-    const std::vector<char> zone = border_zone(out, parts);
-    const std::vector<std::uint32_t> faces = zone_faces(out, zone);
+    std::vector<char> zone = border_zone(out, parts);
+    std::vector<std::uint32_t> faces = zone_faces(out, zone);
     flip_near_borders(out, faces);
     for (int round = 0; round < smoothing_rounds; ++round) {
         smooth_near_borders(out, zone, faces, round + 1 == smoothing_rounds);
+        flip_near_borders(out, faces);
+    }
+    // The valence defects the smoothing left: removed, then the flips and one more round.
+    if (remove_valence_four(out, zone, faces) > 0) {
+        faces = zone_faces(out, zone);
+        smooth_near_borders(out, zone, faces, true);
+        flip_near_borders(out, faces);
+        smooth_near_borders(out, zone, faces, true);
         flip_near_borders(out, faces);
     }
     tag_border_coast(out, parts);
