@@ -10,6 +10,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "globemesh/sphere.hpp"
@@ -32,6 +34,10 @@ public:
     virtual bool contains(const Vec3 &p) const = 0;
     /// True when the coast comes within `angle` radians of p (on the sphere).
     virtual bool coast_within(const Vec3 &p, double angle) const = 0;
+    /// A maker of an independent copy giving the same answers, for another thread: what it
+    /// needs is read now, on the calling thread; the maker may run on any thread. Empty when the
+    /// test cannot be copied (the parts then share it under a lock).
+    virtual std::function<std::shared_ptr<const LandTest>()> copier() const { return {}; }
 };
 
 struct Boundary {

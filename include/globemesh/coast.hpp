@@ -96,6 +96,9 @@ public:
     /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
     bool coast_within(const Vec3 &p, double angle) const override;
+    /// Reads the polygons' rings now; the maker builds a LandMask of its own from them (as much
+    /// memory again, and the build's time, on the thread that runs it).
+    std::function<std::shared_ptr<const LandTest>()> copier() const override;
     std::size_t vertices() const { return vertices_; }
     /// The bytes of the cells in front of `contains` (about 2.7 MB for the world's land).
     std::size_t cell_bytes() const;

@@ -144,15 +144,15 @@ private:
     bool stop_ = false;
 };
 
-/// Runs work(k) for k in [0, count) on `threads` threads, each taking the next k; rethrows the
-/// first exception in k order once all have ended.
+/// Runs work(k, t) for k in [0, count) on `threads` threads (t the thread's number, 0 this
+/// one), each taking the next k; rethrows the first exception in k order once all have ended.
 template <class Work> void run_parts(std::size_t count, unsigned threads, Work work) {
     std::vector<std::exception_ptr> errors(count);
     std::atomic<std::size_t> next{0};
-    auto loop = [&] {
+    auto loop = [&](unsigned t) {
         for (std::size_t k; (k = next++) < count;) {
             try {
-                work(k);
+                work(k, t);
             } catch (...) {
                 errors[k] = std::current_exception();
             }
@@ -160,8 +160,8 @@ template <class Work> void run_parts(std::size_t count, unsigned threads, Work w
     };
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < std::min<std::size_t>(threads, count); ++t)
-        pool.emplace_back(loop);
-    loop();
+        pool.emplace_back(loop, t);
+    loop(0);
     for (auto &t : pool)
         t.join();
     for (auto &e : errors)
@@ -183,10 +183,17 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     const Boundary kept = drop_inland_seas(boundary, size_km, options, report);
     MesherOptions part_options = options;
     part_options.keep_inland_seas = true; // a sea cut by a border is two components
-    if (options.land)
-        part_options.land = std::make_shared<LockedLand>(options.land);
     const std::vector<PartBoundary> split =
         split_boundary(kept, size_km, parts, options.land.get());
+    // The land test: each thread its own (the first the caller's, the others copies built on
+    // their thread; the same answers), or one under a lock where it cannot be copied.
+    threads = std::min<unsigned>(std::max(1u, threads), static_cast<unsigned>(split.size()));
+    const auto copier = options.land && threads > 1 ? options.land->copier() : nullptr;
+    std::vector<std::shared_ptr<const LandTest>> lands(threads);
+    if (options.land && threads > 1 && !copier)
+        part_options.land = std::make_shared<LockedLand>(options.land);
+    else if (options.land)
+        lands[0] = options.land;
     if (timings)
         timings->add("split", seconds_since(t0));
 
@@ -194,10 +201,14 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     std::vector<MesherReport> reports(split.size());
     std::vector<StageTimings> times(split.size());
     SharedProgress shared(progress, split.size());
-    run_parts(split.size(), std::max(1u, threads), [&](std::size_t k) {
+    run_parts(split.size(), threads, [&](std::size_t k, unsigned t) {
         if (!split[k].has_ocean)
             return;
         MesherOptions lune = part_options;
+        if (copier && !lands[t])
+            lands[t] = copier();
+        if (lands[t])
+            lune.land = lands[t];
         lune.lattice_within = lune_normals(static_cast<int>(k), parts);
         lune.lattice_share = 1.0 / parts;
         meshes[k] =

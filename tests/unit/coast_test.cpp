@@ -11,6 +11,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <thread>
 
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -565,6 +566,33 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
     }
     EXPECT_GT(yes, 30);
     EXPECT_GT(no, 30);
+}
+
+TEST(Coast, a_copy_of_the_land_test_built_on_another_thread_answers_as_the_original) {
+    // The parts' threads each take a copy (mesh_parts): the same answers, or the mesh would
+    // depend on the thread count.
+    const CoastData &d = ne50();
+    const auto copier = d.land->copier();
+    ASSERT_TRUE(copier);
+    std::shared_ptr<const LandTest> copy;
+    std::thread([&] { copy = copier(); }).join();
+    ASSERT_TRUE(copy);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> lon(-180, 180), z(-1, 1), reach(0.001, 0.05);
+    int land = 0, near = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p = lonlat_to_vec(lon(rng), std::asin(z(rng)) * 180 / pi);
+        const bool in = d.land->contains(p);
+        ASSERT_EQ(copy->contains(p), in) << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat;
+        land += in;
+        const double a = reach(rng);
+        const bool within = d.land->coast_within(p, a);
+        ASSERT_EQ(copy->coast_within(p, a), within);
+        near += within;
+    }
+    EXPECT_GT(land, 4000); // about 29% of the sphere is land
+    EXPECT_LT(land, 8000);
+    EXPECT_GT(near, 500);
 }
 
 TEST(Coast, missing_coast_option_is_a_usage_error) {
