@@ -179,18 +179,33 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 
 /// Lawson flips of the edges near the borders whose opposite node lies inside the circumcircle
 /// (the borders were constrained in their parts, and a fan split leaves such edges): the faces of
-/// `faces` (zone_faces), the joined mesh Delaunay there as inside.
-void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces) {
-    auto key = [](NodeIndex a, NodeIndex b) { return (std::uint64_t(a) << 32) | b; };
-    std::unordered_map<std::uint64_t, std::uint32_t> face_of;
+/// `faces` (zone_faces, their edges' faces in face_of), the joined mesh Delaunay there as inside.
+using FaceOfEdge = std::unordered_map<std::uint64_t, std::uint32_t>;
+
+std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
+    return (std::uint64_t(a) << 32) | b;
+}
+
+/// The face of each directed edge of `faces`, which the flips keep up to date.
+FaceOfEdge faces_of_edges(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
+    FaceOfEdge face_of;
     face_of.reserve(3 * faces.size());
-    std::vector<std::pair<NodeIndex, NodeIndex>> stack;
     for (std::uint32_t f : faces) {
         const auto &t = mesh.faces[f];
-        for (int i = 0; i < 3; ++i) {
-            face_of[key(t[i], t[(i + 1) % 3])] = f;
+        for (int i = 0; i < 3; ++i)
+            face_of[edge_key(t[i], t[(i + 1) % 3])] = f;
+    }
+    return face_of;
+}
+
+void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, FaceOfEdge &face_of) {
+    const auto key = edge_key;
+    std::vector<std::pair<NodeIndex, NodeIndex>> stack;
+    stack.reserve(3 * faces.size());
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        for (int i = 0; i < 3; ++i)
             stack.push_back({t[i], t[(i + 1) % 3]});
-        }
     }
     auto third = [&](std::uint32_t f, NodeIndex a, NodeIndex b) {
         for (NodeIndex v : mesh.faces[f])
@@ -550,18 +565,20 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
     out.boundary.swap(boundary);
     std::vector<char> zone = border_zone(out, parts);
     std::vector<std::uint32_t> faces = zone_faces(out, zone);
-    flip_near_borders(out, faces);
+    FaceOfEdge face_of = faces_of_edges(out, faces);
+    flip_near_borders(out, faces, face_of);
     for (int round = 0; round < smoothing_rounds; ++round) {
         smooth_near_borders(out, zone, faces, round + 1 == smoothing_rounds);
-        flip_near_borders(out, faces);
+        flip_near_borders(out, faces, face_of);
     }
-    // The valence defects the smoothing left: removed, then the flips and one more round.
+    // The valence defects the smoothing left: removed, then the flips and two more rounds.
     if (remove_valence_four(out, zone, faces) > 0) {
         faces = zone_faces(out, zone);
-        smooth_near_borders(out, zone, faces, true);
-        flip_near_borders(out, faces);
-        smooth_near_borders(out, zone, faces, true);
-        flip_near_borders(out, faces);
+        face_of = faces_of_edges(out, faces);
+        for (int round = 0; round < 2; ++round) {
+            smooth_near_borders(out, zone, faces, true);
+            flip_near_borders(out, faces, face_of);
+        }
     }
     tag_border_coast(out, parts);
     split_pinched(out, zone);
