@@ -1,0 +1,288 @@
+// The joined mesh near the borders (docs/parallel.md, section 6): Lawson flips, smoothing with
+// a pattern search, and the removal of nodes with four faces, over the faces of the zone that
+// join_parts marks around the borders.
+#include "parts_smooth.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "globemesh/predicates.hpp"
+
+namespace globemesh::parts_detail {
+
+namespace {
+
+/// In the last round, a node near a border whose star's worst face is below this quality (the
+/// share above q 0.8 is what the benches count) gets a pattern search of search_steps steps.
+constexpr double search_below = 0.8;
+constexpr int search_steps = 16;
+
+std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
+    return (std::uint64_t(a) << 32) | b;
+}
+
+/// The worst quality of `faces`, -1 when one of them is folded.
+double worst_quality(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
+    double q = 1;
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+        if (predicates::orient(a, b, c) <= 0)
+            return -1;
+        q = std::min(q, triangle_quality(a, b, c));
+    }
+    return q;
+}
+
+/// A pattern search for the place of v where its star's worst face is best (as the mesher's
+/// quality rounds do inside a part): steps along two tangent directions from a fifth of the
+/// mean edge, halved whenever none of the four raises the worst face.
+void search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &faces) {
+    double length = 0;
+    for (std::uint32_t f : faces)
+        for (NodeIndex u : mesh.faces[f])
+            length += norm(mesh.nodes[u] - mesh.nodes[v]);
+    double step = 0.2 * length / (2.0 * static_cast<double>(faces.size()));
+    double best = worst_quality(mesh, faces);
+    for (int k = 0; k < search_steps; ++k) {
+        const Vec3 base = mesh.nodes[v];
+        const Vec3 t1 =
+            normalized(cross(base, std::abs(base.x) < 0.6 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+        const Vec3 t2 = cross(base, t1);
+        Vec3 best_place = base;
+        for (const Vec3 &d : {t1, -t1, t2, -t2}) {
+            mesh.nodes[v] = normalized(base + step * d);
+            if (const double q = worst_quality(mesh, faces); q > best)
+                best = q, best_place = mesh.nodes[v];
+        }
+        mesh.nodes[v] = best_place;
+        if (best_place == base)
+            step *= 0.5;
+    }
+}
+
+} // namespace
+
+/// The face of each directed edge of `faces`, which the flips keep up to date.
+FaceOfEdge faces_of_edges(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
+    FaceOfEdge face_of;
+    face_of.reserve(3 * faces.size());
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        for (int i = 0; i < 3; ++i)
+            face_of[edge_key(t[i], t[(i + 1) % 3])] = f;
+    }
+    return face_of;
+}
+
+/// Lawson flips of the edges near the borders whose opposite node lies inside the circumcircle
+/// (the borders were constrained in their parts, and a fan split leaves such edges): the faces of
+/// `faces` (zone_faces, their edges' faces in face_of), the joined mesh Delaunay there as inside.
+void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, FaceOfEdge &face_of) {
+    const auto key = edge_key;
+    std::vector<std::pair<NodeIndex, NodeIndex>> stack;
+    stack.reserve(3 * faces.size());
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        for (int i = 0; i < 3; ++i)
+            stack.push_back({t[i], t[(i + 1) % 3]});
+    }
+    auto third = [&](std::uint32_t f, NodeIndex a, NodeIndex b) {
+        for (NodeIndex v : mesh.faces[f])
+            if (v != a && v != b)
+                return v;
+        return a;
+    };
+    using predicates::orient;
+    for (std::size_t budget = 20 * stack.size() + 100; !stack.empty() && budget > 0; --budget) {
+        const auto [a, b] = stack.back();
+        stack.pop_back();
+        const auto i1 = face_of.find(key(a, b)), i2 = face_of.find(key(b, a));
+        if (i1 == face_of.end() || i2 == face_of.end())
+            continue;
+        const std::uint32_t f1 = i1->second, f2 = i2->second;
+        const NodeIndex c = third(f1, a, b), d = third(f2, b, a);
+        const Vec3 &pa = mesh.nodes[a], &pb = mesh.nodes[b], &pc = mesh.nodes[c],
+                   &pd = mesh.nodes[d];
+        if (predicates::orient3d(pa, pb, pc, pd) <= 0 || orient(pa, pd, pc) <= 0 ||
+            orient(pd, pb, pc) <= 0)
+            continue;
+        mesh.faces[f1] = {a, d, c};
+        mesh.faces[f2] = {d, b, c};
+        face_of.erase(i1);
+        face_of.erase(key(b, a));
+        face_of[key(a, d)] = f1, face_of[key(d, c)] = f1, face_of[key(c, a)] = f1;
+        face_of[key(d, b)] = f2, face_of[key(b, c)] = f2, face_of[key(c, d)] = f2;
+        for (auto e : {std::pair{a, d}, std::pair{d, b}, std::pair{b, c}, std::pair{c, a}})
+            stack.push_back(e);
+    }
+}
+
+/// The faces with a node in the zone: the only ones the join's flips and smoothing rewrite (a
+/// flip turns two of them into two others of the same four nodes).
+std::vector<std::uint32_t> zone_faces(const Mesh &mesh, const std::vector<char> &zone) {
+    std::vector<std::uint32_t> faces;
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
+        const auto &t = mesh.faces[f];
+        if (zone[t[0]] || zone[t[1]] || zone[t[2]])
+            faces.push_back(f);
+    }
+    return faces;
+}
+
+/// Smoothing that crosses the borders (each part smoothed only its inside): sweeps over the
+/// free nodes near the borders, in index order, each moved to the mean of its neighbours where
+/// its star's worst quality rises and no face folds, then, with `search`, searched for a better
+/// place where its star's worst face is still below search_below.
+void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
+                         const std::vector<std::uint32_t> &zone_face_list, bool search) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    // Each free zone node's faces, in node order: the same sweep every run.
+    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
+    for (std::uint32_t f : zone_face_list)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                at.push_back({v, f});
+    std::sort(at.begin(), at.end());
+    std::vector<std::uint32_t> faces;
+    for (std::size_t i = 0; i < at.size();) {
+        const NodeIndex v = at[i].first;
+        faces.clear();
+        for (; i < at.size() && at[i].first == v; ++i)
+            faces.push_back(at[i].second);
+        Vec3 sum{0, 0, 0};
+        for (std::uint32_t f : faces)
+            for (NodeIndex u : mesh.faces[f])
+                if (u != v)
+                    sum = sum + mesh.nodes[u];
+        const Vec3 old = mesh.nodes[v];
+        const double before = worst_quality(mesh, faces);
+        mesh.nodes[v] = normalized(sum);
+        if (worst_quality(mesh, faces) <= before)
+            mesh.nodes[v] = old;
+        if (search && worst_quality(mesh, faces) < search_below)
+            search_node(mesh, v, faces);
+    }
+}
+
+/// Removes the free nodes near the borders with four faces (a lattice's valence defect that a
+/// border leaves: its faces near q 0.72, which no move of one node mends): the quadrilateral of
+/// their neighbours becomes two faces (the diagonal that keeps both positive; the flips that
+/// follow make it Delaunay), and the nodes and faces are compacted away. Returns how many.
+std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
+                                const std::vector<std::uint32_t> &zone_face_list) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
+    for (std::uint32_t f : zone_face_list)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                at.push_back({v, f});
+    std::sort(at.begin(), at.end());
+    std::vector<char> dead_node(mesh.nodes.size(), 0), dead_face(mesh.faces.size(), 0),
+        touched(mesh.nodes.size(), 0);
+    std::size_t removed = 0;
+    using predicates::orient;
+    for (std::size_t i = 0; i < at.size();) {
+        const NodeIndex v = at[i].first;
+        std::size_t j = i;
+        while (j < at.size() && at[j].first == v)
+            ++j;
+        const std::size_t count = j - i;
+        const std::size_t first = i;
+        i = j;
+        if (count != 4 || touched[v])
+            continue;
+        // The star's faces as (v, x, y), counter-clockwise; the ring x0 -> x1 -> x2 -> x3.
+        std::array<std::pair<NodeIndex, NodeIndex>, 4> side;
+        for (std::size_t k = 0; k < 4; ++k) {
+            const auto &t = mesh.faces[at[first + k].second];
+            const int r = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+            side[k] = {t[(r + 1) % 3], t[(r + 2) % 3]};
+        }
+        std::array<NodeIndex, 4> ring{side[0].first, side[0].second, 0, 0};
+        bool closed = true;
+        for (std::size_t k = 2; k < 4 && closed; ++k) {
+            const auto next = std::find_if(side.begin(), side.end(),
+                                           [&](const auto &e) { return e.first == ring[k - 1]; });
+            closed = next != side.end();
+            if (closed)
+                ring[k] = next->second;
+        }
+        if (!closed || std::none_of(side.begin(), side.end(), [&](const auto &e) {
+                return e.first == ring[3] && e.second == ring[0];
+            }))
+            continue;
+        if (std::any_of(ring.begin(), ring.end(), [&](NodeIndex u) { return touched[u]; }))
+            continue;
+        const auto &p = mesh.nodes;
+        // The diagonal between the two neighbours with the fewer faces first (it adds one to
+        // each): valences nearer six. The smoothing and flips that follow settle it.
+        auto faces_at = [&](NodeIndex u) {
+            return std::count_if(at.begin(), at.end(), [u](const auto &x) { return x.first == u; });
+        };
+        const bool first_diagonal =
+            faces_at(ring[0]) + faces_at(ring[2]) <= faces_at(ring[1]) + faces_at(ring[3]);
+        auto fits = [&](int s) {
+            return orient(p[ring[s]], p[ring[s + 1]], p[ring[(s + 2) % 4]]) > 0 &&
+                   orient(p[ring[s]], p[ring[(s + 2) % 4]], p[ring[(s + 3) % 4]]) > 0;
+        };
+        int s = first_diagonal ? 0 : 1;
+        if (!fits(s))
+            s = 1 - s;
+        if (!fits(s))
+            continue;
+        const std::array<std::array<NodeIndex, 3>, 2> two = {
+            {{ring[s], ring[s + 1], ring[(s + 2) % 4]},
+             {ring[s], ring[(s + 2) % 4], ring[(s + 3) % 4]}}};
+        mesh.faces[at[first].second] = two[0];
+        mesh.faces[at[first + 1].second] = two[1];
+        dead_face[at[first + 2].second] = dead_face[at[first + 3].second] = 1;
+        dead_node[v] = touched[v] = 1;
+        for (NodeIndex u : ring)
+            touched[u] = 1;
+        ++removed;
+    }
+    if (removed == 0)
+        return 0;
+    // Compaction: the nodes and faces left, in their order.
+    std::vector<NodeIndex> new_index(mesh.nodes.size());
+    std::size_t kept = 0;
+    for (std::size_t v = 0; v < mesh.nodes.size(); ++v) {
+        new_index[v] = static_cast<NodeIndex>(kept);
+        if (!dead_node[v]) {
+            mesh.nodes[kept] = mesh.nodes[v];
+            zone[kept] = zone[v];
+            for (Field &field : mesh.node_fields)
+                field.values[kept] = field.values[v];
+            ++kept;
+        }
+    }
+    mesh.nodes.resize(kept);
+    zone.resize(kept);
+    for (Field &field : mesh.node_fields)
+        field.values.resize(kept);
+    std::size_t faces_kept = 0;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        if (!dead_face[f]) {
+            auto t = mesh.faces[f];
+            for (NodeIndex &u : t)
+                u = new_index[u];
+            mesh.faces[faces_kept] = t;
+            for (Field &field : mesh.face_fields)
+                field.values[faces_kept] = field.values[f];
+            ++faces_kept;
+        }
+    mesh.faces.resize(faces_kept);
+    for (Field &field : mesh.face_fields)
+        field.values.resize(faces_kept);
+    for (BoundaryEdge &e : mesh.boundary)
+        e.a = new_index[e.a], e.b = new_index[e.b];
+    return removed;
+}
+
+} // namespace globemesh::parts_detail

@@ -1,0 +1,38 @@
+// Internal to the mesher's parts: the joined mesh made good near the borders (parts_smooth.cpp),
+// over a zone of nodes join_parts marks (non-zero near a border) and the faces touching it.
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "globemesh/mesh.hpp"
+
+namespace globemesh::parts_detail {
+
+/// The face of each directed edge (a << 32 | b), of the zone's faces: the flips keep it.
+using FaceOfEdge = std::unordered_map<std::uint64_t, std::uint32_t>;
+
+/// The faces with a node in the zone: the only ones the flips and smoothing rewrite (a flip
+/// turns two of them into two others of the same four nodes).
+std::vector<std::uint32_t> zone_faces(const Mesh &mesh, const std::vector<char> &zone);
+
+/// The face of each directed edge of `faces`.
+FaceOfEdge faces_of_edges(const Mesh &mesh, const std::vector<std::uint32_t> &faces);
+
+/// Lawson flips of the edges of `faces` whose opposite node lies inside the circumcircle: the
+/// joined mesh Delaunay near the borders as inside.
+void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, FaceOfEdge &face_of);
+
+/// One sweep over the free zone nodes: each to the mean of its neighbours where its star's worst
+/// face rises, then, with `search`, a pattern search where that face is still below q 0.8.
+void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
+                         const std::vector<std::uint32_t> &zone_face_list, bool search);
+
+/// Removes the free zone nodes with four faces (their quadrilateral becomes two faces) and
+/// compacts the nodes, the faces and `zone`. Returns how many; the zone's faces must then be
+/// listed again.
+std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
+                                const std::vector<std::uint32_t> &zone_face_list);
+
+} // namespace globemesh::parts_detail
