@@ -62,6 +62,23 @@ void search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &face
     }
 }
 
+/// Each free zone node (not on the boundary) with each of its faces, in node order: the same
+/// sweep every run.
+std::vector<std::pair<NodeIndex, std::uint32_t>>
+free_zone_stars(const Mesh &mesh, const std::vector<char> &zone,
+                const std::vector<std::uint32_t> &zone_face_list) {
+    std::vector<char> fixed(mesh.nodes.size(), 0);
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
+    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
+    for (std::uint32_t f : zone_face_list)
+        for (NodeIndex v : mesh.faces[f])
+            if (zone[v] && !fixed[v])
+                at.push_back({v, f});
+    std::sort(at.begin(), at.end());
+    return at;
+}
+
 } // namespace
 
 /// The face of each directed edge of `faces`, which the flips keep up to date.
@@ -137,16 +154,7 @@ std::vector<std::uint32_t> zone_faces(const Mesh &mesh, const std::vector<char> 
 /// place where its star's worst face is still below search_below.
 void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
                          const std::vector<std::uint32_t> &zone_face_list, bool search) {
-    std::vector<char> fixed(mesh.nodes.size(), 0);
-    for (const BoundaryEdge &e : mesh.boundary)
-        fixed[e.a] = fixed[e.b] = 1;
-    // Each free zone node's faces, in node order: the same sweep every run.
-    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
-    for (std::uint32_t f : zone_face_list)
-        for (NodeIndex v : mesh.faces[f])
-            if (zone[v] && !fixed[v])
-                at.push_back({v, f});
-    std::sort(at.begin(), at.end());
+    const auto at = free_zone_stars(mesh, zone, zone_face_list);
     std::vector<std::uint32_t> faces;
     for (std::size_t i = 0; i < at.size();) {
         const NodeIndex v = at[i].first;
@@ -174,15 +182,7 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
 /// follow make it Delaunay), and the nodes and faces are compacted away. Returns how many.
 std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
                                 const std::vector<std::uint32_t> &zone_face_list) {
-    std::vector<char> fixed(mesh.nodes.size(), 0);
-    for (const BoundaryEdge &e : mesh.boundary)
-        fixed[e.a] = fixed[e.b] = 1;
-    std::vector<std::pair<NodeIndex, std::uint32_t>> at;
-    for (std::uint32_t f : zone_face_list)
-        for (NodeIndex v : mesh.faces[f])
-            if (zone[v] && !fixed[v])
-                at.push_back({v, f});
-    std::sort(at.begin(), at.end());
+    const auto at = free_zone_stars(mesh, zone, zone_face_list);
     std::vector<char> dead_node(mesh.nodes.size(), 0), dead_face(mesh.faces.size(), 0),
         touched(mesh.nodes.size(), 0);
     std::size_t removed = 0;
