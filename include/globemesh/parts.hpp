@@ -19,6 +19,12 @@ inline constexpr int max_parts = 6;
 /// vertices by construction (0, +-90, +-180).
 double part_border_lon(int k, int parts);
 
+/// The normal of border k's meridian plane: dot(p, normal) > 0 east of the border.
+Vec3 border_normal(int k, int parts);
+
+/// Where border k's meridian meets the equator: dot(p, direction) > 0 on its half of the plane.
+Vec3 border_direction(int k, int parts);
+
 /// The lune (0 .. parts - 1) holding p: between part_border_lon(k) and part_border_lon(k + 1).
 int part_of(const Vec3 &p, int parts);
 

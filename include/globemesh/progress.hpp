@@ -39,6 +39,16 @@ struct StageTimings {
     /// in `stages` too): the rest is the computing.
     double input_seconds = 0;
     void add(const std::string &name, double seconds) { stages.emplace_back(name, seconds); }
+    /// Adds `seconds` to the stage `name`, appended when it is new (the writers of one format,
+    /// the parts' stages).
+    void add_to(const std::string &name, double seconds) {
+        for (auto &[stage, s] : stages)
+            if (stage == name) {
+                s += seconds;
+                return;
+            }
+        add(name, seconds);
+    }
     /// A stage that reads input files (the coast, the bathymetry, the points).
     void add_input(const std::string &name, double seconds) {
         add(name, seconds);

@@ -122,8 +122,7 @@ double polygon_area_m2(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     return std::fabs(area);
 }
 
-GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *)
-    : topo_(topo) {}
+GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo) : topo_(topo) {}
 
 double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f) const {
     const auto &face = topo_.mesh->faces[f];

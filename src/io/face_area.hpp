@@ -16,7 +16,6 @@
 // Memory: nothing beyond the topology; every face's area is computed when asked for.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -31,9 +30,8 @@ public:
     /// GeographicLib's PolygonArea.
     static constexpr double short_side_km = 80;
 
-    /// The areas of topo's mesh, computed face by face in face_m2 (safe from any thread). `stop`
-    /// is not used (the callers' interface of when the edges were solved here ahead).
-    explicit GeodesicFaceAreas(const MeshTopology &topo, const std::atomic<bool> *stop = nullptr);
+    /// The areas of topo's mesh, computed face by face in face_m2 (safe from any thread).
+    explicit GeodesicFaceAreas(const MeshTopology &topo);
 
     /// The area of face f (m2), whose edges edges_of_f are those face_edges gives.
     double face_m2(std::size_t f, const std::int32_t *edges_of_f) const;

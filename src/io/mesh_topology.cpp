@@ -20,9 +20,7 @@ std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
         std::swap(a, b);
     return (std::uint64_t(a) << 32) | b;
 }
-} // namespace
 
-namespace {
 // The one topology a SharedTopology scope shares: its mesh, the topology kept (or, after
 // let_go, only watched).
 struct TopologySlot {
@@ -40,9 +38,11 @@ TopologySlot &slot() {
 
 std::shared_ptr<const MeshTopology> topology_of(const Mesh &mesh) {
     TopologySlot &s = slot();
-    const std::lock_guard<std::mutex> lock(s.mutex);
-    if (s.mesh != &mesh)
+    std::unique_lock<std::mutex> lock(s.mutex);
+    if (s.mesh != &mesh) {
+        lock.unlock(); // not the shared mesh: built apart, another mesh's build not waited for
         return std::make_shared<const MeshTopology>(build_topology(mesh));
+    }
     if (auto alive = s.watched.lock()) {
         if (!s.holding)
             s.kept.reset(); // let go: this caller holds it alone now

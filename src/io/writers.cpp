@@ -242,20 +242,6 @@ std::string writer_stage_name(const Writer &writer) {
     return "write_" + lower(writer.name);
 }
 
-namespace {
-
-/// Adds `seconds` to the stage `name`, appended when it is new.
-void add_to_stage(StageTimings &timings, const std::string &name, double seconds) {
-    for (auto &[stage, s] : timings.stages)
-        if (stage == name) {
-            s += seconds;
-            return;
-        }
-    timings.add(name, seconds);
-}
-
-} // namespace
-
 void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
                    const WriteOptions &common, const std::function<bool()> &cancelled,
                    StageTimings *timings) {
@@ -295,8 +281,8 @@ void write_outputs(const Mesh &mesh, std::span<const OutputRequest> outputs,
         const auto t0 = std::chrono::steady_clock::now();
         o.writer->write(mesh, o.path, options);
         if (timings)
-            add_to_stage(
-                *timings, writer_stage_name(*o.writer),
+            timings->add_to(
+                writer_stage_name(*o.writer),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         if (cancelled && cancelled())
             throw Cancelled();

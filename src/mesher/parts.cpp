@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -75,11 +74,7 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
 /// Lune k of `parts` as MesherOptions::lattice_within takes it: east of border k, west of
 /// border k + 1 (the part's ocean lies there, its borders being arcs of those meridians' planes).
 std::vector<Vec3> lune_normals(int k, int parts) {
-    auto east_of = [parts](int b) { // dot > 0 east of border b
-        const double lon = part_border_lon(b, parts) * deg_to_rad;
-        return Vec3{-std::sin(lon), std::cos(lon), 0};
-    };
-    return {east_of(k), -east_of(k + 1)};
+    return {border_normal(k, parts), -border_normal(k + 1, parts)};
 }
 
 /// Adds a part's report to the run's (counts summed, lists concatenated; not the components).
@@ -223,14 +218,8 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     if (timings) {
         StageTimings summed;
         for (const StageTimings &t : times)
-            for (const auto &stage : t.stages) {
-                auto it = std::find_if(summed.stages.begin(), summed.stages.end(),
-                                       [&](const auto &s) { return s.first == stage.first; });
-                if (it == summed.stages.end())
-                    summed.add(stage.first, stage.second);
-                else
-                    it->second += stage.second;
-            }
+            for (const auto &[stage, seconds] : t.stages)
+                summed.add_to(stage, seconds);
         for (const auto &s : summed.stages)
             timings->stages.push_back(s);
     }

@@ -84,12 +84,10 @@ border_nodes(const Mesh &mesh, int parts, bool all = false,
             return;
         seen[v] = 1;
         const Vec3 &p = mesh.nodes[v];
-        for (int k = 0; k < parts; ++k) {
-            const double lon = part_border_lon(k, parts) * deg_to_rad;
-            if (std::abs(-std::sin(lon) * p.x + std::cos(lon) * p.y) < tolerance &&
-                std::cos(lon) * p.x + std::sin(lon) * p.y > -tolerance)
+        for (int k = 0; k < parts; ++k)
+            if (std::abs(dot(p, border_normal(k, parts))) < tolerance &&
+                dot(p, border_direction(k, parts)) > -tolerance)
                 on[static_cast<std::size_t>(k)].push_back({p.z, v});
-        }
     };
     if (all)
         for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)

@@ -19,16 +19,6 @@ constexpr double border_step_fraction = 0.125;
 /// A segment crossing two borders (near a pole) is halved at most this many times.
 constexpr int max_halvings = 40;
 
-Vec3 border_normal(int k, int n) { // east of the border: dot > 0
-    const double lon = part_border_lon(k, n) * deg_to_rad;
-    return {-std::sin(lon), std::cos(lon), 0};
-}
-
-Vec3 border_direction(int k, int n) { // the border's meridian at the equator
-    const double lon = part_border_lon(k, n) * deg_to_rad;
-    return {std::cos(lon), std::sin(lon), 0};
-}
-
 struct Crossing {
     Vec3 p;
     int border = 0;
@@ -275,6 +265,16 @@ void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces
 
 double part_border_lon(int k, int parts) {
     return -90 + 0.0123456789 + 360.0 * k / parts;
+}
+
+Vec3 border_normal(int k, int parts) {
+    const double lon = part_border_lon(k, parts) * deg_to_rad;
+    return {-std::sin(lon), std::cos(lon), 0};
+}
+
+Vec3 border_direction(int k, int parts) {
+    const double lon = part_border_lon(k, parts) * deg_to_rad;
+    return {std::cos(lon), std::sin(lon), 0};
 }
 
 int part_of(const Vec3 &p, int parts) {
