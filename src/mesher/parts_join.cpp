@@ -41,11 +41,51 @@ constexpr double pinch_offset = 1e-7;
 
 using Edge = std::pair<NodeIndex, NodeIndex>;
 
-/// Appends part `m` to `out`: nodes of its boundary equal to one already there are that node.
-void append_part(Mesh &m, std::map<std::array<double, 3>, NodeIndex> &border, Mesh &out) {
-    std::vector<char> open(m.nodes.size(), 0); // on the boundary: maybe on a border
+/// The borders' planes and directions (border_normal, border_direction), computed once.
+struct Borders {
+    std::vector<Vec3> normal, direction;
+    explicit Borders(int parts) {
+        for (int k = 0; k < parts; ++k) {
+            normal.push_back(border_normal(k, parts));
+            direction.push_back(border_direction(k, parts));
+        }
+    }
+    /// Whether p lies on border k, within `tolerance` of its plane (radians).
+    bool on(const Vec3 &p, std::size_t k, double tolerance = on_border_tolerance) const {
+        return std::abs(dot(p, normal[k])) < tolerance && dot(p, direction[k]) > -tolerance;
+    }
+    bool on_any(const Vec3 &p) const {
+        for (std::size_t k = 0; k < normal.size(); ++k)
+            if (on(p, k))
+                return true;
+        return false;
+    }
+};
+
+/// Appends part `m` to `out`: its boundary nodes on a border equal to one already there are
+/// that node (two parts share points on their borders alone). The first part is moved, not
+/// copied.
+void append_part(Mesh &m, const Borders &borders,
+                 std::map<std::array<double, 3>, NodeIndex> &border, Mesh &out) {
+    std::vector<char> open(m.nodes.size(), 0); // on the boundary and a border
     for (const BoundaryEdge &e : m.boundary)
-        open[e.a] = open[e.b] = 1;
+        for (NodeIndex v : {e.a, e.b})
+            open[v] = borders.on_any(m.nodes[v]);
+    if (out.nodes.empty()) {
+        for (std::size_t v = 0; v < m.nodes.size(); ++v)
+            if (open[v])
+                border.emplace(std::array<double, 3>{m.nodes[v].x, m.nodes[v].y, m.nodes[v].z},
+                               static_cast<NodeIndex>(v));
+        out.nodes = std::move(m.nodes);
+        out.faces = std::move(m.faces);
+        out.boundary = std::move(m.boundary);
+        for (std::size_t i = 0; i < out.node_fields.size(); ++i)
+            out.node_fields[i].values = std::move(m.node_fields[i].values);
+        for (std::size_t i = 0; i < out.face_fields.size(); ++i)
+            out.face_fields[i].values = std::move(m.face_fields[i].values);
+        m = Mesh{};
+        return;
+    }
     std::vector<NodeIndex> global_of(m.nodes.size());
     for (std::size_t v = 0; v < m.nodes.size(); ++v) {
         const Vec3 &p = m.nodes[v];
@@ -75,19 +115,18 @@ void append_part(Mesh &m, std::map<std::array<double, 3>, NodeIndex> &border, Me
 
 /// The nodes on each border, by latitude (z): of the open boundary edges, or all (`all`).
 std::vector<std::vector<std::pair<double, NodeIndex>>>
-border_nodes(const Mesh &mesh, int parts, bool all = false,
+border_nodes(const Mesh &mesh, const Borders &borders, bool all = false,
              double tolerance = on_border_tolerance) {
-    std::vector<std::vector<std::pair<double, NodeIndex>>> on(static_cast<std::size_t>(parts));
+    std::vector<std::vector<std::pair<double, NodeIndex>>> on(borders.normal.size());
     std::vector<char> seen(mesh.nodes.size(), 0);
     auto add = [&](NodeIndex v) {
         if (seen[v])
             return;
         seen[v] = 1;
         const Vec3 &p = mesh.nodes[v];
-        for (int k = 0; k < parts; ++k)
-            if (std::abs(dot(p, border_normal(k, parts))) < tolerance &&
-                dot(p, border_direction(k, parts)) > -tolerance)
-                on[static_cast<std::size_t>(k)].push_back({p.z, v});
+        for (std::size_t k = 0; k < on.size(); ++k)
+            if (borders.on(p, k, tolerance))
+                on[k].push_back({p.z, v});
     };
     if (all)
         for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
@@ -103,11 +142,11 @@ border_nodes(const Mesh &mesh, int parts, bool all = false,
 
 /// The nodes of the other side strictly inside each open edge on a border whose reverse is not
 /// in the mesh, in order from its start.
-std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, int parts) {
+std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, const Borders &borders) {
     std::set<Edge> edges;
     for (const BoundaryEdge &e : mesh.boundary)
         edges.insert({e.a, e.b});
-    const auto on = border_nodes(mesh, parts);
+    const auto on = border_nodes(mesh, borders);
     std::map<Edge, std::vector<NodeIndex>> splits;
     for (const BoundaryEdge &e : mesh.boundary) {
         if (e.tag != EdgeTag::open || edges.count({e.b, e.a}))
@@ -138,10 +177,15 @@ std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, int parts
 void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &splits) {
     if (splits.empty())
         return;
+    std::vector<char> starts(mesh.nodes.size(), 0); // a split edge's first node: few
+    for (const auto &s : splits)
+        starts[s.first.first] = 1;
     const std::size_t faces = mesh.faces.size();
     for (std::size_t f = 0; f < faces; ++f)
         for (int i = 0; i < 3; ++i) {
             const auto face = mesh.faces[f];
+            if (!starts[face[i]])
+                continue;
             const auto it = splits.find({face[i], face[(i + 1) % 3]});
             if (it == splits.end())
                 continue;
@@ -176,9 +220,9 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 
 /// Nodes near the borders: 1 on a border, k + 1 k rings of faces away (k < zone_rings), 0
 /// elsewhere.
-std::vector<char> border_zone(const Mesh &mesh, int parts) {
+std::vector<char> border_zone(const Mesh &mesh, const Borders &borders) {
     std::vector<char> zone(mesh.nodes.size(), 0);
-    for (const auto &list : border_nodes(mesh, parts, true))
+    for (const auto &list : border_nodes(mesh, borders, true))
         for (const auto &x : list)
             zone[x.second] = 1;
     for (char ring = 1; ring < zone_rings; ++ring)
@@ -253,8 +297,8 @@ void split_pinched(Mesh &mesh, const std::vector<char> &zone) {
 
 /// The open edges left on a border (the other side's faces there were removed as land) are
 /// coast; their nodes may lie up to near_border_tolerance off it (a node the mesher split).
-void tag_border_coast(Mesh &mesh, int parts) {
-    const auto on = border_nodes(mesh, parts, false, near_border_tolerance);
+void tag_border_coast(Mesh &mesh, const Borders &borders) {
+    const auto on = border_nodes(mesh, borders, false, near_border_tolerance);
     std::vector<int> border_of(mesh.nodes.size(), -1);
     for (std::size_t k = 0; k < on.size(); ++k)
         for (const auto &x : on[k])
@@ -279,11 +323,12 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
     for (const Field &f : first->face_fields)
         out.face_fields.push_back({f.name, f.long_name, f.units, f.standard_name, {}});
     out.attributes = first->attributes;
+    const Borders borders(parts);
     std::map<std::array<double, 3>, NodeIndex> border;
     for (Mesh &m : meshes)
         if (!m.faces.empty())
-            append_part(m, border, out);
-    split_faces(out, border_splits(out, parts));
+            append_part(m, borders, border, out);
+    split_faces(out, border_splits(out, borders));
     // A boundary edge whose reverse is there too lies between two parts: interior now.
     std::set<Edge> edges;
     for (const BoundaryEdge &e : out.boundary)
@@ -293,7 +338,7 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
         if (!edges.count({e.b, e.a}))
             boundary.push_back(e);
     out.boundary.swap(boundary);
-    std::vector<char> zone = border_zone(out, parts);
+    std::vector<char> zone = border_zone(out, borders);
     std::vector<std::uint32_t> faces = zone_faces(out, zone);
     FaceOfEdge face_of = faces_of_edges(out, faces);
     flip_near_borders(out, faces, face_of);
@@ -310,7 +355,7 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
             flip_near_borders(out, faces, face_of);
         }
     }
-    tag_border_coast(out, parts);
+    tag_border_coast(out, borders);
     split_pinched(out, zone);
     return out;
 }
