@@ -113,9 +113,13 @@ void append_part(Mesh &m, const Borders &borders,
     m = Mesh{}; // its memory back before the next part is copied
 }
 
-/// The nodes on each border, by latitude (z): of the open boundary edges, or all (`all`).
+/// Which nodes border_nodes lists.
+enum class Among { open_edges, boundary_edges, all_nodes };
+
+/// The nodes on each border, by latitude (z): of the open boundary edges, of all boundary edges,
+/// or all.
 std::vector<std::vector<std::pair<double, NodeIndex>>>
-border_nodes(const Mesh &mesh, const Borders &borders, bool all = false,
+border_nodes(const Mesh &mesh, const Borders &borders, Among among,
              double tolerance = on_border_tolerance) {
     std::vector<std::vector<std::pair<double, NodeIndex>>> on(borders.normal.size());
     std::vector<char> seen(mesh.nodes.size(), 0);
@@ -128,12 +132,12 @@ border_nodes(const Mesh &mesh, const Borders &borders, bool all = false,
             if (borders.on(p, k, tolerance))
                 on[k].push_back({p.z, v});
     };
-    if (all)
+    if (among == Among::all_nodes)
         for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
             add(v);
     else
         for (const BoundaryEdge &e : mesh.boundary)
-            if (e.tag == EdgeTag::open)
+            if (e.tag == EdgeTag::open || among == Among::boundary_edges)
                 add(e.a), add(e.b);
     for (auto &list : on)
         std::sort(list.begin(), list.end());
@@ -141,12 +145,13 @@ border_nodes(const Mesh &mesh, const Borders &borders, bool all = false,
 }
 
 /// The nodes of the other side strictly inside each open edge on a border whose reverse is not
-/// in the mesh, in order from its start.
+/// in the mesh, in order from its start: of its open edges, or of its coast where it removed
+/// its faces on the border as land (the coast meets the border at that node).
 std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, const Borders &borders) {
     std::set<Edge> edges;
     for (const BoundaryEdge &e : mesh.boundary)
         edges.insert({e.a, e.b});
-    const auto on = border_nodes(mesh, borders);
+    const auto on = border_nodes(mesh, borders, Among::boundary_edges);
     std::map<Edge, std::vector<NodeIndex>> splits;
     for (const BoundaryEdge &e : mesh.boundary) {
         if (e.tag != EdgeTag::open || edges.count({e.b, e.a}))
@@ -222,7 +227,7 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 /// elsewhere.
 std::vector<char> border_zone(const Mesh &mesh, const Borders &borders) {
     std::vector<char> zone(mesh.nodes.size(), 0);
-    for (const auto &list : border_nodes(mesh, borders, true))
+    for (const auto &list : border_nodes(mesh, borders, Among::all_nodes))
         for (const auto &x : list)
             zone[x.second] = 1;
     for (char ring = 1; ring < zone_rings; ++ring)
@@ -298,7 +303,7 @@ void split_pinched(Mesh &mesh, const std::vector<char> &zone) {
 /// The open edges left on a border (the other side's faces there were removed as land) are
 /// coast; their nodes may lie up to near_border_tolerance off it (a node the mesher split).
 void tag_border_coast(Mesh &mesh, const Borders &borders) {
-    const auto on = border_nodes(mesh, borders, false, near_border_tolerance);
+    const auto on = border_nodes(mesh, borders, Among::open_edges, near_border_tolerance);
     std::vector<int> border_of(mesh.nodes.size(), -1);
     for (std::size_t k = 0; k < on.size(); ++k)
         for (const auto &x : on[k])

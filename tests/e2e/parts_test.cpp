@@ -118,6 +118,41 @@ TEST(Parts, threads_give_the_same_bytes_natural_earth) {
     }
 }
 
+/// No boundary node lies inside another boundary edge (on its arc between its ends): the
+/// joined parts split an edge wherever the other side's boundary meets it.
+void expect_no_node_inside_a_boundary_edge(const Mesh &mesh) {
+    std::set<NodeIndex> on;
+    for (const BoundaryEdge &e : mesh.boundary)
+        on.insert(e.a), on.insert(e.b);
+    for (const BoundaryEdge &e : mesh.boundary) {
+        const Vec3 &a = mesh.nodes[e.a], &b = mesh.nodes[e.b];
+        const Vec3 normal = normalized(cross(a, b));
+        for (NodeIndex v : on) {
+            const Vec3 &p = mesh.nodes[v];
+            if (v == e.a || v == e.b || std::abs(dot(p, normal)) > 1e-12)
+                continue;
+            EXPECT_FALSE(dot(cross(a, p), normal) > 0 && dot(cross(p, b), normal) > 0)
+                << "node " << v << " inside boundary edge " << e.a << "-" << e.b;
+        }
+    }
+}
+
+TEST(Parts, a_coast_meeting_a_border_where_one_side_removed_its_faces_as_land) {
+    // GSHHG low east of New Guinea, 3 parts, the border at 150.01E: one part split its border
+    // edge there and removed the faces beside it as land, leaving its coast to meet the border
+    // inside the other part's unsplit border edge (mesh-verify: boundary edges crossing).
+    TempDir dir;
+    MeshOptions o;
+    o.coast = fixture("coast/hostile/gshhg_l_new_guinea_east.geojson").string();
+    o.region = std::array<double, 4>{146, -13, 154, -6};
+    for (double h : {25.0, 30.0}) {
+        o.hmax_km = h;
+        const Mesh a = mesh_and_write(o, 3, 2, dir / "a.nc");
+        expect_no_node_inside_a_boundary_edge(a);
+        expect_mesh_verify(dir / "a.nc");
+    }
+}
+
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
     // Each part's lattice is its lune's share of the sphere's: with 3 or more parts it had been
     // weighed whole against one part's node estimate, and skipped.
