@@ -8,15 +8,16 @@
 #include <cmath>
 
 #include "globemesh/predicates.hpp"
+#include "star_search.hpp"
 
 namespace globemesh::parts_detail {
 
 namespace {
 
 /// In the last round, a node near a border whose star's worst face is below this quality (the
-/// share above q 0.8 is what the benches count) gets a pattern search of search_steps steps.
+/// share above q 0.8 is what the benches count) gets two pattern searches (smooth_near_borders).
 constexpr double search_below = 0.8;
-constexpr int search_steps = 16;
+constexpr int search_steps = 16; // the worst face's search: its steps
 
 std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
     return (std::uint64_t(a) << 32) | b;
@@ -35,10 +36,20 @@ double worst_quality(const Mesh &mesh, const std::vector<std::uint32_t> &faces) 
     return q;
 }
 
+/// The faces of `faces` above q 0.8 and the worst quality (-1 when one is folded).
+std::pair<int, double> count_and_worst(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
+    int count = 0;
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        count += triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]) > 0.8;
+    }
+    return {count, worst_quality(mesh, faces)};
+}
+
 /// A pattern search for the place of v where its star's worst face is best (as the mesher's
 /// quality rounds do inside a part): steps along two tangent directions from a fifth of the
 /// mean edge, halved whenever none of the four raises the worst face.
-void search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &faces) {
+void worst_search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &faces) {
     double length = 0;
     for (std::uint32_t f : faces)
         for (NodeIndex u : mesh.faces[f])
@@ -60,6 +71,33 @@ void search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &face
         if (best_place == base)
             step *= 0.5;
     }
+}
+
+/// The mesher's quality rounds' score (quality.cpp): the worst face first up to q 0.6, then the
+/// count of faces above q 0.8, ties broken by their qualities capped at 0.82.
+constexpr detail::CountRule count_rule{0.6, 0.8, 0.82, 1000};
+
+/// A pattern search for the place of v with the best count score of its star (as the mesher's
+/// quality rounds do inside a part), from a tenth of the star's mean edge, its worst face kept
+/// at or above where it is.
+void count_search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t> &faces) {
+    std::vector<detail::FarEdge> far;
+    double length = 0;
+    for (std::uint32_t f : faces) {
+        const auto &t = mesh.faces[f];
+        const int i = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        far.emplace_back(mesh.nodes[t[(i + 1) % 3]], mesh.nodes[t[(i + 2) % 3]]);
+        length += norm(far.back().b - mesh.nodes[v]);
+    }
+    const Vec3 p0 = mesh.nodes[v];
+    const double floor = detail::star_worst_quality(p0, far);
+    double best = detail::star_count_score(p0, far, count_rule, floor);
+    if (floor < 0 || best >= detail::star_count_best(far.size(), count_rule))
+        return;
+    const double step = 0.1 * length / static_cast<double>(far.size());
+    mesh.nodes[v] = detail::pattern_search(p0, step, step / 64, [&](const detail::Points8 &p) {
+        return detail::star_count_accepts(p, far, count_rule, floor, best);
+    });
 }
 
 /// Each free zone node (not on the boundary) with each of its faces, in node order: the same
@@ -171,8 +209,16 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
         mesh.nodes[v] = normalized(sum);
         if (worst_quality(mesh, faces) <= before)
             mesh.nodes[v] = old;
-        if (search && worst_quality(mesh, faces) < search_below)
-            search_node(mesh, v, faces);
+        if (search && worst_quality(mesh, faces) < search_below) {
+            // Two searches: for the most faces above q 0.8, then for the best worst face, kept
+            // where it keeps as many.
+            count_search_node(mesh, v, faces);
+            const Vec3 counted = mesh.nodes[v];
+            const auto counted_score = count_and_worst(mesh, faces);
+            worst_search_node(mesh, v, faces);
+            if (count_and_worst(mesh, faces) < counted_score)
+                mesh.nodes[v] = counted;
+        }
     }
 }
 

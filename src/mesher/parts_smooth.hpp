@@ -25,7 +25,8 @@ FaceOfEdge faces_of_edges(const Mesh &mesh, const std::vector<std::uint32_t> &fa
 void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, FaceOfEdge &face_of);
 
 /// One sweep over the free zone nodes: each to the mean of its neighbours where its star's worst
-/// face rises, then, with `search`, a pattern search where that face is still below q 0.8.
+/// face rises, then, with `search`, where that face is still below q 0.8, pattern searches for the
+/// most faces above q 0.8 and for the best worst face.
 void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
                          const std::vector<std::uint32_t> &zone_face_list, bool search);
 
