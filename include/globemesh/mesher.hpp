@@ -141,6 +141,7 @@ struct MesherReport {
     std::size_t segments_split = 0;    ///< segments split because flips could not recover them
     std::size_t encroached_splits = 0; ///< segments split during refinement and mending
     std::size_t estimated_nodes = 0; ///< the size field's node estimate, checked against max_nodes
+    int parts = 1;                   ///< the parts meshed apart and joined (mesh_parts)
     std::size_t sharp_corners = 0;   ///< boundary nodes with an ocean angle below 60 degrees
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
     std::size_t inlets_closed =

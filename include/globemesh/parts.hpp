@@ -15,6 +15,20 @@ namespace globemesh {
 /// triangle's corner) at 6.
 inline constexpr int max_parts = 6;
 
+/// The part count mesh_parts chooses when asked for 0 parts: one part below this many nodes
+/// (the whole ocean's node estimate), auto_parts from it. Measured on 2 cores
+/// (bench/RESULTS-parallel.md): at 1e6 nodes two parts are as fast as one on a real coast and
+/// slower on an open ocean; from 4e6 they are 1.4-1.5 times faster. Fixed, never the core
+/// count, so that the mesh depends on the inputs alone; more parts pay only with more cores
+/// (--parts).
+inline constexpr std::size_t auto_parts_nodes = 2'000'000;
+inline constexpr int auto_parts = 2;
+
+/// The part count for a run of `estimated_nodes` nodes (auto_parts_nodes).
+inline int parts_for_nodes(std::size_t estimated_nodes) {
+    return estimated_nodes < auto_parts_nodes ? 1 : auto_parts;
+}
+
 /// The longitude (degrees) of border k of n parts: off the meridians where source data has
 /// vertices by construction (0, +-90, +-180).
 double part_border_lon(int k, int parts);
@@ -47,8 +61,9 @@ Mesh join_parts(std::vector<Mesh> &parts_meshes, int parts);
 
 /// mesh_boundary over `parts` parts, meshed on up to `threads` threads (0: one) and joined;
 /// the inland seas are told on the whole boundary first (MesherOptions::keep_inland_seas), the
-/// rest per part. Reports and stage times are summed over the parts. Throws what mesh_boundary
-/// throws, the first in part order.
+/// rest per part. `parts` 0: parts_for_nodes of that pass's node estimate (one part is then
+/// mesh_boundary on `boundary`, as `parts` 1). report->parts says how many. Reports and stage times
+/// are summed over the parts. Throws what mesh_boundary throws, the first in part order.
 Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOptions &options,
                 int parts, unsigned threads, MesherReport *report = nullptr,
                 const Progress &progress = {}, StageTimings *timings = nullptr);

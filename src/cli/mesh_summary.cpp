@@ -135,6 +135,9 @@ void print_coast(std::ostream &out, const OceanMesh &run) {
         print_straits(out, m);
     }
     out << "ocean components  " << ocean_components_text(m) << "\n";
+    if (m.parts > 1)
+        out << "parts             " << m.parts << " lunes meshed apart and joined (--parts; of "
+            << m.estimated_nodes << " nodes estimated)\n";
 }
 
 } // namespace

@@ -169,13 +169,22 @@ template <class Work> void run_parts(std::size_t count, unsigned threads, Work w
 Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOptions &options,
                 int parts, unsigned threads, MesherReport *report_out, const Progress &progress,
                 StageTimings *timings) {
-    if (parts <= 1)
+    if (parts == 1)
         return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
     MesherReport local_report;
     MesherReport &report = report_out ? *report_out : local_report;
     report = MesherReport{};
     auto t0 = Clock::now();
     const Boundary kept = drop_inland_seas(boundary, size_km, options, report);
+    if (parts == 0) {
+        parts = parts_for_nodes(report.estimated_nodes);
+        if (parts == 1) {
+            if (timings)
+                timings->add("parts", seconds_since(t0)); // the pass that chose one part
+            return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
+        }
+    }
+    report.parts = parts;
     MesherOptions part_options = options;
     part_options.keep_inland_seas = true; // a sea cut by a border is two components
     const std::vector<PartBoundary> split =

@@ -108,6 +108,8 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
     a.emplace_back("segments_split", std::to_string(m.segments_split + m.encroached_splits));
     a.emplace_back("inlets_closed", inlets_closed_text(m));
     a.emplace_back("lattice_nodes", std::to_string(m.lattice_nodes));
+    if (m.parts > 1)
+        a.emplace_back("parts", std::to_string(m.parts)); // --parts, or chosen from the estimate
     a.emplace_back("corners_blunted", std::to_string(m.corners_blunted));
     a.emplace_back("floor_nodes_removed", std::to_string(m.floor_nodes_removed));
     a.emplace_back("floor_nodes_added", std::to_string(m.floor_nodes_added));

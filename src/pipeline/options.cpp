@@ -80,9 +80,9 @@ void validate_meshing(const MeshingOptions &o) {
             option("max_memory_bytes") + " must be 0 (no limit) or at least 1MB, e.g. 4GB");
     require(o.smooth_iterations >= 0 && o.smooth_iterations <= 1000,
             option("smooth_iterations") + " must be in 0..1000");
-    require(o.parts >= 1 && o.parts <= max_parts,
-            option("parts") + " must be in 1.." + std::to_string(max_parts) +
-                " (lunes meeting at the poles at 360 / N degrees)");
+    require(o.parts >= 0 && o.parts <= max_parts,
+            option("parts") + " must be in 0.." + std::to_string(max_parts) +
+                " (lunes meeting at the poles at 360 / N degrees; 0 chooses from the mesh size)");
     require(o.threads >= 0 && o.threads <= 1024,
             option("threads") + " must be in 0..1024 (0: one per core)");
     require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,

@@ -126,6 +126,22 @@ DepthReport apply_min_depth(std::vector<double> &depths, std::optional<double> m
     return f;
 }
 
+/// --parts, or with 0 (its default) 1 where even the field's smallest size over the whole ocean
+/// (a quarter more, for the sphere's area against the ellipsoid's and the estimate's sampling)
+/// and every boundary node stay below auto_parts_nodes: most runs, which then need no whole-ocean
+/// pass to count their nodes; else 0, for mesh_parts to count them and choose.
+int part_count(const MeshOptions &o, double ocean_area_km2, const SizeField &field,
+               const Boundary &boundary) {
+    if (o.parts != 0)
+        return o.parts;
+    std::size_t boundary_nodes = 0;
+    for (const Ring &r : boundary.rings)
+        boundary_nodes += r.nodes.size();
+    const double most =
+        nodes_for_area(1.25 * ocean_area_km2, field.min_km()) + static_cast<double>(boundary_nodes);
+    return most < static_cast<double>(auto_parts_nodes) ? 1 : 0;
+}
+
 /// Refuses a run whose node count is far above max_nodes from the coast alone, before the
 /// bathymetry, the size field and the coast's shaping spend minutes and gigabytes on it.
 void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
@@ -319,8 +335,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     auto mesh_start = Clock::now();
     const unsigned threads = o.threads > 0 ? static_cast<unsigned>(o.threads)
                                            : std::max(1u, std::thread::hardware_concurrency());
-    Mesh mesh = mesh_parts(boundary, size, mo, o.parts, threads, &report,
-                           sub_progress(progress, 0.3, 0.97), &mesher_times);
+    Mesh mesh = mesh_parts(boundary, size, mo, part_count(o, coast.ocean_area_km2, field, boundary),
+                           threads, &report, sub_progress(progress, 0.3, 0.97), &mesher_times);
     double mesh_seconds = std::chrono::duration<double>(Clock::now() - mesh_start).count();
     clock.restart();
     if (timings) {

@@ -2,6 +2,7 @@
 // joined mesh is one valid mesh (mesh-verify), the same bytes whatever the thread count, and
 // close to the single-part mesh of the same input; borders cut by the coast (Natural Earth)
 // and an aqua-planet (no ring crosses a border).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -39,6 +40,15 @@ Mesh mesh_and_write(MeshOptions o, int parts, int threads, const fs::path &path)
     w.overwrite = true;
     write_ugrid(run.mesh, path, w);
     return std::move(run.mesh);
+}
+
+/// An aqua-planet with one 10 x 8 degree island, written into dir: its path.
+std::string island(const fs::path &dir) {
+    std::ofstream(dir / "island.geojson")
+        << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+           R"("geometry":{"type":"Polygon","coordinates":[[[-150,0],[-140,0],[-140,8],)"
+           R"([-150,8],[-150,0]]]}}]})";
+    return (dir / "island.geojson").string();
 }
 
 /// Every edge between two faces once each way, every other edge a boundary edge (not open on a
@@ -79,14 +89,8 @@ TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
 
 TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     TempDir dir;
-    {
-        std::ofstream(dir / "island.geojson")
-            << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
-               R"("geometry":{"type":"Polygon","coordinates":[[[-150,0],[-140,0],[-140,8],)"
-               R"([-150,8],[-150,0]]]}}]})";
-    }
     MeshOptions o;
-    o.coast = (dir / "island.geojson").string();
+    o.coast = island(dir.path());
     o.hmax_km = 250;
     const Mesh one = mesh_and_write(o, 1, 1, dir / "one.nc");
     const Mesh a = mesh_and_write(o, 2, 1, dir / "a.nc");
@@ -95,6 +99,33 @@ TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     expect_mesh_verify(dir / "a.nc");
     expect_joined(a);
     EXPECT_NEAR(double(a.nodes.size()), double(one.nodes.size()), 0.03 * double(one.nodes.size()));
+}
+
+TEST(Parts, the_default_part_count_follows_the_node_estimate) {
+    // --parts 0, the default: one part below auto_parts_nodes (2e6) estimated nodes, the single-
+    // part mesh itself; two parts from them. An open ocean of 5.1e8 km2: at 18 km about 1.8e6
+    // nodes (the field's bound alone, a quarter more, does not decide: the whole-ocean pass
+    // counts), at 16 km about 2.3e6.
+    TempDir dir;
+    MeshOptions o;
+    o.coast = island(dir.path());
+    ASSERT_EQ(o.parts, 0);
+    o.hmax_km = 18;
+    const OceanMesh small = mesh_ocean(o);
+    EXPECT_EQ(small.mesher.parts, 1);
+    EXPECT_GT(small.mesher.estimated_nodes, 1'600'000u);
+    EXPECT_LT(small.mesher.estimated_nodes, auto_parts_nodes);
+    o.parts = 1;
+    const OceanMesh one = mesh_ocean(o);
+    EXPECT_TRUE(small.mesh.nodes == one.mesh.nodes && small.mesh.faces == one.mesh.faces);
+    o.parts = 0;
+    o.hmax_km = 16;
+    const OceanMesh big = mesh_ocean(o);
+    EXPECT_EQ(big.mesher.parts, 2);
+    EXPECT_GE(big.mesher.estimated_nodes, auto_parts_nodes);
+    EXPECT_NE(std::find(big.mesh.attributes.begin(), big.mesh.attributes.end(),
+                        std::pair<std::string, std::string>{"parts", "2"}),
+              big.mesh.attributes.end());
 }
 
 TEST(Parts, threads_give_the_same_bytes_natural_earth) {
@@ -138,19 +169,18 @@ void expect_no_node_inside_a_boundary_edge(const Mesh &mesh) {
 }
 
 TEST(Parts, a_coast_meeting_a_border_where_one_side_removed_its_faces_as_land) {
-    // GSHHG low east of New Guinea, 3 parts, the border at 150.01E: one part split its border
-    // edge there and removed the faces beside it as land, leaving its coast to meet the border
-    // inside the other part's unsplit border edge (mesh-verify: boundary edges crossing).
+    // GSHHG low east of New Guinea, 3 parts at 30 km (25 km too), the border at 150.01E: one part
+    // split its border edge there and removed the faces beside it as land, leaving its coast to
+    // meet the border inside the other part's unsplit border edge (mesh-verify: boundary edges
+    // crossing).
     TempDir dir;
     MeshOptions o;
     o.coast = fixture("coast/hostile/gshhg_l_new_guinea_east.geojson").string();
     o.region = std::array<double, 4>{146, -13, 154, -6};
-    for (double h : {25.0, 30.0}) {
-        o.hmax_km = h;
-        const Mesh a = mesh_and_write(o, 3, 2, dir / "a.nc");
-        expect_no_node_inside_a_boundary_edge(a);
-        expect_mesh_verify(dir / "a.nc");
-    }
+    o.hmax_km = 30;
+    const Mesh a = mesh_and_write(o, 3, 2, dir / "a.nc");
+    expect_no_node_inside_a_boundary_edge(a);
+    expect_mesh_verify(dir / "a.nc");
 }
 
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
@@ -176,7 +206,7 @@ TEST(Parts, refuses_more_parts_than_the_poles_allow) {
     o.coast = fixture("coast/ne_110m_land.gpkg").string();
     o.parts = 7;
     EXPECT_THROW(validate(o), UsageError);
-    o.parts = 0;
+    o.parts = -1;
     EXPECT_THROW(validate(o), UsageError);
     o.parts = 2;
     o.threads = -1;
