@@ -28,17 +28,23 @@ constexpr double relax_move_floor = 0.8;
 // connectivity can become the Delaunay one; last, Lawson flips restore the constrained-Delaunay
 // property (undoing the few flips the moves could not make Delaunay). Boundary nodes take no
 // part: counting their ideal valence from their ocean angle (one triangle per 60 degrees) and
-// flipping there too made more coast faces below q 0.8 than it mended. Their neighbours take part
-// in the flips (their valence defects had left most of the faces below q 0.8 with no corner on
-// the coast: NE 1:10m at 100 km, 172 of 177) but are not among the free neighbours moved with
-// the flipped corners. Returns the flips made; the nodes moved get their bit in `active` and
-// lose `as_made`.
+// flipping there too made more coast faces below q 0.8 than it mended. Their neighbours on the
+// coast take part in the flips (their valence defects had left most of the faces below q 0.8
+// with no corner on the coast: NE 1:10m at 100 km, 172 of 177) but are not among the free
+// neighbours moved with the flipped corners. The neighbours of an open boundary (a region's
+// edge, a part's border) keep the lattice's connectivity: flipping them too left the joined
+// aqua-planet's worst faces at its borders at q 0.673 (0.800 without). Returns the flips made;
+// the nodes moved get their bit in `active` and lose `as_made`.
 std::size_t relax_valence(Mesher &m, std::vector<char> &as_made,
                           std::vector<std::uint8_t> &active) {
     SphericalDelaunay &dt = m.dt;
     const std::size_t nv = dt.vertex_count();
     std::vector<int> defect(nv, -6);
-    std::vector<char> coastal(nv, 0); // a boundary node or its neighbour
+    std::vector<char> coastal(nv, 0);                    // a boundary node or its neighbour
+    std::vector<char> open_end(nv, 0), near_open(nv, 0); // an open segment's node, its neighbour
+    for (const auto &[e, kind] : m.segments)
+        if (kind == SegmentKind::open)
+            open_end[e.first] = open_end[e.second] = 1;
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean)
             continue;
@@ -46,12 +52,15 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made,
         ++defect[a], ++defect[b], ++defect[c];
         if (m.is_fixed(a) || m.is_fixed(b) || m.is_fixed(c))
             coastal[a] = coastal[b] = coastal[c] = 1;
+        if (open_end[a] || open_end[b] || open_end[c])
+            near_open[a] = near_open[b] = near_open[c] = 1;
     }
+    auto flips_at = [&](VertexId v) { return !m.is_fixed(v) && !near_open[v]; };
     // A flip needs a corner of positive defect at one end of its edge, or one of valence 4
     // opposite it: only the triangles with one are tried (few where the lattice or smoothing
     // left valence 6).
     std::vector<TriangleId> tried;
-    auto wants = [&](VertexId v) { return !m.is_fixed(v) && (defect[v] > 0 || defect[v] <= -2); };
+    auto wants = [&](VertexId v) { return flips_at(v) && (defect[v] > 0 || defect[v] <= -2); };
     for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
         if (!dt.is_live(t) || dt.label(t) != ocean)
             continue;
@@ -85,7 +94,7 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made,
                      std::max({std::abs(defect[a] - 1), std::abs(defect[b] - 1),
                                std::abs(defect[c] + 1), std::abs(defect[d] + 1)}) >= 2))
                     continue;
-                if (m.is_fixed(a) || m.is_fixed(b) || m.is_fixed(c) || m.is_fixed(d))
+                if (!flips_at(a) || !flips_at(b) || !flips_at(c) || !flips_at(d))
                     continue;
                 const Vec3 &pa = dt.point(a), &pb = dt.point(b), &pc = dt.point(c),
                            &pd = dt.point(d);
