@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole run against the mesh stage at scale (issue 41): the 1.7e7-node global ocean on GSHHG
-# low at 5 km, as the default 2 parts and as one (total / mesh, peak bytes per node) and the global mesh of GSHHG full at 50 km
+# low at 5 km, as one part (the default) and as two (total / mesh, peak bytes per node) and the global mesh of GSHHG full at 50 km
 # (180,161 polygons: the whole run's wall seconds). Prints each run's stages (--timings), wall
 # and CPU seconds and peak (/usr/bin/time) and the machine's load before it.
 #   bench/whole_run.sh GLOBEMESH [GSHHG_DIR]
@@ -25,6 +25,6 @@ print(f'{sys.argv[4]}: {n:,} nodes, load {sys.argv[5]}; wall {wall:.1f} s, cpu {
 print('  ' + ', '.join(f'{k} {v:.2f}' for k, v in t.items()))
 PY
 }
-run "GSHHG low, 5 km (the default: 2 parts)" "$dir/l.gpkg" 5km
-run "GSHHG low, 5 km, --parts 1" "$dir/l.gpkg" 5km --parts 1
+run "GSHHG low, 5 km (the default: one part)" "$dir/l.gpkg" 5km
+run "GSHHG low, 5 km, --parts 2" "$dir/l.gpkg" 5km --parts 2
 run "GSHHG full, 50 km" "$dir/f.gpkg" 50km

@@ -126,7 +126,7 @@ DepthReport apply_min_depth(std::vector<double> &depths, std::optional<double> m
     return f;
 }
 
-/// --parts, or with 0 (its default) 1 for a region (the lunes' borders cross a region's coasts
+/// --parts, or with 0 (asked for) 1 for a region (the lunes' borders cross a region's coasts
 /// wherever they happen to fall, and there the worst faces of the Gulf of Mexico at 0.85 km,
 /// 2.8e6 nodes, went from q 0.60 to 0.53) and where even the field's smallest size over the whole
 /// ocean (a quarter more, for the sphere's area against the ellipsoid's and the estimate's

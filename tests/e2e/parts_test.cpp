@@ -101,15 +101,16 @@ TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     EXPECT_NEAR(double(a.nodes.size()), double(one.nodes.size()), 0.03 * double(one.nodes.size()));
 }
 
-TEST(Parts, the_default_part_count_follows_the_node_estimate) {
-    // --parts 0, the default: one part below auto_parts_nodes (2e6) estimated nodes, the single-
-    // part mesh itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km
-    // about 1.8e6 nodes (the field's bound alone, a quarter more, does not decide: the whole-ocean
-    // pass counts), at 16 km about 2.3e6.
+TEST(Parts, part_count_zero_follows_the_node_estimate) {
+    // --parts 0: one part below auto_parts_nodes (2e6) estimated nodes, the single-part mesh
+    // itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km about
+    // 1.8e6 nodes (the field's bound alone, a quarter more, does not decide: the whole-ocean pass
+    // counts), at 16 km about 2.3e6. The default is 1.
     TempDir dir;
     MeshOptions o;
     o.coast = island(dir.path());
-    ASSERT_EQ(o.parts, 0);
+    ASSERT_EQ(o.parts, 1);
+    o.parts = 0;
     o.hmax_km = 18;
     const OceanMesh small = mesh_ocean(o);
     EXPECT_EQ(small.mesher.parts, 1);
@@ -126,7 +127,7 @@ TEST(Parts, the_default_part_count_follows_the_node_estimate) {
     EXPECT_NE(std::find(big.mesh.attributes.begin(), big.mesh.attributes.end(),
                         std::pair<std::string, std::string>{"parts", "2"}),
               big.mesh.attributes.end());
-    // A region is one part by default however large: 30 x 30 degrees at 2.2 km, 2.4e6 nodes.
+    // A region is one part however large: 30 x 30 degrees at 2.2 km, 2.4e6 nodes.
     o.region = std::array<double, 4>{-160, -10, -130, 20};
     o.hmax_km = 2.2;
     const OceanMesh region = mesh_ocean(o);
