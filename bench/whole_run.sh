@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole run against the mesh stage at scale (issue 41): the 1.7e7-node global ocean on GSHHG
-# low at 5 km, as one part (the default) and as two (total / mesh, peak bytes per node) and the global mesh of GSHHG full at 50 km
-# (180,161 polygons: the whole run's wall seconds). Prints each run's stages (--timings), wall
+# low at 5 km, as one part (the default) and as two (total / mesh, peak bytes per node), and the
+# global mesh of GSHHG full at 50 km (180,161 polygons: the whole run's wall seconds). Prints each run's stages (--timings), wall
 # and CPU seconds and peak (/usr/bin/time) and the machine's load before it.
 #   bench/whole_run.sh GLOBEMESH [GSHHG_DIR]
 # GSHHG_DIR holds l.gpkg and f.gpkg (bench/gshhg_land.py l|f GSHHG_DIR/R.gpkg; default /tmp/gshhg).
