@@ -209,13 +209,14 @@ void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeomet
     }
 }
 
-PointList ring_points(Geos &geos, const GEOSGeometry *ring) {
-    const GEOSCoordSequence *seq = GEOSGeom_getCoordSeq_r(geos.get(), ring);
+PointList ring_points(const Geos &geos, const GEOSGeometry *ring) {
+    const GEOSCoordSequence *seq = ring ? GEOSGeom_getCoordSeq_r(geos.get(), ring) : nullptr;
     unsigned n = 0;
-    GEOSCoordSeq_getSize_r(geos.get(), seq, &n);
-    std::vector<double> xy(2 * n);
-    if (n)
-        GEOSCoordSeq_copyToBuffer_r(geos.get(), seq, xy.data(), 0, 0);
+    if (!seq || !GEOSCoordSeq_getSize_r(geos.get(), seq, &n))
+        throw DataError("coast: GEOS failed to read a ring: " + geos.message());
+    std::vector<double> xy(2 * std::size_t(n));
+    if (n && !GEOSCoordSeq_copyToBuffer_r(geos.get(), seq, xy.data(), 0, 0))
+        throw DataError("coast: GEOS failed to read a ring: " + geos.message());
     PointList pts(n);
     for (unsigned i = 0; i < n; ++i)
         pts[i] = {xy[2 * i], xy[2 * i + 1]};

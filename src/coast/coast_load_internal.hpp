@@ -66,8 +66,8 @@ GeomPtr make_collection(Geos &geos, std::vector<GeomPtr> &parts);
 GeomPtr make_valid(Geos &geos, const GEOSGeometry *g);
 /// The non-empty polygons of a polygonal geometry or collection, in order (not owned).
 void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeometry *> &out);
-/// The vertices of a GEOS ring or line.
-PointList ring_points(Geos &geos, const GEOSGeometry *ring);
+/// The vertices of a GEOS ring or line; DataError when GEOS cannot give them.
+PointList ring_points(const Geos &geos, const GEOSGeometry *ring);
 /// Polygonizes closed coastline lines (GSHHG / OSM style). Lines are first merged at shared
 /// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
 /// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the

@@ -10,6 +10,7 @@
 
 #include <geos_c.h>
 
+#include "coast_load_internal.hpp"
 #include "geos_handles.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -322,27 +323,15 @@ LandMask::~LandMask() = default;
 
 std::function<std::shared_ptr<const LandTest>()> LandMask::copier() const {
     const Impl &m = *impl_;
-    auto ring_points = [&m](const GEOSGeometry *ring) {
-        const GEOSCoordSequence *seq = ring ? GEOSGeom_getCoordSeq_r(m.ctx, ring) : nullptr;
-        unsigned size = 0;
-        if (!seq || !GEOSCoordSeq_getSize_r(m.ctx, seq, &size))
-            throw DataError("coast: GEOS failed to read a land ring for the land test");
-        std::vector<double> xy(2 * std::size_t(size));
-        if (size > 0 && !GEOSCoordSeq_copyToBuffer_r(m.ctx, seq, xy.data(), 0, 0))
-            throw DataError("coast: GEOS failed to read a land ring for the land test");
-        std::vector<LonLat> points(size);
-        for (unsigned i = 0; i < size; ++i)
-            points[i] = {xy[2 * std::size_t(i)], xy[2 * std::size_t(i) + 1]};
-        return points;
-    };
+    using coast_detail::ring_points;
     auto polygons = std::make_shared<std::vector<std::vector<std::vector<LonLat>>>>();
     polygons->reserve(m.polygons.size());
     for (const GeomPtr &polygon : m.polygons) {
         std::vector<std::vector<LonLat>> rings{
-            ring_points(GEOSGetExteriorRing_r(m.ctx, polygon.get()))};
+            ring_points(m.geos, GEOSGetExteriorRing_r(m.ctx, polygon.get()))};
         const int holes = GEOSGetNumInteriorRings_r(m.ctx, polygon.get());
         for (int h = 0; h < holes; ++h)
-            rings.push_back(ring_points(GEOSGetInteriorRingN_r(m.ctx, polygon.get(), h)));
+            rings.push_back(ring_points(m.geos, GEOSGetInteriorRingN_r(m.ctx, polygon.get(), h)));
         polygons->push_back(std::move(rings));
     }
     return [polygons]() -> std::shared_ptr<const LandTest> {
