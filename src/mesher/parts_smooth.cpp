@@ -39,11 +39,17 @@ double worst_quality(const Mesh &mesh, const std::vector<std::uint32_t> &faces) 
 /// The faces of `faces` above q 0.8 and the worst quality (-1 when one is folded).
 std::pair<int, double> count_and_worst(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
     int count = 0;
+    double worst = 1;
+    bool folded = false;
     for (std::uint32_t f : faces) {
         const auto &t = mesh.faces[f];
-        count += triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]) > 0.8;
+        const Vec3 &a = mesh.nodes[t[0]], &b = mesh.nodes[t[1]], &c = mesh.nodes[t[2]];
+        folded = folded || predicates::orient(a, b, c) <= 0;
+        const double q = triangle_quality(a, b, c);
+        count += q > 0.8;
+        worst = std::min(worst, q);
     }
-    return {count, worst_quality(mesh, faces)};
+    return {count, folded ? -1 : worst};
 }
 
 /// A pattern search for the place of v where its star's worst face is best (as the mesher's
@@ -75,7 +81,7 @@ void worst_search_node(Mesh &mesh, NodeIndex v, const std::vector<std::uint32_t>
 
 /// The mesher's quality rounds' score (quality.cpp): the worst face first up to q 0.6, then the
 /// count of faces above q 0.8, ties broken by their qualities capped at 0.82.
-constexpr detail::CountRule count_rule{0.6, 0.8, 0.82, 1000};
+constexpr detail::CountRule count_rule = detail::quality_count_rule;
 
 /// A pattern search for the place of v with the best count score of its star (as the mesher's
 /// quality rounds do inside a part), from a tenth of the star's mean edge, its worst face kept

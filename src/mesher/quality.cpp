@@ -11,7 +11,7 @@ namespace {
 
 // Then the nodes of triangles below this quality (away from sharp corners) get a pattern search
 // for their star's best worst triangle, for this many rounds (more rounds change nothing).
-constexpr double worst_goal = 0.6;
+constexpr double worst_goal = detail::quality_count_rule.worst_goal; // 0.6
 constexpr int search_rounds = 2;
 constexpr int mend_passes = 3;
 // Rounds of the last, quality-driven smoothing of the nodes of triangles below q count_cap:
@@ -20,15 +20,14 @@ constexpr int improve_rounds = 6;
 // The faces below the floor that get a node's trial (each copies the triangulation and scans its
 // faces): the last few a run leaves; a mesh with more has another problem to find.
 constexpr std::size_t max_floor_trials = 64;
-// Those rounds move each node where its star has the most triangles above count_quality (the
-// issue's q 0.8), ties broken by the sum of the qualities capped at count_cap, with no triangle
-// below min(the star's worst, worst_goal) (star_count_score): the count and the capped sum at
-// 0.82 gave the most faces above 0.8. The nodes are those of the triangles below count_cap: a
-// node whose triangles are all above it has the best score already and stays.
-constexpr double count_quality = 0.8;
-constexpr double count_cap = 0.82;
-constexpr double count_worst_weight = 1000; // the worst up to worst_goal comes first
-constexpr detail::CountRule count_rule{worst_goal, count_quality, count_cap, count_worst_weight};
+// Those rounds move each node where its star has the most triangles above q 0.8 (the issue's),
+// ties broken by the sum of the qualities capped at count_cap, with no triangle below min(the
+// star's worst, worst_goal) (star_count_score), the worst up to worst_goal first (weight 1000):
+// the count and the capped sum at 0.82 gave the most faces above 0.8. The nodes are those of the
+// triangles below count_cap: a node whose triangles are all above it has the best score already
+// and stays. The four values: detail::quality_count_rule, which the join of parts shares.
+constexpr double count_cap = detail::quality_count_rule.count_cap; // 0.82
+constexpr detail::CountRule count_rule = detail::quality_count_rule;
 
 // The rounds' state: the nodes to move and the scratch of their stars (the lambdas of one
 // block, as members).

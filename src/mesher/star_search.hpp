@@ -52,6 +52,10 @@ struct CountRule {
     double worst_weight;  // the weight of the worst (count_worst_weight)
 };
 
+/// The rule of the mesher's quality rounds (quality.cpp, which says how each value was chosen);
+/// the join of parts (parts_smooth.cpp) scores its nodes by it too.
+inline constexpr CountRule quality_count_rule{0.6, 0.8, 0.82, 1000};
+
 /// The quality rounds' score of the star triangles p, b, c (far edges b -> c): count_worst_weight
 /// times the worst quality up to worst_goal, plus 1 for each triangle above count_quality and its
 /// quality capped at count_cap. A higher score first has a better worst below worst_goal, then more
