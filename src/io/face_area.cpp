@@ -7,6 +7,8 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 
+#include "ordered_blocks.hpp"
+
 namespace globemesh::io {
 
 namespace {
@@ -122,7 +124,23 @@ double polygon_area_m2(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     return std::fabs(area);
 }
 
-GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo) : topo_(topo) {}
+GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo) : topo_(topo) {
+    const Ellipsoid &w = wgs84();
+    const auto &nodes = topo.mesh->nodes;
+    authalic_.resize(nodes.size());
+    for_each_range(nodes.size(), [&](std::size_t first, std::size_t last) {
+        for (std::size_t i = first; i < last; ++i)
+            authalic_[i] = to_authalic(w, nodes[i]);
+    });
+    side_.resize(topo.edge_count());
+    for_each_range(side_.size(), [&](std::size_t first, std::size_t last) {
+        for (std::size_t e = first; e < last; ++e) {
+            const auto [a, b] = topo.edge_nodes(e);
+            side_[e] = side_term(w, nodes[std::size_t(a)], nodes[std::size_t(b)],
+                                 authalic_[std::size_t(a)], authalic_[std::size_t(b)]);
+        }
+    });
+}
 
 double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f) const {
     const auto &face = topo_.mesh->faces[f];
@@ -133,21 +151,19 @@ double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f)
         if (const Vec3 d = v[(k + 1) % 3] - v[k]; dot(d, d) > longest_chord * longest_chord)
             return polygon_area_m2(v[0], v[1], v[2]);
     const Ellipsoid &w = wgs84();
-    const Vec3 s[3] = {to_authalic(w, v[0]), to_authalic(w, v[1]), to_authalic(w, v[2])};
+    const Vec3 s[3] = {authalic_[face[0]], authalic_[face[1]], authalic_[face[2]]};
     // The spherical triangle's excess, tan(E / 2) = det / (1 + a.b + b.c + c.a), the determinant
     // from the sides (b - a, c - a) to keep its digits on small faces.
     const double det = dot(s[0], cross(s[1] - s[0], s[2] - s[0]));
     double area =
         w.rq2 * 2 * std::atan2(det, 1 + dot(s[0], s[1]) + dot(s[1], s[2]) + dot(s[2], s[0]));
     for (int k = 0; k < 3; ++k) {
-        const int j = (k + 1) % 3;
         const auto e = std::size_t(edges_of_f[k]);
-        // Side k runs from corner k to corner j: the edge's own direction when the face is the
-        // edge's first (edge_nodes), the opposite one on its second; the term is computed in the
-        // edge's direction so that both faces get the same value.
+        // Side k runs from corner k to corner k + 1: the edge's own direction when the face is
+        // the edge's first (edge_nodes), the opposite one on its second; the term is the edge's,
+        // so that both faces get the same value.
         const bool forward = topo_.edge_halves[e][0] == 3 * f + std::size_t(k);
-        area +=
-            forward ? side_term(w, v[k], v[j], s[k], s[j]) : -side_term(w, v[j], v[k], s[j], s[k]);
+        area += forward ? side_[e] : -side_[e];
     }
     return std::fabs(area);
 }

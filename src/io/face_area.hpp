@@ -13,7 +13,9 @@
 // edge's own direction (edge_nodes) and enters its two faces with opposite signs, so the
 // areas still tile the ellipsoid.
 //
-// Memory: nothing beyond the topology; every face's area is computed when asked for.
+// Memory: 48 bytes a node while it lives: each node's image on the authalic sphere and each
+// edge's side term, computed once, on every core, when it is built (a node is a corner of about
+// six faces, an edge a side of two).
 #pragma once
 
 #include <cstdint>
@@ -30,7 +32,8 @@ public:
     /// GeographicLib's PolygonArea.
     static constexpr double short_side_km = 80;
 
-    /// The areas of topo's mesh, computed face by face in face_m2 (safe from any thread).
+    /// The areas of topo's mesh, face by face in face_m2 (safe from any thread); the nodes'
+    /// images and the edges' side terms are computed here, on every core.
     explicit GeodesicFaceAreas(const MeshTopology &topo);
 
     /// The area of face f (m2), whose edges edges_of_f are those face_edges gives.
@@ -38,6 +41,8 @@ public:
 
 private:
     const MeshTopology &topo_;
+    std::vector<Vec3> authalic_; ///< each node's image on the authalic sphere
+    std::vector<double> side_;   ///< each edge's side term (m2), in its own direction
 };
 
 /// The area (m2) of the geodesic triangle abc (unit vectors of geodetic lon/lat, as
