@@ -8,7 +8,7 @@ GLOBEMESH_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # with the Python headers (python3-dev, which pybind11-dev does not pull in) and numpy (its arrays)
 # for the Python module.
 GLOBEMESH_BUILD_PACKAGES="g++ cmake make ninja-build pkg-config libgdal-dev libsqlite3-dev libgeos-dev libproj-dev
-  libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin
+  libgeographiclib-dev libnetcdf-dev libhdf5-dev libdeflate-dev libsleef-dev libcli11-dev libgtest-dev libbenchmark-dev gdal-bin netcdf-bin
   pybind11-dev python3-dev python3-numpy"
 # What the tests use besides: GMP as the exact oracle of the predicate tests, mandoc/man for the
 # man-page lint, the independent checkers' Python modules, QGIS for qgis-check, and clang with

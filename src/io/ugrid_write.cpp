@@ -320,8 +320,8 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
     });
     if (detail::after_partial_write)
         detail::after_partial_write(); // tests only (write_hooks.hpp)
-    w.put_lonlat(t.coords[2], t.coords[3], nf, centre);
-    w.put_lonlat(t.coords[4], t.coords[5], ne, midpoint);
+    w.put_derived_lonlat(t.coords[2], t.coords[3], nf, centre);
+    w.put_derived_lonlat(t.coords[4], t.coords[5], ne, midpoint);
     w.put_rows<int, 2>(t.edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
     {
         w.put_lonlat(t.coords[0], t.coords[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
