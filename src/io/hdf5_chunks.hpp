@@ -8,7 +8,8 @@
 // direct chunk write, meant for callers that compress on their own). ChunkEncoder encodes a
 // chunk exactly as those two filters define it, with libdeflate instead of zlib for the deflate:
 // the same zlib stream format, which every HDF5 reads, 1.8 times as fast at level 1 and a little
-// smaller. The file is the same netCDF-4 file, chunk for chunk; only the deflate streams differ.
+// smaller; a double's byte planes that are noise go into the stream as stored blocks, not
+// deflated. The file is the same netCDF-4 file, chunk for chunk; only the deflate streams differ.
 #pragma once
 
 #include <cstddef>
@@ -41,8 +42,11 @@ public:
                 std::size_t element_size, std::vector<unsigned char> &out);
 
 private:
+    /// Whether a plane of `bytes` bytes is noise, not worth deflating (hdf5_chunks.cpp).
+    bool noise(const unsigned char *plane, std::size_t bytes);
+
     libdeflate_compressor *compressor_;
-    std::vector<unsigned char> shuffled_;
+    std::vector<unsigned char> shuffled_, probe_;
 };
 
 /// A closed netCDF-4 file reopened for direct chunk writes. Messages name `target` (the file the
