@@ -205,7 +205,7 @@ public:
         put_xy(v_lon, v_lat, n, [&](std::size_t i) { return vec_to_lonlat(point(i)); });
     }
     /// put_lonlat for points derived from the nodes (face centres, edge midpoints), converted
-    /// by lonlat_batch: within 1 ulp of vec_to_lonlat's, the same bits on every machine.
+    /// by lonlat_batch: within 2 ulp of vec_to_lonlat's, the same bits on every machine.
     template <class Point>
     void put_derived_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point) {
         using Columns = std::pair<std::vector<Vec3>, std::array<std::vector<double>, 2>>;
