@@ -45,9 +45,11 @@ int part_of(const Vec3 &p, int parts);
 /// `boundary` cut into the rings of each part: each ring piece inside a part, joined along the
 /// part's borders by nodes spaced by size_km (open segments), a deterministic function of the
 /// border, the coast crossing it and the size field. An empty boundary (aqua-planet) gives each
-/// part its outline. `land` (may be null) tells whether a border no ring crosses is land. A part
-/// without ocean gets no rings and `has_ocean` false. Throws DataError when the rings do not
-/// alternate along a border (they do not close the ocean).
+/// part its outline. A border no ring crosses is ocean as the south pole is, which the crossed
+/// borders tell; with no crossing at all, not for a region's outline (rings with open segments)
+/// and else where `land` (may be null) has no land. A part without ocean gets no rings and
+/// `has_ocean` false. Throws DataError when the rings do not alternate along a border (they do
+/// not close the ocean).
 struct PartBoundary {
     Boundary boundary;
     bool has_ocean = false;

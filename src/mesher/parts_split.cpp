@@ -141,9 +141,23 @@ struct Splitter {
         return out;
     }
 
+    /// Whether a border no ring crosses is ocean: as the south pole is, which any crossed
+    /// border tells (ocean south of its first crossing where that crossing goes west); with no
+    /// crossing anywhere, not for a region's outline (the ocean is inside it, away from every
+    /// border), else where `land` (may be null) has no land.
+    bool uncrossed_ocean(int k, const LandTest *land, bool region) const {
+        const Crossing *first = nullptr;
+        for (const Crossing &c : crossings)
+            if (!first || c.p.z < first->p.z)
+                first = &c;
+        if (first)
+            return !first->east;
+        return !region && !(land && land->contains(border_direction(k, n)));
+    }
+
     /// Border k's nodes from the south pole to the north: crossings, and the ocean stretches'
     /// nodes with the poles where they are ocean.
-    std::vector<Node> border_nodes(int k, const LandTest *land) const {
+    std::vector<Node> border_nodes(int k, const LandTest *land, bool region) const {
         std::vector<int> on;
         for (std::size_t c = 0; c < crossings.size(); ++c)
             if (crossings[c].border == k)
@@ -153,8 +167,7 @@ struct Splitter {
                                                         : a < b;
         });
         const Vec3 south{0, 0, -1}, north{0, 0, 1};
-        bool ocean = on.empty() ? !(land && land->contains(border_direction(k, n)))
-                                : !crossings[on.front()].east;
+        bool ocean = on.empty() ? uncrossed_ocean(k, land, region) : !crossings[on.front()].east;
         std::vector<Node> out;
         Vec3 from = south;
         if (ocean)
@@ -303,9 +316,14 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
     std::vector<int> piece_of_entry(s.crossings.size(), -1);
     for (const auto &nodes : cut)
         cut_pieces(nodes, parts, pieces, piece_of_entry);
+    // A region's outline is made of open segments; a coast's rings have none.
+    const bool region =
+        std::any_of(boundary.rings.begin(), boundary.rings.end(), [](const Ring &r) {
+            return std::find(r.kinds.begin(), r.kinds.end(), SegmentKind::open) != r.kinds.end();
+        });
     std::vector<std::vector<Node>> borders;
     for (int k = 0; k < parts; ++k)
-        borders.push_back(s.border_nodes(k, land));
+        borders.push_back(s.border_nodes(k, land, region));
     for (int k = 0; k < parts; ++k) {
         const std::vector<Node> loop = part_outline(borders, k, parts);
         auto &b = out[static_cast<std::size_t>(k)];

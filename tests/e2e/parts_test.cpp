@@ -175,19 +175,49 @@ void expect_no_node_inside_a_boundary_edge(const Mesh &mesh) {
     }
 }
 
+/// GSHHG low east of New Guinea (the fixture) in the box 146-154E, 13-6S, at 30 km.
+MeshOptions new_guinea_east() {
+    MeshOptions o;
+    o.coast = fixture("coast/hostile/gshhg_l_new_guinea_east.geojson").string();
+    o.region = std::array<double, 4>{146, -13, 154, -6};
+    o.hmax_km = 30;
+    return o;
+}
+
 TEST(Parts, a_coast_meeting_a_border_where_one_side_removed_its_faces_as_land) {
     // GSHHG low east of New Guinea, 3 parts at 30 km (25 km too), the border at 150.01E: one part
     // split its border edge there and removed the faces beside it as land, leaving its coast to
     // meet the border inside the other part's unsplit border edge (mesh-verify: boundary edges
     // crossing).
     TempDir dir;
-    MeshOptions o;
-    o.coast = fixture("coast/hostile/gshhg_l_new_guinea_east.geojson").string();
-    o.region = std::array<double, 4>{146, -13, 154, -6};
-    o.hmax_km = 30;
+    const MeshOptions o = new_guinea_east();
     const Mesh a = mesh_and_write(o, 3, 2, dir / "a.nc");
     expect_no_node_inside_a_boundary_edge(a);
     expect_mesh_verify(dir / "a.nc");
+}
+
+TEST(Parts, a_region_in_parts_is_meshed_inside_its_box_alone) {
+    // The box (146-154E) lies in one lune of 2 parts and across the border at 150.01E of 3. A
+    // border no ring crosses had been taken for ocean where the coast has no land: 2 parts
+    // refused the box ("a boundary ring has the ocean on its right"), 3 meshed two whole lunes.
+    TempDir dir;
+    const MeshOptions o = new_guinea_east();
+    const std::size_t one = mesh_ocean(o).mesh.nodes.size();
+    for (int parts : {2, 3}) {
+        SCOPED_TRACE(parts);
+        const fs::path path = dir / ("p" + std::to_string(parts) + ".nc");
+        const Mesh m = mesh_and_write(o, parts, 2, path);
+        EXPECT_GT(double(m.nodes.size()), 0.9 * double(one));
+        EXPECT_LT(double(m.nodes.size()), 1.2 * double(one));
+        for (const Vec3 &v : m.nodes) {
+            const LonLat p = vec_to_lonlat(v);
+            // The box's southern edge is a great circle between its corners: a little south.
+            ASSERT_TRUE(p.lon >= 146 - 1e-9 && p.lon <= 154 + 1e-9 && p.lat >= -13.1 &&
+                        p.lat <= -6 + 1e-9)
+                << p.lon << " " << p.lat;
+        }
+        expect_mesh_verify(path);
+    }
 }
 
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
