@@ -14,6 +14,9 @@ namespace {
 
 /// A crossing within this fraction of h of a ring node replaces the node: no segment shorter.
 constexpr double snap_fraction = 0.1;
+/// A ring's excursion across a border no deeper than this fraction of h is dropped: below the
+/// h / 4 by which the mesh's coast may stray from the source's elsewhere (land.cpp).
+constexpr double excursion_fraction = 0.2;
 /// The border's size-field integral is summed in steps of this fraction of h.
 constexpr double border_step_fraction = 0.125;
 /// A segment crossing two borders (near a pole) is halved at most this many times.
@@ -76,17 +79,17 @@ struct Splitter {
         out.push_back({p, kind, static_cast<int>(crossings.size() - 1)});
     }
 
-    /// Whether p lies within snap_fraction * h of border k's meridian plane.
+    /// Whether p lies within excursion_fraction * h of border k's meridian plane.
     bool near_border(const Vec3 &p, int k) const {
         return std::fabs(dot(p, border_normal(k, n))) <
-               std::sin(snap_fraction * km_to_rad(size_km(p)));
+               std::sin(excursion_fraction * km_to_rad(size_km(p)));
     }
 
     /// The nodes of `nodes` with its excursions across a border dropped: two successive
     /// crossings of one border and the nodes between them, when all of those lie within
-    /// snap_fraction * h of it (a coast vertex a few metres past a border made a piece of one
-    /// node, faces of q 0.09 at the border where one part has none). The ring then stays on the
-    /// side it was on before and after (a lune is convex), moved by less than that distance.
+    /// excursion_fraction * h of it (a coast vertex a few metres past a border made a piece of
+    /// one node, faces of q 0.09 at the border where one part has none). The ring then stays on
+    /// the side it was on before and after (a lune is convex), moved by less than that.
     std::vector<Node> drop_excursions(std::vector<Node> nodes) {
         std::vector<std::size_t> at;
         for (std::size_t i = 0; i < nodes.size(); ++i)
@@ -123,9 +126,8 @@ struct Splitter {
         return kept;
     }
 
-    /// The ring's nodes with its crossings inserted, its excursions across a border within
-    /// snap_fraction * h of it dropped, ring nodes within snap_fraction * h of a crossing
-    /// dropped.
+    /// The ring's nodes with its crossings inserted, its shallow excursions across a border
+    /// dropped, ring nodes within snap_fraction * h of a crossing dropped.
     std::vector<Node> cut_ring(const Ring &r) {
         std::vector<Node> nodes;
         const std::size_t m = r.nodes.size();
