@@ -8,8 +8,8 @@
 
 #if defined(__x86_64__)
 // sleef.h declares its AVX functions only to code compiled for AVX; this one is called only
-// where the CPU has it.
-extern "C" __m256d Sleef_cinz_atan2d4_u10avx(__m256d, __m256d);
+// where the CPU has it, from AVX code (its vector arguments in AVX registers, as clang asks).
+extern "C" __attribute__((target("avx"))) __m256d Sleef_cinz_atan2d4_u10avx(__m256d, __m256d);
 #endif
 
 namespace globemesh::io {
