@@ -178,6 +178,9 @@ struct MesherReport {
     /// than.
     std::vector<double> straits_closed_width_below_km;
     std::vector<double> seas_cut_off; ///< km2 of each basin those closings cut off (kept)
+    /// The nodes beside those closings' cuts: mesh_parts tells the basins on the joined mesh, a
+    /// part's own pieces reaching the ocean through another part.
+    std::vector<Vec3> cut_points;
     double straits_water_km2 = 0; ///< water cut off with them and closed (inlet_area, inlet_width)
     std::size_t nodes_split =
         0; ///< nodes added where a strait closed at a node between two fans of water

@@ -90,40 +90,6 @@ void split_pinched(Mesher &m, std::size_t node_count, PinchSplit &split) {
     m.report.nodes_split = split.fan_point.size();
 }
 
-// The areas (km^2, largest first) of the basins the closed straits cut off: the mesh's pieces
-// (union-find over the nodes through the faces) beside a cut (cut_nodes), but for the largest.
-void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report) {
-    std::vector<NodeIndex> parent(mesh.nodes.size());
-    for (NodeIndex i = 0; i < parent.size(); ++i)
-        parent[i] = i;
-    auto find = [&](NodeIndex i) {
-        while (parent[i] != i)
-            i = parent[i] = parent[parent[i]];
-        return i;
-    };
-    for (const auto &f : mesh.faces) {
-        const NodeIndex r = find(f[0]);
-        for (int k = 1; k < 3; ++k)
-            parent[find(f[k])] = r;
-    }
-    std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
-    for (const NodeIndex n : cut_nodes)
-        area.emplace(find(n), 0.0);
-    std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
-    for (const auto &f : mesh.faces)
-        ++faces_of[find(f[0])];
-    const NodeIndex largest = static_cast<NodeIndex>(
-        std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
-    area.erase(largest);
-    for (const auto &f : mesh.faces)
-        if (auto it = area.find(find(f[0])); it != area.end())
-            it->second +=
-                spherical_triangle_area(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]);
-    for (const auto &[r, a] : area)
-        report.seas_cut_off.push_back(a * earth_radius_km * earth_radius_km);
-    std::sort(report.seas_cut_off.rbegin(), report.seas_cut_off.rend());
-}
-
 // Counts the boundary nodes whose ocean angle is below 60 degrees, and the faces at them.
 void count_sharp_corners(const Mesh &mesh, MesherReport &report) {
     std::vector<double> ocean_angle(mesh.nodes.size(), 0.0);
@@ -183,6 +149,39 @@ std::vector<NodeIndex> write_faces(const Mesher &m, const PinchSplit &split, std
 
 } // namespace
 
+// The pieces are found by union-find over the nodes through the faces.
+void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report) {
+    std::vector<NodeIndex> parent(mesh.nodes.size());
+    for (NodeIndex i = 0; i < parent.size(); ++i)
+        parent[i] = i;
+    auto find = [&](NodeIndex i) {
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    for (const auto &f : mesh.faces) {
+        const NodeIndex r = find(f[0]);
+        for (int k = 1; k < 3; ++k)
+            parent[find(f[k])] = r;
+    }
+    std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
+    for (const NodeIndex n : cut_nodes)
+        area.emplace(find(n), 0.0);
+    std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
+    for (const auto &f : mesh.faces)
+        ++faces_of[find(f[0])];
+    const NodeIndex largest = static_cast<NodeIndex>(
+        std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
+    area.erase(largest);
+    for (const auto &f : mesh.faces)
+        if (auto it = area.find(find(f[0])); it != area.end())
+            it->second +=
+                spherical_triangle_area(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]);
+    for (const auto &[r, a] : area)
+        report.seas_cut_off.push_back(a * earth_radius_km * earth_radius_km);
+    std::sort(report.seas_cut_off.rbegin(), report.seas_cut_off.rend());
+}
+
 Mesh to_mesh(Mesher &m) {
     SphericalDelaunay &dt = m.dt;
     // The faces first, then the triangulation goes and its points become the nodes in place: the
@@ -217,6 +216,8 @@ Mesh to_mesh(Mesher &m) {
     std::vector<NodeIndex>().swap(node_of);
     if (!cut_nodes.empty())
         seas_cut_off(mesh, cut_nodes, m.report);
+    for (const NodeIndex n : cut_nodes)
+        m.report.cut_points.push_back(mesh.nodes[n]);
     count_sharp_corners(mesh, m.report);
     Field target{"target_size", "target edge length", "km", "", {}};
     target.values.reserve(mesh.nodes.size());

@@ -4,6 +4,7 @@
 #include "globemesh/parts.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <exception>
 #include <map>
@@ -108,7 +109,7 @@ void add_report(MesherReport &run, const MesherReport &part) {
     append(run.straits_closed_at, part.straits_closed_at);
     append(run.straits_closed_width_km, part.straits_closed_width_km);
     append(run.straits_closed_width_below_km, part.straits_closed_width_below_km);
-    append(run.seas_cut_off, part.seas_cut_off);
+    append(run.cut_points, part.cut_points); // seas_cut_off: told on the joined mesh
     run.straits_water_km2 += part.straits_water_km2;
     run.nodes_split += part.nodes_split;
 }
@@ -138,6 +139,21 @@ private:
     std::mutex mutex_;
     bool stop_ = false;
 };
+
+/// The basins the parts' closed straits cut off, told on the joined mesh (a part's pieces beside
+/// a cut may reach the ocean through another part: alone, a part counted half of Hudson Bay).
+void basins_cut_off(const Mesh &mesh, MesherReport &report) {
+    if (report.cut_points.empty())
+        return;
+    std::set<std::array<double, 3>> cut;
+    for (const Vec3 &p : report.cut_points)
+        cut.insert({p.x, p.y, p.z});
+    std::vector<NodeIndex> cut_nodes;
+    for (NodeIndex i = 0; i < mesh.nodes.size(); ++i)
+        if (cut.count({mesh.nodes[i].x, mesh.nodes[i].y, mesh.nodes[i].z}))
+            cut_nodes.push_back(i);
+    seas_cut_off(mesh, cut_nodes, report);
+}
 
 /// Runs work(k, t) for k in [0, count) on `threads` threads (t the thread's number, 0 this
 /// one), each taking the next k; rethrows the first exception in k order once all have ended.
@@ -233,6 +249,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
             timings->stages.push_back(s);
     }
     Mesh mesh = join_parts(meshes, parts);
+    basins_cut_off(mesh, report);
     if (timings)
         timings->add("join", seconds_since(t0));
     return mesh;

@@ -3,9 +3,11 @@
 // close to the single-part mesh of the same input; borders cut by the coast (Natural Earth)
 // and an aqua-planet (no ring crosses a border).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 #include <string>
 
@@ -220,6 +222,47 @@ TEST(Parts, a_region_in_parts_is_meshed_inside_its_box_alone) {
                 << p.lon << " " << p.lat;
         }
         expect_mesh_verify(path);
+    }
+}
+
+TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
+    // Each part had reported its own pieces beside a closed strait, though they reach the ocean
+    // through another part: NE 1:110m at 150 km in 5 parts listed 6 basins, two of 2.6e6 and
+    // 2.9e6 km2, where the joined mesh has one piece besides the ocean's.
+    MeshOptions o;
+    o.coast = fixture("coast/ne_110m_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = 150;
+    for (int parts : {3, 5}) {
+        SCOPED_TRACE(parts);
+        o.parts = parts;
+        const OceanMesh run = mesh_ocean(o);
+        // The joined mesh's pieces (union-find over the faces' nodes) and their areas, km2.
+        std::vector<NodeIndex> up(run.mesh.nodes.size());
+        for (NodeIndex i = 0; i < up.size(); ++i)
+            up[i] = i;
+        auto root = [&](NodeIndex i) {
+            while (up[i] != i)
+                i = up[i] = up[up[i]];
+            return i;
+        };
+        for (const auto &f : run.mesh.faces)
+            up[root(f[1])] = up[root(f[2])] = root(f[0]);
+        std::map<NodeIndex, double> area;
+        for (const auto &f : run.mesh.faces)
+            area[root(f[0])] += spherical_triangle_area(run.mesh.nodes[f[0]], run.mesh.nodes[f[1]],
+                                                        run.mesh.nodes[f[2]]) *
+                                earth_radius_km * earth_radius_km;
+        std::vector<double> pieces;
+        for (const auto &[r, a] : area)
+            pieces.push_back(a);
+        std::sort(pieces.rbegin(), pieces.rend());
+        pieces.erase(pieces.begin()); // the ocean
+        ASSERT_LE(run.mesher.seas_cut_off.size(), pieces.size());
+        for (const double a : run.mesher.seas_cut_off)
+            EXPECT_TRUE(std::any_of(pieces.begin(), pieces.end(),
+                                    [a](double p) { return std::fabs(p - a) <= 1e-6 * p; }))
+                << a << " km2 is no piece of the joined mesh";
     }
 }
 
