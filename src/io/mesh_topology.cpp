@@ -133,14 +133,7 @@ MeshTopology build_topology(const Mesh &mesh) {
             std::upper_bound(start.begin(), start.end() - 1, std::uint32_t(nh * k / parts)) -
             start.begin()));
     cut.push_back(nn);
-    {
-        std::vector<std::future<void>> sorted;
-        for (std::size_t k = 1; k < parts; ++k)
-            sorted.push_back(start_task([&, k] { sort_nodes(cut[k], cut[k + 1]); }));
-        sort_nodes(cut[0], cut[1]);
-        for (auto &done : sorted)
-            done.get();
-    }
+    for_each_part(parts, [&](std::size_t k) { sort_nodes(cut[k], cut[k + 1]); });
 
     // Calls edge(i, j, v) for each edge in order: its half-edges are bucket[i..j), one or two,
     // and v is its smaller node.

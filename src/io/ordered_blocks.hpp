@@ -36,16 +36,22 @@ template <class Task> auto start_task(const Task &task) {
     }
 }
 
+/// Runs task(k) for k in 0 .. parts - 1: task(0) on this thread, each other on a thread of its
+/// own (start_task); returns once all have ended, rethrowing the first exception in k order.
+template <class Task> void for_each_part(std::size_t parts, const Task &task) {
+    std::vector<std::future<void>> others;
+    for (std::size_t k = 1; k < parts; ++k)
+        others.push_back(start_task([&, k] { task(k); }));
+    task(0);
+    for (auto &done : others)
+        done.get();
+}
+
 /// Runs range(first, last) over [0, n) cut into one range per block thread, the first on this
 /// thread; range must only read shared data and write what belongs to its own indices.
 template <class Range> void for_each_range(std::size_t n, const Range &range) {
     const std::size_t parts = std::max<std::size_t>(1, std::min(n, block_threads()));
-    std::vector<std::future<void>> others;
-    for (std::size_t k = 1; k < parts; ++k)
-        others.push_back(start_task([&, k] { range(n * k / parts, n * (k + 1) / parts); }));
-    range(0, n / parts);
-    for (auto &done : others)
-        done.get();
+    for_each_part(parts, [&](std::size_t k) { range(n * k / parts, n * (k + 1) / parts); });
 }
 
 /// Runs compute(k, slot, worker) for each block k in 0 .. blocks - 1 on up to block_threads()
