@@ -6,12 +6,6 @@
 
 #include <sleef.h>
 
-#if defined(__x86_64__)
-// sleef.h declares its AVX functions only to code compiled for AVX; this one is called only
-// where the CPU has it, from AVX code (its vector arguments in AVX registers, as clang asks).
-extern "C" __attribute__((target("avx"))) __m256d Sleef_cinz_atan2d4_u10avx(__m256d, __m256d);
-#endif
-
 namespace globemesh::io {
 
 namespace detail {
@@ -24,20 +18,6 @@ bool has_avx() {
     return false;
 #endif
 }
-
-#if defined(__x86_64__)
-namespace {
-__attribute__((target("avx"))) void atan2_avx(const double *y, const double *x, double *out,
-                                              std::size_t n) {
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += 4)
-        _mm256_storeu_pd(out + i,
-                         Sleef_cinz_atan2d4_u10avx(_mm256_loadu_pd(y + i), _mm256_loadu_pd(x + i)));
-    for (; i < n; ++i)
-        out[i] = Sleef_cinz_atan2d1_u10purec(y[i], x[i]);
-}
-} // namespace
-#endif
 
 void atan2_batch(Atan2Path path, const double *y, const double *x, double *out, std::size_t n) {
     std::size_t i = 0;

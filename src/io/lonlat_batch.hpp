@@ -26,6 +26,8 @@ enum class Atan2Path { avx, sse2, plain };
 void atan2_batch(Atan2Path path, const double *y, const double *x, double *out, std::size_t n);
 /// Whether this CPU runs AVX.
 bool has_avx();
+/// atan2_batch's AVX path (lonlat_batch_avx.cpp, x86-64 only): only where has_avx().
+void atan2_avx(const double *y, const double *x, double *out, std::size_t n);
 } // namespace detail
 
 } // namespace globemesh::io
