@@ -3,6 +3,7 @@
 // the target size per node.
 #include "mesher_state.hpp"
 
+#include <map>
 #include <tuple>
 
 namespace globemesh::mesher_internal {
@@ -33,29 +34,38 @@ struct PinchSplit {
     }
 };
 
+// Where the corners of faces already split sit: a face may have two or three pinched corners
+// (a coast through a pole), each moved into its own fan.
+using MovedCorners = std::map<std::pair<TriangleId, VertexId>, Vec3>;
+
 // The point pinch_apart or less from vertex v towards the centroid of the fan's middle face
 // (inside the fan's angle): every face of the fan must stay counter-clockwise (a sliver of the
-// fan may be thinner than pinch_apart).
-Vec3 into_fan(const Mesher &m, VertexId v, const std::vector<TriangleId> &fan) {
+// fan may be thinner than pinch_apart), with its corners split before this one where they went.
+Vec3 into_fan(const Mesher &m, VertexId v, const std::vector<TriangleId> &fan,
+              const MovedCorners &moved) {
     const SphericalDelaunay &dt = m.dt;
     const Vec3 &p = dt.point(v);
     const Vec3 into = m.centroid(fan[fan.size() / 2]) - p;
     const Vec3 dir = normalized(into - dot(into, p) * p);
+    auto at = [&](TriangleId t, VertexId u) {
+        const auto it = moved.find({t, u});
+        return it != moved.end() ? it->second : dt.point(u);
+    };
     auto far_edge = [&](TriangleId t) {
         int i = 0;
         while (dt.vertex(t, i) != v)
             ++i;
-        return std::pair{dt.point(dt.vertex(t, next3(i))), dt.point(dt.vertex(t, prev3(i)))};
+        return std::pair{at(t, dt.vertex(t, next3(i))), at(t, dt.vertex(t, prev3(i)))};
     };
     for (double d = pinch_apart; d > 1e-15; d *= 0.5) {
-        const Vec3 moved = normalized(p + d * dir);
+        const Vec3 moved_p = normalized(p + d * dir);
         bool ccw = true;
         for (const TriangleId t : fan) {
             const auto [a, b] = far_edge(t);
-            ccw = ccw && predicates::orient(moved, a, b) > 0;
+            ccw = ccw && predicates::orient(moved_p, a, b) > 0;
         }
         if (ccw)
-            return moved;
+            return moved_p;
     }
     return p;
 }
@@ -67,6 +77,7 @@ void split_pinched(Mesher &m, std::size_t node_count, PinchSplit &split) {
     m.pinched.erase(std::unique(m.pinched.begin(), m.pinched.end()), m.pinched.end());
     std::vector<std::tuple<TriangleId, VertexId, NodeIndex>> corners;
     std::vector<std::vector<TriangleId>> fans;
+    MovedCorners moved;
     for (const VertexId v : m.pinched) {
         fans.clear();
         const int n = m.ocean_fans(dt.leaving(v, no_triangle), [&](TriangleId t, int k) {
@@ -76,10 +87,12 @@ void split_pinched(Mesher &m, std::size_t node_count, PinchSplit &split) {
         });
         for (int k = 1; k < n; ++k) {
             const std::vector<TriangleId> &fan = fans[std::size_t(k)];
-            split.fan_point.push_back(into_fan(m, v, fan));
+            split.fan_point.push_back(into_fan(m, v, fan, moved));
             const auto node = static_cast<NodeIndex>(node_count + split.fan_point.size() - 1);
-            for (const TriangleId t : fan)
+            for (const TriangleId t : fan) {
                 corners.emplace_back(t, v, node);
+                moved[{t, v}] = split.fan_point.back();
+            }
         }
     }
     std::sort(corners.begin(), corners.end());
