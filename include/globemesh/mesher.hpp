@@ -103,7 +103,9 @@ struct MesherOptions {
     /// Where the ocean may lie (a part's lune, parts.hpp): where dot(p, n) > 0 for each normal
     /// n. The lattice's points elsewhere are not looked for in the triangulation, and
     /// `lattice_share` (the share of the sphere that covers) scales the lattice's points
-    /// against the node estimate. Empty: the whole sphere.
+    /// against the node estimate. Empty: the whole sphere. A node on one of these planes (a
+    /// part's border) is never split where a closed strait pinches it: the other part's faces
+    /// may join its fans, and join_parts splits those still pinched.
     std::vector<Vec3> lattice_within;
     double lattice_share = 1;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near

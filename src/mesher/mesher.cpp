@@ -75,7 +75,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     if (options.land)
         measure_closed_straits(m, *options.land, report);
 
-    // Conversion to Mesh (output.cpp).
+    // Conversion to Mesh (output.cpp); a part's border nodes stay whole for the join.
+    keep_border_nodes_whole(m, options.lattice_within);
     Mesh mesh = to_mesh(m);
     globemesh::report(progress, 1.0, "improve");
     return mesh;

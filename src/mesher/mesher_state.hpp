@@ -516,6 +516,10 @@ void blunt_sharp_corners(Mesher &m, const MesherOptions &options);
 // output.cpp: the ocean triangles as a Mesh (nodes a closed strait pinched split, the seas it cut
 // off, sharp corners and the target size per node in the report and the mesh).
 Mesh to_mesh(Mesher &m);
+/// Takes off Mesher::pinched the nodes on one of `borders`' planes (a part's borders,
+/// MesherOptions::lattice_within): the other part's faces may join their fans, and join_parts
+/// splits those still pinched on the joined mesh.
+void keep_border_nodes_whole(Mesher &m, const std::vector<Vec3> &borders);
 /// Appends to report.seas_cut_off the areas (km2, then sorted largest first) of the mesh's
 /// pieces beside a cut (cut_nodes) but the largest: the basins closed straits cut off.
 void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report);

@@ -195,6 +195,16 @@ void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, Mes
     std::sort(report.seas_cut_off.rbegin(), report.seas_cut_off.rend());
 }
 
+void keep_border_nodes_whole(Mesher &m, const std::vector<Vec3> &borders) {
+    // On a border to rounding (1e-16, as split_boundary put them); other nodes are a segment away.
+    constexpr double on_border = 1e-12;
+    std::erase_if(m.pinched, [&](VertexId v) {
+        const Vec3 &p = m.dt.point(v);
+        return std::any_of(borders.begin(), borders.end(),
+                           [&](const Vec3 &n) { return std::abs(dot(p, n)) < on_border; });
+    });
+}
+
 Mesh to_mesh(Mesher &m) {
     SphericalDelaunay &dt = m.dt;
     // The faces first, then the triangulation goes and its points become the nodes in place: the

@@ -14,6 +14,9 @@ namespace {
 
 /// A crossing within this fraction of h of a ring node replaces the node: no segment shorter.
 constexpr double snap_fraction = 0.1;
+/// A ring's excursion across a border no deeper than this fraction of h is dropped: below the
+/// h / 4 by which the mesh's coast may stray from the source's elsewhere (land.cpp).
+constexpr double excursion_fraction = 0.2;
 /// The border's size-field integral is summed in steps of this fraction of h.
 constexpr double border_step_fraction = 0.125;
 /// A segment crossing two borders (near a pole) is halved at most this many times.
@@ -22,7 +25,8 @@ constexpr int max_halvings = 40;
 struct Crossing {
     Vec3 p;
     int border = 0;
-    bool east = false; // the ring goes east across the border (ocean to the north)
+    bool east = false;    // the ring goes east across the border (ocean to the north)
+    bool dropped = false; // with an excursion (drop_excursions): not on the border any more
 };
 
 struct Node {
@@ -75,8 +79,55 @@ struct Splitter {
         out.push_back({p, kind, static_cast<int>(crossings.size() - 1)});
     }
 
-    /// The ring's nodes with its crossings inserted; ring nodes within snap_fraction * h of a
-    /// crossing dropped.
+    /// Whether p lies within excursion_fraction * h of border k's meridian plane.
+    bool near_border(const Vec3 &p, int k) const {
+        return std::fabs(dot(p, border_normal(k, n))) <
+               std::sin(excursion_fraction * km_to_rad(size_km(p)));
+    }
+
+    /// The nodes of `nodes` with its excursions across a border dropped: two successive
+    /// crossings of one border and the nodes between them, when all of those lie within
+    /// excursion_fraction * h of it (a coast vertex a few metres past a border made a piece of
+    /// one node, faces of q 0.09 at the border where one part has none). The ring then stays on
+    /// the side it was on before and after (a lune is convex), moved by less than that.
+    std::vector<Node> drop_excursions(std::vector<Node> nodes) {
+        std::vector<std::size_t> at;
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+            if (nodes[i].crossing >= 0)
+                at.push_back(i);
+        std::vector<char> drop(nodes.size(), 0);
+        std::size_t dropped = 0;
+        for (std::size_t c = 0; at.size() >= 2 && c < at.size(); ++c) {
+            const std::size_t i = at[c], j = at[(c + 1) % at.size()];
+            const int k = crossings[static_cast<std::size_t>(nodes[i].crossing)].border;
+            if (drop[i] || drop[j] ||
+                k != crossings[static_cast<std::size_t>(nodes[j].crossing)].border)
+                continue;
+            bool near = true;
+            std::size_t between = 0;
+            for (std::size_t v = (i + 1) % nodes.size(); v != j && near;
+                 v = (v + 1) % nodes.size(), ++between)
+                near = near_border(nodes[v].p, k);
+            if (!near || nodes.size() - dropped - between - 2 < 3)
+                continue;
+            for (std::size_t v = i; v != j; v = (v + 1) % nodes.size())
+                drop[v] = 1;
+            drop[j] = 1;
+            dropped += between + 2;
+        }
+        if (dropped == 0)
+            return nodes;
+        std::vector<Node> kept;
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+            if (!drop[i])
+                kept.push_back(nodes[i]);
+            else if (nodes[i].crossing >= 0)
+                crossings[static_cast<std::size_t>(nodes[i].crossing)].dropped = true;
+        return kept;
+    }
+
+    /// The ring's nodes with its crossings inserted, its shallow excursions across a border
+    /// dropped, ring nodes within snap_fraction * h of a crossing dropped.
     std::vector<Node> cut_ring(const Ring &r) {
         std::vector<Node> nodes;
         const std::size_t m = r.nodes.size();
@@ -84,6 +135,7 @@ struct Splitter {
             nodes.push_back({r.nodes[i], r.kinds[i], -1});
             split_segment(r.nodes[i], r.nodes[(i + 1) % m], r.kinds[i], 0, nodes);
         }
+        nodes = drop_excursions(std::move(nodes));
         std::vector<char> drop(nodes.size(), 0);
         for (std::size_t i = 0; i < nodes.size(); ++i) {
             if (nodes[i].crossing < 0)
@@ -148,7 +200,7 @@ struct Splitter {
     bool uncrossed_ocean(int k, const LandTest *land, bool region) const {
         const Crossing *first = nullptr;
         for (const Crossing &c : crossings)
-            if (!first || c.p.z < first->p.z)
+            if (!c.dropped && (!first || c.p.z < first->p.z))
                 first = &c;
         if (first)
             return !first->east;
@@ -160,7 +212,7 @@ struct Splitter {
     std::vector<Node> border_nodes(int k, const LandTest *land, bool region) const {
         std::vector<int> on;
         for (std::size_t c = 0; c < crossings.size(); ++c)
-            if (crossings[c].border == k)
+            if (crossings[c].border == k && !crossings[c].dropped)
                 on.push_back(static_cast<int>(c));
         std::sort(on.begin(), on.end(), [&](int a, int b) {
             return crossings[a].p.z != crossings[b].p.z ? crossings[a].p.z < crossings[b].p.z
@@ -306,7 +358,10 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
         if (std::none_of(nodes.begin(), nodes.end(),
                          [](const Node &v) { return v.crossing >= 0; })) {
             auto &b = out[static_cast<std::size_t>(part_of(nodes[0].p, parts))];
-            b.boundary.rings.push_back(r);
+            Ring kept; // r, less the excursions drop_excursions took
+            for (const Node &v : nodes)
+                kept.nodes.push_back(v.p), kept.kinds.push_back(v.kind);
+            b.boundary.rings.push_back(std::move(kept));
             b.has_ocean = true;
         } else {
             cut.push_back(std::move(nodes));
