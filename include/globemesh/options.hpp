@@ -80,11 +80,10 @@ struct MeshingOptions {
     /// water is under the local size squared, 0..2; 0 keeps every inlet.
     double inlet_width = 0.5;
     std::uint64_t seed = 1; ///< seed of every pseudo-random choice
-    /// Parts meshed apart and joined (docs/parallel.md), 1..6: the mesh depends on it; 0 chooses
-    /// from the node estimate (parts_for_nodes: 1 below 2e6 nodes, else 2), 1 for a region. The
-    /// default stays 1: the joined mesh's worst faces where a coast meets a border fall below the
-    /// single part's q 0.3 floor (bench/RESULTS-parallel.md).
-    int parts = 1;
+    /// Parts meshed apart and joined (docs/parallel.md), 1..6: the mesh depends on it; 0, the
+    /// default, chooses from the node estimate (parts_for_nodes: 1 below 2e6 nodes, else 2), 1
+    /// for a region: never from the core count.
+    int parts = 0;
     /// Threads meshing the parts at once, 0: one per core; the mesh never depends on it.
     int threads = 0;
 };

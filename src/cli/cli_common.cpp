@@ -136,7 +136,7 @@ std::string file_configuration(const std::string &config) {
     while (start < config.size()) {
         const std::size_t end = std::min(config.find('\n', start), config.size());
         const std::string line = config.substr(start, end - start);
-        if (line.rfind("threads=", 0) != 0 && line != "parts=1")
+        if (line.rfind("threads=", 0) != 0 && line != "parts=0")
             out += line + (end < config.size() ? "\n" : "");
         start = end + 1;
     }

@@ -62,8 +62,8 @@ std::string usage_text(const CLI::ParseError &e, const std::string &command);
 std::string history_text(const std::string &sub, std::span<const std::string> args);
 
 /// The configuration (config_to_str) as an output file keeps it: without the thread count,
-/// which never changes the mesh (the same bytes on any machine), and without the default single
-/// part (the files of before --parts).
+/// which never changes the mesh (the same bytes on any machine), and without the default part
+/// count (0, chosen from the mesh size: a file of one part is that of before --parts).
 std::string file_configuration(const std::string &config);
 
 /// Throws Cancelled once a cancelling signal arrived (InterruptGuard).

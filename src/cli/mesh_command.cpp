@@ -236,8 +236,8 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
         ->group(mesher)
         ->type_name("N");
     app.add_option("--parts", m.parts,
-                   "Mesh N lunes apart and join them (1..6; the mesh depends on N; 0: 2 for a "
-                   "global mesh of 2e6 nodes or more, else 1)")
+                   "Mesh N lunes apart and join them (1..6; the mesh depends on N; 0, the default: "
+                   "2 for a global mesh of 2e6 nodes or more, else 1)")
         ->group(mesher)
         ->type_name("N");
     app.add_option("--threads", m.threads,

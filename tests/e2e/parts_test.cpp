@@ -107,12 +107,11 @@ TEST(Parts, part_count_zero_follows_the_node_estimate) {
     // --parts 0: one part below auto_parts_nodes (2e6) estimated nodes, the single-part mesh
     // itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km about
     // 1.8e6 nodes (the field's bound alone, a quarter more, does not decide: the whole-ocean pass
-    // counts), at 16 km about 2.3e6. The default is 1.
+    // counts), at 16 km about 2.3e6. It is the default.
     TempDir dir;
     MeshOptions o;
     o.coast = island(dir.path());
-    ASSERT_EQ(o.parts, 1);
-    o.parts = 0;
+    ASSERT_EQ(o.parts, 0);
     o.hmax_km = 18;
     const OceanMesh small = mesh_ocean(o);
     EXPECT_EQ(small.mesher.parts, 1);
