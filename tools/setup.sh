@@ -49,7 +49,7 @@ configure_and_build() {
 # UndefinedBehaviorSanitizer on everything and libFuzzer's coverage on the library. tools/test
 # builds and runs the sanitizer tests in it and tools/fuzz the fuzz targets, so the library is
 # compiled once for both (two trees, g++'s and clang's, took 5.4 + 3.0 min of CI's 22).
-# -O1 with line tables (-g1): what AddressSanitizer's documentation recommends; the asserts stay on.
+# -O1 with line tables (-g1): what AddressSanitizer's documentation recommends.
 configure_sanitized() {
     local cxx=${CXX:-clang++}
     if ! command -v "$cxx" > /dev/null; then

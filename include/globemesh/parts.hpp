@@ -36,6 +36,10 @@ double part_border_lon(int k, int parts);
 /// The normal of border k's meridian plane: dot(p, normal) > 0 east of the border.
 Vec3 border_normal(int k, int parts);
 
+/// A node this close to a border's plane (radians) lies on the border: border nodes are on it
+/// to rounding (1e-16, as split_boundary puts them), every other node a segment's length away.
+inline constexpr double on_border_tolerance = 1e-12;
+
 /// Where border k's meridian meets the equator: dot(p, direction) > 0 on its half of the plane.
 Vec3 border_direction(int k, int parts);
 

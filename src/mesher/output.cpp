@@ -3,6 +3,8 @@
 // the target size per node.
 #include "mesher_state.hpp"
 
+#include "globemesh/parts.hpp"
+
 #include <map>
 #include <tuple>
 
@@ -196,12 +198,11 @@ void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, Mes
 }
 
 void keep_border_nodes_whole(Mesher &m, const std::vector<Vec3> &borders) {
-    // On a border to rounding (1e-16, as split_boundary put them); other nodes are a segment away.
-    constexpr double on_border = 1e-12;
     std::erase_if(m.pinched, [&](VertexId v) {
         const Vec3 &p = m.dt.point(v);
-        return std::any_of(borders.begin(), borders.end(),
-                           [&](const Vec3 &n) { return std::abs(dot(p, n)) < on_border; });
+        return std::any_of(borders.begin(), borders.end(), [&](const Vec3 &n) {
+            return std::abs(dot(p, n)) < on_border_tolerance;
+        });
     });
 }
 

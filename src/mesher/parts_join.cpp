@@ -19,10 +19,6 @@ namespace {
 
 using namespace parts_detail;
 
-/// A node this close to a border's plane (radians) lies on the border: border nodes are on it
-/// to rounding (1e-16), every other node is a boundary segment's length away.
-constexpr double on_border_tolerance = 1e-12;
-
 /// A node the parts' meshers split off a border node (0.64 m, a pinched strait) is this close
 /// to the border (radians): 6 m.
 constexpr double near_border_tolerance = 1e-6;

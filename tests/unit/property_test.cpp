@@ -1172,14 +1172,21 @@ TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
 }
 
 namespace {
-/// A case's mesher options with the coast's land (its straits closed whatever the case asks).
-MesherOptions with_land(const CoastCase &c, const CoastData &coast) {
+/// Meshes case c from its GeoJSON (a file named `name`) with the coast's land, its straits
+/// closed whatever the case asks; its shaped boundary must be valid.
+void mesh_with_land(CoastCase c, const std::string &name, Mesh &mesh, MesherReport &report) {
+    MemFile file(name, c.json);
+    c.options.coast = file.path();
+    const SizeFn size = [h = c.h](const Vec3 &) { return h; };
+    const CoastData coast = load_coast(c.options);
+    const Boundary boundary = shape_boundary(coast, size, c.options);
+    ASSERT_TRUE(check_boundary(boundary).empty());
     MesherOptions mo;
     mo.keep_inland_seas = c.options.keep_inland_seas;
     mo.land = coast.land;
     mo.max_nodes = 20000;
     mo.lattice_km = c.h;
-    return mo;
+    mesh = mesh_boundary(boundary, size, mo, &report);
 }
 } // namespace
 
@@ -1188,15 +1195,9 @@ MesherOptions with_land(const CoastCase &c, const CoastData &coast) {
 // moving the node's copy 0.64 m into its fan turned the sliver clockwise. The copy now moves
 // at most as far as keeps every face of its fan counter-clockwise.
 TEST(MesherProperty, a_node_split_at_a_closed_strait_keeps_its_fan_counter_clockwise) {
-    CoastCase c = coast_case(192);
-    MemFile file("seed192.geojson", c.json);
-    c.options.coast = file.path();
-    const SizeFn size = [h = c.h](const Vec3 &) { return h; };
-    const CoastData coast = load_coast(c.options);
-    const Boundary boundary = shape_boundary(coast, size, c.options);
-    ASSERT_TRUE(check_boundary(boundary).empty());
+    Mesh mesh;
     MesherReport report;
-    const Mesh mesh = mesh_boundary(boundary, size, with_land(c, coast), &report);
+    ASSERT_NO_FATAL_FAILURE(mesh_with_land(coast_case(192), "seed192.geojson", mesh, report));
     EXPECT_GE(report.nodes_split, 1u);
     EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
 }
@@ -1223,14 +1224,9 @@ TEST(MesherProperty, nodes_split_side_by_side_at_a_pole_keep_their_faces_counter
     c.h = 829.1673975464621;
     c.options.keep_inland_seas = true;
     c.options.min_island_triangles = 2;
-    MemFile file("pole_pinches.geojson", c.json);
-    c.options.coast = file.path();
-    const SizeFn size = [h = c.h](const Vec3 &) { return h; };
-    const CoastData coast = load_coast(c.options);
-    const Boundary boundary = shape_boundary(coast, size, c.options);
-    ASSERT_TRUE(check_boundary(boundary).empty());
+    Mesh mesh;
     MesherReport report;
-    const Mesh mesh = mesh_boundary(boundary, size, with_land(c, coast), &report);
+    ASSERT_NO_FATAL_FAILURE(mesh_with_land(c, "pole_pinches.geojson", mesh, report));
     EXPECT_GE(report.nodes_split, 3u);
     EXPECT_TRUE(mesh_problem(mesh).empty()) << mesh_problem(mesh);
 }
