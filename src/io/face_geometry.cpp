@@ -91,6 +91,30 @@ std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &
     return parts;
 }
 
+bool simple_face_ring(const Vec3 v[3], const LonLat ll[3], std::array<LonLatPoint, 3> &ring) {
+    // face_polygons' steps on three corners, with the cases that change the ring left to it.
+    for (int i = 0; i < 3; ++i) {
+        if (is_pole(v[i]))
+            return false;
+        ring[std::size_t(i)] = {ll[i].lon, ll[i].lat};
+    }
+    for (std::size_t i = 1; i < 3; ++i)
+        ring[i][0] = ring[i - 1][0] + wrap_delta(ring[i][0] - ring[i - 1][0]);
+    const double winding = ring[2][0] + wrap_delta(ring[0][0] - ring[2][0]) - ring[0][0];
+    if (std::fabs(winding) > 180)
+        return false;
+    // Strictly inside: a corner at +-180 would leave a sliver in the ring shifted by 360.
+    for (const auto &p : ring)
+        if (!(p[0] > -180 && p[0] < 180))
+            return false;
+    double a = 0; // ring_area's sum, in its order
+    for (std::size_t i = 0; i < 3; ++i) {
+        const auto &p = ring[i], &q = ring[(i + 1) % 3];
+        a += p[0] * q[1] - q[0] * p[1];
+    }
+    return std::fabs(0.5 * a) > 1e-18;
+}
+
 std::vector<LonLatPart> polyline_parts(const std::vector<Vec3> &nodes) {
     LonLatPart line;
     for (const auto &v : nodes) {

@@ -20,6 +20,13 @@ using LonLatPart = std::vector<LonLatPoint>; ///< a ring (not repeated closing p
 /// The face abc (unit vectors, counter-clockwise) as one or more polygon rings within [-180, 180].
 std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
+/// The one ring of face_polygons(v[0], v[1], v[2]) in its common case, from the corners' lon/lat
+/// (vec_to_lonlat of v): no corner at a pole, the face not round a pole, every corner strictly
+/// inside (-180, 180) once the ring is unwrapped, and not degenerate. Then face_polygons returns
+/// exactly {ring} (the same values: its clipping keeps such a ring as it is), and this returns
+/// true without allocating; else false.
+bool simple_face_ring(const Vec3 v[3], const LonLat ll[3], std::array<LonLatPoint, 3> &ring);
+
 /// A polyline of unit vectors (straight in lon/lat between nodes) cut at +-180 into parts.
 std::vector<LonLatPart> polyline_parts(const std::vector<Vec3> &nodes);
 

@@ -2,6 +2,7 @@
 #include "gpkg_rtree.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -14,6 +15,8 @@
 
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
+#include "ordered_blocks.hpp"
+#include "sqlite_pages.hpp"
 
 namespace globemesh::io {
 
@@ -32,6 +35,41 @@ RtreeBox rtree_box(double min_x, double max_x, double min_y, double max_y) {
 
 namespace {
 
+/// keys[from, to) sorted as std::sort sorts (key, index) pairs: by key, ties by index. Each
+/// pair is one 64-bit word, the key's bits in an order that compares as the floats do (the
+/// sign flipped, a negative's other bits inverted; -0 made +0 first), then the index, sorted by
+/// least-significant-digit radix a byte at a time (a byte every word shares is skipped).
+void sort_keyed(std::vector<std::uint64_t> &words, std::vector<std::uint64_t> &scratch) {
+    const std::size_t n = words.size();
+    std::vector<std::array<std::size_t, 256>> counts(8);
+    for (auto &c : counts)
+        c.fill(0);
+    for (std::uint64_t w : words)
+        for (std::size_t d = 0; d < 8; ++d)
+            ++counts[d][(w >> (8 * d)) & 0xff];
+    scratch.resize(n);
+    for (std::size_t d = 0; d < 8; ++d) {
+        auto &c = counts[d];
+        if (std::find(c.begin(), c.end(), n) != c.end())
+            continue; // every word has the same byte here
+        std::size_t at = 0;
+        for (auto &k : c)
+            at += std::exchange(k, at);
+        for (std::uint64_t w : words)
+            scratch[c[(w >> (8 * d)) & 0xff]++] = w;
+        words.swap(scratch);
+    }
+}
+
+/// The word of (key, index) for sort_keyed.
+std::uint64_t keyed_word(float key, std::uint32_t index) {
+    key += 0.0f; // -0 -> +0: the two compare equal
+    std::uint32_t bits;
+    std::memcpy(&bits, &key, sizeof bits);
+    bits = bits & 0x80000000u ? ~bits : bits | 0x80000000u;
+    return std::uint64_t(bits) << 32 | index;
+}
+
 /// Sort-Tile-Recursive packing (Leutenegger, Lopez & Edgington 1997) of the boxes into nodes of
 /// at most `capacity`: sorted by the x of their centres into vertical slices of about
 /// sqrt(nodes) nodes each, each slice sorted by y and cut into nodes. Returns the boxes' order
@@ -43,15 +81,15 @@ std::vector<std::size_t> pack(const std::vector<RtreeBox> &boxes, std::size_t ca
     const std::size_t nodes = (n + capacity - 1) / capacity;
     const auto slices = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(nodes))));
     const std::size_t per_slice = ((nodes + slices - 1) / slices) * capacity;
-    // Sorted as (centre, index) pairs: an index sort that reads the boxes misses the cache
-    // (2.1M faces: 0.4 s).
-    std::vector<std::pair<float, std::uint32_t>> keyed(n);
+    // Sorted as (centre, index) words: an index sort that reads the boxes misses the cache.
+    std::vector<std::uint64_t> words, scratch;
     auto sort_by = [&](std::size_t lo, std::size_t from, std::size_t to) {
+        words.resize(to - from);
         for (std::size_t i = from; i < to; ++i)
-            keyed[i] = {boxes[order[i]][lo] + boxes[order[i]][lo + 1], order[i]};
-        std::sort(keyed.begin() + std::ptrdiff_t(from), keyed.begin() + std::ptrdiff_t(to));
+            words[i - from] = keyed_word(boxes[order[i]][lo] + boxes[order[i]][lo + 1], order[i]);
+        sort_keyed(words, scratch);
         for (std::size_t i = from; i < to; ++i)
-            order[i] = keyed[i].second;
+            order[i] = std::uint32_t(words[i - from]);
     };
     order.resize(n);
     std::iota(order.begin(), order.end(), 0u);
@@ -112,17 +150,7 @@ public:
     ~Statement() { sqlite3_finalize(s_); }
     Statement(const Statement &) = delete;
     Statement &operator=(const Statement &) = delete;
-    /// Binds two integers, steps and resets: an INSERT of one row.
-    void insert(std::int64_t a, std::int64_t b) {
-        sqlite3_bind_int64(s_, 1, a);
-        sqlite3_bind_int64(s_, 2, b);
-        step();
-    }
-    void insert(std::int64_t a, const std::vector<unsigned char> &blob) {
-        sqlite3_bind_int64(s_, 1, a);
-        sqlite3_bind_blob(s_, 2, blob.data(), static_cast<int>(blob.size()), SQLITE_STATIC);
-        step();
-    }
+    /// Binds an integer, steps and resets: an INSERT or UPDATE of one row.
     void insert(std::int64_t a) {
         sqlite3_bind_int64(s_, 1, a);
         step();
@@ -197,106 +225,117 @@ struct Steps {
     }
 };
 
-/// One layer's index: the virtual table (SQLite creates its shadow tables and an empty root),
-/// then the packed tree written into them, then the triggers and the extension's row.
-void add_index(GpkgSqlite &db, const RtreeLayer &layer, Steps &steps) {
-    const std::string rtree = "rtree_" + layer.table + "_" + layer.column;
-    db.exec("CREATE VIRTUAL TABLE " + quoted(rtree) + " USING rtree(id, minx, maxx, miny, maxy)");
-    // The node size SQLite chose for this file's page size (its root is a node of that size).
-    Statement size(db, "SELECT length(data) FROM " + quoted(rtree + "_node") + " WHERE nodeno = 1");
-    const std::int64_t node_bytes = size.single();
-    constexpr std::size_t cell_bytes = 8 + 4 * 4;
-    if (node_bytes < std::int64_t(4 + 2 * cell_bytes))
-        db.fail("spatial index: unexpected root node of " + rtree);
-    const std::size_t capacity = (std::size_t(node_bytes) - 4) / cell_bytes;
+/// A layer's packed tree: level k holds the nodes at height k (0: the leaves); node j of a level
+/// has the cells order[i] for i in [starts[j], starts[j + 1]), each the index of a box in `boxes`
+/// (a feature's at the leaves, fid = index + 1; a node's of the level below above them). The
+/// top level has one node, the root.
+struct PackedTree {
+    struct Level {
+        const std::vector<RtreeBox> *boxes;
+        std::vector<std::uint32_t> order;
+        std::vector<std::size_t> starts;
+    };
+    std::deque<std::vector<RtreeBox>> node_boxes; // the boxes of the levels above the leaves
+    std::vector<Level> levels;
+};
 
-    if (!layer.boxes.empty()) {
-        // Level k holds the nodes at height k (0: the leaves): node j has the cells order[i]
-        // for i in [starts[j], starts[j + 1]), each the index of a box in `boxes` (a feature's
-        // at the leaves, fid = index + 1; a node's of the level below above them). The top
-        // level has one node, the root.
-        struct Level {
-            const std::vector<RtreeBox> *boxes;
-            std::vector<std::uint32_t> order;
-            std::vector<std::size_t> starts;
-        };
-        std::deque<std::vector<RtreeBox>> node_boxes; // the boxes of the levels above the leaves
-        std::vector<Level> levels;
-        levels.push_back({&layer.boxes, {}, {}});
-        for (;;) {
-            Level &l = levels.back();
-            l.starts = pack(*l.boxes, capacity, l.order);
-            if (l.starts.size() == 2)
-                break;
-            std::vector<RtreeBox> &up = node_boxes.emplace_back();
-            up.reserve(l.starts.size() - 1);
-            for (std::size_t j = 0; j + 1 < l.starts.size(); ++j) {
-                RtreeBox b = (*l.boxes)[l.order[l.starts[j]]];
-                for (std::size_t i = l.starts[j] + 1; i < l.starts[j + 1]; ++i) {
-                    const RtreeBox &c = (*l.boxes)[l.order[i]];
-                    b = {std::min(b[0], c[0]), std::max(b[1], c[1]), std::min(b[2], c[2]),
-                         std::max(b[3], c[3])};
-                }
-                up.push_back(b);
+/// (No level for no box: the index keeps the empty root SQLite made.)
+void pack_tree(const RtreeLayer &layer, std::size_t capacity, PackedTree &tree) {
+    auto &levels = tree.levels;
+    if (layer.boxes.empty())
+        return;
+    levels.push_back({&layer.boxes, {}, {}});
+    for (;;) {
+        PackedTree::Level &l = levels.back();
+        l.starts = pack(*l.boxes, capacity, l.order);
+        if (l.starts.size() == 2)
+            break;
+        std::vector<RtreeBox> &up = tree.node_boxes.emplace_back();
+        up.reserve(l.starts.size() - 1);
+        for (std::size_t j = 0; j + 1 < l.starts.size(); ++j) {
+            RtreeBox b = (*l.boxes)[l.order[l.starts[j]]];
+            for (std::size_t i = l.starts[j] + 1; i < l.starts[j + 1]; ++i) {
+                const RtreeBox &c = (*l.boxes)[l.order[i]];
+                b = {std::min(b[0], c[0]), std::max(b[1], c[1]), std::min(b[2], c[2]),
+                     std::max(b[3], c[3])};
             }
-            levels.push_back({&up, {}, {}});
+            up.push_back(b);
         }
-        // Node numbers: the root 1 (where SQLite looks for it), then level by level downwards.
-        const std::size_t height = levels.size() - 1;
-        std::vector<std::int64_t> first(levels.size());
-        first[height] = 1;
-        for (std::size_t k = height; k-- > 0;)
-            first[k] = first[k + 1] + std::int64_t(levels[k + 1].starts.size() - 1);
-
-        Statement node(db, "INSERT OR REPLACE INTO " + quoted(rtree + "_node") +
-                               "(nodeno, data) VALUES (?, ?)");
-        RowInserter rowid(db, rtree + "_rowid", {"rowid", "nodeno"});
-        Statement parent(db, "INSERT INTO " + quoted(rtree + "_parent") +
-                                 "(nodeno, parentnode) VALUES (?, ?)");
-        std::vector<unsigned char> blob(static_cast<std::size_t>(node_bytes));
-        // Each feature's leaf, written in fid order once the nodes are: SQLite appends rows
-        // whose keys ascend (the index at 20 km 3.7 -> 2.6 s).
-        std::vector<std::int64_t> leaf_of(layer.boxes.size());
-        for (std::size_t k = levels.size(); k-- > 0;) {
-            const Level &l = levels[k];
-            for (std::size_t j = 0; j + 1 < l.starts.size(); ++j) {
-                const std::int64_t number = first[k] + std::int64_t(j);
-                std::fill(blob.begin(), blob.end(), 0);
-                put16(&blob[0], k == height ? std::uint32_t(height) : 0);
-                put16(&blob[2], std::uint32_t(l.starts[j + 1] - l.starts[j]));
-                unsigned char *p = &blob[4];
-                for (std::size_t i = l.starts[j]; i < l.starts[j + 1]; ++i, p += cell_bytes) {
-                    const std::uint32_t c = l.order[i];
-                    const std::int64_t id =
-                        k == 0 ? std::int64_t(c) + 1 : first[k - 1] + std::int64_t(c);
-                    put64(p, std::uint64_t(id));
-                    for (std::size_t d = 0; d < 4; ++d)
-                        put_float(p + 8 + 4 * d, (*l.boxes)[c][d]);
-                    if (k == 0)
-                        leaf_of[c] = number;
-                    else
-                        parent.insert(id, number);
-                }
-                node.insert(number, blob);
-                if (k == 0)
-                    steps.add(double(l.starts[j + 1] - l.starts[j]));
-            }
-        }
-        for (std::size_t i = 0; i < leaf_of.size(); ++i) {
-            rowid.bind(0, std::int64_t(i) + 1);
-            rowid.bind(1, leaf_of[i]);
-            rowid.insert();
-            steps.add(1);
-        }
-        rowid.flush();
+        levels.push_back({&up, {}, {}});
     }
-    for (const std::string &sql : triggers(layer.table, layer.column))
-        db.exec(sql);
-    db.exec("INSERT INTO gpkg_extensions (table_name, column_name, extension_name, definition, "
-            "scope) VALUES (" +
-            literal(layer.table) + ", " + literal(layer.column) +
-            ", 'gpkg_rtree_index', 'http://www.geopackage.org/spec120/#extension_rtree', "
-            "'write-only')");
+}
+
+/// A record of two columns, NULL (the rowid's alias) and the integer v, in `out`; returns its
+/// size (SqliteRecord's bytes, made without its buffers: 3.1M rows a 1e6-node mesh).
+std::size_t null_and_integer(std::int64_t v, unsigned char (&out)[11]) {
+    const unsigned type = sqlite_integer_type(v);
+    out[0] = 3, out[1] = 0, out[2] = static_cast<unsigned char>(type); // header size, NULL, v
+    const std::size_t bytes = sqlite_integer_bytes(type);
+    for (std::size_t i = bytes; i-- > 0; v = std::int64_t(std::uint64_t(v) >> 8))
+        out[3 + i] = static_cast<unsigned char>(v);
+    return 3 + bytes;
+}
+
+/// Writes a layer's packed tree into its index's empty tables.
+void write_tree(SqlitePages &file, const RtreeLayer &layer, const PackedTree &tree,
+                const RtreeTables &tables, Steps &steps) {
+    constexpr std::size_t cell_bytes = 8 + 4 * 4;
+    const auto &levels = tree.levels;
+    if (levels.empty())
+        return;
+    // Node numbers: the root 1 (where SQLite looks for it), then level by level downwards, so
+    // the nodes' rows are written in ascending order as they are made.
+    const std::size_t height = levels.size() - 1;
+    std::vector<std::int64_t> first(levels.size());
+    first[height] = 1;
+    for (std::size_t k = height; k-- > 0;)
+        first[k] = first[k + 1] + std::int64_t(levels[k + 1].starts.size() - 1);
+    const auto nodes = std::size_t(first[0]) + levels[0].starts.size() - 1; // 1 + the last
+
+    TableLoader node_rows(file, tables.node);
+    std::vector<unsigned char> blob(tables.node_bytes), record;
+    SqliteRecord row;
+    unsigned char small[11];                       // a _parent or _rowid record
+    std::vector<std::int64_t> parent_of(nodes, 0); // of each node below the root
+    std::vector<std::int64_t> leaf_of(layer.boxes.size());
+    for (std::size_t k = levels.size(); k-- > 0;) {
+        const PackedTree::Level &l = levels[k];
+        for (std::size_t j = 0; j + 1 < l.starts.size(); ++j) {
+            const std::int64_t number = first[k] + std::int64_t(j);
+            std::fill(blob.begin(), blob.end(), 0);
+            put16(&blob[0], k == height ? std::uint32_t(height) : 0);
+            put16(&blob[2], std::uint32_t(l.starts[j + 1] - l.starts[j]));
+            unsigned char *p = &blob[4];
+            for (std::size_t i = l.starts[j]; i < l.starts[j + 1]; ++i, p += cell_bytes) {
+                const std::uint32_t c = l.order[i];
+                const std::int64_t id =
+                    k == 0 ? std::int64_t(c) + 1 : first[k - 1] + std::int64_t(c);
+                put64(p, std::uint64_t(id));
+                for (std::size_t d = 0; d < 4; ++d)
+                    put_float(p + 8 + 4 * d, (*l.boxes)[c][d]);
+                if (k == 0)
+                    leaf_of[c] = number;
+                else
+                    parent_of[std::size_t(id)] = number;
+            }
+            record.clear();
+            row.null(), row.blob(blob.data(), blob.size()), row.append_to(record);
+            node_rows.add(number, record.data(), record.size());
+            if (k == 0)
+                steps.add(double(l.starts[j + 1] - l.starts[j]));
+        }
+    }
+    node_rows.finish();
+    TableLoader parent_rows(file, tables.parent);
+    for (std::size_t n = 2; n < nodes; ++n)
+        parent_rows.add(std::int64_t(n), small, null_and_integer(parent_of[n], small));
+    parent_rows.finish();
+    TableLoader rowid_rows(file, tables.rowid);
+    for (std::size_t i = 0; i < leaf_of.size(); ++i) {
+        rowid_rows.add(std::int64_t(i) + 1, small, null_and_integer(leaf_of[i], small));
+        steps.add(1);
+    }
+    rowid_rows.finish();
 }
 
 } // namespace
@@ -345,148 +384,87 @@ void GpkgSqlite::commit() {
     in_transaction_ = false;
 }
 
-RowInserter::RowInserter(GpkgSqlite &db, const std::string &table,
-                         const std::vector<std::string> &columns)
-    : db_(db), table_(table), columns_(columns.size()), queued_(columns.size()) {
-    std::string names, row;
-    for (const std::string &c : columns) {
-        names += (names.empty() ? "" : ", ") + quoted(c);
-        row += row.empty() ? "(?" : ", ?";
-    }
-    row += ")";
-    const std::string insert = "INSERT INTO " + quoted(table) + " (" + names + ") VALUES ";
-    std::string rows = row;
-    for (std::size_t r = 1; r < rows_per_statement; ++r)
-        rows += ", " + row;
-    if (sqlite3_prepare_v2(db.get(), (insert + rows).c_str(), -1, &full_, nullptr) != SQLITE_OK ||
-        sqlite3_prepare_v2(db.get(), (insert + row).c_str(), -1, &one_, nullptr) != SQLITE_OK) {
-        const std::string why = sqlite3_errmsg(db.get());
-        sqlite3_finalize(full_); // the destructor does not run for a constructor that throws
-        db.fail("preparing the rows of " + table, why);
-    }
+std::uint32_t table_root(GpkgSqlite &db, const std::string &table,
+                         const std::vector<std::string> &columns) {
+    Statement info(db, "SELECT name FROM pragma_table_info(" + literal(table) + ")");
+    std::vector<std::string> found;
+    for (std::string name; !(name = info.text()).empty();)
+        found.push_back(name);
+    if (found != columns)
+        db.fail("the columns of " + table, "not those the writer defined");
+    Statement root(db, "SELECT rootpage FROM sqlite_master WHERE type = 'table' AND name = " +
+                           literal(table));
+    const std::int64_t page = root.single();
+    if (page < 2)
+        db.fail("the root page of " + table, "not found");
+    return std::uint32_t(page);
 }
 
-BulkRows::BulkRows(GpkgSqlite &db, const std::string &table,
-                   const std::vector<std::string> &columns)
-    : RowInserter(db, table, columns) {
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    extent_ = {inf, -inf, inf, -inf};
-    // GDAL's trigger that counts each row inserted into gpkg_ogr_contents (finish() writes the
-    // count once, and puts the trigger back as it was).
-    {
-        Statement find(db, "SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " +
-                               literal("trigger_insert_feature_count_" + table));
-        for (std::string sql; !(sql = find.text()).empty();)
-            triggers_.push_back(sql);
-    }
-    if (!triggers_.empty())
-        db.exec("DROP TRIGGER " + quoted("trigger_insert_feature_count_" + table));
-}
-
-RowInserter::~RowInserter() {
-    sqlite3_finalize(full_);
-    sqlite3_finalize(one_);
-}
-
-void RowInserter::bind(int i, std::int64_t v) {
-    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
-    x.kind = Value::integer, x.i = v;
-}
-
-void RowInserter::bind(int i, double v) {
-    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
-    x.kind = Value::real, x.d = v;
-}
-
-void RowInserter::bind_blob(int i, const unsigned char *data, std::size_t bytes) {
-    Value &x = queued_[queued_rows_ * columns_ + std::size_t(i)];
-    x.kind = Value::blob, x.data = data, x.bytes = bytes;
-}
-
-void RowInserter::insert() {
-    ++queued_rows_;
-    ++rows_;
-    if (queued_rows_ < rows_per_statement) {
-        queued_.resize((queued_rows_ + 1) * columns_);
-        return;
-    }
-    for (std::size_t r = 0; r < queued_rows_; ++r)
-        bind_row(full_, r, int(r * columns_) + 1);
-    step(full_);
-    queued_rows_ = 0;
-}
-
-void RowInserter::flush() {
-    for (std::size_t r = 0; r < queued_rows_; ++r) {
-        bind_row(one_, r, 1);
-        step(one_);
-    }
-    queued_rows_ = 0;
-}
-
-/// Binds queued row `row` to the parameters of `s` from number `first` on.
-void RowInserter::bind_row(sqlite3_stmt *s, std::size_t row, int first) {
-    for (std::size_t c = 0; c < columns_; ++c) {
-        const Value &x = queued_[row * columns_ + c];
-        const int p = first + int(c);
-        if (x.kind == Value::integer)
-            sqlite3_bind_int64(s, p, x.i);
-        else if (x.kind == Value::real)
-            sqlite3_bind_double(s, p, x.d);
-        else
-            sqlite3_bind_blob(s, p, x.data, static_cast<int>(x.bytes), SQLITE_STATIC);
-    }
-}
-
-void RowInserter::step(sqlite3_stmt *s) {
-    if (sqlite3_step(s) != SQLITE_DONE)
-        db_.fail("writing the rows of " + table_);
-    sqlite3_reset(s);
-}
-
-void BulkRows::extend(double min_x, double max_x, double min_y, double max_y) {
-    extent_ = {std::min(extent_[0], min_x), std::max(extent_[1], max_x),
-               std::min(extent_[2], min_y), std::max(extent_[3], max_y)};
-}
-
-void BulkRows::finish() {
-    flush();
-    const std::string what = "counting the rows of " + table_;
-    Statement count(db_,
-                    "UPDATE gpkg_ogr_contents SET feature_count = ? WHERE "
-                    "table_name = " +
-                        literal(table_),
-                    what);
-    count.insert(rows());
-    if (extent_[0] <= extent_[1]) {
-        // As GDAL 3.6 writes it: through SQLite's printf, which keeps 16 significant digits.
-        char *sql = sqlite3_mprintf("UPDATE gpkg_contents SET min_x = %.18g, min_y = %.18g, "
-                                    "max_x = %.18g, max_y = %.18g WHERE table_name = %Q",
-                                    extent_[0], extent_[2], extent_[1], extent_[3], table_.c_str());
-        if (!sql)
-            db_.fail("the extent of " + table_, "out of memory");
-        const std::string text = sql;
-        sqlite3_free(sql);
-        db_.exec(text);
-    }
-    for (const std::string &sql : triggers_)
-        db_.exec(sql);
-    triggers_.clear();
-}
-
-void add_rtree_indexes(GpkgSqlite &db, const std::vector<RtreeLayer> &layers,
-                       const Progress &progress) {
-    Steps steps{progress};
-    for (const RtreeLayer &layer : layers)
-        steps.total += 2.0 * double(layer.boxes.size());
+RtreeTables create_rtree_index(GpkgSqlite &db, const std::string &table,
+                               const std::string &column) {
     // The GeoPackage's table of extensions, in the words of the standard (GDAL creates it only
     // for a file that uses one).
     db.exec("CREATE TABLE IF NOT EXISTS gpkg_extensions (table_name TEXT,column_name "
             "TEXT,extension_name TEXT NOT NULL,"
             "definition TEXT NOT NULL,scope TEXT NOT NULL,CONSTRAINT ge_tce UNIQUE (table_name, "
             "column_name, extension_name))");
+    const std::string rtree = "rtree_" + table + "_" + column;
+    db.exec("CREATE VIRTUAL TABLE " + quoted(rtree) + " USING rtree(id, minx, maxx, miny, maxy)");
+    RtreeTables t;
+    // The node size SQLite chose for this file's page size (its root is a node of that size).
+    Statement size(db, "SELECT length(data) FROM " + quoted(rtree + "_node") + " WHERE nodeno = 1");
+    const std::int64_t node_bytes = size.single();
+    if (node_bytes < std::int64_t(4 + 2 * (8 + 4 * 4)))
+        db.fail("spatial index: unexpected root node of " + rtree);
+    t.node_bytes = std::size_t(node_bytes);
+    t.node = table_root(db, rtree + "_node", {"nodeno", "data"});
+    t.rowid = table_root(db, rtree + "_rowid", {"rowid", "nodeno"});
+    t.parent = table_root(db, rtree + "_parent", {"nodeno", "parentnode"});
+    for (const std::string &sql : triggers(table, column))
+        db.exec(sql);
+    db.exec("INSERT INTO gpkg_extensions (table_name, column_name, extension_name, definition, "
+            "scope) VALUES (" +
+            literal(table) + ", " + literal(column) +
+            ", 'gpkg_rtree_index', 'http://www.geopackage.org/spec120/#extension_rtree', "
+            "'write-only')");
+    return t;
+}
+
+void write_rtree_indexes(SqlitePages &file, const std::vector<RtreeLayer> &layers,
+                         const std::vector<RtreeTables> &tables, const Progress &progress) {
+    Steps steps{progress};
     for (const RtreeLayer &layer : layers)
-        add_index(db, layer, steps);
+        steps.total += 2.0 * double(layer.boxes.size());
+    // Packed on every core, a layer to a thread, then written in turn.
+    std::vector<PackedTree> trees(layers.size());
+    for_each_part(layers.size(), [&](std::size_t i) {
+        pack_tree(layers[i], (tables[i].node_bytes - 4) / (8 + 4 * 4), trees[i]);
+    });
+    for (std::size_t i = 0; i < layers.size(); ++i)
+        write_tree(file, layers[i], trees[i], tables[i], steps);
+}
+
+void finish_bulk_layer(GpkgSqlite &db, const std::string &table, std::int64_t rows,
+                       const std::array<double, 4> &extent) {
+    Statement count(
+        db, "UPDATE gpkg_ogr_contents SET feature_count = ? WHERE table_name = " + literal(table),
+        "counting the rows of " + table);
+    count.insert(rows);
+    Statement sequence(db,
+                       "INSERT INTO sqlite_sequence (name, seq) VALUES (" + literal(table) + ", ?)",
+                       "the fid sequence of " + table);
+    sequence.insert(rows);
+    if (extent[0] <= extent[1]) {
+        // As GDAL 3.6 writes it: through SQLite's printf, which keeps 16 significant digits.
+        char *sql = sqlite3_mprintf("UPDATE gpkg_contents SET min_x = %.18g, min_y = %.18g, "
+                                    "max_x = %.18g, max_y = %.18g WHERE table_name = %Q",
+                                    extent[0], extent[2], extent[1], extent[3], table.c_str());
+        if (!sql)
+            db.fail("the extent of " + table, "out of memory");
+        const std::string text = sql;
+        sqlite3_free(sql);
+        db.exec(text);
+    }
 }
 
 } // namespace globemesh::io

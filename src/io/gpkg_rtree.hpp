@@ -1,21 +1,21 @@
-// The GeoPackage writer's bulk steps in SQLite (gpkg_write.cpp): the rows of its large layers
-// and their spatial indexes (extension gpkg_rtree_index).
+// The GeoPackage writer's bulk steps (gpkg_write.cpp): the metadata of its large layers and
+// their spatial indexes (extension gpkg_rtree_index).
 //
-// GDAL creates the file, its tables and metadata, and closes it; this opens the closed file
-// with SQLite and, in one transaction, inserts the rows through one prepared statement per
-// table (GDAL's per-feature path cost more than SQLite itself), then packs each spatial index.
-// SQLite's journal and syncs are off while it writes: the file is a temporary one, deleted when
-// the write fails, and whole once the transaction commits.
+// GDAL creates the file, its tables and metadata, and closes it. Then this opens it with SQLite
+// to create each spatial index's tables, empty, as GDAL does; the rows of the large layers and
+// of the indexes are written as pages (sqlite_pages.hpp); then SQLite again writes each large
+// layer's count, extent and sequence. SQLite's journal and syncs are off while it writes: the
+// file is a temporary one, deleted when the write fails, and whole once the last step commits.
 //
 // GDAL 3.6 (Debian 12) fills a GeoPackage's RTree at close with one SQLite R*Tree insertion a
 // row, about 9 us each: two thirds of writing a GeoPackage. GDAL 3.7 and later pack the tree
 // themselves; this does the same for every version. The layers are written without an index
 // (SPATIAL_INDEX=NO), then this creates each index's virtual table as GDAL does, and writes the
-// tree's shadow tables directly: nodes packed by Sort-Tile-Recursive, in SQLite's node format
-// (the layout SQLite's rtree module documents in its source: a 2-byte depth in the root, a
-// 2-byte cell count, then per cell a 64-bit id and four 32-bit floats, all big-endian). The
-// triggers and the gpkg_extensions row are GDAL's own (GeoPackage 1.2's), so that editing the
-// layer later in QGIS or GDAL keeps the index.
+// tree's shadow tables: nodes packed by Sort-Tile-Recursive, in SQLite's node format (the
+// layout SQLite's rtree module documents in its source: a 2-byte depth in the root, a 2-byte
+// cell count, then per cell a 64-bit id and four 32-bit floats, all big-endian). The triggers
+// and the gpkg_extensions row are GDAL's own (GeoPackage 1.2's), so that editing the layer
+// later in QGIS or GDAL keeps the index.
 #pragma once
 
 #include <array>
@@ -27,9 +27,10 @@
 #include "globemesh/progress.hpp"
 
 struct sqlite3;
-struct sqlite3_stmt;
 
 namespace globemesh::io {
+
+class SqlitePages;
 
 /// A feature's envelope as the RTree keeps it: min x, max x, min y, max y in 32-bit floats,
 /// rounded outwards from the geometry's (double) envelope.
@@ -70,71 +71,32 @@ private:
     bool in_transaction_ = false;
 };
 
-/// Rows inserted into one table of `db`, 64 to a statement (SQLite updates an AUTOINCREMENT
-/// table's sequence once a statement: one a row cost half the insert), `columns` in the order
-/// the values are set.
-class RowInserter {
-public:
-    RowInserter(GpkgSqlite &db, const std::string &table, const std::vector<std::string> &columns);
-    ~RowInserter();
-    RowInserter(const RowInserter &) = delete;
-    RowInserter &operator=(const RowInserter &) = delete;
+/// The root page of `table` in sqlite_master, once its columns are checked to be `columns` in
+/// order (the order of the records written into it).
+std::uint32_t table_root(GpkgSqlite &db, const std::string &table,
+                         const std::vector<std::string> &columns);
 
-    /// Sets column i (0-based in `columns`) of the next row; a blob must live until flush().
-    void bind(int i, std::int64_t v);
-    void bind(int i, double v);
-    void bind_blob(int i, const unsigned char *data, std::size_t bytes);
-    /// Queues the row set (every column must be), inserting a full statement's rows.
-    void insert();
-    /// Inserts the rows queued.
-    void flush();
-    /// The rows queued or inserted.
-    std::int64_t rows() const { return rows_; }
-
-protected:
-    GpkgSqlite &db_;
-    std::string table_;
-
-private:
-    static constexpr std::size_t rows_per_statement = 64;
-    struct Value {
-        enum { integer, real, blob } kind = integer;
-        std::int64_t i = 0;
-        double d = 0;
-        const unsigned char *data = nullptr;
-        std::size_t bytes = 0;
-    };
-    void bind_row(sqlite3_stmt *s, std::size_t row, int first);
-    void step(sqlite3_stmt *s);
-
-    std::size_t columns_;
-    sqlite3_stmt *full_ = nullptr; ///< rows_per_statement rows
-    sqlite3_stmt *one_ = nullptr;  ///< one row, for the last of a flush
-    std::vector<Value> queued_;    ///< the rows queued, then the row being set
-    std::size_t queued_rows_ = 0;
-    std::int64_t rows_ = 0;
+/// A spatial layer's index as create_rtree_index leaves it: empty, with the size of a node's
+/// blob (SQLite's choice for the file's page size) and the root pages of its shadow tables.
+struct RtreeTables {
+    std::size_t node_bytes = 0;
+    std::uint32_t node = 0, rowid = 0, parent = 0;
 };
 
-/// The bulk rows of one feature table that GDAL created empty (a row's fid among `columns`).
-/// GDAL's feature-count trigger is dropped while the rows go in and put back by finish(), which
-/// writes the table's row count to gpkg_ogr_contents and its features' extent to gpkg_contents,
-/// as GDAL does at close.
-class BulkRows : public RowInserter {
-public:
-    BulkRows(GpkgSqlite &db, const std::string &table, const std::vector<std::string> &columns);
-    /// Widens the layer's extent by a feature's envelope.
-    void extend(double min_x, double max_x, double min_y, double max_y);
-    /// Flushes, then the count, the extent (none: left as GDAL wrote it) and the trigger.
-    void finish();
+/// Creates the index of a layer written by GDAL with SPATIAL_INDEX=NO, as GDAL does: the virtual
+/// table (empty), GDAL's triggers and the gpkg_extensions row (and that table when missing).
+RtreeTables create_rtree_index(GpkgSqlite &db, const std::string &table, const std::string &column);
 
-private:
-    std::vector<std::string> triggers_; ///< the SQL of the triggers dropped
-    std::array<double, 4> extent_;      ///< min x, max x, min y, max y
-};
+/// Writes each layer's packed tree into its index's tables, made by create_rtree_index (the
+/// file closed by SQLite since). Reports to `progress` under the stage "write_gpkg" (and stops
+/// with Cancelled when asked).
+void write_rtree_indexes(SqlitePages &file, const std::vector<RtreeLayer> &layers,
+                         const std::vector<RtreeTables> &tables, const Progress &progress = {});
 
-/// Adds the spatial index of each layer (written by GDAL with SPATIAL_INDEX=NO) to the file.
-/// Reports to `progress` under the stage "write_gpkg" (and stops with Cancelled when asked).
-void add_rtree_indexes(GpkgSqlite &db, const std::vector<RtreeLayer> &layers,
-                       const Progress &progress = {});
+/// A layer whose rows were written as pages gets what GDAL keeps of them: its row count
+/// (gpkg_ogr_contents), its extent (gpkg_contents: min x, max x, min y, max y; none is left as
+/// GDAL wrote it) and its AUTOINCREMENT sequence (sqlite_sequence: the last fid).
+void finish_bulk_layer(GpkgSqlite &db, const std::string &table, std::int64_t rows,
+                       const std::array<double, 4> &extent);
 
 } // namespace globemesh::io

@@ -1,5 +1,6 @@
 // GeoPackage writer: see globemesh/gpkg.hpp. GDAL's GPKG driver creates the file, its layers
-// and small tables; the faces' and nodes' rows go in through SQLite in bulk (gpkg_rtree.hpp).
+// and small tables; the faces' and nodes' rows are written as SQLite pages (sqlite_pages.hpp,
+// gpkg_rtree.hpp).
 //
 // Layers: faces (MultiPolygon, one feature per face, FID = face index + 1, cut at +-180 and with
 // pole corners split, see face_geometry.hpp), nodes (Point, every node field), boundary (runs of
@@ -30,6 +31,7 @@
 #include "gpkg_rtree.hpp"
 #include "mesh_topology.hpp"
 #include "ordered_blocks.hpp"
+#include "sqlite_pages.hpp"
 #include "write_hooks.hpp"
 
 #ifndef GLOBEMESH_VERSION
@@ -304,17 +306,16 @@ using Envelope = std::array<double, 4>;
 /// ISO WKB, little-endian. Appended to one buffer, a block's rows one after the other.
 class BlobBytes {
 public:
-    explicit BlobBytes(std::vector<unsigned char> &out) : out_(out) {}
-    void u8(unsigned v) { out_.push_back(static_cast<unsigned char>(v)); }
-    void u32(std::uint32_t v) {
-        for (int i = 0; i < 4; ++i, v >>= 8)
-            out_.push_back(static_cast<unsigned char>(v));
+    /// Writes the next `bytes` bytes of `out` (it grows by them now).
+    BlobBytes(std::vector<unsigned char> &out, std::size_t bytes) : out_(out), at_(out.size()) {
+        out.resize(at_ + bytes);
     }
+    void u8(unsigned v) { out_[at_++] = static_cast<unsigned char>(v); }
+    void u32(std::uint32_t v) { put(v); }
     void f64(double d) {
         std::uint64_t v;
         std::memcpy(&v, &d, sizeof v);
-        for (int i = 0; i < 8; ++i, v >>= 8)
-            out_.push_back(static_cast<unsigned char>(v));
+        put(v);
     }
     /// The header, with `envelope` when given; `empty` flags a geometry with no points.
     void header(const Envelope *envelope, bool empty = false) {
@@ -324,18 +325,26 @@ public:
             for (double d : *envelope)
                 f64(d);
     }
+    static constexpr std::size_t header_bytes(bool envelope) { return 8 + (envelope ? 32 : 0); }
 
 private:
+    /// v little-endian (one store on a little-endian machine: GCC merges the bytes' stores).
+    template <class U> void put(U v) {
+        for (std::size_t i = 0; i < sizeof v; ++i, v >>= 8)
+            out_[at_ + i] = static_cast<unsigned char>(v);
+        at_ += sizeof v;
+    }
     static constexpr std::uint32_t wgs84_srs_id = 4326;
     std::vector<unsigned char> &out_;
+    std::size_t at_;
 };
 
 /// A multipolygon of one ring per part (each closed by repeating its first point) appended to
 /// `out` as a GeoPackage blob; returns its envelope, the points' extremes as OGR takes them
 /// (none, an empty envelope, for no part: a degenerate face, written as GDAL writes an empty
 /// geometry).
-Envelope append_multipolygon(std::vector<unsigned char> &out,
-                             const std::vector<io::LonLatPart> &parts) {
+template <class Parts>
+Envelope append_multipolygon(std::vector<unsigned char> &out, const Parts &parts) {
     constexpr double inf = std::numeric_limits<double>::infinity();
     Envelope e = {inf, -inf, inf, -inf};
     for (const auto &part : parts)
@@ -343,7 +352,10 @@ Envelope append_multipolygon(std::vector<unsigned char> &out,
             e[0] = p[0] < e[0] ? p[0] : e[0], e[1] = p[0] > e[1] ? p[0] : e[1];
             e[2] = p[1] < e[2] ? p[1] : e[2], e[3] = p[1] > e[3] ? p[1] : e[3];
         }
-    BlobBytes b(out);
+    std::size_t bytes = BlobBytes::header_bytes(!parts.empty()) + 9;
+    for (const auto &ring : parts)
+        bytes += 13 + 16 * (ring.size() + 1);
+    BlobBytes b(out, bytes);
     b.header(parts.empty() ? nullptr : &e, parts.empty());
     constexpr unsigned little_endian = 1, wkb_polygon = 3, wkb_multipolygon = 6;
     b.u8(little_endian), b.u32(wkb_multipolygon), b.u32(std::uint32_t(parts.size()));
@@ -355,9 +367,29 @@ Envelope append_multipolygon(std::vector<unsigned char> &out,
     return e;
 }
 
+/// The face with corners v (lon/lat ll) appended to `out` as a GeoPackage blob: its rings as
+/// face_polygons and narrow_rings cut them (`empty` when it has none); returns its envelope.
+Envelope append_face(std::vector<unsigned char> &out, const Vec3 v[3], const LonLat ll[3],
+                     bool &empty) {
+    std::array<std::array<io::LonLatPoint, 3>, 1> one;
+    if (io::simple_face_ring(v, ll, one[0])) { // most faces: one triangle, made in place
+        const auto [lo, hi] = std::minmax({one[0][0][0], one[0][1][0], one[0][2][0]});
+        if (hi - lo <= max_part_width_deg) {
+            empty = false;
+            return append_multipolygon(out, one);
+        }
+    }
+    std::vector<io::LonLatPart> parts;
+    for (auto &ring : io::face_polygons(v[0], v[1], v[2]))
+        for (auto &part : narrow_rings(std::move(ring)))
+            parts.push_back(std::move(part));
+    empty = parts.empty();
+    return append_multipolygon(out, parts);
+}
+
 /// A point appended to `out` as a GeoPackage blob (no envelope, as GDAL writes points).
 void append_point(std::vector<unsigned char> &out, double x, double y) {
-    BlobBytes b(out);
+    BlobBytes b(out, BlobBytes::header_bytes(false) + 21);
     b.header(nullptr);
     constexpr unsigned little_endian = 1, wkb_point = 1;
     b.u8(little_endian), b.u32(wkb_point), b.f64(x), b.f64(y);
@@ -368,73 +400,105 @@ struct FacesLayer {
     const Field *depth = nullptr; ///< the nodes' depth, as the mean of each face's corners
     const Field *size = nullptr;  ///< the nodes' target_size, likewise
     std::vector<const Field *> face_fields; ///< the mesh's other face fields, as they are
+    std::vector<std::string> columns;       ///< the table's, in order
 };
 
 FacesLayer define_faces_layer(GpkgWriter &w, const Mesh &mesh) {
     FacesLayer l;
     OGRLayer *faces =
         w.layer("faces", wkbMultiPolygon, "mesh triangles, cut at +-180 (one feature per face)");
+    l.columns = {"fid", "geom", "face"};
     w.field(faces, "face", OFTInteger);
-    w.field(faces, "quality", OFTReal);
-    w.field(faces, "area_km2", OFTReal);
+    auto real = [&](const std::string &name) {
+        w.field(faces, name.c_str(), OFTReal);
+        l.columns.push_back(name);
+    };
+    real("quality");
+    real("area_km2");
     const Field *depth = l.depth = mesh.node_field("depth");
     const Field *size = l.size = mesh.node_field("target_size");
     if (depth)
-        w.field(faces, "depth", OFTReal);
+        real("depth");
     if (size)
-        w.field(faces, "target_size", OFTReal);
+        real("target_size");
     for (const auto &f : mesh.face_fields)
         if (f.name != "quality" && f.name != "area" && f.name != "area_km2" && f.name != "face" &&
             !(depth && f.name == "depth") && !(size && f.name == "target_size") &&
             f.values.size() == mesh.faces.size()) {
-            w.field(faces, f.name.c_str(), OFTReal);
+            real(f.name);
             l.face_fields.push_back(&f);
         }
     return l;
 }
 
-/// The columns of a bulk insert: fid, geom, the integer `number`, then `reals`.
+/// The columns of a bulk layer: fid, geom, the integer `number`, then `reals`.
 std::vector<std::string> bulk_columns(const char *number, const std::vector<std::string> &reals) {
     std::vector<std::string> columns = {"fid", "geom", number};
     columns.insert(columns.end(), reals.begin(), reals.end());
     return columns;
 }
 
-/// A block of rows made on any core (ordered_blocks.hpp): each row's blob in `bytes` up to
-/// ends[r], its real columns at values[r * reals ...], its envelope and index box.
+/// A block of rows made on any core (ordered_blocks.hpp): each row's record (sqlite_pages.hpp)
+/// in `bytes` up to ends[r], its envelope and index box.
 struct RowBlock {
     std::vector<unsigned char> bytes;
     std::vector<std::size_t> ends;
-    std::vector<double> values;
     std::vector<Envelope> envelopes;
     std::vector<io::RtreeBox> boxes;
-    void clear() { bytes.clear(), ends.clear(), values.clear(), envelopes.clear(), boxes.clear(); }
+    void clear() { bytes.clear(), ends.clear(), envelopes.clear(), boxes.clear(); }
 };
 
-/// Inserts a block's rows, the first with fid (and number) first + 1 (first), and adds their
-/// boxes to `boxes`.
-void insert_block(io::BulkRows &rows, const RowBlock &b, std::size_t first, std::size_t reals,
-                  std::vector<io::RtreeBox> &boxes) {
-    std::size_t start = 0;
-    for (std::size_t r = 0; r < b.ends.size(); ++r) {
-        rows.bind(0, std::int64_t(first + r) + 1);
-        rows.bind_blob(1, b.bytes.data() + start, b.ends[r] - start);
-        rows.bind(2, std::int64_t(first + r));
-        for (std::size_t c = 0; c < reals; ++c)
-            rows.bind(int(3 + c), b.values[r * reals + c]);
-        rows.insert();
-        const Envelope &e = b.envelopes[r];
-        rows.extend(e[0], e[1], e[2], e[3]);
-        start = b.ends[r];
-    }
-    rows.flush(); // before the block's blobs go
-    boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
+/// What a worker reuses from row to row.
+struct RowScratch {
+    std::vector<unsigned char> blob;
+    io::SqliteRecord record;
+    std::vector<std::int32_t> edges;
+};
+
+/// A row of a bulk layer appended to `b`: fid (the rowid), the geometry blob in scratch.blob,
+/// the feature's `number`, then `reals`.
+void append_row(RowBlock &b, RowScratch &scratch, std::size_t number,
+                const std::vector<double> &reals) {
+    io::SqliteRecord &r = scratch.record;
+    r.null(); // fid, the INTEGER PRIMARY KEY: the rowid itself
+    r.blob(scratch.blob.data(), scratch.blob.size());
+    r.integer(std::int64_t(number));
+    for (double v : reals)
+        r.real(v);
+    r.append_to(b.bytes);
+    b.ends.push_back(b.bytes.size());
+    scratch.blob.clear();
 }
 
-/// The faces' rows, and their boxes into `indexes`.
-void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
-                 const io::MeshTopology &topo, const GpkgOptions &options,
-                 std::vector<io::RtreeBox> &boxes) {
+/// A bulk layer's rows as they go into its table: their count and extent, and their boxes for
+/// its index.
+struct BulkLayer {
+    io::TableLoader rows;
+    std::vector<io::RtreeBox> &boxes;
+    std::array<double, 4> extent = {
+        std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+        std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    std::int64_t count = 0;
+
+    /// Adds a block's rows, the first with fid first + 1.
+    void add(const RowBlock &b, std::size_t first) {
+        std::size_t start = 0;
+        for (std::size_t r = 0; r < b.ends.size(); ++r) {
+            rows.add(std::int64_t(first + r) + 1, b.bytes.data() + start, b.ends[r] - start);
+            const Envelope &e = b.envelopes[r];
+            extent = {std::min(extent[0], e[0]), std::max(extent[1], e[1]),
+                      std::min(extent[2], e[2]), std::max(extent[3], e[3])};
+            start = b.ends[r];
+        }
+        count += std::int64_t(b.ends.size());
+        boxes.insert(boxes.end(), b.boxes.begin(), b.boxes.end());
+    }
+};
+
+/// The faces' rows into `layer`.
+void write_faces(BulkLayer &layer, const FacesLayer &l, const Mesh &mesh,
+                 const std::vector<LonLat> &lonlat, const io::MeshTopology &topo,
+                 const GpkgOptions &options) {
     const Field *depth = l.depth, *size = l.size;
     const std::vector<const Field *> &face_fields = l.face_fields;
     // The face areas as the UGRID file has them: those write_ugrid gave, else computed face by
@@ -445,19 +509,12 @@ void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
     std::optional<io::GeodesicFaceAreas> areas;
     if (!given)
         areas.emplace(topo);
-    std::vector<std::string> reals = {"quality", "area_km2"};
-    if (depth)
-        reals.push_back("depth");
-    if (size)
-        reals.push_back("target_size");
-    for (const Field *f : face_fields)
-        reals.push_back(f->name);
-    io::BulkRows rows(db, "faces", bulk_columns("face", reals));
-    boxes.reserve(mesh.faces.size());
+    layer.boxes.reserve(mesh.faces.size());
     // The rows (fields, geometry cut at +-180, box) are made a block at a time on every core,
-    // and inserted in order from this thread, the one that calls SQLite (ordered_blocks.hpp).
+    // and added in order from this thread (ordered_blocks.hpp).
     struct Scratch {
-        std::vector<std::int32_t> edges;
+        RowScratch row;
+        std::vector<double> reals;
     };
     constexpr std::size_t block_faces = 4096;
     io::compute_in_order<RowBlock, Scratch>(
@@ -466,38 +523,38 @@ void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
             const std::size_t first = k * block_faces,
                               last = std::min(mesh.faces.size(), first + block_faces);
             b.clear();
+            std::vector<double> &reals = scratch.reals;
             for (std::size_t i = first; i < last; ++i) {
                 const auto &t = mesh.faces[i];
-                b.values.push_back(
+                reals.clear();
+                reals.push_back(
                     triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
                 double area_m2;
                 if (given) {
                     area_m2 = (*given)[i];
                 } else {
-                    io::face_edges(topo, i, 1, scratch.edges);
-                    area_m2 = areas->face_m2(i, scratch.edges.data());
+                    io::face_edges(topo, i, 1, scratch.row.edges);
+                    area_m2 = areas->face_m2(i, scratch.row.edges.data());
                 }
-                b.values.push_back(area_m2 * 1e-6);
+                reals.push_back(area_m2 * 1e-6);
                 auto mean = [&](const Field *f) {
                     return (f->values[t[0]] + f->values[t[1]] + f->values[t[2]]) / 3.0;
                 };
                 if (depth)
-                    b.values.push_back(mean(depth));
+                    reals.push_back(mean(depth));
                 if (size)
-                    b.values.push_back(mean(size));
+                    reals.push_back(mean(size));
                 for (const Field *f : face_fields)
-                    b.values.push_back(f->values[i]);
-                std::vector<io::LonLatPart> parts;
-                for (auto &ring :
-                     io::face_polygons(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]))
-                    for (auto &part : narrow_rings(std::move(ring)))
-                        parts.push_back(std::move(part));
-                const Envelope e = append_multipolygon(b.bytes, parts);
-                b.ends.push_back(b.bytes.size());
+                    reals.push_back(f->values[i]);
+                const Vec3 v[3] = {mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]};
+                const LonLat ll[3] = {lonlat[t[0]], lonlat[t[1]], lonlat[t[2]]};
+                bool empty = false;
+                const Envelope e = append_face(scratch.row.blob, v, ll, empty);
+                append_row(b, scratch.row, i, reals);
                 b.envelopes.push_back(e);
                 // An empty geometry's box is OGR's envelope of it, all 0.
-                b.boxes.push_back(parts.empty() ? io::rtree_box(0, 0, 0, 0)
-                                                : io::rtree_box(e[0], e[1], e[2], e[3]));
+                b.boxes.push_back(empty ? io::rtree_box(0, 0, 0, 0)
+                                        : io::rtree_box(e[0], e[1], e[2], e[3]));
             }
         },
         [&](std::size_t k, RowBlock &b) {
@@ -505,9 +562,9 @@ void write_faces(io::GpkgSqlite &db, const FacesLayer &l, const Mesh &mesh,
                 report(options.progress,
                        face_share * double(k * block_faces) / double(mesh.faces.size()),
                        "write_gpkg");
-            insert_block(rows, b, k * block_faces, reals.size(), boxes);
+            layer.add(b, k * block_faces);
         });
-    rows.finish();
+    layer.rows.finish();
 }
 
 /// The nodes layer with every node field (the rows are write_nodes').
@@ -519,31 +576,48 @@ void define_nodes_layer(GpkgWriter &w, const Mesh &mesh) {
             w.field(nodes, f.name.c_str(), OFTReal);
 }
 
-/// The nodes' rows, and their boxes into `boxes`: every node field with a value per node.
-void write_nodes(io::GpkgSqlite &db, const Mesh &mesh, const GpkgOptions &options,
-                 std::vector<io::RtreeBox> &boxes) {
+/// The node fields of the nodes layer (define_nodes_layer's).
+std::vector<const Field *> node_fields(const Mesh &mesh) {
     std::vector<const Field *> fields;
-    std::vector<std::string> reals;
     for (const auto &f : mesh.node_fields)
-        if (f.name != "node" && f.values.size() == mesh.nodes.size()) {
+        if (f.name != "node")
             fields.push_back(&f);
-            reals.push_back(f.name);
-        }
-    io::BulkRows rows(db, "nodes", bulk_columns("node", reals));
-    boxes.reserve(mesh.nodes.size());
+    return fields;
+}
+
+/// The nodes table's columns.
+std::vector<std::string> node_columns(const Mesh &mesh) {
+    std::vector<std::string> reals;
+    for (const Field *f : node_fields(mesh))
+        reals.push_back(f->name);
+    return bulk_columns("node", reals);
+}
+
+/// The nodes' rows into `layer`.
+void write_nodes(BulkLayer &layer, const Mesh &mesh, const std::vector<LonLat> &lonlat,
+                 const GpkgOptions &options) {
+    const std::vector<const Field *> fields = node_fields(mesh);
+    layer.boxes.reserve(mesh.nodes.size());
+    struct Scratch {
+        RowScratch row;
+        std::vector<double> reals;
+    };
     constexpr std::size_t block_nodes = 16384;
-    io::compute_in_order<RowBlock, char>(
+    io::compute_in_order<RowBlock, Scratch>(
         (mesh.nodes.size() + block_nodes - 1) / block_nodes,
-        [&](std::size_t k, RowBlock &b, char &) {
+        [&](std::size_t k, RowBlock &b, Scratch &scratch) {
             const std::size_t first = k * block_nodes,
                               last = std::min(mesh.nodes.size(), first + block_nodes);
             b.clear();
             for (std::size_t i = first; i < last; ++i) {
-                for (const Field *f : fields)
-                    b.values.push_back(f->values[i]);
-                const LonLat p = vec_to_lonlat(mesh.nodes[i]);
-                append_point(b.bytes, p.lon, p.lat);
-                b.ends.push_back(b.bytes.size());
+                scratch.reals.clear();
+                for (const Field *f : fields) // NULL (as NaN) where a field has no value
+                    scratch.reals.push_back(f->values.size() == mesh.nodes.size()
+                                                ? f->values[i]
+                                                : std::numeric_limits<double>::quiet_NaN());
+                const LonLat p = lonlat[i];
+                append_point(scratch.row.blob, p.lon, p.lat);
+                append_row(b, scratch.row, i, scratch.reals);
                 b.envelopes.push_back({p.lon, p.lon, p.lat, p.lat});
                 b.boxes.push_back(io::rtree_box(p.lon, p.lon, p.lat, p.lat));
             }
@@ -552,9 +626,9 @@ void write_nodes(io::GpkgSqlite &db, const Mesh &mesh, const GpkgOptions &option
             report(options.progress,
                    face_share + node_share * double(k * block_nodes) / double(mesh.nodes.size()),
                    "write_gpkg");
-            insert_block(rows, b, k * block_nodes, reals.size(), boxes);
+            layer.add(b, k * block_nodes);
         });
-    rows.finish();
+    layer.rows.finish();
 }
 
 /// The boundary layer, one feature per run, and its boxes into `run_boxes`; runs is not empty.
@@ -713,20 +787,44 @@ void write_gpkg(const Mesh &mesh, const std::filesystem::path &path, const GpkgO
         {"faces", "geom", {}}, {"nodes", "geom", {}}, {"boundary", "geom", {}}};
     const FacesLayer faces =
         define_gdal_layers(mesh, path, out.temp_path(), runs, stats, indexes[2].boxes);
-    // The faces' and nodes' rows and every index in one SQLite transaction: a failure or a
-    // cancel anywhere before its end leaves a file that OutputFile deletes.
-    io::GpkgSqlite db(out.temp_path(), path);
-    write_faces(db, faces, mesh, *topo, options, indexes[0].boxes);
+    if (runs.empty()) // no boundary layer (closed mesh)
+        indexes.pop_back();
+    // SQLite creates the indexes' tables and finds where each bulk table's pages go; then the
+    // rows are written as pages (sqlite_pages.hpp), with no connection open; then SQLite writes
+    // what GDAL keeps of the rows. A failure or a cancel anywhere before the last commit leaves
+    // a file that OutputFile deletes.
+    std::uint32_t face_root = 0, node_root = 0;
+    std::vector<io::RtreeTables> tables;
+    {
+        io::GpkgSqlite db(out.temp_path(), path);
+        face_root = io::table_root(db, "faces", faces.columns);
+        node_root = io::table_root(db, "nodes", node_columns(mesh));
+        for (const io::RtreeLayer &layer : indexes)
+            tables.push_back(io::create_rtree_index(db, layer.table, layer.column));
+        db.commit();
+    }
+    io::SqlitePages pages(out.temp_path(), "GeoPackage output " + path.string(), path);
+    BulkLayer face_rows{io::TableLoader(pages, face_root), indexes[0].boxes};
+    // Each node's lon/lat, once (a face's corners are shared by six faces).
+    std::vector<LonLat> lonlat(mesh.nodes.size());
+    io::for_each_range(mesh.nodes.size(), [&](std::size_t from, std::size_t to) {
+        for (std::size_t i = from; i < to; ++i)
+            lonlat[i] = vec_to_lonlat(mesh.nodes[i]);
+    });
+    write_faces(face_rows, faces, mesh, lonlat, *topo, options);
     if (options.face_areas_m2)
         std::vector<double>().swap(*options.face_areas_m2); // not needed any more
     topo.reset(); // freed here unless an earlier stage still shares it (SharedTopology)
     if (detail::after_partial_write)
         detail::after_partial_write(); // tests only (write_hooks.hpp)
-    write_nodes(db, mesh, options, indexes[1].boxes);
-    if (runs.empty()) // no boundary layer (closed mesh)
-        indexes.pop_back();
-    io::add_rtree_indexes(db, indexes,
-                          sub_progress(options.progress, face_share + node_share, 1.0));
+    BulkLayer node_rows{io::TableLoader(pages, node_root), indexes[1].boxes};
+    write_nodes(node_rows, mesh, lonlat, options);
+    io::write_rtree_indexes(pages, indexes, tables,
+                            sub_progress(options.progress, face_share + node_share, 1.0));
+    pages.finish();
+    io::GpkgSqlite db(out.temp_path(), path);
+    io::finish_bulk_layer(db, "faces", face_rows.count, face_rows.extent);
+    io::finish_bulk_layer(db, "nodes", node_rows.count, node_rows.extent);
     db.commit();
     report(options.progress, 1.0, "write_gpkg");
     out.commit();

@@ -11,10 +11,12 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <random>
 #include <set>
 
 #include <sqlite3.h>
 
+#include "face_geometry.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/gpkg.hpp"
 #include "globemesh/preview.hpp"
@@ -293,6 +295,7 @@ TEST(Gpkg, spatial_indexes_are_rtrees_holding_each_features_tightest_float_box) 
         OGRLayer *layer = d.ds->GetLayerByName(table.c_str());
         ASSERT_TRUE(layer);
         EXPECT_EQ(db.one("SELECT rtreecheck('" + rtree + "')"), "ok");
+        EXPECT_EQ(db.one("PRAGMA integrity_check"), "ok"); // the pages written without SQLite
         EXPECT_EQ(db.one("SELECT scope FROM gpkg_extensions WHERE table_name = '" + table +
                          "' AND column_name = 'geom' AND extension_name = 'gpkg_rtree_index'"),
                   "write-only");
@@ -391,10 +394,10 @@ TEST(Gpkg, spatial_index_follows_features_edited_later_through_gdal) {
     EXPECT_EQ(box[0], (std::vector<std::string>{"10.0", "11.0", "80.0", "81.0"}));
 }
 
-// The faces' and nodes' rows go in through SQLite, not GDAL: the layer's count and extent are
-// still those GDAL keeps (gpkg_ogr_contents, gpkg_contents: the union of the features'
-// envelopes as OGR reads them, written by GDAL with 16 significant digits and read here as
-// SQLite's text, 15), and a row added later still counts (GDAL's trigger is back).
+// The faces' and nodes' rows are written as SQLite pages, not through GDAL: the layer's count
+// and extent are still those GDAL keeps (gpkg_ogr_contents, gpkg_contents: the union of the
+// features' envelopes as OGR reads them, written by GDAL with 16 significant digits and read
+// here as SQLite's text, 15), and a row added later still counts (GDAL's trigger is in place).
 TEST(Gpkg, bulk_layers_keep_gdal_counts_extents_and_count_triggers) {
     TempDir dir;
     const Mesh m = icosphere_with_holes(3);
@@ -479,6 +482,51 @@ TEST(Gpkg, closed_mesh_faces_tile_the_lonlat_rectangle_with_no_part_wider_than_1
     auto [area, widest] = faces_area_and_widest_part(d.ds->GetLayerByName("faces"));
     EXPECT_NEAR(area, 360.0 * 180.0, 1e-6); // no gap and no overlap, poles and seam included
     EXPECT_LT(widest, 180.0);
+}
+
+// The writer's shortcut for the common face (face_geometry.hpp, simple_face_ring) gives what
+// face_polygons gives, value for value, on faces anywhere: across +-180, at and round the poles,
+// with corners on +-180, tiny and degenerate.
+TEST(Gpkg, simple_face_ring_is_face_polygons_one_ring_wherever_it_applies) {
+    std::mt19937_64 random(11);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    auto jitter = [&](const Vec3 &c, double size) {
+        const Vec3 v{c.x + size * unit(random), c.y + size * unit(random),
+                     c.z + size * unit(random)};
+        const double n = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+        return Vec3{v.x / n, v.y / n, v.z / n};
+    };
+    const std::vector<Vec3> centres = {lonlat_to_vec(180, 0),  lonlat_to_vec(-180, 60),
+                                       lonlat_to_vec(0, 89.9), lonlat_to_vec(40, -89.99),
+                                       lonlat_to_vec(100, 10), lonlat_to_vec(179.99, -30)};
+    int simple = 0, general = 0;
+    for (int k = 0; k < 60000; ++k) {
+        const Vec3 &c = centres[std::size_t(k) % centres.size()];
+        const double size = std::pow(10.0, -6 + 6 * (unit(random) + 1) / 2); // 1e-6 .. 1
+        Vec3 v[3] = {jitter(c, size), jitter(c, size), jitter(c, size)};
+        if (k % 50 == 0)
+            v[k % 3] = {0, 0, k % 100 ? 1.0 : -1.0}; // a corner at a pole
+        if (k % 70 == 0)
+            v[1] = lonlat_to_vec(180, 10 * unit(random)); // a corner on the antimeridian
+        if (k % 110 == 0)
+            v[2] = lonlat_to_vec(-180, 10 * unit(random)); // and a side along it
+        if (k % 90 == 0)
+            v[2] = v[0]; // degenerate
+        const LonLat ll[3] = {vec_to_lonlat(v[0]), vec_to_lonlat(v[1]), vec_to_lonlat(v[2])};
+        std::array<io::LonLatPoint, 3> ring;
+        const auto parts = io::face_polygons(v[0], v[1], v[2]);
+        if (!io::simple_face_ring(v, ll, ring)) {
+            ++general;
+            continue;
+        }
+        ++simple;
+        ASSERT_EQ(parts.size(), 1u) << k;
+        ASSERT_EQ(parts[0].size(), 3u) << k;
+        for (std::size_t i = 0; i < 3; ++i)
+            ASSERT_TRUE(parts[0][i] == ring[i]) << k << " corner " << i;
+    }
+    EXPECT_GT(simple, 10000); // both ways are taken often
+    EXPECT_GT(general, 10000);
 }
 
 TEST(Gpkg, pole_corner_is_written_as_two_points_at_the_neighbouring_longitudes) {
