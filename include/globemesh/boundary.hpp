@@ -34,6 +34,18 @@ public:
     virtual bool contains(const Vec3 &p) const = 0;
     /// True when the coast comes within `angle` radians of p (on the sphere).
     virtual bool coast_within(const Vec3 &p, double angle) const = 0;
+    /// The distance (radians) from p to the coast when it is within `reach`, else `reach`. This
+    /// default bisects with coast_within, to within reach / 2^13; LandMask's is exact.
+    virtual double coast_distance(const Vec3 &p, double reach) const {
+        if (!coast_within(p, reach))
+            return reach;
+        double lo = 0, hi = reach;
+        for (int i = 0; i < 12; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (coast_within(p, mid) ? hi : lo) = mid;
+        }
+        return 0.5 * (lo + hi);
+    }
     /// A maker of an independent copy giving the same answers, for another thread: what it
     /// needs is read now, on the calling thread; the maker may run on any thread. Empty when the
     /// test cannot be copied (the parts then share it under a lock).

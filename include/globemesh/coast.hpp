@@ -96,6 +96,9 @@ public:
     /// True when the coast (a land polygon's outline, shells and holes, each segment taken as a
     /// great-circle arc, as mesh-verify measures it) comes within `angle` radians of p.
     bool coast_within(const Vec3 &p, double angle) const override;
+    /// The least distance from p to the outline's arcs within `reach` (the nearest coast is
+    /// found in one query of the segments' index), else `reach`.
+    double coast_distance(const Vec3 &p, double reach) const override;
     /// Reads the polygons' rings now; the maker builds a LandMask of its own from them (as much
     /// memory again, and the build's time, on the thread that runs it).
     std::function<std::shared_ptr<const LandTest>()> copier() const override;
@@ -105,6 +108,9 @@ public:
 
 private:
     struct Impl;
+    /// visit(k) for the outline segments near p (land_mask.cpp), until it returns true.
+    template <class Visit>
+    void visit_segments_near(const Vec3 &p, double angle, Visit &&visit) const;
     std::unique_ptr<Impl> impl_;
     std::size_t vertices_ = 0;
 };

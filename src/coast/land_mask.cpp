@@ -364,12 +364,15 @@ bool LandMask::contains(const Vec3 &p) const {
     return a == 1;
 }
 
-bool LandMask::coast_within(const Vec3 &p, double angle) const {
+/// Calls visit(k) for each outline segment k (outline[k] to outline[k + 1]) whose piece's box
+/// meets the lon/lat box of the cap of radius `angle` round p, until visit returns true.
+template <class Visit>
+void LandMask::visit_segments_near(const Vec3 &p, double angle, Visit &&visit) const {
     const Impl &m = *impl_;
     if (m.envelopes.empty())
-        return false;
-    // The lon/lat box of the cap of that radius around p (the whole band of longitudes near a
-    // pole), split in two where it crosses +-180.
+        return;
+    // The lon/lat box of the cap (the whole band of longitudes near a pole), split in two where
+    // it crosses +-180.
     const LonLat ll = vec_to_lonlat(p);
     const double dlat = angle * rad_to_deg;
     const double c = std::cos(ll.lat * deg_to_rad);
@@ -385,10 +388,9 @@ bool LandMask::coast_within(const Vec3 &p, double angle) const {
         spans = {{spans[0].first, 180}, {-180, spans[0].second - 360}};
     struct Query {
         const Impl *m;
-        Vec3 p;
-        double angle;
-        bool near = false;
-    } q{&m, p, angle};
+        std::remove_reference_t<Visit> *visit;
+        bool done = false;
+    } q{&m, &visit};
     for (const auto &[x0, x1] : spans) {
         const GeomPtr box(GEOSGeom_createRectangle_r(m.ctx, x0, y0, x1, y1), GeosDeleter{m.ctx});
         if (!box)
@@ -397,19 +399,33 @@ bool LandMask::coast_within(const Vec3 &p, double angle) const {
             m.ctx, m.pieces.get(), box.get(),
             [](void *item, void *data) {
                 auto &q = *static_cast<Query *>(data);
-                if (q.near)
-                    return;
                 const auto i = reinterpret_cast<std::size_t>(item);
-                const std::vector<Vec3> &o = q.m->outline;
                 for (std::size_t k = q.m->piece_start[i];
-                     k + 1 < q.m->piece_start[i + 1] && !q.near; ++k)
-                    q.near = arc_distance(o[k], o[k + 1], q.p) <= q.angle;
+                     k + 1 < q.m->piece_start[i + 1] && !q.done; ++k)
+                    q.done = (*q.visit)(k);
             },
             &q);
-        if (q.near)
+        if (q.done)
             break;
     }
-    return q.near;
+}
+
+bool LandMask::coast_within(const Vec3 &p, double angle) const {
+    const std::vector<Vec3> &o = impl_->outline;
+    bool near = false;
+    visit_segments_near(
+        p, angle, [&](std::size_t k) { return near = arc_distance(o[k], o[k + 1], p) <= angle; });
+    return near;
+}
+
+double LandMask::coast_distance(const Vec3 &p, double reach) const {
+    const std::vector<Vec3> &o = impl_->outline;
+    double nearest = reach;
+    visit_segments_near(p, reach, [&](std::size_t k) {
+        nearest = std::min(nearest, arc_distance(o[k], o[k + 1], p));
+        return false;
+    });
+    return nearest;
 }
 
 } // namespace globemesh

@@ -34,6 +34,10 @@ public:
         const std::lock_guard<std::mutex> lock(mutex_);
         return land_->coast_within(p, angle);
     }
+    double coast_distance(const Vec3 &p, double reach) const override {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return land_->coast_distance(p, reach);
+    }
 
 private:
     std::shared_ptr<const LandTest> land_;

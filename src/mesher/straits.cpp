@@ -148,18 +148,6 @@ namespace {
 
 constexpr int passage_rings = 16; // passage_width's grid: rings of samples out to its reach
 
-// The distance (radians) from p to the coast, to within reach / 2^12; `reach` when farther.
-double coast_distance(const LandTest &land, const Vec3 &p, double reach) {
-    if (!land.coast_within(p, reach))
-        return reach;
-    double lo = 0, hi = reach;
-    for (int i = 0; i < 12; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (land.coast_within(p, mid) ? hi : lo) = mid;
-    }
-    return 0.5 * (lo + hi);
-}
-
 // The width (radians) of the narrowest passage of the water around p, within `reach`: twice the
 // bottleneck distance to the coast on the water path, sampled on a polar grid, that joins two
 // separate stretches of water on the grid's rim (the widest such path: a maximin, samples added
@@ -181,7 +169,7 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
             const Vec3 q = normalized(std::cos(d) * p +
                                       std::sin(d) * (std::cos(a) * east + std::sin(a) * north));
             if (!land.contains(q))
-                clearance[index(r, k)] = coast_distance(land, q, reach);
+                clearance[index(r, k)] = land.coast_distance(q, reach);
         }
     // The rim's stretches of water: each rim sample's stretch (-1 on land).
     std::vector<int> stretch(spokes, -1);

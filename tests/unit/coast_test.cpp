@@ -545,8 +545,9 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
     for (auto g : source)
         OGR_G_DestroyGeometry(g);
 
-    // coast_within agrees with the brute-force distance on the sphere, at every latitude and
-    // across +-180 (the source splits land there; a cap that crosses it must find both sides).
+    // coast_within and coast_distance agree with the brute-force distance on the sphere, at every
+    // latitude and across +-180 (the source splits land there; a cap that crosses it must find
+    // both sides).
     std::uniform_real_distribution<double> lon(-180, 180), lat(-85, 85), reach(0.002, 0.1);
     int yes = 0, no = 0;
     for (int i = 0; i < 400; ++i) {
@@ -562,6 +563,10 @@ TEST(Coast, land_mask_agrees_with_ogr_on_the_source_polygons) {
         const bool within = d.land->coast_within(p, a);
         EXPECT_EQ(within, nearest <= a) << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat
                                         << " reach " << a << " nearest " << nearest;
+        // coast_distance: the same nearest arc, or the reach beyond it (within 1e-9 rad, 6 mm,
+        // as the ties above: near +-180 the mask's outline has vertices of its own).
+        EXPECT_NEAR(d.land->coast_distance(p, a), std::min(nearest, a), 1e-8)
+            << vec_to_lonlat(p).lon << " " << vec_to_lonlat(p).lat << " reach " << a;
         (within ? yes : no) += 1;
     }
     EXPECT_GT(yes, 30);
