@@ -142,11 +142,17 @@ SqlitePages::SqlitePages(const std::filesystem::path &file, std::string label,
     const std::uint32_t size = get_be(h + 16, 2);
     page_size_ = size == 1 ? 65536 : size;
     usable_ = page_size_ - h[20];
-    // Rollback journal (version 1), no auto-vacuum (no pointer-map pages to keep), and no
-    // journal or WAL file beside it: the file is the whole database.
-    if (std::memcmp(h, "SQLite format 3", 16) != 0 || page_size_ < 512 || h[18] != 1 ||
-        h[19] != 1 || get_be(h + 52, 4) != 0 || st.st_size % page_size_ != 0)
-        throw IoError(label_ + ": not a plain SQLite file (rollback journal, no auto-vacuum)");
+    // A rollback-journal file (version 1: the file is the whole database) without auto-vacuum
+    // (no pointer-map pages to keep). GDAL makes one unless told otherwise.
+    if (std::memcmp(h, "SQLite format 3", 16) != 0 || page_size_ < 512 ||
+        st.st_size % page_size_ != 0)
+        throw IoError(label_ + ": not a SQLite file");
+    if (h[18] != 1 || h[19] != 1)
+        throw IoError(label_ + ": the SQLite file is in WAL mode (is OGR_SQLITE_JOURNAL set?), "
+                               "which the writer cannot fill");
+    if (get_be(h + 52, 4) != 0)
+        throw IoError(label_ + ": the SQLite file has auto-vacuum (is OGR_SQLITE_PRAGMA set?), "
+                               "which the writer cannot fill");
     pages_ = std::uint32_t(st.st_size / page_size_);
     // The page holding the pending byte is never used (fileformat2 1.3); SQLite's own value.
     const int pending = sqlite3_test_control(SQLITE_TESTCTRL_PENDING_BYTE, 0u);

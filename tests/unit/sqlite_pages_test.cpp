@@ -232,18 +232,27 @@ TEST(SqlitePages, the_lock_byte_page_is_skipped) {
     sqlite3_test_control(SQLITE_TESTCTRL_PENDING_BYTE, unsigned(before));
 }
 
-// A file that is not a plain rollback-journal SQLite database is refused, not written into.
-TEST(SqlitePages, a_file_in_wal_mode_or_not_sqlite_is_refused) {
+// A file that is not a plain rollback-journal SQLite database is refused, not written into,
+// with what to look at (GDAL makes such a file only when its settings ask for it).
+TEST(SqlitePages, a_file_in_wal_mode_with_auto_vacuum_or_not_sqlite_is_refused) {
     TempDir dir;
     {
         Db db(dir / "wal.sqlite");
         db.exec("PRAGMA journal_mode = WAL");
         db.exec("CREATE TABLE t (a)");
     }
+    {
+        Db db(dir / "vacuum.sqlite");
+        db.exec("PRAGMA auto_vacuum = FULL");
+        db.exec("CREATE TABLE t (a)");
+    }
     std::ofstream(dir / "text.sqlite") << std::string(4096, 'x');
-    for (const char *name : {"wal.sqlite", "text.sqlite"}) {
+    for (const auto &[name, why] :
+         {std::pair{"wal.sqlite", "the SQLite file is in WAL mode (is OGR_SQLITE_JOURNAL set?)"},
+          std::pair{"vacuum.sqlite", "the SQLite file has auto-vacuum (is OGR_SQLITE_PRAGMA set?)"},
+          std::pair{"text.sqlite", "not a SQLite file"}}) {
         const std::string m = thrown_message<IoError>(
             [&] { io::SqlitePages pages(dir / name, "output o.gpkg", dir / name); });
-        EXPECT_NE(m.find("output o.gpkg: not a plain SQLite file"), std::string::npos) << m;
+        EXPECT_EQ(m.find(std::string("output o.gpkg: ") + why), 0u) << m;
     }
 }
