@@ -35,8 +35,8 @@ RtreeBox rtree_box(double min_x, double max_x, double min_y, double max_y) {
 
 namespace {
 
-/// keys[from, to) sorted as std::sort sorts (key, index) pairs: by key, ties by index. Each
-/// pair is one 64-bit word, the key's bits in an order that compares as the floats do (the
+/// `words` sorted as std::sort sorts (key, index) pairs: by key, ties by index. Each pair is
+/// one 64-bit word (keyed_word), the key's bits in an order that compares as the floats do (the
 /// sign flipped, a negative's other bits inverted; -0 made +0 first), then the index, sorted by
 /// least-significant-digit radix a byte at a time (a byte every word shares is skipped).
 void sort_keyed(std::vector<std::uint64_t> &words, std::vector<std::uint64_t> &scratch) {
@@ -239,7 +239,8 @@ struct PackedTree {
     std::vector<Level> levels;
 };
 
-/// (No level for no box: the index keeps the empty root SQLite made.)
+/// `layer`'s boxes packed into `tree`, nodes of at most `capacity` cells (no level for no box:
+/// the index keeps the empty root SQLite made).
 void pack_tree(const RtreeLayer &layer, std::size_t capacity, PackedTree &tree) {
     auto &levels = tree.levels;
     if (layer.boxes.empty())

@@ -1,15 +1,15 @@
 // Internal to io/: rowid tables of a closed SQLite file filled by writing their B-tree pages,
 // for the GeoPackage writer's millions of rows (gpkg_write.cpp, gpkg_rtree.cpp).
 //
-// SQLite inserts a row in about 1 us on one core, whatever the batching: 3.1M rows of a 1e6-node
-// mesh took 3.6 s, four times the mesh. It has no bulk load of rows already in key order, so
-// this writes what its B-tree would hold, in the documented file format
-// (https://www.sqlite.org/fileformat2.html): records (2.1), table leaf pages (0x0D) filled in
-// rowid order, interior pages (0x05) built bottom-up, overflow chains for long payloads, the
-// lock-byte page left unused, and the header's page count and change counter. The tables are
-// created by SQLite (empty, so each is one leaf at its root page); their pages are appended to
-// the file and the top page of each tree is written at its root. The file is a temporary one
-// with no connection open on it; a failure leaves it for deletion.
+// SQLite inserts a row in about 1 us on one core, whatever the batching (RESULTS-writers.md),
+// and has no bulk load of rows already in key order. So this writes what its B-tree would
+// hold, in the documented file format (https://www.sqlite.org/fileformat2.html): records (2.1),
+// table leaf pages (0x0D) filled in rowid order, interior pages (0x05) built bottom-up, overflow
+// chains for long payloads, the lock-byte page left unused, and the header's page count and
+// change counter. The tables are created by SQLite (empty, so each is one leaf at its root
+// page); their pages are appended to the file and the top page of each tree is written at its
+// root. The file is a temporary one with no connection open on it; a failure leaves it for
+// deletion.
 #pragma once
 
 #include <cstdint>
