@@ -39,15 +39,6 @@ LonLatPart clip_ring(const LonLatPart &ring, double x, bool keep_below) {
     return out;
 }
 
-double ring_area(const LonLatPart &r) {
-    double a = 0;
-    for (std::size_t i = 0; i < r.size(); ++i) {
-        const auto &p = r[i], &q = r[(i + 1) % r.size()];
-        a += p[0] * q[1] - q[0] * p[1];
-    }
-    return 0.5 * a;
-}
-
 } // namespace
 
 std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
@@ -107,12 +98,7 @@ bool simple_face_ring(const Vec3 v[3], const LonLat ll[3], std::array<LonLatPoin
     for (const auto &p : ring)
         if (!(p[0] > -180 && p[0] < 180))
             return false;
-    double a = 0; // ring_area's sum, in its order
-    for (std::size_t i = 0; i < 3; ++i) {
-        const auto &p = ring[i], &q = ring[(i + 1) % 3];
-        a += p[0] * q[1] - q[0] * p[1];
-    }
-    return std::fabs(0.5 * a) > 1e-18;
+    return std::fabs(ring_area(ring)) > 1e-18;
 }
 
 std::vector<LonLatPart> polyline_parts(const std::vector<Vec3> &nodes) {

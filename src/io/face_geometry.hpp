@@ -17,6 +17,18 @@ namespace globemesh::io {
 using LonLatPoint = std::array<double, 2>;
 using LonLatPart = std::vector<LonLatPoint>; ///< a ring (not repeated closing point) or a line
 
+/// The signed area of a lon/lat ring (no repeated closing point), square degrees in the plane,
+/// positive counter-clockwise: the shoelace sum over its sides in order. Any ring of points
+/// that index as [0] lon, [1] lat (a LonLatPart, a std::array of them).
+template <class Ring> double ring_area(const Ring &r) {
+    double a = 0;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+        const auto &p = r[i], &q = r[(i + 1) % r.size()];
+        a += p[0] * q[1] - q[0] * p[1];
+    }
+    return 0.5 * a;
+}
+
 /// The face abc (unit vectors, counter-clockwise) as one or more polygon rings within [-180, 180].
 std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &c);
 

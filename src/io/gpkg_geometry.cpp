@@ -51,12 +51,7 @@ std::vector<LonLatPart> narrow_rings(LonLatPart ring) {
     const double w = max_part_width_deg;
     for (double band = std::floor(lo / w) * w; band < hi; band += w) {
         LonLatPart piece = clip_ring_to_band(ring, std::max(lo, band), std::min(hi, band + w));
-        double twice_area = 0;
-        for (std::size_t i = 0; i < piece.size(); ++i) {
-            const auto &p = piece[i], &q = piece[(i + 1) % piece.size()];
-            twice_area += p[0] * q[1] - q[0] * p[1];
-        }
-        if (piece.size() >= 3 && std::fabs(twice_area) > 1e-18)
+        if (piece.size() >= 3 && std::fabs(2 * ring_area(piece)) > 1e-18) // twice the area
             parts.push_back(std::move(piece));
     }
     return parts;

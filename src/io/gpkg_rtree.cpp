@@ -105,21 +105,11 @@ std::vector<std::size_t> pack(const std::vector<RtreeBox> &boxes, std::size_t ca
     return starts;
 }
 
-void put16(unsigned char *p, std::uint32_t v) {
-    p[0] = static_cast<unsigned char>(v >> 8);
-    p[1] = static_cast<unsigned char>(v);
-}
-
-void put64(unsigned char *p, std::uint64_t v) {
-    for (int i = 7; i >= 0; --i, v >>= 8)
-        p[i] = static_cast<unsigned char>(v);
-}
-
+/// A float's bits at p, big-endian (an RTree node's coordinates).
 void put_float(unsigned char *p, float f) {
     std::uint32_t v;
     std::memcpy(&v, &f, sizeof v);
-    for (int i = 3; i >= 0; --i, v >>= 8)
-        p[i] = static_cast<unsigned char>(v);
+    put_big_endian(p, v, 4);
 }
 
 /// "name" as an SQL identifier.
@@ -266,17 +256,6 @@ void pack_tree(const RtreeLayer &layer, std::size_t capacity, PackedTree &tree) 
     }
 }
 
-/// A record of two columns, NULL (the rowid's alias) and the integer v, in `out`; returns its
-/// size (SqliteRecord's bytes, made without its buffers: 3.1M rows a 1e6-node mesh).
-std::size_t null_and_integer(std::int64_t v, unsigned char (&out)[11]) {
-    const unsigned type = sqlite_integer_type(v);
-    out[0] = 3, out[1] = 0, out[2] = static_cast<unsigned char>(type); // header size, NULL, v
-    const std::size_t bytes = sqlite_integer_bytes(type);
-    for (std::size_t i = bytes; i-- > 0; v = std::int64_t(std::uint64_t(v) >> 8))
-        out[3 + i] = static_cast<unsigned char>(v);
-    return 3 + bytes;
-}
-
 /// Writes a layer's packed tree into its index's empty tables.
 void write_tree(SqlitePages &file, const RtreeLayer &layer, const PackedTree &tree,
                 const RtreeTables &tables, Steps &steps) {
@@ -304,14 +283,14 @@ void write_tree(SqlitePages &file, const RtreeLayer &layer, const PackedTree &tr
         for (std::size_t j = 0; j + 1 < l.starts.size(); ++j) {
             const std::int64_t number = first[k] + std::int64_t(j);
             std::fill(blob.begin(), blob.end(), 0);
-            put16(&blob[0], k == height ? std::uint32_t(height) : 0);
-            put16(&blob[2], std::uint32_t(l.starts[j + 1] - l.starts[j]));
+            put_big_endian(&blob[0], k == height ? height : 0, 2);
+            put_big_endian(&blob[2], l.starts[j + 1] - l.starts[j], 2);
             unsigned char *p = &blob[4];
             for (std::size_t i = l.starts[j]; i < l.starts[j + 1]; ++i, p += cell_bytes) {
                 const std::uint32_t c = l.order[i];
                 const std::int64_t id =
                     k == 0 ? std::int64_t(c) + 1 : first[k - 1] + std::int64_t(c);
-                put64(p, std::uint64_t(id));
+                put_big_endian(p, std::uint64_t(id), 8);
                 for (std::size_t d = 0; d < 4; ++d)
                     put_float(p + 8 + 4 * d, (*l.boxes)[c][d]);
                 if (k == 0)
@@ -329,11 +308,11 @@ void write_tree(SqlitePages &file, const RtreeLayer &layer, const PackedTree &tr
     node_rows.finish();
     TableLoader parent_rows(file, tables.parent);
     for (std::size_t n = 2; n < nodes; ++n)
-        parent_rows.add(std::int64_t(n), small, null_and_integer(parent_of[n], small));
+        parent_rows.add(std::int64_t(n), small, null_and_integer_record(parent_of[n], small));
     parent_rows.finish();
     TableLoader rowid_rows(file, tables.rowid);
     for (std::size_t i = 0; i < leaf_of.size(); ++i) {
-        rowid_rows.add(std::int64_t(i) + 1, small, null_and_integer(leaf_of[i], small));
+        rowid_rows.add(std::int64_t(i) + 1, small, null_and_integer_record(leaf_of[i], small));
         steps.add(1);
     }
     rowid_rows.finish();

@@ -41,11 +41,6 @@ std::size_t put_varint(unsigned char *p, std::uint64_t v) {
     return n;
 }
 
-void put_be(unsigned char *p, std::uint64_t v, int bytes) {
-    for (int i = bytes - 1; i >= 0; --i, v >>= 8)
-        p[i] = static_cast<unsigned char>(v);
-}
-
 std::uint32_t get_be(const unsigned char *p, int bytes) {
     std::uint32_t v = 0;
     for (int i = 0; i < bytes; ++i)
@@ -58,6 +53,11 @@ constexpr std::size_t header_bytes = 100; // the database header, at the start o
 constexpr std::size_t flush_bytes = 1 << 20;
 
 } // namespace
+
+void put_big_endian(unsigned char *p, std::uint64_t v, int bytes) {
+    for (int i = bytes - 1; i >= 0; --i, v >>= 8)
+        p[i] = static_cast<unsigned char>(v);
+}
 
 unsigned sqlite_integer_type(std::int64_t v) {
     if (v == 0 || v == 1)
@@ -75,13 +75,21 @@ std::size_t sqlite_integer_bytes(unsigned type) {
     return sizes[type];
 }
 
+std::size_t null_and_integer_record(std::int64_t v, unsigned char (&out)[11]) {
+    const unsigned type = sqlite_integer_type(v);
+    out[0] = 3, out[1] = 0, out[2] = static_cast<unsigned char>(type); // header size, NULL, v
+    const std::size_t bytes = sqlite_integer_bytes(type);
+    put_big_endian(out + 3, std::uint64_t(v), int(bytes));
+    return 3 + bytes;
+}
+
 void SqliteRecord::integer(std::int64_t v) {
     const unsigned type = sqlite_integer_type(v);
     types_.push_back(type);
     const std::size_t at = body_.size(), bytes = sqlite_integer_bytes(type);
     body_.resize(at + bytes);
     if (bytes)
-        put_be(&body_[at], std::uint64_t(v), int(bytes));
+        put_big_endian(&body_[at], std::uint64_t(v), int(bytes));
 }
 
 void SqliteRecord::real(double v) {
@@ -94,8 +102,7 @@ void SqliteRecord::real(double v) {
     // SQLite would write it.
     if (v > -9.2e18 && v < 9.2e18) {
         const auto i = static_cast<std::int64_t>(v);
-        const std::uint64_t u = i < 0 ? ~std::uint64_t(i) : std::uint64_t(i);
-        if (static_cast<double>(i) == v && u <= 0x7fffffffffff) {
+        if (static_cast<double>(i) == v && sqlite_integer_type(i) != 6) { // not 8 bytes
             integer(i);
             return;
         }
@@ -105,7 +112,7 @@ void SqliteRecord::real(double v) {
     std::memcpy(&bits, &v, sizeof bits);
     const std::size_t at = body_.size();
     body_.resize(at + 8);
-    put_be(&body_[at], bits, 8);
+    put_big_endian(&body_[at], bits, 8);
 }
 
 void SqliteRecord::blob(const unsigned char *data, std::size_t bytes) {
@@ -190,24 +197,21 @@ void SqlitePages::write(std::uint32_t number, const unsigned char *page) {
                       std::ptrdiff_t(std::size_t(number - buffer_first_) * page_size_));
         return;
     }
-    const off_t at = off_t(number - 1) * page_size_;
-    for (std::size_t done = 0; done < page_size_;) {
-        const ssize_t n = ::pwrite(fd_, page + done, page_size_ - done, at + off_t(done));
+    write_at(page, page_size_, off_t(number - 1) * page_size_, "writing");
+}
+
+void SqlitePages::write_at(const unsigned char *data, std::size_t bytes, off_t offset,
+                           const std::string &step) {
+    for (std::size_t done = 0; done < bytes;) {
+        const ssize_t n = ::pwrite(fd_, data + done, bytes - done, offset + off_t(done));
         if (n <= 0)
-            fail("writing", n < 0 ? errno : ENOSPC);
+            fail(step, n < 0 ? errno : ENOSPC);
         done += std::size_t(n);
     }
 }
 
 void SqlitePages::flush() {
-    const off_t at = off_t(buffer_first_ - 1) * page_size_;
-    for (std::size_t done = 0; done < buffer_.size();) {
-        const ssize_t n =
-            ::pwrite(fd_, buffer_.data() + done, buffer_.size() - done, at + off_t(done));
-        if (n <= 0)
-            fail("writing", n < 0 ? errno : ENOSPC);
-        done += std::size_t(n);
-    }
+    write_at(buffer_.data(), buffer_.size(), off_t(buffer_first_ - 1) * page_size_, "writing");
     buffer_.clear();
     buffer_first_ = pages_ + 1;
 }
@@ -219,12 +223,11 @@ void SqlitePages::finish() {
         fail("reading its header", errno ? errno : EIO);
     // The page count is valid when the version-valid-for number is the change counter.
     const std::uint32_t counter = get_be(h + 24, 4) + 1;
-    put_be(h + 24, counter, 4);
-    put_be(h + 28, pages_, 4);
-    put_be(h + 92, counter, 4);
-    put_be(h + 96, std::uint32_t(sqlite3_libversion_number()), 4);
-    if (::pwrite(fd_, h, sizeof h, 0) != std::ptrdiff_t(sizeof h))
-        fail("writing its header", errno ? errno : ENOSPC);
+    put_big_endian(h + 24, counter, 4);
+    put_big_endian(h + 28, pages_, 4);
+    put_big_endian(h + 92, counter, 4);
+    put_big_endian(h + 96, std::uint32_t(sqlite3_libversion_number()), 4);
+    write_at(h, sizeof h, 0, "writing its header");
     const int fd = fd_;
     fd_ = -1;
     if (::close(fd) != 0)
@@ -254,8 +257,8 @@ void TableLoader::add(std::int64_t rowid, const unsigned char *record, std::size
     p += put_varint(p, std::uint64_t(rowid));
     std::memcpy(p, record, local);
     if (chain)
-        put_be(p + local, chain, 4);
-    put_be(&page_[8 + 2 * cells_], u - content_, 2);
+        put_big_endian(p + local, chain, 4);
+    put_big_endian(&page_[8 + 2 * cells_], u - content_, 2);
     ++cells_;
     last_rowid_ = rowid;
 }
@@ -269,7 +272,7 @@ std::uint32_t TableLoader::overflow(const unsigned char *rest, std::size_t bytes
     std::uint32_t next = 0;
     for (std::size_t i = count; i-- > 0;) {
         std::fill(page.begin(), page.end(), 0);
-        put_be(&page[0], next, 4);
+        put_big_endian(&page[0], next, 4);
         const std::size_t from = i * per_page, n = std::min(per_page, bytes - from);
         std::memcpy(&page[4], rest + from, n);
         next = file_.append(page.data());
@@ -282,8 +285,8 @@ void TableLoader::close_leaf() {
     if (page_.empty())
         page_.assign(file_.page_size(), 0);
     page_[0] = table_leaf;
-    put_be(&page_[3], cells_, 2);
-    put_be(&page_[5], (u - content_) & 0xffff, 2); // 65536 is written 0
+    put_big_endian(&page_[3], cells_, 2);
+    put_big_endian(&page_[5], (u - content_) & 0xffff, 2); // 65536 is written 0
     store(last_rowid_);
     page_.clear();
     cells_ = 0, content_ = 0;
@@ -328,18 +331,18 @@ void TableLoader::finish() {
                 --j;
             std::vector<unsigned char> &page = pages.emplace_back(file_.page_size(), 0);
             page[0] = table_interior;
-            put_be(&page[3], j - i, 2);
-            put_be(&page[8], level[j].page, 4);
+            put_big_endian(&page[3], j - i, 2);
+            put_big_endian(&page[8], level[j].page, 4);
             std::size_t content = 0;
             for (std::size_t k = i; k < j; ++k) {
                 unsigned char cell[13];
-                put_be(cell, level[k].page, 4);
+                put_big_endian(cell, level[k].page, 4);
                 const std::size_t n = 4 + put_varint(cell + 4, std::uint64_t(level[k].max_rowid));
                 content += n;
                 std::memcpy(&page[u - content], cell, n);
-                put_be(&page[12 + 2 * (k - i)], u - content, 2);
+                put_big_endian(&page[12 + 2 * (k - i)], u - content, 2);
             }
-            put_be(&page[5], (u - content) & 0xffff, 2);
+            put_big_endian(&page[5], (u - content) & 0xffff, 2);
             up.push_back({0, level[j].max_rowid});
             i = j + 1;
         }

@@ -17,12 +17,23 @@
 #include <string>
 #include <vector>
 
+#include <sys/types.h>
+
 namespace globemesh::io {
+
+/// v's low `bytes` bytes at p, big-endian (SQLite's order for its integers, page headers and
+/// the RTree's nodes).
+void put_big_endian(unsigned char *p, std::uint64_t v, int bytes);
 
 /// The serial type SQLite stores the integer v as (1-6, or 8 and 9 for 0 and 1), and the bytes
 /// of its value for such a type.
 unsigned sqlite_integer_type(std::int64_t v);
 std::size_t sqlite_integer_bytes(unsigned type);
+
+/// The record of two columns, NULL (a rowid's alias) and the integer v, in `out`, as SqliteRecord
+/// makes it, without its buffers (an RTree's _rowid and _parent rows: millions); returns its
+/// size.
+std::size_t null_and_integer_record(std::int64_t v, unsigned char (&out)[11]);
 
 /// One row in SQLite's record format, appended to `out`: the header (its size and a serial type
 /// per column), then the values. Columns are added in the table's order; a rowid table's
@@ -63,6 +74,9 @@ public:
 
 private:
     [[noreturn]] void fail(const std::string &step, int error) const;
+    /// Writes `bytes` bytes at `offset` of the file; fails naming `step`.
+    void write_at(const unsigned char *data, std::size_t bytes, off_t offset,
+                  const std::string &step);
     void flush();
 
     int fd_ = -1;

@@ -50,26 +50,33 @@ struct Row {
     std::vector<unsigned char> b;
 };
 
+/// Integers at the edges of each of SQLite's sizes (1, 2, 3, 4, 6 and 8 bytes, 0 and 1 kept in
+/// the type), on both signs.
+const std::int64_t integer_edges[] = {0,
+                                      1,
+                                      -1,
+                                      2,
+                                      127,
+                                      128,
+                                      -128,
+                                      -129,
+                                      32767,
+                                      32768,
+                                      -32768,
+                                      -32769,
+                                      8388607,
+                                      8388608,
+                                      2147483647,
+                                      -2147483649LL,
+                                      140737488355327LL,
+                                      140737488355328LL,
+                                      std::numeric_limits<std::int64_t>::max(),
+                                      std::numeric_limits<std::int64_t>::min()};
+
 /// Rows with every integer size and sign, reals whole (stored as integers) and not, -0, NaN
 /// (NULL), blobs from empty to several overflow pages, and gaps in the rowids.
 std::vector<Row> test_rows(std::size_t n) {
-    const std::int64_t ints[] = {0,
-                                 1,
-                                 -1,
-                                 2,
-                                 127,
-                                 128,
-                                 -129,
-                                 32767,
-                                 -32768,
-                                 8388607,
-                                 8388608,
-                                 2147483647,
-                                 -2147483649LL,
-                                 140737488355327LL,
-                                 140737488355328LL,
-                                 std::numeric_limits<std::int64_t>::max(),
-                                 std::numeric_limits<std::int64_t>::min()};
+    const auto &ints = integer_edges;
     const double reals[] = {
         0.1,         -0.0, 3.0, -7.0, 1e300, 1125899906842624.0, -2.5, 1e-300, 140737488355327.0,
         std::nan("")};
@@ -193,6 +200,24 @@ TEST(SqlitePages, every_table_size_makes_a_valid_tree) {
         ASSERT_EQ(db.one("SELECT sum(i) FROM pages WHERE id > 100"),
                   std::to_string(n * (n - 1) / 2 - 4950))
             << n;
+    }
+}
+
+// The RTree's two-column rows are made without SqliteRecord's buffers: the same bytes.
+TEST(SqlitePages, null_and_integer_record_is_the_records_bytes) {
+    std::mt19937_64 random(3);
+    std::vector<std::int64_t> values(std::begin(integer_edges), std::end(integer_edges));
+    for (int k = 0; k < 1000; ++k)
+        values.push_back(std::int64_t(random()) >> (random() % 64));
+    io::SqliteRecord record;
+    for (const std::int64_t v : values) {
+        std::vector<unsigned char> expected;
+        record.null();
+        record.integer(v);
+        record.append_to(expected);
+        unsigned char bytes[11];
+        const std::size_t n = io::null_and_integer_record(v, bytes);
+        EXPECT_EQ(std::vector<unsigned char>(bytes, bytes + n), expected) << v;
     }
 }
 
