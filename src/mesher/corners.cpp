@@ -279,7 +279,7 @@ void blunt_sharp_corners(Mesher &m, const MesherOptions &options) {
                           m.cut_sides};
     const detail::CornerReport corners = detail::blunt_corners(cm, options.close_straits);
     MesherReport &report = m.report;
-    report.corners_blunted = corners.blunted;
+    report.corners_blunted += corners.blunted;
     report.encroached_splits += corners.splits;
     report.straits_closed += corners.straits_at.size();
     for (const Vec3 &p : corners.straits_at)

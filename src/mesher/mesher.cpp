@@ -69,9 +69,14 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
         timed("land");
     }
 
-    // Last, the coast's corners too sharp for the faces there (corners.cpp).
+    // Last, the coast's corners too sharp for the faces there (corners.cpp), then the floor
+    // (quality.cpp). The floor's moves can leave a sliver on the coast below it, which blunting
+    // removes: then both run once more.
     blunt_sharp_corners(m, options);
-    raise_quality_floor(m, options, as_made);
+    if (!raise_quality_floor(m, options, as_made)) {
+        blunt_sharp_corners(m, options);
+        raise_quality_floor(m, options, as_made);
+    }
     if (options.land)
         measure_closed_straits(m, *options.land, report);
 

@@ -483,11 +483,12 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made, std::vector<std
 // when options.land is given), pattern searches raise the worst triangles, and triangles with
 // two or three boundary corners are mended.
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
-// The same search for the free nodes of the faces below q 0.3 that the land and corner stages
-// leave (their nodes moved or their neighbours removed after improve_quality).
 /// Fills report.straits_closed_width_km from report.straits_closed_at (straits.cpp).
 void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport &report);
-void raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
+// The same search for the free nodes of the faces below q 0.3 that the land and corner stages
+// leave (their nodes moved or their neighbours removed after improve_quality). Returns whether
+// no ocean face is left below it.
+bool raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
 
 // islands.cpp: face centroids moved off the islands the coast shaping dropped.
 std::size_t clear_dropped_islands(Mesher &m, const Boundary &boundary, MesherReport &report,

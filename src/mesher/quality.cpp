@@ -38,7 +38,8 @@ public:
     void run_count_rounds();
     void run_search_rounds();
     void mend_corners();
-    void raise_floor();
+    bool raise_floor();
+    bool floor_holds() const;
     std::size_t remove_floor_nodes();
     std::size_t insert_floor_nodes();
     bool try_floor_node(TriangleId t, VertexId a, VertexId b,
@@ -402,7 +403,7 @@ void QualityRounds::mend_corners() {
     }
 }
 
-void QualityRounds::raise_floor() {
+bool QualityRounds::raise_floor() {
     // After the land and corner clean-up, which move and remove faces after the rounds above:
     // the free nodes of the faces still below the floor (sharp corners included) get the
     // search that raises their star's worst, a few rounds; a move never lowers a star's worst.
@@ -427,6 +428,20 @@ void QualityRounds::raise_floor() {
         while (remove_floor_nodes() > 0)
             search();
     }
+    return floor_holds();
+}
+
+// Whether no ocean face is below the floor (a face of three unmoved lattice nodes is not, as
+// collect assumes).
+bool QualityRounds::floor_holds() const {
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t) || dt.label(t) != ocean)
+            continue;
+        const VertexId a = dt.vertex(t, 0), b = dt.vertex(t, 1), c = dt.vertex(t, 2);
+        if (!(as_made[a] && as_made[b] && as_made[c]) && face_quality(t) < detail::blunt_floor)
+            return false;
+    }
+    return true;
 }
 
 // A free node (not sharp) of a face still below the floor, whose star is all ocean, goes when
@@ -572,8 +587,8 @@ bool QualityRounds::try_floor_node(TriangleId t, VertexId a, VertexId b,
 
 } // namespace
 
-void raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made) {
-    QualityRounds(m, options, as_made).raise_floor();
+bool raise_quality_floor(Mesher &m, const MesherOptions &options, std::vector<char> &as_made) {
+    return QualityRounds(m, options, as_made).raise_floor();
 }
 
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made) {

@@ -11,6 +11,7 @@
 #include "globemesh/coast.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/pipeline.hpp"
+#include "globemesh/sphere.hpp"
 #include "globemesh/ugrid.hpp"
 #include "support.hpp"
 
@@ -112,6 +113,26 @@ TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_t
     const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GE(count_attribute(mesh, "floor_nodes_added"), 1u);
     expect_valid_mesh(mesh, o, "yangtze.nc");
+}
+
+// GSHHG full around the Suez Canal at 5 km, the region the fixture's own box: a stub of the
+// canal (300 m wide, left open where straits closed north of it) holds nodes 12 m to 100 m
+// apart. The floor's searches raised an interior face there from q 0.24 to 0.285, a sliver on a
+// coast side of 100 m whose third corner lies 24 m off it; blunting had run before and removed
+// such slivers only before the floor's moves (the global GSHHG full run at 5 km had this face
+// as its worst, q 0.2852 at 32.354E 30.427N, in one part and in two). Blunting and the floor
+// now run once more when a face is left below it.
+TEST(CoastReal, a_sliver_the_floor_leaves_on_the_coast_is_blunted_after_it) {
+    const MeshOptions o =
+        region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+    const Mesh mesh = mesh_ocean(o).mesh;
+    double worst = 1;
+    for (const auto &f : mesh.faces)
+        worst =
+            std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
+    EXPECT_GE(worst, 0.3);                // 0.284 before
+    EXPECT_GE(corners_blunted(mesh), 7u); // 6 before, the sliver the seventh
+    expect_valid_mesh(mesh, o, "suez.nc");
 }
 
 // GSHHG intermediate around Seram and Misool (128.5..131.5E, 4.5..1.5S): in the global run at
