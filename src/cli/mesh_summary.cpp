@@ -81,7 +81,7 @@ void print_straits(std::ostream &out, const MesherReport &m) {
     }
     if (m.straits_closed_at.size() > shown)
         out << "                  ... " << m.straits_closed_at.size() - shown
-            << " more (straits_closed_at, straits_closed_width_km; --report)\n";
+            << " more (all in --report's straits_closed; the first in straits_closed_at)\n";
 }
 
 /// The warning on `err` that straits were closed, and how to keep them.
