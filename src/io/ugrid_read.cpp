@@ -226,7 +226,8 @@ int read_nodes(const Reader &r, int topo, Mesh &mesh) {
     };
     if (is_lat(cx) && !is_lat(cy))
         std::swap(cx, cy);
-    if (r.text(cx, "standard_name").value_or("") == "projection_x_coordinate")
+    const std::string x_name = r.text(cx, "standard_name").value_or("");
+    if (x_name == "projection_x_coordinate")
         r.fail("its nodes are in a projected CRS (" + r.name(cx) +
                " is projection_x_coordinate); globemesh reads longitude and latitude");
     auto node_dims = r.dims(cx);

@@ -96,11 +96,15 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
             a.emplace_back("straits_closed_at", places_text(m.straits_closed_at, max_places));
         if (!m.straits_closed_width_km.empty()) {
             std::string widths;
-            for (std::size_t i = 0; i < m.straits_closed_width_km.size() && i < max_places; ++i)
-                widths += (i ? ", " : "") +
-                          (m.straits_closed_width_km[i] > 0
-                               ? report_number(m.straits_closed_width_km[i])
-                               : "<" + report_number(m.straits_closed_width_below_km[i]));
+            for (std::size_t i = 0; i < m.straits_closed_width_km.size() && i < max_places; ++i) {
+                if (i)
+                    widths += ", ";
+                const bool measured = m.straits_closed_width_km[i] > 0; // else only a bound
+                if (!measured)
+                    widths += '<';
+                widths += report_number(measured ? m.straits_closed_width_km[i]
+                                                 : m.straits_closed_width_below_km[i]);
+            }
             a.emplace_back("straits_closed_width_km", widths);
         }
     }
