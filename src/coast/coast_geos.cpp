@@ -100,12 +100,8 @@ void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Group
     auto find = [&](std::size_t i) { return groups.find(i); };
     std::vector<std::size_t> &parent = groups.parent;
     std::vector<PolygonRings> outlines(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        outlines[i].push_back(ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polys[i].get())));
-        for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polys[i].get()); ++h)
-            outlines[i].push_back(
-                ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polys[i].get(), h)));
-    }
+    for (std::size_t i = 0; i < n; ++i)
+        outlines[i] = polygon_rings(geos, polys[i].get());
     for (auto [i, j] : coast_detail::near_pairs(outlines, 2 * grid)) {
         if (find(i) == find(j))
             continue;
@@ -119,7 +115,7 @@ std::size_t rings_of(Geos &geos, const GEOSGeometry *polygon) {
 }
 
 /// Polygons snap-rounded together: a group (one snap-rounding union) or a batch of lone ones
-/// (GEOS's precision reducer on their MultiPolygon).
+/// (no union: see snap_job).
 struct SnapJob {
     bool group = false;
     std::vector<GeomPtr> polygons; ///< taken by snap_job
@@ -127,28 +123,48 @@ struct SnapJob {
     std::vector<GeomPtr> out; ///< the polygons it gave, owned in the caller's context
 };
 
-/// Runs a job in `geos` (a worker's context, or the caller's `owner`).
-void snap_job(Geos &geos, SnapJob &job, double grid, GEOSContextHandle_t owner) {
-    std::vector<GEOSGeometry *> raw;
-    for (auto &p : job.polygons)
-        raw.push_back(p.release());
-    job.polygons.clear();
-    GeomPtr all = own(geos,
-                      GEOSGeom_createCollection_r(
-                          geos.get(), job.group ? GEOS_GEOMETRYCOLLECTION : GEOS_MULTIPOLYGON,
-                          raw.data(), static_cast<unsigned>(raw.size())),
-                      "collect polygons");
-    GeomPtr snapped = job.group ? own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid),
-                                      "dissolve the land polygons")
-                                : own(geos, GEOSGeom_setPrecision_r(geos.get(), all.get(), grid, 0),
-                                      "snap-round the land");
+/// Adds the polygons of `snapped` to job.out, owned in the caller's context `owner`.
+void add_output(Geos &geos, SnapJob &job, const GEOSGeometry *snapped, GEOSContextHandle_t owner) {
     std::vector<const GEOSGeometry *> ps;
-    polygons_of(geos, snapped.get(), ps);
+    polygons_of(geos, snapped, ps);
     for (const auto *p : ps) {
         job.rings_out += rings_of(geos, p);
         GeomPtr copy = own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon");
         job.out.emplace_back(copy.release(), GeosDeleter{owner});
     }
+}
+
+/// Runs a job in `geos` (a worker's context, or the caller's `owner`). A batch's lone polygons
+/// come out in order, each as GEOS's precision reducer rounds it alone: rounded here when
+/// rounding cannot change it (rounded_if_clear: GEOS's vertices in GEOS's order), else by GEOS
+/// (15 us a call beside the rounding: each seeds a random generator). A group goes through
+/// GEOS's snap-rounding union.
+void snap_job(Geos &geos, SnapJob &job, double grid, GEOSContextHandle_t owner) {
+    if (!job.group) {
+        for (const auto &p : job.polygons)
+            if (auto rounded = rounded_if_clear(polygon_rings(geos, p.get()), grid)) {
+                job.rings_out += rounded->size();
+                job.out.emplace_back(make_polygon(geos, *rounded).release(), GeosDeleter{owner});
+            } else {
+                const GeomPtr snapped =
+                    own(geos, GEOSGeom_setPrecision_r(geos.get(), p.get(), grid, 0),
+                        "snap-round the land");
+                add_output(geos, job, snapped.get(), owner);
+            }
+        job.polygons.clear();
+        return;
+    }
+    std::vector<GEOSGeometry *> raw;
+    for (auto &p : job.polygons)
+        raw.push_back(p.release());
+    job.polygons.clear();
+    GeomPtr all = own(geos,
+                      GEOSGeom_createCollection_r(geos.get(), GEOS_GEOMETRYCOLLECTION, raw.data(),
+                                                  static_cast<unsigned>(raw.size())),
+                      "collect polygons");
+    const GeomPtr snapped =
+        own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), grid), "dissolve the land polygons");
+    add_output(geos, job, snapped.get(), owner);
 }
 
 } // namespace
@@ -221,6 +237,13 @@ PointList ring_points(const Geos &geos, const GEOSGeometry *ring) {
     for (unsigned i = 0; i < n; ++i)
         pts[i] = {xy[2 * i], xy[2 * i + 1]};
     return pts;
+}
+
+PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon) {
+    PolygonRings rings{ring_points(geos, GEOSGetExteriorRing_r(geos.get(), polygon))};
+    for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polygon); ++h)
+        rings.push_back(ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), polygon, h)));
+    return rings;
 }
 
 GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where) {
@@ -313,10 +336,8 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
     join_intersecting(geos, polys, vertices, joined);
     // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
     join_near(geos, polys, grid, joined, near_only);
-    // Each group goes to GEOS as one collection: a polygon alone through GEOS's precision
-    // reducer, several through a snap-rounding union. Lone polygons go in batches of about
-    // batch_vertices (a valid MultiPolygon, as they are at least 2 cells apart): each GEOS snap
-    // rounding seeds a random generator through CPUID, which a virtual machine traps. Groups are
+    // A polygon alone is rounded alone (snap_job), a group of several through a snap-rounding
+    // union; lone polygons go to the threads in batches of about batch_vertices. Groups are
     // far enough apart (2 cells: rounding moves a vertex at most 0.71 cell) that rounding them
     // apart cannot make them meet. The batches and groups are snap-rounded on every core, the
     // largest first, and join the output in a fixed order.

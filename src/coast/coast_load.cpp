@@ -132,13 +132,8 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     report(progress, 0.85, "checking rings");
     {
         std::vector<PolygonRings> polygons;
-        for (const auto &g : land) {
-            PolygonRings rings_of{ring_points(geos, GEOSGetExteriorRing_r(geos.get(), g.get()))};
-            for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), g.get()); ++h)
-                rings_of.push_back(
-                    ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), g.get(), h)));
-            polygons.push_back(std::move(rings_of));
-        }
+        for (const auto &g : land)
+            polygons.push_back(polygon_rings(geos, g.get()));
         out.land = std::make_shared<const LandMask>(polygons);
     }
 

@@ -68,6 +68,8 @@ GeomPtr make_valid(Geos &geos, const GEOSGeometry *g);
 void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeometry *> &out);
 /// The vertices of a GEOS ring or line; DataError when GEOS cannot give them.
 PointList ring_points(const Geos &geos, const GEOSGeometry *ring);
+/// The rings of a GEOS polygon, shell first.
+PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon);
 /// Polygonizes closed coastline lines (GSHHG / OSM style). Lines are first merged at shared
 /// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
 /// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the
@@ -91,6 +93,14 @@ struct SnapCount {
 /// stands, the lone polygons with the batch they were rounded in (deterministic).
 std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,
                               SnapCount &count);
+
+/// A valid polygon's rings rounded to the lon/lat grid of `grid` degrees (as GEOS rounds), when
+/// every vertex lies at least 2.5 cells from every edge it is not an end of: each vertex then
+/// moves at most 0.71 cell, so no edge crosses or comes within half a cell of another and the
+/// result is what snap rounding would give, but for the order of its rings' vertices. Else
+/// std::nullopt (the polygon needs GEOS's snap-rounding noder). Most coastline polygons are
+/// clear: this costs a sort of their edges by grid cell, the noder a KdTree query per edge.
+std::optional<PolygonRings> rounded_if_clear(const PolygonRings &rings, double grid);
 
 /// The part of a valid polygonal geometry inside a lon/lat box: a copy when it lies inside,
 /// else GEOS's overlay intersection with the box (valid output). Not GEOSClipByRect: its
