@@ -83,8 +83,11 @@ namespace globemesh {
 /// GEOS context of its own.
 class LandMask final : public LandTest {
 public:
-    /// Each polygon is its shell, then its holes (lon/lat rings, first == last).
-    explicit LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons);
+    /// Each polygon is its shell, then its holes (lon/lat rings, first == last). The polygons are
+    /// prepared on every core, or on the calling thread alone without `every_core` (the copies
+    /// that the threads meshing parts make while the others mesh).
+    explicit LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons,
+                      bool every_core = true);
     ~LandMask();
     LandMask(const LandMask &) = delete;
     LandMask &operator=(const LandMask &) = delete;

@@ -11,6 +11,7 @@
 #include <geos_c.h>
 
 #include "coast_load_internal.hpp"
+#include "coast_parallel.hpp"
 #include "geos_handles.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
@@ -270,7 +271,7 @@ struct LandMask::Impl {
     }
 };
 
-LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons)
+LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons, bool every_core)
     : impl_(std::make_unique<Impl>()) {
     Impl &m = *impl_;
     std::vector<LonLat> probes; // a point of each polygon's shell
@@ -299,16 +300,28 @@ LandMask::LandMask(const std::vector<std::vector<std::vector<LonLat>>> &polygons
     m.piece_start.push_back(m.outline.size());
     m.label_pieces();
     // Every polygon prepared now, its point locator built by a first test (GEOS builds it
-    // lazily): the index belongs to loading the coast, not to the meshing that asks it.
-    m.prepared.reserve(m.polygons.size());
-    for (std::size_t i = 0; i < m.polygons.size(); ++i) {
-        m.prepared.emplace_back(GEOSPrepare_r(m.ctx, m.polygons[i].get()), GeosDeleter{m.ctx});
+    // lazily): the index belongs to loading the coast, not to the meshing that asks it. On every
+    // core (every_core), the largest polygons first; each polygon's index is its own.
+    m.prepared.resize(m.polygons.size());
+    auto prepare = [&](coast_detail::Geos &g, std::size_t i) {
+        m.prepared[i] =
+            PreparedPtr(GEOSPrepare_r(g.get(), m.polygons[i].get()), GeosDeleter{m.ctx});
         if (!m.prepared[i])
             throw DataError("coast: GEOS failed to prepare a land polygon for the land test");
-        const GeomPtr probe(GEOSGeom_createPointFromXY_r(m.ctx, probes[i].lon, probes[i].lat),
-                            GeosDeleter{m.ctx});
+        const GeomPtr probe(GEOSGeom_createPointFromXY_r(g.get(), probes[i].lon, probes[i].lat),
+                            GeosDeleter{g.get()});
         if (probe)
-            GEOSPreparedContains_r(m.ctx, m.prepared[i].get(), probe.get());
+            GEOSPreparedContains_r(g.get(), m.prepared[i].get(), probe.get());
+    };
+    if (every_core) {
+        std::vector<std::size_t> sizes(m.polygons.size());
+        for (std::size_t i = 0; i < sizes.size(); ++i)
+            sizes[i] = std::size_t(GEOSGetNumCoordinates_r(m.ctx, m.polygons[i].get()));
+        const std::vector<std::size_t> first = coast_detail::largest_first(sizes);
+        coast_detail::parallel_for_each_geos(m.geos, m.polygons.size(), prepare, &first);
+    } else {
+        for (std::size_t i = 0; i < m.polygons.size(); ++i)
+            prepare(m.geos, i);
     }
     m.tree = TreePtr(GEOSSTRtree_create_r(m.ctx, 10), GeosDeleter{m.ctx});
     for (std::size_t i = 0; i < m.polygons.size(); ++i)
@@ -323,19 +336,12 @@ LandMask::~LandMask() = default;
 
 std::function<std::shared_ptr<const LandTest>()> LandMask::copier() const {
     const Impl &m = *impl_;
-    using coast_detail::ring_points;
     auto polygons = std::make_shared<std::vector<std::vector<std::vector<LonLat>>>>();
     polygons->reserve(m.polygons.size());
-    for (const GeomPtr &polygon : m.polygons) {
-        std::vector<std::vector<LonLat>> rings{
-            ring_points(m.geos, GEOSGetExteriorRing_r(m.ctx, polygon.get()))};
-        const int holes = GEOSGetNumInteriorRings_r(m.ctx, polygon.get());
-        for (int h = 0; h < holes; ++h)
-            rings.push_back(ring_points(m.geos, GEOSGetInteriorRingN_r(m.ctx, polygon.get(), h)));
-        polygons->push_back(std::move(rings));
-    }
+    for (const GeomPtr &polygon : m.polygons)
+        polygons->push_back(coast_detail::polygon_rings(m.geos, polygon.get()));
     return [polygons]() -> std::shared_ptr<const LandTest> {
-        return std::make_shared<LandMask>(*polygons);
+        return std::make_shared<LandMask>(*polygons, false);
     };
 }
 
