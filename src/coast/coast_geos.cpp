@@ -64,31 +64,51 @@ void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
         static_cast<std::vector<std::size_t> *>(user)->push_back(
             reinterpret_cast<std::size_t>(item));
     };
-    // Of each pair, the polygon with more vertices is the prepared one, kept for its other
-    // pairs: a continent meets hundreds of islands' boxes, and GEOS builds the index of
-    // the geometry tested against a prepared one anew on every call. Intersection is
-    // symmetric: the groups are the same.
-    std::vector<PreparedPtr> prepared;
-    for (std::size_t i = 0; i < n; ++i)
-        prepared.emplace_back(nullptr, GeosDeleter{geos.get()});
-    auto prepared_of = [&](std::size_t i) {
-        if (!prepared[i])
-            prepared[i].reset(GEOSPrepare_r(geos.get(), polys[i].get()));
-        return prepared[i].get();
-    };
+    // The pairs whose boxes meet, i < j, in the order the joins are made.
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t i = 0; i < n; ++i) {
         coast::GeosInterrupt::poll(); // a long run of short GEOS calls, none of which reports
         hits.clear();
         GEOSSTRtree_query_r(geos.get(), tree.get(), polys[i].get(), collect, &hits);
         std::sort(hits.begin(), hits.end());
-        for (std::size_t j : hits) {
-            if (j <= i || find(i) == find(j))
-                continue;
-            const auto [big, small] = vertices[j] > vertices[i] ? std::pair{j, i} : std::pair{i, j};
-            if (GEOSPreparedIntersects_r(geos.get(), prepared_of(big), polys[small].get()) == 1)
-                parent[find(j)] = find(i);
-        }
-        prepared[i].reset(); // its pairs are all done: later ones have both indices above i
+        for (std::size_t j : hits)
+            if (j > i)
+                pairs.emplace_back(i, j);
+    }
+    // Each pair tested against its polygon with more vertices, prepared once on the thread that
+    // takes that polygon: a continent meets hundreds of islands' boxes, and GEOS builds the
+    // index of the geometry tested against a prepared one anew on every call. On every core,
+    // the largest polygons first.
+    std::vector<std::vector<std::size_t>> pairs_of(n);
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+        const auto [i, j] = pairs[k];
+        pairs_of[vertices[j] > vertices[i] ? j : i].push_back(k);
+    }
+    std::vector<std::size_t> sizes(n);
+    for (std::size_t i = 0; i < n; ++i)
+        sizes[i] = pairs_of[i].empty() ? 0 : std::size_t(vertices[i]);
+    const std::vector<std::size_t> first = largest_first(sizes);
+    std::vector<char> meet(pairs.size(), 0);
+    parallel_for_each_geos(
+        geos, n,
+        [&](Geos &g, std::size_t big) {
+            if (pairs_of[big].empty())
+                return;
+            coast::GeosInterrupt::poll();
+            const PreparedPtr prepared(GEOSPrepare_r(g.get(), polys[big].get()),
+                                       GeosDeleter{g.get()});
+            for (std::size_t k : pairs_of[big]) {
+                const std::size_t small = pairs[k].first == big ? pairs[k].second : pairs[k].first;
+                meet[k] =
+                    GEOSPreparedIntersects_r(g.get(), prepared.get(), polys[small].get()) == 1;
+            }
+        },
+        &first);
+    // The joins in pair order, as one thread made them (the same groups, the same roots).
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+        const auto [i, j] = pairs[k];
+        if (meet[k] && find(i) != find(j))
+            parent[find(j)] = find(i);
     }
 }
 
