@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "coast_internal.hpp"
+#include "coast_parallel.hpp"
 
 namespace globemesh::coast_detail {
 
@@ -75,22 +76,50 @@ near_pairs(const std::vector<std::vector<std::vector<LonLat>>> &polygons, double
             for (std::uint64_t j = index(y0, -91.0); j <= index(y1, -91.0); ++j)
                 entries.push_back({j * columns + i, k});
     }
-    std::sort(entries.begin(), entries.end());
+    // Sorted by cell on every core: chunks sorted, then merged pairwise.
+    const std::size_t chunks = 4 * coast_threads();
+    std::vector<std::size_t> bound(chunks + 1);
+    for (std::size_t c = 0; c <= chunks; ++c)
+        bound[c] = entries.size() * c / chunks;
+    parallel_for_each(chunks, [&](std::size_t c) {
+        std::sort(entries.begin() + std::ptrdiff_t(bound[c]),
+                  entries.begin() + std::ptrdiff_t(bound[c + 1]));
+    });
+    for (std::size_t width = 1; width < chunks; width *= 2)
+        parallel_for_each((chunks + 2 * width - 1) / (2 * width), [&](std::size_t m) {
+            const std::size_t lo = 2 * width * m, mid = std::min(chunks, lo + width),
+                              hi = std::min(chunks, lo + 2 * width);
+            std::inplace_merge(entries.begin() + std::ptrdiff_t(bound[lo]),
+                               entries.begin() + std::ptrdiff_t(bound[mid]),
+                               entries.begin() + std::ptrdiff_t(bound[hi]));
+        });
+    // The cells' pairs tested in chunks that end where a cell does, on every core; the pairs
+    // come out sorted and unique, the same on any number of threads.
+    for (std::size_t c = 1; c < chunks; ++c)
+        for (bound[c] = std::max(bound[c], bound[c - 1]);
+             bound[c] > 0 && bound[c] < entries.size() &&
+             entries[bound[c]].first == entries[bound[c] - 1].first;)
+            ++bound[c];
     const double d2 = distance * distance;
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found(chunks);
+    parallel_for_each(chunks, [&](std::size_t c) {
+        for (std::size_t a = bound[c]; a < bound[c + 1];) {
+            std::size_t b = a + 1;
+            while (b < bound[c + 1] && entries[b].first == entries[a].first)
+                ++b;
+            for (std::size_t u = a; u < b; ++u)
+                for (std::size_t v = u + 1; v < b; ++v) {
+                    const std::uint32_t s = entries[u].second, t = entries[v].second;
+                    if (owner[s] == owner[t] || !segments_within(segs[s], segs[t], d2))
+                        continue;
+                    found[c].push_back(std::minmax(owner[s], owner[t]));
+                }
+            a = b;
+        }
+    });
     std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-    for (std::size_t a = 0; a < entries.size();) {
-        std::size_t b = a + 1;
-        while (b < entries.size() && entries[b].first == entries[a].first)
-            ++b;
-        for (std::size_t u = a; u < b; ++u)
-            for (std::size_t v = u + 1; v < b; ++v) {
-                const std::uint32_t s = entries[u].second, t = entries[v].second;
-                if (owner[s] == owner[t] || !segments_within(segs[s], segs[t], d2))
-                    continue;
-                out.push_back(std::minmax(owner[s], owner[t]));
-            }
-        a = b;
-    }
+    for (const auto &f : found)
+        out.insert(out.end(), f.begin(), f.end());
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
