@@ -1,6 +1,7 @@
 // Internal pieces of the coast module shared by its source files (not installed).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -11,6 +12,16 @@
 #include "globemesh/sphere.hpp"
 
 namespace globemesh::coast_detail {
+
+/// Squared distance from (px, py) to the segment a-b, in the lon/lat plane.
+inline double planar_distance2(double px, double py, double ax, double ay, double bx, double by) {
+    const double dx = bx - ax, dy = by - ay;
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const double ex = ax + t * dx - px, ey = ay + t * dy - py;
+    return ex * ex + ey * ey;
+}
 
 /// Two arcs (ring_a, seg_a) and (ring_b, seg_b) that touch or cross.
 struct ArcPair {

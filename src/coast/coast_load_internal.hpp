@@ -68,6 +68,12 @@ GeomPtr make_valid(Geos &geos, const GEOSGeometry *g);
 void polygons_of(Geos &geos, const GEOSGeometry *g, std::vector<const GEOSGeometry *> &out);
 /// The vertices of a GEOS ring or line; DataError when GEOS cannot give them.
 PointList ring_points(const Geos &geos, const GEOSGeometry *ring);
+/// The signed area of a closed lon/lat ring in the plane (degrees^2, counter-clockwise positive).
+double signed_planar_area(const PointList &pts);
+/// Orients a closed lon/lat ring: counter-clockwise in the plane when ccw, else clockwise (the
+/// first vertex stays first).
+void orient(PointList &pts, bool ccw);
+
 /// The rings of a GEOS polygon, shell first.
 PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon);
 /// Polygonizes closed coastline lines (GSHHG / OSM style). Lines are first merged at shared

@@ -267,25 +267,12 @@ private:
     std::vector<std::pair<double, double>> seam_;
 };
 
-double signed_planar_area(const PointList &pts) {
-    double a = 0;
-    for (std::size_t i = 0; i + 1 < pts.size(); ++i)
-        a += pts[i].lon * pts[i + 1].lat - pts[i + 1].lon * pts[i].lat;
-    return 0.5 * a;
-}
-
 /// Geodesic area to the left of densified chains (closed rings), km2.
 double chains_area_km2(const std::vector<Chain> &chains) {
     std::vector<std::vector<LonLat>> ll;
     for (const auto &c : chains)
         ll.push_back(c.pts);
     return coast_detail::rings_area_km2(ll);
-}
-
-/// Orients a closed lon/lat ring: counter-clockwise in the plane when ccw, else clockwise.
-void orient(PointList &pts, bool ccw) {
-    if ((signed_planar_area(pts) > 0) != ccw)
-        std::reverse(pts.begin(), pts.end());
 }
 
 struct Bbox {
@@ -353,6 +340,23 @@ GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_m
 }
 
 } // namespace
+
+double signed_planar_area(const PointList &pts) {
+    // About the first vertex: a small ring far from lon/lat 0 keeps its sign.
+    if (pts.empty())
+        return 0;
+    const LonLat o = pts.front();
+    double a = 0;
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i)
+        a += (pts[i].lon - o.lon) * (pts[i + 1].lat - o.lat) -
+             (pts[i + 1].lon - o.lon) * (pts[i].lat - o.lat);
+    return 0.5 * a;
+}
+
+void orient(PointList &pts, bool ccw) {
+    if ((signed_planar_area(pts) > 0) != ccw)
+        std::reverse(pts.begin(), pts.end());
+}
 
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
 Ring to_sphere(const Chain &c) {

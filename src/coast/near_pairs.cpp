@@ -23,12 +23,7 @@ double cross2(double ux, double uy, double vx, double vy) {
 }
 
 double point_segment_distance2(double px, double py, const Seg &s) {
-    const double dx = s.bx - s.ax, dy = s.by - s.ay;
-    const double len2 = dx * dx + dy * dy;
-    double t = len2 > 0 ? ((px - s.ax) * dx + (py - s.ay) * dy) / len2 : 0.0;
-    t = std::clamp(t, 0.0, 1.0);
-    const double ex = s.ax + t * dx - px, ey = s.ay + t * dy - py;
-    return ex * ex + ey * ey;
+    return planar_distance2(px, py, s.ax, s.ay, s.bx, s.by);
 }
 
 /// True when segments s and t come within sqrt(d2): they cross, or an end of one is near the other.

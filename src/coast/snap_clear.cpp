@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "coast_internal.hpp"
 #include "coast_load_internal.hpp"
 
 namespace globemesh::coast_detail {
@@ -19,17 +20,6 @@ constexpr double clear_cells = 2.5;
 /// Past this many (cell, edge) entries per edge (long edges over fine cells) the test gives up.
 constexpr std::size_t max_entries_per_edge = 16;
 
-/// Squared distance from p to the segment a-b, in the lon/lat plane.
-double distance2(const LonLat &p, const LonLat &a, const LonLat &b) {
-    const double dx = b.lon - a.lon, dy = b.lat - a.lat;
-    const double px = p.lon - a.lon, py = p.lat - a.lat;
-    const double len2 = dx * dx + dy * dy;
-    double t = len2 > 0 ? (px * dx + py * dy) / len2 : 0;
-    t = std::clamp(t, 0.0, 1.0);
-    const double ex = px - t * dx, ey = py - t * dy;
-    return ex * ex + ey * ey;
-}
-
 /// GEOS's rounding of a coordinate to the grid (PrecisionModel::makePrecise: half up).
 double round_to(double v, double grid) {
     return std::floor(v / grid + 0.5) * grid;
@@ -39,13 +29,7 @@ double round_to(double v, double grid) {
 /// vertex in coast_dissolve_test): clockwise for a shell, counter-clockwise for a hole, starting
 /// at what was the ring's second vertex once so oriented.
 void lay_out_as_geos(PointList &r, bool clockwise) {
-    double twice_area = 0; // shoelace, about the first vertex
-    const LonLat o = r.front();
-    for (std::size_t i = 0; i + 1 < r.size(); ++i)
-        twice_area += (r[i].lon - o.lon) * (r[i + 1].lat - o.lat) -
-                      (r[i + 1].lon - o.lon) * (r[i].lat - o.lat);
-    if ((twice_area < 0) != clockwise)
-        std::reverse(r.begin(), r.end()); // closed: the first vertex stays first
+    orient(r, !clockwise);
     r.pop_back();
     std::rotate(r.begin(), r.begin() + 1, r.end());
     r.push_back(r.front());
@@ -112,7 +96,7 @@ std::optional<PolygonRings> rounded_if_clear(const PolygonRings &rings, double g
                 if (it->second == own || it->second == before)
                     continue;
                 const auto [a, b] = edge_ends(it->second);
-                if (distance2(p, a, b) < reach * reach)
+                if (planar_distance2(p.lon, p.lat, a.lon, a.lat, b.lon, b.lat) < reach * reach)
                     return std::nullopt;
             }
         }
