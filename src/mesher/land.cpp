@@ -93,6 +93,7 @@ private:
     bool corners_allowed();
     void commit(const std::vector<std::uint32_t> &arc_loops, bool cuts, TriangleId needed);
     bool try_remove(const std::vector<TriangleId> &group, TriangleId needed);
+    bool corners_on_boundary(TriangleId t) const;
     bool remove_with_pocket(TriangleId t);
     bool remove_with_fan(TriangleId t);
     bool remove_face(TriangleId t);
@@ -205,6 +206,15 @@ int LandRemoval::land_points(TriangleId t) const {
     return on_land;
 }
 
+// Whether every corner of face t is on the boundary: no move of a corner into the water can
+// take its centroid off land.
+bool LandRemoval::corners_on_boundary(TriangleId t) const {
+    for (int k = 0; k < 3; ++k)
+        if (loops_state.of.count(dt.vertex(t, k)) == 0)
+            return false;
+    return true;
+}
+
 // The faces of `group` still in the ocean (members), their corners, and the contact arcs: the
 // corners on the boundary, joined (arc_parent) by the members' boundary edges.
 void LandRemoval::gather(const std::vector<TriangleId> &group) {
@@ -315,8 +325,10 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
 // opens a hole: a dropped island comes back; c = 1 bites into the coast) and never
 // disconnects the mesh; two arcs on one loop would cut it in two. A removal that joins loops
 // closes narrow water between two rings: only where most of `needed` is land
-// (join_land_points), not because an islet lies under its centroid in open water. Every
-// corner that comes onto the boundary must lie within land_exposed_reach h of the coast.
+// (join_land_points), not because an islet lies under its centroid in open water; with
+// `straits`, also where every corner of `needed` is on the boundary, since no nudge can take
+// such a face off the land (it would stay centred on it). Every corner that comes onto the
+// boundary must lie within land_exposed_reach h of the coast.
 bool LandRemoval::try_remove(const std::vector<TriangleId> &group, TriangleId needed) {
     if (!is_ocean(needed))
         return false;
@@ -325,7 +337,8 @@ bool LandRemoval::try_remove(const std::vector<TriangleId> &group, TriangleId ne
     bool cuts = false;                    // two contact arcs on one loop
     if (!contact_loops(arc_loops, cuts))
         return false;
-    if ((arc_loops.size() > 1 || cuts) && land_points(needed) < join_land_points)
+    if ((arc_loops.size() > 1 || cuts) && land_points(needed) < join_land_points &&
+        !(straits && corners_on_boundary(needed)))
         return false;
     for (TriangleId t : members)
         dt.set_label(t, land);

@@ -268,6 +268,20 @@ TEST(Mesher, quality_on_the_50m_coast_at_100_km) {
     EXPECT_LT(q.corner_faces, mesh.faces.size() / 100);
 }
 
+// Natural Earth 1:50m at 80 km: a face across a fjord of Greenland's west coast (53.83W
+// 71.18N) has its three corners on the coast and its centroid on an islet, with most of it
+// water. No move of a corner can take it off the land, and a closing there was refused because
+// of the water. It now closes (mesh-verify found it centred on land before).
+TEST(Mesher, a_face_on_an_islet_with_every_corner_on_the_coast_closes) {
+    MeshOptions o = land_110m(80);
+    o.coast = fixture("coast/ne_50m_land.gpkg").string();
+    const OceanMesh run = mesh_ocean(o);
+    EXPECT_EQ(run.mesher.land_faces_left, 0u);
+    EXPECT_TRUE(straits_closed(run).near(-53.83, 71.18));
+    expect_verified(run.mesh, "g.nc", "0.95",
+                    "--coast " + o.coast + " --coast-layer land --max-land-faces 0");
+}
+
 // The Dardanelles and the Bosphorus (1-6 km wide) at 100 km: the faces across them are centred
 // on land. By default they close, and the Black Sea becomes a basin of its own; with
 // keep_straits they stay, centred on land, and the mesh is one piece. (Other water behind
