@@ -159,6 +159,7 @@ struct CoastReport {
     std::size_t islands_removed = 0;    ///< by --min-island-area (stage 1) and by size (stage 2)
     std::size_t lakes_removed = 0;      ///< holes and closed water bodies removed (both stages)
     std::size_t conflicts_repaired = 0; ///< corners added because resampled arcs touched another
+    std::size_t close_nodes_merged = 0; ///< nodes dropped from arcs far shorter than the size
     double area_lost_km2 = 0;   ///< ocean removed: dropped lakes + net loss of simplification
     double area_gained_km2 = 0; ///< ocean added: dropped islands + net gain of simplification
     double ocean_area_km2 = 0;  ///< geodesic area enclosed by the shaped boundary

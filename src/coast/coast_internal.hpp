@@ -77,6 +77,17 @@ private:
         pairs_; // conflicting arc ids, smaller first
 };
 
+/// Merges the samples of rings that lie closer together than `gap` times the local size
+/// (h[r][k], radians, at sample k of ring r): of an arc that short, one end is dropped (one that
+/// is `movable`) unless the arc that replaces it would touch or cross another (coast_merge.cpp).
+/// `rings` are the samples as the grid indexes them, changed in place; `kept` gets each ring's
+/// samples kept, in order (at least four of a ring). Returns the samples dropped.
+std::size_t merge_close_samples(const std::vector<std::vector<Vec3>> &samples,
+                                const std::vector<std::vector<double>> &h,
+                                const std::vector<std::vector<char>> &movable, double gap,
+                                std::vector<std::vector<Vec3>> &rings, ArcGrid &grid,
+                                std::vector<std::vector<std::uint32_t>> &kept);
+
 /// Pairs (i < j) of polygons (each its closed lon/lat rings) whose outlines come within
 /// `distance` degrees of each other in the lon/lat plane, touching or crossing included
 /// (near_pairs.cpp). Sorted, each once.

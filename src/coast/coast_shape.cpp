@@ -394,9 +394,48 @@ void check_node_count(const std::vector<ShapedRing> &shaped, std::uint64_t max_n
                         option("hmax_km") + " or " + option("max_nodes"));
 }
 
+/// Step 3's last part: merge_close_samples on the resampled rings (every arc clear in `grid`),
+/// for nodes closer than `gap` times the local size (CoastOptions::close_node_gap; dropping one
+/// moves the coast by less than that, well within the fidelity target h/4). A sample can go
+/// when it and the one before start coast segments and it is no anchor.
+void merge_close(const std::vector<ShapedRing> &shaped, double gap,
+                 std::vector<Resampled> &resampled, std::vector<std::vector<Vec3>> &rings,
+                 coast_detail::ArcGrid &grid, CoastReport &rep) {
+    if (gap <= 0)
+        return;
+    const std::size_t count = shaped.size();
+    std::vector<std::vector<Vec3>> points(count);
+    std::vector<std::vector<double>> h(count);
+    std::vector<std::vector<char>> movable(count);
+    for (std::size_t r = 0; r < count; ++r) {
+        const Ring &source = *shaped[r].ring;
+        const std::vector<Sample> &x = resampled[r].samples;
+        for (std::size_t k = 0; k < x.size(); ++k) {
+            const std::uint32_t node = x[k].node, before = x[(k + x.size() - 1) % x.size()].node;
+            points[r].push_back(x[k].p);
+            h[r].push_back(shaped[r].h_rad[node]);
+            movable[r].push_back(source.kinds[node] == SegmentKind::coast &&
+                                 source.kinds[before] == SegmentKind::coast &&
+                                 !(shaped[r].anchor[node] && x[k].p == source.nodes[node]));
+        }
+    }
+    std::vector<std::vector<std::uint32_t>> kept;
+    rep.close_nodes_merged +=
+        coast_detail::merge_close_samples(points, h, movable, gap, rings, grid, kept);
+    for (std::size_t r = 0; r < count; ++r) {
+        if (kept[r].size() == resampled[r].samples.size())
+            continue;
+        std::vector<Sample> samples;
+        for (const std::uint32_t k : kept[r])
+            samples.push_back(resampled[r].samples[k]);
+        resampled[r].samples = std::move(samples);
+        resampled[r].runs.clear(); // (not resampled again)
+    }
+}
+
 /// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
 template <class H>
-std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &h_at,
+std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &h_at, double gap,
                                       CoastReport &rep, const Progress &progress) {
     // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
     //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
@@ -490,6 +529,7 @@ std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &
         }
         report(progress, 0.5 + 0.4 * (1.0 - 1.0 / (round + 2)), "checking coast topology");
     }
+    merge_close(shaped, gap, resampled, rings, *grid, rep);
     return resampled;
 }
 
@@ -523,7 +563,8 @@ Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const Coa
     report(progress, 0.5, "resampling coast");
     check_node_count(shaped, max_nodes);
 
-    const std::vector<Resampled> resampled = resample_clear(shaped, h_at, rep, progress);
+    const std::vector<Resampled> resampled =
+        resample_clear(shaped, h_at, options.close_node_gap, rep, progress);
 
     Boundary out;
     for (std::size_t r = 0; r < shaped.size(); ++r) {

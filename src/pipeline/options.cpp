@@ -93,6 +93,8 @@ void validate_meshing(const MeshingOptions &o) {
 void validate_coast(const CoastOptions &o) {
     require(std::isfinite(o.min_island_area_km2) && o.min_island_area_km2 >= 0,
             option("min_island_area_km2") + " must be a positive area, e.g. 100km2");
+    require(o.close_node_gap >= 0 && o.close_node_gap <= 0.25,
+            "close_node_gap must be a fraction of the local size in [0, 0.25]");
     const ErrorText region = option("region"), region_file = option("region_file");
     if (o.region) {
         const auto &r = *o.region;

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -106,10 +108,11 @@ TEST(CoastReal, a_face_below_the_floor_with_one_coast_corner_goes_with_the_faces
 // region) at 50 km: a face of q 0.202 between a free node and two coast nodes 0.6 km apart, whose
 // neighbours lie 3 to 7 km off, where no position of the node and no removal of it mends the face
 // (the same as the last face below the floor of the global GSHHG h run at 50 km). A node at the
-// apex of the equilateral triangle on the short side mends it.
+// apex of the equilateral triangle on the short side mends it. (With the coast's close nodes
+// kept: merged, as by default, the two nodes are one and the face is not made.)
 TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_that_side) {
-    const MeshOptions o =
-        region_run("coast/hostile/gshhg_h_yangtze.geojson", {119, 29, 125, 34}, 50);
+    MeshOptions o = region_run("coast/hostile/gshhg_h_yangtze.geojson", {119, 29, 125, 34}, 50);
+    o.close_node_gap = 0;
     const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GE(count_attribute(mesh, "floor_nodes_added"), 1u);
     expect_valid_mesh(mesh, o, "yangtze.nc");
@@ -121,10 +124,11 @@ TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_t
 // coast side of 100 m whose third corner lies 24 m off it; blunting had run before and removed
 // such slivers only before the floor's moves (the global GSHHG full run at 5 km had this face
 // as its worst, q 0.2852 at 32.354E 30.427N, in one part and in two). Blunting and the floor
-// now run once more when a face is left below it.
+// now run once more when a face is left below it. (With the coast's close nodes kept, as
+// before they were merged.)
 TEST(CoastReal, a_sliver_the_floor_leaves_on_the_coast_is_blunted_after_it) {
-    const MeshOptions o =
-        region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+    MeshOptions o = region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+    o.close_node_gap = 0;
     const Mesh mesh = mesh_ocean(o).mesh;
     double worst = 1;
     for (const auto &f : mesh.faces)
@@ -132,6 +136,55 @@ TEST(CoastReal, a_sliver_the_floor_leaves_on_the_coast_is_blunted_after_it) {
             std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
     EXPECT_GE(worst, 0.3);                // 0.284 before
     EXPECT_GE(corners_blunted(mesh), 7u); // 6 before, the sliver the seventh
+    expect_valid_mesh(mesh, o, "suez.nc");
+}
+
+// The shortest side of the mesh's faces, and of its boundary (the sides of one face), km.
+struct Shortest {
+    double side = 1e9, boundary = 1e9;
+};
+Shortest shortest_sides(const Mesh &mesh) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (const auto &f : mesh.faces)
+        for (int i = 0; i < 3; ++i)
+            ++uses[std::minmax(f[i], f[(i + 1) % 3])];
+    Shortest s;
+    for (const auto &[e, n] : uses) {
+        const double km = arc_angle(mesh.nodes[e.first], mesh.nodes[e.second]) * earth_radius_km;
+        s.side = std::min(s.side, km);
+        if (n == 1)
+            s.boundary = std::min(s.boundary, km);
+    }
+    return s;
+}
+
+// The Yangtze mouth as above, with the coast's close nodes merged (the default): the two coast
+// nodes 0.6 km apart are one, and no coast side is shorter than h/32.
+TEST(CoastReal, coast_nodes_far_closer_than_h_among_coarse_ones_are_merged) {
+    const MeshOptions o =
+        region_run("coast/hostile/gshhg_h_yangtze.geojson", {119, 29, 125, 34}, 50);
+    const Mesh mesh = mesh_ocean(o).mesh;
+    EXPECT_GE(shortest_sides(mesh).boundary, 50.0 / 32); // 0.60 km before
+    expect_valid_mesh(mesh, o, "yangtze.nc");
+}
+
+// The Suez Canal as above, with the coast's close nodes merged (the default). Kept, the
+// canal stub's coast nodes are 4 m to 100 m apart: the topology repair's corners at the
+// source's own vertices (a jetty's tip among them), and its faces have sides of 7 m. Merged, no
+// coast side is under h/32 and no side under 0.1 km (the canal is 0.3 km wide): an explicit
+// model's time step there is some 30 times longer.
+TEST(CoastReal, a_canal_narrower_than_h_keeps_no_side_far_shorter_than_its_width) {
+    const MeshOptions o =
+        region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+    const Mesh mesh = mesh_ocean(o).mesh;
+    double worst = 1;
+    for (const auto &f : mesh.faces)
+        worst =
+            std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
+    EXPECT_GE(worst, 0.3); // 0.284 before the second round
+    const Shortest s = shortest_sides(mesh);
+    EXPECT_GE(s.boundary, 5.0 / 32); // 0.007 km before
+    EXPECT_GE(s.side, 0.1);
     expect_valid_mesh(mesh, o, "suez.nc");
 }
 
