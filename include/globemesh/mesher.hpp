@@ -116,6 +116,9 @@ struct MesherOptions {
     /// With `land`: close the straits narrower than a face that faces centred on land are left
     /// across (step 7), rather than keep them open with those faces.
     bool close_straits = true;
+    /// With close_straits and inlet_width: a channel the closings leave as a dead end (the stub
+    /// of a canal closed further along) closes by the inlet rule too.
+    bool close_dead_ends = true;
     /// Lines across straits (passages.hpp): no strait closing removes a face one of them meets.
     std::vector<std::vector<Vec3>> passages;
 };

@@ -307,6 +307,10 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
         if (cuts || !pinches.empty() || arc_loops.size() > 1) {
             ++report.straits_closed;
             report.straits_closed_at.push_back(m.centroid(needed));
+            for (TriangleId t : members)
+                for (int i = 0; i < 3; ++i)
+                    if (is_ocean(dt.neighbour(t, i)))
+                        m.strait_sides.push_back(dt.neighbour(t, i));
         }
     }
     if (cuts && cut_sides)

@@ -111,6 +111,8 @@ struct Mesher {
     std::vector<char> sharp; // per vertex: a boundary corner with an ocean angle below 60 degrees
     std::vector<VertexId> pinched; // boundary vertices a closed strait left between fans of ocean
     std::vector<TriangleId> cut_sides; // ocean faces beside closings that cut the mesh in two
+    // Ocean faces beside every strait closing (cut, join or pinch), until close_dead_ends.
+    std::vector<TriangleId> strait_sides;
 
     bool is_sharp(VertexId v) const { return v < sharp.size() && sharp[v]; }
     std::vector<char> fixed; // per vertex: on a boundary segment (moved only by the slides)
@@ -151,6 +153,8 @@ struct Mesher {
         for (VertexId &v : pinched)
             v = new_of_old[v];
         for (TriangleId &t : cut_sides)
+            t = new_of_slot[t];
+        for (TriangleId &t : strait_sides)
             t = new_of_slot[t];
         return new_of_slot;
     }
@@ -509,6 +513,8 @@ std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
 void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces);
 void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId> &faces,
                    const MesherOptions &options, BoundaryLoops &loops, MesherReport &report);
+// dead_ends.cpp: the dead ends the closings left (Mesher::strait_sides), closed by the inlet rule.
+void close_dead_ends(Mesher &m, const MesherOptions &options, MesherReport &report);
 
 // corners.cpp: the last step, the ocean faces below q 0.3 that the coast's sharp corners leave
 // removed (counted in report.corners_blunted; closings across narrow water with the straits).

@@ -254,6 +254,7 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
     report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
     if (options.close_straits && !left.empty()) {
         close_straits(m, *options.land, left, options, loops, report);
+        close_dead_ends(m, options, report);
         report.land_faces_at.clear();
         if (!left.empty())
             report.land_faces_nudged +=

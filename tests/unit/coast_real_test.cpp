@@ -124,11 +124,12 @@ TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_t
 // coast side of 100 m whose third corner lies 24 m off it; blunting had run before and removed
 // such slivers only before the floor's moves (the global GSHHG full run at 5 km had this face
 // as its worst, q 0.2852 at 32.354E 30.427N, in one part and in two). Blunting and the floor
-// now run once more when a face is left below it. (With the coast's close nodes kept, as
-// before they were merged.)
+// now run once more when a face is left below it. (With the coast's close nodes kept and the
+// stub left open, as before they were merged and dead ends closed.)
 TEST(CoastReal, a_sliver_the_floor_leaves_on_the_coast_is_blunted_after_it) {
     MeshOptions o = region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
     o.close_node_gap = 0;
+    o.close_dead_ends = false;
     const Mesh mesh = mesh_ocean(o).mesh;
     double worst = 1;
     for (const auto &f : mesh.faces)
@@ -186,6 +187,26 @@ TEST(CoastReal, a_canal_narrower_than_h_keeps_no_side_far_shorter_than_its_width
     EXPECT_GE(s.boundary, 5.0 / 32); // 0.007 km before
     EXPECT_GE(s.side, 0.1);
     expect_valid_mesh(mesh, o, "suez.nc");
+}
+
+// The Suez Canal as above: the straits closed north of 30.51N leave the canal's stub above the
+// Bitter Lakes (0.3 km wide) a dead end, narrower than inlet_width h (2.5 km), which the inlet
+// rule closes. Its closing comes after the straits', so the stub's northern part goes and no
+// face is left there; the Bitter Lakes stay, a basin cut off.
+TEST(CoastReal, a_canal_stub_the_strait_closings_leave_as_a_dead_end_closes) {
+    const MeshOptions o =
+        region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+    const OceanMesh run = mesh_ocean(o);
+    std::size_t in_stub = 0;
+    for (const auto &f : run.mesh.faces) {
+        const LonLat c = vec_to_lonlat(
+            normalized(run.mesh.nodes[f[0]] + run.mesh.nodes[f[1]] + run.mesh.nodes[f[2]]));
+        in_stub += c.lon > 32.3 && c.lon < 32.4 && c.lat > 30.45 && c.lat < 30.55;
+    }
+    EXPECT_EQ(in_stub, 0u); // 43 faces before
+    ASSERT_EQ(run.mesher.seas_cut_off.size(), 1u);
+    EXPECT_GT(run.mesher.seas_cut_off[0], 150.0); // the Bitter Lakes, 177 km2
+    expect_valid_mesh(run.mesh, o, "suez.nc");
 }
 
 // GSHHG intermediate around Seram and Misool (128.5..131.5E, 4.5..1.5S): in the global run at
