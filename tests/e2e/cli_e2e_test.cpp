@@ -102,7 +102,7 @@ TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
     std::vector<std::string> rings, holes, straits;
     ASSERT_TRUE(globemesh::test::regex_search(
         out,
-        R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, inlets closed \d+ \()",
+        R"(\ncoast +(\d+) rings kept, islands dropped \d+, lakes dropped \d+, close nodes merged \d+, inlets closed \d+ \()",
         &rings))
         << out;
     ASSERT_TRUE(globemesh::test::regex_search(

@@ -186,6 +186,7 @@ TEST(CoastReal, a_canal_narrower_than_h_keeps_no_side_far_shorter_than_its_width
     const Shortest s = shortest_sides(mesh);
     EXPECT_GE(s.boundary, 5.0 / 32); // 0.007 km before
     EXPECT_GE(s.side, 0.1);
+    EXPECT_GT(count_attribute(mesh, "coast_nodes_merged"), 0u);
     expect_valid_mesh(mesh, o, "suez.nc");
 }
 
