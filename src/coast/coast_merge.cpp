@@ -89,9 +89,7 @@ std::size_t merge_close_samples(const std::vector<std::vector<Vec3>> &samples,
         state[r].pending.assign(n, 0);
         state[r].locked.assign(n, 0);
     }
-    std::size_t merged = 0;
-    for (bool again = true; again;) {
-        again = false;
+    for (;;) {
         std::vector<std::uint32_t> changed;
         for (std::uint32_t r = 0; r < count; ++r)
             if (drop_short(samples[r], h[r], movable[r], gap, state[r])) {
@@ -100,7 +98,6 @@ std::size_t merge_close_samples(const std::vector<std::vector<Vec3>> &samples,
             }
         if (changed.empty())
             break;
-        again = true;
         // Every conflict has an arc made in this pass: its dropped sample comes back, to stay.
         for (grid.update(); !changed.empty(); grid.update()) {
             const std::vector<ArcPair> conflicts = grid.conflicts();
@@ -132,6 +129,7 @@ std::size_t merge_close_samples(const std::vector<std::vector<Vec3>> &samples,
         for (MergeRing &s : state)
             std::fill(s.pending.begin(), s.pending.end(), 0);
     }
+    std::size_t merged = 0;
     kept.assign(count, {});
     for (std::uint32_t r = 0; r < count; ++r) {
         merged += samples[r].size() - state[r].order.size();

@@ -404,7 +404,7 @@ void merge_close(const std::vector<ShapedRing> &shaped, double gap,
     if (gap <= 0)
         return;
     const std::size_t count = shaped.size();
-    std::vector<std::vector<Vec3>> points(count);
+    const std::vector<std::vector<Vec3>> points = rings; // the samples, as resampled
     std::vector<std::vector<double>> h(count);
     std::vector<std::vector<char>> movable(count);
     for (std::size_t r = 0; r < count; ++r) {
@@ -412,7 +412,6 @@ void merge_close(const std::vector<ShapedRing> &shaped, double gap,
         const std::vector<Sample> &x = resampled[r].samples;
         for (std::size_t k = 0; k < x.size(); ++k) {
             const std::uint32_t node = x[k].node, before = x[(k + x.size() - 1) % x.size()].node;
-            points[r].push_back(x[k].p);
             h[r].push_back(shaped[r].h_rad[node]);
             movable[r].push_back(source.kinds[node] == SegmentKind::coast &&
                                  source.kinds[before] == SegmentKind::coast &&

@@ -100,12 +100,12 @@ void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report)
     });
     std::vector<std::uint32_t> mark(dt.triangle_slots(), 0);
     std::uint32_t stamp = 0;
-    // The ocean on one side of `cut` from `seed` (square radians), or -1 when it holds more than
-    // `cap` and is wider on average than `width` (twice its area over its perimeter, cut
-    // included, in radians), or holds more than `narrow_cap`, touches an open boundary or
-    // another ring than `own`, or reaches `other` (the cut does not separate).
-    auto flood = [&](TriangleId seed, HalfEdge cut, TriangleId other, std::uint32_t own, double cap,
-                     double width, double narrow_cap, std::vector<TriangleId> &out) {
+    // The ocean on one side of `cut` from `seed` (square radians), where the size is h, or -1
+    // when the inlet rule keeps it (inlet_closes, its perimeter the cut included), it touches an
+    // open boundary or another ring than `own`, or it reaches `other` (the cut does not separate).
+    auto flood = [&](TriangleId seed, HalfEdge cut, TriangleId other, std::uint32_t own, double h,
+                     std::vector<TriangleId> &out) {
+        const double narrow_cap = inlet_narrow_area * h * h;
         ++stamp;
         out.assign(1, seed);
         mark[seed] = stamp;
@@ -140,7 +140,7 @@ void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report)
                 out.push_back(nb);
             }
         }
-        return area <= cap || 2 * area < width * perimeter ? area : -1.0;
+        return inlet_closes(area, perimeter, h, options) ? area : -1.0;
     };
     // Passes until nothing closes: a closed tip makes the water behind the next edge out small
     // enough, so a dead-end channel narrower than the bound closes whole, whatever the order.
@@ -151,12 +151,8 @@ void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report)
             const TriangleId left = triangle_of(c.edge), right = triangle_of(dt.twin(c.edge));
             if (dt.label(left) != ocean || dt.label(right) != ocean)
                 continue; // closed already
-            const double cap = options.inlet_area * c.h * c.h, width = options.inlet_width * c.h;
-            const double narrow_cap = inlet_narrow_area * c.h * c.h;
-            const double area_left =
-                flood(left, c.edge, right, ring(c.a), cap, width, narrow_cap, side[0]);
-            const double area_right =
-                flood(right, c.edge, left, ring(c.a), cap, width, narrow_cap, side[1]);
+            const double area_left = flood(left, c.edge, right, ring(c.a), c.h, side[0]);
+            const double area_right = flood(right, c.edge, left, ring(c.a), c.h, side[1]);
             if (area_left < 0 && area_right < 0)
                 continue;
             const int s = area_right < 0 || (area_left >= 0 && area_left <= area_right) ? 0 : 1;

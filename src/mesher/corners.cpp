@@ -81,14 +81,7 @@ private:
         return half_edge(triangle_of(back), next3(edge_of(back)));
     }
     bool on_boundary(VertexId v, TriangleId t) const {
-        const HalfEdge from = dt_.leaving(v, t);
-        HalfEdge h = from;
-        do {
-            if (!is_ocean(triangle_of(h)))
-                return true;
-            h = dt_.next_around_origin(h);
-        } while (h != from);
-        return false;
+        return detail::on_boundary(dt_, m_.ocean, v, t);
     }
     // Whether corner i of t lies within blunt_reach h of its opposite side.
     bool within_reach(TriangleId t, int i) const {

@@ -35,6 +35,20 @@ struct CornerReport {
     std::vector<Vec3> straits_at; ///< faces removed where the water is narrower than them
 };
 
+/// Whether a triangle around v (near: one of them, or a hint) is not labelled `ocean`: v is a
+/// node of the water's boundary.
+inline bool on_boundary(const SphericalDelaunay &dt, std::uint8_t ocean, VertexId v,
+                        TriangleId near) {
+    const HalfEdge from = dt.leaving(v, near);
+    HalfEdge h = from;
+    do {
+        if (dt.label(triangle_of(h)) != ocean)
+            return true;
+        h = dt.next_around_origin(h);
+    } while (h != from);
+    return false;
+}
+
 /// The floor and the reach: a face below `floor` goes when its corner lies within `reach` h
 /// of its opposite side (see corners.cpp).
 inline constexpr double blunt_floor = 0.3;

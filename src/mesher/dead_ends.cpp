@@ -1,6 +1,7 @@
 // Dead ends the strait closings leave, closed by the inlet rule.
 #include <algorithm>
 
+#include "corners.hpp"
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
@@ -64,18 +65,6 @@ public:
 private:
     bool is_ocean(TriangleId t) const { return dt.is_live(t) && dt.label(t) == ocean; }
 
-    // Whether v has a face off the ocean around it (a node of the boundary as it is now).
-    bool on_boundary(VertexId v, TriangleId near) const {
-        const HalfEdge first = dt.leaving(v, near);
-        HalfEdge h = first;
-        do {
-            if (!is_ocean(triangle_of(h)))
-                return true;
-            h = dt.next_around_origin(h);
-        } while (h != first);
-        return false;
-    }
-
     // The ocean edges between two boundary nodes, shorter than inlet_width h, among the faces
     // a flood from each face beside a closing reaches within inlet_narrow_area h^2.
     std::vector<Chord> find_chords() {
@@ -118,7 +107,8 @@ private:
         const VertexId a = dt.origin(e), b = dt.destination(e);
         const double length = arc_angle(dt.point(a), dt.point(b));
         const double h = km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b))));
-        if (length < options.inlet_width * h && on_boundary(a, t) && on_boundary(b, t))
+        if (length < options.inlet_width * h && detail::on_boundary(dt, ocean, a, t) &&
+            detail::on_boundary(dt, ocean, b, t))
             chords.push_back({length, h, e});
     }
 
@@ -134,8 +124,7 @@ private:
         ++stamp;
         out.assign(1, seed);
         mark[seed] = stamp;
-        const double cap = options.inlet_area * c.h * c.h, width = options.inlet_width * c.h,
-                     narrow_cap = inlet_narrow_area * c.h * c.h;
+        const double narrow_cap = inlet_narrow_area * c.h * c.h;
         double area = 0, perimeter = c.length;
         bool at_closing = false;
         for (std::size_t k = 0; k < out.size(); ++k) {
@@ -165,9 +154,7 @@ private:
                 }
             }
         }
-        if (!at_closing)
-            return -1.0;
-        return area <= cap || 2 * area < width * perimeter ? area : -1.0;
+        return at_closing && inlet_closes(area, perimeter, c.h, options) ? area : -1.0;
     }
 
     Mesher &m;

@@ -300,6 +300,12 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
     }
     for (const auto &c : corners)
         loops_state.of.emplace(c.first, loop);
+    auto add_beside = [&](std::vector<TriangleId> &out) { // the ocean faces beside the members
+        for (TriangleId t : members)
+            for (int i = 0; i < 3; ++i)
+                if (is_ocean(dt.neighbour(t, i)))
+                    out.push_back(dt.neighbour(t, i));
+    };
     if (straits) {
         // A strait closed: the removal cut the mesh, joined loops or pinched it at a node
         // (not an island coming back as a hole, or a bite into one coast).
@@ -307,17 +313,11 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
         if (cuts || !pinches.empty() || arc_loops.size() > 1) {
             ++report.straits_closed;
             report.straits_closed_at.push_back(m.centroid(needed));
-            for (TriangleId t : members)
-                for (int i = 0; i < 3; ++i)
-                    if (is_ocean(dt.neighbour(t, i)))
-                        m.strait_sides.push_back(dt.neighbour(t, i));
+            add_beside(m.strait_sides);
         }
     }
     if (cuts && cut_sides)
-        for (TriangleId t : members)
-            for (int i = 0; i < 3; ++i)
-                if (is_ocean(dt.neighbour(t, i)))
-                    cut_sides->push_back(dt.neighbour(t, i));
+        add_beside(*cut_sides);
     removed_faces += members.size();
 }
 

@@ -44,6 +44,15 @@ constexpr double inlet_narrow_area = 25;
 
 constexpr std::uint8_t land = 0;
 constexpr std::uint8_t ocean = 1;
+
+/// close_inlets' rule: water behind a narrow mouth, of `area` (square radians) and `perimeter`
+/// (radians, the mouth included), where the size is h (radians), closes when it holds at most
+/// inlet_area h^2, or is narrower on average (twice its area over its perimeter) than
+/// inlet_width h and holds at most inlet_narrow_area h^2.
+inline bool inlet_closes(double area, double perimeter, double h, const MesherOptions &options) {
+    return area <= options.inlet_area * h * h ||
+           (area <= inlet_narrow_area * h * h && 2 * area < options.inlet_width * h * perimeter);
+}
 constexpr int next3(int i) {
     return i == 2 ? 0 : i + 1;
 }

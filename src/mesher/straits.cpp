@@ -117,10 +117,7 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
     for (const std::uint32_t k : whole) {
         const Flood &p = floods[k];
         const double h = km_to_rad(m.size_km(m.centroid(p.faces[0])));
-        const bool small = p.area <= options.inlet_area * h * h ||
-                           (p.area <= inlet_narrow_area * h * h &&
-                            2 * p.area < options.inlet_width * h * p.perimeter);
-        if (p.open || !small || passes_through(k))
+        if (p.open || !inlet_closes(p.area, p.perimeter, h, options) || passes_through(k))
             continue;
         report.straits_water_km2 += p.area * earth_radius_km * earth_radius_km;
         for (std::uint32_t f = 0; f < floods.size(); ++f)
