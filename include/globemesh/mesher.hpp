@@ -71,7 +71,9 @@
 //      between two fans of water (the output gives each fan after the first a node of its
 //      own, 0.64 m into it or less, so the mesh stays a manifold), and the nodes they put on
 //      the boundary may lie up to 0.75 h from the coast. The faces left on land are reported
-//      with their centroids.
+//      with their centroids. Last (after the corners are blunted), the pieces beside the
+//      closings and the fans at split nodes go under the same rule: no piece the output
+//      makes apart from the largest is one close_inlets would close, and each is reported.
 // The result is constrained Delaunay, every face counter-clockwise, and deterministic: the same
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
@@ -119,6 +121,9 @@ struct MesherOptions {
     /// With close_straits and inlet_width: a channel the closings leave as a dead end (the stub
     /// of a canal closed further along) closes by the inlet rule too.
     bool close_dead_ends = true;
+    /// With inlet_width: after the corners are blunted, the pieces the closings left apart (a
+    /// face hanging at a split node) close by the inlet rule too.
+    bool close_pieces_apart = true;
     /// Lines across straits (passages.hpp): no strait closing removes a face one of them meets.
     std::vector<std::vector<Vec3>> passages;
 };

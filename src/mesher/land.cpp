@@ -1,4 +1,6 @@
 // Land clean-up: faces centred on land removed, or nudged off it.
+#include <unordered_set>
+
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
@@ -32,9 +34,10 @@ namespace {
 class LandRemoval {
 public:
     LandRemoval(Mesher &m, const LandTest &land_test, double pocket_area, MesherReport &report,
-                BoundaryLoops &loops_state, bool straits, std::vector<TriangleId> *cut_sides)
+                BoundaryLoops &loops_state, bool straits)
         : m(m), dt(m.dt), land_test(land_test), pocket_area(pocket_area), report(report),
-          loops_state(loops_state), straits(straits), cut_sides(cut_sides) {}
+          loops_state(loops_state), straits(straits),
+          side_faces(m.cut_sides.begin(), m.cut_sides.end()) {}
     std::size_t run(std::vector<TriangleId> island_faces, std::vector<TriangleId> &left_faces);
 
 private:
@@ -45,7 +48,7 @@ private:
     MesherReport &report;
     BoundaryLoops &loops_state;
     const bool straits;
-    std::vector<TriangleId> *const cut_sides;
+    std::unordered_set<TriangleId> side_faces; // Mesher::cut_sides, to find one a removal takes
     // The boundary: each boundary half-edge's origin -> destination (one per boundary vertex in
     // a manifold), and its half-edges with the ocean on the left.
     std::unordered_map<VertexId, VertexId> next_on_boundary;
@@ -315,9 +318,17 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
             report.straits_closed_at.push_back(m.centroid(needed));
             add_beside(m.strait_sides);
         }
+        // A cut or a pinch (the output splits the node) may leave a piece apart, found from
+        // the faces beside it (Mesher::cut_sides); a removal that takes one of those faces
+        // hands that on to the faces beside it, so every piece apart keeps one.
+        const bool takes_side = std::any_of(members.begin(), members.end(),
+                                            [&](TriangleId t) { return side_faces.count(t); });
+        if (cuts || !pinches.empty() || takes_side) {
+            const std::size_t from = m.cut_sides.size();
+            add_beside(m.cut_sides);
+            side_faces.insert(m.cut_sides.begin() + std::ptrdiff_t(from), m.cut_sides.end());
+        }
     }
-    if (cuts && cut_sides)
-        add_beside(*cut_sides);
     removed_faces += members.size();
 }
 
@@ -477,8 +488,9 @@ std::size_t LandRemoval::run(std::vector<TriangleId> island_faces,
 // With `straits` (close_straits), the faces looked at are `island_faces` alone, and a removal
 // may also cut the mesh in two or leave a node between two fans of water (in Mesher::pinched;
 // the output splits it); nodes it puts on the boundary may lie up to strait_exposed_reach h
-// from the coast. The ocean faces beside each removal that cut the mesh go to `cut_sides`,
-// and each removal that closed a strait (cut, joined or pinched) to report.straits_closed.
+// from the coast. The ocean faces beside each removal that cut or pinched the mesh go to
+// Mesher::cut_sides, and each removal that closed a strait (cut, joined or pinched) to
+// report.straits_closed.
 //
 // `loops`: the boundary loops, traced by the first call and kept up to date by its removals
 // (the nudge between the calls moves nodes but changes no boundary edge), so that the second
@@ -486,9 +498,8 @@ std::size_t LandRemoval::run(std::vector<TriangleId> island_faces,
 std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
                               std::vector<TriangleId> island_faces, double pocket_area,
                               MesherReport &report, std::vector<TriangleId> &left_faces,
-                              BoundaryLoops &loops_state, bool straits,
-                              std::vector<TriangleId> *cut_sides) {
-    return LandRemoval(m, land_test, pocket_area, report, loops_state, straits, cut_sides)
+                              BoundaryLoops &loops_state, bool straits) {
+    return LandRemoval(m, land_test, pocket_area, report, loops_state, straits)
         .run(std::move(island_faces), left_faces);
 }
 

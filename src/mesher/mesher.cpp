@@ -77,6 +77,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
         blunt_sharp_corners(m, options);
         raise_quality_floor(m, options, as_made);
     }
+    // The closings may leave small pieces alone (a face hanging at a pinched node): they go.
+    close_cut_off_pieces(m, options, report);
     if (options.land)
         measure_closed_straits(m, *options.land, report);
 

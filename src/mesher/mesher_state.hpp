@@ -511,8 +511,7 @@ std::size_t clear_dropped_islands(Mesher &m, const Boundary &boundary, MesherRep
 std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
                               std::vector<TriangleId> island_faces, double pocket_area,
                               MesherReport &report, std::vector<TriangleId> &left_faces,
-                              BoundaryLoops &loops_state, bool straits = false,
-                              std::vector<TriangleId> *cut_sides = nullptr);
+                              BoundaryLoops &loops_state, bool straits = false);
 std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
                            const std::vector<TriangleId> &faces, std::vector<TriangleId> &left,
                            std::vector<Vec3> &left_at);
@@ -522,6 +521,16 @@ std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
 void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces);
 void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId> &faces,
                    const MesherOptions &options, BoundaryLoops &loops, MesherReport &report);
+// pieces.cpp: whether a passage line (MesherOptions::passages) meets face t, and the small
+// pieces beside closings (`sides`: faces beside them) closed by the inlet rule. `land_test`
+// (may be null) counts the faces closed as land or water.
+bool on_passage(const Mesher &m, const MesherOptions &options, TriangleId t);
+void close_small_pieces(Mesher &m, const std::vector<TriangleId> &sides,
+                        const MesherOptions &options, const LandTest *land_test,
+                        MesherReport &report);
+// The last of them, after every closing: the ocean's pieces over shared edges but the largest,
+// where the inlet rule would close them.
+void close_cut_off_pieces(Mesher &m, const MesherOptions &options, MesherReport &report);
 // dead_ends.cpp: the dead ends the closings left (Mesher::strait_sides), closed by the inlet rule.
 void close_dead_ends(Mesher &m, const MesherOptions &options, MesherReport &report);
 
