@@ -226,18 +226,22 @@ private:
             dt_.set_constrained(h, true);
             m_.add_segment(dt_.destination(h), dt_.origin(h), kind);
         }
+        // A closing may cut the mesh in two: the faces beside it go to cut_sides, as do those
+        // beside a removal of a face in cut_sides (it hands that on, so the piece keeps one).
+        bool sides = std::find(m_.cut_sides.begin(), m_.cut_sides.end(), t) != m_.cut_sides.end();
         for (int i = 0; i < 3; ++i) {
             const VertexId v = dt_.vertex(t, i);
             queue_around(v, t); // their corners may now be on the boundary
             if (fans(v, t) < 2)
                 continue;
             m_.pinched.push_back(v);
-            // The closing may cut the mesh in two: the faces beside it go to cut_sides.
+            sides = true;
+        }
+        if (sides)
             for (int k = 0; k < 3; ++k)
                 if (const TriangleId behind = triangle_of(dt_.twin(half_edge(t, k)));
                     is_ocean(behind))
                     m_.cut_sides.push_back(behind);
-        }
     }
 
     CornerMesh &m_;

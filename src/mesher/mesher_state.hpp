@@ -528,8 +528,8 @@ bool on_passage(const Mesher &m, const MesherOptions &options, TriangleId t);
 void close_small_pieces(Mesher &m, const std::vector<TriangleId> &sides,
                         const MesherOptions &options, const LandTest *land_test,
                         MesherReport &report);
-// The last of them, after every closing: the ocean's pieces over shared edges but the largest,
-// where the inlet rule would close them.
+// The last of them, after every closing: the pieces beside the cuts and pinches
+// (Mesher::cut_sides), where the inlet rule would close them.
 void close_cut_off_pieces(Mesher &m, const MesherOptions &options, MesherReport &report);
 // dead_ends.cpp: the dead ends the closings left (Mesher::strait_sides), closed by the inlet rule.
 void close_dead_ends(Mesher &m, const MesherOptions &options, MesherReport &report);

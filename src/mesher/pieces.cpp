@@ -149,24 +149,11 @@ void close_small_pieces(Mesher &m, const std::vector<TriangleId> &sides,
         pieces.close_if_small(k, land_test, report);
 }
 
-// The faces beside the cuts (Mesher::cut_sides) and around the pinched nodes (the output splits
-// them, so a fan there is a piece of its own), after every closing: a face or two left hanging
-// at a pinched node go.
+// The pieces beside the cuts and pinches (Mesher::cut_sides), after every closing: a face or
+// two left hanging at a pinched node go (the output splits the node, so they stand apart).
 void close_cut_off_pieces(Mesher &m, const MesherOptions &options, MesherReport &report) {
-    if (!options.close_pieces_apart || options.inlet_width <= 0 ||
-        (m.pinched.empty() && m.cut_sides.empty()))
-        return;
-    SphericalDelaunay &dt = m.dt;
-    std::vector<TriangleId> sides = m.cut_sides;
-    for (const VertexId v : m.pinched) {
-        const HalfEdge first = dt.leaving(v, no_triangle);
-        HalfEdge h = first;
-        do {
-            sides.push_back(triangle_of(h));
-            h = dt.next_around_origin(h);
-        } while (h != first);
-    }
-    close_small_pieces(m, sides, options, options.land.get(), report);
+    if (options.close_pieces_apart && options.inlet_width > 0 && !m.cut_sides.empty())
+        close_small_pieces(m, m.cut_sides, options, options.land.get(), report);
 }
 
 } // namespace globemesh::mesher_internal
