@@ -118,8 +118,9 @@ struct MesherOptions {
     /// With `land`: close the straits narrower than a face that faces centred on land are left
     /// across (step 7), rather than keep them open with those faces.
     bool close_straits = true;
-    /// With close_straits and inlet_width: a channel the closings leave as a dead end (the stub
-    /// of a canal closed further along) closes by the inlet rule too.
+    /// With inlet_width: a channel the strait closings leave as a dead end (the stub of a canal
+    /// closed further along), and the water behind any edge between two boundary nodes shorter
+    /// than inlet_width h / 2 (a stub the refinement left), close by the inlet rule too.
     bool close_dead_ends = true;
     /// With inlet_width: after the corners are blunted, the pieces the closings left apart (a
     /// face hanging at a split node) close by the inlet rule too.

@@ -8,10 +8,16 @@ namespace globemesh::mesher_internal {
 
 namespace {
 
+// A chord across water this short against the inlet width closes by the inlet rule wherever it
+// is, not only beside a closing: the mouth of a stub the refinement and the land removals left,
+// meshed with faces hundreds of metres across at a size of kilometres.
+constexpr double short_chord = 0.5;
+
 struct Chord {
     double length;
     double h; // the size at its midpoint, radians
     HalfEdge edge;
+    bool short_; // shorter than short_chord inlet_width h
 };
 
 class DeadEnds {
@@ -27,6 +33,7 @@ public:
         for (const TriangleId t : m.cut_sides)
             cut_side[t] = 1;
         std::vector<Chord> chords = find_chords();
+        add_short_chords(chords);
         std::sort(chords.begin(), chords.end(), [](const Chord &x, const Chord &y) {
             if (x.length != y.length)
                 return x.length > y.length;
@@ -109,7 +116,41 @@ private:
         const double h = km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b))));
         if (length < options.inlet_width * h && detail::on_boundary(dt, ocean, a, t) &&
             detail::on_boundary(dt, ocean, b, t))
-            chords.push_back({length, h, e});
+            chords.push_back({length, h, e, length < short_chord * options.inlet_width * h});
+    }
+
+    // The ocean edges anywhere between two boundary nodes shorter than short_chord inlet_width
+    // h (the boundary nodes found from the faces beside land), added to `chords` once each.
+    void add_short_chords(std::vector<Chord> &chords) {
+        std::vector<char> on_boundary(dt.vertex_count(), 0);
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
+            if (is_ocean(t))
+                for (int i = 0; i < 3; ++i)
+                    if (!is_ocean(dt.neighbour(t, i)))
+                        on_boundary[dt.vertex(t, next3(i))] = on_boundary[dt.vertex(t, prev3(i))] =
+                            1;
+        const std::size_t before = chords.size();
+        for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+            if (!is_ocean(t))
+                continue;
+            for (int i = 0; i < 3; ++i) {
+                const HalfEdge e = half_edge(t, i);
+                const VertexId a = dt.origin(e), b = dt.destination(e);
+                if (a > b || !on_boundary[a] || !on_boundary[b] || !is_ocean(dt.neighbour(t, i)))
+                    continue;
+                const double length = arc_angle(dt.point(a), dt.point(b));
+                const double h = km_to_rad(m.size_km(arc_midpoint(dt.point(a), dt.point(b))));
+                if (length < short_chord * options.inlet_width * h)
+                    chords.push_back({length, h, e, true});
+            }
+        }
+        if (chords.size() == before)
+            return;
+        std::sort(chords.begin(), chords.end(),
+                  [](const Chord &x, const Chord &y) { return x.edge < y.edge; });
+        chords.erase(std::unique(chords.begin(), chords.end(),
+                                 [](const Chord &x, const Chord &y) { return x.edge == y.edge; }),
+                     chords.end());
     }
 
     double triangle_area(TriangleId t) const {
@@ -154,7 +195,8 @@ private:
                 }
             }
         }
-        return at_closing && inlet_closes(area, perimeter, c.h, options) ? area : -1.0;
+        return (at_closing || c.short_) && inlet_closes(area, perimeter, c.h, options) ? area
+                                                                                       : -1.0;
     }
 
     Mesher &m;
@@ -173,10 +215,11 @@ private:
 // h. It closes by close_inlets' rule on the mesh as it is: an ocean edge between two boundary
 // nodes, shorter than inlet_width h, with at most inlet_area h^2 of water behind it (or narrow
 // on average and at most inlet_narrow_area h^2), water that holds a face beside a closing
-// (Mesher::strait_sides) and touches no open boundary. The longest such edge first, so a stub
+// (Mesher::strait_sides) and touches no open boundary; or, for an edge shorter than short_chord
+// inlet_width h, any water behind it the rule closes. The longest such edge first, so a stub
 // closes whole at its mouth. Counted with the inlets closed.
 void close_dead_ends(Mesher &m, const MesherOptions &options, MesherReport &report) {
-    if (options.close_dead_ends && options.inlet_width > 0 && !m.strait_sides.empty())
+    if (options.close_dead_ends && options.inlet_width > 0)
         DeadEnds(m, options).run(report);
     m.strait_sides.clear();
 }

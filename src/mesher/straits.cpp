@@ -147,6 +147,8 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
         if (!left.empty())
             report.land_faces_nudged +=
                 nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+    } else {
+        close_dead_ends(m, options, report); // the short chords alone
     }
     report.land_faces_left = report.land_faces_at.size();
 }
