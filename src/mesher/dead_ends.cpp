@@ -159,8 +159,9 @@ private:
     }
 
     // The ocean on one side of chord c from `seed` (square radians), or -1 when it reaches
-    // `other` (the chord does not cut it off), touches an open boundary, holds no face beside a
-    // closing (not a dead end the closings made), or is too large for the inlet rule.
+    // `other` (the chord does not cut it off), touches an open boundary or a passage line, holds
+    // no face beside a closing (not a dead end the closings made) unless c is short, or is too
+    // large for the inlet rule.
     double flood(TriangleId seed, const Chord &c, TriangleId other, std::vector<TriangleId> &out) {
         ++stamp;
         out.assign(1, seed);
@@ -172,8 +173,8 @@ private:
             const TriangleId t = out[k];
             area += triangle_area(t);
             at_closing = at_closing || beside[t];
-            if (area > narrow_cap)
-                return -1.0;
+            if (area > narrow_cap || (!options.passages.empty() && on_passage(m, options, t)))
+                return -1.0; // too large, or a passage runs through it (it stays open)
             for (int i = 0; i < 3; ++i) {
                 const HalfEdge e = half_edge(t, i);
                 if (e == c.edge || e == dt.twin(c.edge))
