@@ -83,8 +83,9 @@ struct MeshingOptions {
     /// Close inlets and lagoons whose mouth is narrower than this times the local size and whose
     /// water is under the local size squared, 0..2; 0 keeps every inlet.
     double inlet_width = 0.5;
-    /// With the straits closed: close by the inlet rule the channels their closings leave as
-    /// dead ends (MesherOptions::close_dead_ends); no flag sets it.
+    /// Close by the inlet rule the channels the strait closings leave as dead ends, and the water
+    /// behind any chord shorter than inlet_width h / 2 (MesherOptions::close_dead_ends); no flag
+    /// sets it.
     bool close_dead_ends = true;
     std::uint64_t seed = 1; ///< seed of every pseudo-random choice
     /// Parts meshed apart and joined (docs/parallel.md), 1..6: the mesh depends on it; 0, the

@@ -126,8 +126,7 @@ void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report)
                     // Another ring inside (an island) would vanish with the inlet: keep it open.
                     if (ring(dt.origin(e)) != own || ring(dt.destination(e)) != own)
                         return -1.0;
-                    auto it = m.segments.find(key(dt.origin(e), dt.destination(e)));
-                    if (it != m.segments.end() && it->second == SegmentKind::open)
+                    if (m.is_open(dt.origin(e), dt.destination(e)))
                         return -1.0;
                     continue;
                 }

@@ -34,6 +34,12 @@ public:
             cut_side[t] = 1;
         std::vector<Chord> chords = find_chords();
         add_short_chords(chords);
+        // Each edge once (both searches may find it), then the longest first.
+        std::sort(chords.begin(), chords.end(),
+                  [](const Chord &x, const Chord &y) { return x.edge < y.edge; });
+        chords.erase(std::unique(chords.begin(), chords.end(),
+                                 [](const Chord &x, const Chord &y) { return x.edge == y.edge; }),
+                     chords.end());
         std::sort(chords.begin(), chords.end(), [](const Chord &x, const Chord &y) {
             if (x.length != y.length)
                 return x.length > y.length;
@@ -73,7 +79,8 @@ private:
     bool is_ocean(TriangleId t) const { return dt.is_live(t) && dt.label(t) == ocean; }
 
     // The ocean edges between two boundary nodes, shorter than inlet_width h, among the faces
-    // a flood from each face beside a closing reaches within inlet_narrow_area h^2.
+    // a flood from each face beside a closing reaches within inlet_narrow_area h^2 (an edge
+    // may come twice, from two floods).
     std::vector<Chord> find_chords() {
         std::vector<Chord> chords;
         std::vector<TriangleId> reached;
@@ -102,11 +109,6 @@ private:
                 }
             }
         }
-        std::sort(chords.begin(), chords.end(),
-                  [](const Chord &x, const Chord &y) { return x.edge < y.edge; });
-        chords.erase(std::unique(chords.begin(), chords.end(),
-                                 [](const Chord &x, const Chord &y) { return x.edge == y.edge; }),
-                     chords.end());
         return chords;
     }
 
@@ -120,7 +122,7 @@ private:
     }
 
     // The ocean edges anywhere between two boundary nodes shorter than short_chord inlet_width
-    // h (the boundary nodes found from the faces beside land), added to `chords` once each.
+    // h (the boundary nodes found from the faces beside land), added to `chords`.
     void add_short_chords(std::vector<Chord> &chords) {
         std::vector<char> on_boundary(dt.vertex_count(), 0);
         for (TriangleId t = 0; t < dt.triangle_slots(); ++t)
@@ -129,7 +131,6 @@ private:
                     if (!is_ocean(dt.neighbour(t, i)))
                         on_boundary[dt.vertex(t, next3(i))] = on_boundary[dt.vertex(t, prev3(i))] =
                             1;
-        const std::size_t before = chords.size();
         for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
             if (!is_ocean(t))
                 continue;
@@ -144,13 +145,6 @@ private:
                     chords.push_back({length, h, e, true});
             }
         }
-        if (chords.size() == before)
-            return;
-        std::sort(chords.begin(), chords.end(),
-                  [](const Chord &x, const Chord &y) { return x.edge < y.edge; });
-        chords.erase(std::unique(chords.begin(), chords.end(),
-                                 [](const Chord &x, const Chord &y) { return x.edge == y.edge; }),
-                     chords.end());
     }
 
     double triangle_area(TriangleId t) const {
@@ -185,8 +179,7 @@ private:
                 if (!is_ocean(n)) {
                     const VertexId x = dt.origin(e), y = dt.destination(e);
                     perimeter += arc_angle(dt.point(x), dt.point(y));
-                    const auto it = m.segments.find(key(x, y));
-                    if (it != m.segments.end() && it->second == SegmentKind::open)
+                    if (m.is_open(x, y))
                         return -1.0;
                     continue;
                 }

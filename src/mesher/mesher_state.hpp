@@ -212,6 +212,12 @@ struct Mesher {
         return v;
     }
 
+    /// Whether a-b (either way) is a segment of an open (region) boundary.
+    bool is_open(VertexId a, VertexId b) const {
+        const auto it = segments.find(key(a, b));
+        return it != segments.end() && it->second == SegmentKind::open;
+    }
+
     void add_segment(VertexId a, VertexId b, SegmentKind kind) {
         segments[key(a, b)] = kind;
         directed.emplace_back(a, b);

@@ -148,10 +148,7 @@ std::vector<NodeIndex> write_faces(const Mesher &m, const PinchSplit &split, std
             if (dt.label(other) == ocean)
                 continue;
             VertexId a = dt.origin(h), b = dt.destination(h);
-            auto it = m.segments.find(key(a, b));
-            EdgeTag tag = it != m.segments.end() && it->second == SegmentKind::open
-                              ? EdgeTag::open
-                              : EdgeTag::coast;
+            const EdgeTag tag = m.is_open(a, b) ? EdgeTag::open : EdgeTag::coast;
             mesh.boundary.push_back({split.node_at(t, a), split.node_at(t, b), tag});
         }
     }

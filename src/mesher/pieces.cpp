@@ -98,8 +98,7 @@ private:
                 if (!is_ocean(n)) {
                     const VertexId x = dt.vertex(t, next3(i)), y = dt.vertex(t, prev3(i));
                     r.perimeter += arc_angle(dt.point(x), dt.point(y));
-                    const auto it = m.segments.find(key(x, y));
-                    r.open = r.open || (it != m.segments.end() && it->second == SegmentKind::open);
+                    r.open = r.open || m.is_open(x, y);
                     continue;
                 }
                 const auto [it, added] = piece.emplace(n, f);

@@ -452,13 +452,6 @@ std::size_t QualityRounds::remove_floor_nodes() {
     collect(detail::blunt_floor, false);
     std::size_t removed = 0;
     std::vector<TriangleId> star, changed;
-    auto q = [&](TriangleId t) {
-        return triangle_quality(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
-                                dt.point(dt.vertex(t, 2)));
-    };
-    auto cut = [&](TriangleId t) {
-        return std::find(m.cut_sides.begin(), m.cut_sides.end(), t) != m.cut_sides.end();
-    };
     for (auto &[v, hint] : todo) {
         const HalfEdge from = m.is_sharp(v) ? no_half_edge : leaving(v, hint);
         if (from == no_half_edge)
@@ -469,8 +462,8 @@ std::size_t QualityRounds::remove_floor_nodes() {
         HalfEdge h = from;
         do {
             const TriangleId t = triangle_of(h);
-            ocean_star = ocean_star && dt.label(t) == ocean && !cut(t);
-            worst = std::min(worst, q(t));
+            ocean_star = ocean_star && dt.label(t) == ocean && !is_cut(t);
+            worst = std::min(worst, face_quality(t));
             star.push_back(dt.destination(h));
             h = dt.next_around_origin(h);
         } while (h != from);
@@ -478,7 +471,7 @@ std::size_t QualityRounds::remove_floor_nodes() {
             continue;
         auto better = [&] {
             for (TriangleId t : changed)
-                if (dt.label(t) != ocean || cut(t) || q(t) <= worst)
+                if (dt.label(t) != ocean || is_cut(t) || face_quality(t) <= worst)
                     return false;
             return true;
         };

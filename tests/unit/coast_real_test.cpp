@@ -231,6 +231,19 @@ TEST(CoastReal, islands_near_130E_3S_mesh_as_a_manifold_above_the_floor_at_every
     }
 }
 
+// An edge of a mesh by its two nodes, smaller first, and the faces on each edge of `mesh`.
+using MeshEdge = std::pair<NodeIndex, NodeIndex>;
+MeshEdge edge_of(NodeIndex a, NodeIndex b) {
+    return {std::min(a, b), std::max(a, b)};
+}
+std::map<MeshEdge, std::vector<std::size_t>> faces_of_edges(const Mesh &mesh) {
+    std::map<MeshEdge, std::vector<std::size_t>> out;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        for (int i = 0; i < 3; ++i)
+            out[edge_of(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3])].push_back(f);
+    return out;
+}
+
 // The mesh's pieces over shared edges (the output splits a node between two fans of water, so a
 // piece hanging at one stands apart): each piece's area and perimeter (km2, km).
 struct Piece {
@@ -245,12 +258,7 @@ std::vector<Piece> pieces_of(const Mesh &mesh) {
             i = parent[i] = parent[parent[i]];
         return i;
     };
-    std::map<std::pair<NodeIndex, NodeIndex>, std::vector<std::size_t>> faces_of_edge;
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        for (int i = 0; i < 3; ++i) {
-            const NodeIndex a = mesh.faces[f][i], b = mesh.faces[f][(i + 1) % 3];
-            faces_of_edge[{std::min(a, b), std::max(a, b)}].push_back(f);
-        }
+    const auto faces_of_edge = faces_of_edges(mesh);
     for (const auto &[edge, faces] : faces_of_edge)
         for (std::size_t k = 1; k < faces.size(); ++k)
             parent[root(faces[k])] = root(faces[0]);
@@ -305,16 +313,11 @@ struct Behind {
     bool open = false;
 };
 std::vector<Behind> water_behind_short_chords(const Mesh &mesh, double h) {
-    using Edge = std::pair<NodeIndex, NodeIndex>;
-    auto edge = [](NodeIndex a, NodeIndex b) { return Edge{std::min(a, b), std::max(a, b)}; };
-    std::map<Edge, std::vector<std::size_t>> faces_of;
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        for (int i = 0; i < 3; ++i)
-            faces_of[edge(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3])].push_back(f);
-    std::map<Edge, EdgeTag> tag;
+    const auto faces_of = faces_of_edges(mesh);
+    std::map<MeshEdge, EdgeTag> tag;
     std::vector<char> on_boundary(mesh.nodes.size(), 0);
     for (const BoundaryEdge &b : mesh.boundary) {
-        tag[edge(b.a, b.b)] = b.tag;
+        tag[edge_of(b.a, b.b)] = b.tag;
         on_boundary[b.a] = on_boundary[b.b] = 1;
     }
     auto km = [&](NodeIndex a, NodeIndex b) {
@@ -340,7 +343,7 @@ std::vector<Behind> water_behind_short_chords(const Mesh &mesh, double h) {
                     spherical_triangle_area(mesh.nodes[n[0]], mesh.nodes[n[1]], mesh.nodes[n[2]]) *
                     earth_radius_km * earth_radius_km;
                 for (int i = 0; i < 3; ++i) {
-                    const Edge e = edge(n[i], n[(i + 1) % 3]);
+                    const MeshEdge e = edge_of(n[i], n[(i + 1) % 3]);
                     if (e == chord)
                         continue;
                     const std::vector<std::size_t> &across = faces_of.at(e);
