@@ -10,7 +10,9 @@
 //      inlets narrower than inlet_width * h (an edge between two nodes of one ring, shorter than
 //      that, becomes coast when the water behind it is under inlet_area * h^2, or narrower on
 //      average than inlet_width * h and under 25 h^2; repeated, so a dead-end channel closes
-//      whole), which no triangle of size h could fill but slivers;
+//      whole), which no triangle of size h could fill but slivers; then a coast segment shorter
+//      than close_node_gap * h (a closed mouth between the source's own vertices) loses one end
+//      where the segment joining its neighbours crosses nothing;
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
@@ -97,7 +99,10 @@ struct MesherOptions {
     bool keep_inland_seas = false; ///< keep ocean components apart from the largest
     double inlet_width = 0.5;      ///< close inlets narrower than this times h (0: none)
     double inlet_area = 1.0; ///< ... holding at most this times h^2 of water (or narrow on average)
-    std::uint64_t seed = 1;  ///< seed of the core's insertion order
+    /// Once the inlets have closed, a coast segment shorter than this times h (a closed mouth
+    /// between the source's own vertices) loses one of its ends (CoastOptions::close_node_gap).
+    double close_node_gap = 1.0 / 32;
+    std::uint64_t seed = 1; ///< seed of the core's insertion order
     /// The size field's largest value (km): where the field reaches it, away from the boundary,
     /// the ocean is first filled with a regular (icosahedral) lattice of that spacing, and the
     /// refinement fills the rest. 0: no lattice, every node from the refinement.
@@ -157,8 +162,9 @@ struct MesherReport {
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
     std::size_t inlets_closed =
         0; ///< closings (MesherOptions::inlet_width; a long channel may take several)
-    double inlet_area_km2 = 0;     ///< the water they held
-    std::size_t lattice_nodes = 0; ///< nodes from the lattice (MesherOptions::lattice_km)
+    double inlet_area_km2 = 0;          ///< the water they held
+    std::size_t coast_nodes_merged = 0; ///< ends of coast segments shorter than close_node_gap h
+    std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
     std::size_t lattice_patched =
         0; ///< of which placed with their lattice triangles, not inserted one by one
     std::size_t island_centroids_moved = 0; ///< faces moved off islands the shaping dropped

@@ -30,7 +30,9 @@ struct CoastOptions {
     double min_island_triangles = 4;
     /// Coast nodes closer together than this times the local size are merged where no arc then
     /// touches or crosses another (the topology repair makes nodes of the source's vertices,
-    /// metres apart in a canal narrower than the size). 0 keeps every node; no flag sets it.
+    /// metres apart in a canal narrower than the size), and again once the inlets have closed
+    /// (MesherOptions::close_node_gap: a closed mouth's ends). 0 keeps every node; no flag sets
+    /// it.
     double close_node_gap = 1.0 / 32;
     bool keep_inland_seas = false; ///< keep water bodies not connected to the ocean
     /// Keep open the straits narrower than a triangle, with their triangles centred on land,

@@ -116,8 +116,8 @@ void print_coast(std::ostream &out, const OceanMesh &run) {
     const MesherReport &m = run.mesher;
     out << "coast             " << run.coast.rings << " rings kept, islands dropped "
         << run.coast.islands_removed << ", lakes dropped " << run.coast.lakes_removed
-        << ", close nodes merged " << run.coast.close_nodes_merged << ", inlets closed "
-        << inlets_closed_text(m) << ", corners blunted " << m.corners_blunted
+        << ", close nodes merged " << run.coast.close_nodes_merged + m.coast_nodes_merged
+        << ", inlets closed " << inlets_closed_text(m) << ", corners blunted " << m.corners_blunted
         << ", floor nodes removed " << m.floor_nodes_removed << " / added " << m.floor_nodes_added
         << "\n"
         << "coast repairs     " << coast_repairs_text(run.coast_repairs) << "\n"

@@ -39,6 +39,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     classify_ocean(m, boundary, options);
     if (options.inlet_width > 0 && !boundary.empty())
         close_inlets(m, options, report);
+    if (!boundary.empty())
+        report.coast_nodes_merged = merge_close_coast_nodes(m, options);
     globemesh::report(progress, 0.15, "classify");
     mark_sharp_corners(m);
     estimate_nodes(m, options);

@@ -476,6 +476,7 @@ void recover_segments(Mesher &m, const Boundary &boundary, const std::vector<Ver
 // reserved for them.
 void classify_ocean(Mesher &m, const Boundary &boundary, const MesherOptions &options);
 void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report);
+std::size_t merge_close_coast_nodes(Mesher &m, const MesherOptions &options);
 void mark_sharp_corners(Mesher &m);
 // reserve: size the triangulation for them (not for a triangulation only counted, parts.cpp).
 void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve = true);

@@ -92,6 +92,7 @@ void add_report(MesherReport &run, const MesherReport &part) {
     run.sharp_corners += part.sharp_corners;
     run.sharp_corner_faces += part.sharp_corner_faces;
     run.inlets_closed += part.inlets_closed;
+    run.coast_nodes_merged += part.coast_nodes_merged;
     run.inlet_area_km2 += part.inlet_area_km2;
     run.lattice_nodes += part.lattice_nodes;
     run.lattice_patched += part.lattice_patched;

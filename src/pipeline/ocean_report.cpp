@@ -83,7 +83,8 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
     a.emplace_back("boundary_nodes", std::to_string(c.nodes));
     a.emplace_back("islands_removed", std::to_string(c.islands_removed));
     a.emplace_back("lakes_removed", std::to_string(c.lakes_removed));
-    a.emplace_back("coast_nodes_merged", std::to_string(c.close_nodes_merged));
+    a.emplace_back("coast_nodes_merged",
+                   std::to_string(c.close_nodes_merged + m.coast_nodes_merged));
     a.emplace_back("coast_repairs", coast_repairs_text(run.coast_repairs));
     a.emplace_back("faces_on_removed_islands", std::to_string(m.island_centroids_left) + " (" +
                                                    std::to_string(m.island_centroids_moved) +

@@ -324,6 +324,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     mo.keep_inland_seas = o.keep_inland_seas;
     mo.close_straits = !o.keep_straits;
     mo.inlet_width = o.inlet_width;
+    mo.close_node_gap = o.close_node_gap;
     mo.close_dead_ends = o.close_dead_ends;
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;

@@ -96,12 +96,36 @@ TEST(CoastReal, a_coast_corner_sharper_than_the_mesh_can_hold_is_blunted) {
 // 0.217 at 29.0E 44.68N without a coast side, each with one corner on the coast (an interior
 // node 0.3 km from a coast node beside a sharp corner). The faces between them and the coast
 // at that corner go first, then the faces themselves.
+// (With the coast's close nodes kept: merged, as by default, the mouth of the Sulina arm behind
+// that corner is one node once its inlet closes, and the faces are not made.)
 TEST(CoastReal, a_face_below_the_floor_with_one_coast_corner_goes_with_the_faces_beside_it) {
-    const MeshOptions o =
-        region_run("coast/hostile/gshhg_i_danube.geojson", {28, 43.5, 30.5, 46}, 25);
+    MeshOptions o = region_run("coast/hostile/gshhg_i_danube.geojson", {28, 43.5, 30.5, 46}, 25);
+    o.close_node_gap = 0;
     const Mesh mesh = mesh_ocean(o).mesh;
     EXPECT_GE(corners_blunted(mesh), 2u);
     expect_valid_mesh(mesh, o, "danube.nc");
+}
+
+// The same coast at 20 and 25 km: the inlet closed at the Sulina arm left its mouth, between the
+// banks' own vertices 0.23 km apart, as a coast segment of h/100, meshed with faces as small (q
+// 0.40 at 20 km; at 25 km the faces of the test above). The coast shaping merges nodes closer
+// than close_node_gap h (1/32), but there the banks were apart. Once the inlets close, such a
+// segment loses an end too: no coast edge is left shorter than h/32.
+TEST(CoastReal, no_coast_edge_is_left_shorter_than_the_close_node_gap_once_the_inlets_close) {
+    for (double h : {20.0, 25.0}) {
+        SCOPED_TRACE("--hmax " + std::to_string(h) + " km");
+        const MeshOptions o =
+            region_run("coast/hostile/gshhg_i_danube.geojson", {28, 43.5, 30.5, 46}, h);
+        const Mesh mesh = mesh_ocean(o).mesh;
+        EXPECT_GE(count_attribute(mesh, "coast_nodes_merged"), 1u);
+        double shortest_km = 1e300;
+        for (const BoundaryEdge &b : mesh.boundary)
+            if (b.tag == EdgeTag::coast)
+                shortest_km = std::min(shortest_km, arc_angle(mesh.nodes[b.a], mesh.nodes[b.b]) *
+                                                        earth_radius_km);
+        EXPECT_GE(shortest_km, h / 32);
+        expect_valid_mesh(mesh, o, "danube.nc");
+    }
 }
 
 // GSHHG high around the Yangtze mouth (land clipped to 120..124E, 30..33N, meshed in a wider

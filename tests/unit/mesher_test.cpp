@@ -20,6 +20,7 @@
 #include "globemesh/pipeline.hpp"
 #include "globemesh/sizefield.hpp"
 #include "globemesh/ugrid.hpp"
+#include "ring_through.hpp"
 #include "support.hpp"
 
 using namespace globemesh;
@@ -888,20 +889,7 @@ TEST(Mesher, boundary_nodes_slide_only_near_the_source_coast_and_make_no_corner_
 
 namespace {
 
-// A ring through lon/lat corners, land on its right (ocean on the left), each side cut into
-// pieces of at most `step` degrees.
-Ring ring_through(const std::vector<LonLat> &corners, double step = 0.8) {
-    Ring r;
-    for (std::size_t i = 0; i < corners.size(); ++i) {
-        const LonLat a = corners[i], b = corners[(i + 1) % corners.size()];
-        const int n = std::max(1, int(std::ceil(std::hypot(b.lon - a.lon, b.lat - a.lat) / step)));
-        for (int k = 0; k < n; ++k)
-            r.nodes.push_back(
-                lonlat_to_vec(a.lon + (b.lon - a.lon) * k / n, a.lat + (b.lat - a.lat) * k / n));
-    }
-    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
-    return r;
-}
+using test::ring_through;
 
 // Faces whose centroid lies in the lon/lat box.
 std::size_t faces_in(const Mesh &m, double w, double s, double e, double n) {

@@ -1174,7 +1174,8 @@ TEST(MesherProperty, hostile_coast_seed_32_meshes_in_bounded_time) {
 namespace {
 /// Meshes case c from its GeoJSON (a file named `name`) with the coast's land, its straits
 /// closed whatever the case asks; its shaped boundary must be valid. `as_made`: without the
-/// closings that came after the case was made (dead ends, pieces apart), which close its water.
+/// closings that came after the case was made (dead ends, pieces apart), which close its water,
+/// and without the merge of close coast nodes once the inlets close, which reshapes its coast.
 void mesh_with_land(CoastCase c, const std::string &name, Mesh &mesh, MesherReport &report,
                     bool as_made = false) {
     MemFile file(name, c.json);
@@ -1190,6 +1191,8 @@ void mesh_with_land(CoastCase c, const std::string &name, Mesh &mesh, MesherRepo
     mo.lattice_km = c.h;
     mo.close_dead_ends = !as_made;
     mo.close_pieces_apart = !as_made;
+    if (as_made)
+        mo.close_node_gap = 0;
     mesh = mesh_boundary(boundary, size, mo, &report);
 }
 } // namespace
