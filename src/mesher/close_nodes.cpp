@@ -230,21 +230,30 @@ private:
         // land on its right. (With no neighbour on a side, the segment was a side of the rim and
         // the triangle there lies outside.)
         const HalfEdge joined = dt.find_edge(dt.leaving(s.prev), s.next);
-        if (!s.ocean_side.empty())
-            label_within_constraints(triangle_of(joined), ocean);
-        if (!s.land_side.empty())
-            label_within_constraints(triangle_of(dt.twin(joined)), land);
+        // The hole holds two triangles fewer than v had spokes.
+        const std::size_t hole = s.spokes.size() - 2;
+        const std::size_t labelled =
+            (s.ocean_side.empty() ? 0
+                                  : label_within_constraints(triangle_of(joined), ocean, hole)) +
+            (s.land_side.empty()
+                 ? 0
+                 : label_within_constraints(triangle_of(dt.twin(joined)), land, hole));
+        if (labelled != hole)
+            throw DataError("internal: merging close coast nodes near " +
+                            Mesher::describe(dt.point(s.v)) +
+                            " left a hole not closed in; please report this");
         free_rim();
         dt.set_constrained(joined, true); // when it was a side of the rim
         dt.make_delaunay(rim);
         return true;
     }
 
-    // Labels `seed` and every triangle reached from it across unconstrained edges.
-    void label_within_constraints(TriangleId seed, std::uint8_t label) {
+    // Labels `seed` and every triangle reached from it across unconstrained edges, up to `most`
+    // of them (the hole's; more means it is not closed in); returns how many.
+    std::size_t label_within_constraints(TriangleId seed, std::uint8_t label, std::size_t most) {
         std::vector<TriangleId> stack{seed};
         std::vector<TriangleId> seen{seed};
-        while (!stack.empty()) {
+        while (!stack.empty() && seen.size() <= most) {
             const TriangleId t = stack.back();
             stack.pop_back();
             dt.set_label(t, label);
@@ -257,6 +266,7 @@ private:
                 stack.push_back(nb);
             }
         }
+        return seen.size();
     }
 
     Mesher &m;
