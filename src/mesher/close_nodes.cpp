@@ -27,11 +27,19 @@ public:
     CloseNodes(Mesher &m, const MesherOptions &options)
         : m(m), dt(m.dt), options(options), gone(dt.vertex_count(), 0) {}
 
-    // Passes until no merge is left: a merge can make the next segment along short too.
+    // Passes until no merge is left: a merge can make the next segment along short too. After
+    // the first pass over every segment, only the segments a merge made and the short ones
+    // left are looked at again: no other segment changed.
     std::size_t run() {
+        std::vector<std::pair<VertexId, VertexId>> look_at = m.directed;
         std::size_t merged = 0;
-        for (std::size_t pass = merged_in_pass(); pass > 0; pass = merged_in_pass())
+        for (std::size_t pass = merged_in_pass(look_at); pass > 0; pass = merged_in_pass(look_at))
             merged += pass;
+        auto involves_gone = [&](const std::pair<VertexId, VertexId> &d) {
+            return gone[d.first] || gone[d.second];
+        };
+        m.directed.erase(std::remove_if(m.directed.begin(), m.directed.end(), involves_gone),
+                         m.directed.end());
         return merged;
     }
 
@@ -41,10 +49,12 @@ private:
         VertexId a, b; // the coast segment a -> b, ocean on its left
     };
 
-    std::size_t merged_in_pass() {
+    // Merges along the short live segments of `look_at`, shortest first; leaves in it the
+    // segments to look at in the next pass.
+    std::size_t merged_in_pass(std::vector<std::pair<VertexId, VertexId>> &look_at) {
         std::vector<Short> shorts;
         TriangleId hint = no_triangle;
-        for (const auto &[a, b] : m.directed) {
+        for (const auto &[a, b] : look_at) {
             if (gone[a] || gone[b])
                 continue;
             const HalfEdge h = dt.find_edge(dt.leaving(a, hint), b);
@@ -63,6 +73,7 @@ private:
                 return x.length < y.length;
             return x.a != y.a ? x.a < y.a : x.b < y.b;
         });
+        const std::size_t made_from = m.directed.size(); // the segments merges add follow
         std::size_t merged = 0;
         for (const Short &s : shorts) {
             if (gone[s.a] || gone[s.b])
@@ -73,18 +84,14 @@ private:
             const double move_a = a_can ? distance_to_new(at_a) : 1e300;
             const double move_b = b_can ? distance_to_new(at_b) : 1e300;
             const bool a_first = move_a <= move_b;
-
             if ((a_first ? a_can && drop(at_a) : b_can && drop(at_b)) ||
                 (a_first ? b_can && drop(at_b) : a_can && drop(at_a)))
                 ++merged;
         }
-        if (merged > 0) {
-            auto involves_gone = [&](const std::pair<VertexId, VertexId> &d) {
-                return gone[d.first] || gone[d.second];
-            };
-            m.directed.erase(std::remove_if(m.directed.begin(), m.directed.end(), involves_gone),
-                             m.directed.end());
-        }
+        look_at.assign(m.directed.begin() + std::ptrdiff_t(made_from), m.directed.end());
+        for (const Short &s : shorts)
+            if (!gone[s.a] && !gone[s.b])
+                look_at.emplace_back(s.a, s.b);
         return merged;
     }
 
