@@ -176,18 +176,22 @@ void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, Mes
         for (int k = 1; k < 3; ++k)
             parent[find(f[k])] = r;
     }
-    std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
-    for (const NodeIndex n : cut_nodes)
-        area.emplace(find(n), 0.0);
+    // Each node's root once, in place (roots stay roots): the passes over the faces read it.
+    for (NodeIndex i = 0; i < parent.size(); ++i)
+        parent[i] = find(i);
     std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
     for (const auto &f : mesh.faces)
-        ++faces_of[find(f[0])];
+        ++faces_of[parent[f[0]]];
     const NodeIndex largest = static_cast<NodeIndex>(
         std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
-    area.erase(largest);
+    std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
+    std::vector<char> beside_cut(mesh.nodes.size(), 0);
+    for (const NodeIndex n : cut_nodes)
+        if (parent[n] != largest)
+            area.emplace(parent[n], 0.0), beside_cut[parent[n]] = 1;
     for (const auto &f : mesh.faces)
-        if (auto it = area.find(find(f[0])); it != area.end())
-            it->second +=
+        if (beside_cut[parent[f[0]]])
+            area[parent[f[0]]] +=
                 spherical_triangle_area(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]);
     for (const auto &[r, a] : area)
         report.seas_cut_off.push_back(a * earth_radius_km * earth_radius_km);
