@@ -12,7 +12,9 @@
 //      average than inlet_width * h and under 25 h^2; repeated, so a dead-end channel closes
 //      whole), which no triangle of size h could fill but slivers; then a coast segment shorter
 //      than close_node_gap * h (a closed mouth between the source's own vertices) loses one end
-//      where the segment joining its neighbours crosses nothing;
+//      where the segment joining its neighbours crosses nothing, and one shorter than
+//      inlet_width * h / 2 where that end then lies within close_node_gap * h of the new
+//      segment and begins no ocean chord as short;
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a
@@ -100,7 +102,8 @@ struct MesherOptions {
     double inlet_width = 0.5;      ///< close inlets narrower than this times h (0: none)
     double inlet_area = 1.0; ///< ... holding at most this times h^2 of water (or narrow on average)
     /// Once the inlets have closed, a coast segment shorter than this times h (a closed mouth
-    /// between the source's own vertices) loses one of its ends (CoastOptions::close_node_gap).
+    /// between the source's own vertices) loses one of its ends (CoastOptions::close_node_gap);
+    /// one shorter than inlet_width h / 2 loses an end that moves the coast by less. 0: none.
     double close_node_gap = 1.0 / 32;
     std::uint64_t seed = 1; ///< seed of the core's insertion order
     /// The size field's largest value (km): where the field reaches it, away from the boundary,
@@ -163,7 +166,7 @@ struct MesherReport {
     std::size_t inlets_closed =
         0; ///< closings (MesherOptions::inlet_width; a long channel may take several)
     double inlet_area_km2 = 0;          ///< the water they held
-    std::size_t coast_nodes_merged = 0; ///< ends of coast segments shorter than close_node_gap h
+    std::size_t coast_nodes_merged = 0; ///< ends of short coast segments (close_node_gap)
     std::size_t lattice_nodes = 0;      ///< nodes from the lattice (MesherOptions::lattice_km)
     std::size_t lattice_patched =
         0; ///< of which placed with their lattice triangles, not inserted one by one

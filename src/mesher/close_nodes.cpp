@@ -47,6 +47,7 @@ private:
     struct Short {
         double length;
         VertexId a, b; // the coast segment a -> b, ocean on its left
+        bool tiny;     // under close_node_gap h
     };
 
     // Merges along the short live segments of `look_at`, shortest first; leaves in it the
@@ -65,8 +66,9 @@ private:
                 continue; // a closed inlet's segment, land on both sides
             const Vec3 &p = dt.point(a), &q = dt.point(b);
             const double length = arc_angle(p, q);
-            if (length < options.close_node_gap * km_to_rad(m.size_km(arc_midpoint(p, q))))
-                shorts.push_back({length, a, b});
+            const double size = km_to_rad(m.size_km(arc_midpoint(p, q)));
+            if (length < trigger() * size)
+                shorts.push_back({length, a, b, length < options.close_node_gap * size});
         }
         std::sort(shorts.begin(), shorts.end(), [](const Short &x, const Short &y) {
             if (x.length != y.length)
@@ -80,7 +82,8 @@ private:
                 continue;
             // Of the two ends, the one nearer the segment that replaces it goes; else the other.
             Star at_a, at_b;
-            const bool a_can = star_of(s.a, at_a), b_can = star_of(s.b, at_b);
+            const bool a_can = star_of(s.a, at_a) && (s.tiny || may_go(at_a)),
+                       b_can = star_of(s.b, at_b) && (s.tiny || may_go(at_b));
             const double move_a = a_can ? distance_to_new(at_a) : 1e300;
             const double move_b = b_can ? distance_to_new(at_b) : 1e300;
             const bool a_first = move_a <= move_b;
@@ -93,6 +96,25 @@ private:
             if (!gone[s.a] && !gone[s.b])
                 look_at.emplace_back(s.a, s.b);
         return merged;
+    }
+
+    // The segments looked at: under close_node_gap h, or under the dead ends' short chord.
+    double trigger() const {
+        return std::max(options.close_node_gap, short_chord * options.inlet_width);
+    }
+
+    // An end of a segment no shorter than close_node_gap h goes only where the coast moves by
+    // less (the new segment passes within close_node_gap h of it), and where it ends no ocean
+    // chord under the short chord to another coast node: the mouth the dead ends close by.
+    bool may_go(const Star &s) const {
+        const double h = km_to_rad(m.size_km(dt.point(s.v)));
+        if (distance_to_new(s) >= options.close_node_gap * h)
+            return false;
+        // Every node of the triangulation is a boundary node yet (the lattice and the
+        // refinement come later): a spoke to the ocean side is a chord between two of them.
+        return std::none_of(s.ocean_side.begin(), s.ocean_side.end(), [&](VertexId w) {
+            return arc_angle(dt.point(w), dt.point(s.v)) < short_chord * options.inlet_width * h;
+        });
     }
 
     double distance_to_new(const Star &s) const {
@@ -288,7 +310,9 @@ private:
 // source's own vertices (the shaping keeps them where the river's banks would touch): a
 // segment of metres to hundreds of metres at a size of kilometres, which the refinement then
 // meshes with faces as small. Such a segment, shorter than close_node_gap times the size, loses
-// one of its ends, as the coast shaping merges its nodes (CoastOptions::close_node_gap).
+// one of its ends, as the coast shaping merges its nodes (CoastOptions::close_node_gap). So does
+// one under the dead ends' short chord (a quarter of the size) where the coast moves by less
+// than close_node_gap h: the source's vertices along a lagoon's spit or a river's bank.
 std::size_t merge_close_coast_nodes(Mesher &m, const MesherOptions &options) {
     if (options.close_node_gap <= 0)
         return 0;

@@ -8,10 +8,9 @@ namespace globemesh::mesher_internal {
 
 namespace {
 
-// A chord across water this short against the inlet width closes by the inlet rule wherever it
-// is, not only beside a closing: the mouth of a stub the refinement and the land removals left,
-// meshed with faces hundreds of metres across at a size of kilometres.
-constexpr double short_chord = 0.5;
+// A chord under short_chord inlet_width h (mesher_state.hpp) closes by the inlet rule wherever
+// it is, not only beside a closing: the mouth of a stub the refinement and the land removals
+// left, meshed with faces hundreds of metres across at a size of kilometres.
 
 struct Chord {
     double length;

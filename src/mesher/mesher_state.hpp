@@ -476,6 +476,10 @@ void recover_segments(Mesher &m, const Boundary &boundary, const std::vector<Ver
 // reserved for them.
 void classify_ocean(Mesher &m, const Boundary &boundary, const MesherOptions &options);
 void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report);
+// A chord across water this short against the inlet width closes by the inlet rule wherever it
+// is (dead_ends.cpp); a coast segment as short loses an end where the coast moves little
+// (close_nodes.cpp).
+constexpr double short_chord = 0.5;
 std::size_t merge_close_coast_nodes(Mesher &m, const MesherOptions &options);
 void mark_sharp_corners(Mesher &m);
 // reserve: size the triangulation for them (not for a triangulation only counted, parts.cpp).

@@ -3,6 +3,7 @@
 // the ocean on one side only, every unconstrained edge between two triangles of one label.
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -139,6 +140,55 @@ TEST(CloseNodes, the_seas_meshed_whole_keep_their_area_without_the_node) {
         write_ugrid(mesh, dir / "merged.nc");
         test::expect_mesh_verify(dir / "merged.nc");
     }
+}
+
+// A sea like sea_with's whose cape node has its neighbours 2.5 km either side (h/8 at 20 km),
+// `off` degrees into the sea; with `islet`, a 2.2 km square island whose west corners lie 2.4 km
+// from the cape (ocean chords under h/4: the mouth between them would close as a dead end).
+Boundary cape_with(double off, bool islet) {
+    Boundary b;
+    b.rings.push_back(ring_through({{0, 2},
+                                    {0.3, 0.3},
+                                    {0, 0.0225},
+                                    {off, 0},
+                                    {0, -0.0225},
+                                    {0.3, -0.3},
+                                    {0, -2},
+                                    {4, -2},
+                                    {4, 2}}));
+    if (islet)
+        b.rings.push_back(ring_through({{0.02, 0.01}, {0.04, 0.01}, {0.04, -0.01}, {0.02, -0.01}}));
+    return b;
+}
+
+// The merges of the mesher's stages up to them, and whether the node at (off, 0) is gone.
+std::pair<std::size_t, bool> merged_at(const Boundary &b, double off) {
+    const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
+    MesherReport report;
+    const MesherOptions options; // inlet_width 0.5: the short chord h/4
+    Mesher m(SphericalDelaunay::Options{1e-12, 1}, size, report);
+    const std::vector<VertexId> ids = insert_boundary(m, b);
+    recover_segments(m, b, ids);
+    classify_ocean(m, b, options);
+    const std::size_t merged = merge_close_coast_nodes(m, options);
+    const std::vector<std::string> after = problems(m);
+    EXPECT_TRUE(after.empty()) << after.size() << " problems, first: " << after.front();
+    const Vec3 p = lonlat_to_vec(off, 0);
+    for (VertexId k = 0; k < m.dt.vertex_count(); ++k)
+        if (m.dt.point(k) == p)
+            return {merged, m.dt.vertex_half_edges()[k] == no_half_edge};
+    ADD_FAILURE() << "no node at the cape";
+    return {merged, false};
+}
+
+TEST(CloseNodes, a_segment_under_h_over_4_loses_an_end_where_the_coast_moves_under_h_over_32) {
+    // 55 m off its neighbours' line (under h/32 = 625 m): it goes, though its segments are
+    // 2.5 km long (four times h/32).
+    EXPECT_EQ(merged_at(cape_with(0.0005, false), 0.0005), std::make_pair(std::size_t(1), true));
+    // 890 m off: the coast would move by more than h/32; no end of either segment goes.
+    EXPECT_EQ(merged_at(cape_with(0.008, false), 0.008), std::make_pair(std::size_t(0), false));
+    // 55 m off, but beginning 2.4 km chords to the islet: kept for the dead ends to close.
+    EXPECT_EQ(merged_at(cape_with(0.0005, true), 0.0005), std::make_pair(std::size_t(0), false));
 }
 
 } // namespace
