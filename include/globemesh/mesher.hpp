@@ -197,6 +197,11 @@ struct MesherReport {
     /// Where the width is 0: the sampling's finest spacing (km), which the passage is narrower
     /// than.
     std::vector<double> straits_closed_width_below_km;
+    /// The place of each closing: closings less than the size apart, in a chain, are one place
+    /// (a channel narrower than its faces closes at many points along it). Numbered from 0 in
+    /// the order of each place's first closing.
+    std::vector<std::uint32_t> straits_closed_place;
+    std::size_t straits_closed_places = 0;
     std::vector<double> seas_cut_off; ///< km2 of each basin those closings cut off (kept)
     /// The nodes beside those closings' cuts: mesh_parts tells the basins on the joined mesh, a
     /// part's own pieces reaching the ocean through another part.

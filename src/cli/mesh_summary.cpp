@@ -1,5 +1,7 @@
 // The summary and the --report JSON of a `mesh` run (mesh_summary.hpp).
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -58,30 +60,50 @@ void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, boo
 /// The cells a strait needs across to stay open (the size it needs: its width over this).
 constexpr double strait_cells = 2;
 
-/// The summary's lines of the closed straits: each place, its width and the size it needs.
+/// Each closing's place (MesherReport::straits_closed_place), each its own where not grouped.
+std::uint32_t place_of(const MesherReport &m, std::size_t i) {
+    return m.straits_closed_place.size() == m.straits_closed_at.size()
+               ? m.straits_closed_place[i]
+               : static_cast<std::uint32_t>(i);
+}
+
+/// The summary's lines of the closed straits: the first six places, each by its narrowest
+/// closing (its width and the size it needs), with how many closings it holds.
 void print_straits(std::ostream &out, const MesherReport &m) {
     constexpr std::size_t shown = 6;
-    for (std::size_t i = 0; i < m.straits_closed_at.size() && i < shown; ++i) {
-        const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
-        char line[160];
-        const double w = m.straits_closed_width_km[i];
-        if (w == 0) {
-            const std::string below = report_number(m.straits_closed_width_below_km[i]);
-            std::snprintf(line, sizeof line,
-                          "                  at %.2f %.2f, under %s km wide: needs h < %s km\n",
-                          ll.lon, ll.lat, below.c_str(),
-                          report_number(m.straits_closed_width_below_km[i] / strait_cells).c_str());
-            out << line;
-            continue;
-        }
-        std::snprintf(line, sizeof line,
-                      "                  at %.2f %.2f, %s km wide: needs h <= %s km\n", ll.lon,
-                      ll.lat, report_number(w).c_str(), report_number(w / strait_cells).c_str());
-        out << line;
+    const std::size_t n = m.straits_closed_at.size();
+    std::size_t places = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        places = std::max<std::size_t>(places, place_of(m, i) + 1);
+    // A width under the sampling is narrower than its bound.
+    auto bound = [&](std::size_t i) {
+        return m.straits_closed_width_km[i] > 0 ? m.straits_closed_width_km[i]
+                                                : m.straits_closed_width_below_km[i];
+    };
+    std::vector<std::size_t> narrowest(places, n), closings(places, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t p = place_of(m, i);
+        ++closings[p];
+        if (narrowest[p] == n || bound(i) < bound(narrowest[p]))
+            narrowest[p] = i;
     }
-    if (m.straits_closed_at.size() > shown)
-        out << "                  ... " << m.straits_closed_at.size() - shown
-            << " more (all in --report's straits_closed; the first in straits_closed_at)\n";
+    for (std::size_t p = 0; p < places && p < shown; ++p) {
+        const std::size_t i = narrowest[p];
+        const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
+        const double w = m.straits_closed_width_km[i];
+        const std::string width = w > 0
+                                      ? report_number(w) + " km wide: needs h <= "
+                                      : "under " + report_number(bound(i)) + " km wide: needs h < ";
+        const std::string along =
+            closings[p] > 1 ? " (" + std::to_string(closings[p]) + " closings there)" : "";
+        char line[96];
+        std::snprintf(line, sizeof line, "                  at %.2f %.2f, ", ll.lon, ll.lat);
+        out << line << width << report_number(bound(i) / strait_cells) << " km" << along << "\n";
+    }
+    if (places > shown)
+        out << "                  ... " << places - shown
+            << " more places (every closing in --report's straits_closed; the first in "
+               "straits_closed_at)\n";
 }
 
 /// The warning on `err` that straits were closed, and how to keep them.
@@ -89,6 +111,8 @@ void warn_straits(std::ostream &err, const MesherReport &m) {
     err << "globemesh: warning: " << m.straits_closed
         << (m.straits_closed == 1 ? " strait narrower than its faces was closed"
                                   : " straits narrower than their faces were closed")
+        << " at " << m.straits_closed_places
+        << (m.straits_closed_places == 1 ? " place" : " places")
         << " (listed in the summary); keep one open with --passages (a line drawn across it, or "
            "'default' for the world's critical passages) or --size-regions (h at most half its "
            "width there), every channel with --feature-size 3, or all with --keep-straits\n";
@@ -106,7 +130,8 @@ std::string straits_json(const MesherReport &m) {
              ", \"lat\": " + json_number(ll.lat) +
              ", \"width_km\": " + (w > 0 ? json_number(w) : std::string("null")) +
              (w > 0 ? "" : ", \"width_below_km\": " + json_number(below)) +
-             ", \"size_needed_km\": " + json_number(bound / strait_cells) + "}";
+             ", \"size_needed_km\": " + json_number(bound / strait_cells) +
+             ", \"place\": " + std::to_string(place_of(m, i)) + "}";
     }
     return r + "]";
 }

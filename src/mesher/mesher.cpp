@@ -83,6 +83,7 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     close_cut_off_pieces(m, options, report);
     if (options.land)
         measure_closed_straits(m, *options.land, report);
+    group_closed_straits(size_km, report);
 
     // Conversion to Mesh (output.cpp); a part's border nodes stay whole for the join.
     keep_border_nodes_whole(m, options.lattice_within);

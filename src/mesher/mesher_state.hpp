@@ -509,6 +509,8 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made, std::vector<std
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
 /// Fills report.straits_closed_width_km from report.straits_closed_at (straits.cpp).
 void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport &report);
+/// Fills report.straits_closed_place(s) from report.straits_closed_at (straits.cpp).
+void group_closed_straits(const SizeFn &size_km, MesherReport &report);
 // The same search for the free nodes of the faces below q 0.3 that the land and corner stages
 // leave (their nodes moved or their neighbours removed after improve_quality). Returns whether
 // no ocean face is left below it.

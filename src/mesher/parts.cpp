@@ -255,7 +255,8 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     const std::size_t estimated = report.estimated_nodes;
     for (const MesherReport &r : reports)
         add_report(report, r);
-    report.estimated_nodes = estimated; // the whole ocean's, as one part counts it
+    report.estimated_nodes = estimated;    // the whole ocean's, as one part counts it
+    group_closed_straits(size_km, report); // a place may reach across a border
     // Each stage's seconds summed over the parts (the parts ran at once: more than its wall time).
     if (timings) {
         StageTimings summed;

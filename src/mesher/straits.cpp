@@ -133,6 +133,43 @@ void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport 
     }
 }
 
+// Closings in a chain of steps each shorter than the size (the larger of its two ends') are one
+// place: union-find over the pairs, found in order of z within the largest size.
+void group_closed_straits(const SizeFn &size_km, MesherReport &report) {
+    const std::vector<Vec3> &at = report.straits_closed_at;
+    const std::size_t n = at.size();
+    std::vector<double> h(n);
+    double most = 0;
+    for (std::size_t i = 0; i < n; ++i)
+        most = std::max(most, h[i] = km_to_rad(size_km(at[i])));
+    std::vector<std::size_t> by_z(n), root(n);
+    for (std::size_t i = 0; i < n; ++i)
+        by_z[i] = root[i] = i;
+    std::sort(by_z.begin(), by_z.end(), [&](std::size_t a, std::size_t b) {
+        return at[a].z != at[b].z ? at[a].z < at[b].z : a < b;
+    });
+    auto find = [&](std::size_t i) {
+        while (root[i] != i)
+            i = root[i] = root[root[i]];
+        return i;
+    };
+    for (std::size_t k = 0; k < n; ++k)
+        for (std::size_t l = k + 1; l < n && at[by_z[l]].z - at[by_z[k]].z < most; ++l) {
+            const std::size_t i = by_z[k], j = by_z[l];
+            if (arc_angle(at[i], at[j]) < std::max(h[i], h[j]))
+                root[find(i)] = find(j);
+        }
+    std::vector<std::uint32_t> place_of_root(n, UINT32_MAX);
+    report.straits_closed_place.assign(n, 0);
+    report.straits_closed_places = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t &place = place_of_root[find(i)];
+        if (place == UINT32_MAX)
+            place = static_cast<std::uint32_t>(report.straits_closed_places++);
+        report.straits_closed_place[i] = place;
+    }
+}
+
 void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces) {
     MesherReport &report = m.report;
     std::vector<TriangleId> left;

@@ -26,8 +26,11 @@ std::string land_faces_text(const MesherReport &r) {
 }
 
 std::string straits_closed_text(const MesherReport &r) {
-    std::string closed = std::to_string(r.straits_closed) + " (cutting off " +
-                         std::to_string(r.seas_cut_off.size()) + " basins";
+    std::string closed = std::to_string(r.straits_closed);
+    if (r.straits_closed > 0)
+        closed += " at " + std::to_string(r.straits_closed_places) +
+                  (r.straits_closed_places == 1 ? " place" : " places");
+    closed += " (cutting off " + std::to_string(r.seas_cut_off.size()) + " basins";
     for (std::size_t i = 0; i < r.seas_cut_off.size(); ++i)
         closed += (i ? ", " : ": ") + report_number(r.seas_cut_off[i]) + " km2";
     return closed + "; " + report_number(r.straits_water_km2) + " km2 of water closed with them; " +

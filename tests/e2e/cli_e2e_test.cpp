@@ -111,11 +111,12 @@ TEST(CliE2e, global_mesh_writes_every_output_and_the_report_matches_the_file) {
         &holes))
         << out;
     ASSERT_TRUE(globemesh::test::regex_search(
-        out, R"(\nstraits closed +(\d+) \(cutting off \d+ basins.*; (\d+) nodes split\)\n +at )",
+        out,
+        R"(\nstraits closed +(\d+) at (\d+) places? \(cutting off \d+ basins.*; (\d+) nodes split\)\n +at )",
         &straits))
         << out;
     const int loops = std::stoi(rings[1]) + std::stoi(holes[1]) - std::stoi(holes[2]);
-    const int loops_at_most = loops + std::stoi(straits[1]) + std::stoi(straits[2]);
+    const int loops_at_most = loops + std::stoi(straits[1]) + std::stoi(straits[3]);
     // Exactly the outputs asked for: no temporary file left beside them.
     EXPECT_EQ(files_in(dir.path()),
               (std::set<std::string>{"g.nc", "g.gpkg", "g.png", "r.json", "t.json"}));
@@ -148,6 +149,11 @@ assert )" + std::to_string(loops) + R"( <= r['mesh']['boundary_loops'] <= )" +
 # The run's attributes, as in the NetCDF file's global attributes.
 for k in ('coast_file', 'boundary_rings', 'faces_on_land', 'inlets_closed', 'straits_closed', 'straits_closed_at'):
     assert r['attributes'][k] == ds.getncattr(k), (k, r['attributes'].get(k), ds.getncattr(k))
+# Every closing has a place, the places numbered 0 .. the summary's count - 1 as they first come.
+places = [c['place'] for c in r['straits_closed']]
+assert len(places) == )" + straits[1] + R"( and sorted(set(places)) == list(range()" +
+                                           straits[2] + R"()), places
+assert all(p <= max(places[:i], default=-1) + 1 for i, p in enumerate(places)), places
 print('OK', lon.shape[0])
 )",
                                        dir.path());

@@ -76,6 +76,7 @@ TEST(OceanMesh, the_file_metadata_is_formatted_from_the_typed_reports) {
     run.mesher.land_faces_at = {lonlat_to_vec(10, 20), lonlat_to_vec(-30.5, -40.25)};
     run.straits_closing = true;
     run.mesher.straits_closed = 1;
+    run.mesher.straits_closed_places = 1;
     run.mesher.seas_cut_off = {436000, 39000};
     run.mesher.straits_water_km2 = 12.5;
     run.mesher.inlets_closed = 4;
@@ -102,7 +103,7 @@ TEST(OceanMesh, the_file_metadata_is_formatted_from_the_typed_reports) {
               "2 (10 removed, opening 0 holes, joining 0 loops, 0 moved off)");
     EXPECT_EQ(value("faces_on_land_at"), "10.00 20.00, -30.50 -40.25");
     EXPECT_EQ(value("straits_closed"),
-              "1 (cutting off 2 basins: 436000 km2, 39000 km2; 12.5 km2 of water "
+              "1 at 1 place (cutting off 2 basins: 436000 km2, 39000 km2; 12.5 km2 of water "
               "closed with them; 0 nodes split)");
     EXPECT_EQ(value("straits_closed_at"), "(none)"); // no place given
     EXPECT_EQ(value("ocean_area_km2"), "1.23457e+06");
