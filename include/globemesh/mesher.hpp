@@ -14,7 +14,7 @@
 //      than close_node_gap * h (a closed mouth between the source's own vertices) loses one end
 //      where the segment joining its neighbours crosses nothing, and one shorter than
 //      inlet_width * h / 2 where that end then lies within close_node_gap * h of the new
-//      segment and begins no ocean chord as short;
+//      segment, is no corner of a closed inlet's mouth and begins no ocean chord as short;
 //   4. refines by Delaunay refinement: the triangle whose circumradius is largest against the
 //      local target (an equilateral triangle of side h has circumradius h/sqrt(3)) or whose
 //      radius-edge ratio is worst gets a new node at its circumcentre; a circumcentre beyond a

@@ -104,11 +104,13 @@ private:
     }
 
     // An end of a segment no shorter than close_node_gap h goes only where the coast moves by
-    // less (the new segment passes within close_node_gap h of it), and where it ends no ocean
-    // chord under the short chord to another coast node: the mouth the dead ends close by.
+    // less (the new segment passes within close_node_gap h of it), where it is no corner of a
+    // closed inlet's mouth (a segment with land on both sides at it: the mouth would move and
+    // the inlet's bank come out, its source vertices metres apart), and where it begins no
+    // ocean chord under the short chord to another coast node (a mouth the dead ends close by).
     bool may_go(const Star &s) const {
         const double h = km_to_rad(m.size_km(dt.point(s.v)));
-        if (distance_to_new(s) >= options.close_node_gap * h)
+        if (distance_to_new(s) >= options.close_node_gap * h || s.constrained.size() > 2)
             return false;
         // Every node of the triangulation is a boundary node yet (the lattice and the
         // refinement come later): a spoke to the ocean side is a chord between two of them.

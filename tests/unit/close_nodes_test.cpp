@@ -191,5 +191,35 @@ TEST(CloseNodes, a_segment_under_h_over_4_loses_an_end_where_the_coast_moves_und
     EXPECT_EQ(merged_at(cape_with(0.0005, true), 0.0005), std::make_pair(std::size_t(0), false));
 }
 
+// A sea at h = 20 km whose coast at x = 0 has an inlet 3 km wide and 10 km long (it closes: under
+// h/2 wide, under h^2 of water); its mouth's corners lie 20 m off the line of their neighbours
+// along the closed coast (those 5.2 km away, over h/4), the mouth 3 km long (under h/4).
+TEST(CloseNodes, a_closed_inlets_mouth_keeps_its_corners) {
+    Boundary b;
+    b.rings.push_back(ring_through({{0, 2},
+                                    {0.0005, 0.06},
+                                    {0, 0.0135},
+                                    {-0.09, 0.0135},
+                                    {-0.09, -0.0135},
+                                    {0, -0.0135},
+                                    {0.0005, -0.06},
+                                    {0, -2},
+                                    {4, -2},
+                                    {4, 2}}));
+    const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
+    MesherReport report;
+    const MesherOptions options;
+    Mesher m(SphericalDelaunay::Options{1e-12, 1}, size, report);
+    const std::vector<VertexId> ids = insert_boundary(m, b);
+    recover_segments(m, b, ids);
+    classify_ocean(m, b, options);
+    close_inlets(m, options, report);
+    ASSERT_EQ(report.inlets_closed, 1u);
+    // Moving a corner would move the mouth and bring the inlet's bank out as coast.
+    EXPECT_EQ(merge_close_coast_nodes(m, options), 0u);
+    const std::vector<std::string> after = problems(m);
+    EXPECT_TRUE(after.empty()) << after.size() << " problems, first: " << after.front();
+}
+
 } // namespace
 } // namespace globemesh::mesher_internal
