@@ -7,6 +7,8 @@
 # counts wrote the same file (every variable and attribute but the history line, which holds
 # the date and the command line: tools/same-outputs compare) and mesh-verify's verdict.
 #   bench/parallel.sh GLOBEMESH [ROUNDS] [GSHHG_LOW_GPKG] [PARTS]
+# AQUA_HMAX and GSHHG_HMAX (default 24km and 20km: about 1e6 nodes each) set the sizes: 12km and
+# 10km give about 4.2e6 and 4.3e6 nodes, where --parts 0 meshes in two parts.
 set -euo pipefail
 exe=$(realpath "$1") rounds=${2:-1} gshhg=${3:-/tmp/gshhg/l.gpkg} parts=${4:-2}
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -20,8 +22,8 @@ printf '%-7s %5s %-9s %9s %6s %7s %6s %5s %6s %7s %6s %7s %6s %s\n' case round r
     load q_min q_mean "q>0.8" fit_med fit_in verify
 for r in $(seq "$rounds"); do
     for c in aqua gshhg_l; do
-        if [ $c = aqua ]; then args=(--coast "$work/aqua.geojson" --hmax 24km); else
-            args=(--coast "$gshhg" --coast-layer land --hmax 20km); fi
+        if [ $c = aqua ]; then args=(--coast "$work/aqua.geojson" --hmax "${AQUA_HMAX:-24km}"); else
+            args=(--coast "$gshhg" --coast-layer land --hmax "${GSHHG_HMAX:-20km}"); fi
         for run in p1 "p$parts-t1" "p$parts-t2"; do
             p=${run#p}; p=${p%-t*}; t=${run##*-t}; [ "$run" = p1 ] && t=2
             mkdir -p "$work/$run"

@@ -130,14 +130,76 @@ free_zone_stars(const Mesh &mesh, const std::vector<char> &zone,
 
 } // namespace
 
+FaceOfEdge::FaceOfEdge(std::size_t edges) {
+    std::size_t slots = 16;
+    while (slots < 4 * edges)
+        slots *= 2;
+    keys_.assign(slots, empty);
+    faces_.assign(slots, 0);
+    mask_ = slots - 1;
+}
+
+// The first slot of key's probe (a multiplicative hash of both node indices).
+std::size_t FaceOfEdge::slot(std::uint64_t key) const {
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 20) & mask_;
+}
+
+std::uint32_t *FaceOfEdge::find(std::uint64_t key) {
+    for (std::size_t s = slot(key);; s = (s + 1) & mask_) {
+        if (keys_[s] == key)
+            return &faces_[s];
+        if (keys_[s] == empty)
+            return nullptr;
+    }
+}
+
+void FaceOfEdge::set(std::uint64_t key, std::uint32_t face) {
+    std::size_t reuse = keys_.size(); // the first erased slot on the probe
+    for (std::size_t s = slot(key);; s = (s + 1) & mask_) {
+        if (keys_[s] == key) {
+            faces_[s] = face;
+            return;
+        }
+        if (keys_[s] == erased && reuse == keys_.size())
+            reuse = s;
+        if (keys_[s] == empty) {
+            const std::size_t at = reuse < keys_.size() ? reuse : s;
+            keys_[at] = key, faces_[at] = face;
+            if (at == s && ++filled_ > 3 * (mask_ + 1) / 4)
+                rebuild();
+            return;
+        }
+    }
+}
+
+void FaceOfEdge::rebuild() {
+    std::vector<std::uint64_t> keys(keys_.size(), empty);
+    std::vector<std::uint32_t> faces(faces_.size(), 0);
+    keys.swap(keys_), faces.swap(faces_);
+    filled_ = 0;
+    for (std::size_t s = 0; s < keys.size(); ++s)
+        if (keys[s] != empty && keys[s] != erased)
+            set(keys[s], faces[s]);
+}
+
+void FaceOfEdge::erase(std::uint64_t key) {
+    for (std::size_t s = slot(key);; s = (s + 1) & mask_) {
+        if (keys_[s] == key) {
+            keys_[s] = erased;
+            return;
+        }
+        if (keys_[s] == empty)
+            return;
+    }
+}
+
 /// The face of each directed edge of `faces`, which the flips keep up to date.
 FaceOfEdge faces_of_edges(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
-    FaceOfEdge face_of;
-    face_of.reserve(3 * faces.size());
+    FaceOfEdge face_of(3 * faces.size());
     for (std::uint32_t f : faces) {
         const auto &t = mesh.faces[f];
         for (int i = 0; i < 3; ++i)
-            face_of[edge_key(t[i], t[(i + 1) % 3])] = f;
+            face_of.set(edge_key(t[i], t[(i + 1) % 3]), f);
     }
     return face_of;
 }
@@ -164,10 +226,10 @@ void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, Face
     for (std::size_t budget = 20 * stack.size() + 100; !stack.empty() && budget > 0; --budget) {
         const auto [a, b] = stack.back();
         stack.pop_back();
-        const auto i1 = face_of.find(key(a, b)), i2 = face_of.find(key(b, a));
-        if (i1 == face_of.end() || i2 == face_of.end())
+        const std::uint32_t *i1 = face_of.find(key(a, b)), *i2 = face_of.find(key(b, a));
+        if (!i1 || !i2)
             continue;
-        const std::uint32_t f1 = i1->second, f2 = i2->second;
+        const std::uint32_t f1 = *i1, f2 = *i2;
         const NodeIndex c = third(f1, a, b), d = third(f2, b, a);
         const Vec3 &pa = mesh.nodes[a], &pb = mesh.nodes[b], &pc = mesh.nodes[c],
                    &pd = mesh.nodes[d];
@@ -176,10 +238,10 @@ void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, Face
             continue;
         mesh.faces[f1] = {a, d, c};
         mesh.faces[f2] = {d, b, c};
-        face_of.erase(i1);
+        face_of.erase(key(a, b));
         face_of.erase(key(b, a));
-        face_of[key(a, d)] = f1, face_of[key(d, c)] = f1, face_of[key(c, a)] = f1;
-        face_of[key(d, b)] = f2, face_of[key(b, c)] = f2, face_of[key(c, d)] = f2;
+        face_of.set(key(a, d), f1), face_of.set(key(d, c), f1), face_of.set(key(c, a), f1);
+        face_of.set(key(d, b), f2), face_of.set(key(b, c), f2), face_of.set(key(c, d), f2);
         for (auto e : {std::pair{a, d}, std::pair{d, b}, std::pair{b, c}, std::pair{c, a}})
             stack.push_back(e);
     }

@@ -3,15 +3,35 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "globemesh/mesh.hpp"
 
 namespace globemesh::parts_detail {
 
-/// The face of each directed edge (a << 32 | b), of the zone's faces: the flips keep it.
-using FaceOfEdge = std::unordered_map<std::uint64_t, std::uint32_t>;
+/// The face of each directed edge (a << 32 | b), of the zone's faces: the flips keep it. An open
+/// addressing table (linear probes, erased slots marked): std::unordered_map's node per entry
+/// made the flips and its building most of the join's smoothing time.
+class FaceOfEdge {
+public:
+    /// Room for `edges` entries at a quarter of the slots (a flip erases two and adds two).
+    explicit FaceOfEdge(std::size_t edges = 0);
+    /// The face of `key`, or null.
+    std::uint32_t *find(std::uint64_t key);
+    /// Sets the face of `key` (added where absent).
+    void set(std::uint64_t key, std::uint32_t face);
+    void erase(std::uint64_t key);
+
+private:
+    static constexpr std::uint64_t empty = ~std::uint64_t(0), erased = empty - 1;
+    std::size_t slot(std::uint64_t key) const;
+    /// The live entries again, without the erased slots (when few empty ones are left).
+    void rebuild();
+    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint32_t> faces_;
+    std::size_t mask_ = 0;
+    std::size_t filled_ = 0; // slots not empty: entries and erased ones
+};
 
 /// The faces with a node in the zone: the only ones the flips and smoothing rewrite (a flip
 /// turns two of them into two others of the same four nodes).
