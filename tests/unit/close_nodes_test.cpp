@@ -142,6 +142,30 @@ TEST(CloseNodes, the_seas_meshed_whole_keep_their_area_without_the_node) {
     }
 }
 
+// sea_with's cape with an islet 6 km east of it and a small lake 17 km inland: the hole the
+// cape node leaves has triangles whose circumcircles hold points beyond its rim, so flips would
+// leave it; held constrained, the rim keeps them in (without that, the merge stops with its
+// internal error: its floods reach past the hole).
+TEST(CloseNodes, the_rim_held_keeps_the_flips_in_the_hole) {
+    Boundary b = sea_with(0.0005);
+    b.rings.pop_back(); // sea_with's lake
+    b.rings.push_back(
+        ring_through({{0.055, 0.045}, {0.066, 0.045}, {0.066, 0.034}, {0.055, 0.034}}));
+    b.rings.push_back(
+        ring_through({{-0.16, -0.037}, {-0.16, -0.0395}, {-0.1575, -0.0395}, {-0.1575, -0.037}}));
+    const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
+    MesherReport report;
+    MesherOptions options;
+    options.inlet_width = 0;
+    Mesher m(SphericalDelaunay::Options{1e-12, 1}, size, report);
+    const std::vector<VertexId> ids = insert_boundary(m, b);
+    recover_segments(m, b, ids);
+    classify_ocean(m, b, options);
+    EXPECT_EQ(merge_close_coast_nodes(m, options), 1u);
+    const std::vector<std::string> after = problems(m);
+    EXPECT_TRUE(after.empty()) << after.size() << " problems, first: " << after.front();
+}
+
 // A sea like sea_with's whose cape node has its neighbours 2.5 km either side (h/8 at 20 km),
 // `off` degrees into the sea; with `islet`, a 2.2 km square island whose west corners lie 2.4 km
 // from the cape (ocean chords under h/4: the mouth between them would close as a dead end).
