@@ -425,7 +425,7 @@ public:
                     return false;
                 const Vec3 c = cross(u, w);
                 const double d = dot(p, c);
-                if (d * d >= sin2 * dot(c, c) || arc_distance(u, w, p) >= clearance)
+                if (d * d >= sin2 * dot(c, c) || beyond_ends(u, w, p, c))
                     continue; // far from the arc's circle, or its ends
                 if (dt.is_constrained(e))
                     return false;
@@ -441,6 +441,16 @@ public:
     }
 
 private:
+    // Whether arc u-w (c = u x w) lies the clearance or farther from p, p being nearer than
+    // that to its great circle: p's foot on the circle lies beyond the arc's ends and both ends
+    // are that far (arc_distance's cases, compared as chords: no asin or atan2 per edge, each
+    // lattice point of a part's lune is near a dozen of its border's long edges).
+    bool beyond_ends(const Vec3 &u, const Vec3 &w, const Vec3 &p, const Vec3 &c) const {
+        if (dot(c, c) > 1e-30 && dot(cross(u, p), c) >= 0 && dot(cross(p, w), c) >= 0)
+            return false;
+        return dot(u - p, u - p) >= chord2 && dot(w - p, w - p) >= chord2;
+    }
+
     const SphericalDelaunay &dt;
     const double clearance, sin2, chord2;
     std::vector<TriangleId> seen;
