@@ -163,22 +163,12 @@ std::vector<NodeIndex> write_faces(const Mesher &m, const PinchSplit &split, std
 
 // The pieces are found by union-find over the nodes through the faces.
 void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report) {
-    std::vector<NodeIndex> parent(mesh.nodes.size());
-    for (NodeIndex i = 0; i < parent.size(); ++i)
-        parent[i] = i;
-    auto find = [&](NodeIndex i) {
-        while (parent[i] != i)
-            i = parent[i] = parent[parent[i]];
-        return i;
-    };
-    for (const auto &f : mesh.faces) {
-        const NodeIndex r = find(f[0]);
+    DisjointSets pieces(mesh.nodes.size());
+    for (const auto &f : mesh.faces)
         for (int k = 1; k < 3; ++k)
-            parent[find(f[k])] = r;
-    }
-    // Each node's root once, in place (roots stay roots): the passes over the faces read it.
-    for (NodeIndex i = 0; i < parent.size(); ++i)
-        parent[i] = find(i);
+            pieces.join(f[0], f[k]);
+    // Each node's root once: the passes over the faces read it.
+    const std::vector<NodeIndex> parent = std::move(pieces).roots();
     std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
     for (const auto &f : mesh.faces)
         ++faces_of[parent[f[0]]];

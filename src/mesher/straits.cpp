@@ -142,28 +142,24 @@ void group_closed_straits(const SizeFn &size_km, MesherReport &report) {
     double most = 0;
     for (std::size_t i = 0; i < n; ++i)
         most = std::max(most, h[i] = km_to_rad(size_km(at[i])));
-    std::vector<std::size_t> by_z(n), root(n);
-    for (std::size_t i = 0; i < n; ++i)
-        by_z[i] = root[i] = i;
-    std::sort(by_z.begin(), by_z.end(), [&](std::size_t a, std::size_t b) {
+    std::vector<std::uint32_t> by_z(n);
+    std::iota(by_z.begin(), by_z.end(), 0u);
+    std::sort(by_z.begin(), by_z.end(), [&](std::uint32_t a, std::uint32_t b) {
         return at[a].z != at[b].z ? at[a].z < at[b].z : a < b;
     });
-    auto find = [&](std::size_t i) {
-        while (root[i] != i)
-            i = root[i] = root[root[i]];
-        return i;
-    };
+    DisjointSets chains(n);
     for (std::size_t k = 0; k < n; ++k)
         for (std::size_t l = k + 1; l < n && at[by_z[l]].z - at[by_z[k]].z < most; ++l) {
-            const std::size_t i = by_z[k], j = by_z[l];
+            const std::uint32_t i = by_z[k], j = by_z[l];
             if (arc_angle(at[i], at[j]) < std::max(h[i], h[j]))
-                root[find(i)] = find(j);
+                chains.join(j, i);
         }
+    const std::vector<std::uint32_t> root = std::move(chains).roots();
     std::vector<std::uint32_t> place_of_root(n, UINT32_MAX);
     report.straits_closed_place.assign(n, 0);
     report.straits_closed_places = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        std::uint32_t &place = place_of_root[find(i)];
+        std::uint32_t &place = place_of_root[root[i]];
         if (place == UINT32_MAX)
             place = static_cast<std::uint32_t>(report.straits_closed_places++);
         report.straits_closed_place[i] = place;
