@@ -1,5 +1,4 @@
 // The summary and the --report JSON of a `mesh` run (mesh_summary.hpp).
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
@@ -60,11 +59,20 @@ void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, boo
 /// The cells a strait needs across to stay open (the size it needs: its width over this).
 constexpr double strait_cells = 2;
 
-/// Each closing's place (MesherReport::straits_closed_place), each its own where not grouped.
+/// Whether the closings have their places (MesherReport::straits_closed_place); where not, each
+/// is a place of its own.
+bool grouped(const MesherReport &m) {
+    return m.straits_closed_place.size() == m.straits_closed_at.size();
+}
+
 std::uint32_t place_of(const MesherReport &m, std::size_t i) {
-    return m.straits_closed_place.size() == m.straits_closed_at.size()
-               ? m.straits_closed_place[i]
-               : static_cast<std::uint32_t>(i);
+    return grouped(m) ? m.straits_closed_place[i] : static_cast<std::uint32_t>(i);
+}
+
+/// Closing i's width, or the bound it is under when narrower than the sampling (width 0).
+double width_bound(const MesherReport &m, std::size_t i) {
+    return m.straits_closed_width_km[i] > 0 ? m.straits_closed_width_km[i]
+                                            : m.straits_closed_width_below_km[i];
 }
 
 /// The summary's lines of the closed straits: the first six places, each by its narrowest
@@ -72,33 +80,27 @@ std::uint32_t place_of(const MesherReport &m, std::size_t i) {
 void print_straits(std::ostream &out, const MesherReport &m) {
     constexpr std::size_t shown = 6;
     const std::size_t n = m.straits_closed_at.size();
-    std::size_t places = 0;
-    for (std::size_t i = 0; i < n; ++i)
-        places = std::max<std::size_t>(places, place_of(m, i) + 1);
-    // A width under the sampling is narrower than its bound.
-    auto bound = [&](std::size_t i) {
-        return m.straits_closed_width_km[i] > 0 ? m.straits_closed_width_km[i]
-                                                : m.straits_closed_width_below_km[i];
-    };
+    const std::size_t places = grouped(m) ? m.straits_closed_places : n;
     std::vector<std::size_t> narrowest(places, n), closings(places, 0);
     for (std::size_t i = 0; i < n; ++i) {
         const std::uint32_t p = place_of(m, i);
         ++closings[p];
-        if (narrowest[p] == n || bound(i) < bound(narrowest[p]))
+        if (narrowest[p] == n || width_bound(m, i) < width_bound(m, narrowest[p]))
             narrowest[p] = i;
     }
     for (std::size_t p = 0; p < places && p < shown; ++p) {
         const std::size_t i = narrowest[p];
         const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
         const double w = m.straits_closed_width_km[i];
-        const std::string width = w > 0
-                                      ? report_number(w) + " km wide: needs h <= "
-                                      : "under " + report_number(bound(i)) + " km wide: needs h < ";
+        const std::string width =
+            w > 0 ? report_number(w) + " km wide: needs h <= "
+                  : "under " + report_number(width_bound(m, i)) + " km wide: needs h < ";
         const std::string along =
             closings[p] > 1 ? " (" + std::to_string(closings[p]) + " closings there)" : "";
         char line[96];
         std::snprintf(line, sizeof line, "                  at %.2f %.2f, ", ll.lon, ll.lat);
-        out << line << width << report_number(bound(i) / strait_cells) << " km" << along << "\n";
+        out << line << width << report_number(width_bound(m, i) / strait_cells) << " km" << along
+            << "\n";
     }
     if (places > shown)
         out << "                  ... " << places - shown
@@ -125,12 +127,11 @@ std::string straits_json(const MesherReport &m) {
         const LonLat ll = vec_to_lonlat(m.straits_closed_at[i]);
         // A passage narrower than the sampling: its width is null, under width_below_km.
         const double w = m.straits_closed_width_km[i], below = m.straits_closed_width_below_km[i];
-        const double bound = w > 0 ? w : below;
         r += std::string(i ? ", " : "") + "{\"lon\": " + json_number(ll.lon) +
              ", \"lat\": " + json_number(ll.lat) +
              ", \"width_km\": " + (w > 0 ? json_number(w) : std::string("null")) +
              (w > 0 ? "" : ", \"width_below_km\": " + json_number(below)) +
-             ", \"size_needed_km\": " + json_number(bound / strait_cells) +
+             ", \"size_needed_km\": " + json_number(width_bound(m, i) / strait_cells) +
              ", \"place\": " + std::to_string(place_of(m, i)) + "}";
     }
     return r + "]";
