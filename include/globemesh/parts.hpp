@@ -63,7 +63,10 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
 
 /// The part meshes joined: nodes equal on a border are one node, a border segment one side
 /// split is split on the other (a fan), boundary edges with their reverse become interior.
-Mesh join_parts(std::vector<Mesh> &parts_meshes, int parts);
+/// With the parts' lattice size (MesherOptions::lattice_km) and size field, the band along the
+/// borders is made the lattice again where it is open ocean at that size.
+Mesh join_parts(std::vector<Mesh> &parts_meshes, int parts, const SizeFn &size_km = {},
+                double lattice_km = 0);
 
 /// mesh_boundary over `parts` parts, meshed on up to `threads` threads (0: one) and joined;
 /// the inland seas are told on the whole boundary first (MesherOptions::keep_inland_seas), the

@@ -1,4 +1,5 @@
 // The icosahedral lattice: the open ocean filled with near-equilateral triangles.
+#include "lattice_points.hpp"
 #include "mesher_state.hpp"
 
 #include <algorithm>
@@ -9,16 +10,6 @@
 namespace globemesh::mesher_internal {
 
 namespace {
-
-// The icosahedral lattice (fill_lattice): n subdivisions of an icosahedron's edge give a median
-// chord of lattice_edge_scale / n (its chords lie within [0.74, 1.09] of the median, its
-// triangles' q above 0.88). A lattice node is kept where the size field reaches lattice_level
-// times the lattice's size, and no boundary segment or other node lies within lattice_clearance
-// times that size.
-constexpr double lattice_edge_scale = 1.2185;
-constexpr double lattice_level = 0.99;
-constexpr double lattice_clearance = 1.5;
-constexpr double lattice_jitter = 1e-6;
 
 // The lattice points walked, per face of the icosahedron and row: row i of face f walks j in
 // [lo, hi] (weights i, j, rows - i - j on the face's corners), its cells at cell[start + j -
@@ -202,46 +193,6 @@ std::size_t place_lattice(Mesher &m, LatticeCells &grid, std::vector<Vec3> &poin
     return dt.vertex_count() - before;
 }
 
-// The icosahedron's 20 faces (indices of its corners, ico_corners).
-constexpr int ico_face[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-
-// The icosahedron's 12 corners on the unit sphere.
-std::array<Vec3, 12> ico_corners() {
-    const double g = 0.5 * (1.0 + std::sqrt(5.0));
-    return {normalized(Vec3{-1, g, 0}),  normalized(Vec3{1, g, 0}),   normalized(Vec3{-1, -g, 0}),
-            normalized(Vec3{1, -g, 0}),  normalized(Vec3{0, -1, g}),  normalized(Vec3{0, 1, g}),
-            normalized(Vec3{0, -1, -g}), normalized(Vec3{0, 1, -g}),  normalized(Vec3{g, 0, -1}),
-            normalized(Vec3{g, 0, 1}),   normalized(Vec3{-g, 0, -1}), normalized(Vec3{-g, 0, 1})};
-}
-
-// The first face with the edge a-b, or with the corner a when b < 0: a node shared by faces (on
-// an edge or a corner) is made by the first face that has it.
-int owner(int a, int b) {
-    for (int f = 0; f < 20; ++f) {
-        const int *v = ico_face[f];
-        const bool has_a = v[0] == a || v[1] == a || v[2] == a;
-        const bool has_b = b < 0 || v[0] == b || v[1] == b || v[2] == b;
-        if (has_a && has_b)
-            return f;
-    }
-    return -1;
-}
-
-// Whether face f makes its node (i, j, k) (weights on its corners a, b, c): a node on the edge
-// opposite a corner (its weight 0) or at a corner belongs to the first face that has it.
-bool owns_node(int f, int i, int j, int k) {
-    const int ia = ico_face[f][0], ib = ico_face[f][1], ic = ico_face[f][2];
-    const int zeros = (i == 0) + (j == 0) + (k == 0);
-    if (zeros == 2)
-        return owner(i > 0 ? ia : j > 0 ? ib : ic, -1) == f;
-    if (zeros == 1)
-        return owner(i == 0 ? ib : ia, k == 0 ? ib : ic) == f;
-    return true;
-}
-
 // The cap holding the ocean: around the mean of the ocean triangles' corners, out to the
 // farthest corner. A cap narrower than a hemisphere holds each triangle whose corners it holds;
 // a wider one is taken as the whole sphere (cos_r -1).
@@ -344,23 +295,6 @@ bool row_within(const std::vector<Vec3> &normals, const Vec3 &a, const Vec3 &b, 
     lo = std::max(lo, 0);
     hi = std::min(hi, len);
     return lo <= hi;
-}
-
-// The pseudo-random shift of lattice point (f, i, j), each coordinate in [-0.5, 0.5) (its index
-// hashed, splitmix64): the lattice's mirror symmetries make many four points exactly
-// cocircular, each an in-circle test that only exact arithmetic decides.
-Vec3 lattice_shift(int f, int i, int j) {
-    std::uint64_t x = (static_cast<std::uint64_t>(f) << 42) ^
-                      (static_cast<std::uint64_t>(i) << 21) ^ static_cast<std::uint64_t>(j);
-    Vec3 shift;
-    for (double *e : {&shift.x, &shift.y, &shift.z}) {
-        x += 0x9e3779b97f4a7c15ull;
-        std::uint64_t z = x;
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        *e = double((z ^ (z >> 31)) >> 11) * 0x1p-53 - 0.5;
-    }
-    return shift;
 }
 
 // The nodes on the icosahedron's 30 edges (by their smaller corner and the steps from it) and at
@@ -478,7 +412,8 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::v
     };
     SphericalDelaunay &dt = m.dt;
     const double s = km_to_rad(s_km);
-    const double n = std::max(1.0, std::round(lattice_edge_scale / s));
+    const LatticePoints lattice(s_km);
+    const double n = lattice.rows();
     const Cap cap = ocean_cap(dt, s);
     const double cap_points = (10 * n * n + 2) * 0.5 * (1 - cap.cos_r) *
                               (cap.cos_r > -1 ? 1 : share); // the lattice's points there, about
@@ -523,9 +458,7 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::v
                 if (!owns_node(f, i, j, k))
                     continue;
                 // Each point moved by a pseudo-random 1e-6 of the spacing.
-                const Vec3 p =
-                    normalized(normalized(double(i) * a + double(j) * b + double(k) * c) +
-                               (lattice_jitter * s) * lattice_shift(f, i, j));
+                const Vec3 p = lattice.point(f, i, j);
                 if (!inside(p) || m.size_km(p) < lattice_level * s_km)
                     continue; // outside a part's lune: outside its ocean, not located
                 hint = dt.locate(p, hint);

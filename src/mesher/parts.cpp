@@ -266,7 +266,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
         for (const auto &s : summed.stages)
             timings->stages.push_back(s);
     }
-    Mesh mesh = join_parts(meshes, parts);
+    Mesh mesh = join_parts(meshes, parts, size_km, options.lattice_km);
     basins_cut_off(mesh, report);
     if (timings)
         timings->add("join", seconds_since(t0));

@@ -344,7 +344,7 @@ void tag_border_coast(Mesh &mesh, const Borders &borders) {
 
 } // namespace
 
-Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
+Mesh join_parts(std::vector<Mesh> &meshes, int parts, const SizeFn &size_km, double lattice_km) {
     Mesh out;
     const auto first =
         std::find_if(meshes.begin(), meshes.end(), [](const Mesh &m) { return !m.faces.empty(); });
@@ -372,6 +372,7 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts) {
             boundary.push_back(e);
     out.boundary.swap(boundary);
     std::vector<char> zone = border_zone(out, borders);
+    stitch_lattice(out, zone, borders.normal, size_km, lattice_km);
     std::vector<std::uint32_t> faces = zone_faces(out, zone);
     FaceOfEdge face_of = faces_of_edges(out, faces);
     flip_near_borders(out, faces, face_of);

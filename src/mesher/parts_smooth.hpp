@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "globemesh/mesh.hpp"
+#include "globemesh/size_fn.hpp"
 
 namespace globemesh::parts_detail {
 
@@ -55,5 +56,14 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
 /// listed again.
 std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
                                 const std::vector<std::uint32_t> &zone_face_list);
+
+/// Where the band along the borders (`normals`: their planes) is open ocean at the lattice's
+/// size (lattice_km), its nodes that are not lattice points are removed and the lattice's points
+/// there put in their place (parts_stitch.cpp): its faces become the lattice's, as inside a
+/// part. The new nodes take the removed ones' slots (then are appended, or the last nodes fill
+/// the slots left); only those next to a node kept off the lattice stay in `zone`. Changes
+/// nothing when the band's new triangulation does not fit. Returns the lattice points added.
+std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vector<Vec3> &normals,
+                           const SizeFn &size_km, double lattice_km);
 
 } // namespace globemesh::parts_detail

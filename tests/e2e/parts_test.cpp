@@ -103,6 +103,34 @@ TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     EXPECT_NEAR(double(a.nodes.size()), double(one.nodes.size()), 0.03 * double(one.nodes.size()));
 }
 
+/// The faces below quality q.
+std::size_t faces_below(const Mesh &mesh, double q) {
+    return static_cast<std::size_t>(
+        std::count_if(mesh.faces.begin(), mesh.faces.end(), [&](const auto &f) {
+            return triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]) < q;
+        }));
+}
+
+TEST(Parts, the_band_along_the_borders_is_the_lattice_again) {
+    // Each part keeps its lattice 1.5 spacings off its borders and refines the band between:
+    // joined, that band held the mesh's worst faces (q 0.60 in 3 parts, 300 faces below q 0.85
+    // in 2, against 30 in one part). The join puts the lattice back there: the open ocean's
+    // faces are the lattice's (q above 0.88), as in one part.
+    TempDir dir;
+    MeshOptions o;
+    o.coast = island(dir.path());
+    o.hmax_km = 150;
+    o.parts = 1;
+    const Mesh one = mesh_ocean(o).mesh;
+    for (int parts : {2, 3}) {
+        o.parts = parts;
+        const Mesh joined = mesh_ocean(o).mesh;
+        EXPECT_LE(faces_below(joined, 0.85), faces_below(one, 0.85) + 3) << parts;
+        EXPECT_EQ(faces_below(joined, 0.8), faces_below(one, 0.8)) << parts;
+        expect_joined(joined);
+    }
+}
+
 TEST(Parts, part_count_zero_follows_the_node_estimate) {
     // --parts 0: one part below auto_parts_nodes (2e6) estimated nodes, the single-part mesh
     // itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km about
