@@ -82,6 +82,7 @@
 // input and options give the same mesh. Standard library only (sphere, delaunay).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -118,6 +119,10 @@ struct MesherOptions {
     /// may join its fans, and join_parts splits those still pinched.
     std::vector<Vec3> lattice_within;
     double lattice_share = 1;
+    /// Coast nodes the close-node merge keeps (sorted as x, y, z): the corners of the inlets'
+    /// mouths mesh_parts closed on the whole boundary before the split, which a part's rings
+    /// hold as plain coast nodes (one part keeps such a corner: land on both sides of it).
+    std::vector<std::array<double, 3>> mouth_corners;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
     /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where
     /// the mesh stays one manifold and its new boundary nodes near the coast (step 7). Null:

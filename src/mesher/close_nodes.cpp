@@ -98,6 +98,11 @@ private:
         return merged;
     }
 
+    // A corner of an inlet's mouth closed before a part's split (MesherOptions::mouth_corners).
+    bool is_mouth_corner(const Vec3 &p) const {
+        return std::binary_search(options.mouth_corners.begin(), options.mouth_corners.end(),
+                                  std::array<double, 3>{p.x, p.y, p.z});
+    }
     // The segments looked at: under close_node_gap h, or under the dead ends' short chord.
     double trigger() const {
         return std::max(options.close_node_gap, short_chord * options.inlet_width);
@@ -110,7 +115,8 @@ private:
     // ocean chord under the short chord to another coast node (a mouth the dead ends close by).
     bool may_go(const Star &s) const {
         const double h = km_to_rad(m.size_km(dt.point(s.v)));
-        if (distance_to_new(s) >= options.close_node_gap * h || s.constrained.size() > 2)
+        if (distance_to_new(s) >= options.close_node_gap * h || s.constrained.size() > 2 ||
+            is_mouth_corner(dt.point(s.v)))
             return false;
         // Every node of the triangulation is a boundary node yet (the lattice and the
         // refinement come later): a spoke to the ocean side is a chord between two of them.

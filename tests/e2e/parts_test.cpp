@@ -131,6 +131,33 @@ TEST(Parts, the_band_along_the_borders_is_the_lattice_again) {
     }
 }
 
+TEST(Parts, an_inlet_a_border_runs_through_closes_as_in_one_part) {
+    // A channel 11 km wide and 555 km long into a 10 x 10 degree island, at 50 km: one part
+    // closes it by the inlet rule (narrower than inlet_width h). The border at 89.99W runs up
+    // its middle: each part saw half a channel on its border, open water the inlet rule keeps,
+    // and meshed it with 268 faces. The inlets are now closed on the whole boundary before
+    // the split.
+    TempDir dir;
+    std::ofstream(dir / "inlet.geojson")
+        << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+           R"("geometry":{"type":"Polygon","coordinates":[[[-95,0],[-90.05,0],[-90.05,5],)"
+           R"([-89.95,5],[-89.95,0],[-85,0],[-85,10],[-95,10],[-95,0]]]}}]})";
+    MeshOptions o;
+    o.coast = (dir / "inlet.geojson").string();
+    o.hmax_km = 50;
+    for (int parts : {1, 2}) {
+        o.parts = parts;
+        const Mesh mesh = mesh_ocean(o).mesh;
+        std::size_t in_channel = 0; // faces whose centroid lies more than 1 degree up it
+        for (const auto &f : mesh.faces) {
+            const LonLat c =
+                vec_to_lonlat(normalized(mesh.nodes[f[0]] + mesh.nodes[f[1]] + mesh.nodes[f[2]]));
+            in_channel += c.lon > -90.05 && c.lon < -89.95 && c.lat > 1 && c.lat < 5;
+        }
+        EXPECT_EQ(in_channel, 0u) << parts << " parts";
+    }
+}
+
 TEST(Parts, part_count_zero_follows_the_node_estimate) {
     // --parts 0: one part below auto_parts_nodes (2e6) estimated nodes, the single-part mesh
     // itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km about

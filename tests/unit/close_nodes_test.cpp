@@ -245,5 +245,36 @@ TEST(CloseNodes, a_closed_inlets_mouth_keeps_its_corners) {
     EXPECT_TRUE(after.empty()) << after.size() << " problems, first: " << after.front();
 }
 
+TEST(CloseNodes, the_mouth_corners_given_stay_where_the_inlet_was_cut_before) {
+    // mesh_parts closes the inlets on the whole boundary and cuts their nodes from the rings
+    // before the split: a part sees the mouth's corners as plain coast nodes, which the merge
+    // took (GSHHG low at 20 km in 2 parts: 162 merged against 45 in one part). It keeps those
+    // it is given, as one part keeps a mouth's corners.
+    Boundary b;
+    b.rings.push_back(ring_through({{0, 2},
+                                    {0.0005, 0.06},
+                                    {0, 0.0135},
+                                    {0, -0.0135},
+                                    {0.0005, -0.06},
+                                    {0, -2},
+                                    {4, -2},
+                                    {4, 2}}));
+    const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
+    auto merged = [&](const MesherOptions &options) {
+        MesherReport report;
+        Mesher m(SphericalDelaunay::Options{1e-12, 1}, size, report);
+        const std::vector<VertexId> ids = insert_boundary(m, b);
+        recover_segments(m, b, ids);
+        classify_ocean(m, b, options);
+        return merge_close_coast_nodes(m, options);
+    };
+    MesherOptions options;
+    EXPECT_GT(merged(options), 0u); // a corner goes, as a plain coast node
+    for (const Vec3 &p : {lonlat_to_vec(0, 0.0135), lonlat_to_vec(0, -0.0135)})
+        options.mouth_corners.push_back({p.x, p.y, p.z});
+    std::sort(options.mouth_corners.begin(), options.mouth_corners.end());
+    EXPECT_EQ(merged(options), 0u);
+}
+
 } // namespace
 } // namespace globemesh::mesher_internal
