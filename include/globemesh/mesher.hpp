@@ -120,8 +120,9 @@ struct MesherOptions {
     std::vector<Vec3> lattice_within;
     double lattice_share = 1;
     /// Coast nodes the close-node merge keeps (sorted as x, y, z): the corners of the inlets'
-    /// mouths mesh_parts closed on the whole boundary before the split, which a part's rings
-    /// hold as plain coast nodes (one part keeps such a corner: land on both sides of it).
+    /// mouths mesh_parts closed on the whole boundary before the split (those a border crosses),
+    /// which a part's rings hold as plain coast nodes (one part keeps such a corner: land on
+    /// both sides of it).
     std::vector<std::array<double, 3>> mouth_corners;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
     /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where

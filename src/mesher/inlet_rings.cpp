@@ -1,5 +1,6 @@
 // The rings with the inlets close_inlets closed cut out (mesher_state.hpp).
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -7,10 +8,13 @@
 
 namespace globemesh::mesher_internal {
 
-// Each ring as a list linked by `next`, each chord relinking it past the inlet's nodes.
-std::vector<Ring> rings_with_inlets_closed(const Mesher &m, const Boundary &boundary,
-                                           const std::vector<VertexId> &ids, std::size_t first) {
+// Each ring as a list linked by `next`, each chord that crosses relinking it past the inlet's
+// nodes.
+InletCut rings_with_inlets_closed(const Mesher &m, const Boundary &boundary,
+                                  const std::vector<VertexId> &ids, std::size_t first,
+                                  const std::function<bool(const Vec3 &, const Vec3 &)> &crosses) {
     constexpr std::uint32_t none = 0xffffffffu;
+    InletCut out;
     std::vector<std::uint32_t> ring_of(m.dt.vertex_count(), none), pos_of(m.dt.vertex_count());
     std::vector<std::vector<std::uint32_t>> next(boundary.rings.size());
     std::vector<std::vector<SegmentKind>> kinds(boundary.rings.size());
@@ -40,12 +44,29 @@ std::vector<Ring> rings_with_inlets_closed(const Mesher &m, const Boundary &boun
             ++steps;
         if (steps > next[r].size())
             continue; // v not ahead of u: not this ring's arc
-        for (std::uint32_t p = next[r][pu]; p != pv; p = next[r][p])
+        // The inlet as the source ring had it (closings inside it included), and its chord.
+        const std::vector<Vec3> &nodes = boundary.rings[r].nodes;
+        bool crossed = crosses(nodes[pv], nodes[pu]);
+        for (std::uint32_t p = pu; p != pv && !crossed; p = (p + 1) % nodes.size())
+            crossed = crosses(nodes[p], nodes[(p + 1) % nodes.size()]);
+        if (!crossed)
+            continue;
+        for (const Vec3 &c : {nodes[pu], nodes[pv]})
+            out.mouths.push_back({c.x, c.y, c.z});
+        // The water cut: the fan from u over the arc left (closings before it already cut).
+        double area = 0;
+        for (std::uint32_t p = next[r][pu]; p != pv; p = next[r][p]) {
             cut[r][p] = 1;
+            const Vec3 &a = nodes[pu], &b = nodes[p], &c = nodes[next[r][p]];
+            const double t = spherical_triangle_area(a, b, c);
+            area += dot(cross(b - a, c - a), a) > 0 ? t : -t;
+        }
+        ++out.closed;
+        out.area_km2 += std::abs(area) * earth_radius_km * earth_radius_km;
         next[r][pu] = pv;
         kinds[r][pu] = SegmentKind::coast;
     }
-    std::vector<Ring> rings;
+    std::sort(out.mouths.begin(), out.mouths.end());
     for (std::uint32_t r = 0; r < boundary.rings.size(); ++r) {
         const auto start = std::find(cut[r].begin(), cut[r].end(), 0);
         Ring ring;
@@ -58,18 +79,9 @@ std::vector<Ring> rings_with_inlets_closed(const Mesher &m, const Boundary &boun
                 p = next[r][p];
             } while (p != s);
         }
-        rings.push_back(ring.nodes.size() >= 3 ? std::move(ring) : boundary.rings[r]);
+        out.rings.push_back(ring.nodes.size() >= 3 ? std::move(ring) : boundary.rings[r]);
     }
-    return rings;
-}
-
-std::vector<std::array<double, 3>> inlet_mouth_corners(const Mesher &m, std::size_t first) {
-    std::vector<std::array<double, 3>> mouths;
-    for (std::size_t k = first; k < m.directed.size(); ++k)
-        for (const VertexId v : {m.directed[k].first, m.directed[k].second})
-            mouths.push_back({m.dt.point(v).x, m.dt.point(v).y, m.dt.point(v).z});
-    std::sort(mouths.begin(), mouths.end());
-    return mouths;
+    return out;
 }
 
 } // namespace globemesh::mesher_internal

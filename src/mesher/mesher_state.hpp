@@ -537,15 +537,22 @@ void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport 
 /// Fills report.straits_closed_place(s) from report.straits_closed_at (straits.cpp).
 void group_closed_straits(const SizeFn &size_km, MesherReport &report);
 
-/// The rings after close_inlets: each closing's chord u -> v (ocean on its left; the segments it
-/// added to m.directed from `first`) cuts the ring's nodes from u forward to v (inlet_rings.cpp).
-/// `ids`: each ring node's vertex (insert_boundary), rings in order; a chord at a vertex two
-/// ring nodes merged into, or not on one ring, is left out. mesh_parts meshes its parts on
-/// these: a part's inlet rule keeps the water against its border open.
-std::vector<Ring> rings_with_inlets_closed(const Mesher &m, const Boundary &boundary,
-                                           const std::vector<VertexId> &ids, std::size_t first);
-/// The corners of those closings' mouths, sorted (MesherOptions::mouth_corners).
-std::vector<std::array<double, 3>> inlet_mouth_corners(const Mesher &m, std::size_t first);
+/// The rings after close_inlets, with the inlets `crosses` picks cut out: each closing's chord
+/// u -> v (ocean on its left; the segments it added to m.directed from `first`) whose inlet
+/// (the source ring from u to v, and the chord) has a segment that `crosses` (a border's plane,
+/// for mesh_parts) replaces the ring's nodes from u forward to v (inlet_rings.cpp). `ids`: each
+/// ring node's vertex (insert_boundary), rings in order; a chord at a vertex two ring nodes
+/// merged into, or not on one ring, is left out. With the corners of the mouths cut, sorted
+/// (MesherOptions::mouth_corners), and the inlets' count and water.
+struct InletCut {
+    std::vector<Ring> rings;
+    std::vector<std::array<double, 3>> mouths;
+    std::size_t closed = 0; ///< the inlets cut
+    double area_km2 = 0;    ///< their water
+};
+InletCut rings_with_inlets_closed(const Mesher &m, const Boundary &boundary,
+                                  const std::vector<VertexId> &ids, std::size_t first,
+                                  const std::function<bool(const Vec3 &, const Vec3 &)> &crosses);
 // The same search for the free nodes of the faces below q 0.3 that the land and corner stages
 // leave (their nodes moved or their neighbours removed after improve_quality). Returns whether
 // no ocean face is left below it.

@@ -46,14 +46,28 @@ private:
     mutable std::mutex mutex_;
 };
 
+/// Whether the arc a-b crosses one of the borders of `parts` lunes (a half great circle each).
+bool crosses_a_border(const Vec3 &a, const Vec3 &b, int parts) {
+    for (int k = 0; k < parts; ++k) {
+        const Vec3 n = border_normal(k, parts);
+        if ((dot(a, n) > 0) != (dot(b, n) > 0) &&
+            dot(a + b, border_direction(k, parts)) > 0) // on the border's half of its circle
+            return true;
+    }
+    return false;
+}
+
 /// The rings that bound some of the ocean mesh_boundary keeps (the largest component, or all
 /// with keep_inland_seas), told on the triangulation of the boundary nodes alone, as
-/// classify_ocean does, with the inlets one part closes there closed (rings_with_inlets_closed);
-/// the components (of the whole ocean) go to report.components, the inlets to its counts, the
-/// corners of their mouths to `mouths` (sorted). Throws DataError as mesh_boundary does when
-/// the node estimate passes max_nodes or max_memory.
+/// classify_ocean does; the components (of the whole ocean) go to report.components. `parts` 0
+/// becomes parts_for_nodes of the node estimate. With more than one part, the inlets a border
+/// crosses, closed there by one part's inlet rule, are cut from the rings
+/// (rings_with_inlets_closed) and counted in the report, their mouths' corners in `mouths`: a
+/// part's own rule keeps water against its border open, and an inlet a border ran up was meshed
+/// in both parts with faces as narrow as it. Throws DataError as mesh_boundary does when the
+/// node estimate passes max_nodes or max_memory.
 Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
-                          const MesherOptions &options, MesherReport &report,
+                          const MesherOptions &options, MesherReport &report, int &parts,
                           std::vector<std::array<double, 3>> &mouths) {
     MesherReport local;
     Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, local);
@@ -63,6 +77,8 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     estimate_nodes(m, options, false); // refused here as one part would be, before any part
     report.components = local.components;
     report.estimated_nodes = local.estimated_nodes;
+    if (parts == 0)
+        parts = parts_for_nodes(report.estimated_nodes);
     std::vector<char> ocean_ring;
     std::size_t offset = 0;
     for (const Ring &r : boundary.rings) {
@@ -77,13 +93,17 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
         offset += r.nodes.size();
     }
     std::vector<Ring> rings = boundary.rings;
-    if (options.inlet_width > 0 && !boundary.empty()) {
+    if (parts > 1 && options.inlet_width > 0 && !boundary.empty()) {
         const std::size_t first = m.directed.size();
         close_inlets(m, options, local);
-        rings = rings_with_inlets_closed(m, boundary, ids, first);
-        mouths = inlet_mouth_corners(m, first);
-        report.inlets_closed += local.inlets_closed;
-        report.inlet_area_km2 += local.inlet_area_km2;
+        InletCut cut =
+            rings_with_inlets_closed(m, boundary, ids, first, [&](const Vec3 &a, const Vec3 &b) {
+                return crosses_a_border(a, b, parts);
+            });
+        rings = std::move(cut.rings);
+        mouths = std::move(cut.mouths);
+        report.inlets_closed += cut.closed;
+        report.inlet_area_km2 += cut.area_km2;
     }
     Boundary kept;
     kept.dropped_islands = boundary.dropped_islands;
@@ -224,14 +244,12 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     report = MesherReport{};
     auto t0 = Clock::now();
     std::vector<std::array<double, 3>> mouths;
-    const Boundary kept = drop_inland_seas(boundary, size_km, options, report, mouths);
-    if (parts == 0) {
-        parts = parts_for_nodes(report.estimated_nodes);
-        if (parts == 1) {
-            if (timings)
-                timings->add("parts", seconds_since(t0)); // the pass that chose one part
-            return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
-        }
+    const bool chosen = parts == 0;
+    const Boundary kept = drop_inland_seas(boundary, size_km, options, report, parts, mouths);
+    if (chosen && parts == 1) {
+        if (timings)
+            timings->add("parts", seconds_since(t0)); // the pass that chose one part
+        return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
     }
     report.parts = parts;
     MesherOptions part_options = options;

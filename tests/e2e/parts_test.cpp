@@ -135,8 +135,8 @@ TEST(Parts, an_inlet_a_border_runs_through_closes_as_in_one_part) {
     // A channel 11 km wide and 555 km long into a 10 x 10 degree island, at 50 km: one part
     // closes it by the inlet rule (narrower than inlet_width h). The border at 89.99W runs up
     // its middle: each part saw half a channel on its border, open water the inlet rule keeps,
-    // and meshed it with 268 faces. The inlets are now closed on the whole boundary before
-    // the split.
+    // and meshed it with 268 faces. The inlets a border crosses are now closed on the whole
+    // boundary before the split.
     TempDir dir;
     std::ofstream(dir / "inlet.geojson")
         << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"

@@ -246,10 +246,10 @@ TEST(CloseNodes, a_closed_inlets_mouth_keeps_its_corners) {
 }
 
 TEST(CloseNodes, the_mouth_corners_given_stay_where_the_inlet_was_cut_before) {
-    // mesh_parts closes the inlets on the whole boundary and cuts their nodes from the rings
-    // before the split: a part sees the mouth's corners as plain coast nodes, which the merge
-    // took (GSHHG low at 20 km in 2 parts: 162 merged against 45 in one part). It keeps those
-    // it is given, as one part keeps a mouth's corners.
+    // mesh_parts closes the inlets a border crosses on the whole boundary and cuts their nodes
+    // from the rings before the split: a part sees the mouth's corners as plain coast nodes,
+    // which the merge took (every inlet cut, GSHHG low at 20 km in 2 parts: 162 merged against
+    // 45 in one part). It keeps those it is given, as one part keeps a mouth's corners.
     Boundary b;
     b.rings.push_back(ring_through({{0, 2},
                                     {0.0005, 0.06},
