@@ -301,7 +301,10 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
         for (const auto &s : summed.stages)
             timings->stages.push_back(s);
     }
-    Mesh mesh = join_parts(meshes, parts, size_km, options.lattice_km);
+    // The lattice is stitched back only where the parts laid one (fill_lattice skips it when
+    // the size field is below its largest value over most of the ocean).
+    Mesh mesh =
+        join_parts(meshes, parts, size_km, report.lattice_nodes > 0 ? options.lattice_km : 0.0);
     basins_cut_off(mesh, report);
     if (timings)
         timings->add("join", seconds_since(t0));
