@@ -369,13 +369,16 @@ std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vecto
     // The lattice points near the removed nodes, then near each point added (the band may be
     // wider than the removed nodes' neighbourhoods), each tried once, in the order they are met.
     std::vector<LatticePoints::Index> candidates;
-    std::vector<char> met(lattice.index_count(), 0);
+    std::vector<bool> met(lattice.index_count(), false); // 48e6 indices at 5 km: bits
     auto meet_near = [&](const Vec3 &p) {
         const std::size_t from = candidates.size();
         lattice.near(p, 1, candidates);
         candidates.erase(std::remove_if(candidates.begin() + std::ptrdiff_t(from), candidates.end(),
                                         [&](const auto &x) {
-                                            return std::exchange(met[lattice.index_of(x)], 1);
+                                            auto bit = met[lattice.index_of(x)];
+                                            const bool seen = bit;
+                                            bit = true;
+                                            return seen;
                                         }),
                          candidates.end());
     };
