@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "globemesh/error.hpp"
+#include "globemesh/mesher.hpp"
 #include "globemesh/parts.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/ugrid.hpp"
@@ -156,6 +157,32 @@ TEST(Parts, an_inlet_a_border_runs_through_closes_as_in_one_part) {
         }
         EXPECT_EQ(in_channel, 0u) << parts << " parts";
     }
+}
+
+TEST(Parts, an_excursion_is_kept_where_its_shortcut_would_cross_the_coast) {
+    // Mindanao in GSHHG low at 150 km (Davao Gulf closed), moved 36 degrees west so that its
+    // east coast lies 18-21 km past the border at 90.01E of 2 parts, within the 0.2 h (30 km)
+    // of an excursion. Dropped, its shortcut from the north-east cape (89.44E 9.83N) to the
+    // gulf's west corner (89.73E 6.32N) passed west of the north coast's node at 89.54E 8.96N:
+    // the west part's ring crossed itself and could not be recovered (GSHHG low 150 km in 5
+    // parts failed so). It is kept where the shortcut would cross the ring.
+    const std::vector<LonLat> mindanao = {
+        {124.9992, 5.8596}, {124.0543, 6.4791}, {124.0116, 7.6480}, {122.8231, 7.7590},
+        {122.1517, 6.9096}, {122.0838, 7.7383}, {123.2977, 8.6680}, {124.1905, 8.2381},
+        {125.5399, 8.9645}, {125.4392, 9.8279}, {126.1713, 8.7901}, {126.2017, 7.5381},
+        {126.1917, 6.2737}, {125.7281, 6.3237}};
+    Boundary b;
+    Ring r;
+    for (const LonLat &c : mindanao)
+        r.nodes.push_back(lonlat_to_vec(c.lon - 36, c.lat));
+    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
+    b.rings.push_back(r);
+    const SizeFn h = [](const Vec3 &) { return 150.0; };
+    MesherOptions o;
+    o.lattice_km = 150;
+    const Mesh mesh = mesh_parts(b, h, o, 2, 1);
+    expect_joined(mesh);
+    EXPECT_GT(mesh.faces.size(), 1000u);
 }
 
 TEST(Parts, part_count_zero_follows_the_node_estimate) {
