@@ -46,17 +46,6 @@ private:
     mutable std::mutex mutex_;
 };
 
-/// Whether the arc a-b crosses one of the borders of `parts` lunes (a half great circle each).
-bool crosses_a_border(const Vec3 &a, const Vec3 &b, int parts) {
-    for (int k = 0; k < parts; ++k) {
-        const Vec3 n = border_normal(k, parts);
-        if ((dot(a, n) > 0) != (dot(b, n) > 0) &&
-            dot(a + b, border_direction(k, parts)) > 0) // on the border's half of its circle
-            return true;
-    }
-    return false;
-}
-
 /// The rings that bound some of the ocean mesh_boundary keeps (the largest component, or all
 /// with keep_inland_seas), told on the triangulation of the boundary nodes alone, as
 /// classify_ocean does; the components (of the whole ocean) go to report.components. `parts` 0
@@ -96,9 +85,10 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     if (parts > 1 && options.inlet_width > 0 && !boundary.empty()) {
         const std::size_t first = m.directed.size();
         close_inlets(m, options, local);
+        // A segment crosses a border where its ends lie in two parts (as split_boundary cuts).
         InletCut cut =
             rings_with_inlets_closed(m, boundary, ids, first, [&](const Vec3 &a, const Vec3 &b) {
-                return crosses_a_border(a, b, parts);
+                return part_of(a, parts) != part_of(b, parts);
             });
         rings = std::move(cut.rings);
         mouths = std::move(cut.mouths);

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <ranges>
 #include <set>
 #include <unordered_map>
 
@@ -44,15 +45,14 @@ public:
     explicit DirectedEdges(const std::vector<BoundaryEdge> &boundary) {
         keys_.reserve(boundary.size());
         for (const BoundaryEdge &e : boundary)
-            keys_.push_back(key(e.a, e.b));
+            keys_.push_back(edge_key(e.a, e.b));
         std::sort(keys_.begin(), keys_.end());
     }
     bool has(NodeIndex a, NodeIndex b) const {
-        return std::binary_search(keys_.begin(), keys_.end(), key(a, b));
+        return std::binary_search(keys_.begin(), keys_.end(), edge_key(a, b));
     }
 
 private:
-    static std::uint64_t key(NodeIndex a, NodeIndex b) { return (std::uint64_t(a) << 32) | b; }
     std::vector<std::uint64_t> keys_;
 };
 
@@ -257,12 +257,8 @@ std::vector<char> border_zone(const Mesh &mesh, const Borders &borders) {
     for (const auto &list : border_nodes(mesh, borders, Among::all_nodes))
         for (const auto &x : list)
             zone[x.second] = 1;
-    for (char ring = 1; ring < zone_rings; ++ring)
-        for (const auto &f : mesh.faces)
-            if (zone[f[0]] == ring || zone[f[1]] == ring || zone[f[2]] == ring)
-                for (NodeIndex v : f)
-                    if (!zone[v])
-                        zone[v] = static_cast<char>(ring + 1);
+    grow_rings(mesh, std::views::iota(std::uint32_t{0}, std::uint32_t(mesh.faces.size())), zone,
+               zone_rings);
     return zone;
 }
 

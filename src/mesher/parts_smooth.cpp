@@ -19,10 +19,6 @@ namespace {
 constexpr double search_below = 0.8;
 constexpr int search_steps = 16; // the worst face's search: its steps
 
-std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
-    return (std::uint64_t(a) << 32) | b;
-}
-
 /// The worst quality of `faces`, -1 when one of them is folded.
 double worst_quality(const Mesh &mesh, const std::vector<std::uint32_t> &faces) {
     double q = 1;

@@ -10,7 +10,27 @@
 
 namespace globemesh::parts_detail {
 
-/// The face of each directed edge (a << 32 | b), of the zone's faces: the flips keep it. An open
+/// The directed edge a -> b as one 64-bit key (FaceOfEdge's, the join's boundary edges').
+inline std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
+    return (std::uint64_t(a) << 32) | b;
+}
+
+/// Numbers the rings of faces around the nodes marked 1 in `ring`, over the faces `faces`
+/// (indices into mesh.faces): the nodes of a face with a corner at r, not numbered yet, get
+/// r + 1, up to `last`.
+template <class FaceIndices>
+void grow_rings(const Mesh &mesh, const FaceIndices &faces, std::vector<char> &ring, char last) {
+    for (char r = 1; r < last; ++r)
+        for (const auto f : faces) {
+            const auto &t = mesh.faces[f];
+            if (ring[t[0]] == r || ring[t[1]] == r || ring[t[2]] == r)
+                for (NodeIndex v : t)
+                    if (!ring[v])
+                        ring[v] = static_cast<char>(r + 1);
+        }
+}
+
+/// The face of each directed edge (edge_key), of the zone's faces: the flips keep it. An open
 /// addressing table (linear probes, erased slots marked): std::unordered_map's node per entry
 /// made the flips and its building most of the join's smoothing time.
 class FaceOfEdge {

@@ -60,20 +60,6 @@ NearBorders near_borders(const Mesh &mesh, const std::vector<Vec3> &normals, dou
     return near;
 }
 
-/// Numbers the rings of faces around the nodes marked 1 in `ring` over `faces`: the nodes of a
-/// face with a corner at r, not numbered yet, get r + 1, up to `last`.
-void grow_rings(const Mesh &mesh, const std::vector<std::uint32_t> &faces, std::vector<char> &ring,
-                char last) {
-    for (char r = 1; r < last; ++r)
-        for (std::uint32_t f : faces) {
-            const auto &t = mesh.faces[f];
-            if (ring[t[0]] == r || ring[t[1]] == r || ring[t[2]] == r)
-                for (NodeIndex v : t)
-                    if (!ring[v])
-                        ring[v] = static_cast<char>(r + 1);
-        }
-}
-
 /// The band to re-mesh: its faces and the removed nodes.
 struct Band {
     std::vector<char> removed;         // per node
@@ -152,7 +138,7 @@ std::vector<std::pair<NodeIndex, NodeIndex>> band_outline(const Mesh &mesh, cons
         const auto &t = mesh.faces[f];
         for (int i = 0; i < 3; ++i) {
             const NodeIndex a = t[i], b = t[(i + 1) % 3];
-            if (!face_of.find((std::uint64_t(b) << 32) | a))
+            if (!face_of.find(edge_key(b, a)))
                 outline.push_back({a, b});
         }
     }
