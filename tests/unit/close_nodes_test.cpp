@@ -217,19 +217,21 @@ TEST(CloseNodes, a_segment_under_h_over_4_loses_an_end_where_the_coast_moves_und
 
 // A sea at h = 20 km whose coast at x = 0 has an inlet 3 km wide and 10 km long (it closes: under
 // h/2 wide, under h^2 of water); its mouth's corners lie 20 m off the line of their neighbours
-// along the closed coast (those 5.2 km away, over h/4), the mouth 3 km long (under h/4).
-TEST(CloseNodes, a_closed_inlets_mouth_keeps_its_corners) {
+// along the closed coast (those 5.2 km away, over h/4), the mouth 3 km long (under h/4). With
+// `cut`, the inlet's nodes are left out: its mouth is a coast segment.
+Boundary sea_with_inlet(bool cut) {
+    std::vector<LonLat> coast = {{0, 2},           {0.0005, 0.06}, {0, 0.0135},     {-0.09, 0.0135},
+                                 {-0.09, -0.0135}, {0, -0.0135},   {0.0005, -0.06}, {0, -2},
+                                 {4, -2},          {4, 2}};
+    if (cut)
+        coast.erase(coast.begin() + 3, coast.begin() + 5);
     Boundary b;
-    b.rings.push_back(ring_through({{0, 2},
-                                    {0.0005, 0.06},
-                                    {0, 0.0135},
-                                    {-0.09, 0.0135},
-                                    {-0.09, -0.0135},
-                                    {0, -0.0135},
-                                    {0.0005, -0.06},
-                                    {0, -2},
-                                    {4, -2},
-                                    {4, 2}}));
+    b.rings.push_back(ring_through(coast));
+    return b;
+}
+
+TEST(CloseNodes, a_closed_inlets_mouth_keeps_its_corners) {
+    const Boundary b = sea_with_inlet(false);
     const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
     MesherReport report;
     const MesherOptions options;
@@ -250,15 +252,7 @@ TEST(CloseNodes, the_mouth_corners_given_stay_where_the_inlet_was_cut_before) {
     // from the rings before the split: a part sees the mouth's corners as plain coast nodes,
     // which the merge took (every inlet cut, GSHHG low at 20 km in 2 parts: 162 merged against
     // 45 in one part). It keeps those it is given, as one part keeps a mouth's corners.
-    Boundary b;
-    b.rings.push_back(ring_through({{0, 2},
-                                    {0.0005, 0.06},
-                                    {0, 0.0135},
-                                    {0, -0.0135},
-                                    {0.0005, -0.06},
-                                    {0, -2},
-                                    {4, -2},
-                                    {4, 2}}));
+    const Boundary b = sea_with_inlet(true);
     const std::function<double(const Vec3 &)> size = [](const Vec3 &) { return 20.0; };
     auto merged = [&](const MesherOptions &options) {
         MesherReport report;
