@@ -257,8 +257,7 @@ std::vector<char> border_zone(const Mesh &mesh, const Borders &borders) {
     for (const auto &list : border_nodes(mesh, borders, Among::all_nodes))
         for (const auto &x : list)
             zone[x.second] = 1;
-    grow_rings(mesh, std::views::iota(std::uint32_t{0}, std::uint32_t(mesh.faces.size())), zone,
-               zone_rings);
+    grow_rings(mesh, nullptr, zone, zone_rings);
     return zone;
 }
 

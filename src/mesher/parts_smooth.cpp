@@ -243,6 +243,24 @@ void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, Face
     }
 }
 
+void grow_rings(const Mesh &mesh, const std::vector<std::uint32_t> *faces, std::vector<char> &ring,
+                char last) {
+    auto grow = [&](const std::array<NodeIndex, 3> &t, char r) {
+        if (ring[t[0]] == r || ring[t[1]] == r || ring[t[2]] == r)
+            for (NodeIndex v : t)
+                if (!ring[v])
+                    ring[v] = static_cast<char>(r + 1);
+    };
+    for (char r = 1; r < last; ++r) {
+        if (faces)
+            for (std::uint32_t f : *faces)
+                grow(mesh.faces[f], r);
+        else
+            for (const auto &t : mesh.faces)
+                grow(t, r);
+    }
+}
+
 /// The faces with a node in the zone: the only ones the join's flips and smoothing rewrite (a
 /// flip turns two of them into two others of the same four nodes).
 std::vector<std::uint32_t> zone_faces(const Mesh &mesh, const std::vector<char> &zone) {

@@ -15,20 +15,11 @@ inline std::uint64_t edge_key(NodeIndex a, NodeIndex b) {
     return (std::uint64_t(a) << 32) | b;
 }
 
-/// Numbers the rings of faces around the nodes marked 1 in `ring`, over the faces `faces`
-/// (indices into mesh.faces): the nodes of a face with a corner at r, not numbered yet, get
-/// r + 1, up to `last`.
-template <class FaceIndices>
-void grow_rings(const Mesh &mesh, const FaceIndices &faces, std::vector<char> &ring, char last) {
-    for (char r = 1; r < last; ++r)
-        for (const auto f : faces) {
-            const auto &t = mesh.faces[f];
-            if (ring[t[0]] == r || ring[t[1]] == r || ring[t[2]] == r)
-                for (NodeIndex v : t)
-                    if (!ring[v])
-                        ring[v] = static_cast<char>(r + 1);
-        }
-}
+/// Numbers the rings of faces around the nodes marked 1 in `ring`, over the faces listed in
+/// `faces` (indices into mesh.faces; null: all of them): the nodes of a face with a corner at r,
+/// not numbered yet, get r + 1, up to `last`.
+void grow_rings(const Mesh &mesh, const std::vector<std::uint32_t> *faces, std::vector<char> &ring,
+                char last);
 
 /// The face of each directed edge (edge_key), of the zone's faces: the flips keep it. An open
 /// addressing table (linear probes, erased slots marked): std::unordered_map's node per entry

@@ -80,7 +80,7 @@ std::vector<char> blocked_nodes(const Mesh &mesh, const std::vector<char> &ring,
     for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
         if (ring[v] && !blocked[v] && size_km(mesh.nodes[v]) < lattice_level * lattice_km)
             blocked[v] = 1;
-    grow_rings(mesh, near_faces, blocked, blocked_rings + 1);
+    grow_rings(mesh, &near_faces, blocked, blocked_rings + 1);
     return blocked;
 }
 
@@ -344,7 +344,7 @@ std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vecto
     std::vector<char> ring(mesh.nodes.size(), 0); // rings of faces from the border nodes
     for (std::size_t v = 0; v < zone.size(); ++v)
         ring[v] = zone[v] == 1;
-    grow_rings(mesh, near_nodes.faces, ring, looked_rings);
+    grow_rings(mesh, &near_nodes.faces, ring, looked_rings);
     const Band band = find_band(mesh, ring, near_nodes, lattice, size_km, lattice_km);
     if (band.removed_count == 0)
         return 0;
