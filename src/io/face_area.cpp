@@ -7,6 +7,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 
+#include "fresh_memory.hpp"
 #include "ordered_blocks.hpp"
 
 namespace globemesh::io {
@@ -127,17 +128,17 @@ double polygon_area_m2(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
 GeodesicFaceAreas::GeodesicFaceAreas(const MeshTopology &topo) : topo_(topo) {
     const Ellipsoid &w = wgs84();
     const auto &nodes = topo.mesh->nodes;
-    authalic_.resize(nodes.size());
+    authalic_ = fresh_array<Point>(nodes.size());
     for_each_range(nodes.size(), [&](std::size_t first, std::size_t last) {
         for (std::size_t i = first; i < last; ++i)
-            authalic_[i] = to_authalic(w, nodes[i]);
+            authalic_[i] = Point(to_authalic(w, nodes[i]));
     });
-    side_.resize(topo.edge_count());
-    for_each_range(side_.size(), [&](std::size_t first, std::size_t last) {
+    side_ = fresh_array<double>(topo.edge_count());
+    for_each_range(topo.edge_count(), [&](std::size_t first, std::size_t last) {
         for (std::size_t e = first; e < last; ++e) {
             const auto [a, b] = topo.edge_nodes(e);
             side_[e] = side_term(w, nodes[std::size_t(a)], nodes[std::size_t(b)],
-                                 authalic_[std::size_t(a)], authalic_[std::size_t(b)]);
+                                 authalic_[std::size_t(a)].vec(), authalic_[std::size_t(b)].vec());
         }
     });
 }
@@ -151,7 +152,8 @@ double GeodesicFaceAreas::face_m2(std::size_t f, const std::int32_t *edges_of_f)
         if (const Vec3 d = v[(k + 1) % 3] - v[k]; dot(d, d) > longest_chord * longest_chord)
             return polygon_area_m2(v[0], v[1], v[2]);
     const Ellipsoid &w = wgs84();
-    const Vec3 s[3] = {authalic_[face[0]], authalic_[face[1]], authalic_[face[2]]};
+    const Vec3 s[3] = {authalic_[face[0]].vec(), authalic_[face[1]].vec(),
+                       authalic_[face[2]].vec()};
     // The spherical triangle's excess, tan(E / 2) = det / (1 + a.b + b.c + c.a), the determinant
     // from the sides (b - a, c - a) to keep its digits on small faces.
     const double det = dot(s[0], cross(s[1] - s[0], s[2] - s[0]));

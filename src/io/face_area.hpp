@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "globemesh/sphere.hpp"
@@ -40,9 +41,16 @@ public:
     double face_m2(std::size_t f, const std::int32_t *edges_of_f) const;
 
 private:
+    /// A Vec3 without default member initializers, which fresh_array can leave unwritten.
+    struct Point {
+        double x, y, z;
+        Point() = default;
+        explicit Point(const Vec3 &v) : x(v.x), y(v.y), z(v.z) {}
+        Vec3 vec() const { return {x, y, z}; }
+    };
     const MeshTopology &topo_;
-    std::vector<Vec3> authalic_; ///< each node's image on the authalic sphere
-    std::vector<double> side_;   ///< each edge's side term (m2), in its own direction
+    std::unique_ptr<Point[]> authalic_; ///< each node's image on the authalic sphere
+    std::unique_ptr<double[]> side_;    ///< each edge's side term (m2), in its own direction
 };
 
 /// The area (m2) of the geodesic triangle abc (unit vectors of geodetic lon/lat, as

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <string>
 
+#include "fresh_memory.hpp"
 #include "globemesh/error.hpp"
 #include "ordered_blocks.hpp"
 
@@ -107,13 +108,16 @@ MeshTopology build_topology(const Mesh &mesh) {
         std::uint32_t a = face[h % 3], b = face[(h % 3 + 1) % 3];
         return a < b ? std::pair{a, b} : std::pair{b, a};
     };
-    std::vector<std::uint32_t> start(nn + 1, 0);
+    // The scratch and the edges are fresh memory (fresh_memory.hpp), at 1.7e7 nodes over a GB.
+    auto start = fresh_array<std::uint32_t>(nn + 1);
+    std::fill(start.get(), start.get() + nn + 1, 0);
     for (std::uint32_t h = 0; h < nh; ++h)
         ++start[ends(h).first + 1];
-    std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<std::uint32_t> bucket(nh);
+    std::partial_sum(start.get(), start.get() + nn + 1, start.get());
+    auto bucket = fresh_array<std::uint32_t>(nh);
     {
-        std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+        auto fill = fresh_array<std::uint32_t>(nn);
+        std::copy(start.get(), start.get() + nn, fill.get());
         for (std::uint32_t h = 0; h < nh; ++h)
             bucket[fill[ends(h).first]++] = h;
     }
@@ -124,14 +128,14 @@ MeshTopology build_topology(const Mesh &mesh) {
     // of the half-edges (the keys are distinct: the same order on any number of threads).
     auto sort_nodes = [&](std::size_t v0, std::size_t v1) {
         for (std::size_t v = v0; v < v1; ++v)
-            std::sort(bucket.begin() + start[v], bucket.begin() + start[v + 1], by_larger_node);
+            std::sort(bucket.get() + start[v], bucket.get() + start[v + 1], by_larger_node);
     };
     const std::size_t parts = nh < sort_alone ? 1 : block_threads();
     std::vector<std::size_t> cut{0};
     for (std::size_t k = 1; k < parts; ++k)
         cut.push_back(std::size_t(
-            std::upper_bound(start.begin(), start.end() - 1, std::uint32_t(nh * k / parts)) -
-            start.begin()));
+            std::upper_bound(start.get(), start.get() + nn, std::uint32_t(nh * k / parts)) -
+            start.get()));
     cut.push_back(nn);
     for_each_part(parts, [&](std::size_t k) { sort_nodes(cut[k], cut[k + 1]); });
 
@@ -157,19 +161,20 @@ MeshTopology build_topology(const Mesh &mesh) {
     for_each_edge([&](std::size_t, std::size_t, std::size_t) { ++ne; });
     MeshTopology t;
     t.mesh = &mesh;
-    t.edge_halves.reserve(ne); // exactly: growing by push_back would double it
-    t.node_edges.assign(nn + 1, 0);
+    fresh_resize(t.edge_halves, ne);
+    fresh_resize(t.node_edges, nn + 1);
+    std::fill(t.node_edges.begin(), t.node_edges.end(), 0);
+    std::size_t e = 0;
     for_each_edge([&](std::size_t i, std::size_t j, std::size_t v) {
         if (j - i == 1)
-            t.boundary_edges.push_back(std::int32_t(t.edge_halves.size()));
-        t.edge_halves.push_back(
-            {bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge});
-        t.node_edges[v + 1] = std::uint32_t(t.edge_halves.size());
+            t.boundary_edges.push_back(std::int32_t(e));
+        t.edge_halves[e++] = {bucket[i], j - i == 2 ? bucket[i + 1] : MeshTopology::no_half_edge};
+        t.node_edges[v + 1] = std::uint32_t(e);
     });
     for (std::size_t v = 0; v < nn; ++v)
         t.node_edges[v + 1] = std::max(t.node_edges[v + 1], t.node_edges[v]);
-    std::vector<std::uint32_t>().swap(start);
-    std::vector<std::uint32_t>().swap(bucket);
+    start.reset();
+    bucket.reset();
 
     // Tags: boundary edges from mesh.boundary by node pair (binary search on sorted keys).
     std::vector<std::pair<std::uint64_t, int>> tagged;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "fresh_memory.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/sphere.hpp"
 #include "globemesh/ugrid.hpp"
@@ -28,11 +29,12 @@ struct MeshTopology {
     static constexpr std::uint32_t no_half_edge = UINT32_MAX;
 
     const Mesh *mesh = nullptr; ///< the mesh it was built from, which must outlive it
-    std::vector<std::array<std::uint32_t, 2>>
-        edge_halves; ///< second is no_half_edge on the boundary
+    using HalfPair = std::array<std::uint32_t, 2>;
+    /// Second is no_half_edge on the boundary.
+    std::vector<HalfPair, FreshAllocator<HalfPair>> edge_halves;
     /// The edges whose smaller node is v are node_edges[v] .. node_edges[v + 1] - 1 (nodes + 1
     /// entries).
-    std::vector<std::uint32_t> node_edges;
+    std::vector<std::uint32_t, FreshAllocator<std::uint32_t>> node_edges;
     std::vector<std::int32_t> boundary_edges; ///< edge indices with one face, ascending
     std::vector<int> boundary_tags;           ///< EdgeTag of each of boundary_edges
 
