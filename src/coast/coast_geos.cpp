@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "coast_internal.hpp"
 #include "coast_load_internal.hpp"
 #include "coast_parallel.hpp"
+#include "disjoint_sets.hpp"
 #include "globemesh/error.hpp"
 
 namespace globemesh::coast_detail {
@@ -39,23 +39,14 @@ GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
     return std::move(parts.front());
 }
 
-/// Union-find over polygon indices (path halving).
-struct Groups {
-    std::vector<std::size_t> parent;
-    explicit Groups(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-    std::size_t find(std::size_t i) {
-        while (parent[i] != i)
-            i = parent[i] = parent[parent[i]];
-        return i;
-    }
-};
+/// Union-find over polygon indices.
+using Groups = DisjointSets<std::size_t>;
 
 /// Joins the polygons that intersect: an STR tree's candidates confirmed by GEOS's prepared test.
 void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
                        const std::vector<int> &vertices, Groups &groups) {
     const std::size_t n = polys.size();
     auto find = [&](std::size_t i) { return groups.find(i); };
-    std::vector<std::size_t> &parent = groups.parent;
     TreePtr tree(GEOSSTRtree_create_r(geos.get(), 10), GeosDeleter{geos.get()});
     for (std::size_t i = 0; i < n; ++i)
         GEOSSTRtree_insert_r(geos.get(), tree.get(), polys[i].get(), reinterpret_cast<void *>(i));
@@ -108,7 +99,7 @@ void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
     for (std::size_t k = 0; k < pairs.size(); ++k) {
         const auto [i, j] = pairs[k];
         if (meet[k] && find(i) != find(j))
-            parent[find(j)] = find(i);
+            groups.join(i, j);
     }
 }
 
@@ -118,7 +109,6 @@ void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Group
                std::vector<char> &near_only) {
     const std::size_t n = polys.size();
     auto find = [&](std::size_t i) { return groups.find(i); };
-    std::vector<std::size_t> &parent = groups.parent;
     std::vector<PolygonRings> outlines(n);
     for (std::size_t i = 0; i < n; ++i)
         outlines[i] = polygon_rings(geos, polys[i].get());
@@ -126,7 +116,7 @@ void join_near(Geos &geos, const std::vector<GeomPtr> &polys, double grid, Group
         if (find(i) == find(j))
             continue;
         near_only[j] = 1;
-        parent[find(j)] = find(i);
+        groups.join(i, j);
     }
 }
 

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <string>
 
+#include "disjoint_sets.hpp"
 #include "fresh_memory.hpp"
 #include "globemesh/error.hpp"
 #include "ordered_blocks.hpp"
@@ -227,25 +228,17 @@ std::array<std::int32_t, 3> face_faces(const MeshTopology &topo, const std::int3
 }
 
 std::size_t count_boundary_loops(const MeshTopology &topo, std::size_t node_count) {
-    std::vector<std::uint32_t> parent(node_count);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](std::uint32_t x) {
-        while (parent[x] != x)
-            x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    DisjointSets<> loops_of(node_count);
     std::vector<char> on_boundary(node_count, 0);
     for (auto e : topo.boundary_edges) {
         const auto nodes = topo.edge_nodes(std::size_t(e));
-        auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
+        const auto a = std::uint32_t(nodes[0]), b = std::uint32_t(nodes[1]);
         on_boundary[a] = on_boundary[b] = 1;
-        a = find(a), b = find(b);
-        if (a != b)
-            parent[a] = b;
+        loops_of.join(b, a);
     }
     std::size_t loops = 0;
     for (std::uint32_t v = 0; v < node_count; ++v)
-        if (on_boundary[v] && find(v) == v)
+        if (on_boundary[v] && loops_of.find(v) == v)
             ++loops;
     return loops;
 }

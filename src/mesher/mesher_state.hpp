@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "disjoint_sets.hpp"
 #include "globemesh/delaunay.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/mesher.hpp"
@@ -109,30 +110,7 @@ void renumber_per_vertex(std::vector<T> &per_vertex, const std::vector<VertexId>
     per_vertex.swap(out);
 }
 
-// Disjoint sets of 0 .. n - 1: union-find with path halving.
-class DisjointSets {
-public:
-    explicit DisjointSets(std::size_t n) : parent_(n) {
-        for (std::size_t i = 0; i < n; ++i)
-            parent_[i] = static_cast<std::uint32_t>(i);
-    }
-    std::uint32_t find(std::uint32_t i) {
-        while (parent_[i] != i)
-            i = parent_[i] = parent_[parent_[i]];
-        return i;
-    }
-    // b's set joins a's: b's root then points at a's.
-    void join(std::uint32_t a, std::uint32_t b) { parent_[find(b)] = find(a); }
-    // Each element's root, in place (roots stay roots); the sets are spent.
-    std::vector<std::uint32_t> roots() && {
-        for (std::uint32_t i = 0; i < parent_.size(); ++i)
-            parent_[i] = find(i);
-        return std::move(parent_);
-    }
-
-private:
-    std::vector<std::uint32_t> parent_;
-};
+using DisjointSets = globemesh::DisjointSets<>;
 
 // The state shared by the steps: the triangulation, the boundary segments with their kinds,
 // the size field.

@@ -9,6 +9,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "disjoint_sets.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/parts.hpp"
 #include "globemesh/predicates.hpp"
@@ -272,25 +273,18 @@ void split_pinched(Mesh &mesh, const std::vector<char> &zone) {
                 star[v].push_back(f);
     for (const auto &[v, faces] : star) {
         // Faces sharing an edge at v are one fan (union-find over the star).
-        std::vector<std::size_t> root(faces.size());
-        for (std::size_t i = 0; i < faces.size(); ++i)
-            root[i] = i;
-        auto find = [&](std::size_t i) {
-            while (root[i] != i)
-                i = root[i] = root[root[i]];
-            return i;
-        };
+        DisjointSets<std::size_t> fan(faces.size());
         std::map<NodeIndex, std::size_t> by_neighbour;
         for (std::size_t i = 0; i < faces.size(); ++i)
             for (NodeIndex u : mesh.faces[faces[i]])
                 if (u != v) {
                     const auto [it, added] = by_neighbour.emplace(u, i);
                     if (!added)
-                        root[find(i)] = find(it->second);
+                        fan.join(it->second, i);
                 }
         std::map<std::size_t, std::vector<std::uint32_t>> fans;
         for (std::size_t i = 0; i < faces.size(); ++i)
-            fans[find(i)].push_back(faces[i]);
+            fans[fan.find(i)].push_back(faces[i]);
         if (fans.size() < 2)
             continue;
         for (auto it = std::next(fans.begin()); it != fans.end(); ++it) {

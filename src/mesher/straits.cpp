@@ -70,18 +70,14 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
     for (int k = 0; k < 2 * spokes; ++k)
         if (stretch[k % spokes] < 0 && clearance[index(rings, k)] >= 0)
             stretch[k % spokes] = stretch[(k + spokes - 1) % spokes];
-    std::vector<int> order, parent(n), reached(n, -1); // reached: a stretch the component touches
+    std::vector<int> order, reached(n, -1); // reached: a stretch the component touches
     for (int i = 0; i < n; ++i)
         if (clearance[i] >= 0)
             order.push_back(i);
     std::sort(order.begin(), order.end(),
               [&](int x, int y) { return clearance[x] > clearance[y]; });
-    std::iota(parent.begin(), parent.end(), 0);
-    auto root = [&](int x) {
-        while (parent[x] != x)
-            x = parent[x] = parent[parent[x]];
-        return x;
-    };
+    DisjointSets components(static_cast<std::size_t>(n));
+    auto root = [&](int x) { return int(components.find(std::uint32_t(x))); };
     std::vector<char> added(n, 0);
     for (const int i : order) {
         added[i] = 1;
@@ -104,7 +100,7 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
                 continue;
             if (reached[a] >= 0 && reached[b] >= 0 && reached[a] != reached[b])
                 return 2 * clearance[i];
-            parent[b] = a;
+            components.join(std::uint32_t(a), std::uint32_t(b));
             if (reached[a] < 0)
                 reached[a] = reached[b];
         }
