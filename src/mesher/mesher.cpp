@@ -87,7 +87,7 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
 
     // Conversion to Mesh (output.cpp); a part's border nodes stay whole for the join.
     keep_border_nodes_whole(m, options.lattice_within);
-    Mesh mesh = to_mesh(m);
+    Mesh mesh = to_mesh(m, options.lattice_within);
     globemesh::report(progress, 1.0, "improve");
     return mesh;
 }

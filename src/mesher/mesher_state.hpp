@@ -572,8 +572,10 @@ void close_dead_ends(Mesher &m, const MesherOptions &options, MesherReport &repo
 void blunt_sharp_corners(Mesher &m, const MesherOptions &options);
 
 // output.cpp: the ocean triangles as a Mesh (nodes a closed strait pinched split, the seas it cut
-// off, sharp corners and the target size per node in the report and the mesh).
-Mesh to_mesh(Mesher &m);
+// off, sharp corners and the target size per node in the report and the mesh). A part (borders:
+// MesherOptions::lattice_within) reports only its cuts' points: its seas are measured on the
+// joined mesh (mesh_parts' basins_cut_off).
+Mesh to_mesh(Mesher &m, const std::vector<Vec3> &borders);
 /// Takes off Mesher::pinched the nodes on one of `borders`' planes (a part's borders,
 /// MesherOptions::lattice_within): the other part's faces may join their fans, and join_parts
 /// splits those still pinched on the joined mesh.

@@ -197,7 +197,7 @@ void keep_border_nodes_whole(Mesher &m, const std::vector<Vec3> &borders) {
     });
 }
 
-Mesh to_mesh(Mesher &m) {
+Mesh to_mesh(Mesher &m, const std::vector<Vec3> &borders) {
     SphericalDelaunay &dt = m.dt;
     // The faces first, then the triangulation goes and its points become the nodes in place: the
     // triangulation and the output nodes never coexist (this is the mesher's peak).
@@ -229,7 +229,7 @@ Mesh to_mesh(Mesher &m) {
     mesh.nodes.insert(mesh.nodes.end(), split.fan_point.begin(), split.fan_point.end());
     mesh.nodes.shrink_to_fit(); // the triangulation is gone: the copy is not the peak
     std::vector<NodeIndex>().swap(node_of);
-    if (!cut_nodes.empty())
+    if (!cut_nodes.empty() && borders.empty())
         seas_cut_off(mesh, cut_nodes, m.report);
     for (const NodeIndex n : cut_nodes)
         m.report.cut_points.push_back(mesh.nodes[n]);
