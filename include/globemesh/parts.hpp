@@ -29,22 +29,30 @@ inline int parts_for_nodes(std::size_t estimated_nodes) {
     return estimated_nodes < auto_parts_nodes ? 1 : auto_parts;
 }
 
-/// The longitude (degrees) of border k of n parts: off the meridians where source data has
-/// vertices by construction (0, +-90, +-180).
-double part_border_lon(int k, int parts);
-
-/// The normal of border k's meridian plane: dot(p, normal) > 0 east of the border.
-Vec3 border_normal(int k, int parts);
+/// The first border's longitude (degrees) where none is asked for and none chosen: off the
+/// meridians where source data has vertices by construction (0, +-90, +-180).
+inline constexpr double default_border_lon = -90 + 0.0123456789;
 
 /// A node this close to a border's plane (radians) lies on the border: border nodes are on it
 /// to rounding (1e-16, as split_boundary puts them), every other node a segment's length away.
 inline constexpr double on_border_tolerance = 1e-12;
 
-/// Where border k's meridian meets the equator: dot(p, direction) > 0 on its half of the plane.
-Vec3 border_direction(int k, int parts);
+/// The sphere cut into `count` lunes: border k is the meridian at first_lon + 360 k / count
+/// degrees, and part k lies east of border k and west of border k + 1.
+struct Lunes {
+    int count = 1;
+    double first_lon = default_border_lon;
 
-/// The lune (0 .. parts - 1) holding p: between part_border_lon(k) and part_border_lon(k + 1).
-int part_of(const Vec3 &p, int parts);
+    /// The longitude (degrees) of border k.
+    double border_lon(int k) const { return first_lon + 360.0 * k / count; }
+    /// The normal of border k's meridian plane: dot(p, normal) > 0 east of the border.
+    Vec3 border_normal(int k) const;
+    /// Where border k's meridian meets the equator: dot(p, direction) > 0 on its half of the
+    /// plane.
+    Vec3 border_direction(int k) const;
+    /// The lune (0 .. count - 1) holding p.
+    int part_of(const Vec3 &p) const;
+};
 
 /// `boundary` cut into the rings of each part: each ring piece inside a part, joined along the
 /// part's borders by nodes spaced by size_km (open segments), a deterministic function of the
@@ -58,14 +66,14 @@ struct PartBoundary {
     Boundary boundary;
     bool has_ocean = false;
 };
-std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km, int parts,
-                                         const LandTest *land);
+std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km,
+                                         const Lunes &lunes, const LandTest *land);
 
 /// The part meshes joined: nodes equal on a border are one node, a border segment one side
 /// split is split on the other (a fan), boundary edges with their reverse become interior.
 /// With the parts' lattice size (MesherOptions::lattice_km) and size field, the band along the
 /// borders is made the lattice again where it is open ocean at that size.
-Mesh join_parts(std::vector<Mesh> &parts_meshes, int parts, const SizeFn &size_km = {},
+Mesh join_parts(std::vector<Mesh> &parts_meshes, const Lunes &lunes, const SizeFn &size_km = {},
                 double lattice_km = 0);
 
 /// mesh_boundary over `parts` parts, meshed on up to `threads` threads (0: one) and joined;

@@ -56,7 +56,7 @@ private:
 /// in both parts with faces as narrow as it. Throws DataError as mesh_boundary does when the
 /// node estimate passes max_nodes or max_memory.
 Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
-                          const MesherOptions &options, MesherReport &report, int &parts,
+                          const MesherOptions &options, MesherReport &report, Lunes &lunes,
                           std::vector<std::array<double, 3>> &mouths) {
     MesherReport local;
     Mesher m(SphericalDelaunay::Options{1e-12, options.seed}, size_km, local);
@@ -66,8 +66,8 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     estimate_nodes(m, options, false); // refused here as one part would be, before any part
     report.components = local.components;
     report.estimated_nodes = local.estimated_nodes;
-    if (parts == 0)
-        parts = parts_for_nodes(report.estimated_nodes);
+    if (lunes.count == 0)
+        lunes.count = parts_for_nodes(report.estimated_nodes);
     std::vector<char> ocean_ring;
     std::size_t offset = 0;
     for (const Ring &r : boundary.rings) {
@@ -82,13 +82,13 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
         offset += r.nodes.size();
     }
     std::vector<Ring> rings = boundary.rings;
-    if (parts > 1 && options.inlet_width > 0 && !boundary.empty()) {
+    if (lunes.count > 1 && options.inlet_width > 0 && !boundary.empty()) {
         const std::size_t first = m.directed.size();
         close_inlets(m, options, local);
         // A segment crosses a border where its ends lie in two parts (as split_boundary cuts).
         InletCut cut =
             rings_with_inlets_closed(m, boundary, ids, first, [&](const Vec3 &a, const Vec3 &b) {
-                return part_of(a, parts) != part_of(b, parts);
+                return lunes.part_of(a) != lunes.part_of(b);
             });
         rings = std::move(cut.rings);
         mouths = std::move(cut.mouths);
@@ -103,10 +103,10 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     return kept;
 }
 
-/// Lune k of `parts` as MesherOptions::lattice_within takes it: east of border k, west of
+/// Lune k of `lunes` as MesherOptions::lattice_within takes it: east of border k, west of
 /// border k + 1 (the part's ocean lies there, its borders being arcs of those meridians' planes).
-std::vector<Vec3> lune_normals(int k, int parts) {
-    return {border_normal(k, parts), -border_normal(k + 1, parts)};
+std::vector<Vec3> lune_normals(const Lunes &lunes, int k) {
+    return {lunes.border_normal(k), -lunes.border_normal(k + 1)};
 }
 
 /// Adds a part's report to the run's (counts summed, lists concatenated; not the components).
@@ -234,9 +234,10 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     report = MesherReport{};
     auto t0 = Clock::now();
     std::vector<std::array<double, 3>> mouths;
-    const bool chosen = parts == 0;
-    const Boundary kept = drop_inland_seas(boundary, size_km, options, report, parts, mouths);
-    if (chosen && parts == 1) {
+    Lunes lunes{parts};
+    const Boundary kept = drop_inland_seas(boundary, size_km, options, report, lunes, mouths);
+    parts = lunes.count;
+    if (parts == 1) { // chosen
         if (timings)
             timings->add("parts", seconds_since(t0)); // the pass that chose one part
         return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
@@ -246,7 +247,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     part_options.keep_inland_seas = true; // a sea cut by a border is two components
     part_options.mouth_corners = std::move(mouths);
     const std::vector<PartBoundary> split =
-        split_boundary(kept, size_km, parts, options.land.get());
+        split_boundary(kept, size_km, lunes, options.land.get());
     // The land test: each thread its own (the first the caller's, the others copies built on
     // their thread; the same answers), or one under a lock where it cannot be copied.
     threads = std::min<unsigned>(std::max(1u, threads), static_cast<unsigned>(split.size()));
@@ -271,7 +272,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
             lands[t] = copier();
         if (lands[t])
             lune.land = lands[t];
-        lune.lattice_within = lune_normals(static_cast<int>(k), parts);
+        lune.lattice_within = lune_normals(lunes, static_cast<int>(k));
         lune.lattice_share = 1.0 / parts;
         meshes[k] =
             mesh_boundary(split[k].boundary, size_km, lune, &reports[k], shared.part(k), &times[k]);
@@ -294,7 +295,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     // The lattice is stitched back only where the parts laid one (fill_lattice skips it when
     // the size field is below its largest value over most of the ocean).
     Mesh mesh =
-        join_parts(meshes, parts, size_km, report.lattice_nodes > 0 ? options.lattice_km : 0.0);
+        join_parts(meshes, lunes, size_km, report.lattice_nodes > 0 ? options.lattice_km : 0.0);
     basins_cut_off(mesh, report);
     if (timings)
         timings->add("join", seconds_since(t0));

@@ -57,13 +57,13 @@ private:
     std::vector<std::uint64_t> keys_;
 };
 
-/// The borders' planes and directions (border_normal, border_direction), computed once.
+/// The borders' planes and directions (Lunes::border_normal, border_direction), computed once.
 struct Borders {
     std::vector<Vec3> normal, direction;
-    explicit Borders(int parts) {
-        for (int k = 0; k < parts; ++k) {
-            normal.push_back(border_normal(k, parts));
-            direction.push_back(border_direction(k, parts));
+    explicit Borders(const Lunes &lunes) {
+        for (int k = 0; k < lunes.count; ++k) {
+            normal.push_back(lunes.border_normal(k));
+            direction.push_back(lunes.border_direction(k));
         }
     }
     /// Whether p lies on border k, within `tolerance` of its plane (radians).
@@ -333,7 +333,8 @@ void tag_border_coast(Mesh &mesh, const Borders &borders) {
 
 } // namespace
 
-Mesh join_parts(std::vector<Mesh> &meshes, int parts, const SizeFn &size_km, double lattice_km) {
+Mesh join_parts(std::vector<Mesh> &meshes, const Lunes &lunes, const SizeFn &size_km,
+                double lattice_km) {
     Mesh out;
     const auto first =
         std::find_if(meshes.begin(), meshes.end(), [](const Mesh &m) { return !m.faces.empty(); });
@@ -344,7 +345,7 @@ Mesh join_parts(std::vector<Mesh> &meshes, int parts, const SizeFn &size_km, dou
     for (const Field &f : first->face_fields)
         out.face_fields.push_back({f.name, f.long_name, f.units, f.standard_name, {}});
     out.attributes = first->attributes;
-    const Borders borders(parts);
+    const Borders borders(lunes);
     std::map<std::array<double, 3>, NodeIndex> border;
     Sizes total;
     for (const Mesh &m : meshes)

@@ -37,26 +37,26 @@ struct Node {
 };
 
 struct Splitter {
-    int n;
+    const Lunes &lunes;
     const SizeFn &size_km;
     std::vector<Crossing> crossings;
 
     /// Where arc a-b crosses border k's meridian, if it does.
     bool cross_border(const Vec3 &a, const Vec3 &b, int k, Vec3 &p) const {
-        const Vec3 normal = border_normal(k, n);
+        const Vec3 normal = lunes.border_normal(k);
         if ((dot(normal, a) > 0) == (dot(normal, b) > 0))
             return false;
         p = normalized(cross(cross(a, b), normal));
         if (dot(p, a + b) < 0)
             p = Vec3{-p.x, -p.y, -p.z};
-        return dot(p, border_direction(k, n)) > 0;
+        return dot(p, lunes.border_direction(k)) > 0;
     }
 
     /// Appends to `out` the crossings of arc a-b (kind `kind`), halving it where it crosses
     /// more than one border.
     void split_segment(const Vec3 &a, const Vec3 &b, SegmentKind kind, int depth,
                        std::vector<Node> &out) {
-        const int la = part_of(a, n), lb = part_of(b, n);
+        const int la = lunes.part_of(a), lb = lunes.part_of(b), n = lunes.count;
         if (la == lb)
             return;
         const int east = (la + 1) % n, west = (la + n - 1) % n;
@@ -82,7 +82,7 @@ struct Splitter {
 
     /// Whether p lies within excursion_fraction * h of border k's meridian plane.
     bool near_border(const Vec3 &p, int k) const {
-        return std::fabs(dot(p, border_normal(k, n))) <
+        return std::fabs(dot(p, lunes.border_normal(k))) <
                std::sin(excursion_fraction * km_to_rad(size_km(p)));
     }
 
@@ -198,7 +198,7 @@ struct Splitter {
     /// The nodes strictly between p and q (p south of q, both on border k's meridian), spaced
     /// by equal shares of the integral of ds / h.
     std::vector<Vec3> stretch_nodes(const Vec3 &p, const Vec3 &q, int k) const {
-        const double lon = part_border_lon(k, n) * deg_to_rad;
+        const double lon = lunes.border_lon(k) * deg_to_rad;
         auto at = [&](double lat) {
             return Vec3{std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon),
                         std::sin(lat)};
@@ -239,7 +239,7 @@ struct Splitter {
                 first = &c;
         if (first)
             return !first->east;
-        return !region && !(land && land->contains(border_direction(k, n)));
+        return !region && !(land && land->contains(lunes.border_direction(k)));
     }
 
     /// Border k's nodes from the south pole to the north: crossings, and the ocean stretches'
@@ -272,7 +272,7 @@ struct Splitter {
             if (crossings[on[i]].east == ocean)
                 throw DataError("parts: the coast does not alternate between land and ocean along "
                                 "the part border at longitude " +
-                                std::to_string(part_border_lon(k, n)) +
+                                std::to_string(lunes.border_lon(k)) +
                                 " (rings crossing); use --parts 1");
             out.push_back({to, SegmentKind::open, on[i]});
             ocean = crossings[on[i]].east;
@@ -290,7 +290,7 @@ struct Piece {
 };
 
 /// The pieces of a ring cut at its crossings (at least one), each with its part.
-void cut_pieces(const std::vector<Node> &ring, int n, std::vector<Piece> &pieces,
+void cut_pieces(const std::vector<Node> &ring, const Lunes &lunes, std::vector<Piece> &pieces,
                 std::vector<int> &piece_of_entry) {
     std::size_t start = 0;
     while (ring[start].crossing < 0)
@@ -303,7 +303,7 @@ void cut_pieces(const std::vector<Node> &ring, int n, std::vector<Piece> &pieces
             piece.exit = v.crossing;
             const Vec3 inside =
                 piece.nodes.size() > 1 ? piece.nodes[1].p : arc_midpoint(piece.nodes[0].p, v.p);
-            piece.part = part_of(inside, n);
+            piece.part = lunes.part_of(inside);
             piece_of_entry[piece.nodes[0].crossing] = static_cast<int>(pieces.size());
             pieces.push_back(std::move(piece));
             piece = Piece{};
@@ -363,36 +363,33 @@ void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces
 
 } // namespace
 
-double part_border_lon(int k, int parts) {
-    return -90 + 0.0123456789 + 360.0 * k / parts;
-}
-
-Vec3 border_normal(int k, int parts) {
-    const double lon = part_border_lon(k, parts) * deg_to_rad;
+Vec3 Lunes::border_normal(int k) const {
+    const double lon = border_lon(k) * deg_to_rad;
     return {-std::sin(lon), std::cos(lon), 0};
 }
 
-Vec3 border_direction(int k, int parts) {
-    const double lon = part_border_lon(k, parts) * deg_to_rad;
+Vec3 Lunes::border_direction(int k) const {
+    const double lon = border_lon(k) * deg_to_rad;
     return {std::cos(lon), std::sin(lon), 0};
 }
 
-int part_of(const Vec3 &p, int parts) {
-    double east = std::atan2(p.y, p.x) * rad_to_deg - part_border_lon(0, parts);
+int Lunes::part_of(const Vec3 &p) const {
+    double east = std::atan2(p.y, p.x) * rad_to_deg - first_lon;
     east -= 360 * std::floor(east / 360);
-    return std::min(parts - 1, static_cast<int>(east / (360.0 / parts)));
+    return std::min(count - 1, static_cast<int>(east / (360.0 / count)));
 }
 
-std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km, int parts,
-                                         const LandTest *land) {
-    Splitter s{parts, size_km, {}};
+std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km,
+                                         const Lunes &lunes, const LandTest *land) {
+    const int parts = lunes.count;
+    Splitter s{lunes, size_km, {}};
     std::vector<PartBoundary> out(static_cast<std::size_t>(parts));
     std::vector<std::vector<Node>> cut;
     for (const Ring &r : boundary.rings) {
         std::vector<Node> nodes = s.cut_ring(r);
         if (std::none_of(nodes.begin(), nodes.end(),
                          [](const Node &v) { return v.crossing >= 0; })) {
-            auto &b = out[static_cast<std::size_t>(part_of(nodes[0].p, parts))];
+            auto &b = out[static_cast<std::size_t>(lunes.part_of(nodes[0].p))];
             Ring kept; // r, less the excursions drop_excursions took
             for (const Node &v : nodes)
                 kept.nodes.push_back(v.p), kept.kinds.push_back(v.kind);
@@ -405,7 +402,7 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
     std::vector<Piece> pieces;
     std::vector<int> piece_of_entry(s.crossings.size(), -1);
     for (const auto &nodes : cut)
-        cut_pieces(nodes, parts, pieces, piece_of_entry);
+        cut_pieces(nodes, lunes, pieces, piece_of_entry);
     // A region's outline is made of open segments; a coast's rings have none.
     const bool region =
         std::any_of(boundary.rings.begin(), boundary.rings.end(), [](const Ring &r) {
@@ -430,7 +427,7 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
         b.has_ocean = b.has_ocean || !loop.empty();
     }
     for (const auto &island : boundary.dropped_islands)
-        out[static_cast<std::size_t>(part_of(island[0], parts))].boundary.dropped_islands.push_back(
+        out[static_cast<std::size_t>(lunes.part_of(island[0]))].boundary.dropped_islands.push_back(
             island);
     return out;
 }

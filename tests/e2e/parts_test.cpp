@@ -72,7 +72,7 @@ void expect_joined(const Mesh &mesh) {
 TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
     const SizeFn h = [](const Vec3 &) { return 500.0; };
     for (int parts : {2, 3, 6}) {
-        const auto split = split_boundary(Boundary{}, h, parts, nullptr);
+        const auto split = split_boundary(Boundary{}, h, Lunes{parts}, nullptr);
         ASSERT_EQ(split.size(), std::size_t(parts));
         std::multiset<std::tuple<double, double, double>> nodes;
         for (const auto &p : split) {
