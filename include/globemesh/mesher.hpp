@@ -85,6 +85,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -119,6 +120,9 @@ struct MesherOptions {
     /// may join its fans, and join_parts splits those still pinched.
     std::vector<Vec3> lattice_within;
     double lattice_share = 1;
+    /// mesh_parts: the longitude (degrees) of the lunes' first border; NaN, the default: chosen
+    /// from the inputs (docs/parallel.md, section 1).
+    double parts_border_lon = std::numeric_limits<double>::quiet_NaN();
     /// Coast nodes the close-node merge keeps (sorted as x, y, z): the corners of the inlets'
     /// mouths mesh_parts closed on the whole boundary before the split (those a border crosses),
     /// which a part's rings hold as plain coast nodes (one part keeps such a corner: land on
@@ -167,6 +171,7 @@ struct MesherReport {
     std::size_t encroached_splits = 0; ///< segments split during refinement and mending
     std::size_t estimated_nodes = 0; ///< the size field's node estimate, checked against max_nodes
     int parts = 1;                   ///< the parts meshed apart and joined (mesh_parts)
+    double parts_border_lon = 0;     ///< their first border's longitude, degrees (parts > 1)
     std::size_t sharp_corners = 0;   ///< boundary nodes with an ocean angle below 60 degrees
     std::size_t sharp_corner_faces = 0; ///< faces touching such a corner (quality reported apart)
     std::size_t inlets_closed =

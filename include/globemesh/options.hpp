@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -94,6 +95,9 @@ struct MeshingOptions {
     /// default, chooses from the node estimate (parts_for_nodes: 1 below 2e6 nodes, else 2), 1
     /// for a region: never from the core count.
     int parts = 0;
+    /// The longitude (degrees, -180..180) of the parts' first border; NaN, the default: chosen
+    /// from the inputs, balancing the parts' work and keeping the borders off the coasts.
+    double parts_border_lon = std::numeric_limits<double>::quiet_NaN();
     /// Threads meshing the parts at once, 0: one per core; the mesh never depends on it.
     int threads = 0;
 };

@@ -240,6 +240,12 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
                    "2 for a global mesh of 2e6 nodes or more, else 1)")
         ->group(mesher)
         ->type_name("N");
+    app.add_option("--parts-border", m.parts_border_lon,
+                   "Longitude of the parts' first border, degrees (default: chosen from the "
+                   "inputs, where the parts' work balances and the fewest coast nodes lie near a "
+                   "border)")
+        ->group(mesher)
+        ->type_name("LON");
     app.add_option("--threads", m.threads,
                    "Threads meshing the parts (0: one per core; never changes the mesh)")
         ->group(mesher)

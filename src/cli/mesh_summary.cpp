@@ -164,7 +164,8 @@ void print_coast(std::ostream &out, const OceanMesh &run) {
     out << "ocean components  " << ocean_components_text(m) << "\n";
     if (m.parts > 1)
         out << "parts             " << m.parts << " lunes meshed apart and joined (--parts; of "
-            << m.estimated_nodes << " nodes estimated)\n";
+            << m.estimated_nodes << " nodes estimated), the first border at "
+            << report_number(m.parts_border_lon) << " E (--parts-border)\n";
 }
 
 } // namespace

@@ -8,7 +8,7 @@ namespace globemesh::cli {
 namespace {
 
 /// Every MeshOptions field that a flag of `globemesh mesh` sets (mesh_command.cpp's MeshCommand).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 38> flags{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 39> flags{{
     {"coast", "--coast"},
     {"coast_layer", "--coast-layer"},
     {"coast_where", "--coast-where"},
@@ -47,6 +47,7 @@ constexpr std::array<std::pair<std::string_view, std::string_view>, 38> flags{{
     {"smooth_iterations", "--smooth"},
     {"seed", "--seed"},
     {"parts", "--parts"},
+    {"parts_border_lon", "--parts-border"},
     {"threads", "--threads"},
 }};
 

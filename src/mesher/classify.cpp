@@ -16,9 +16,11 @@ constexpr double estimate_reach = 32;
 /// a, b, c: on pieces split in four at the arcs' midpoints until the size varies little over
 /// each (estimate_ratio, estimate_reach), with each piece's 1/h^2 the mean of its corners' and
 /// centroid's. A size of metres at the coast and hundreds of km offshore is counted as it grows,
-/// not at its smallest over the whole triangle. Stops once `sum` passes `stop`.
+/// not at its smallest over the whole triangle. Stops once `sum` passes `stop`. `each` (may be
+/// empty) is told each piece's corners and nodes.
 void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const Vec3 &a,
-                       const Vec3 &b, const Vec3 &c, double stop, double &sum) {
+                       const Vec3 &b, const Vec3 &c, double stop, double &sum,
+                       const NodesAt &each) {
     struct Piece {
         Vec3 p[3];
         double h[3]; // radians
@@ -51,8 +53,12 @@ void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const
             stack.push_back({{mid[0], mid[1], mid[2]}, {hm[0], hm[1], hm[2]}});
             continue;
         }
-        if (area > 0)
-            sum += nodes_for_area(area, 1 / std::sqrt(inverse / 4));
+        if (area > 0) {
+            const double nodes = nodes_for_area(area, 1 / std::sqrt(inverse / 4));
+            sum += nodes;
+            if (each)
+                each(q.p[0], q.p[1], q.p[2], nodes);
+        }
     }
 }
 
@@ -289,7 +295,7 @@ void mark_sharp_corners(Mesher &m) {
     }
 }
 
-void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve) {
+void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve, const NodesAt &each) {
     SphericalDelaunay &dt = m.dt;
     MesherReport &report = m.report;
     std::size_t limit = options.max_nodes;
@@ -300,7 +306,7 @@ void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve) {
     for (TriangleId t = 0; t < dt.triangle_slots() && estimate <= stop; ++t)
         if (dt.is_live(t) && dt.label(t) == ocean)
             add_node_estimate(m.size_km, dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
-                              dt.point(dt.vertex(t, 2)), stop, estimate);
+                              dt.point(dt.vertex(t, 2)), stop, estimate, each);
     report.estimated_nodes = static_cast<std::size_t>(estimate) + dt.vertex_count();
     if (estimate > stop) {
         const std::string nodes = "more than " + std::to_string(limit) + " nodes";

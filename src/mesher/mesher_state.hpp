@@ -486,9 +486,14 @@ constexpr double short_chord = 0.5;
 std::size_t merge_close_coast_nodes(Mesher &m, const MesherOptions &options);
 void mark_sharp_corners(Mesher &m);
 // reserve: size the triangulation for them (not for a triangulation only counted, parts.cpp).
-void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve = true);
+// each: told where the nodes are (a piece's corners and its nodes; parts.cpp spreads them over
+// the longitudes).
+using NodesAt = std::function<void(const Vec3 &, const Vec3 &, const Vec3 &, double)>;
+void estimate_nodes(Mesher &m, const MesherOptions &options, bool reserve = true,
+                    const NodesAt &each = {});
 void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const Vec3 &a,
-                       const Vec3 &b, const Vec3 &c, double stop, double &sum);
+                       const Vec3 &b, const Vec3 &c, double stop, double &sum,
+                       const NodesAt &each = {});
 
 // lattice.cpp: the open ocean filled with an icosahedral lattice; returns the nodes added.
 // within (MesherOptions::lattice_within): where the ocean may lie, covering `share` of the sphere.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -16,10 +17,14 @@
 
 #include "globemesh/error.hpp"
 #include "mesher_state.hpp"
+#include "parts_lunes.hpp"
 
 namespace globemesh {
 
 using namespace mesher_internal;
+using parts_detail::choose_lunes;
+using parts_detail::lon_bins;
+using parts_detail::spread_over_longitudes;
 
 namespace {
 
@@ -63,7 +68,12 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
     const std::vector<VertexId> ids = insert_boundary(m, boundary);
     recover_segments(m, boundary, ids);
     classify_ocean(m, boundary, options);
-    estimate_nodes(m, options, false); // refused here as one part would be, before any part
+    // Refused here as one part would be, before any part; the nodes spread over the longitudes.
+    std::vector<double> by_lon(lon_bins, 0.0);
+    estimate_nodes(m, options, false,
+                   [&](const Vec3 &a, const Vec3 &b, const Vec3 &c, double nodes) {
+                       spread_over_longitudes(by_lon, a, b, c, nodes);
+                   });
     report.components = local.components;
     report.estimated_nodes = local.estimated_nodes;
     if (lunes.count == 0)
@@ -81,6 +91,8 @@ Boundary drop_inland_seas(const Boundary &boundary, const SizeFn &size_km,
         ocean_ring.push_back(ocean || !found);
         offset += r.nodes.size();
     }
+    if (lunes.count > 1 && std::isnan(lunes.first_lon))
+        lunes = choose_lunes(lunes.count, by_lon, boundary.rings, ocean_ring, size_km);
     std::vector<Ring> rings = boundary.rings;
     if (lunes.count > 1 && options.inlet_width > 0 && !boundary.empty()) {
         const std::size_t first = m.directed.size();
@@ -234,7 +246,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     report = MesherReport{};
     auto t0 = Clock::now();
     std::vector<std::array<double, 3>> mouths;
-    Lunes lunes{parts};
+    Lunes lunes{parts, options.parts_border_lon};
     const Boundary kept = drop_inland_seas(boundary, size_km, options, report, lunes, mouths);
     parts = lunes.count;
     if (parts == 1) { // chosen
@@ -243,6 +255,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
         return mesh_boundary(boundary, size_km, options, report_out, progress, timings);
     }
     report.parts = parts;
+    report.parts_border_lon = lunes.first_lon;
     MesherOptions part_options = options;
     part_options.keep_inland_seas = true; // a sea cut by a border is two components
     part_options.mouth_corners = std::move(mouths);

@@ -1,4 +1,5 @@
 // The run's metadata and report texts, formatted once from mesh_ocean's typed reports.
+#include <charconv>
 #include <cstdio>
 #include <sstream>
 
@@ -117,8 +118,13 @@ std::vector<std::pair<std::string, std::string>> ocean_attributes(const OceanMes
     a.emplace_back("segments_split", std::to_string(m.segments_split + m.encroached_splits));
     a.emplace_back("inlets_closed", inlets_closed_text(m));
     a.emplace_back("lattice_nodes", std::to_string(m.lattice_nodes));
-    if (m.parts > 1)
+    if (m.parts > 1) {
         a.emplace_back("parts", std::to_string(m.parts)); // --parts, or chosen from the estimate
+        // Every digit: --parts-border given this text makes the same borders.
+        char lon[32];
+        const auto end = std::to_chars(lon, lon + sizeof lon, m.parts_border_lon).ptr;
+        a.emplace_back("parts_border_lon", std::string(lon, end));
+    }
     a.emplace_back("corners_blunted", std::to_string(m.corners_blunted));
     a.emplace_back("floor_nodes_removed", std::to_string(m.floor_nodes_removed));
     a.emplace_back("floor_nodes_added", std::to_string(m.floor_nodes_added));

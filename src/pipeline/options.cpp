@@ -83,6 +83,9 @@ void validate_meshing(const MeshingOptions &o) {
     require(o.parts >= 0 && o.parts <= max_parts,
             option("parts") + " must be in 0.." + std::to_string(max_parts) +
                 " (lunes meeting at the poles at 360 / N degrees; 0 chooses from the mesh size)");
+    require(std::isnan(o.parts_border_lon) ||
+                (o.parts_border_lon >= -180 && o.parts_border_lon <= 180),
+            option("parts_border_lon") + " must be a longitude in -180..180 degrees");
     require(o.threads >= 0 && o.threads <= 1024,
             option("threads") + " must be in 0..1024 (0: one per core)");
     require(std::isfinite(o.inlet_width) && o.inlet_width >= 0 && o.inlet_width <= 2,

@@ -328,6 +328,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     mo.close_dead_ends = o.close_dead_ends;
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
+    mo.parts_border_lon = o.parts_border_lon;
     for (const Passage &p : passages)
         mo.passages.push_back(p.line);
     if (coast.land) {

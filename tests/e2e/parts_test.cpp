@@ -116,11 +116,14 @@ TEST(Parts, the_band_along_the_borders_is_the_lattice_again) {
     // Each part keeps its lattice 1.5 spacings off its borders and refines the band between:
     // joined, that band held the mesh's worst faces (q 0.60 in 3 parts, 300 faces below q 0.85
     // in 2, against 30 in one part). The join puts the lattice back there: the open ocean's
-    // faces are the lattice's (q above 0.88), as in one part.
+    // faces are the lattice's (q above 0.88), as in one part. The borders from 89.99W, off the
+    // island: chosen, one cuts it (its coast holds 7% of the work, and no other position
+    // balances 3 parts within 3%), and the band beside the cut is the parts' (q min 0.787).
     TempDir dir;
     MeshOptions o;
     o.coast = island(dir.path());
     o.hmax_km = 150;
+    o.parts_border_lon = default_border_lon;
     o.parts = 1;
     const Mesh one = mesh_ocean(o).mesh;
     for (int parts : {2, 3}) {
@@ -146,6 +149,7 @@ TEST(Parts, an_inlet_a_border_runs_through_closes_as_in_one_part) {
     MeshOptions o;
     o.coast = (dir / "inlet.geojson").string();
     o.hmax_km = 50;
+    o.parts_border_lon = default_border_lon; // chosen, the border keeps off the channel
     for (int parts : {1, 2}) {
         o.parts = parts;
         const Mesh mesh = mesh_ocean(o).mesh;
@@ -180,6 +184,7 @@ TEST(Parts, an_excursion_is_kept_where_its_shortcut_would_cross_the_coast) {
     const SizeFn h = [](const Vec3 &) { return 150.0; };
     MesherOptions o;
     o.lattice_km = 150;
+    o.parts_border_lon = default_border_lon;
     const Mesh mesh = mesh_parts(b, h, o, 2, 1);
     expect_joined(mesh);
     EXPECT_GT(mesh.faces.size(), 1000u);
@@ -224,8 +229,9 @@ TEST(Parts, threads_give_the_same_bytes_natural_earth) {
     o.coast = fixture("coast/ne_110m_land.gpkg").string();
     o.coast_layer = "land";
     // 2 parts: a border node in the Canadian Arctic with land on both sides; 5 parts: nodes
-    // with four faces near the borders, removed by the join.
+    // with four faces near the borders, removed by the join (both with the borders from -89.99).
     o.hmax_km = 150;
+    o.parts_border_lon = default_border_lon;
     const Mesh one = mesh_and_write(o, 1, 1, dir / "one.nc");
     for (int parts : {2, 5}) {
         const Mesh a = mesh_and_write(o, parts, 1, dir / "a.nc");
@@ -288,6 +294,7 @@ MeshOptions new_guinea_east() {
     o.coast = fixture("coast/hostile/gshhg_l_new_guinea_east.geojson").string();
     o.region = std::array<double, 4>{146, -13, 154, -6};
     o.hmax_km = 30;
+    o.parts_border_lon = default_border_lon; // a border at 150.0123E in 3 parts
     return o;
 }
 
@@ -330,6 +337,60 @@ TEST(Parts, a_region_in_parts_is_meshed_inside_its_box_alone) {
         expect_no_slit(m);
         expect_mesh_verify(path);
     }
+}
+
+/// The edges shorter than `km` whose midpoint lies within 1 degree of a border of `lunes`.
+std::size_t short_edges_near_borders(const Mesh &mesh, const Lunes &lunes, double km) {
+    std::set<std::pair<NodeIndex, NodeIndex>> seen;
+    std::size_t count = 0;
+    const double near = std::sin(1.0 * pi / 180);
+    for (const auto &f : mesh.faces)
+        for (int i = 0; i < 3; ++i) {
+            const NodeIndex a = std::min(f[i], f[(i + 1) % 3]), b = std::max(f[i], f[(i + 1) % 3]);
+            if (!seen.insert({a, b}).second)
+                continue;
+            const Vec3 &p = mesh.nodes[a], &q = mesh.nodes[b];
+            if (std::acos(std::clamp(dot(p, q), -1.0, 1.0)) * earth_radius_km >= km)
+                continue;
+            const Vec3 mid = normalized(p + q);
+            for (int k = 0; k < lunes.count; ++k)
+                if (std::abs(dot(mid, lunes.border_normal(k))) < near &&
+                    dot(mid, lunes.border_direction(k)) > 0) {
+                    ++count;
+                    break;
+                }
+        }
+    return count;
+}
+
+TEST(Parts, the_borders_are_chosen_off_the_coasts) {
+    // Natural Earth 1:50m at 60 km in 2 parts. With the borders at 89.99W and 90.01E, the west
+    // one runs less than a face off the coasts of Ellesmere, Devon and Boothia: the parts
+    // meshed those slivers of water with 32 edges shorter than h / 4 within a degree of the
+    // borders (one part: none) and the worst face fell from q 0.323 to 0.230. Chosen (the
+    // parts' work balanced, the borders passing the coast least closely), the borders at 2.76E
+    // and 177.24W have none, and the worst face is one part's.
+    MeshOptions o;
+    o.coast = fixture("coast/ne_50m_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = 60;
+    o.parts = 1;
+    const Mesh one = mesh_ocean(o).mesh;
+    o.parts = 2;
+    const OceanMesh chosen = mesh_ocean(o);
+    o.parts_border_lon = default_border_lon;
+    const OceanMesh fixed = mesh_ocean(o);
+    const Lunes at{2, chosen.mesher.parts_border_lon}, from_default{2, default_border_lon};
+    EXPECT_GT(std::abs(at.first_lon - default_border_lon), 1);
+    const double km = o.hmax_km / 4;
+    EXPECT_GT(short_edges_near_borders(fixed.mesh, from_default, km),
+              short_edges_near_borders(one, from_default, km) + 15);
+    EXPECT_LE(short_edges_near_borders(chosen.mesh, at, km),
+              short_edges_near_borders(one, at, km) + 2);
+    const double q_one = compute_stats(one).quality_min;
+    EXPECT_LT(compute_stats(fixed.mesh).quality_min, q_one - 0.05);
+    EXPECT_GE(compute_stats(chosen.mesh).quality_min, q_one - 0.01);
+    expect_joined(chosen.mesh);
 }
 
 TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
@@ -401,6 +462,11 @@ TEST(Parts, refuses_more_parts_than_the_poles_allow) {
     o.parts = 2;
     o.threads = -1;
     EXPECT_THROW(validate(o), UsageError);
+    o.threads = 0;
+    o.parts_border_lon = 200;
+    EXPECT_THROW(validate(o), UsageError);
+    o.parts_border_lon = -180;
+    EXPECT_NO_THROW(validate(o));
 }
 
 } // namespace
