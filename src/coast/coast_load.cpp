@@ -142,6 +142,11 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
         if (r.nodes.size() >= 3)
             out.rings.rings.push_back(std::move(r));
     }
+    // A region's rings come out of GEOS's overlay in an order of its own, which the mesher's
+    // choices follow: put them in one of ours, so that the same ocean makes the same mesh however
+    // it was computed.
+    if (options.region || !options.region_file.empty())
+        canonical_order(out.rings);
     separate_pinches(out.rings);
     // 30 rounds shorten an arc 2^30 times: far past any bulge that snap rounding leaves room for.
     bool clear = false;

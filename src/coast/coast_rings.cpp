@@ -382,6 +382,20 @@ Ring to_sphere(const Chain &c) {
     return r;
 }
 
+void canonical_order(Boundary &b) {
+    auto less = [](const Vec3 &p, const Vec3 &q) {
+        return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
+    };
+    for (Ring &r : b.rings) {
+        const auto first = std::min_element(r.nodes.begin(), r.nodes.end(), less);
+        const auto shift = first - r.nodes.begin();
+        std::rotate(r.nodes.begin(), first, r.nodes.end());
+        std::rotate(r.kinds.begin(), r.kinds.begin() + shift, r.kinds.end());
+    }
+    std::sort(b.rings.begin(), b.rings.end(),
+              [&](const Ring &r, const Ring &s) { return less(r.nodes.front(), s.nodes.front()); });
+}
+
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in
 /// GEOS) by 1e-7 rad into the land on its right.
 std::size_t separate_pinches(Boundary &b) {
