@@ -543,6 +543,62 @@ std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, boo
     return rings;
 }
 
+/// How far inside the region's outline a piece of land must lie to skip the overlay (degrees,
+/// 64 times outline_snap_deg: about 100 m).
+constexpr double interior_margin_deg = 64 * outline_snap_deg;
+
+/// The dissolved land pieces near a region: those wholly inside it, interior_margin_deg clear of
+/// its outline and without lakes, and the others.
+struct RegionLand {
+    std::vector<GeomPtr> interior, rest;
+};
+
+RegionLand split_interior(Geos &geos, const GEOSGeometry *domain, std::vector<GeomPtr> &pieces) {
+    PreparedPtr prepared(GEOSPrepare_r(geos.get(), domain), GeosDeleter{geos.get()});
+    RegionLand out;
+    for (auto &p : pieces) {
+        double x0, y0, x1, y1;
+        GEOSGeom_getExtent_r(geos.get(), p.get(), &x0, &y0, &x1, &y1);
+        const double m = interior_margin_deg;
+        const GeomPtr box = own(
+            geos, GEOSGeom_createRectangle_r(geos.get(), x0 - m, y0 - m, x1 + m, y1 + m), "box");
+        const bool inside =
+            GEOSGetNumInteriorRings_r(geos.get(), p.get()) == 0 &&
+            GEOSPreparedContainsProperly_r(geos.get(), prepared.get(), box.get()) == 1;
+        (inside ? out.interior : out.rest).push_back(std::move(p));
+    }
+    pieces.clear();
+    return out;
+}
+
+/// For each island, the index of the ocean polygon that holds it (ocean.size() when none does:
+/// it then lies in no water the overlay kept).
+std::vector<std::size_t> island_holders(Geos &geos, const std::vector<const GEOSGeometry *> &ocean,
+                                        const std::vector<GeomPtr> &islands) {
+    std::vector<PreparedPtr> prepared;
+    std::vector<std::array<double, 4>> extent(ocean.size());
+    for (std::size_t i = 0; i < ocean.size(); ++i) {
+        prepared.emplace_back(GEOSPrepare_r(geos.get(), ocean[i]), GeosDeleter{geos.get()});
+        auto &e = extent[i];
+        GEOSGeom_getExtent_r(geos.get(), ocean[i], &e[0], &e[1], &e[2], &e[3]);
+    }
+    std::vector<std::size_t> holder(islands.size(), ocean.size());
+    for (std::size_t k = 0; k < islands.size(); ++k) {
+        const GeomPtr inner =
+            own(geos, GEOSPointOnSurface_r(geos.get(), islands[k].get()), "find an inner point");
+        double x, y;
+        GEOSGeomGetX_r(geos.get(), inner.get(), &x);
+        GEOSGeomGetY_r(geos.get(), inner.get(), &y);
+        for (std::size_t i = 0; i < ocean.size() && holder[k] == ocean.size(); ++i) {
+            const auto &e = extent[i];
+            if (x > e[0] && x < e[2] && y > e[1] && y < e[3] &&
+                GEOSPreparedContainsProperly_r(geos.get(), prepared[i].get(), inner.get()) == 1)
+                holder[k] = i;
+        }
+    }
+    return holder;
+}
+
 /// The ocean of a region (--region box, two boxes across +-180, or --region-file polygons):
 /// region minus land with GEOS, its rings with region edges tagged open.
 std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
@@ -571,9 +627,23 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
             continue;
         near.push_back(clip_to_box(geos, g.get(), x0, y0, x1, y1, "clip the land"));
     }
-    GeomPtr land_near = make_collection(geos, near);
-    land_near = own(geos, GEOSUnaryUnionPrec_r(geos.get(), land_near.get(), snap_grid_deg),
-                    "dissolve the land");
+    // The land is dissolved already (load_coast): its pieces cut to the region go through the
+    // same dissolve, which puts the cuts on the snap grid and unions only the pieces that meet
+    // or nearly meet (one snap-rounding union of every piece took 35 s for the Arctic in GSHHG
+    // high, 0.6 s for the whole globe's rings).
+    SnapCount unused;
+    std::vector<GeomPtr> dissolved = dissolve(geos, near, snap_grid_deg, unused);
+    // The pieces wholly inside the region are the ocean's holes as they are: the overlay places
+    // each hole in its polygon by a search that grows as their number squared in GEOS 3.11 (the
+    // Arctic in GSHHG high: 7 s of 12). Only the others go through it.
+    RegionLand pieces = split_interior(geos, domain.get(), dissolved);
+    std::vector<GEOSGeometry *> raw;
+    for (auto &p : pieces.rest)
+        raw.push_back(p.release());
+    GeomPtr land_near = own(geos,
+                            GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, raw.data(),
+                                                        static_cast<unsigned>(raw.size())),
+                            "collect the land");
     // An outline that runs along the coast (land clipped to the region, or the region drawn
     // from the same data in another CRS) follows the land there: it takes the land's vertices
     // within outline_snap_deg, so no sliver of water is left between the two.
@@ -595,6 +665,17 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
     std::vector<double> planar_area(ocean_polys.size());
     for (std::size_t i = 0; i < ocean_polys.size(); ++i)
         GEOSArea_r(geos.get(), ocean_polys[i], &planar_area[i]);
+    const std::vector<std::size_t> holder = island_holders(geos, ocean_polys, pieces.interior);
+    std::vector<std::vector<PointList>> island_holes(ocean_polys.size());
+    for (std::size_t k = 0; k < pieces.interior.size(); ++k) {
+        if (holder[k] == ocean_polys.size())
+            continue;
+        double area;
+        GEOSArea_r(geos.get(), pieces.interior[k].get(), &area);
+        planar_area[holder[k]] -= area;
+        island_holes[holder[k]].push_back(
+            ring_points(geos, GEOSGetExteriorRing_r(geos.get(), pieces.interior[k].get())));
+    }
 
     RingBuilder builder(geos, clip);
     // Water bodies with no edge on the region outline are inland seas (dropped unless
@@ -611,6 +692,12 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
             PointList hole = ring_points(geos, GEOSGetInteriorRingN_r(geos.get(), p, h));
             if (std::abs(signed_planar_area(hole)) < min_ring_area_deg2)
                 continue; // zero-area sliver
+            orient(hole, false);
+            prings.push_back(std::move(hole));
+        }
+        for (PointList &hole : island_holes[i]) {
+            if (std::abs(signed_planar_area(hole)) < min_ring_area_deg2)
+                continue;
             orient(hole, false);
             prings.push_back(std::move(hole));
         }

@@ -1,7 +1,7 @@
 // Coast module on real Natural Earth fixtures: ring invariants (checked by an independent brute
 // force), ocean area against GeographicLib on the source's own ocean layer, Antarctica around
 // the South Pole, shapefile = GeoPackage, projected copy within 1 m, shaping at 100 and 10 km,
-// regions across +-180 and at a pole.
+// regions across +-180 and at a pole, a region with islands inside against the source clipped.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -279,6 +279,77 @@ TEST(Coast, shaping_follows_a_varying_size) {
     ASSERT_GT(ns, 0u);
     EXPECT_LT(north / nn, 25.0);
     EXPECT_GT(south / ns, 60.0);
+}
+
+/// The source's ocean layer clipped to a lon/lat box: its area (km2, on WGS84, GeographicLib) and
+/// its islands (the holes of the clipped polygons).
+struct ClippedOcean {
+    double area_km2 = 0;
+    std::size_t islands = 0;
+};
+ClippedOcean clipped_ocean(const std::string &path, const std::array<double, 4> &box) {
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpenEx(path.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+    EXPECT_NE(ds, nullptr) << path;
+    ClippedOcean out;
+    if (!ds)
+        return out;
+    OGRGeometryH rect = OGR_G_CreateGeometry(wkbPolygon),
+                 ring = OGR_G_CreateGeometry(wkbLinearRing);
+    for (auto [x, y] : {std::pair{box[0], box[1]},
+                        {box[2], box[1]},
+                        {box[2], box[3]},
+                        {box[0], box[3]},
+                        {box[0], box[1]}})
+        OGR_G_AddPoint_2D(ring, x, y);
+    OGR_G_AddGeometryDirectly(rect, ring);
+    const auto &wgs = GeographicLib::Geodesic::WGS84();
+    auto ring_area = [&](OGRGeometryH r) {
+        GeographicLib::PolygonArea poly(wgs);
+        for (int i = 0; i + 1 < OGR_G_GetPointCount(r); ++i)
+            poly.AddPoint(OGR_G_GetY(r, i), OGR_G_GetX(r, i));
+        double perimeter, area;
+        poly.Compute(false, false, perimeter, area); // either way round: the smaller side
+        return std::min(area, wgs.EllipsoidArea() - area) * 1e-6;
+    };
+    OGRLayerH layer = GDALDatasetGetLayerByName(ds, "ocean");
+    OGR_L_ResetReading(layer);
+    while (OGRFeatureH f = OGR_L_GetNextFeature(layer)) {
+        OGRGeometryH cut = OGR_G_Intersection(OGR_F_GetGeometryRef(f), rect);
+        const bool multi = wkbFlatten(OGR_G_GetGeometryType(cut)) == wkbMultiPolygon;
+        for (int p = 0; p < (multi ? OGR_G_GetGeometryCount(cut) : 1); ++p) {
+            OGRGeometryH poly = multi ? OGR_G_GetGeometryRef(cut, p) : cut;
+            if (OGR_G_IsEmpty(poly) || OGR_G_GetGeometryCount(poly) == 0)
+                continue;
+            out.area_km2 += ring_area(OGR_G_GetGeometryRef(poly, 0));
+            for (int h = 1; h < OGR_G_GetGeometryCount(poly); ++h, ++out.islands)
+                out.area_km2 -= ring_area(OGR_G_GetGeometryRef(poly, h));
+        }
+        OGR_G_DestroyGeometry(cut);
+        OGR_F_Destroy(f);
+    }
+    OGR_G_DestroyGeometry(rect);
+    GDALClose(ds);
+    return out;
+}
+
+TEST(Coast, a_region_with_islands_inside_holds_the_source_ocean_clipped_to_it) {
+    // Celebes Sea to the Moluccas: 13 islands lie wholly inside the box, which the coast stage
+    // keeps out of the overlay (each becomes a hole of the ocean polygon holding it); Sulawesi and
+    // Halmahera cross its edges. 8 degrees at 6S..2N: the box's great-circle edges lie within
+    // 0.012 degrees of the parallels.
+    const std::array<double, 4> box{119, -6, 127, 2};
+    MeshOptions o = coast_options("coast/ne_50m_land.gpkg");
+    o.region = box;
+    const CoastData d = load_coast(o);
+    expect_valid(d.rings);
+    const ClippedOcean oracle = clipped_ocean(fixture("coast/ne_50m_land.gpkg").string(), box);
+    std::size_t islands = 0; // rings with no open segment: the coast all round
+    for (const auto &r : d.rings.rings)
+        islands += std::none_of(r.kinds.begin(), r.kinds.end(),
+                                [](SegmentKind k) { return k == SegmentKind::open; });
+    EXPECT_NEAR(d.ocean_area_km2, oracle.area_km2, 0.003 * oracle.area_km2);
+    EXPECT_EQ(islands, oracle.islands);
 }
 
 TEST(Coast, region_across_the_antimeridian_gets_open_edges_on_the_box) {
