@@ -50,6 +50,8 @@ struct Lunes {
     /// Where border k's meridian meets the equator: dot(p, direction) > 0 on its half of the
     /// plane.
     Vec3 border_direction(int k) const;
+    /// Degrees from the first border east to p's meridian, in [0, 360).
+    double east_of_first(const Vec3 &p) const;
     /// The lune (0 .. count - 1) holding p.
     int part_of(const Vec3 &p) const;
 };

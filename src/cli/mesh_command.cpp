@@ -242,8 +242,8 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
         ->type_name("N");
     app.add_option("--parts-border", m.parts_border_lon,
                    "Longitude of the parts' first border, degrees (default: chosen from the "
-                   "inputs, where the parts' work balances and the fewest coast nodes lie near a "
-                   "border)")
+                   "inputs, where the parts' work balances and the borders pass the coast least "
+                   "closely)")
         ->group(mesher)
         ->type_name("LON");
     app.add_option("--threads", m.threads,

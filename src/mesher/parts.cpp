@@ -54,8 +54,9 @@ private:
 
 /// The rings that bound some of the ocean mesh_boundary keeps (the largest component, or all
 /// with keep_inland_seas), told on the triangulation of the boundary nodes alone, as
-/// classify_ocean does; the components (of the whole ocean) go to report.components. `parts` 0
-/// becomes parts_for_nodes of the node estimate. With more than one part, the inlets a border
+/// classify_ocean does; the components (of the whole ocean) go to report.components. A count of
+/// 0 in `lunes` becomes parts_for_nodes of the node estimate, and a first border of NaN the one
+/// choose_lunes finds on this pass. With more than one part, the inlets a border
 /// crosses, closed there by one part's inlet rule, are cut from the rings
 /// (rings_with_inlets_closed) and counted in the report, their mouths' corners in `mouths`: a
 /// part's own rule keeps water against its border open, and an inlet a border ran up was meshed

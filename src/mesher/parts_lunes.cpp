@@ -28,8 +28,12 @@ constexpr double max_passed = 50;
 
 /// Degrees east of default_border_lon, in [0, 360).
 double east_of_default(const Vec3 &p) {
-    double east = std::atan2(p.y, p.x) * rad_to_deg - default_border_lon;
-    return east - 360 * std::floor(east / 360);
+    return Lunes{}.east_of_first(p);
+}
+
+/// The bin of position u, any number of turns away.
+std::size_t bin_at(long u) {
+    return static_cast<std::size_t>((u % lon_bins + lon_bins) % lon_bins);
 }
 
 /// The normal of the meridian plane at border position u (a bin's start).
@@ -70,7 +74,9 @@ std::vector<double> coast_passed_by(const std::vector<Ring> &rings, const std::v
     for (std::size_t k = 0; k < rings.size(); ++k) {
         const std::vector<Vec3> &nodes = rings[k].nodes;
         const std::size_t n = nodes.size();
-        for (std::size_t i = 0; i < n && kept[k] && n >= 2; ++i) {
+        if (!kept[k] || n < 2)
+            continue;
+        for (std::size_t i = 0; i < n; ++i) {
             const Vec3 &a = nodes[i], &b = nodes[(i + 1) % n];
             const double h = km_to_rad(size_km(arc_midpoint(a, b)));
             const double reach = std::sin(h);
@@ -86,8 +92,7 @@ std::vector<double> coast_passed_by(const std::vector<Ring> &rings, const std::v
                 std::min(static_cast<long>(std::floor((std::max(ea, eb) + half) / bin_degrees)),
                          from + lon_bins - 1);
             for (long u = from; u <= to; ++u)
-                passed[static_cast<std::size_t>((u % lon_bins + lon_bins) % lon_bins)] +=
-                    passed_by(a, b, h, u);
+                passed[bin_at(u)] += passed_by(a, b, h, u);
         }
     }
     return passed;
@@ -96,7 +101,7 @@ std::vector<double> coast_passed_by(const std::vector<Ring> &rings, const std::v
 } // namespace
 
 int lon_bin(const Vec3 &p) {
-    return std::min(lon_bins - 1, static_cast<int>(east_of_default(p) / bin_degrees));
+    return Lunes{lon_bins}.part_of(p); // the bins are lunes of bin_degrees from the default
 }
 
 void spread_over_longitudes(std::vector<double> &bins, const Vec3 &a, const Vec3 &b, const Vec3 &c,
@@ -121,17 +126,19 @@ void spread_over_longitudes(std::vector<double> &bins, const Vec3 &a, const Vec3
     }
     const double share = nodes / double(to - from + 1);
     for (long u = from; u <= to; ++u)
-        bins[static_cast<std::size_t>((u % lon_bins + lon_bins) % lon_bins)] += share;
+        bins[bin_at(u)] += share;
 }
 
 Lunes choose_lunes(int count, const std::vector<double> &nodes, const std::vector<Ring> &rings,
                    const std::vector<char> &kept, const SizeFn &size_km) {
     std::vector<double> work(nodes);
     work.resize(lon_bins, 0.0);
-    for (std::size_t r = 0; r < rings.size(); ++r)
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+        if (!kept[r])
+            continue;
         for (const Vec3 &p : rings[r].nodes)
-            if (kept[r])
-                work[static_cast<std::size_t>(lon_bin(p))] += coast_node_work;
+            work[static_cast<std::size_t>(lon_bin(p))] += coast_node_work;
+    }
     // sums[i]: the work of bins 0 .. i - 1, over two turns so that a lune may wrap.
     std::vector<double> sums(2 * lon_bins + 1, 0.0);
     for (int i = 0; i < 2 * lon_bins; ++i)

@@ -373,10 +373,13 @@ Vec3 Lunes::border_direction(int k) const {
     return {std::cos(lon), std::sin(lon), 0};
 }
 
+double Lunes::east_of_first(const Vec3 &p) const {
+    const double east = std::atan2(p.y, p.x) * rad_to_deg - first_lon;
+    return east - 360 * std::floor(east / 360);
+}
+
 int Lunes::part_of(const Vec3 &p) const {
-    double east = std::atan2(p.y, p.x) * rad_to_deg - first_lon;
-    east -= 360 * std::floor(east / 360);
-    return std::min(count - 1, static_cast<int>(east / (360.0 / count)));
+    return std::min(count - 1, static_cast<int>(east_of_first(p) / (360.0 / count)));
 }
 
 std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km,
