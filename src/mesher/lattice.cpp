@@ -390,6 +390,55 @@ private:
     std::vector<TriangleId> seen;
 };
 
+/// The grid's cells whose lattice point may lie within `clearance` (radians) of a node or a
+/// constrained edge of the triangulation: only those need Clearance's walk, the others are clear.
+/// (In a part's lune with a small island, the island's fan of long edges made that walk see five
+/// triangles a point.) Each edge marks the cells within clearance of its midpoint plus half its
+/// chord, in pieces no longer than `piece` (radians); a node on no constrained edge, its own.
+std::vector<char> near_boundary(const SphericalDelaunay &dt, const LatticePoints &lattice,
+                                const LatticeCells &grid, double clearance, double piece) {
+    std::vector<char> near(grid.cell.size(), 0);
+    const double chord = 2 * std::sin(0.5 * clearance);
+    auto mark = [&](const Vec3 &p, double reach_chord) {
+        const int reach = lattice.reach_for(reach_chord);
+        if (reach < 0) { // a lattice of a few rows: every cell
+            std::fill(near.begin(), near.end(), 1);
+            return;
+        }
+        lattice.for_each_near(p, reach, [&](const auto &x) {
+            const std::size_t c = grid.index(x.f, x.i, x.j);
+            if (c != SIZE_MAX)
+                near[c] = 1;
+        });
+    };
+    std::vector<char> on_edge(dt.vertex_count(), 0);
+    for (TriangleId t = 0; t < dt.triangle_slots(); ++t) {
+        if (!dt.is_live(t))
+            continue;
+        for (int i = 0; i < 3; ++i) {
+            const HalfEdge h = half_edge(t, i);
+            const VertexId a = dt.origin(h), b = dt.destination(h);
+            if (!dt.is_constrained(h) || a > b)
+                continue; // each edge once, from its smaller end
+            on_edge[a] = on_edge[b] = 1;
+            const Vec3 &u = dt.point(a), &w = dt.point(b);
+            const int pieces = std::max(1, static_cast<int>(std::ceil(norm(u - w) / piece)));
+            Vec3 from = u;
+            for (int k = 1; k <= pieces; ++k) {
+                const Vec3 to =
+                    k == pieces ? w : normalized(double(pieces - k) * u + double(k) * w);
+                const Vec3 mid = normalized(from + to);
+                mark(mid, chord + norm(from - mid));
+                from = to;
+            }
+        }
+    }
+    for (VertexId v = 0; v < dt.vertex_count(); ++v)
+        if (!on_edge[v])
+            mark(dt.point(v), chord);
+    return near;
+}
+
 } // namespace
 
 // Fills the open ocean where the size field reaches s_km, its largest value, with the nodes of
@@ -398,7 +447,8 @@ private:
 // equilateral and the right size, so the refinement then only fills the band between the
 // lattice and the coast (or smaller sizes), growing fronts from both. The points are chosen on
 // the triangulation of the boundary alone, whose triangles are large (walked face by face, row
-// by row, each row the other way than the last, so each walk is a step). Those on the rim of
+// by row, each row the other way than the last, so each walk is a step); only those that may lie
+// within the clearance of the boundary (near_boundary) look for it there. Those on the rim of
 // the kept lattice and on the icosahedron's edges are then inserted as any point set; the
 // others come with their six lattice triangles, put in place by replace_region (see below).
 // Only the lattice's points in a cap around the ocean are walked (a region's), and none when
@@ -434,7 +484,7 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::v
     // Room for every lattice point of the cap (those on land or too near the coast are never
     // written, so never touched): growing by doubling would copy and touch about twice the points.
     points.reserve(static_cast<std::size_t>(cap_points) + 1);
-    TriangleId hint = no_triangle;
+    // The rows first (each a run of cells), then the cells near the boundary, then the points.
     for (int f = 0; f < 20; ++f) {
         const Vec3 &a = corner[ico_face[f][0]], &b = corner[ico_face[f][1]],
                    &c = corner[ico_face[f][2]];
@@ -449,11 +499,17 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::v
             if ((cap.cos_r > -1 && !row_in_cap(cap, a, b, c, i, len, lo, hi)) ||
                 !row_within(within, a, b, c, i, len, lo, hi))
                 continue;
-            LatticeCells::Row &row = grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i];
-            row = {lo, hi, cell.size()};
+            grid.row_of[static_cast<std::size_t>(f) * (rows + 1) + i] = {lo, hi, cell.size()};
             cell.resize(cell.size() + static_cast<std::size_t>(hi - lo + 1), none);
-            for (int step = 0; step <= hi - lo; ++step) {
-                const int j = i % 2 == 0 ? lo + step : hi - step;
+        }
+    }
+    const std::vector<char> near = near_boundary(dt, lattice, grid, lattice_clearance * s, s);
+    TriangleId hint = no_triangle;
+    for (int f = 0; f < 20; ++f)
+        for (int i = 0; i <= rows; ++i) {
+            const LatticeCells::Row &row = grid.row(f, i);
+            for (int step = 0; step <= row.hi - row.lo; ++step) {
+                const int j = i % 2 == 0 ? row.lo + step : row.hi - step;
                 const int k = rows - i - j;
                 if (!owns_node(f, i, j, k))
                     continue;
@@ -462,16 +518,16 @@ std::size_t fill_lattice(Mesher &m, double s_km, double max_points, const std::v
                 if (!inside(p) || m.size_km(p) < lattice_level * s_km)
                     continue; // outside a part's lune: outside its ocean, not located
                 hint = dt.locate(p, hint);
-                if (dt.label(hint) != ocean || !clearance.clear(p, hint))
+                const std::size_t at = row.start + static_cast<std::size_t>(j - row.lo);
+                if (dt.label(hint) != ocean || (near[at] && !clearance.clear(p, hint)))
                     continue;
                 const auto id = static_cast<std::uint32_t>(points.size());
-                cell[row.start + static_cast<std::size_t>(j - lo)] = id;
+                cell[at] = id;
                 if (std::uint32_t *shared = shared_nodes.at(f, i, j, k))
                     *shared = id;
                 points.push_back(p);
             }
         }
-    }
     if (points.empty())
         return 0;
     // Every face's edge and corner cells from their owners.

@@ -82,23 +82,23 @@ Vec3 LatticePoints::point(int f, int i, int j) const {
                       (lattice_jitter * s_) * lattice_shift(f, i, j));
 }
 
-void LatticePoints::near(const Vec3 &p, int reach, std::vector<Index> &out) const {
-    for (int f = 0; f < 20; ++f) {
-        // p's weights on the face's corners, scaled to sum to rows: where its ray meets the face.
-        const std::array<double, 3> w = {dot(inverse_[f][0], p), dot(inverse_[f][1], p),
-                                         dot(inverse_[f][2], p)};
-        const double sum = w[0] + w[1] + w[2];
-        if (sum <= 0)
-            continue;
-        const double i0 = rows_ * w[0] / sum, j0 = rows_ * w[1] / sum, k0 = rows_ - i0 - j0;
-        if (i0 < -reach - 1 || j0 < -reach - 1 || k0 < -reach - 1)
-            continue;
-        const int ic = static_cast<int>(std::lround(i0)), jc = static_cast<int>(std::lround(j0));
-        for (int i = std::max(0, ic - reach); i <= std::min(rows_, ic + reach); ++i)
-            for (int j = std::max(0, jc - reach); j <= std::min(rows_ - i, jc + reach); ++j)
-                if (owns_node(f, i, j, rows_ - i - j))
-                    out.push_back({f, i, j});
-    }
+// Two points of a face's plane whose weights differ by h steps in i or j (a step is an edge of the
+// flat face's n^2 triangles, |a - b| / n) are at least sqrt(3) / 2 h of those edges apart, and a
+// point outside the box near() walks is at least reach + 1/2 steps from p's rounded weights.
+// Projected from the centre, a flat distance is at most the arc between the points over
+// cos^2(phi) / cos(phi_face), phi the larger angle of an arc's point from the face's centre: at
+// most phi_face (0.65 rad, the corners') plus the arc. Past 1.45 rad no box is sure to hold them.
+int LatticePoints::reach_for(double chord) const {
+    const Vec3 &a = corner_[ico_face[0][0]], &b = corner_[ico_face[0][1]],
+               &c = corner_[ico_face[0][2]];
+    const double cos_face = dot(normalized(a + b + c), a); // the corners' angle from the centre
+    const double arc = 2 * std::asin(std::min(1.0, 0.5 * chord));
+    const double phi = std::acos(cos_face) + arc;
+    if (phi > 1.45)
+        return -1;
+    const double flat = arc * cos_face / std::pow(std::cos(phi), 2);
+    const double step = 0.5 * std::sqrt(3.0) * norm(a - b) / rows_;
+    return static_cast<int>(std::ceil(flat / step - 0.5)) + 1;
 }
 
 bool LatticePoints::is_point(const Vec3 &p) const {

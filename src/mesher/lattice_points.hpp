@@ -3,7 +3,9 @@
 // function of the spacing and its index alone, so every part and the join compute the same bits.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -48,7 +50,14 @@ public:
     Vec3 point(int f, int i, int j) const;
     /// Appends the lattice's points (each by the face that owns it) whose weights lie within
     /// `reach` steps of p's in a face of the icosahedron near p.
-    void near(const Vec3 &p, int reach, std::vector<Index> &out) const;
+    void near(const Vec3 &p, int reach, std::vector<Index> &out) const {
+        for_each_near(p, reach, [&](const Index &x) { out.push_back(x); });
+    }
+    /// Calls fn(Index) on each point near(p, reach) would append, in the same order.
+    template <class Fn> void for_each_near(const Vec3 &p, int reach, Fn fn) const;
+    /// A reach at which near(p, reach) holds every lattice point within `chord` of p (see
+    /// lattice_points.cpp), or -1 where the chord is too long for any.
+    int reach_for(double chord) const;
     /// How many indices index_of numbers: (rows + 1)^2 per face.
     std::size_t index_count() const { return 20 * std::size_t(rows_ + 1) * std::size_t(rows_ + 1); }
     std::size_t index_of(const Index &x) const {
@@ -65,5 +74,24 @@ private:
     std::array<Vec3, 12> corner_;
     std::array<std::array<Vec3, 3>, 20> inverse_; // rows of each face's [a b c]^-1
 };
+
+template <class Fn> void LatticePoints::for_each_near(const Vec3 &p, int reach, Fn fn) const {
+    for (int f = 0; f < 20; ++f) {
+        // p's weights on the face's corners, scaled to sum to rows: where its ray meets the face.
+        const std::array<double, 3> w = {dot(inverse_[f][0], p), dot(inverse_[f][1], p),
+                                         dot(inverse_[f][2], p)};
+        const double sum = w[0] + w[1] + w[2];
+        if (sum <= 0)
+            continue;
+        const double i0 = rows_ * w[0] / sum, j0 = rows_ * w[1] / sum, k0 = rows_ - i0 - j0;
+        if (i0 < -reach - 1 || j0 < -reach - 1 || k0 < -reach - 1)
+            continue;
+        const int ic = static_cast<int>(std::lround(i0)), jc = static_cast<int>(std::lround(j0));
+        for (int i = std::max(0, ic - reach); i <= std::min(rows_, ic + reach); ++i)
+            for (int j = std::max(0, jc - reach); j <= std::min(rows_ - i, jc + reach); ++j)
+                if (owns_node(f, i, j, rows_ - i - j))
+                    fn(Index{f, i, j});
+    }
+}
 
 } // namespace globemesh::mesher_internal

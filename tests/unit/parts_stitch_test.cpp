@@ -83,6 +83,55 @@ TEST(LatticePoints, each_point_is_one_index_and_known_to_the_bit) {
     }
 }
 
+// near(p, reach_for(D)) is the fill's test of which lattice points may lie within D of a
+// boundary node (lattice.cpp, near_boundary): a point it misses would be kept however close.
+// Checked against every point of the lattice, around points near the icosahedron's corners and
+// edges (where a point's neighbours belong to other faces) and elsewhere.
+TEST(LatticePoints, near_at_reach_for_holds_every_point_within_the_chord) {
+    for (const double km : {1500.0, 500.0, 90.0}) {
+        const LatticePoints lattice(km);
+        const double s = lattice.spacing();
+        const std::vector<Vec3> points = all_points(lattice);
+        std::vector<Vec3> around;
+        const std::array<Vec3, 12> corners = mesher_internal::ico_corners();
+        for (const Vec3 &c : corners) {
+            around.push_back(normalized(c + Vec3{0.3 * s, -0.2 * s, 0.1 * s}));
+            for (const Vec3 &d : corners)
+                if (dot(c, d) > 0.4 && dot(c, d) < 0.99) // an edge's midpoint and a point past it
+                    around.push_back(normalized(c + d)),
+                        around.push_back(normalized(c + 0.8 * d + Vec3{0, 0.4 * s, 0}));
+        }
+        for (int k = 0; k < 40; ++k) { // a spiral over the sphere
+            const double z = 1 - (k + 0.5) / 20.0, r = std::sqrt(1 - z * z), lon = 2.39996 * k;
+            around.push_back({r * std::cos(lon), r * std::sin(lon), z});
+        }
+        for (const double chord_in_s : {0.3, 1.5, 2.2, 5.0}) {
+            const double chord = chord_in_s * s;
+            const int reach = lattice.reach_for(chord);
+            if (km < 100) { // few to walk where the fill walks many
+                EXPECT_LE(reach, static_cast<int>(2 * chord_in_s) + 3) << chord_in_s;
+            }
+            if (reach < 0) // none holds them: the fill tests every point
+                continue;
+            for (const Vec3 &p : around) {
+                std::vector<LatticePoints::Index> near;
+                lattice.near(p, reach, near);
+                std::set<std::array<double, 3>> found;
+                for (const auto &x : near) {
+                    const Vec3 q = lattice.point(x.f, x.i, x.j);
+                    found.insert({q.x, q.y, q.z});
+                }
+                for (const Vec3 &q : points) {
+                    if (norm(q - p) < chord) {
+                        ASSERT_TRUE(found.count({q.x, q.y, q.z}))
+                            << km << " km, chord " << chord_in_s << " spacings, reach " << reach;
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The lattice without its points within 1.5 spacings of the equator, and in their place
 /// nodes of the parts' own along it: on the equator (the border) `per_spacing` to a spacing,
 /// and as many on circles `rows` at 0.5 and 1 spacing north and south.
