@@ -90,6 +90,46 @@ TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
     }
 }
 
+TEST(Parts, a_coast_node_near_a_crossing_goes_where_the_coast_is_straight) {
+    // An island across the border at 0E (h 100 km): on its straight south coast (the equator) a
+    // node 30 km east of the crossing made a 30 km segment there, and faces as short (GSHHG low
+    // at 20 km, the Benin coast at 2.01E: q 0.54). It goes; on the north coast a cape as near
+    // the crossing, 33 km off the coast's line, stays.
+    const SizeFn h = [](const Vec3 &) { return 100.0; };
+    std::vector<LonLat> ring;
+    for (double lon : {5.0, 4.1, 3.2, 2.07, 1.17, 0.27, -0.63, -1.53, -2.43, -3.33, -4.23})
+        ring.push_back({lon, 0}); // west along the south coast: the ocean on the left
+    for (double lat : {0.0, 0.9, 1.8, 2.7})
+        ring.push_back({-5, lat});
+    for (double lon : {-5.0, -4.1, -3.2, -2.3, -1.4, -0.63})
+        ring.push_back({lon, 3});
+    ring.push_back({0.27, 3.3}); // the cape
+    for (double lon : {1.17, 2.07, 3.2, 4.1, 5.0})
+        ring.push_back({lon, 3});
+    for (double lat : {2.1, 1.2, 0.3})
+        ring.push_back({5, lat});
+    Boundary b;
+    Ring r;
+    for (const LonLat &c : ring)
+        r.nodes.push_back(lonlat_to_vec(c));
+    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
+    b.rings.push_back(r);
+    const auto split = split_boundary(b, h, Lunes{2, 0.0}, nullptr);
+    auto has = [&](double lon, double lat) {
+        const Vec3 p = lonlat_to_vec(lon, lat);
+        for (const auto &part : split)
+            for (const Ring &x : part.boundary.rings)
+                for (const Vec3 &v : x.nodes)
+                    if (norm(v - p) < 1e-12)
+                        return true;
+        return false;
+    };
+    ASSERT_TRUE(has(1.17, 0)) << "the island is not where the test thinks";
+    EXPECT_FALSE(has(0.27, 0)) << "the straight coast's node 30 km from the crossing";
+    EXPECT_TRUE(has(-0.63, 0));
+    EXPECT_TRUE(has(0.27, 3.3)) << "the cape";
+}
+
 TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     TempDir dir;
     MeshOptions o;
