@@ -38,11 +38,14 @@ import json, sys
 t = json.load(open(sys.argv[1]))["stages"]; m = json.load(open(sys.argv[2]))["mesh"]
 wall, user, sys_ = map(float, open(sys.argv[3]).read().split()[-3:])
 q, f = m["quality"], m["size_ratio"]
-print(f'{sys.argv[4]:<7} {sys.argv[5]:>5} {sys.argv[6]:<9} {m["nodes"]:>9} {t["mesh"]:6.2f} {wall:7.2f} '
+open(sys.argv[1] + '.mesh', 'w').write(str(t["mesh"]))
+print(f'{sys.argv[4]:<7} {sys.argv[5]:>5} {sys.argv[6]:<9} {m["nodes"]:>9} {t["mesh"]:6.3f} {wall:7.2f} '
       f'{user + sys_:6.2f} {float(sys.argv[7]):5.1f} {q["min"]:6.3f} {q["mean"]:7.4f} {100 * q["above_0_8"]:6.2f} '
       f'{f["median"]:7.3f} {100 * f["in_0_7_1_4"]:6.2f} {sys.argv[8]}')
 PY
+            cp "$work/t.json.mesh" "$work/$run.mesh"
         done
+        echo "$c: mesh stage --threads 1 / --threads 2: $(/usr/bin/python3 -c "import sys; print('%.2fx' % (float(open(sys.argv[1]).read()) / float(open(sys.argv[2]).read())))" "$work/p$parts-t1.mesh" "$work/p$parts-t2.mesh")"
         "$root/tools/same-outputs" compare "$work/p$parts-t1" "$work/p$parts-t2" >/dev/null &&
             echo "$c: --threads 1 and 2 wrote the same mesh file (but the history line)" ||
             echo "$c: --threads 1 and 2 DIFFER"
