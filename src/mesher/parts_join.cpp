@@ -252,9 +252,22 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 }
 
 /// Nodes near the borders: 1 on a border, k + 1 k rings of faces away (k < zone_rings), 0
-/// elsewhere.
-std::vector<char> border_zone(const Mesh &mesh, const Borders &borders) {
+/// elsewhere. With `near` (may be null), grown over its faces alone: exact where every node
+/// reached before the last ring is near (all its faces are there), else grown again over all.
+std::vector<char> border_zone(const Mesh &mesh, const Borders &borders, const NearBorders *near) {
     std::vector<char> zone(mesh.nodes.size(), 0);
+    if (near) {
+        for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
+            if (near->node[v] && borders.on_any(mesh.nodes[v]))
+                zone[v] = 1;
+        grow_rings(mesh, &near->faces, zone, zone_rings);
+        bool whole = true;
+        for (NodeIndex v = 0; v < mesh.nodes.size() && whole; ++v)
+            whole = !zone[v] || zone[v] == zone_rings || near->node[v];
+        if (whole)
+            return zone;
+        std::fill(zone.begin(), zone.end(), 0);
+    }
     for (const auto &list : border_nodes(mesh, borders, Among::all_nodes))
         for (const auto &x : list)
             zone[x.second] = 1;
@@ -361,8 +374,13 @@ Mesh join_parts(std::vector<Mesh> &meshes, const Lunes &lunes, const SizeFn &siz
         if (!edges.has(e.b, e.a))
             boundary.push_back(e);
     out.boundary.swap(boundary);
-    std::vector<char> zone = border_zone(out, borders);
-    stitch_lattice(out, zone, borders.normal, size_km, lattice_km);
+    // The nodes near the borders, once for the zone and the stitch (where there is a lattice).
+    const NearBorders near = lattice_km > 0
+                                 ? near_borders(out, borders.normal, stitch_reach(lattice_km))
+                                 : NearBorders{};
+    std::vector<char> zone = border_zone(out, borders, lattice_km > 0 ? &near : nullptr);
+    stitch_lattice(out, zone, borders.normal, size_km, lattice_km,
+                   lattice_km > 0 ? &near : nullptr);
     std::vector<std::uint32_t> faces = zone_faces(out, zone);
     FaceOfEdge face_of = faces_of_edges(out, faces);
     flip_near_borders(out, faces, face_of);

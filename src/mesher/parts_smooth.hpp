@@ -68,13 +68,26 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
 std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
                                 const std::vector<std::uint32_t> &zone_face_list);
 
+/// The nodes within `reach` (radians) of a border's plane, and the faces with such a corner:
+/// every face of those nodes. One pass over the nodes and one over the faces.
+struct NearBorders {
+    std::vector<char> node;
+    std::vector<std::uint32_t> faces;
+};
+NearBorders near_borders(const Mesh &mesh, const std::vector<Vec3> &normals, double reach);
+
+/// How far from the borders' planes stitch_lattice looks (radians), at lattice_km.
+double stitch_reach(double lattice_km);
+
 /// Where the band along the borders (`normals`: their planes) is open ocean at the lattice's
 /// size (lattice_km), its nodes that are not lattice points are removed and the lattice's points
 /// there put in their place (parts_stitch.cpp): its faces become the lattice's, as inside a
 /// part. The new nodes take the removed ones' slots (then are appended, or the last nodes fill
 /// the slots left); only those next to a node kept off the lattice stay in `zone`. Changes
 /// nothing when the band's new triangulation does not fit. Returns the lattice points added.
+/// `near`: near_borders of the mesh at stitch_reach(lattice_km), or null (then computed here).
 std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vector<Vec3> &normals,
-                           const SizeFn &size_km, double lattice_km);
+                           const SizeFn &size_km, double lattice_km,
+                           const NearBorders *near = nullptr);
 
 } // namespace globemesh::parts_detail

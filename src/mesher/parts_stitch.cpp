@@ -38,28 +38,6 @@ constexpr double kept_clearance = 0.5;
 
 constexpr std::uint8_t inside_band = 1;
 
-/// The nodes within `reach` (radians) of a border's plane, and the faces with such a corner:
-/// every face of those nodes, and the only faces the rings below can reach. One pass over the
-/// nodes and one over the faces.
-struct NearBorders {
-    std::vector<char> node;
-    std::vector<std::uint32_t> faces;
-};
-NearBorders near_borders(const Mesh &mesh, const std::vector<Vec3> &normals, double reach) {
-    const double limit = std::sin(reach);
-    NearBorders near;
-    near.node.assign(mesh.nodes.size(), 0);
-    for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
-        for (const Vec3 &n : normals)
-            near.node[v] |= std::abs(dot(mesh.nodes[v], n)) < limit;
-    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
-        const auto &t = mesh.faces[f];
-        if (near.node[t[0]] || near.node[t[1]] || near.node[t[2]])
-            near.faces.push_back(f);
-    }
-    return near;
-}
-
 /// The band to re-mesh: its faces and the removed nodes.
 struct Band {
     std::vector<char> removed;         // per node
@@ -329,8 +307,28 @@ void replace_band(Mesh &mesh, std::vector<char> &zone, const Band &band,
 
 } // namespace
 
+NearBorders near_borders(const Mesh &mesh, const std::vector<Vec3> &normals, double reach) {
+    const double limit = std::sin(reach);
+    NearBorders near;
+    near.node.assign(mesh.nodes.size(), 0);
+    for (std::size_t v = 0; v < mesh.nodes.size(); ++v)
+        for (const Vec3 &n : normals)
+            near.node[v] |= std::abs(dot(mesh.nodes[v], n)) < limit;
+    for (std::uint32_t f = 0; f < mesh.faces.size(); ++f) {
+        const auto &t = mesh.faces[f];
+        if (near.node[t[0]] || near.node[t[1]] || near.node[t[2]])
+            near.faces.push_back(f);
+    }
+    return near;
+}
+
+// The rings' faces at the lattice's size are at most 1.4 spacings across (the size fit).
+double stitch_reach(double lattice_km) {
+    return 1.4 * looked_rings * LatticePoints(lattice_km).spacing();
+}
+
 std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vector<Vec3> &normals,
-                           const SizeFn &size_km, double lattice_km) {
+                           const SizeFn &size_km, double lattice_km, const NearBorders *near) {
     // The joined mesh's only node field is the target size; a face field would need values for
     // the new faces.
     if (lattice_km <= 0 || !size_km || !mesh.face_fields.empty() ||
@@ -338,9 +336,10 @@ std::size_t stitch_lattice(Mesh &mesh, std::vector<char> &zone, const std::vecto
                     [](const Field &f) { return f.name != "target_size"; }))
         return 0;
     const LatticePoints lattice(lattice_km);
-    // The rings' faces at the lattice's size are at most 1.4 spacings across (the size fit).
-    const NearBorders near_nodes =
-        near_borders(mesh, normals, 1.4 * looked_rings * lattice.spacing());
+    NearBorders own;
+    if (!near)
+        own = near_borders(mesh, normals, stitch_reach(lattice_km));
+    const NearBorders &near_nodes = near ? *near : own;
     std::vector<char> ring(mesh.nodes.size(), 0); // rings of faces from the border nodes
     for (std::size_t v = 0; v < zone.size(); ++v)
         ring[v] = zone[v] == 1;
