@@ -72,7 +72,8 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
                                          const Lunes &lunes, const LandTest *land);
 
 /// The part meshes joined: nodes equal on a border are one node, a border segment one side
-/// split is split on the other (a fan), boundary edges with their reverse become interior.
+/// split is split on the other (a fan, or a star around a node of its own where a fan face
+/// would fall below q 0.3), boundary edges with their reverse become interior.
 /// With the parts' lattice size (MesherOptions::lattice_km) and size field, the band along the
 /// borders is made the lattice again where it is open ocean at that size.
 Mesh join_parts(std::vector<Mesh> &parts_meshes, const Lunes &lunes, const SizeFn &size_km = {},

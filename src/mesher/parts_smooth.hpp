@@ -62,9 +62,14 @@ void flip_near_borders(Mesh &mesh, const std::vector<std::uint32_t> &faces, Face
 void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
                          const std::vector<std::uint32_t> &zone_face_list, bool search);
 
-/// Removes the free zone nodes with four faces (their quadrilateral becomes two faces) and
-/// compacts the nodes, the faces and `zone`. Returns how many; the zone's faces must then be
-/// listed again.
+/// The join makes no face below this quality that it can avoid (the mesher's floor,
+/// blunt_floor): a fan split is made a star instead, and a node with four faces stays where its
+/// two replacing faces would fall below it.
+inline constexpr double join_floor = 0.3;
+
+/// Removes the free zone nodes with four faces (their quadrilateral becomes two faces, unless one
+/// would fall below join_floor and below the four) and compacts the nodes, the faces and `zone`.
+/// Returns how many; the zone's faces must then be listed again.
 std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
                                 const std::vector<std::uint32_t> &zone_face_list);
 

@@ -130,6 +130,46 @@ TEST(Parts, a_coast_node_near_a_crossing_goes_where_the_coast_is_straight) {
     EXPECT_TRUE(has(0.27, 3.3)) << "the cape";
 }
 
+TEST(Parts, a_border_side_split_many_times_on_one_side_gets_a_node_on_the_other) {
+    // The east part's face A-P-B lies on the border at 0E (A to B 15 km, P a coast node 12 km
+    // east); the west part split A-B at M, 1.9 km from B, and M is a coast node there (an
+    // archipelago at the border: GSHHG high's Arctic at 15 km in 2 parts). A fan from P made a
+    // face M-B-P of q 0.21 that no smoothing mends (P, M and B are fixed); the join adds a node
+    // inside A-P-B and smooths it.
+    const Vec3 a = lonlat_to_vec(0, 0), b = lonlat_to_vec(0, 0.135), m = lonlat_to_vec(0, 0.118);
+    const Vec3 p = lonlat_to_vec(0.108, 0.07), q = lonlat_to_vec(-0.1, 0.07),
+               w = lonlat_to_vec(-0.02, 0.128);
+    auto part = [](std::vector<Vec3> nodes, std::vector<std::array<NodeIndex, 3>> faces,
+                   std::vector<BoundaryEdge> boundary) {
+        Mesh mesh;
+        mesh.nodes = std::move(nodes);
+        mesh.faces = std::move(faces);
+        mesh.boundary = std::move(boundary);
+        mesh.node_fields.push_back({"target_size", "target edge length", "km", "", {}});
+        mesh.node_fields[0].values.assign(mesh.nodes.size(), 15.0);
+        return mesh;
+    };
+    using T = EdgeTag;
+    std::vector<Mesh> meshes;
+    meshes.push_back(
+        part({a, p, b}, {{0, 1, 2}}, {{0, 1, T::coast}, {1, 2, T::coast}, {2, 0, T::open}}));
+    meshes.push_back(part({a, m, b, q, w}, {{0, 1, 3}, {1, 2, 4}},
+                          {{0, 1, T::open},
+                           {1, 3, T::coast},
+                           {3, 0, T::coast},
+                           {1, 2, T::open},
+                           {2, 4, T::coast},
+                           {4, 1, T::coast}}));
+    const SizeFn h = [](const Vec3 &) { return 15.0; };
+    const Mesh joined = join_parts(meshes, Lunes{2, 0.0}, h);
+    EXPECT_EQ(joined.nodes.size(), 7u) << "a node added inside A-P-B";
+    double worst = 1;
+    for (const auto &f : joined.faces)
+        worst = std::min(
+            worst, triangle_quality(joined.nodes[f[0]], joined.nodes[f[1]], joined.nodes[f[2]]));
+    EXPECT_GE(worst, 0.3) << "a fan from P has a face of q 0.21";
+}
+
 TEST(Parts, threads_give_the_same_bytes_aqua_planet) {
     TempDir dir;
     MeshOptions o;
