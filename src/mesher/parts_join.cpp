@@ -207,13 +207,13 @@ std::map<Edge, std::vector<NodeIndex>> border_splits(const Mesh &mesh, const Bor
 }
 
 /// The faces of face (a, b, apex) with the nodes `inside` on its side a-b: a fan from the apex,
-/// or, where a fan face would fall below join_floor, a star around a node added at the face's
-/// centroid (index `centre`; `star` tells), which the join's smoothing then moves to its best
-/// place. A side the other part's refinement split (an archipelago at a border) left fan faces
-/// of q 0.14-0.27 where the apex is a coast node, which no smoothing moves (GSHHG high's Arctic
-/// at 15 km in 2 parts: 0.207, one part 0.301).
+/// or, where a fan face would fall below join_floor and the apex is on the boundary (`apex_fixed`:
+/// no smoothing moves it to mend the fan), a star around a node added at the face's centroid
+/// (index `centre`; `star` tells), which the join's smoothing then moves to its best place. A
+/// side the other part's refinement split near its end (an archipelago at a border) left a fan
+/// face of q 0.21 at a coast node (GSHHG high's Arctic at 15 km in 2 parts; one part 0.301).
 std::vector<std::array<NodeIndex, 3>> fan_or_star(const Mesh &mesh, NodeIndex a, NodeIndex b,
-                                                  NodeIndex apex,
+                                                  NodeIndex apex, bool apex_fixed,
                                                   const std::vector<NodeIndex> &inside,
                                                   NodeIndex centre, bool &star) {
     std::vector<std::array<NodeIndex, 3>> faces;
@@ -225,7 +225,7 @@ std::vector<std::array<NodeIndex, 3>> fan_or_star(const Mesh &mesh, NodeIndex a,
     for (const auto &t : faces)
         worst =
             std::min(worst, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-    star = worst < join_floor;
+    star = apex_fixed && worst < join_floor;
     if (!star)
         return faces;
     for (auto &t : faces)
@@ -244,6 +244,9 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
     std::vector<char> starts(mesh.nodes.size(), 0); // a split edge's first node: few
     for (const auto &s : splits)
         starts[s.first.first] = 1;
+    std::vector<char> fixed(mesh.nodes.size(), 0); // on the boundary: the smoothing leaves it
+    for (const BoundaryEdge &e : mesh.boundary)
+        fixed[e.a] = fixed[e.b] = 1;
     const std::size_t faces = mesh.faces.size();
     for (std::size_t f = 0; f < faces; ++f)
         for (int i = 0; i < 3; ++i) {
@@ -256,8 +259,8 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
             const NodeIndex apex = face[(i + 2) % 3];
             const auto centre = static_cast<NodeIndex>(mesh.nodes.size());
             bool star = false;
-            const auto fan =
-                fan_or_star(mesh, face[i], face[(i + 1) % 3], apex, it->second, centre, star);
+            const auto fan = fan_or_star(mesh, face[i], face[(i + 1) % 3], apex, fixed[apex],
+                                         it->second, centre, star);
             if (star) {
                 const Vec3 x = normalized(mesh.nodes[face[i]] + mesh.nodes[face[(i + 1) % 3]] +
                                           mesh.nodes[apex]);
