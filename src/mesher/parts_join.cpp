@@ -144,10 +144,10 @@ void append_part(Mesh &m, const Borders &borders, const Sizes &total,
 }
 
 /// Which nodes border_nodes lists.
-enum class Among { open_edges, boundary_edges, all_nodes };
+enum class Among { open_edges, boundary_edges };
 
-/// The nodes on each border, by latitude (z): of the open boundary edges, of all boundary edges,
-/// or all.
+/// The nodes on each border, by latitude (z): of the open boundary edges, or of all boundary
+/// edges.
 std::vector<std::vector<std::pair<double, NodeIndex>>>
 border_nodes(const Mesh &mesh, const Borders &borders, Among among,
              double tolerance = on_border_tolerance) {
@@ -162,13 +162,9 @@ border_nodes(const Mesh &mesh, const Borders &borders, Among among,
             if (borders.on(p, k, tolerance))
                 on[k].push_back({p.z, v});
     };
-    if (among == Among::all_nodes)
-        for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
-            add(v);
-    else
-        for (const BoundaryEdge &e : mesh.boundary)
-            if (e.tag == EdgeTag::open || among == Among::boundary_edges)
-                add(e.a), add(e.b);
+    for (const BoundaryEdge &e : mesh.boundary)
+        if (e.tag == EdgeTag::open || among == Among::boundary_edges)
+            add(e.a), add(e.b);
     for (auto &list : on)
         std::sort(list.begin(), list.end());
     return on;
@@ -293,26 +289,18 @@ void split_faces(Mesh &mesh, const std::map<Edge, std::vector<NodeIndex>> &split
 }
 
 /// Nodes near the borders: 1 on a border, k + 1 k rings of faces away (k < zone_rings), 0
-/// elsewhere. With `near` (may be null), grown over its faces alone: exact where every node
-/// reached before the last ring is near (all its faces are there), else grown again over all.
+/// elsewhere. With `near` (may be null), found among its nodes and grown over its faces alone:
+/// exact where every node reached before the last ring is near (all its faces are there), else
+/// found again over the whole mesh.
 std::vector<char> border_zone(const Mesh &mesh, const Borders &borders, const NearBorders *near) {
     std::vector<char> zone(mesh.nodes.size(), 0);
-    if (near) {
-        for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
-            if (near->node[v] && borders.on_any(mesh.nodes[v]))
-                zone[v] = 1;
-        grow_rings(mesh, &near->faces, zone, zone_rings);
-        bool whole = true;
-        for (NodeIndex v = 0; v < mesh.nodes.size() && whole; ++v)
-            whole = !zone[v] || zone[v] == zone_rings || near->node[v];
-        if (whole)
-            return zone;
-        std::fill(zone.begin(), zone.end(), 0);
-    }
-    for (const auto &list : border_nodes(mesh, borders, Among::all_nodes))
-        for (const auto &x : list)
-            zone[x.second] = 1;
-    grow_rings(mesh, nullptr, zone, zone_rings);
+    for (NodeIndex v = 0; v < mesh.nodes.size(); ++v)
+        if ((!near || near->node[v]) && borders.on_any(mesh.nodes[v]))
+            zone[v] = 1;
+    grow_rings(mesh, near ? &near->faces : nullptr, zone, zone_rings);
+    for (NodeIndex v = 0; near && v < mesh.nodes.size(); ++v)
+        if (zone[v] && zone[v] < zone_rings && !near->node[v])
+            return border_zone(mesh, borders, nullptr);
     return zone;
 }
 
@@ -416,12 +404,12 @@ Mesh join_parts(std::vector<Mesh> &meshes, const Lunes &lunes, const SizeFn &siz
             boundary.push_back(e);
     out.boundary.swap(boundary);
     // The nodes near the borders, once for the zone and the stitch (where there is a lattice).
-    const NearBorders near = lattice_km > 0
-                                 ? near_borders(out, borders.normal, stitch_reach(lattice_km))
-                                 : NearBorders{};
-    std::vector<char> zone = border_zone(out, borders, lattice_km > 0 ? &near : nullptr);
-    stitch_lattice(out, zone, borders.normal, size_km, lattice_km,
-                   lattice_km > 0 ? &near : nullptr);
+    NearBorders near;
+    if (lattice_km > 0)
+        near = near_borders(out, borders.normal, stitch_reach(lattice_km));
+    const NearBorders *near_or_none = lattice_km > 0 ? &near : nullptr;
+    std::vector<char> zone = border_zone(out, borders, near_or_none);
+    stitch_lattice(out, zone, borders.normal, size_km, lattice_km, near_or_none);
     std::vector<std::uint32_t> faces = zone_faces(out, zone);
     FaceOfEdge face_of = faces_of_edges(out, faces);
     flip_near_borders(out, faces, face_of);

@@ -38,8 +38,7 @@ std::size_t bin_at(long u) {
 
 /// The normal of the meridian plane at border position u (a bin's start).
 Vec3 position_normal(long u) {
-    const double lon = (default_border_lon + double(u) * bin_degrees) * deg_to_rad;
-    return {-std::sin(lon), std::cos(lon), 0};
+    return Lunes{1, default_border_lon + double(u) * bin_degrees}.border_normal(0);
 }
 
 /// How closely the border at position u passes segment a-b by (h its size, radians): the

@@ -204,12 +204,12 @@ struct Splitter {
             nodes.push_back({r.nodes[i], r.kinds[i], -1});
             split_segment(r.nodes[i], r.nodes[(i + 1) % m], r.kinds[i], 0, nodes);
         }
+        // Off the arc as near_border measures off a meridian: the sine against the plane's normal.
         auto drops = [&](const Node &c, const Node &v, const Node &after) {
             const double h = km_to_rad(size_km(c.p)), gap = arc_angle(c.p, v.p);
-            const double off =
-                std::asin(std::clamp(dot(v.p, normalized(cross(c.p, after.p))), -1.0, 1.0));
+            const double off = std::fabs(dot(v.p, normalized(cross(c.p, after.p))));
             return gap < snap_fraction * h ||
-                   (gap < short_fraction * h && std::fabs(off) < straight_fraction * h);
+                   (gap < short_fraction * h && off < std::sin(straight_fraction * h));
         };
         return drop_beside_crossings(drop_excursions(std::move(nodes)), drops);
     }
