@@ -96,6 +96,9 @@
 
 namespace globemesh {
 
+/// MesherOptions::whole_rings of a segment along a border between parts.
+inline constexpr std::uint32_t no_whole_ring = 0xffffffffu;
+
 struct MesherOptions {
     std::uint64_t max_nodes = 20'000'000; ///< refuse when the size field asks for more nodes
     std::uint64_t max_memory = 0;  ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
@@ -128,6 +131,13 @@ struct MesherOptions {
     /// which a part's rings hold as plain coast nodes (one part keeps such a corner: land on
     /// both sides of it).
     std::vector<std::array<double, 3>> mouth_corners;
+    /// mesh_parts, for a part: per ring of the boundary, per segment, the ring of the whole
+    /// boundary the segment lies on, or no_whole_ring along a border between parts. The land
+    /// stage then tells a removal that would cut the ocean in two (two contacts with one ring)
+    /// from one that joins two coasts by these rings: the part's borders join its coasts into
+    /// loops the whole ocean does not have (the Suez canal, within a part whose Mediterranean
+    /// reaches the border, was kept open as a cut). Empty: the boundary is the whole.
+    std::vector<std::vector<std::uint32_t>> whole_rings;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
     /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where
     /// the mesh stays one manifold and its new boundary nodes near the coast (step 7). Null:

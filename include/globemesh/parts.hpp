@@ -66,6 +66,9 @@ struct Lunes {
 /// not close the ocean).
 struct PartBoundary {
     Boundary boundary;
+    /// Per ring of `boundary`, per segment: the ring of the whole boundary it lies on, or
+    /// no_whole_ring along a border (MesherOptions::whole_rings).
+    std::vector<std::vector<std::uint32_t>> whole_rings;
     bool has_ocean = false;
 };
 std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km,

@@ -120,6 +120,7 @@ void LandRemoval::trace_loops() {
         return it != next_on_boundary.end() && it->second == b;
     };
     std::uint32_t &loops = loops_state.count;
+    std::vector<std::size_t> starts; // of each loop in boundary_edges
     TriangleId hint = no_triangle;
     for (const auto &[segment, kind] : m.segments) {
         const auto [a, b] = segment;
@@ -134,6 +135,7 @@ void LandRemoval::trace_loops() {
             if (!is_ocean(triangle_of(start)) || is_ocean(triangle_of(dt.twin(start))))
                 continue;
             HalfEdge h = start;
+            starts.push_back(boundary_edges.size());
             do {
                 next_on_boundary.emplace(dt.origin(h), dt.destination(h));
                 loops_state.of.emplace(dt.origin(h), loops);
@@ -143,6 +145,7 @@ void LandRemoval::trace_loops() {
             loops_state.parent.push_back(loops++);
         }
     }
+    loops_as_whole(m, boundary_edges, starts, loops_state);
 }
 
 // The faces centred on land looked at, sorted: without `straits`, the ocean faces around the

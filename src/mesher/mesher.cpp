@@ -29,6 +29,7 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
 
     // Boundary insertion and recovery (insert.cpp).
     const std::vector<VertexId> ids = insert_boundary(m, boundary);
+    note_whole_rings(m, boundary, ids, options.whole_rings);
     globemesh::report(progress, 0.05, "insert_boundary");
     timed("insert_boundary");
     recover_segments(m, boundary, ids);

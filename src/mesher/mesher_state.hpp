@@ -132,6 +132,11 @@ struct Mesher {
     static constexpr std::uint32_t no_ring = 0xffffffffu, shared_ring = 0xfffffffeu;
     std::vector<std::uint32_t> ring_of;
     std::uint32_t current_ring = no_ring; // the ring recover() is working on
+    // A part's (MesherOptions::whole_rings): per vertex, the whole boundary's ring of the
+    // segment leaving it in the part's rings (no_whole_ring: a border's; not_given: a vertex the
+    // rings did not give); empty for a whole boundary.
+    static constexpr std::uint32_t not_given = 0xfffffffeu;
+    std::vector<std::uint32_t> whole_ring_from;
     void set_ring(VertexId v) {
         if (v >= ring_of.size())
             ring_of.resize(v + 1, no_ring);
@@ -156,6 +161,8 @@ struct Mesher {
         renumber_per_vertex(sharp, new_of_old, char{0});
         renumber_per_vertex(fixed, new_of_old, char{0});
         renumber_per_vertex(ring_of, new_of_old, no_ring);
+        if (!whole_ring_from.empty())
+            renumber_per_vertex(whole_ring_from, new_of_old, not_given);
         std::map<EdgeKey, SegmentKind> renamed;
         for (const auto &[e, kind] : segments)
             renamed.emplace(key(new_of_old[e.first], new_of_old[e.second]), kind);
@@ -464,6 +471,17 @@ struct BoundaryLoops {
     std::uint32_t count = 0;
     bool traced = false;
 };
+
+// whole_loops.cpp, for a part (MesherOptions::whole_rings): its rings' vertices noted with
+// their whole rings after insert_boundary; the loops remove_land_faces traced (`starts`: where
+// each begins in `edges`, its boundary half-edges in order) renumbered as the whole's, each
+// stretch between borders taking one loop for the whole rings it runs along. A part's borders
+// join its coasts into loops the whole ocean does not have: a removal touching two coasts would
+// look like a cut of the ocean where it joins two of the whole's rings.
+void note_whole_rings(Mesher &m, const Boundary &boundary, const std::vector<VertexId> &ids,
+                      const std::vector<std::vector<std::uint32_t>> &whole_rings);
+void loops_as_whole(const Mesher &m, const std::vector<HalfEdge> &edges,
+                    const std::vector<std::size_t> &starts, BoundaryLoops &loops);
 
 // The stages' entry points, in the order mesh_boundary (mesher.cpp) runs them, each in the file
 // named.

@@ -297,6 +297,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
             lune.land = lands[t];
         lune.lattice_within = lune_normals(lunes, static_cast<int>(k));
         lune.lattice_share = 1.0 / parts;
+        lune.whole_rings = split[k].whole_rings;
         meshes[k] =
             mesh_boundary(split[k].boundary, size_km, lune, &reports[k], shared.part(k), &times[k]);
     });

@@ -40,6 +40,7 @@ struct Node {
     Vec3 p;
     SegmentKind kind; // of the segment from this node
     int crossing = -1;
+    std::uint32_t ring = no_whole_ring; // of the whole boundary the segment from it lies on
 };
 
 struct Splitter {
@@ -350,7 +351,7 @@ std::vector<Node> part_outline(const std::vector<std::vector<Node>> &borders, in
 /// Part k's rings from its pieces, each exit joined to the next entry along its outline.
 void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces,
                  const std::vector<int> &piece_of_entry, int k, std::size_t crossing_count,
-                 Boundary &out) {
+                 PartBoundary &out) {
     std::vector<int> position(crossing_count, -1);
     for (std::size_t i = 0; i < loop.size(); ++i)
         if (loop[i].crossing >= 0)
@@ -360,23 +361,28 @@ void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces
         if (pieces[first].part != k || used[first])
             continue;
         Ring ring;
+        std::vector<std::uint32_t> whole;
         for (std::size_t p = first, guard = 0; !used[p]; ++guard) {
             if (guard > pieces.size() || position[pieces[p].exit] < 0)
                 throw DataError("parts: a coast piece leaves its part where no border is; use "
                                 "--parts 1");
             used[p] = 1;
+            auto add = [&](const Node &v, SegmentKind kind, std::uint32_t r) {
+                ring.nodes.push_back(v.p), ring.kinds.push_back(kind), whole.push_back(r);
+            };
             for (const Node &v : pieces[p].nodes)
-                ring.nodes.push_back(v.p), ring.kinds.push_back(v.kind);
+                add(v, v.kind, v.ring);
             std::size_t i = static_cast<std::size_t>(position[pieces[p].exit]);
-            ring.nodes.push_back(loop[i].p), ring.kinds.push_back(SegmentKind::open);
+            add(loop[i], SegmentKind::open, no_whole_ring);
             for (i = (i + 1) % loop.size(); loop[i].crossing < 0; i = (i + 1) % loop.size())
-                ring.nodes.push_back(loop[i].p), ring.kinds.push_back(SegmentKind::open);
+                add(loop[i], SegmentKind::open, no_whole_ring);
             p = static_cast<std::size_t>(piece_of_entry[loop[i].crossing]);
             if (pieces[p].part != k)
                 throw DataError("parts: the coast enters a part across a border it leaves; use "
                                 "--parts 1");
         }
-        out.rings.push_back(std::move(ring));
+        out.boundary.rings.push_back(std::move(ring));
+        out.whole_rings.push_back(std::move(whole));
     }
 }
 
@@ -407,8 +413,10 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
     Splitter s{lunes, size_km, {}};
     std::vector<PartBoundary> out(static_cast<std::size_t>(parts));
     std::vector<std::vector<Node>> cut;
-    for (const Ring &r : boundary.rings) {
-        std::vector<Node> nodes = s.cut_ring(r);
+    for (std::uint32_t r = 0; r < boundary.rings.size(); ++r) {
+        std::vector<Node> nodes = s.cut_ring(boundary.rings[r]);
+        for (Node &v : nodes)
+            v.ring = r;
         if (std::none_of(nodes.begin(), nodes.end(),
                          [](const Node &v) { return v.crossing >= 0; })) {
             auto &b = out[static_cast<std::size_t>(lunes.part_of(nodes[0].p))];
@@ -416,6 +424,7 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
             for (const Node &v : nodes)
                 kept.nodes.push_back(v.p), kept.kinds.push_back(v.kind);
             b.boundary.rings.push_back(std::move(kept));
+            b.whole_rings.emplace_back(nodes.size(), r);
             b.has_ocean = true;
         } else {
             cut.push_back(std::move(nodes));
@@ -439,12 +448,13 @@ std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn 
         const bool crossed =
             std::any_of(loop.begin(), loop.end(), [](const Node &v) { return v.crossing >= 0; });
         if (crossed) {
-            join_pieces(loop, pieces, piece_of_entry, k, s.crossings.size(), b.boundary);
+            join_pieces(loop, pieces, piece_of_entry, k, s.crossings.size(), b);
         } else if (!loop.empty()) { // the whole outline is ocean
             Ring ring;
             for (const Node &v : loop)
                 ring.nodes.push_back(v.p), ring.kinds.push_back(SegmentKind::open);
             b.boundary.rings.push_back(std::move(ring));
+            b.whole_rings.emplace_back(loop.size(), no_whole_ring);
         }
         b.has_ocean = b.has_ocean || !loop.empty();
     }

@@ -394,6 +394,26 @@ TEST(Parts, a_coast_vertex_metres_past_a_border_leaves_no_sliver_at_it) {
     expect_mesh_verify(dir / "a.nc");
 }
 
+TEST(Parts, a_channel_between_two_coasts_a_border_joins_closes_as_in_one_part) {
+    // Natural Earth 1:50m around Greece at 25 km in 4 parts, a border at 20.7623E (the first at
+    // -69.2377E) beside the channel between Lefkada and the mainland. In its part the border
+    // joined the mainland's coast and the island's into one loop: a face across the channel,
+    // centred on land, looked like a cut of the ocean and stayed, and the channel kept a fan of
+    // 16 faces down to q 0.333 (one part: one face, q min 0.397 elsewhere). The land stage now
+    // tells the loops by the whole coast's rings.
+    TempDir dir;
+    MeshOptions o;
+    o.coast = fixture("coast/ne_50m_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = 25;
+    o.region = {15, 33, 28, 45};
+    o.parts_border_lon = -69.2377;
+    const double one = compute_stats(mesh_ocean(o).mesh).quality_min;
+    const Mesh parts = mesh_and_write(o, 4, 2, dir / "p.nc");
+    EXPECT_GE(compute_stats(parts).quality_min, one);
+    expect_mesh_verify(dir / "p.nc");
+}
+
 TEST(Parts, a_region_in_parts_is_meshed_inside_its_box_alone) {
     // The box (146-154E) lies in one lune of 2 parts and across the border at 150.01E of 3. A
     // border no ring crosses had been taken for ocean where the coast has no land: 2 parts
