@@ -397,7 +397,10 @@ void canonical_order(Boundary &b) {
 }
 
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in
-/// GEOS) by 1e-7 rad into the land on its right.
+/// GEOS) by 1e-7 rad into the sector its own two arcs bound with no other arc inside: the land
+/// on its right where two land polygons touch, the water on its left where a lake touches its
+/// coast (the coast's land sector holds the lake's arcs: moved into it, each copy crossed the
+/// other ring's arcs; GSHHG high's Evros delta with --keep-inland-seas).
 std::size_t separate_pinches(Boundary &b) {
     struct Occ {
         Vec3 v;
@@ -413,27 +416,52 @@ std::size_t separate_pinches(Boundary &b) {
     });
     std::size_t moved = 0;
     constexpr double delta = 1e-7;
+    std::vector<std::array<Vec3, 2>> arcs; // per copy: the tangents towards its node before, after
+    std::vector<Vec3> to;
     for (std::size_t i = 0; i < occ.size();) {
         std::size_t j = i + 1;
         while (j < occ.size() && occ[j].v == occ[i].v)
             ++j;
         if (j - i > 1) {
+            const Vec3 p = occ[i].v;
+            auto tangent = [&](const Vec3 &q) { return normalized(q - dot(p, q) * p); };
+            arcs.clear();
             for (std::size_t k = i; k < j; ++k) {
-                auto &nodes = b.rings[occ[k].ring].nodes;
-                std::size_t n = nodes.size(), at = occ[k].index;
-                const Vec3 p = occ[k].v;
-                const Vec3 &a = nodes[(at + n - 1) % n];
-                const Vec3 &c = nodes[(at + 1) % n];
-                // The land is the sector swept counter-clockwise from the incoming arc (towards
-                // a) to the outgoing one (towards c); move along its bisector.
-                Vec3 ta = normalized(a - dot(p, a) * p), tc = normalized(c - dot(p, c) * p);
-                double theta = std::atan2(dot(p, cross(ta, tc)), dot(ta, tc));
-                if (theta <= 0)
-                    theta += 2 * pi;
-                Vec3 u = std::cos(0.5 * theta) * ta + std::sin(0.5 * theta) * cross(p, ta);
-                nodes[at] = normalized(p + delta * u);
-                ++moved;
+                const auto &nodes = b.rings[occ[k].ring].nodes;
+                const std::size_t n = nodes.size(), at = occ[k].index;
+                arcs.push_back({tangent(nodes[(at + n - 1) % n]), tangent(nodes[(at + 1) % n])});
             }
+            // The counter-clockwise angle from tangent s to tangent t, in (0, 2 pi].
+            auto sweep = [&](const Vec3 &s, const Vec3 &t) {
+                const double theta = std::atan2(dot(p, cross(s, t)), dot(s, t));
+                return theta <= 0 ? theta + 2 * pi : theta;
+            };
+            // Whether another copy's arc lies strictly inside the sweep from s by theta.
+            auto holds_other = [&](std::size_t own, const Vec3 &s, double theta) {
+                for (std::size_t k = 0; k < arcs.size(); ++k)
+                    for (const Vec3 &t : arcs[k])
+                        if (k != own && sweep(s, t) < theta)
+                            return true;
+                return false;
+            };
+            to.clear();
+            for (std::size_t k = 0; k < arcs.size(); ++k) {
+                // The land is the sector swept counter-clockwise from the incoming arc to the
+                // outgoing one, the water the rest.
+                const auto &[ta, tc] = arcs[k];
+                Vec3 from = ta;
+                double theta = sweep(ta, tc);
+                if (holds_other(k, ta, theta) && !holds_other(k, tc, 2 * pi - theta)) {
+                    from = tc;
+                    theta = 2 * pi - theta;
+                }
+                const Vec3 u =
+                    std::cos(0.5 * theta) * from + std::sin(0.5 * theta) * cross(p, from);
+                to.push_back(normalized(p + delta * u));
+            }
+            for (std::size_t k = i; k < j; ++k)
+                b.rings[occ[k].ring].nodes[occ[k].index] = to[k - i];
+            moved += j - i;
         }
         i = j;
     }

@@ -18,6 +18,7 @@
 
 using namespace globemesh;
 using globemesh::test::count_violations;
+using globemesh::test::fixture;
 using globemesh::test::TempDir;
 
 namespace {
@@ -303,6 +304,33 @@ TEST(CoastHostile, polygons_touching_at_one_point_are_moved_apart) {
                                polygon("[[5,5],[10,5],[10,10],[5,10],[5,5]]")}));
     CoastData d = load_coast(options_for(path));
     expect_valid_both_stages(d);
+}
+
+TEST(CoastHostile, a_lake_touching_its_coast_at_one_point_is_moved_apart) {
+    // The lake's ring and the coast's share the node (10, 10). Each copy used to move into the
+    // land on its own right, which for the coast's ring holds the lake and for the lake's ring
+    // the ocean: the two copies crossed each other's arcs and the coast was refused.
+    TempDir dir;
+    auto path = write(dir, "lake_touch.geojson",
+                      geojson({polygon("[[0,10],[10,10],[20,10],[20,30],[0,30],[0,10]],"
+                                       "[[10,10],[15,15],[10,20],[5,15],[10,10]]")}));
+    MeshOptions o = options_for(path);
+    o.keep_inland_seas = true;
+    CoastData d = load_coast(o);
+    EXPECT_EQ(d.rings.rings.size(), 2u);
+    expect_valid_both_stages(d);
+}
+
+TEST(CoastHostile, gshhg_high_evros_delta_keeps_its_lake_that_touches_the_coast) {
+    // GSHHG high's Eurasia touches itself at 26.0191E 40.8146N (a vertex on another of its
+    // segments); cleaned, a lake touches the coast there. With --keep-inland-seas the global
+    // run at 30 km was refused ("arcs touch or cross"), as GSHHG full was at 126.37W 73.28S.
+    MeshOptions o = options_for(fixture("coast/hostile/gshhg_h_evros.geojson").string());
+    o.region = std::array<double, 4>{25.9, 40.7, 26.2, 40.9};
+    o.keep_inland_seas = true;
+    CoastData d = load_coast(o);
+    EXPECT_GE(d.rings.rings.size(), 2u);
+    expect_valid_both_stages(d, 1);
 }
 
 TEST(CoastHostile, overlapping_polygons_are_dissolved) {
