@@ -47,6 +47,29 @@ struct Splitter {
     const Lunes &lunes;
     const SizeFn &size_km;
     std::vector<Crossing> crossings;
+    std::vector<Vec3> by_z; // every ring's nodes, sorted by z (holds_node)
+
+    /// Whether a node of the rings other than a, b and c lies inside or on the spherical
+    /// triangle a, b, c (at most a few h across): dropping b for the arc a-c would then cross
+    /// that coast (a ring no part could recover).
+    bool holds_node(const Vec3 &a, const Vec3 &b, const Vec3 &c) const {
+        using predicates::orient;
+        const int turn = orient(a, b, c);
+        if (turn == 0)
+            return false; // b on the arc a-c: no room between
+        const double reach = std::max({norm(a - b), norm(b - c), norm(c - a)});
+        const auto [lo, hi] = std::minmax({a.z, b.z, c.z});
+        auto first = std::lower_bound(by_z.begin(), by_z.end(), lo - reach,
+                                      [](const Vec3 &p, double z) { return p.z < z; });
+        for (auto it = first; it != by_z.end() && it->z <= hi + reach; ++it) {
+            const Vec3 &x = *it;
+            if (x == a || x == b || x == c || dot(x, a) <= 0)
+                continue;
+            if (orient(a, b, x) != -turn && orient(b, c, x) != -turn && orient(c, a, x) != -turn)
+                return true;
+        }
+        return false;
+    }
 
     /// Where arc a-b crosses border k's meridian, if it does.
     bool cross_border(const Vec3 &a, const Vec3 &b, int k, Vec3 &p) const {
@@ -197,7 +220,8 @@ struct Splitter {
 
     /// The ring's nodes with its crossings inserted, its shallow excursions across a border
     /// dropped, ring nodes within snap_fraction * h of a crossing dropped, and those within
-    /// short_fraction * h where the coast runs straight on past them.
+    /// short_fraction * h where the coast runs straight on past them; none where another coast's
+    /// node lies between the node and the arc that would replace it.
     std::vector<Node> cut_ring(const Ring &r) {
         std::vector<Node> nodes;
         const std::size_t m = r.nodes.size();
@@ -209,8 +233,9 @@ struct Splitter {
         auto drops = [&](const Node &c, const Node &v, const Node &after) {
             const double h = km_to_rad(size_km(c.p)), gap = arc_angle(c.p, v.p);
             const double off = std::fabs(dot(v.p, normalized(cross(c.p, after.p))));
-            return gap < snap_fraction * h ||
-                   (gap < short_fraction * h && off < std::sin(straight_fraction * h));
+            return (gap < snap_fraction * h ||
+                    (gap < short_fraction * h && off < std::sin(straight_fraction * h))) &&
+                   !holds_node(c.p, v.p, after.p);
         };
         return drop_beside_crossings(drop_excursions(std::move(nodes)), drops);
     }
@@ -410,7 +435,10 @@ int Lunes::part_of(const Vec3 &p) const {
 std::vector<PartBoundary> split_boundary(const Boundary &boundary, const SizeFn &size_km,
                                          const Lunes &lunes, const LandTest *land) {
     const int parts = lunes.count;
-    Splitter s{lunes, size_km, {}};
+    Splitter s{lunes, size_km, {}, {}};
+    for (const Ring &r : boundary.rings)
+        s.by_z.insert(s.by_z.end(), r.nodes.begin(), r.nodes.end());
+    std::sort(s.by_z.begin(), s.by_z.end(), [](const Vec3 &p, const Vec3 &q) { return p.z < q.z; });
     std::vector<PartBoundary> out(static_cast<std::size_t>(parts));
     std::vector<std::vector<Node>> cut;
     for (std::uint32_t r = 0; r < boundary.rings.size(); ++r) {

@@ -90,44 +90,79 @@ TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
     }
 }
 
+/// A coast ring through `corners` (lon/lat, the ocean on the left).
+Ring coast_ring(const std::vector<LonLat> &corners) {
+    Ring r;
+    for (const LonLat &c : corners)
+        r.nodes.push_back(lonlat_to_vec(c));
+    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
+    return r;
+}
+
+/// An island from 5W to 5E, 0 to 3N, across the border at 0E, the ocean on the left: its south
+/// coast's nodes at `south` (west from 5E), one node of its north coast at `north` (between
+/// 0.63W and 1.17E).
+std::vector<LonLat> island_across_0e(const std::vector<double> &south, LonLat north) {
+    std::vector<LonLat> ring;
+    for (double lon : south)
+        ring.push_back({lon, 0});
+    for (double lat : {0.0, 0.9, 1.8, 2.7})
+        ring.push_back({-5, lat});
+    for (double lon : {-5.0, -4.1, -3.2, -2.3, -1.4, -0.63})
+        ring.push_back({lon, 3});
+    ring.push_back(north);
+    for (double lon : {1.17, 2.07, 3.2, 4.1, 5.0})
+        ring.push_back({lon, 3});
+    for (double lat : {2.1, 1.2, 0.3})
+        ring.push_back({5, lat});
+    return ring;
+}
+
+/// Whether a part of `split` has a ring node at lon, lat.
+bool split_has(const std::vector<PartBoundary> &split, double lon, double lat) {
+    const Vec3 p = lonlat_to_vec(lon, lat);
+    for (const auto &part : split)
+        for (const Ring &x : part.boundary.rings)
+            for (const Vec3 &v : x.nodes)
+                if (norm(v - p) < 1e-12)
+                    return true;
+    return false;
+}
+
 TEST(Parts, a_coast_node_near_a_crossing_goes_where_the_coast_is_straight) {
     // An island across the border at 0E (h 100 km): on its straight south coast (the equator) a
     // node 30 km east of the crossing made a 30 km segment there, and faces as short (GSHHG low
     // at 20 km, the Benin coast at 2.01E: q 0.54). It goes; on the north coast a cape as near
     // the crossing, 33 km off the coast's line, stays.
     const SizeFn h = [](const Vec3 &) { return 100.0; };
-    std::vector<LonLat> ring;
-    for (double lon : {5.0, 4.1, 3.2, 2.07, 1.17, 0.27, -0.63, -1.53, -2.43, -3.33, -4.23})
-        ring.push_back({lon, 0}); // west along the south coast: the ocean on the left
-    for (double lat : {0.0, 0.9, 1.8, 2.7})
-        ring.push_back({-5, lat});
-    for (double lon : {-5.0, -4.1, -3.2, -2.3, -1.4, -0.63})
-        ring.push_back({lon, 3});
-    ring.push_back({0.27, 3.3}); // the cape
-    for (double lon : {1.17, 2.07, 3.2, 4.1, 5.0})
-        ring.push_back({lon, 3});
-    for (double lat : {2.1, 1.2, 0.3})
-        ring.push_back({5, lat});
     Boundary b;
-    Ring r;
-    for (const LonLat &c : ring)
-        r.nodes.push_back(lonlat_to_vec(c));
-    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
-    b.rings.push_back(r);
+    b.rings.push_back(coast_ring(island_across_0e(
+        {5.0, 4.1, 3.2, 2.07, 1.17, 0.27, -0.63, -1.53, -2.43, -3.33, -4.23}, {0.27, 3.3})));
     const auto split = split_boundary(b, h, Lunes{2, 0.0}, nullptr);
-    auto has = [&](double lon, double lat) {
-        const Vec3 p = lonlat_to_vec(lon, lat);
-        for (const auto &part : split)
-            for (const Ring &x : part.boundary.rings)
-                for (const Vec3 &v : x.nodes)
-                    if (norm(v - p) < 1e-12)
-                        return true;
-        return false;
-    };
+    auto has = [&](double lon, double lat) { return split_has(split, lon, lat); };
     ASSERT_TRUE(has(1.17, 0)) << "the island is not where the test thinks";
     EXPECT_FALSE(has(0.27, 0)) << "the straight coast's node 30 km from the crossing";
     EXPECT_TRUE(has(-0.63, 0));
     EXPECT_TRUE(has(0.27, 3.3)) << "the cape";
+}
+
+TEST(Parts, a_coast_node_near_a_crossing_stays_where_another_coast_lies_behind_it) {
+    // A shallow bay 30 km east of the crossing at 0E (h 100 km), 4.1 km off the arc from the
+    // crossing to the node after it: the node goes, as on a straight coast. With an islet in
+    // the bay that arc would cross the islet's coast (a ring no part could recover): the node
+    // stays. So for a node within snap_fraction h of a crossing, which goes however far it
+    // lies off that arc.
+    const SizeFn h = [](const Vec3 &) { return 100.0; };
+    const std::vector<LonLat> coast = island_across_0e(
+        {5.0, 4.1, 3.2, 2.3, 1.4, 0.5, -0.4, -1.3, -2.2, -3.1, -4.0}, {0.27, 2.92});
+    for (const bool islet : {false, true}) {
+        Boundary b;
+        b.rings.push_back(coast_ring(coast));
+        if (islet)
+            b.rings.push_back(coast_ring({{0.19, 2.935}, {0.21, 2.945}, {0.23, 2.935}}));
+        EXPECT_EQ(split_has(split_boundary(b, h, Lunes{2, 0.0}, nullptr), 0.27, 2.92), islet)
+            << (islet ? "with" : "without") << " the islet";
+    }
 }
 
 TEST(Parts, a_border_side_split_many_times_on_one_side_gets_a_node_on_the_other) {
