@@ -3,8 +3,8 @@
 # each coast option, fine regions that break meshers, and the shared rasters, each run in one
 # part and, where PARTS is given, in that many parts too. Every run is judged by its exit status
 # (a refusal must be a one-line message, printed here) and every output by mesh-verify; q min
-# of one part and of the parts side by side. Found the lake touching its coast (6987404) and the
-# part loops joined by borders (2847b6b).
+# of one part and of the parts side by side. Its GSHHG high run with --keep-inland-seas
+# --keep-straits is how the lake touching its coast (6987404) was found.
 #
 #   bench/options_sweep.sh GLOBEMESH [PARTS] [GSHHG_DIR]
 # GSHHG_DIR holds l.gpkg, i.gpkg, h.gpkg, f.gpkg (bench/gshhg_land.py; layer 'land'), default
