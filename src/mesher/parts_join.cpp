@@ -217,11 +217,7 @@ std::vector<std::array<NodeIndex, 3>> fan_or_star(const Mesh &mesh, NodeIndex a,
     for (NodeIndex v : inside)
         faces.push_back({from, v, apex}), from = v;
     faces.push_back({from, b, apex});
-    double worst = 1;
-    for (const auto &t : faces)
-        worst =
-            std::min(worst, triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]));
-    star = apex_fixed && worst < join_floor;
+    star = apex_fixed && lowest_quality(mesh.nodes, faces) < join_floor;
     if (!star)
         return faces;
     for (auto &t : faces)

@@ -372,14 +372,11 @@ std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
         const std::array<std::array<NodeIndex, 3>, 2> two = {
             {{ring[s], ring[s + 1], ring[(s + 2) % 4]},
              {ring[s], ring[(s + 2) % 4], ring[(s + 3) % 4]}}};
-        double four = 1, after = 1;
-        for (std::size_t k = 0; k < 4; ++k) {
-            const auto &t = mesh.faces[at[first + k].second];
-            four = std::min(four, triangle_quality(p[t[0]], p[t[1]], p[t[2]]));
-        }
-        for (const auto &t : two)
-            after = std::min(after, triangle_quality(p[t[0]], p[t[1]], p[t[2]]));
-        if (after < join_floor && after < four)
+        const std::array<std::array<NodeIndex, 3>, 4> four = {
+            mesh.faces[at[first].second], mesh.faces[at[first + 1].second],
+            mesh.faces[at[first + 2].second], mesh.faces[at[first + 3].second]};
+        const double after = lowest_quality(p, two);
+        if (after < join_floor && after < lowest_quality(p, four))
             continue; // a star the join made at a fan split (fan_or_star)
         mesh.faces[at[first].second] = two[0];
         mesh.faces[at[first + 1].second] = two[1];

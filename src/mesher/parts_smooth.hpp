@@ -2,11 +2,13 @@
 // over a zone of nodes join_parts marks (non-zero near a border) and the faces touching it.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
 #include "globemesh/mesh.hpp"
 #include "globemesh/size_fn.hpp"
+#include "globemesh/sphere.hpp"
 
 namespace globemesh::parts_detail {
 
@@ -66,6 +68,15 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
 /// blunt_floor): a fan split is made a star instead, and a node with four faces stays where its
 /// two replacing faces would fall below it.
 inline constexpr double join_floor = 0.3;
+
+/// The lowest triangle_quality of `faces` (node triples of `nodes`; no fold test), 1 for none:
+/// for faces the join weighs before they are in the mesh.
+template <class Faces> double lowest_quality(const std::vector<Vec3> &nodes, const Faces &faces) {
+    double q = 1;
+    for (const auto &t : faces)
+        q = std::min(q, triangle_quality(nodes[t[0]], nodes[t[1]], nodes[t[2]]));
+    return q;
+}
 
 /// Removes the free zone nodes with four faces (their quadrilateral becomes two faces, unless one
 /// would fall below join_floor and below the four) and compacts the nodes, the faces and `zone`.

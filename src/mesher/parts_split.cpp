@@ -387,14 +387,14 @@ void join_pieces(const std::vector<Node> &loop, const std::vector<Piece> &pieces
             continue;
         Ring ring;
         std::vector<std::uint32_t> whole;
+        auto add = [&](const Node &v, SegmentKind kind, std::uint32_t r) {
+            ring.nodes.push_back(v.p), ring.kinds.push_back(kind), whole.push_back(r);
+        };
         for (std::size_t p = first, guard = 0; !used[p]; ++guard) {
             if (guard > pieces.size() || position[pieces[p].exit] < 0)
                 throw DataError("parts: a coast piece leaves its part where no border is; use "
                                 "--parts 1");
             used[p] = 1;
-            auto add = [&](const Node &v, SegmentKind kind, std::uint32_t r) {
-                ring.nodes.push_back(v.p), ring.kinds.push_back(kind), whole.push_back(r);
-            };
             for (const Node &v : pieces[p].nodes)
                 add(v, v.kind, v.ring);
             std::size_t i = static_cast<std::size_t>(position[pieces[p].exit]);
