@@ -45,6 +45,15 @@ Mesh mesh_and_write(MeshOptions o, int parts, int threads, const fs::path &path)
     return std::move(run.mesh);
 }
 
+/// Natural Earth land from the fixtures (`scale` "110m" or "50m"), uniform at hmax_km.
+MeshOptions natural_earth(const std::string &scale, double hmax_km) {
+    MeshOptions o;
+    o.coast = fixture("coast/ne_" + scale + "_land.gpkg").string();
+    o.coast_layer = "land";
+    o.hmax_km = hmax_km;
+    return o;
+}
+
 /// An aqua-planet with one 10 x 8 degree island, written into dir: its path.
 std::string island(const fs::path &dir) {
     std::ofstream(dir / "island.geojson")
@@ -340,12 +349,9 @@ TEST(Parts, part_count_zero_follows_the_node_estimate) {
 
 TEST(Parts, threads_give_the_same_bytes_natural_earth) {
     TempDir dir;
-    MeshOptions o;
-    o.coast = fixture("coast/ne_110m_land.gpkg").string();
-    o.coast_layer = "land";
     // 2 parts: a border node in the Canadian Arctic with land on both sides; 5 parts: nodes
     // with four faces near the borders, removed by the join (both with the borders from -89.99).
-    o.hmax_km = 150;
+    MeshOptions o = natural_earth("110m", 150);
     o.parts_border_lon = default_border_lon;
     const Mesh one = mesh_and_write(o, 1, 1, dir / "one.nc");
     for (int parts : {2, 5}) {
@@ -437,10 +443,7 @@ TEST(Parts, a_channel_between_two_coasts_a_border_joins_closes_as_in_one_part) {
     // 16 faces down to q 0.333 (one part: one face, q min 0.397 elsewhere). The land stage now
     // tells the loops by the whole coast's rings.
     TempDir dir;
-    MeshOptions o;
-    o.coast = fixture("coast/ne_50m_land.gpkg").string();
-    o.coast_layer = "land";
-    o.hmax_km = 25;
+    MeshOptions o = natural_earth("50m", 25);
     o.region = {15, 33, 28, 45};
     o.parts_border_lon = -69.2377;
     const double one = compute_stats(mesh_ocean(o).mesh).quality_min;
@@ -505,10 +508,7 @@ TEST(Parts, the_borders_are_chosen_off_the_coasts) {
     // borders (one part: none) and the worst face fell from q 0.323 to 0.230. Chosen (the
     // parts' work balanced, the borders passing the coast least closely), the borders at 2.76E
     // and 177.24W have none, and the worst face is one part's.
-    MeshOptions o;
-    o.coast = fixture("coast/ne_50m_land.gpkg").string();
-    o.coast_layer = "land";
-    o.hmax_km = 60;
+    MeshOptions o = natural_earth("50m", 60);
     o.parts = 1;
     const Mesh one = mesh_ocean(o).mesh;
     o.parts = 2;
@@ -532,10 +532,7 @@ TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
     // Each part had reported its own pieces beside a closed strait, though they reach the ocean
     // through another part: NE 1:110m at 150 km in 5 parts listed 6 basins, two of 2.6e6 and
     // 2.9e6 km2, where the joined mesh has one piece besides the ocean's.
-    MeshOptions o;
-    o.coast = fixture("coast/ne_110m_land.gpkg").string();
-    o.coast_layer = "land";
-    o.hmax_km = 150;
+    MeshOptions o = natural_earth("110m", 150);
     for (int parts : {3, 5}) {
         SCOPED_TRACE(parts);
         o.parts = parts;
@@ -572,10 +569,7 @@ TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
     // Each part's lattice is its lune's share of the sphere's: with 3 or more parts it had been
     // weighed whole against one part's node estimate, and skipped.
-    MeshOptions o;
-    o.coast = fixture("coast/ne_110m_land.gpkg").string();
-    o.coast_layer = "land";
-    o.hmax_km = 250;
+    MeshOptions o = natural_earth("110m", 250);
     const std::size_t one = mesh_ocean(o).mesher.lattice_nodes;
     ASSERT_GT(one, 2000u);
     for (int parts = 2; parts <= 6; ++parts) {
