@@ -50,23 +50,29 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
     auto index = [&](int r, int k) {
         return r == 0 ? 0 : 1 + (r - 1) * spokes + (k + spokes) % spokes;
     };
-    std::vector<double> clearance(n, -1); // -1: land
-    for (int r = 0; r <= rings; ++r)
-        for (int k = 0; k < (r ? spokes : 1); ++k) {
-            const double d = reach * r / rings, a = 2 * M_PI * k / spokes;
-            const Vec3 q = normalized(std::cos(d) * p +
-                                      std::sin(d) * (std::cos(a) * east + std::sin(a) * north));
-            if (!land.contains(q))
-                clearance[index(r, k)] = land.coast_distance(q, reach);
-        }
-    // The rim's stretches of water: each rim sample's stretch (-1 on land).
+    auto sample = [&](int r, int k) {
+        const double d = reach * r / rings, a = 2 * M_PI * k / spokes;
+        return normalized(std::cos(d) * p +
+                          std::sin(d) * (std::cos(a) * east + std::sin(a) * north));
+    };
+    // The rim's stretches of water first (each rim sample's stretch, -1 on land): most closings
+    // have one stretch or none at some zooms, where the inner samples are not needed.
+    std::vector<char> rim_water(spokes);
+    for (int k = 0; k < spokes; ++k)
+        rim_water[k] = !land.contains(sample(rings, k));
     std::vector<int> stretch(spokes, -1);
     int stretches = 0;
     for (int k = 0; k < spokes; ++k)
-        if (clearance[index(rings, k)] >= 0 && clearance[index(rings, k - 1)] < 0)
+        if (rim_water[k] && !rim_water[(k + spokes - 1) % spokes])
             stretch[k] = stretches++;
+    // (A rim all water is one stretch: no passage to measure.)
     if (stretches < 2)
-        return 0; // (a rim all water is one stretch: no passage to measure)
+        return 0;
+    std::vector<double> clearance(n, -1); // -1: land
+    for (int r = 0; r <= rings; ++r)
+        for (int k = 0; k < (r ? spokes : 1); ++k)
+            if (const Vec3 q = sample(r, k); r == rings ? rim_water[k] : !land.contains(q))
+                clearance[index(r, k)] = land.coast_distance(q, reach);
     for (int k = 0; k < 2 * spokes; ++k)
         if (stretch[k % spokes] < 0 && clearance[index(rings, k)] >= 0)
             stretch[k % spokes] = stretch[(k + spokes - 1) % spokes];
