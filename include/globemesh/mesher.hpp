@@ -138,6 +138,10 @@ struct MesherOptions {
     /// loops the whole ocean does not have (the Suez canal, within a part whose Mediterranean
     /// reaches the border, was kept open as a cut). Empty: the boundary is the whole.
     std::vector<std::vector<std::uint32_t>> whole_rings;
+    /// With `land`: measure the width of each strait closed (MesherReport::
+    /// straits_closed_width_km). mesh_parts measures its parts' closings after the parts, beside
+    /// their join, and turns this off in the parts.
+    bool measure_straits = true;
     /// The source land at full resolution (e.g. coast.hpp's LandMask): boundary nodes slide near
     /// its coast (step 5 above), and faces whose centroid lies on it are removed at the end where
     /// the mesh stays one manifold and its new boundary nodes near the coast (step 7). Null:

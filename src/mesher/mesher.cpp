@@ -82,8 +82,8 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     }
     // The closings may leave small pieces alone (a face hanging at a pinched node): they go.
     close_cut_off_pieces(m, options, report);
-    if (options.land)
-        measure_closed_straits(m, *options.land, report);
+    if (options.land && options.measure_straits)
+        measure_closed_straits(size_km, *options.land, report);
     group_closed_straits(size_km, report);
 
     // Conversion to Mesh (output.cpp); a part's border nodes stay whole for the join.

@@ -534,7 +534,7 @@ std::size_t relax_valence(Mesher &m, std::vector<char> &as_made, std::vector<std
 // two or three boundary corners are mended.
 void improve_quality(Mesher &m, const MesherOptions &options, std::vector<char> &as_made);
 /// Fills report.straits_closed_width_km from report.straits_closed_at (straits.cpp).
-void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport &report);
+void measure_closed_straits(const SizeFn &size_km, const LandTest &land, MesherReport &report);
 /// Fills report.straits_closed_place(s) from report.straits_closed_at (straits.cpp).
 void group_closed_straits(const SizeFn &size_km, MesherReport &report);
 

@@ -153,8 +153,6 @@ void add_report(MesherReport &run, const MesherReport &part) {
     run.land_loops_joined += part.land_loops_joined;
     run.straits_closed += part.straits_closed;
     append(run.straits_closed_at, part.straits_closed_at);
-    append(run.straits_closed_width_km, part.straits_closed_width_km);
-    append(run.straits_closed_width_below_km, part.straits_closed_width_below_km);
     append(run.cut_points, part.cut_points); // seas_cut_off: told on the joined mesh
     run.straits_water_km2 += part.straits_water_km2;
     run.nodes_split += part.nodes_split;
@@ -270,6 +268,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     MesherOptions part_options = options;
     part_options.keep_inland_seas = true; // a sea cut by a border is two components
     part_options.mouth_corners = std::move(mouths);
+    part_options.measure_straits = false; // below, beside the join
     const std::vector<PartBoundary> split =
         split_boundary(kept, size_km, lunes, options.land.get());
     // The land test: each thread its own (the first the caller's, the others the copies; the
@@ -316,11 +315,28 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
         for (const auto &s : summed.stages)
             timings->stages.push_back(s);
     }
+    // The widths of the straits closed are measured on a thread of their own while this one
+    // joins the parts (the join does not use the land test); the same widths as in the parts.
+    MesherReport widths;
+    widths.straits_closed_at = report.straits_closed_at;
+    auto measure = [&] {
+        if (options.land && options.measure_straits)
+            measure_closed_straits(size_km, *options.land, widths);
+    };
+    std::future<void> measured;
+    if (threads > 1)
+        measured = std::async(std::launch::async, measure);
     // The lattice is stitched back only where the parts laid one (fill_lattice skips it when
     // the size field is below its largest value over most of the ocean).
     Mesh mesh =
         join_parts(meshes, lunes, size_km, report.lattice_nodes > 0 ? options.lattice_km : 0.0);
     basins_cut_off(mesh, report);
+    if (measured.valid())
+        measured.get();
+    else
+        measure();
+    report.straits_closed_width_km = std::move(widths.straits_closed_width_km);
+    report.straits_closed_width_below_km = std::move(widths.straits_closed_width_below_km);
     if (timings)
         timings->add("join", seconds_since(t0));
     return mesh;

@@ -116,7 +116,7 @@ double passage_width(const LandTest &land, const Vec3 &p, double reach) {
 
 } // namespace
 
-void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport &report) {
+void measure_closed_straits(const SizeFn &size_km, const LandTest &land, MesherReport &report) {
     // From 0.6 h (about the closed face's circumradius) in to 0.6 h / 64: the narrowest passage
     // found at any of these scales (at the widest, the rim may cross one sea twice around a cape,
     // joined by open water; closer in, only the strait joins the two sides). A passage found at
@@ -125,7 +125,7 @@ void measure_closed_straits(const Mesher &m, const LandTest &land, MesherReport 
     report.straits_closed_width_km.clear();
     report.straits_closed_width_below_km.clear();
     for (const Vec3 &p : report.straits_closed_at) {
-        double reach = 0.6 * km_to_rad(m.size_km(p)), width = 0;
+        double reach = 0.6 * km_to_rad(size_km(p)), width = 0;
         for (int zoom = 0; zoom < zooms; ++zoom, reach /= 4)
             if (const double w = passage_width(land, p, reach); w > 0 && (width == 0 || w < width))
                 width = w;

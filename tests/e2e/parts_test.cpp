@@ -566,6 +566,38 @@ TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
     }
 }
 
+TEST(Parts, the_straits_closed_are_measured_as_in_one_part) {
+    // mesh_parts measures its parts' closings after them, beside the join (on a thread of its
+    // own when there are two): a closing at the same place as one part's has its width, and
+    // the thread count changes none. NE 1:50m, the Aegean and the Black Sea at 100 km (one
+    // part closes the Ionian Sea at 20.42E 38.25N, 12.6 km wide; a border runs at 28.5E).
+    MeshOptions o = natural_earth("50m", 100);
+    o.region = std::array<double, 4>{20, 35, 45, 48};
+    const MesherReport one = mesh_ocean(o).mesher;
+    ASSERT_EQ(one.straits_closed_width_km.size(), one.straits_closed_at.size());
+    o.parts = 2;
+    std::vector<double> widths[2];
+    for (int threads : {1, 2}) {
+        o.threads = threads;
+        const MesherReport r = mesh_ocean(o).mesher;
+        ASSERT_EQ(r.parts, 2);
+        ASSERT_EQ(r.straits_closed_width_km.size(), r.straits_closed_at.size());
+        ASSERT_EQ(r.straits_closed_width_below_km.size(), r.straits_closed_at.size());
+        std::size_t same_place = 0;
+        for (std::size_t i = 0; i < r.straits_closed_at.size(); ++i) {
+            EXPECT_GT(r.straits_closed_width_km[i] + r.straits_closed_width_below_km[i], 0);
+            for (std::size_t j = 0; j < one.straits_closed_at.size(); ++j)
+                if (norm(one.straits_closed_at[j] - r.straits_closed_at[i]) < 1e-12) {
+                    ++same_place;
+                    EXPECT_EQ(r.straits_closed_width_km[i], one.straits_closed_width_km[j]);
+                }
+        }
+        EXPECT_GE(same_place, 1u) << "the Ionian Sea's closing, as in one part";
+        widths[threads - 1] = r.straits_closed_width_km;
+    }
+    EXPECT_EQ(widths[0], widths[1]);
+}
+
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
     // Each part's lattice is its lune's share of the sphere's: with 3 or more parts it had been
     // weighed whole against one part's node estimate, and skipped.
