@@ -21,6 +21,11 @@ namespace {
 
 constexpr double line_end_snap_deg = 1e-3;
 constexpr double max_line_gap_deg = 0.5;
+/// dissolve's groups of this many polygons or more (countries side by side: GSHHG's and Natural
+/// Earth's largest have tens), with more than four tiles' vertices, are unioned by tiles of
+/// about tile_vertices vertices (tiled_union).
+constexpr std::size_t tiled_polygons = 256;
+constexpr std::size_t tile_vertices = 16'384;
 
 /// XOR of many polygonal geometries by pairwise reduction (even-odd fill of nested rings).
 GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
@@ -162,6 +167,17 @@ void snap_job(Geos &geos, SnapJob &job, double grid, GEOSContextHandle_t owner) 
                 add_output(geos, job, snapped.get(), owner);
             }
         job.polygons.clear();
+        return;
+    }
+    std::vector<GeomPtr> tiled;
+    if (job.polygons.size() >= tiled_polygons && job.vertices > 4 * tile_vertices)
+        tiled = tiled_union(geos, job.polygons, grid, tile_vertices);
+    if (!tiled.empty()) {
+        job.polygons.clear();
+        for (auto &p : tiled) {
+            job.rings_out += rings_of(geos, p.get());
+            job.out.emplace_back(p.release(), GeosDeleter{owner});
+        }
         return;
     }
     std::vector<GEOSGeometry *> raw;

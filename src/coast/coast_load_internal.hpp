@@ -94,11 +94,26 @@ struct SnapCount {
 /// came within about half a cell of each other touch there, and no vertex lies closer than half
 /// a cell to an edge it is not on. Polygons that intersect (an STR tree's candidates confirmed by
 /// GEOS's prepared test) or come within 2 cells of each other (near_pairs) are snap-rounded
-/// together (one union), every other one alone: most coastline polygons are disjoint, and a
-/// union of all of them costs seconds at 1:10m. Output order: each group where its first polygon
+/// together (one union; a group of hundreds, countries side by side, by tiles: tiled_union),
+/// every other one alone: most coastline polygons are disjoint, and a union of all of them costs
+/// seconds at 1:10m. Output order: each group where its first polygon
 /// stands, the lone polygons with the batch they were rounded in (deterministic).
 std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,
                               SnapCount &count);
+
+/// The snap-rounding union of a group of polygons as dissolve's, by tiles (tiled_union.cpp):
+/// the group is cut in halves (clip_to_box, on grid lines) until a tile holds at most
+/// `tile_vertices`; each tile's pieces are snap-rounded together; the tiles' shells, their holes
+/// set aside, are joined by an overlay without rounding (they meet only along the tile lines, at
+/// vertices they have: checked); each hole goes back into the polygon around it, and a polygon
+/// in another's hole (an island in a lake) stays whole. GEOS 3.11 places each hole of a union by
+/// a scan of the shells around it, so one union of a group with many gaps between its polygons
+/// (countries side by side) costs holes x shell vertices. The land is the same, the rounding
+/// the tiles' (a vertex may lie within half a cell of an edge across a tile line). Empty when
+/// the join made a vertex or a hole finds no polygon around it: the caller unions the group
+/// whole.
+std::vector<GeomPtr> tiled_union(Geos &geos, const std::vector<GeomPtr> &polygons, double grid,
+                                 std::size_t tile_vertices);
 
 /// A valid polygon's rings rounded to the lon/lat grid of `grid` degrees (as GEOS rounds), when
 /// every vertex lies at least 2.5 cells from every edge it is not an end of: each vertex then

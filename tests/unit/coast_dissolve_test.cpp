@@ -193,3 +193,147 @@ TEST(CoastDissolve, a_polygon_that_rounding_would_change_is_left_to_geos) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_TRUE(same_polygons(geos, out[0].get(), rounded(geos, parts[0].get()).get()));
 }
+
+namespace {
+
+/// The polygons as one MULTIPOLYGON (copies), for GEOS's overlay and point tests.
+GeomPtr multipolygon(Geos &geos, const std::vector<GeomPtr> &polygons) {
+    std::vector<GEOSGeometry *> raw;
+    for (const auto &p : polygons) {
+        std::vector<const GEOSGeometry *> ps;
+        polygons_of(geos, p.get(), ps);
+        for (const auto *q : ps)
+            raw.push_back(GEOSGeom_clone_r(geos.get(), q));
+    }
+    return own(geos,
+               GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, raw.data(),
+                                           static_cast<unsigned>(raw.size())),
+               "collect");
+}
+
+/// One snap-rounding union of all the polygons, as dissolve made it for every group.
+GeomPtr one_union(Geos &geos, const std::vector<GeomPtr> &polygons) {
+    std::vector<GeomPtr> copies;
+    for (const auto &p : polygons)
+        copies.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p.get()), "copy"));
+    const GeomPtr all = make_collection(geos, copies);
+    return own(geos, GEOSUnaryUnionPrec_r(geos.get(), all.get(), snap_grid_deg), "union");
+}
+
+double area(Geos &geos, const GEOSGeometry *g) {
+    double a = 0;
+    GEOSArea_r(geos.get(), g, &a);
+    return a;
+}
+
+std::size_t holes(Geos &geos, const GEOSGeometry *g) {
+    std::vector<const GEOSGeometry *> ps;
+    polygons_of(geos, g, ps);
+    std::size_t n = 0;
+    for (const auto *p : ps)
+        n += std::size_t(GEOSGetNumInteriorRings_r(geos.get(), p));
+    return n;
+}
+
+/// Every polygon valid and every vertex on the snap grid.
+void expect_valid_on_grid(Geos &geos, const std::vector<GeomPtr> &polygons) {
+    for (const auto &p : polygons) {
+        EXPECT_EQ(GEOSisValid_r(geos.get(), p.get()), 1);
+        for (const PointList &ring : polygon_rings(geos, p.get()))
+            for (const LonLat &q : ring) {
+                ASSERT_EQ(q.lon / snap_grid_deg, std::round(q.lon / snap_grid_deg));
+                ASSERT_EQ(q.lat / snap_grid_deg, std::round(q.lat / snap_grid_deg));
+            }
+    }
+}
+
+/// How far apart two snap roundings of the polygons may lie (square degrees): each moves the
+/// boundary by at most 0.71 cell, so they differ within 1.42 cells of it.
+double rounding_apart(Geos &geos, const std::vector<GeomPtr> &polygons) {
+    double length = 0;
+    for (const auto &p : polygons) {
+        double l = 0;
+        GEOSLength_r(geos.get(), p.get(), &l);
+        length += l;
+    }
+    return 1.42 * snap_grid_deg * length;
+}
+
+bool land_at(Geos &geos, const GEOSGeometry *land, double x, double y) {
+    const GeomPtr p = own(geos, GEOSGeom_createPointFromXY_r(geos.get(), x, y), "point");
+    return GEOSContains_r(geos.get(), land, p.get()) == 1;
+}
+
+} // namespace
+
+// Countries side by side whose borders do not match (the Digital Chart of the World, five
+// countries round Belgium: 210 gaps in their union), unioned by tiles of 256 vertices: valid
+// polygons on the grid, the land and the gaps of one snap-rounding union.
+TEST(CoastDissolve, countries_unioned_by_tiles_are_the_land_of_one_union) {
+    Geos geos;
+    const auto source = read_source(test::fixture("coast/hostile/dcw_benelux.geojson").string(), "",
+                                    "", "", "coast");
+    std::vector<GeomPtr> parts;
+    for (const PolygonRings &rings : source.polygons) {
+        const GeomPtr valid = make_valid(geos, make_polygon(geos, rings).get());
+        std::vector<const GEOSGeometry *> ps;
+        polygons_of(geos, valid.get(), ps);
+        for (const auto *p : ps)
+            parts.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy"));
+    }
+    const GeomPtr reference = one_union(geos, parts);
+    const std::vector<GeomPtr> tiled = tiled_union(geos, parts, snap_grid_deg, 256);
+    ASSERT_FALSE(tiled.empty()) << "the tiles' union gave up";
+    expect_valid_on_grid(geos, tiled);
+    const GeomPtr land = multipolygon(geos, tiled);
+    const GeomPtr apart =
+        own(geos, GEOSSymDifference_r(geos.get(), land.get(), reference.get()), "difference");
+    EXPECT_LT(area(geos, apart.get()), rounding_apart(geos, parts));
+    EXPECT_GT(holes(geos, reference.get()), 150u);
+    EXPECT_EQ(holes(geos, land.get()), holes(geos, reference.get()));
+}
+
+// A lake inside a tile with an island in it (tiles of 600 vertices leave the corner country's
+// tile whole), and a lake the tile lines cross with an island they cross too: each island stays
+// land in its lake, as in one union.
+TEST(CoastDissolve, islands_in_lakes_unioned_by_tiles_stay_in_their_lakes) {
+    auto square = [](double x0, double y0, double x1, double y1) {
+        PointList ring; // 40 vertices a side: the tiles cut it
+        const double corners[5][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}, {x0, y0}};
+        for (int s = 0; s < 4; ++s)
+            for (int k = 0; k < 40; ++k) {
+                const double t = k / 40.0;
+                ring.push_back({corners[s][0] + t * (corners[s + 1][0] - corners[s][0]),
+                                corners[s][1] + t * (corners[s + 1][1] - corners[s][1])});
+            }
+        ring.push_back(ring.front());
+        return ring;
+    };
+    // A 4 x 4 map of unit countries without its middle 2 x 2 (a lake, an island across its
+    // centre); the corner country holds a lake with an island of its own.
+    Geos geos;
+    std::vector<GeomPtr> parts;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+            if ((i == 1 || i == 2) && (j == 1 || j == 2))
+                continue;
+            PolygonRings country{square(i, j, i + 1, j + 1)};
+            if (i == 0 && j == 0)
+                country.push_back(square(0.1, 0.1, 0.4, 0.4));
+            parts.push_back(make_polygon(geos, country));
+        }
+    parts.push_back(make_polygon(geos, {square(1.8, 1.8, 2.2, 2.2)}));
+    parts.push_back(make_polygon(geos, {square(0.2, 0.2, 0.3, 0.3)}));
+    const std::vector<GeomPtr> tiled = tiled_union(geos, parts, snap_grid_deg, 600);
+    ASSERT_FALSE(tiled.empty()) << "the tiles' union gave up";
+    expect_valid_on_grid(geos, tiled);
+    const GeomPtr land = multipolygon(geos, tiled);
+    EXPECT_NEAR(area(geos, land.get()), 12 - 0.09 + 0.01 + 0.16, rounding_apart(geos, parts));
+    EXPECT_NEAR(area(geos, land.get()), area(geos, one_union(geos, parts).get()),
+                rounding_apart(geos, parts));
+    EXPECT_TRUE(land_at(geos, land.get(), 2.0, 2.0)) << "the island across the middle";
+    EXPECT_FALSE(land_at(geos, land.get(), 1.5, 1.5)) << "the middle lake";
+    EXPECT_TRUE(land_at(geos, land.get(), 0.25, 0.25)) << "the corner lake's island";
+    EXPECT_FALSE(land_at(geos, land.get(), 0.15, 0.15)) << "the corner lake";
+    EXPECT_TRUE(land_at(geos, land.get(), 0.5, 0.5));
+}
