@@ -339,6 +339,26 @@ GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_m
     return domain;
 }
 
+/// Per point of `points` (sorted by z), the distance (radians) to the nearest arc of `b` that
+/// does not end at it, or `reach` where none comes within reach (an arc's z range taken from its
+/// ends: a long arc's bulge past them is missed, and its point keeps `reach`).
+std::vector<double> clearance_from_arcs(const Boundary &b, const std::vector<Vec3> &points,
+                                        double reach) {
+    std::vector<double> near(points.size(), reach);
+    for (const Ring &r : b.rings)
+        for (std::size_t k = 0, n = r.nodes.size(); k < n; ++k) {
+            const Vec3 &a = r.nodes[k], &c = r.nodes[(k + 1) % n];
+            auto it = std::lower_bound(points.begin(), points.end(), std::min(a.z, c.z) - reach,
+                                       [](const Vec3 &p, double z) { return p.z < z; });
+            for (; it != points.end() && it->z <= std::max(a.z, c.z) + reach; ++it)
+                if (!(*it == a) && !(*it == c)) {
+                    double &d = near[std::size_t(it - points.begin())];
+                    d = std::min(d, arc_distance(a, c, *it));
+                }
+        }
+    return near;
+}
+
 } // namespace
 
 double signed_planar_area(const PointList &pts) {
@@ -400,7 +420,11 @@ void canonical_order(Boundary &b) {
 /// GEOS) by 1e-7 rad into the sector its own two arcs bound with no other arc inside: the land
 /// on its right where two land polygons touch, the water on its left where a lake touches its
 /// coast (the coast's land sector holds the lake's arcs: moved into it, each copy crossed the
-/// other ring's arcs; GSHHG high's Evros delta with --keep-inland-seas).
+/// other ring's arcs; GSHHG high's Evros delta with --keep-inland-seas). A copy moves at most a
+/// quarter of its shorter arc, and of the distance to the nearest arc that does not end at the
+/// node: between two countries' borders that touch at a point (the Digital Chart of the World),
+/// a gap's arc of 3e-8 rad (Hungary and Slovakia on the Danube) and an arc passing 1e-6 degree
+/// from the node (Croatia at Neum) were crossed by copies moved 1e-7 rad.
 std::size_t separate_pinches(Boundary &b) {
     struct Occ {
         Vec3 v;
@@ -418,18 +442,37 @@ std::size_t separate_pinches(Boundary &b) {
     constexpr double delta = 1e-7;
     std::vector<std::array<Vec3, 2>> arcs; // per copy: the tangents towards its node before, after
     std::vector<Vec3> to;
+    std::vector<double> reach; // per copy: how far it moves
+    // The shared nodes, by z, and how far each lies from the arcs that do not end at it.
+    std::vector<Vec3> shared;
+    for (std::size_t i = 0; i + 1 < occ.size(); ++i)
+        if (occ[i + 1].v == occ[i].v && (shared.empty() || !(shared.back() == occ[i].v)))
+            shared.push_back(occ[i].v);
+    std::sort(shared.begin(), shared.end(), [](const Vec3 &p, const Vec3 &q) {
+        return std::tie(p.z, p.x, p.y) < std::tie(q.z, q.x, q.y);
+    });
+    const std::vector<double> clear = clearance_from_arcs(b, shared, 4 * delta);
     for (std::size_t i = 0; i < occ.size();) {
         std::size_t j = i + 1;
         while (j < occ.size() && occ[j].v == occ[i].v)
             ++j;
         if (j - i > 1) {
             const Vec3 p = occ[i].v;
+            const auto at =
+                std::lower_bound(shared.begin(), shared.end(), p, [](const Vec3 &x, const Vec3 &y) {
+                    return std::tie(x.z, x.x, x.y) < std::tie(y.z, y.x, y.y);
+                });
+            const double clearance = clear[std::size_t(at - shared.begin())];
             auto tangent = [&](const Vec3 &q) { return normalized(q - dot(p, q) * p); };
             arcs.clear();
+            reach.clear();
             for (std::size_t k = i; k < j; ++k) {
                 const auto &nodes = b.rings[occ[k].ring].nodes;
                 const std::size_t n = nodes.size(), at = occ[k].index;
-                arcs.push_back({tangent(nodes[(at + n - 1) % n]), tangent(nodes[(at + 1) % n])});
+                const Vec3 &before = nodes[(at + n - 1) % n], &after = nodes[(at + 1) % n];
+                arcs.push_back({tangent(before), tangent(after)});
+                reach.push_back(std::min(delta, 0.25 * std::min({arc_angle(p, before),
+                                                                 arc_angle(p, after), clearance})));
             }
             // The counter-clockwise angle from tangent s to tangent t, in (0, 2 pi].
             auto sweep = [&](const Vec3 &s, const Vec3 &t) {
@@ -457,7 +500,7 @@ std::size_t separate_pinches(Boundary &b) {
                 }
                 const Vec3 u =
                     std::cos(0.5 * theta) * from + std::sin(0.5 * theta) * cross(p, from);
-                to.push_back(normalized(p + delta * u));
+                to.push_back(normalized(p + reach[k] * u));
             }
             for (std::size_t k = i; k < j; ++k)
                 b.rings[occ[k].ring].nodes[occ[k].index] = to[k - i];

@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "coast_load_internal.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 #include "support.hpp"
@@ -331,6 +332,47 @@ TEST(CoastHostile, gshhg_high_evros_delta_keeps_its_lake_that_touches_the_coast)
     CoastData d = load_coast(o);
     EXPECT_GE(d.rings.rings.size(), 2u);
     expect_valid_both_stages(d, 1);
+}
+
+TEST(CoastHostile, dcw_danube_keeps_its_gaps_that_touch_at_a_point) {
+    // The Digital Chart of the World's Hungary and Slovakia on the Danube (18.76E 47.81N): their
+    // borders cross, and the gaps between them are two lakes touching at a point, one with an
+    // arc of 3e-8 rad there. The pinch's copy moved 1e-7 rad past that arc's end, and with
+    // --keep-inland-seas the coast was refused ("arcs touch or cross").
+    MeshOptions o = options_for(fixture("coast/hostile/dcw_danube.geojson").string());
+    o.region = std::array<double, 4>{18.7, 47.78, 18.82, 47.85};
+    o.keep_inland_seas = true;
+    CoastData d = load_coast(o);
+    EXPECT_EQ(d.rings.rings.size(), 2u); // the two gaps: the countries fill the box
+    expect_valid_both_stages(d, 1);
+}
+
+TEST(CoastHostile, a_shared_node_moves_less_than_an_arc_passing_beside_it) {
+    // The Digital Chart of the World at Neum (17.627E 42.912N), as the region's rings had it: the
+    // coast and a gap between Croatia and Bosnia share a node, and the gap's arc from its next
+    // node on passes 1e-6 degree south of it (snap rounding keeps half a cell, 5e-7). Moved 1e-7
+    // rad (6e-6 degree), the gap's copy crossed that arc ("arcs touch or cross").
+    auto ring = [](std::initializer_list<LonLat> points) {
+        Ring r;
+        for (const LonLat &p : points) {
+            r.nodes.push_back(lonlat_to_vec(p));
+            r.kinds.push_back(SegmentKind::coast);
+        }
+        return r;
+    };
+    const LonLat shared{17.627166748047, 42.912093162537};
+    Boundary b;
+    b.rings.push_back(ring({{17.619922637939, 42.911896705627},
+                            shared,
+                            {17.616481781006, 42.917777061462},
+                            {17.5, 42.85}}));
+    b.rings.push_back(ring({{17.616561889648, 42.917789459229},
+                            {17.616572380066, 42.917777061462},
+                            shared,
+                            {17.626621246338, 42.912073135376},
+                            {17.627195358276, 42.912093162537}}));
+    ASSERT_EQ(coast_detail::separate_pinches(b), 2u);
+    EXPECT_TRUE(check_boundary(b, 5).empty());
 }
 
 TEST(CoastHostile, overlapping_polygons_are_dissolved) {
