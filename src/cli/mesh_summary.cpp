@@ -120,6 +120,19 @@ void warn_straits(std::ostream &err, const MesherReport &m) {
            "width there), every channel with --feature-size 3, or all with --keep-straits\n";
 }
 
+/// The warning on `err` that --keep-straits left faces centred on land across straits narrower
+/// than them (the mesh's worst faces, often: a face across a strait spans it from coast to
+/// coast), and how to resolve such a strait instead.
+void warn_kept_straits(std::ostream &err, const MesherReport &m, double quality_min) {
+    err << "globemesh: warning: --keep-straits kept " << m.land_faces_left
+        << (m.land_faces_left == 1 ? " face" : " faces")
+        << " centred on land across straits narrower than a face (listed in the summary under "
+           "'faces on land'; the mesh's worst face has q "
+        << report_number(std::round(quality_min * 1000) / 1000)
+        << "); resolve a strait with --size-regions (h at most half its width there) or every "
+           "channel with --feature-size 3\n";
+}
+
 /// The closed straits in the --report JSON: place, width and the size each needs.
 std::string straits_json(const MesherReport &m) {
     std::string r = "[";
@@ -204,6 +217,8 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
         print_depth(out, err, *s.run.depth, o.quiet);
     if (s.run.straits_closing && s.run.mesher.straits_closed > 0 && !o.quiet)
         warn_straits(err, s.run.mesher);
+    if (!s.run.straits_closing && s.run.mesher.land_faces_left > 0 && !o.quiet)
+        warn_kept_straits(err, s.run.mesher, s.stats.quality_min);
     print_timings(out, s.timings); // its last line: the total
     out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
         << "wrote             " << outputs_text(s.planned, &s.run.mesh);

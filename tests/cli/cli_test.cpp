@@ -1705,3 +1705,48 @@ TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
         globemesh::test::expect_mesh_verify(dir / out);
     }
 }
+
+// Straits narrower than a face: by default closed, with the warning that says how to keep one;
+// with --keep-straits the faces across them stay, centred on land, and the warning says so, with
+// the mesh's worst quality and how to resolve them. Neither with --quiet. (NE 1:50m, the Aegean
+// and the Black Sea at 100 km: the Dardanelles and the Bosphorus are 1-6 km wide.)
+TEST(Cli, straits_narrower_than_a_face_warn_when_closed_and_when_kept) {
+    TempDir dir;
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {"mesh",
+                                         "--coast",
+                                         fixture("coast/ne_50m_land.gpkg").string(),
+                                         "--coast-layer",
+                                         "land",
+                                         "--region",
+                                         "20,35,45,48",
+                                         "--hmax",
+                                         "100km",
+                                         "-o",
+                                         (dir / "s.nc").string(),
+                                         "--overwrite"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result closed = with({});
+    ASSERT_EQ(closed.status, 0) << closed.err;
+    EXPECT_TRUE(regex_search(closed.err, R"(globemesh: warning: [0-9]+ straits? narrower than )"))
+        << closed.err;
+    EXPECT_EQ(closed.err.find("--keep-straits kept"), std::string::npos) << closed.err;
+    const Result kept = with({"--keep-straits"});
+    ASSERT_EQ(kept.status, 0) << kept.err;
+    std::vector<std::string> g;
+    ASSERT_TRUE(regex_search(kept.err,
+                             R"(globemesh: warning: --keep-straits kept ([0-9]+) faces? centred )"
+                             R"(on land across straits narrower than a face \(listed in the )"
+                             R"(summary under 'faces on land'; the mesh's worst face has q )"
+                             R"(([0-9.]+)\); resolve a strait with --size-regions)",
+                             &g))
+        << kept.err;
+    EXPECT_GE(std::stoi(g[1]), 1);
+    // The summary's counts and quality are the warning's.
+    EXPECT_TRUE(regex_search(kept.out, "faces on land     " + g[1] + " ")) << kept.out;
+    EXPECT_TRUE(regex_search(kept.out, "quality           min " + g[2].substr(0, 4))) << kept.out;
+    EXPECT_EQ(kept.err.find("were closed"), std::string::npos) << kept.err;
+    EXPECT_EQ(with({"--keep-straits", "-q"}).err, "");
+}
