@@ -8,8 +8,11 @@
 #
 #   bench/options_sweep.sh GLOBEMESH [PARTS] [GSHHG_DIR]
 # GSHHG_DIR holds l.gpkg, i.gpkg, h.gpkg, f.gpkg (bench/gshhg_land.py; layer 'land'), default
-# /tmp/gshhg; missing resolutions are skipped. ../shared/tools/mesh-verify and ../shared/data
-# are used when present. About 15 minutes on 2 cores without PARTS.
+# /tmp/gshhg; missing resolutions are skipped. With DCW=FILE.gpkg (bench/dcw_land.py: countries
+# side by side) its runs follow: the regions whose gaps between countries were refused with
+# --keep-inland-seas (80c48e6) and the global runs whose read was quadratic (d2ef012); about 10
+# minutes more. ../shared/tools/mesh-verify and ../shared/data are used when present. About 15
+# minutes on 2 cores without PARTS.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 exe=$(realpath "$1") parts=${2:-} gshhg=${3:-/tmp/gshhg}
@@ -62,4 +65,16 @@ if [ -d "$data" ] && [ -f "$gshhg/i.gpkg" ] && [ -f "$gshhg/h.gpkg" ]; then
         --hmin 10km --hmax 100km --wavelength 40 --slope 8
     run --coast "$gshhg/h.gpkg" --coast-layer land --bathy "$data/etopo5_nwshelf_5min.tif" \
         --region -12,48,10,62 --hmin 2km --hmax 20km --wavelength 60
+fi
+if [ -n "${DCW:-}" ] && [ -f "$DCW" ]; then
+    for case in "4,58,12,64 2km" "13,42,19,46 2km" "20,35,28,41 3km" "8,54,13,58 1km" \
+        "-12,34,42,66 10km" "95,-11,141,6 10km" "170,-50,-170,-30 5km"; do
+        read -r box h <<<"$case"
+        for opt in "" --keep-inland-seas --keep-straits; do
+            # shellcheck disable=SC2086
+            run --coast "$DCW" --coast-layer land --region "$box" --hmax "$h" $opt
+        done
+    done
+    run --coast "$DCW" --coast-layer land --hmax 50km
+    run --coast "$DCW" --coast-layer land --hmax 50km --keep-inland-seas
 fi
