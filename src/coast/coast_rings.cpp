@@ -448,9 +448,10 @@ std::size_t separate_pinches(Boundary &b) {
     for (std::size_t i = 0; i + 1 < occ.size(); ++i)
         if (occ[i + 1].v == occ[i].v && (shared.empty() || !(shared.back() == occ[i].v)))
             shared.push_back(occ[i].v);
-    std::sort(shared.begin(), shared.end(), [](const Vec3 &p, const Vec3 &q) {
+    auto z_first = [](const Vec3 &p, const Vec3 &q) {
         return std::tie(p.z, p.x, p.y) < std::tie(q.z, q.x, q.y);
-    });
+    };
+    std::sort(shared.begin(), shared.end(), z_first);
     const std::vector<double> clear = clearance_from_arcs(b, shared, 4 * delta);
     for (std::size_t i = 0; i < occ.size();) {
         std::size_t j = i + 1;
@@ -458,10 +459,7 @@ std::size_t separate_pinches(Boundary &b) {
             ++j;
         if (j - i > 1) {
             const Vec3 p = occ[i].v;
-            const auto at =
-                std::lower_bound(shared.begin(), shared.end(), p, [](const Vec3 &x, const Vec3 &y) {
-                    return std::tie(x.z, x.x, x.y) < std::tie(y.z, y.x, y.y);
-                });
+            const auto at = std::lower_bound(shared.begin(), shared.end(), p, z_first);
             const double clearance = clear[std::size_t(at - shared.begin())];
             auto tangent = [&](const Vec3 &q) { return normalized(q - dot(p, q) * p); };
             arcs.clear();

@@ -177,9 +177,11 @@ void Tiles::add_tile(std::vector<Piece> pieces) {
     }
 }
 
-/// The coordinates of a geometry's vertices, as bit patterns.
+/// A vertex's coordinates as bit patterns, hashed: the join's vertices looked up among the
+/// shells'.
 struct XY {
     std::uint64_t x, y;
+    explicit XY(const LonLat &p) { std::memcpy(&x, &p.lon, 8), std::memcpy(&y, &p.lat, 8); }
     bool operator==(const XY &o) const { return x == o.x && y == o.y; }
 };
 struct XYHash {
@@ -187,25 +189,6 @@ struct XYHash {
         return std::size_t(p.x * 0x9e3779b97f4a7c15ull ^ (p.y + 0x632be59bd9b4e019ull));
     }
 };
-
-template <class Visit> void visit_vertices(Geos &geos, const GEOSGeometry *polygon, Visit &&visit) {
-    auto ring_points = [&](const GEOSGeometry *ring) {
-        const GEOSCoordSequence *seq = GEOSGeom_getCoordSeq_r(geos.get(), ring);
-        unsigned n = 0;
-        if (!seq || !GEOSCoordSeq_getSize_r(geos.get(), seq, &n))
-            throw DataError("coast: GEOS cannot give a ring's vertices: " + geos.message());
-        for (unsigned i = 0; i < n; ++i) {
-            double x, y;
-            GEOSCoordSeq_getXY_r(geos.get(), seq, i, &x, &y);
-            XY p;
-            std::memcpy(&p.x, &x, 8), std::memcpy(&p.y, &y, 8);
-            visit(p);
-        }
-    };
-    ring_points(GEOSGetExteriorRing_r(geos.get(), polygon));
-    for (int h = 0; h < GEOSGetNumInteriorRings_r(geos.get(), polygon); ++h)
-        ring_points(GEOSGetInteriorRingN_r(geos.get(), polygon, h));
-}
 
 /// The polygon `p` with the rings of `holes` added to its own.
 GeomPtr with_holes(Geos &geos, const GEOSGeometry *p,
@@ -245,19 +228,20 @@ std::vector<GeomPtr> tiled_union(Geos &geos, const std::vector<GeomPtr> &polygon
     // only along a tile line, at vertices they have. A vertex the union made (GEOS's robust
     // overlay falling back to snapping) would break that: the group is then unioned whole.
     std::unordered_set<XY, XYHash> had;
-    for (const auto &s : tiles.shells)
-        visit_vertices(geos, s.get(), [&](const XY &p) { had.insert(p); });
+    for (const auto &shell : tiles.shells)
+        for (const PointList &ring : polygon_rings(geos, shell.get()))
+            for (const LonLat &p : ring)
+                had.insert(XY(p));
     const GeomPtr shells = make_collection(geos, tiles.shells);
     const GeomPtr joined =
         own(geos, GEOSUnaryUnion_r(geos.get(), shells.get()), "join the land's tiles");
     std::vector<const GEOSGeometry *> land;
     polygons_of(geos, joined.get(), land);
-    bool same_vertices = true;
     for (const auto *p : land)
-        visit_vertices(geos, p,
-                       [&](const XY &q) { same_vertices = same_vertices && had.count(q); });
-    if (!same_vertices)
-        return {};
+        for (const PointList &ring : polygon_rings(geos, p))
+            for (const LonLat &q : ring)
+                if (!had.count(XY(q)))
+                    return {};
     // Each hole set aside goes back into the polygon around a point inside it.
     std::vector<Extent> land_extents;
     for (const auto *p : land)
