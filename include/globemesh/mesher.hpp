@@ -59,7 +59,9 @@
 //      on one loop would cut the mesh, so a face across the mouth of a basin goes only with
 //      the water behind it, when that holds at most inlet_area * h^2 (a bay, or a river
 //      narrower than its faces); a sea behind a strait stays connected (Gibraltar, the
-//      Bosphorus at 100 km). Otherwise a face goes with the one or two water faces between it
+//      Bosphorus at 100 km). Water behind the mouth that reaches a part's border (lattice_within)
+//      goes on unseen in the other part: it goes only with close_straits, as a strait closed
+//      (reported), else stays. Otherwise a face goes with the one or two water faces between it
 //      and the boundary at a corner. A node it leaves on the boundary lies within h/2 of the
 //      coast (LandTest::coast_within). Removing faces keeps every other
 //      face and edge, so the mesh stays constrained Delaunay. A face left on land then gets one

@@ -1,6 +1,7 @@
 // Land clean-up: faces centred on land removed, or nudged off it.
 #include <unordered_set>
 
+#include "globemesh/parts.hpp"
 #include "mesher_state.hpp"
 
 namespace globemesh::mesher_internal {
@@ -33,9 +34,10 @@ namespace {
 // removal being tried and its counts.
 class LandRemoval {
 public:
-    LandRemoval(Mesher &m, const LandTest &land_test, double pocket_area, MesherReport &report,
-                BoundaryLoops &loops_state, bool straits)
-        : m(m), dt(m.dt), land_test(land_test), pocket_area(pocket_area), report(report),
+    LandRemoval(Mesher &m, const LandTest &land_test, const MesherOptions &options,
+                MesherReport &report, BoundaryLoops &loops_state, bool straits)
+        : m(m), dt(m.dt), land_test(land_test), pocket_area(options.inlet_area),
+          borders(options.lattice_within), close_straits(options.close_straits), report(report),
           loops_state(loops_state), straits(straits),
           side_faces(m.cut_sides.begin(), m.cut_sides.end()) {}
     std::size_t run(std::vector<TriangleId> island_faces, std::vector<TriangleId> &left_faces);
@@ -45,6 +47,8 @@ private:
     SphericalDelaunay &dt;
     const LandTest &land_test;
     const double pocket_area;
+    const std::vector<Vec3> &borders; // a part's (MesherOptions::lattice_within)
+    const bool close_straits;
     MesherReport &report;
     BoundaryLoops &loops_state;
     const bool straits;
@@ -60,6 +64,7 @@ private:
     std::vector<VertexId> arc_parent;
     std::vector<VertexId> pinches;
     std::size_t holes = 0, joins = 0, removed_faces = 0;
+    bool pocket_at_border = false; // the removal tried is a pocket reaching a part's border
     // remove_face's: the group tried, the flood's stack and its marks.
     std::vector<TriangleId> group, stack;
     std::vector<std::uint32_t> seen_at;
@@ -97,6 +102,7 @@ private:
     void commit(const std::vector<std::uint32_t> &arc_loops, bool cuts, TriangleId needed);
     bool try_remove(const std::vector<TriangleId> &group, TriangleId needed);
     bool corners_on_boundary(TriangleId t) const;
+    bool on_border(VertexId a, VertexId b) const;
     bool remove_with_pocket(TriangleId t);
     bool remove_with_fan(TriangleId t);
     bool remove_face(TriangleId t);
@@ -312,25 +318,25 @@ void LandRemoval::commit(const std::vector<std::uint32_t> &arc_loops, bool cuts,
                 if (is_ocean(dt.neighbour(t, i)))
                     out.push_back(dt.neighbour(t, i));
     };
-    if (straits) {
-        // A strait closed: the removal cut the mesh, joined loops or pinched it at a node
-        // (not an island coming back as a hole, or a bite into one coast).
+    // A strait closed: with `straits`, the removal cut the mesh, joined loops or pinched it at
+    // a node (not an island coming back as a hole, or a bite into one coast); or a pocket
+    // reaching a part's border went, which may cut the joined mesh.
+    if (straits)
         m.pinched.insert(m.pinched.end(), pinches.begin(), pinches.end());
-        if (cuts || !pinches.empty() || arc_loops.size() > 1) {
-            ++report.straits_closed;
-            report.straits_closed_at.push_back(m.centroid(needed));
-            add_beside(m.strait_sides);
-        }
-        // A cut or a pinch (the output splits the node) may leave a piece apart, found from
-        // the faces beside it (Mesher::cut_sides); a removal that takes one of those faces
-        // hands that on to the faces beside it, so every piece apart keeps one.
-        const bool takes_side = std::any_of(members.begin(), members.end(),
-                                            [&](TriangleId t) { return side_faces.count(t); });
-        if (cuts || !pinches.empty() || takes_side) {
-            const std::size_t from = m.cut_sides.size();
-            add_beside(m.cut_sides);
-            side_faces.insert(m.cut_sides.begin() + std::ptrdiff_t(from), m.cut_sides.end());
-        }
+    if (pocket_at_border || (straits && (cuts || !pinches.empty() || arc_loops.size() > 1))) {
+        ++report.straits_closed;
+        report.straits_closed_at.push_back(m.centroid(needed));
+        add_beside(m.strait_sides);
+    }
+    // A cut or a pinch (the output splits the node) may leave a piece apart, found from the
+    // faces beside it (Mesher::cut_sides); a removal that takes one of those faces hands that
+    // on to the faces beside it, so every piece apart keeps one.
+    const bool takes_side = std::any_of(members.begin(), members.end(),
+                                        [&](TriangleId t) { return side_faces.count(t); });
+    if (pocket_at_border || (straits && (cuts || !pinches.empty() || takes_side))) {
+        const std::size_t from = m.cut_sides.size();
+        add_beside(m.cut_sides);
+        side_faces.insert(m.cut_sides.begin() + std::ptrdiff_t(from), m.cut_sides.end());
     }
     removed_faces += members.size();
 }
@@ -369,10 +375,20 @@ bool LandRemoval::try_remove(const std::vector<TriangleId> &group, TriangleId ne
     return true;
 }
 
+// Whether a-b lies on one of a part's borders.
+bool LandRemoval::on_border(VertexId a, VertexId b) const {
+    return std::any_of(borders.begin(), borders.end(), [&](const Vec3 &n) {
+        return std::abs(dot(dt.point(a), n)) < on_border_tolerance &&
+               std::abs(dot(dt.point(b), n)) < on_border_tolerance;
+    });
+}
+
 // Face t with the pocket of ocean it cuts off beyond one of its sides (a bay behind it, whose
 // mouth is mostly land), when the pocket's faces centred off land hold at most pocket_area
 // h^2 (the inlet rule of close_inlets): a river narrower than its faces goes, a sea behind a
-// strait stays.
+// strait stays. A pocket that reaches a part's border may go on beyond it, unseen (alone, a
+// part takes its half of the Sea of Marmara for a pocket; one part keeps it with the Black
+// Sea): it goes only where straits close, and as a strait closed (commit).
 bool LandRemoval::remove_with_pocket(TriangleId t) {
     const double h = km_to_rad(m.size_km(m.centroid(t)));
     for (int i = 0; i < 3; ++i) {
@@ -384,6 +400,7 @@ bool LandRemoval::remove_with_pocket(TriangleId t) {
         seen_at[t] = seen_at[n] = ++stamp;
         double area = 0;
         bool closed = true;
+        pocket_at_border = false;
         while (!stack.empty() && closed) {
             const TriangleId u = stack.back();
             stack.pop_back();
@@ -392,17 +409,22 @@ bool LandRemoval::remove_with_pocket(TriangleId t) {
                 area +=
                     spherical_triangle_area(dt.point(dt.vertex(u, 0)), dt.point(dt.vertex(u, 1)),
                                             dt.point(dt.vertex(u, 2)));
-            if (area > pocket_area * h * h)
-                closed = false;
             for (int j = 0; j < 3; ++j) {
                 const TriangleId w = dt.neighbour(u, j);
+                const VertexId a = dt.vertex(u, next3(j)), b = dt.vertex(u, prev3(j));
+                if (!is_ocean(w) && m.is_open(a, b) && on_border(a, b))
+                    pocket_at_border = true;
                 if (is_ocean(w) && seen_at[w] != stamp) {
                     seen_at[w] = stamp;
                     stack.push_back(w);
                 }
             }
+            if (area > pocket_area * h * h || (pocket_at_border && !close_straits))
+                closed = false;
         }
-        if (closed && try_remove(group, t))
+        const bool removed = closed && try_remove(group, t);
+        pocket_at_border = false;
+        if (removed)
             return true;
     }
     return false;
@@ -499,10 +521,10 @@ std::size_t LandRemoval::run(std::vector<TriangleId> island_faces,
 // (the nudge between the calls moves nodes but changes no boundary edge), so that the second
 // call takes them as they are.
 std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
-                              std::vector<TriangleId> island_faces, double pocket_area,
+                              std::vector<TriangleId> island_faces, const MesherOptions &options,
                               MesherReport &report, std::vector<TriangleId> &left_faces,
                               BoundaryLoops &loops_state, bool straits) {
-    return LandRemoval(m, land_test, pocket_area, report, loops_state, straits)
+    return LandRemoval(m, land_test, options, report, loops_state, straits)
         .run(std::move(island_faces), left_faces);
 }
 

@@ -565,7 +565,7 @@ std::size_t clear_dropped_islands(Mesher &m, const Boundary &boundary, MesherRep
 
 // land.cpp: faces centred on land removed, or nudged off it.
 std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
-                              std::vector<TriangleId> island_faces, double pocket_area,
+                              std::vector<TriangleId> island_faces, const MesherOptions &options,
                               MesherReport &report, std::vector<TriangleId> &left_faces,
                               BoundaryLoops &loops_state, bool straits = false);
 std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,

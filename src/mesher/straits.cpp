@@ -20,7 +20,7 @@ void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId>
     std::vector<TriangleId> passage_faces(kept, faces.end());
     faces.erase(kept, faces.end());
     const std::size_t sides_before = m.cut_sides.size();
-    remove_land_faces(m, land_test, faces, options.inlet_area, report, left, loops, true);
+    remove_land_faces(m, land_test, faces, options, report, left, loops, true);
     close_small_pieces(m, {m.cut_sides.begin() + std::ptrdiff_t(sides_before), m.cut_sides.end()},
                        options, &land_test, report);
     faces.clear();
@@ -172,8 +172,7 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
     MesherReport &report = m.report;
     std::vector<TriangleId> left;
     BoundaryLoops loops;
-    remove_land_faces(m, *options.land, std::move(island_faces), options.inlet_area, report, left,
-                      loops);
+    remove_land_faces(m, *options.land, std::move(island_faces), options, report, left, loops);
     report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
     if (options.close_straits && !left.empty()) {
         close_straits(m, *options.land, left, options, loops, report);

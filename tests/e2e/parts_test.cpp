@@ -598,6 +598,38 @@ TEST(Parts, the_straits_closed_are_measured_as_in_one_part) {
     EXPECT_EQ(widths[0], widths[1]);
 }
 
+TEST(Parts, water_a_part_takes_for_a_pocket_closes_as_a_strait_or_stays_with_keep_straits) {
+    // NE 1:50m, the Aegean and the Black Sea at 100 km in 2 parts, the border at 28.5123E
+    // across the Sea of Marmara. Alone, each part took its half of Marmara for a pocket behind
+    // a face centred on land (at the Dardanelles, at the Bosporus) and removed it: the Black
+    // Sea was cut off from the Aegean with no closing listed there, and with --keep-straits too,
+    // where one part keeps them one ocean (one boundary loop).
+    MeshOptions o = natural_earth("50m", 100);
+    o.region = std::array<double, 4>{20, 35, 45, 48};
+    o.parts_border_lon = 28.5123;
+    auto closings_at_the_straits = [](const MesherReport &r) {
+        return std::count_if(
+            r.straits_closed_at.begin(), r.straits_closed_at.end(), [](const Vec3 &p) {
+                const LonLat ll = vec_to_lonlat(p);
+                return ll.lon > 26 && ll.lon < 30 && ll.lat > 39.8 && ll.lat < 41.5;
+            });
+    };
+    ASSERT_GE(closings_at_the_straits(mesh_ocean(o).mesher), 1) << "one part closes them";
+    o.parts = 2;
+    const OceanMesh parts = mesh_ocean(o);
+    ASSERT_EQ(parts.mesher.parts, 2);
+    EXPECT_GE(closings_at_the_straits(parts.mesher), 1);
+    EXPECT_GE(parts.mesher.seas_cut_off.size(), 2u) << "the Gulf of Corinth and the Aegean";
+
+    o.keep_straits = true;
+    o.parts = 1;
+    ASSERT_EQ(compute_stats(mesh_ocean(o).mesh).boundary_loops, 1u);
+    o.parts = 2;
+    const OceanMesh kept = mesh_ocean(o);
+    EXPECT_EQ(compute_stats(kept.mesh).boundary_loops, 1u) << "the Black Sea cut off";
+    EXPECT_TRUE(kept.mesher.straits_closed_at.empty());
+}
+
 TEST(Parts, every_part_count_fills_its_lunes_with_the_lattice) {
     // Each part's lattice is its lune's share of the sphere's: with 3 or more parts it had been
     // weighed whole against one part's node estimate, and skipped.
