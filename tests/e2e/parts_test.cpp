@@ -18,6 +18,7 @@
 #include "globemesh/parts.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/ugrid.hpp"
+#include "ring_through.hpp"
 #include "support.hpp"
 
 namespace fs = std::filesystem;
@@ -101,11 +102,7 @@ TEST(Parts, aqua_planet_outlines_share_their_border_nodes) {
 
 /// A coast ring through `corners` (lon/lat, the ocean on the left).
 Ring coast_ring(const std::vector<LonLat> &corners) {
-    Ring r;
-    for (const LonLat &c : corners)
-        r.nodes.push_back(lonlat_to_vec(c));
-    r.kinds.assign(r.nodes.size(), SegmentKind::coast);
-    return r;
+    return globemesh::test::ring_of_points(corners);
 }
 
 /// An island from 5W to 5E, 0 to 3N, across the border at 0E, the ocean on the left: its south

@@ -18,6 +18,7 @@
 
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/error.hpp"
+#include "ring_through.hpp"
 #include "support.hpp"
 
 using namespace globemesh;
@@ -674,14 +675,9 @@ struct Stages {
     }
 };
 
-/// A closed ring of unit vectors through the lon/lat points, all segments tagged open.
-Ring ring_of(const std::vector<std::pair<double, double>> &points) {
-    Ring r;
-    for (const auto &[lon, lat] : points) {
-        r.nodes.push_back(lonlat_to_vec(lon, lat));
-        r.kinds.push_back(SegmentKind::open);
-    }
-    return r;
+/// A closed ring through the lon/lat points, all segments tagged open.
+Ring ring_of(const std::vector<LonLat> &points) {
+    return test::ring_of_points(points, SegmentKind::open);
 }
 
 } // namespace
@@ -920,9 +916,9 @@ TEST(Bathymetry, ocean_extent_takes_the_short_way_round_and_the_pole_an_ocean_ho
     EXPECT_NEAR(e->south, -10, 1e-9);
     EXPECT_NEAR(e->north, 10, 1e-9);
     // A parallel at 60 N walked east: the ocean on its left is the cap round the north pole.
-    std::vector<std::pair<double, double>> parallel;
+    std::vector<LonLat> parallel;
     for (int k = 0; k < 36; ++k)
-        parallel.emplace_back(-180 + 10 * k, 60);
+        parallel.push_back({-180.0 + 10 * k, 60});
     Boundary cap;
     cap.rings.push_back(ring_of(parallel));
     EXPECT_EQ(ocean_pole_winding(cap), 1);

@@ -14,6 +14,7 @@
 #include "coast_load_internal.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
+#include "ring_through.hpp"
 #include "support.hpp"
 #include "unit/coast_support.hpp"
 
@@ -352,25 +353,18 @@ TEST(CoastHostile, a_shared_node_moves_less_than_an_arc_passing_beside_it) {
     // coast and a gap between Croatia and Bosnia share a node, and the gap's arc from its next
     // node on passes 1e-6 degree south of it (snap rounding keeps half a cell, 5e-7). Moved 1e-7
     // rad (6e-6 degree), the gap's copy crossed that arc ("arcs touch or cross").
-    auto ring = [](std::initializer_list<LonLat> points) {
-        Ring r;
-        for (const LonLat &p : points) {
-            r.nodes.push_back(lonlat_to_vec(p));
-            r.kinds.push_back(SegmentKind::coast);
-        }
-        return r;
-    };
+    using globemesh::test::ring_of_points;
     const LonLat shared{17.627166748047, 42.912093162537};
     Boundary b;
-    b.rings.push_back(ring({{17.619922637939, 42.911896705627},
-                            shared,
-                            {17.616481781006, 42.917777061462},
-                            {17.5, 42.85}}));
-    b.rings.push_back(ring({{17.616561889648, 42.917789459229},
-                            {17.616572380066, 42.917777061462},
-                            shared,
-                            {17.626621246338, 42.912073135376},
-                            {17.627195358276, 42.912093162537}}));
+    b.rings.push_back(ring_of_points({{17.619922637939, 42.911896705627},
+                                      shared,
+                                      {17.616481781006, 42.917777061462},
+                                      {17.5, 42.85}}));
+    b.rings.push_back(ring_of_points({{17.616561889648, 42.917789459229},
+                                      {17.616572380066, 42.917777061462},
+                                      shared,
+                                      {17.626621246338, 42.912073135376},
+                                      {17.627195358276, 42.912093162537}}));
     ASSERT_EQ(coast_detail::separate_pinches(b), 2u);
     EXPECT_TRUE(check_boundary(b, 5).empty());
 }

@@ -17,6 +17,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/pipeline.hpp"
 #include "globemesh/sizefield.hpp"
+#include "ring_through.hpp"
 #include "support.hpp"
 
 using namespace globemesh;
@@ -69,13 +70,8 @@ double distance_to_boundary_km(const Vec3 &p, const Boundary &b) {
 }
 
 Boundary ring_of(std::initializer_list<LonLat> corners) {
-    Ring r;
-    for (const LonLat &c : corners) {
-        r.nodes.push_back(lonlat_to_vec(c));
-        r.kinds.push_back(SegmentKind::coast);
-    }
     Boundary b;
-    b.rings.push_back(r);
+    b.rings.push_back(test::ring_of_points(corners));
     return b;
 }
 

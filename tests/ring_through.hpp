@@ -1,4 +1,4 @@
-// Boundary rings drawn through lon/lat corners, for the mesher's tests.
+// Boundary rings drawn through lon/lat corners, for the tests.
 #pragma once
 
 #include <algorithm>
@@ -22,6 +22,17 @@ inline Ring ring_through(const std::vector<LonLat> &corners, double step = 0.8) 
                 lonlat_to_vec(a.lon + (b.lon - a.lon) * k / n, a.lat + (b.lat - a.lat) * k / n));
     }
     r.kinds.assign(r.nodes.size(), SegmentKind::coast);
+    return r;
+}
+
+/// A ring through the lon/lat points as they are (no node added between them), every segment
+/// of `kind`.
+inline Ring ring_of_points(const std::vector<LonLat> &points,
+                           SegmentKind kind = SegmentKind::coast) {
+    Ring r;
+    for (const LonLat &p : points)
+        r.nodes.push_back(lonlat_to_vec(p));
+    r.kinds.assign(r.nodes.size(), kind);
     return r;
 }
 
