@@ -144,7 +144,7 @@ void add_output(Geos &geos, SnapJob &job, const GEOSGeometry *snapped, GEOSConte
     polygons_of(geos, snapped, ps);
     for (const auto *p : ps) {
         job.rings_out += rings_of(geos, p);
-        GeomPtr copy = own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon");
+        GeomPtr copy = clone(geos, p);
         job.out.emplace_back(copy.release(), GeosDeleter{owner});
     }
 }
@@ -350,7 +350,7 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
         std::vector<const GEOSGeometry *> ps;
         polygons_of(geos, part.get(), ps);
         for (const auto *p : ps)
-            polys.push_back(own(geos, GEOSGeom_clone_r(geos.get(), p), "copy a polygon"));
+            polys.push_back(clone(geos, p));
     }
     std::size_t n = polys.size();
     Groups joined(n);
@@ -424,7 +424,7 @@ GeomPtr clip_to_box(Geos &geos, const GEOSGeometry *g, double x0, double y0, dou
     double a0, b0, a1, b1;
     if (GEOSGeom_getExtent_r(geos.get(), g, &a0, &b0, &a1, &b1) != 0 && a0 >= x0 && a1 <= x1 &&
         b0 >= y0 && b1 <= y1)
-        return own(geos, GEOSGeom_clone_r(geos.get(), g), what);
+        return clone(geos, g, what);
     GeomPtr box = own(geos, GEOSGeom_createRectangle_r(geos.get(), x0, y0, x1, y1), what);
     GeomPtr out = own(geos, GEOSIntersection_r(geos.get(), g, box.get()), what);
     const int type = GEOSGeomTypeId_r(geos.get(), out.get());
@@ -435,7 +435,7 @@ GeomPtr clip_to_box(Geos &geos, const GEOSGeometry *g, double x0, double y0, dou
     polygons_of(geos, out.get(), polys);
     std::vector<GeomPtr> parts;
     for (const auto *q : polys)
-        parts.push_back(own(geos, GEOSGeom_clone_r(geos.get(), q), what));
+        parts.push_back(clone(geos, q, what));
     return make_collection(geos, parts);
 }
 

@@ -54,4 +54,9 @@ inline GeomPtr own(Geos &geos, GEOSGeometry *g, const char *what) {
     return owned;
 }
 
+/// A copy of g, owned.
+inline GeomPtr clone(Geos &geos, const GEOSGeometry *g, const char *what = "copy a polygon") {
+    return own(geos, GEOSGeom_clone_r(geos.get(), g), what);
+}
+
 } // namespace globemesh::coast_detail

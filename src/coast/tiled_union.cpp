@@ -39,10 +39,6 @@ Extent extent_of(Geos &geos, const GEOSGeometry *g) {
     return e;
 }
 
-GeomPtr clone(Geos &geos, const GEOSGeometry *g) {
-    return own(geos, GEOSGeom_clone_r(geos.get(), g), "copy a polygon");
-}
-
 /// The polygon of a ring: a shell, or a hole as the water it holds.
 GeomPtr polygon_of_ring(Geos &geos, const GEOSGeometry *ring) {
     GeomPtr shell = clone(geos, ring);
