@@ -101,6 +101,13 @@ struct SnapCount {
 std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,
                               SnapCount &count);
 
+/// For each of `inner` (islands, holes as polygons), the index of the polygon of `outer` that
+/// holds a point inside it (outer.size() when none does: an island then lies in no water the
+/// overlay kept).
+std::vector<std::size_t> polygons_holding(Geos &geos,
+                                          const std::vector<const GEOSGeometry *> &outer,
+                                          const std::vector<GeomPtr> &inner);
+
 /// The snap-rounding union of a group of polygons as dissolve's, by tiles (tiled_union.cpp):
 /// the group is cut in halves (clip_to_box, on grid lines) until a tile holds at most
 /// `tile_vertices`; each tile's pieces are snap-rounded together; the tiles' shells, their holes

@@ -640,28 +640,27 @@ RegionLand split_interior(Geos &geos, const GEOSGeometry *domain, std::vector<Ge
     return out;
 }
 
-/// For each island, the index of the ocean polygon that holds it (ocean.size() when none does:
-/// it then lies in no water the overlay kept).
-std::vector<std::size_t> island_holders(Geos &geos, const std::vector<const GEOSGeometry *> &ocean,
-                                        const std::vector<GeomPtr> &islands) {
+std::vector<std::size_t> polygons_holding(Geos &geos,
+                                          const std::vector<const GEOSGeometry *> &outer,
+                                          const std::vector<GeomPtr> &inner) {
     std::vector<PreparedPtr> prepared;
-    std::vector<std::array<double, 4>> extent(ocean.size());
-    for (std::size_t i = 0; i < ocean.size(); ++i) {
-        prepared.emplace_back(GEOSPrepare_r(geos.get(), ocean[i]), GeosDeleter{geos.get()});
+    std::vector<std::array<double, 4>> extent(outer.size());
+    for (std::size_t i = 0; i < outer.size(); ++i) {
+        prepared.emplace_back(GEOSPrepare_r(geos.get(), outer[i]), GeosDeleter{geos.get()});
         auto &e = extent[i];
-        GEOSGeom_getExtent_r(geos.get(), ocean[i], &e[0], &e[1], &e[2], &e[3]);
+        GEOSGeom_getExtent_r(geos.get(), outer[i], &e[0], &e[1], &e[2], &e[3]);
     }
-    std::vector<std::size_t> holder(islands.size(), ocean.size());
-    for (std::size_t k = 0; k < islands.size(); ++k) {
-        const GeomPtr inner =
-            own(geos, GEOSPointOnSurface_r(geos.get(), islands[k].get()), "find an inner point");
+    std::vector<std::size_t> holder(inner.size(), outer.size());
+    for (std::size_t k = 0; k < inner.size(); ++k) {
+        const GeomPtr at =
+            own(geos, GEOSPointOnSurface_r(geos.get(), inner[k].get()), "find an inner point");
         double x, y;
-        GEOSGeomGetX_r(geos.get(), inner.get(), &x);
-        GEOSGeomGetY_r(geos.get(), inner.get(), &y);
-        for (std::size_t i = 0; i < ocean.size() && holder[k] == ocean.size(); ++i) {
+        GEOSGeomGetX_r(geos.get(), at.get(), &x);
+        GEOSGeomGetY_r(geos.get(), at.get(), &y);
+        for (std::size_t i = 0; i < outer.size() && holder[k] == outer.size(); ++i) {
             const auto &e = extent[i];
             if (x > e[0] && x < e[2] && y > e[1] && y < e[3] &&
-                GEOSPreparedContainsProperly_r(geos.get(), prepared[i].get(), inner.get()) == 1)
+                GEOSPreparedContainsProperly_r(geos.get(), prepared[i].get(), at.get()) == 1)
                 holder[k] = i;
         }
     }
@@ -734,7 +733,7 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
     std::vector<double> planar_area(ocean_polys.size());
     for (std::size_t i = 0; i < ocean_polys.size(); ++i)
         GEOSArea_r(geos.get(), ocean_polys[i], &planar_area[i]);
-    const std::vector<std::size_t> holder = island_holders(geos, ocean_polys, pieces.interior);
+    const std::vector<std::size_t> holder = polygons_holding(geos, ocean_polys, pieces.interior);
     std::vector<std::vector<PointList>> island_holes(ocean_polys.size());
     for (std::size_t k = 0; k < pieces.interior.size(); ++k) {
         if (holder[k] == ocean_polys.size())

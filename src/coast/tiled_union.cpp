@@ -239,27 +239,12 @@ std::vector<GeomPtr> tiled_union(Geos &geos, const std::vector<GeomPtr> &polygon
                 if (!had.count(XY(q)))
                     return {};
     // Each hole set aside goes back into the polygon around a point inside it.
-    std::vector<Extent> land_extents;
-    for (const auto *p : land)
-        land_extents.push_back(extent_of(geos, p));
-    std::vector<PreparedPtr> prepared(land.size()); // made when first asked: an indexed test
+    const std::vector<std::size_t> holder = polygons_holding(geos, land, tiles.holes);
     std::vector<std::vector<const GEOSGeometry *>> holes_of(land.size());
-    for (const auto &hole : tiles.holes) {
-        const GeomPtr at = point_inside(geos, hole.get());
-        const Extent e = extent_of(geos, at.get());
-        std::size_t found = land.size();
-        for (std::size_t r = 0; r < land.size() && found == land.size(); ++r) {
-            if (!land_extents[r].holds(e))
-                continue;
-            if (!prepared[r])
-                prepared[r] =
-                    PreparedPtr(GEOSPrepare_r(geos.get(), land[r]), GeosDeleter{geos.get()});
-            if (prepared[r] && GEOSPreparedContains_r(geos.get(), prepared[r].get(), at.get()) == 1)
-                found = r;
-        }
-        if (found == land.size())
+    for (std::size_t k = 0; k < tiles.holes.size(); ++k) {
+        if (holder[k] == land.size())
             return {};
-        holes_of[found].push_back(hole.get());
+        holes_of[holder[k]].push_back(tiles.holes[k].get());
     }
     std::vector<GeomPtr> out;
     for (std::size_t r = 0; r < land.size(); ++r)
