@@ -432,12 +432,43 @@ void merge_close(const std::vector<ShapedRing> &shaped, double gap,
     }
 }
 
+/// The source node that becomes a corner where the resampled arc p-q conflicts: the farthest
+/// from p-q among the nodes whose projection falls between p and q (a corner there moves p-q
+/// itself; one past its ends can leave p-q in conflict round after round: GSHHG full at 50 km
+/// took 909 rounds, 3 this way), else the farthest in range; the ring's size when none is left.
+std::uint32_t corner_under(const ShapedRing &s, const Sample &p, const Sample &q) {
+    const std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
+    // From p's arc's start to q's arc's end (the kept node after q's), or to q's node when q
+    // lies on it: the nodes past it are not under p-q (DCW: 6,600 rounds at one conflict).
+    std::uint32_t a = p.node;
+    const auto after = std::upper_bound(s.kept.begin(), s.kept.end(), q.node);
+    std::uint32_t b = q.p == s.ring->nodes[q.node] ? q.node
+                      : after == s.kept.end()      ? s.kept.front()
+                                                   : *after;
+    if (b <= a)
+        b += n;
+    const Vec3 pole = cross(p.p, q.p);
+    double worst = -1, worst_under = -1;
+    std::uint32_t at = n, at_under = n;
+    for (std::uint32_t k = a + 1; k < b; ++k) {
+        if (s.corner[k % n])
+            continue;
+        const Vec3 &v = s.ring->nodes[k % n];
+        const double d = arc_distance(p.p, q.p, v);
+        if (d > worst)
+            worst = d, at = k % n;
+        if (d > worst_under && dot(cross(p.p, v), pole) >= 0 && dot(cross(v, q.p), pole) >= 0)
+            worst_under = d, at_under = k % n;
+    }
+    return at_under < n ? at_under : at;
+}
+
 /// Step 3 of shape_boundary: the rings resampled until no two arcs touch or cross.
 template <class H>
 std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &h_at, double gap,
                                       CoastReport &rep, const Progress &progress) {
     // 3. Resample, then topology: where a resampled arc touches or crosses another, the source
-    //    node farthest from it (among those it spans) becomes a corner, until no arcs conflict.
+    //    node farthest from it (corner_under) becomes a corner, until no arcs conflict.
     //    This ends: with every source node a corner, the arcs lie on the source rings, which do
     //    not conflict.
     //    Each round after the first resamples only the runs that got a corner (resample) and
@@ -472,33 +503,9 @@ std::vector<Resampled> resample_clear(std::vector<ShapedRing> &shaped, const H &
             break;
         std::vector<std::vector<std::uint32_t>> insert(shaped.size());
         auto refine = [&](std::uint32_t r, std::uint32_t seg) {
-            const auto &s = shaped[r];
             const auto &x = resampled[r].samples;
-            const std::uint32_t n = static_cast<std::uint32_t>(s.ring->nodes.size());
-            const Sample &p = x[seg];
-            const Sample &q = x[(seg + 1) % x.size()];
-            // From p's arc's start to q's arc's end (the kept node after q's), or to q's node
-            // when q lies on it: the nodes past it are not under p-q, and a corner there would
-            // leave p-q as it is, round after round (DCW: 6,600 rounds at one conflict).
-            std::uint32_t a = p.node;
-            const auto after = std::upper_bound(s.kept.begin(), s.kept.end(), q.node);
-            std::uint32_t b = q.p == s.ring->nodes[q.node] ? q.node
-                              : after == s.kept.end()      ? s.kept.front()
-                                                           : *after;
-            if (b <= a)
-                b += n;
-            double worst = -1;
-            std::uint32_t at = n;
-            for (std::uint32_t k = a + 1; k < b; ++k) {
-                if (s.corner[k % n])
-                    continue;
-                double d = arc_distance(p.p, q.p, s.ring->nodes[k % n]);
-                if (d > worst) {
-                    worst = d;
-                    at = k % n;
-                }
-            }
-            if (at < n)
+            const std::uint32_t at = corner_under(shaped[r], x[seg], x[(seg + 1) % x.size()]);
+            if (at < shaped[r].ring->nodes.size())
                 insert[r].push_back(at);
         };
         for (const auto &c : conflicts) {

@@ -616,7 +616,13 @@ TEST(Parts, water_a_part_takes_for_a_pocket_closes_as_a_strait_or_stays_with_kee
     const OceanMesh parts = mesh_ocean(o);
     ASSERT_EQ(parts.mesher.parts, 2);
     EXPECT_GE(closings_at_the_straits(parts.mesher), 1);
-    EXPECT_GE(parts.mesher.seas_cut_off.size(), 2u) << "the Gulf of Corinth and the Aegean";
+    // The basin those closings cut off is the Black Sea's (436,000 km2 with the Sea of Azov), as
+    // in one part.
+    ASSERT_FALSE(parts.mesher.seas_cut_off.empty());
+    const double largest =
+        *std::max_element(parts.mesher.seas_cut_off.begin(), parts.mesher.seas_cut_off.end());
+    EXPECT_GT(largest, 3.5e5);
+    EXPECT_LT(largest, 5.0e5);
 
     o.keep_straits = true;
     o.parts = 1;

@@ -47,6 +47,14 @@ std::size_t corners_blunted(const Mesh &mesh) {
     return count_attribute(mesh, "corners_blunted");
 }
 
+double worst_quality(const Mesh &mesh) {
+    double worst = 1;
+    for (const auto &f : mesh.faces)
+        worst =
+            std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
+    return worst;
+}
+
 // GSHHG intermediate around the Great Sandy Strait (Queensland): an islet's vertex 0.4 m from
 // the mainland's 5 km edge, which as a great-circle arc passes on the islet's other side. The
 // check on the cleaned coast refused the whole run ("arcs touch or cross near lon 152.6166,
@@ -130,46 +138,42 @@ TEST(CoastReal, no_coast_edge_is_left_shorter_than_the_close_node_gap_once_the_i
 
 // A face below the floor on a short coast side beside nodes of a much coarser spacing, which no
 // move and no removal of a node mends, gets a node at the apex of the equilateral triangle on
-// that side. The case first found: GSHHG high around the Yangtze mouth at 50 km, a face of q
-// 0.202 between a free node and two coast nodes 0.6 km apart (the last face below the floor of
-// the global GSHHG h run at 50 km). It arose in the order GEOS's overlay gave the region's
-// rings; in the order the coast stage now gives them (canonical_order) no h from 10 to 100 km
-// makes it. Of the hostile fixtures swept (7, at sizes 6% apart: 385 runs), GSHHG full around
-// the Suez Canal needs the node at 2.9-3.1 km and 4.9-5.2 km. (With the coast's close nodes
-// kept: merged, as by default, the two nodes are one and the face is not made.)
-TEST(CoastReal, a_face_on_a_short_coast_side_among_coarse_nodes_gets_a_node_on_that_side) {
+// that side (quality.cpp). The cases found: GSHHG high around the Yangtze mouth at 50 km, a face
+// of q 0.202 between a free node and two coast nodes 0.6 km apart (the last face below the floor
+// of the global GSHHG h run at 50 km), and GSHHG full around the Suez Canal at 2.9-3.1 km and
+// 4.9-5.2 km, with the coast's close nodes kept. Since the coast's conflicts get their corners
+// under the arc in conflict, neither coast makes such a side: no run of the hostile fixtures
+// and of eight GSHHG full regions at sizes 1.5-7% apart adds the node (bench/RESULTS-coast.md).
+// The cases stay, above the floor.
+TEST(CoastReal, a_short_coast_side_among_coarse_nodes_leaves_no_face_below_the_floor) {
     MeshOptions o = region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 3);
     o.close_node_gap = 0;
     const Mesh mesh = mesh_ocean(o).mesh;
-    EXPECT_GE(count_attribute(mesh, "floor_nodes_added"), 1u);
+    EXPECT_GE(worst_quality(mesh), 0.3);
     expect_valid_mesh(mesh, o, "suez_3km.nc");
-    // The Yangtze at 50 km stays a valid mesh.
     o = region_run("coast/hostile/gshhg_h_yangtze.geojson", {119, 29, 125, 34}, 50);
     o.close_node_gap = 0;
-    expect_valid_mesh(mesh_ocean(o).mesh, o, "yangtze.nc");
+    const Mesh yangtze = mesh_ocean(o).mesh;
+    EXPECT_GE(worst_quality(yangtze), 0.3);
+    expect_valid_mesh(yangtze, o, "yangtze.nc");
 }
 
 // GSHHG full around the Suez Canal at 5.2 km, the region the fixture's own box: a stub of the
-// canal (300 m wide, left open where straits closed north of it) holds nodes 12 m to 100 m
+// canal (300 m wide, left open where straits closed north of it) held nodes 12 m to 100 m
 // apart. The floor's searches raised an interior face there from q 0.24 to 0.284, a sliver on a
-// coast side of 100 m whose third corner lies 24 m off it; blunting had run before and removed
+// coast side of 100 m whose third corner lay 24 m off it; blunting had run before and removed
 // such slivers only before the floor's moves (the global GSHHG full run at 5 km had this face
 // as its worst, q 0.2852 at 32.354E 30.427N, in one part and in two). Blunting and the floor
-// now run once more when a face is left below it. (With the coast's close nodes kept and the
-// stub left open, as before they were merged and dead ends closed. The sliver was found at
-// 5 km; since the coast's conflicts get their corners under the arc in conflict, the coast
-// there makes it at 5.2 km and 3.0 km: without the second run, q 0.284 at 32.354E 30.427N.)
-TEST(CoastReal, a_sliver_the_floor_leaves_on_the_coast_is_blunted_after_it) {
+// run once more when a face is left below it. (With the coast's close nodes kept and the stub
+// left open. Since the coast's conflicts get their corners under the arc in conflict, the
+// stub's nodes are no longer crowded and the second run is not needed here, nor in any run
+// swept; the case stays, above the floor.)
+TEST(CoastReal, a_canal_stub_with_its_close_nodes_kept_leaves_no_sliver_below_the_floor) {
     MeshOptions o = region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5.2);
     o.close_node_gap = 0;
     o.close_dead_ends = false;
     const Mesh mesh = mesh_ocean(o).mesh;
-    double worst = 1;
-    for (const auto &f : mesh.faces)
-        worst =
-            std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
-    EXPECT_GE(worst, 0.3);                // 0.284 without the second run
-    EXPECT_GE(corners_blunted(mesh), 6u); // 5 without it, the sliver the sixth
+    EXPECT_GE(worst_quality(mesh), 0.3); // 0.284 once
     expect_valid_mesh(mesh, o, "suez.nc");
 }
 
@@ -218,25 +222,26 @@ TEST(CoastReal, coast_nodes_far_closer_than_h_among_coarse_ones_are_merged) {
     expect_valid_mesh(mesh, o, "yangtze.nc");
 }
 
-// The Suez Canal as above, with the coast's close nodes merged (the default). Kept, the
-// canal stub's coast nodes are 4 m to 100 m apart: the topology repair's corners at the
-// source's own vertices (a jetty's tip among them), and its faces have sides of 7 m. Merged, no
-// coast side is under h/32 and no side under 0.1 km (the canal is 0.3 km wide): an explicit
-// model's time step there is some 30 times longer.
+// The Suez Canal as above at 5 km. The topology repair put its corners at the source's own
+// vertices along the canal's stub (a jetty's tip among them): with the coast's close nodes kept
+// they were 4 m to 100 m apart and the faces there had sides of 7 m, and only the close nodes'
+// merge (the default) took them off. Since the conflicts get their corners under the arc in
+// conflict, the repair puts none there: with the close nodes merged or kept, no coast side is
+// under h/32 and no side under 0.1 km (the canal is 0.3 km wide; an explicit model's time step
+// there is some 30 times longer than at 7 m).
 TEST(CoastReal, a_canal_narrower_than_h_keeps_no_side_far_shorter_than_its_width) {
-    const MeshOptions o =
-        region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
-    const Mesh mesh = mesh_ocean(o).mesh;
-    double worst = 1;
-    for (const auto &f : mesh.faces)
-        worst =
-            std::min(worst, triangle_quality(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]));
-    EXPECT_GE(worst, 0.3); // 0.284 before the second round
-    const Shortest s = shortest_sides(mesh);
-    EXPECT_GE(s.boundary, 5.0 / 32); // 0.007 km before
-    EXPECT_GE(s.side, 0.1);
-    EXPECT_GT(count_attribute(mesh, "coast_nodes_merged"), 0u);
-    expect_valid_mesh(mesh, o, "suez.nc");
+    for (double gap : {1.0 / 32, 0.0}) {
+        SCOPED_TRACE("close_node_gap " + std::to_string(gap));
+        MeshOptions o =
+            region_run("coast/hostile/gshhg_f_suez.geojson", {31.5, 29.5, 33.5, 31.5}, 5);
+        o.close_node_gap = gap;
+        const Mesh mesh = mesh_ocean(o).mesh;
+        EXPECT_GE(worst_quality(mesh), 0.3);
+        const Shortest s = shortest_sides(mesh);
+        EXPECT_GE(s.boundary, 5.0 / 32); // 0.007 km, kept, before
+        EXPECT_GE(s.side, 0.1);
+        expect_valid_mesh(mesh, o, "suez.nc");
+    }
 }
 
 // The Suez Canal as above: the straits closed north of 30.51N leave the canal's stub above the
