@@ -43,11 +43,15 @@ constexpr double snap_grid_deg = 1.0 / (1 << 20);
 /// `field` is the option whose file it is, named in messages ("coast" or "region_file"; its
 /// layer option is "coast_layer" or "region_layer"). With `near` (a region
 /// W,S,E,N) a polygon layer is read through OGR's spatial filter: only the features whose
-/// envelope meets the box widened by 1% of its larger side (its latitude band when it crosses
-/// +-180), in the layer's CRS; the land elsewhere plays no part in a region (region_rings cuts
-/// it off), and a layer with an index (GeoPackage, a shapefile's .qix) is then not read whole.
-/// A filter that leaves no feature is dropped (the errors below stay those of the whole layer).
-/// Line layers are read whole: their lines close into land only together.
+/// envelope meets the box widened by 1% of its larger side, in the layer's CRS; the land
+/// elsewhere plays no part in a region (region_rings cuts it off), and a layer with an index
+/// (GeoPackage, a shapefile's .qix) is then not read whole. In lon/lat a box across +-180 is
+/// read as its two sides, and every box also shifted by 360 degrees where the layer's extent
+/// passes +-180 (land stored from 0 to 360); a projected layer is read through the box's
+/// bounds in its CRS (across +-180, the box's latitude band). When the filter leaves no
+/// feature (a region of open sea) the layer is read whole only up to a first polygon or line,
+/// so that a layer of no features, or of points only, gets the errors below as without a
+/// region. Line layers are read whole: their lines close into land only together.
 /// max_bytes (0: no limit): the layer's vertices are counted while they are read; once they
 /// pass max_bytes / coast_bytes_per_vertex nothing more is kept (memory stays bounded by one
 /// feature), the rest is only counted, and a DataError names the layer, the count and

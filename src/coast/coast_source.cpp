@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -318,29 +319,45 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const ErrorT
     return source_srs;
 }
 
-/// Sets the layer's spatial filter to the box `near` widened (see read_source), in the layer's
-/// CRS; false, with no filter, when that CRS cannot take the box.
-bool filter_near(OGRLayerH layer, const std::array<double, 4> &near,
-                 OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
-                 OGRSpatialReferenceH source_srs) {
+using Box = std::array<double, 4>; // x0, y0, x1, y1 in the layer's CRS
+
+/// The boxes the layer is read through for the region `near` (see read_source), widened by 1%
+/// of its larger side; none (read it whole) when its CRS cannot take them. In lon/lat, a region
+/// across +-180 is its two sides, and each box is also read shifted by 360 degrees where the
+/// layer's extent passes +-180 (GSHHG's Antarctica runs 0..360, Eurasia to 190).
+std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near,
+                              OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
+                              OGRSpatialReferenceH source_srs) {
     auto [w, s, e, n] = near;
-    if (e <= w)
-        w = -180, e = 180;
-    const double pad = 0.01 * std::max(e - w, n - s);
-    w = std::max(-180.0, w - pad), e = std::min(180.0, e + pad);
+    const double width = e > w ? e - w : e + 360 - w;
+    const double pad = 0.01 * std::max(width, n - s);
     s = std::max(-90.0, s - pad), n = std::min(90.0, n + pad);
-    double x0 = w, y0 = s, x1 = e, y1 = n;
-    bool ok = true;
+    std::vector<Box> sides;
+    if (width >= 360 - 2 * pad)
+        sides.push_back({-180, s, 180, n});
+    else if (e > w)
+        sides.push_back({std::max(-180.0, w - pad), s, std::min(180.0, e + pad), n});
+    else
+        sides = {{w - pad, s, 180, n}, {-180, s, e + pad, n}};
     if (transform) {
-        // The box in the layer's CRS (densified edges); a CRS that cannot take it: no filter.
+        // The box in the layer's CRS (densified edges); a CRS that cannot take it: none.
         TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84, source_srs));
-        ok = to_layer && OCTTransformBounds(to_layer.get(), w, s, e, n, &x0, &y0, &x1, &y1, 21) &&
-             x0 < x1 && y0 < y1 && std::isfinite(x0) && std::isfinite(y0) && std::isfinite(x1) &&
-             std::isfinite(y1);
+        const Box b = sides.size() == 1 ? sides.front() : Box{-180, s, 180, n};
+        Box t;
+        const bool ok = to_layer &&
+                        OCTTransformBounds(to_layer.get(), b[0], b[1], b[2], b[3], &t[0], &t[1],
+                                           &t[2], &t[3], 21) &&
+                        t[0] < t[2] && t[1] < t[3] && std::isfinite(t[0] + t[1] + t[2] + t[3]);
+        return ok ? std::vector<Box>{t} : std::vector<Box>{};
     }
-    if (ok)
-        OGR_L_SetSpatialFilterRect(layer, x0, y0, x1, y1);
-    return ok;
+    OGREnvelope extent{};
+    const bool known = OGR_L_GetExtent(layer, &extent, FALSE) == OGRERR_NONE;
+    std::vector<Box> boxes;
+    for (const Box &b : sides)
+        for (const double shift : {0.0, 360.0, -360.0})
+            if (shift == 0 || !known || (shift > 0 ? extent.MaxX > 180 : extent.MinX < -180))
+                boxes.push_back({b[0] + shift, b[1], b[2] + shift, b[3]});
+    return boxes;
 }
 
 } // namespace
@@ -378,29 +395,20 @@ Source read_source(const std::string &path, const std::string &layer_name, const
                             CPLGetLastErrorMsg() + ")");
     }
 
-    bool filtered = near && is_polygon_type(OGR_L_GetGeomType(layer)) &&
-                    filter_near(layer, *near, transform.get(), wgs84.get(), source_srs.get());
-
-    OGR_L_ResetReading(layer);
+    const std::vector<Box> boxes =
+        near && is_polygon_type(OGR_L_GetGeomType(layer))
+            ? filter_boxes(layer, *near, transform.get(), wgs84.get(), source_srs.get())
+            : std::vector<Box>{};
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;
     bool too_many = false;
-    for (;;) {
-        FeaturePtr f(OGR_L_GetNextFeature(layer));
-        if (!f && filtered && src.features == 0) {
-            // Nothing near the region: read the whole layer, as without a region.
-            OGR_L_SetSpatialFilter(layer, nullptr);
-            OGR_L_ResetReading(layer);
-            filtered = false;
-            continue;
-        }
-        if (!f)
-            break;
+    // One feature: counted, and its polygons and lines kept in lon/lat.
+    auto take = [&](OGRFeatureH f) {
         ++src.features;
-        OGRGeometryH g = OGR_F_GetGeometryRef(f.get());
+        OGRGeometryH g = OGR_F_GetGeometryRef(f);
         if (!g)
-            continue;
+            return;
         vertices += vertex_count(g);
         if (max_bytes > 0 && vertices > max_vertices && !too_many) {
             too_many = true; // from here on only count, to name the total
@@ -408,15 +416,37 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             src.lines = {};
         }
         if (too_many)
-            continue;
+            return;
         if (transform) {
             OgrGeometryPtr copy(OGR_G_Clone(g));
             if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
-                throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f.get())) +
+                throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
                                 " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
             collect_geometry(copy.get(), true, src);
         } else {
             collect_geometry(g, false, src);
+        }
+    };
+    // Through each box, a feature met by two read once.
+    std::unordered_set<GIntBig> seen;
+    for (const Box &b : boxes) {
+        OGR_L_SetSpatialFilterRect(layer, b[0], b[1], b[2], b[3]);
+        OGR_L_ResetReading(layer);
+        while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
+            const GIntBig fid = OGR_F_GetFID(f.get());
+            if (fid == OGRNullFID || seen.insert(fid).second)
+                take(f.get());
+        }
+    }
+    // Whole, without a region or with nothing near it; then only up to a first polygon or
+    // line (a region of open sea reads no more), for the errors below to be the whole layer's.
+    if (src.features == 0) {
+        OGR_L_SetSpatialFilter(layer, nullptr);
+        OGR_L_ResetReading(layer);
+        while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
+            take(f.get());
+            if (!boxes.empty() && (!src.polygons.empty() || !src.lines.empty()))
+                break;
         }
     }
     if (too_many)
