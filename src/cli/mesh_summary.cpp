@@ -1,6 +1,7 @@
 // The summary and the --report JSON of a `mesh` run (mesh_summary.hpp).
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, boo
 
 /// The cells a strait needs across to stay open (the size it needs: its width over this).
 constexpr double strait_cells = 2;
+/// The quality floor the mesher keeps where straits close (issue 37's, mesher/corners.hpp).
+constexpr double quality_floor = 0.3;
 
 /// Whether the closings have their places (MesherReport::straits_closed_place); where not, each
 /// is a place of its own.
@@ -130,6 +133,30 @@ void warn_kept_straits(std::ostream &err, const MesherReport &m, double quality_
            "'faces on land'; the mesh's worst face has q "
         << report_number(std::round(quality_min * 1000) / 1000)
         << "); resolve a strait with --size-regions (h at most half its width there) or every "
+           "channel with --feature-size 3\n";
+}
+
+/// The warning on `err` that --keep-straits left a face below the floor (q 0.3, issue 37's; the
+/// mesher's own guarantee where straits close) in water: a channel narrowing to a point between
+/// two coasts, its faces squeezed (GSHHG i in the Sundarbans at 1.3 km: q 0.108, no face on land).
+void warn_thin_channels(std::ostream &err, const Mesh &mesh) {
+    double worst = 2;
+    std::size_t at = 0;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        const auto &t = mesh.faces[f];
+        const double q = triangle_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
+        if (q < worst)
+            worst = q, at = f;
+    }
+    const auto &t = mesh.faces[at];
+    const LonLat ll =
+        vec_to_lonlat(normalized(mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]]));
+    char place[64];
+    std::snprintf(place, sizeof place, "lon %.3f, lat %.3f", ll.lon, ll.lat);
+    err << "globemesh: warning: --keep-straits kept channels narrower than a face open; the "
+           "mesh's worst face has q "
+        << report_number(std::round(worst * 1000) / 1000) << " at " << place
+        << "; resolve a channel with --size-regions (h at most half its width there) or every "
            "channel with --feature-size 3\n";
 }
 
@@ -219,6 +246,9 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
         warn_straits(err, s.run.mesher);
     if (!s.run.straits_closing && s.run.mesher.land_faces_left > 0 && !o.quiet)
         warn_kept_straits(err, s.run.mesher, s.stats.quality_min);
+    else if (o.mesh.keep_straits && !s.run.mesh.faces.empty() &&
+             s.stats.quality_min < quality_floor && !o.quiet)
+        warn_thin_channels(err, s.run.mesh);
     print_timings(out, s.timings); // its last line: the total
     out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
         << "wrote             " << outputs_text(s.planned, &s.run.mesh);

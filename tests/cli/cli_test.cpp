@@ -1750,3 +1750,46 @@ TEST(Cli, straits_narrower_than_a_face_warn_when_closed_and_when_kept) {
     EXPECT_EQ(kept.err.find("were closed"), std::string::npos) << kept.err;
     EXPECT_EQ(with({"--keep-straits", "-q"}).err, "");
 }
+
+// GSHHG intermediate in the Sundarbans at 1.3 km: a tidal channel narrows to a point between two
+// coasts. With --keep-straits its faces there are squeezed to q 0.11 (a side of 6 m) in water,
+// with no face on land: the run said nothing of a face below the floor the mesher keeps (q 0.3)
+// wherever straits close. It now warns, with the place.
+TEST(Cli, keep_straits_warns_of_a_face_below_the_floor_in_a_channel_it_kept) {
+    TempDir dir;
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {
+            "mesh",
+            "--coast",
+            fixture("coast/hostile/gshhg_i_sundarbans.geojson").string(),
+            "--region",
+            "88.1,21.55,88.35,21.8",
+            "--hmax",
+            "1.3km",
+            "-o",
+            (dir / "s.nc").string(),
+            "--overwrite"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result kept = with({"--keep-straits"});
+    ASSERT_EQ(kept.status, 0) << kept.err;
+    std::vector<std::string> g;
+    ASSERT_TRUE(regex_search(kept.err,
+                             R"(globemesh: warning: --keep-straits kept channels narrower than a )"
+                             R"(face open; the mesh's worst face has q ([0-9.]+) at lon )"
+                             R"(([0-9.]+), lat ([0-9.]+); resolve a channel with --size-regions)",
+                             &g))
+        << kept.err;
+    EXPECT_LT(std::stod(g[1]), 0.3);
+    EXPECT_TRUE(regex_search(kept.out, "quality           min " + g[1].substr(0, 4))) << kept.out;
+    EXPECT_NEAR(std::stod(g[2]), 88.225, 0.01);
+    EXPECT_NEAR(std::stod(g[3]), 21.670, 0.01);
+    EXPECT_TRUE(regex_search(kept.out, "faces on land     0 ")) << kept.out;
+    // Where straits close (the default) the floor holds and nothing of the kind is said.
+    const Result closed = with({});
+    ASSERT_EQ(closed.status, 0) << closed.err;
+    EXPECT_EQ(closed.err.find("channels narrower"), std::string::npos) << closed.err;
+    EXPECT_TRUE(regex_search(closed.out, R"(quality           min 0\.[3-9])")) << closed.out;
+    EXPECT_EQ(with({"--keep-straits", "-q"}).err, "");
+}
