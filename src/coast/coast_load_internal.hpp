@@ -39,6 +39,13 @@ constexpr double snap_grid_deg = 1.0 / (1 << 20);
 
 // ----------------------------------------------------------------------------- OGR source
 
+/// A box x0, y0, x1, y1: lon/lat degrees, or a layer's CRS.
+using Box = std::array<double, 4>;
+
+/// The region W,S,E,N widened by 1% of its larger side, as lon/lat boxes within +-180: one, or
+/// its two sides when it crosses +-180 (read_source's filter, load_coast's clip).
+std::vector<Box> near_sides(const std::array<double, 4> &near);
+
 /// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
 /// `field` is the option whose file it is, named in messages ("coast" or "region_file"; its
 /// layer option is "coast_layer" or "region_layer"). With `near` (a region

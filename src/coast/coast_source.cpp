@@ -319,30 +319,18 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const ErrorT
     return source_srs;
 }
 
-using Box = std::array<double, 4>; // x0, y0, x1, y1 in the layer's CRS
-
-/// The boxes the layer is read through for the region `near` (see read_source), widened by 1%
-/// of its larger side; none (read it whole) when its CRS cannot take them. In lon/lat, a region
-/// across +-180 is its two sides, and each box is also read shifted by 360 degrees where the
-/// layer's extent passes +-180 (GSHHG's Antarctica runs 0..360, Eurasia to 190).
+/// The boxes the layer is read through for the region `near` (see read_source): its sides
+/// (near_sides); none (read it whole) when its CRS cannot take them. In lon/lat each side is
+/// also read shifted by 360 degrees where the layer's extent passes +-180 (GSHHG's Antarctica
+/// runs 0..360, Eurasia to 190).
 std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near,
                               OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
                               OGRSpatialReferenceH source_srs) {
-    auto [w, s, e, n] = near;
-    const double width = e > w ? e - w : e + 360 - w;
-    const double pad = 0.01 * std::max(width, n - s);
-    s = std::max(-90.0, s - pad), n = std::min(90.0, n + pad);
-    std::vector<Box> sides;
-    if (width >= 360 - 2 * pad)
-        sides.push_back({-180, s, 180, n});
-    else if (e > w)
-        sides.push_back({std::max(-180.0, w - pad), s, std::min(180.0, e + pad), n});
-    else
-        sides = {{w - pad, s, 180, n}, {-180, s, e + pad, n}};
+    const std::vector<Box> sides = near_sides(near);
     if (transform) {
         // The box in the layer's CRS (densified edges); a CRS that cannot take it: none.
         TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84, source_srs));
-        const Box b = sides.size() == 1 ? sides.front() : Box{-180, s, 180, n};
+        const Box b = sides.size() == 1 ? sides.front() : Box{-180, sides[0][1], 180, sides[0][3]};
         Box t;
         const bool ok = to_layer &&
                         OCTTransformBounds(to_layer.get(), b[0], b[1], b[2], b[3], &t[0], &t[1],
@@ -361,6 +349,18 @@ std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near
 }
 
 } // namespace
+
+std::vector<Box> near_sides(const std::array<double, 4> &near) {
+    auto [w, s, e, n] = near;
+    const double width = e > w ? e - w : e + 360 - w;
+    const double pad = 0.01 * std::max(width, n - s);
+    s = std::max(-90.0, s - pad), n = std::min(90.0, n + pad);
+    if (width >= 360 - 2 * pad)
+        return {{-180, s, 180, n}};
+    if (e > w)
+        return {{std::max(-180.0, w - pad), s, std::min(180.0, e + pad), n}};
+    return {{w - pad, s, 180, n}, {-180, s, e + pad, n}};
+}
 
 Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
                    const std::string &srs_override, const char *field, std::uint64_t max_bytes,
