@@ -8,7 +8,8 @@
 // open_2... (tags 4, 5...), in the order of the ADCIRC writer's open strings. In 4.1 the entities
 // are the discrete curves 1 (coast) and 2 (open; open_k: 1 + k) and the surface 1 (ocean), which
 // holds every node. The depth, when the mesh has one, follows as $NodeData "depth" (metres,
-// positive down). Coordinates: lon/lat degrees (z = 0); with COORDS=SPHERE, x y z in metres on the
+// positive down). Coordinates: lon/lat degrees (z = 0) as the other model formats place them
+// (longitudes in [0, 360) for a region across 180); with COORDS=SPHERE, x y z in metres on the
 // sphere of RADIUS; with an --output-srs (WriteOptions), x y in that CRS (z = 0), whose WKT ends
 // the file as seamsh writes it, a section "$Projection" of two lines, "WKT" and the WKT, which
 // gmsh keeps as the model attribute "Projection". Written as it goes through a buffer of 1 MiB.
@@ -168,10 +169,7 @@ private:
         const Vec3 &v = mesh_.nodes[i];
         if (c_.sphere)
             return {c_.radius * v.x, c_.radius * v.y, c_.radius * v.z};
-        if (xy_)
-            return {xy_->x[i], xy_->y[i], 0.0};
-        const LonLat p = vec_to_lonlat(v);
-        return {p.lon, p.lat, 0.0};
+        return {xy_->x[i], xy_->y[i], 0.0};
     }
 
     void tick() {
@@ -309,8 +307,15 @@ private:
 
 void write_as_gmsh(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     const MshChoices choices = msh_choices(options.creation_options, path);
+    // In lon/lat as the other model formats place them (node_lonlats: in [0, 360) where that
+    // spares every face a cut at the seam, as for a region across 180), or in --output-srs.
+    if (choices.sphere && !options.output_srs.empty())
+        throw UsageError(path.string() +
+                         ": GMSH creation option COORDS=SPHERE writes x y z on a "
+                         "sphere, --output-srs " +
+                         options.output_srs + " planar x y: give one of them");
     std::optional<io::ModelCoordinates> xy;
-    if (!options.output_srs.empty())
+    if (!choices.sphere)
         xy = io::model_coordinates(mesh, options.output_srs, "gmsh output " + path.string());
     OutputFile out(path, options.overwrite, "gmsh output");
     const auto topology = io::topology_of(mesh);

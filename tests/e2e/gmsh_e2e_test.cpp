@@ -54,8 +54,10 @@ want = {name: set(map(tuple, np.sort(edges[tag == t], axis=1))) for name, t in (
 depth = ds['depth'][:] if 'depth' in ds.variables else None
 
 def check_points(xyz):
-    if coords == 'lonlat':
-        assert np.allclose(xyz[:, 0], lon, atol=1e-9) and np.allclose(xyz[:, 1], lat, atol=1e-9), 'lon/lat'
+    if coords.startswith('lonlat'):
+        # The same longitudes, or 360 more (a region across 180 is written in [0, 360)).
+        d = (xyz[:, 0] - lon + 180) % 360 - 180
+        assert np.allclose(d, 0, atol=1e-9) and np.allclose(xyz[:, 1], lat, atol=1e-9), 'lon/lat'
         assert np.all(xyz[:, 2] == 0), 'z'
     else:
         r = float(coords)
@@ -84,6 +86,11 @@ for dim, ptag in gmsh.model.getPhysicalGroups():
             elems.append(np.asarray(n, dtype=np.int64).reshape(-1, k) - 1)
     groups[name] = (dim, np.concatenate(elems))
 assert groups['ocean'][0] == 2 and len(groups['ocean'][1]) == nfaces, ('ocean', nfaces)
+if coords == 'lonlat-ccw':  # every triangle counter-clockwise in the file's own x, y
+    p = xyz.reshape(-1, 3)[order][groups['ocean'][1]]
+    area = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - \
+           (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1])
+    assert (area > 0).all(), ('clockwise triangles', int((area <= 0).sum()))
 for name, pairs in want.items():
     got = set(map(tuple, np.sort(groups[name][1], axis=1))) if name in groups else set()
     assert (name not in groups) == (len(pairs) == 0), ('group present', name)
@@ -174,6 +181,28 @@ TEST(GmshE2e, regional_41_and_22_read_back_as_the_ugrid_file_says) {
     std::getline(head22, line);
     EXPECT_EQ(line, "2.2 0 8");
     EXPECT_EQ(check(dir / "s.msh", dir / "s.nc", "lonlat", dir.path()), out);
+}
+
+// A region across 180 (W > E), and one ending at 180: the lon/lat of MSH are the other model
+// formats' (longitudes in [0, 360) where that spares every face a cut at the seam). They were
+// in [-180, 180): faces spanning 350 degrees, clockwise in the file's x, y (124 of 3,980 at
+// GSHHG low 170,-50,-170,-30 at 50 km), and a region ending at 180 had its east edge at -180.
+TEST(GmshE2e, a_region_across_or_up_to_180_has_every_triangle_counter_clockwise) {
+    if (!readers_available())
+        return;
+    TempDir dir;
+    for (const std::string box : {"170,-50,-170,-30", "170,-50,180,-30"}) {
+        SCOPED_TRACE(box);
+        std::string err;
+        ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", box,
+                           "--hmax", "60km", "-o", (dir / "r.nc").string(), "-o",
+                           (dir / "r.msh").string(), "--overwrite"},
+                          err, dir.path()),
+                  0)
+            << err;
+        const std::string out = check(dir / "r.msh", dir / "r.nc", "lonlat-ccw", dir.path());
+        EXPECT_NE(out.find("OK coast="), std::string::npos) << out;
+    }
 }
 
 TEST(GmshE2e, global_on_the_sphere_has_no_open_group_in_either_version) {
