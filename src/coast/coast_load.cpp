@@ -53,8 +53,13 @@ std::vector<Box> region_boxes(const std::array<double, 4> &region) {
 /// meets it. The land beyond a region plays no part in it (region_rings cuts it off); a
 /// continent read whole for a region of its coast cost 90% of the run (GSHHG f, Norway).
 GeomPtr within_boxes(Geos &geos, GeomPtr p, const std::vector<Box> &boxes) {
+    // Small polygons stay whole: a clip bends a segment across the clip line where the union's
+    // snap rounding moves the new vertex (by up to 2^-20 degree), and the region's own cut of
+    // that segment then moves too; worth it only for the continents.
+    constexpr int clip_min_vertices = 4096;
     double x0, y0, x1, y1;
-    if (boxes.empty() || GEOSGeom_getExtent_r(geos.get(), p.get(), &x0, &y0, &x1, &y1) == 0)
+    if (boxes.empty() || GEOSGetNumCoordinates_r(geos.get(), p.get()) < clip_min_vertices ||
+        GEOSGeom_getExtent_r(geos.get(), p.get(), &x0, &y0, &x1, &y1) == 0)
         return p;
     std::vector<GeomPtr> pieces;
     for (const Box &b : boxes) {
@@ -120,8 +125,10 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
 
     Geos geos;
     // Land: valid polygons, dissolved.
-    std::vector<GeomPtr> parts = valid_parts(
-        geos, src.polygons, options.region ? region_boxes(*options.region) : std::vector<Box>{});
+    // Cut to the region first, unless --min-island-area weighs each island whole.
+    const bool clip = options.region && !(options.min_island_area_km2 > 0);
+    std::vector<GeomPtr> parts =
+        valid_parts(geos, src.polygons, clip ? region_boxes(*options.region) : std::vector<Box>{});
     if (!src.lines.empty())
         add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
     SnapCount snapped;
