@@ -2,6 +2,7 @@
 #include "mesh_topology.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <mutex>
 #include <numeric>
 #include <string>
@@ -295,24 +296,41 @@ std::vector<BoundaryRun> loop_runs(const MeshTopology &topo, const std::vector<s
     return runs;
 }
 
-std::vector<LonLat> node_lonlats(const Mesh &mesh) {
-    std::vector<LonLat> p(mesh.nodes.size());
-    for (std::size_t i = 0; i < p.size(); ++i)
-        p[i] = vec_to_lonlat(mesh.nodes[i]);
+bool east_longitudes(const Mesh &mesh) {
+    // A face is cut in [-180, 180) (or in [0, 360) with shift 360) when its longitudes span more
+    // than 180 degrees; only a face with a corner beyond +-90 (x < 0) can be in [-180, 180), only
+    // one with a corner within +-90 (x > 0) in [0, 360).
+    std::vector<double> lon(mesh.nodes.size(), std::nan(""));
+    const auto lon_of = [&](NodeIndex n) {
+        if (std::isnan(lon[n]))
+            lon[n] = vec_to_lonlat(mesh.nodes[n]).lon;
+        return lon[n];
+    };
     const auto cuts = [&](double shift) {
         for (const auto &f : mesh.faces) {
+            const double side = shift == 0 ? 1 : -1;
+            if (side * mesh.nodes[f[0]].x >= 0 && side * mesh.nodes[f[1]].x >= 0 &&
+                side * mesh.nodes[f[2]].x >= 0)
+                continue;
             double lo = 1e9, hi = -1e9;
             for (NodeIndex n : f) {
-                const double lon = p[n].lon < 0 ? p[n].lon + shift : p[n].lon;
-                lo = std::min(lo, lon);
-                hi = std::max(hi, lon);
+                const double l = lon_of(n) < 0 ? lon_of(n) + shift : lon_of(n);
+                lo = std::min(lo, l);
+                hi = std::max(hi, l);
             }
             if (hi - lo > 180)
                 return true;
         }
         return false;
     };
-    if (cuts(0) && !cuts(360))
+    return cuts(0) && !cuts(360);
+}
+
+std::vector<LonLat> node_lonlats(const Mesh &mesh) {
+    std::vector<LonLat> p(mesh.nodes.size());
+    for (std::size_t i = 0; i < p.size(); ++i)
+        p[i] = vec_to_lonlat(mesh.nodes[i]);
+    if (east_longitudes(mesh))
         for (auto &q : p)
             q.lon += q.lon < 0 ? 360 : 0;
     return p;

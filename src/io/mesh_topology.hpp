@@ -117,8 +117,12 @@ std::vector<BoundaryRun> loop_runs(const MeshTopology &topo, const std::vector<s
 /// compute_stats on an already built topology (the writer has one).
 MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo);
 
-/// The nodes in lon/lat for the model formats that store degrees (ADCIRC, SCHISM, SELAFIN):
-/// longitudes in [-180, 180), or in [0, 360) when that spares every face a cut at the seam.
+/// Whether the mesh's longitudes go in [0, 360) rather than [-180, 180): when that spares every
+/// face a cut at the seam (a region across 180, or up to it), which nothing spares a global mesh.
+bool east_longitudes(const Mesh &mesh);
+
+/// The nodes in lon/lat for the formats that store degrees (UGRID, ADCIRC, SCHISM, SELAFIN,
+/// gmsh, D-Flow FM, FESOM2): longitudes in [-180, 180), or in [0, 360) by east_longitudes.
 std::vector<LonLat> node_lonlats(const Mesh &mesh);
 
 } // namespace globemesh::io

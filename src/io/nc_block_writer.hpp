@@ -199,15 +199,20 @@ public:
     }
 
     /// Writes the lon and lat of n points to variables v_lon and v_lat, point(i) giving point i
-    /// (a unit vector), each converted once.
+    /// (a unit vector), each converted once; with `east`, longitudes in [0, 360) (see
+    /// io::east_longitudes).
     template <class Point>
-    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point) {
-        put_xy(v_lon, v_lat, n, [&](std::size_t i) { return vec_to_lonlat(point(i)); });
+    void put_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point, bool east) {
+        put_xy(v_lon, v_lat, n, [&](std::size_t i) {
+            LonLat p = vec_to_lonlat(point(i));
+            p.lon += east && p.lon < 0 ? 360 : 0;
+            return p;
+        });
     }
     /// put_lonlat for points derived from the nodes (face centres, edge midpoints), converted
     /// by lonlat_batch: within 2 ulp of vec_to_lonlat's, the same bits on every machine.
     template <class Point>
-    void put_derived_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point) {
+    void put_derived_lonlat(int v_lon, int v_lat, std::size_t n, const Point &point, bool east) {
         using Columns = std::pair<std::vector<Vec3>, std::array<std::vector<double>, 2>>;
         in_blocks<Columns>(n, [&](std::size_t first, std::size_t count, Columns &b, Block &block) {
             b.first.resize(count);
@@ -216,6 +221,9 @@ public:
             for (std::size_t i = 0; i < count; ++i)
                 b.first[i] = point(first + i);
             lonlat_batch(b.first.data(), count, b.second[0].data(), b.second[1].data());
+            if (east)
+                for (double &lon : b.second[0])
+                    lon += lon < 0 ? 360 : 0;
             block.put(v_lon, b.second[0].data(), count);
             block.put(v_lat, b.second[1].data(), count);
         });

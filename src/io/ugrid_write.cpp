@@ -320,11 +320,15 @@ void write_data(NcBlockWriter &w, const Mesh &mesh, const io::MeshTopology &topo
     });
     if (detail::after_partial_write)
         detail::after_partial_write(); // tests only (write_hooks.hpp)
-    w.put_derived_lonlat(t.coords[2], t.coords[3], nf, centre);
-    w.put_derived_lonlat(t.coords[4], t.coords[5], ne, midpoint);
+    // Longitudes in [0, 360) for a region across 180 (or up to it): no face cut at the seam,
+    // which QGIS (MDAL) draws across the whole map; as the model formats write them.
+    const bool east = io::east_longitudes(mesh);
+    w.put_derived_lonlat(t.coords[2], t.coords[3], nf, centre, east);
+    w.put_derived_lonlat(t.coords[4], t.coords[5], ne, midpoint, east);
     w.put_rows<int, 2>(t.edge_nodes, ne, [&](std::size_t e) { return topo.edge_nodes(e); });
     {
-        w.put_lonlat(t.coords[0], t.coords[1], nn, [&](std::size_t i) { return mesh.nodes[i]; });
+        w.put_lonlat(
+            t.coords[0], t.coords[1], nn, [&](std::size_t i) { return mesh.nodes[i]; }, east);
         const io::GeodesicFaceAreas areas(topo);
         if (options.face_areas_m2)
             options.face_areas_m2->assign(nf, 0.0);
