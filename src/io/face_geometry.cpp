@@ -70,13 +70,16 @@ std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &
         ring.push_back({ring.front()[0] + winding, lat});
         ring.push_back({ring.front()[0], lat});
     }
+    // A piece of under 1e-9 of the face is a sliver along a cut meridian the face only touches
+    // (a corner at -180 and the others near 180: its clip's corners within rounding of -180).
+    const double floor = std::max(1e-18, 1e-9 * std::fabs(ring_area(ring)));
     std::vector<LonLatPart> parts;
     for (double shift : {-360.0, 0.0, 360.0}) {
         LonLatPart r = ring;
         for (auto &p : r)
             p[0] += shift;
         r = clip_ring(clip_ring(r, 180.0, true), -180.0, false);
-        if (r.size() >= 3 && std::fabs(ring_area(r)) > 1e-18)
+        if (r.size() >= 3 && std::fabs(ring_area(r)) > floor)
             parts.push_back(std::move(r));
     }
     return parts;

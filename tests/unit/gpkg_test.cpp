@@ -484,6 +484,34 @@ TEST(Gpkg, closed_mesh_faces_tile_the_lonlat_rectangle_with_no_part_wider_than_1
     EXPECT_LT(widest, 180.0);
 }
 
+// A face with a side along the antimeridian, its two corners within rounding of -180 (a
+// region's east edge at 180, as the nodes come out: -179.99999999999997 and -180), and its third
+// just west of 180, only touches it: one polygon, without the sliver along -180 its clip left
+// beside it (GSHHG low 170,-50,180,-30 at 50 km: 12 faces written as two parts, the second of
+// area 1.4e-14 square degrees; globally at 100 km 73). A face across 180 still gives two parts.
+TEST(Gpkg, a_face_touching_the_antimeridian_is_one_polygon) {
+    const double deg = std::acos(-1.0) / 180;
+    auto near_180 = [&](double lat, double y) {
+        return normalized(Vec3{-std::cos(lat * deg), y, std::sin(lat * deg)});
+    };
+    int slivers = 0;
+    for (const double y0 : {-0.0, -1e-15, -3e-15, 1e-15})
+        for (const double y1 : {-0.0, -2e-15, 2e-15}) {
+            const Vec3 a = near_180(-37.73, y0), b = near_180(-37.27, y1),
+                       c = lonlat_to_vec(179.64, -37.56);
+            const auto parts = io::face_polygons(a, c, b);
+            slivers += parts.size() != 1;
+            for (const auto &p : parts)
+                EXPECT_GT(std::fabs(io::ring_area(p)), 0.01);
+        }
+    EXPECT_EQ(slivers, 0);
+    const auto across = io::face_polygons(lonlat_to_vec(179.5, -37.7), lonlat_to_vec(-179.6, -37.6),
+                                          lonlat_to_vec(179.7, -37.2));
+    ASSERT_EQ(across.size(), 2u);
+    for (const auto &p : across)
+        EXPECT_GT(std::fabs(io::ring_area(p)), 0.001);
+}
+
 // The writer's shortcut for the common face (face_geometry.hpp, simple_face_ring) gives what
 // face_polygons gives, value for value, on faces anywhere: across +-180, at and round the poles,
 // with corners on +-180, tiny and degenerate.
