@@ -126,7 +126,9 @@ std::vector<LonLatPart> polyline_parts(const std::vector<Vec3> &nodes) {
             // Clip segment p-q to -180 <= lon <= 180 (Liang-Barsky on lon only).
             double t0 = 0, t1 = 1, dx = q[0] - p[0];
             if (dx == 0) {
-                if (p[0] < -180 || p[0] > 180) {
+                // A segment along the antimeridian is kept at 180 only: at -180 too, it was drawn
+                // twice (a region ending at 180: its open edge's every segment).
+                if (p[0] <= -180 || p[0] > 180) {
                     flush();
                     continue;
                 }

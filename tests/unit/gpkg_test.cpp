@@ -512,6 +512,25 @@ TEST(Gpkg, a_face_touching_the_antimeridian_is_one_polygon) {
         EXPECT_GT(std::fabs(io::ring_area(p)), 0.001);
 }
 
+// A line along the antimeridian (a region's open edge at 180) is drawn once, at 180: each of its
+// segments came out at -180 too (GSHHG low 170,-50,180,-30 at 10 km: 805 segments for 583
+// open edges). A line across 180 is cut there into two.
+TEST(Gpkg, a_line_along_the_antimeridian_is_drawn_once) {
+    std::vector<Vec3> along;
+    for (double lat = -10; lat <= 10; lat += 5)
+        along.push_back(lonlat_to_vec(180, lat));
+    const auto parts = io::polyline_parts(along);
+    std::size_t segments = 0;
+    for (const auto &p : parts) {
+        segments += p.size() - 1;
+        for (const auto &q : p)
+            EXPECT_EQ(std::fabs(q[0]), 180.0);
+    }
+    EXPECT_EQ(segments, along.size() - 1);
+    const auto across = io::polyline_parts({lonlat_to_vec(179, 0), lonlat_to_vec(-179, 1)});
+    EXPECT_EQ(across.size(), 2u);
+}
+
 // The writer's shortcut for the common face (face_geometry.hpp, simple_face_ring) gives what
 // face_polygons gives, value for value, on faces anywhere: across +-180, at and round the poles,
 // with corners on +-180, tiny and degenerate.
