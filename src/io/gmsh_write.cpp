@@ -308,12 +308,8 @@ private:
 void write_as_gmsh(const Mesh &mesh, const fs::path &path, const WriteOptions &options) {
     const MshChoices choices = msh_choices(options.creation_options, path);
     // In lon/lat as the other model formats place them (node_lonlats: in [0, 360) where that
-    // spares every face a cut at the seam, as for a region across 180), or in --output-srs.
-    if (choices.sphere && !options.output_srs.empty())
-        throw UsageError(path.string() +
-                         ": GMSH creation option COORDS=SPHERE writes x y z on a "
-                         "sphere, --output-srs " +
-                         options.output_srs + " planar x y: give one of them");
+    // spares every face a cut at the seam, as for a region across 180), or in --output-srs
+    // (write_outputs' check_output_srs refuses it with COORDS=SPHERE).
     std::optional<io::ModelCoordinates> xy;
     if (!choices.sphere)
         xy = io::model_coordinates(mesh, options.output_srs, "gmsh output " + path.string());
