@@ -38,16 +38,6 @@ bool touches_pole(const PointList &ring) {
                        [](const LonLat &p) { return std::abs(p.lat) == 90.0; });
 }
 
-/// A region's boxes in the source's lon/lat: its sides (near_sides), each also shifted by 360
-/// degrees either way (land stored past +-180, which add_wrapped brings back).
-std::vector<Box> region_boxes(const std::array<double, 4> &region) {
-    std::vector<Box> boxes;
-    for (const Box &b : near_sides(region))
-        for (const double shift : {0.0, 360.0, -360.0})
-            boxes.push_back({b[0] + shift, b[1], b[2] + shift, b[3]});
-    return boxes;
-}
-
 /// `p` within the boxes: whole when one holds it, else its clips by the boxes it meets (GEOS's
 /// rectangle clip, which takes invalid input; its output is made valid after). Null when none
 /// meets it. The land beyond a region plays no part in it (region_rings cuts it off); a
@@ -128,7 +118,7 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     // Cut to the region first, unless --min-island-area weighs each island whole.
     const bool clip = options.region && !(options.min_island_area_km2 > 0);
     std::vector<GeomPtr> parts =
-        valid_parts(geos, src.polygons, clip ? region_boxes(*options.region) : std::vector<Box>{});
+        valid_parts(geos, src.polygons, clip ? near_boxes(*options.region) : std::vector<Box>{});
     if (!src.lines.empty())
         add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
     SnapCount snapped;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,9 +43,13 @@ constexpr double snap_grid_deg = 1.0 / (1 << 20);
 /// A box x0, y0, x1, y1: lon/lat degrees, or a layer's CRS.
 using Box = std::array<double, 4>;
 
-/// The region W,S,E,N widened by 1% of its larger side, as lon/lat boxes within +-180: one, or
-/// its two sides when it crosses +-180 (read_source's filter, load_coast's clip).
-std::vector<Box> near_sides(const std::array<double, 4> &near);
+/// The region W,S,E,N widened by 1% of its larger side, as lon/lat boxes: one, or its two
+/// sides when it crosses +-180, each also shifted by 360 degrees east where x_max passes 180
+/// and west where x_min passes -180 (a source's longitudes; by default both): land stored past
+/// +-180 (read_source's filter, load_coast's clip).
+std::vector<Box> near_boxes(const std::array<double, 4> &near,
+                            double x_min = -std::numeric_limits<double>::infinity(),
+                            double x_max = std::numeric_limits<double>::infinity());
 
 /// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
 /// `field` is the option whose file it is, named in messages ("coast" or "region_file"; its

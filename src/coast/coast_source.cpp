@@ -319,37 +319,8 @@ SrsPtr source_crs(OGRLayerH layer, const std::string &srs_override, const ErrorT
     return source_srs;
 }
 
-/// The boxes the layer is read through for the region `near` (see read_source): its sides
-/// (near_sides); none (read it whole) when its CRS cannot take them. In lon/lat each side is
-/// also read shifted by 360 degrees where the layer's extent passes +-180 (GSHHG's Antarctica
-/// runs 0..360, Eurasia to 190).
-std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near,
-                              OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
-                              OGRSpatialReferenceH source_srs) {
-    const std::vector<Box> sides = near_sides(near);
-    if (transform) {
-        // The box in the layer's CRS (densified edges); a CRS that cannot take it: none.
-        TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84, source_srs));
-        const Box b = sides.size() == 1 ? sides.front() : Box{-180, sides[0][1], 180, sides[0][3]};
-        Box t;
-        const bool ok = to_layer &&
-                        OCTTransformBounds(to_layer.get(), b[0], b[1], b[2], b[3], &t[0], &t[1],
-                                           &t[2], &t[3], 21) &&
-                        t[0] < t[2] && t[1] < t[3] && std::isfinite(t[0] + t[1] + t[2] + t[3]);
-        return ok ? std::vector<Box>{t} : std::vector<Box>{};
-    }
-    OGREnvelope extent{};
-    const bool known = OGR_L_GetExtent(layer, &extent, FALSE) == OGRERR_NONE;
-    std::vector<Box> boxes;
-    for (const Box &b : sides)
-        for (const double shift : {0.0, 360.0, -360.0})
-            if (shift == 0 || !known || (shift > 0 ? extent.MaxX > 180 : extent.MinX < -180))
-                boxes.push_back({b[0] + shift, b[1], b[2] + shift, b[3]});
-    return boxes;
-}
-
-} // namespace
-
+/// The region W,S,E,N widened by 1% of its larger side, as lon/lat boxes within +-180: one, or
+/// its two sides when it crosses +-180.
 std::vector<Box> near_sides(const std::array<double, 4> &near) {
     auto [w, s, e, n] = near;
     const double width = e > w ? e - w : e + 360 - w;
@@ -360,6 +331,42 @@ std::vector<Box> near_sides(const std::array<double, 4> &near) {
     if (e > w)
         return {{std::max(-180.0, w - pad), s, std::min(180.0, e + pad), n}};
     return {{w - pad, s, 180, n}, {-180, s, e + pad, n}};
+}
+
+/// The boxes the layer is read through for the region `near` (see read_source): near_boxes
+/// shifted where the layer's extent passes +-180 (GSHHG's Antarctica runs 0..360, Eurasia to
+/// 190); in a projected CRS the bounds of its sides; none (read it whole) when the CRS cannot
+/// take them.
+std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near,
+                              OGRCoordinateTransformationH transform, OGRSpatialReferenceH wgs84,
+                              OGRSpatialReferenceH source_srs) {
+    if (transform) {
+        // The box in the layer's CRS (densified edges); a CRS that cannot take it: none.
+        const std::vector<Box> sides = near_sides(near);
+        TransformPtr to_layer(OCTNewCoordinateTransformation(wgs84, source_srs));
+        const Box b = sides.size() == 1 ? sides.front() : Box{-180, sides[0][1], 180, sides[0][3]};
+        Box t;
+        const bool ok = to_layer &&
+                        OCTTransformBounds(to_layer.get(), b[0], b[1], b[2], b[3], &t[0], &t[1],
+                                           &t[2], &t[3], 21) &&
+                        t[0] < t[2] && t[1] < t[3] && std::isfinite(t[0] + t[1] + t[2] + t[3]);
+        return ok ? std::vector<Box>{t} : std::vector<Box>{};
+    }
+    OGREnvelope extent{};
+    return OGR_L_GetExtent(layer, &extent, FALSE) == OGRERR_NONE
+               ? near_boxes(near, extent.MinX, extent.MaxX)
+               : near_boxes(near);
+}
+
+} // namespace
+
+std::vector<Box> near_boxes(const std::array<double, 4> &near, double x_min, double x_max) {
+    std::vector<Box> boxes;
+    for (const Box &b : near_sides(near))
+        for (const double shift : {0.0, 360.0, -360.0})
+            if (shift == 0 || (shift > 0 ? x_max > 180 : x_min < -180))
+                boxes.push_back({b[0] + shift, b[1], b[2] + shift, b[3]});
+    return boxes;
 }
 
 Source read_source(const std::string &path, const std::string &layer_name, const std::string &where,
