@@ -296,19 +296,16 @@ std::vector<BoundaryRun> loop_runs(const MeshTopology &topo, const std::vector<s
     return runs;
 }
 
-bool east_longitudes(const Mesh &mesh) {
+namespace {
+
+/// east_longitudes with lon_of(n) giving node n's longitude in [-180, 180).
+template <class Lon> bool east_of(const Mesh &mesh, const Lon &lon_of) {
     // A face is cut in [-180, 180) (or in [0, 360) with shift 360) when its longitudes span more
     // than 180 degrees; only a face with a corner beyond +-90 (x < 0) can be in [-180, 180), only
     // one with a corner within +-90 (x > 0) in [0, 360).
-    std::vector<double> lon(mesh.nodes.size(), std::nan(""));
-    const auto lon_of = [&](NodeIndex n) {
-        if (std::isnan(lon[n]))
-            lon[n] = vec_to_lonlat(mesh.nodes[n]).lon;
-        return lon[n];
-    };
     const auto cuts = [&](double shift) {
+        const double side = shift == 0 ? 1 : -1;
         for (const auto &f : mesh.faces) {
-            const double side = shift == 0 ? 1 : -1;
             if (side * mesh.nodes[f[0]].x >= 0 && side * mesh.nodes[f[1]].x >= 0 &&
                 side * mesh.nodes[f[2]].x >= 0)
                 continue;
@@ -326,11 +323,23 @@ bool east_longitudes(const Mesh &mesh) {
     return cuts(0) && !cuts(360);
 }
 
+} // namespace
+
+bool east_longitudes(const Mesh &mesh) {
+    // Each longitude computed when first asked: only the corners of faces that can be cut are.
+    std::vector<double> lon(mesh.nodes.size(), std::nan(""));
+    return east_of(mesh, [&](NodeIndex n) {
+        if (std::isnan(lon[n]))
+            lon[n] = vec_to_lonlat(mesh.nodes[n]).lon;
+        return lon[n];
+    });
+}
+
 std::vector<LonLat> node_lonlats(const Mesh &mesh) {
     std::vector<LonLat> p(mesh.nodes.size());
     for (std::size_t i = 0; i < p.size(); ++i)
         p[i] = vec_to_lonlat(mesh.nodes[i]);
-    if (east_longitudes(mesh))
+    if (east_of(mesh, [&](NodeIndex n) { return p[n].lon; }))
         for (auto &q : p)
             q.lon += q.lon < 0 ? 360 : 0;
     return p;
