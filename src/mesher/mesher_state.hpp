@@ -603,8 +603,23 @@ Mesh to_mesh(Mesher &m, const std::vector<Vec3> &borders);
 /// MesherOptions::lattice_within): the other part's faces may join their fans, and join_parts
 /// splits those still pinched on the joined mesh.
 void keep_border_nodes_whole(Mesher &m, const std::vector<Vec3> &borders);
+/// The mesh's pieces over shared nodes: each node's root, and the root of the piece with the
+/// most faces.
+struct MeshPieces {
+    std::vector<NodeIndex> root;
+    NodeIndex largest;
+};
+MeshPieces mesh_pieces(const Mesh &mesh);
 /// Appends to report.seas_cut_off the areas (km2, then sorted largest first) of the mesh's
 /// pieces beside a cut (cut_nodes) but the largest: the basins closed straits cut off.
 void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report);
+/// The joined mesh's pieces (over shared nodes) but the largest, told as one part's are: each
+/// that the inlet rule closes goes unless it touches an open boundary or a passage runs through
+/// it (none with keep_inland_seas; counted in report.water_faces_removed and
+/// straits_water_km2), and those left beside a cut (cut_nodes) are the basins closed straits
+/// cut off (report.seas_cut_off). A part keeps its water against its border, where the next
+/// part may close its side, and a pocket removed at a border may leave a face apart.
+void close_joined_pieces(Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, const SizeFn &size_km,
+                         const MesherOptions &options, MesherReport &report);
 
 } // namespace globemesh::mesher_internal

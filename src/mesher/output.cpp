@@ -162,18 +162,22 @@ std::vector<NodeIndex> write_faces(const Mesher &m, const PinchSplit &split, std
 } // namespace
 
 // The pieces are found by union-find over the nodes through the faces.
-void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report) {
+MeshPieces mesh_pieces(const Mesh &mesh) {
     DisjointSets pieces(mesh.nodes.size());
     for (const auto &f : mesh.faces)
         for (int k = 1; k < 3; ++k)
             pieces.join(f[0], f[k]);
-    // Each node's root once: the passes over the faces read it.
-    const std::vector<NodeIndex> parent = std::move(pieces).roots();
+    MeshPieces out{std::move(pieces).roots(), 0};
     std::vector<std::uint32_t> faces_of(mesh.nodes.size(), 0);
     for (const auto &f : mesh.faces)
-        ++faces_of[parent[f[0]]];
-    const NodeIndex largest = static_cast<NodeIndex>(
-        std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
+        ++faces_of[out.root[f[0]]];
+    out.largest = static_cast<NodeIndex>(std::max_element(faces_of.begin(), faces_of.end()) -
+                                         faces_of.begin());
+    return out;
+}
+
+void seas_cut_off(const Mesh &mesh, const std::vector<NodeIndex> &cut_nodes, MesherReport &report) {
+    const auto [parent, largest] = mesh_pieces(mesh);
     std::unordered_map<NodeIndex, double> area; // steradians per piece beside a cut
     std::vector<char> beside_cut(mesh.nodes.size(), 0);
     for (const NodeIndex n : cut_nodes)

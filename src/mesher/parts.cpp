@@ -184,11 +184,11 @@ private:
     bool stop_ = false;
 };
 
-/// The basins the parts' closed straits cut off, told on the joined mesh (a part's pieces beside
-/// a cut may reach the ocean through another part: alone, a part counted half of Hudson Bay).
-void basins_cut_off(const Mesh &mesh, MesherReport &report) {
-    if (report.cut_points.empty())
-        return;
+/// The joined mesh's pieces apart closed by the inlet rule, and the basins the parts' closed
+/// straits cut off told there (a part's pieces beside a cut may reach the ocean through another
+/// part: alone, a part counted half of Hudson Bay).
+void close_pieces(Mesh &mesh, const SizeFn &size_km, const MesherOptions &options,
+                  MesherReport &report) {
     std::set<std::array<double, 3>> cut;
     for (const Vec3 &p : report.cut_points)
         cut.insert({p.x, p.y, p.z});
@@ -206,7 +206,7 @@ void basins_cut_off(const Mesh &mesh, MesherReport &report) {
         if (may[bucket(mesh.nodes[i].x)] &&
             cut.count({mesh.nodes[i].x, mesh.nodes[i].y, mesh.nodes[i].z}))
             cut_nodes.push_back(i);
-    seas_cut_off(mesh, cut_nodes, report);
+    close_joined_pieces(mesh, cut_nodes, size_km, options, report);
 }
 
 /// Runs work(k, t) for k in [0, count) on `threads` threads (t the thread's number, 0 this
@@ -330,7 +330,7 @@ Mesh mesh_parts(const Boundary &boundary, const SizeFn &size_km, const MesherOpt
     // the size field is below its largest value over most of the ocean).
     Mesh mesh =
         join_parts(meshes, lunes, size_km, report.lattice_nodes > 0 ? options.lattice_km : 0.0);
-    basins_cut_off(mesh, report);
+    close_pieces(mesh, size_km, options, report);
     if (measured.valid())
         measured.get();
     else

@@ -309,6 +309,44 @@ void smooth_near_borders(Mesh &mesh, const std::vector<char> &zone,
     }
 }
 
+void compact_mesh(Mesh &mesh, const std::vector<char> &dead_node,
+                  const std::vector<char> &dead_face, std::vector<char> *zone) {
+    std::vector<NodeIndex> new_index(mesh.nodes.size());
+    std::size_t kept = 0;
+    for (std::size_t v = 0; v < mesh.nodes.size(); ++v) {
+        new_index[v] = static_cast<NodeIndex>(kept);
+        if (!dead_node[v]) {
+            mesh.nodes[kept] = mesh.nodes[v];
+            if (zone)
+                (*zone)[kept] = (*zone)[v];
+            for (Field &field : mesh.node_fields)
+                field.values[kept] = field.values[v];
+            ++kept;
+        }
+    }
+    mesh.nodes.resize(kept);
+    if (zone)
+        zone->resize(kept);
+    for (Field &field : mesh.node_fields)
+        field.values.resize(kept);
+    std::size_t faces_kept = 0;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+        if (!dead_face[f]) {
+            auto t = mesh.faces[f];
+            for (NodeIndex &u : t)
+                u = new_index[u];
+            mesh.faces[faces_kept] = t;
+            for (Field &field : mesh.face_fields)
+                field.values[faces_kept] = field.values[f];
+            ++faces_kept;
+        }
+    mesh.faces.resize(faces_kept);
+    for (Field &field : mesh.face_fields)
+        field.values.resize(faces_kept);
+    for (BoundaryEdge &e : mesh.boundary)
+        e.a = new_index[e.a], e.b = new_index[e.b];
+}
+
 /// Removes the free nodes near the borders with four faces (a lattice's valence defect that a
 /// border leaves: its faces near q 0.72, which no move of one node mends): the quadrilateral of
 /// their neighbours becomes two faces (the diagonal that keeps both positive; the flips that
@@ -386,41 +424,8 @@ std::size_t remove_valence_four(Mesh &mesh, std::vector<char> &zone,
             touched[u] = 1;
         ++removed;
     }
-    if (removed == 0)
-        return 0;
-    // Compaction: the nodes and faces left, in their order.
-    std::vector<NodeIndex> new_index(mesh.nodes.size());
-    std::size_t kept = 0;
-    for (std::size_t v = 0; v < mesh.nodes.size(); ++v) {
-        new_index[v] = static_cast<NodeIndex>(kept);
-        if (!dead_node[v]) {
-            mesh.nodes[kept] = mesh.nodes[v];
-            zone[kept] = zone[v];
-            for (Field &field : mesh.node_fields)
-                field.values[kept] = field.values[v];
-            ++kept;
-        }
-    }
-    mesh.nodes.resize(kept);
-    zone.resize(kept);
-    for (Field &field : mesh.node_fields)
-        field.values.resize(kept);
-    std::size_t faces_kept = 0;
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        if (!dead_face[f]) {
-            auto t = mesh.faces[f];
-            for (NodeIndex &u : t)
-                u = new_index[u];
-            mesh.faces[faces_kept] = t;
-            for (Field &field : mesh.face_fields)
-                field.values[faces_kept] = field.values[f];
-            ++faces_kept;
-        }
-    mesh.faces.resize(faces_kept);
-    for (Field &field : mesh.face_fields)
-        field.values.resize(faces_kept);
-    for (BoundaryEdge &e : mesh.boundary)
-        e.a = new_index[e.a], e.b = new_index[e.b];
+    if (removed > 0)
+        compact_mesh(mesh, dead_node, dead_face, &zone);
     return removed;
 }
 

@@ -78,6 +78,11 @@ template <class Faces> double lowest_quality(const std::vector<Vec3> &nodes, con
     return q;
 }
 
+/// Drops the faces and nodes marked dead (no live face may use a dead node), keeping the
+/// others' order, with their fields, `zone` (may be null) and the boundary edges' node indices.
+void compact_mesh(Mesh &mesh, const std::vector<char> &dead_node,
+                  const std::vector<char> &dead_face, std::vector<char> *zone = nullptr);
+
 /// Removes the free zone nodes with four faces (their quadrilateral becomes two faces, unless one
 /// would fall below join_floor and below the four) and compacts the nodes, the faces and `zone`.
 /// Returns how many; the zone's faces must then be listed again.

@@ -525,6 +525,32 @@ TEST(Parts, the_borders_are_chosen_off_the_coasts) {
     expect_joined(chosen.mesh);
 }
 
+/// The areas (km2, largest first) of the mesh's pieces over shared nodes (union-find), but the
+/// largest (the ocean).
+std::vector<double> pieces_but_the_ocean(const Mesh &mesh) {
+    std::vector<NodeIndex> up(mesh.nodes.size());
+    for (NodeIndex i = 0; i < up.size(); ++i)
+        up[i] = i;
+    auto root = [&](NodeIndex i) {
+        while (up[i] != i)
+            i = up[i] = up[up[i]];
+        return i;
+    };
+    for (const auto &f : mesh.faces)
+        up[root(f[1])] = up[root(f[2])] = root(f[0]);
+    std::map<NodeIndex, double> area;
+    for (const auto &f : mesh.faces)
+        area[root(f[0])] +=
+            spherical_triangle_area(mesh.nodes[f[0]], mesh.nodes[f[1]], mesh.nodes[f[2]]) *
+            earth_radius_km * earth_radius_km;
+    std::vector<double> pieces;
+    for (const auto &[r, a] : area)
+        pieces.push_back(a);
+    std::sort(pieces.rbegin(), pieces.rend());
+    pieces.erase(pieces.begin());
+    return pieces;
+}
+
 TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
     // Each part had reported its own pieces beside a closed strait, though they reach the ocean
     // through another part: NE 1:110m at 150 km in 5 parts listed 6 basins, two of 2.6e6 and
@@ -534,32 +560,29 @@ TEST(Parts, the_basins_cut_off_are_pieces_of_the_joined_mesh) {
         SCOPED_TRACE(parts);
         o.parts = parts;
         const OceanMesh run = mesh_ocean(o);
-        // The joined mesh's pieces (union-find over the faces' nodes) and their areas, km2.
-        std::vector<NodeIndex> up(run.mesh.nodes.size());
-        for (NodeIndex i = 0; i < up.size(); ++i)
-            up[i] = i;
-        auto root = [&](NodeIndex i) {
-            while (up[i] != i)
-                i = up[i] = up[up[i]];
-            return i;
-        };
-        for (const auto &f : run.mesh.faces)
-            up[root(f[1])] = up[root(f[2])] = root(f[0]);
-        std::map<NodeIndex, double> area;
-        for (const auto &f : run.mesh.faces)
-            area[root(f[0])] += spherical_triangle_area(run.mesh.nodes[f[0]], run.mesh.nodes[f[1]],
-                                                        run.mesh.nodes[f[2]]) *
-                                earth_radius_km * earth_radius_km;
-        std::vector<double> pieces;
-        for (const auto &[r, a] : area)
-            pieces.push_back(a);
-        std::sort(pieces.rbegin(), pieces.rend());
-        pieces.erase(pieces.begin()); // the ocean
+        const std::vector<double> pieces = pieces_but_the_ocean(run.mesh);
         ASSERT_LE(run.mesher.seas_cut_off.size(), pieces.size());
         for (const double a : run.mesher.seas_cut_off)
             EXPECT_TRUE(std::any_of(pieces.begin(), pieces.end(),
                                     [a](double p) { return std::fabs(p - a) <= 1e-6 * p; }))
                 << a << " km2 is no piece of the joined mesh";
+    }
+}
+
+TEST(Parts, a_face_a_border_leaves_apart_closes_and_every_piece_left_is_a_basin) {
+    // NE 1:110m at 80 km: in 3 parts the joined mesh kept a face of 230 km2 apart north of
+    // Greenland (-30E 82N), water a part kept against its border where the next part closed its
+    // side; in 2 parts the Black Sea stood apart, cut off with no basin listed. One part leaves
+    // no piece the inlet rule closes (under h^2 here) and lists every basin.
+    MeshOptions o = natural_earth("110m", 80);
+    for (int parts : {2, 3, 4, 5}) {
+        SCOPED_TRACE(parts);
+        o.parts = parts;
+        const OceanMesh run = mesh_ocean(o);
+        const std::vector<double> pieces = pieces_but_the_ocean(run.mesh);
+        EXPECT_EQ(pieces.size(), run.mesher.seas_cut_off.size());
+        for (const double a : pieces)
+            EXPECT_GT(a, 80.0 * 80.0) << "a piece the inlet rule closes";
     }
 }
 
