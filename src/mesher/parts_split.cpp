@@ -116,6 +116,38 @@ struct Splitter {
                std::sin(excursion_fraction * km_to_rad(size_km(p)));
     }
 
+    /// The nodes kept before i and after j (not dropped yet): the shortcut's ends.
+    static std::pair<std::size_t, std::size_t> kept_ends(const std::vector<Node> &nodes,
+                                                         const std::vector<char> &drop,
+                                                         std::size_t i, std::size_t j) {
+        const std::size_t n = nodes.size();
+        std::size_t a = (i + n - 1) % n, b = (j + 1) % n;
+        for (std::size_t guard = 0; drop[a] && guard < n; ++guard)
+            a = (a + n - 1) % n;
+        for (std::size_t guard = 0; drop[b] && guard < n; ++guard)
+            b = (b + 1) % n;
+        return {a, b};
+    }
+
+    /// Whether the shortcut that would replace nodes i to j passes over a node of any ring: the
+    /// polygon it closes with them, fanned from its first corner, holds one (every point inside
+    /// lies in a fan triangle). An excursion at a cape had its shortcut cut the cape and cross
+    /// another ring (NE 1:50m at 150 km in 4 parts, the border at 67.74W: across Alexander
+    /// Island's coast, a ring no part could recover).
+    bool shortcut_sweeps(const std::vector<Node> &nodes, const std::vector<char> &drop,
+                         std::size_t i, std::size_t j) const {
+        const auto [a, b] = kept_ends(nodes, drop, i, j);
+        std::vector<Vec3> fan{nodes[a].p};
+        for (std::size_t v = i; v != j; v = (v + 1) % nodes.size())
+            fan.push_back(nodes[v].p);
+        fan.push_back(nodes[j].p);
+        fan.push_back(nodes[b].p);
+        for (std::size_t t = 1; t + 1 < fan.size(); ++t)
+            if (holds_node(fan[0], fan[t], fan[t + 1]))
+                return true;
+        return false;
+    }
+
     /// Whether the arc that would replace nodes i to j (from the node kept before i to the one
     /// kept after j) crosses or touches the ring's other segments: an excursion can hold a
     /// bulge of the coast whose far side then lies on the wrong side of the shortcut (GSHHG low
@@ -124,11 +156,7 @@ struct Splitter {
     static bool shortcut_crosses(const std::vector<Node> &nodes, const std::vector<char> &drop,
                                  std::size_t i, std::size_t j) {
         const std::size_t n = nodes.size();
-        std::size_t a = (i + n - 1) % n, b = (j + 1) % n;
-        for (std::size_t guard = 0; drop[a] && guard < n; ++guard)
-            a = (a + n - 1) % n;
-        for (std::size_t guard = 0; drop[b] && guard < n; ++guard)
-            b = (b + 1) % n;
+        const auto [a, b] = kept_ends(nodes, drop, i, j);
         const Vec3 &pa = nodes[a].p, &pb = nodes[b].p;
         using predicates::orient;
         // The segments from b on round to a, each from a kept node to the next kept one.
@@ -173,7 +201,7 @@ struct Splitter {
                  v = (v + 1) % nodes.size(), ++between)
                 near = near_border(nodes[v].p, k);
             if (!near || nodes.size() - dropped - between - 2 < 3 ||
-                shortcut_crosses(nodes, drop, i, j))
+                shortcut_crosses(nodes, drop, i, j) || shortcut_sweeps(nodes, drop, i, j))
                 continue;
             for (std::size_t v = i; v != j; v = (v + 1) % nodes.size())
                 drop[v] = 1;

@@ -311,6 +311,21 @@ TEST(Parts, an_excursion_is_kept_where_its_shortcut_would_cross_the_coast) {
     EXPECT_GT(mesh.faces.size(), 1000u);
 }
 
+TEST(Parts, an_excursion_is_kept_where_its_shortcut_would_cut_a_cape) {
+    // NE 1:50m at 150 km in 4 parts, the border the parts chose at 67.74W: the cape south of
+    // George VI Sound (67.68W 72.84S) lies 2 km past it, within the 0.2 h of an excursion.
+    // Dropped, its shortcut from 68.15W 71.45S to 72.20W 73.38S passed 60 km off the cape and
+    // across Alexander Island's coast, and the run failed ("a boundary segment cannot be
+    // recovered"). The shortcut may stray from the nodes it replaces by 0.2 h at most, and
+    // pass over no node of any ring.
+    const TempDir dir;
+    MeshOptions o = natural_earth("50m", 150);
+    o.parts_border_lon = -67.737654321099996;
+    const Mesh mesh = mesh_and_write(o, 4, 2, dir / "a.nc");
+    expect_joined(mesh);
+    expect_mesh_verify(dir / "a.nc");
+}
+
 TEST(Parts, part_count_zero_follows_the_node_estimate) {
     // --parts 0: one part below auto_parts_nodes (2e6) estimated nodes, the single-part mesh
     // itself; two parts from them on a global mesh. An open ocean of 5.1e8 km2: at 18 km about
