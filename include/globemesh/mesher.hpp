@@ -89,6 +89,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "globemesh/boundary.hpp"
@@ -161,6 +162,10 @@ struct MesherOptions {
     bool close_pieces_apart = true;
     /// Lines across straits (passages.hpp): no strait closing removes a face one of them meets.
     std::vector<std::vector<Vec3>> passages;
+    /// The region's box W,S,E,N in degrees (W > E crosses 180), when there is one: a boundary
+    /// node slides along the coast (the quality rounds, nudge_off_land) only to points inside
+    /// it, as the source coast runs on past the region's edge.
+    std::optional<std::array<double, 4>> region;
 };
 
 /// Peak bytes per output node allowed for meshing, used to turn the node estimate into a memory

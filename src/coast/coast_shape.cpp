@@ -39,6 +39,11 @@ double left_area_sr(const std::vector<Vec3> &nodes) {
 /// simplified line, so within this of the source (the mesher's fidelity target is h/4).
 constexpr double simplify_tolerance = 0.3;
 
+/// The same for a node between two open segments (a region's outline), in the last pass: the
+/// mesh stays inside the region. A box's parallel kept as its chord bulged past it (NE 1:50m,
+/// the north-west shelf to 62N at 60 km: nodes at 62.127N, past the raster cut there).
+constexpr double open_simplify_tolerance = 0.002;
+
 /// A kept node where the simplified line turns by more than this is a corner: the resampled ring
 /// passes through it. Elsewhere resampling cuts across the simplified line's small bends.
 constexpr double corner_turn = 40.0 * deg_to_rad;
@@ -69,11 +74,18 @@ struct Resampled {
 };
 
 /// Douglas-Peucker between kept nodes i < j (indices modulo n): keeps the node farthest from the
-/// arc while it is farther than `tolerance` times the local size, or while the arc is too long.
+/// arc while it is farther than `tolerance` times the local size (`open_tolerance` between two
+/// open segments), or while the arc is too long.
 void simplify_span(const ShapedRing &s, std::uint32_t i, std::uint32_t j, double tolerance,
-                   std::vector<bool> &keep) {
+                   double open_tolerance, std::vector<bool> &keep) {
     const auto &nodes = s.ring->nodes;
+    const auto &kinds = s.ring->kinds;
     std::uint32_t n = static_cast<std::uint32_t>(nodes.size());
+    auto tolerance_at = [&](std::uint32_t k) {
+        const bool open =
+            kinds[k] == SegmentKind::open && kinds[(k + n - 1) % n] == SegmentKind::open;
+        return open ? open_tolerance : tolerance;
+    };
     std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{i, j}};
     while (!stack.empty()) {
         auto [a, b] = stack.back();
@@ -85,7 +97,7 @@ void simplify_span(const ShapedRing &s, std::uint32_t i, std::uint32_t j, double
         double worst = 0;
         std::uint32_t at = a + 1;
         for (std::uint32_t k = a + 1; k < b; ++k) {
-            double r = arc_distance(pa, pb, nodes[k % n]) / (tolerance * s.h_rad[k % n]);
+            double r = arc_distance(pa, pb, nodes[k % n]) / (tolerance_at(k % n) * s.h_rad[k % n]);
             if (r > worst) {
                 worst = r;
                 at = k;
@@ -337,16 +349,16 @@ void simplify_ring(ShapedRing &s) {
     keep[0] = keep[n / 3] = keep[(2 * n) / 3] = true;
     s.anchor = keep;
     // The shape at the scale of h (tolerance h/2, nodes at least h/2 apart) gives the corners.
-    auto simplify = [&](double tolerance) {
+    auto simplify = [&](double tolerance, double open_tolerance) {
         std::vector<std::uint32_t> from;
         for (std::uint32_t i = 0; i < n; ++i)
             if (keep[i])
                 from.push_back(i);
         for (std::size_t a = 0; a < from.size(); ++a)
             simplify_span(s, from[a], a + 1 < from.size() ? from[a + 1] : from[0] + n, tolerance,
-                          keep);
+                          open_tolerance, keep);
     };
-    simplify(0.5);
+    simplify(0.5, 0.5);
     // Thin nodes closer than half the local size to the previous kept node.
     std::uint32_t last = 0;
     for (std::uint32_t i = 1; i < n; ++i) {
@@ -369,7 +381,7 @@ void simplify_ring(ShapedRing &s) {
     }
     mark_corners(s, keep);
     // The line the nodes are placed on: within simplify_tolerance * h of the source.
-    simplify(simplify_tolerance);
+    simplify(simplify_tolerance, open_simplify_tolerance);
     for (std::uint32_t i = 0; i < n; ++i)
         if (keep[i])
             s.kept.push_back(i);

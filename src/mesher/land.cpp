@@ -539,7 +539,7 @@ std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
 // the corner's star before. The edges between ocean and land are constrained first, so that
 // no flip crosses the boundary the removals made. Returns how many fewer faces are centred
 // on land; `left` and `left_at` get those still on land and their centroids.
-std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
+std::size_t nudge_off_land(Mesher &m, const LandTest &land_test, const MesherOptions &options,
                            const std::vector<TriangleId> &faces, std::vector<TriangleId> &left,
                            std::vector<Vec3> &left_at) {
     SphericalDelaunay &dt = m.dt;
@@ -605,6 +605,8 @@ std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
                 if (star_worst_quality(to, far, floor) < floor)
                     return false;
                 if (slide) {
+                    if (!in_region(options, to))
+                        return false;
                     for (const FarEdge &e : land_far)
                         if (predicates::orient(to, e) <= 0)
                             return false;

@@ -70,6 +70,17 @@ using detail::star_count_score;
 using detail::star_worst_accepts;
 using detail::star_worst_quality;
 
+/// Whether p lies in the region's box (MesherOptions::region; true without one): where a
+/// boundary node may slide to.
+inline bool in_region(const MesherOptions &options, const Vec3 &p) {
+    if (!options.region)
+        return true;
+    const auto [w, s, e, n] = *options.region;
+    const LonLat q = vec_to_lonlat(p);
+    return q.lat >= s && q.lat <= n &&
+           (w <= e ? q.lon >= w && q.lon <= e : q.lon >= w || q.lon <= e);
+}
+
 /// How many of the star triangles p, b, c (far edges b -> c) have their centroid on land.
 inline int star_faces_on_land(const LandTest &land, const Vec3 &p,
                               const std::vector<FarEdge> &far) {
@@ -568,7 +579,7 @@ std::size_t remove_land_faces(Mesher &m, const LandTest &land_test,
                               std::vector<TriangleId> island_faces, const MesherOptions &options,
                               MesherReport &report, std::vector<TriangleId> &left_faces,
                               BoundaryLoops &loops_state, bool straits = false);
-std::size_t nudge_off_land(Mesher &m, const LandTest &land_test,
+std::size_t nudge_off_land(Mesher &m, const LandTest &land_test, const MesherOptions &options,
                            const std::vector<TriangleId> &faces, std::vector<TriangleId> &left,
                            std::vector<Vec3> &left_at);
 

@@ -235,6 +235,8 @@ void QualityRounds::slide_node(VertexId v, TriangleId &hint, std::vector<char> *
     chain.clear();
     Vec3 to = p0;
     auto consider = [&](const Vec3 &p) {
+        if (!in_region(options, p))
+            return false;
         for (const FarEdge &e : land_far)
             if (predicates::orient(p, e) <= 0)
                 return false;
@@ -263,7 +265,7 @@ void QualityRounds::slide_node(VertexId v, TriangleId &hint, std::vector<char> *
     // has some (rarely: most stars have none either way).
     int land0 = -1;
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-        if (!options.land->coast_within(*it, reach))
+        if (!in_region(options, *it) || !options.land->coast_within(*it, reach))
             continue;
         if (const int land = star_faces_on_land(*options.land, *it, far); land > 0) {
             if (land0 < 0)

@@ -173,14 +173,15 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
     std::vector<TriangleId> left;
     BoundaryLoops loops;
     remove_land_faces(m, *options.land, std::move(island_faces), options, report, left, loops);
-    report.land_faces_nudged = nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+    report.land_faces_nudged =
+        nudge_off_land(m, *options.land, options, left, left, report.land_faces_at);
     if (options.close_straits && !left.empty()) {
         close_straits(m, *options.land, left, options, loops, report);
         close_dead_ends(m, options, report);
         report.land_faces_at.clear();
         if (!left.empty())
             report.land_faces_nudged +=
-                nudge_off_land(m, *options.land, left, left, report.land_faces_at);
+                nudge_off_land(m, *options.land, options, left, left, report.land_faces_at);
     } else {
         close_dead_ends(m, options, report); // the short chords alone
     }

@@ -329,6 +329,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     mo.lattice_km = std::max(o.hmax_km, o.hmin_km); // the field's largest value
     mo.seed = o.seed;
     mo.parts_border_lon = o.parts_border_lon;
+    mo.region = o.region;
     for (const Passage &p : passages)
         mo.passages.push_back(p.line);
     if (coast.land) {

@@ -459,5 +459,28 @@ TEST(CoastReal, land_stored_past_180_is_found_by_a_region_west_of_180) {
     expect_valid_mesh(mesh, o, "chukotka.nc");
 }
 
+// A box's parallel edge, held as the chord between the coasts it meets, bulged past the box:
+// NE 1:50m, the north-west shelf to 62N at 60 km (the man page's shelf example) had nodes at
+// 62.127N, past a raster cut there, from the chord between the Faroes and Norway (12 degrees
+// of longitude). Nodes may lie past it by the bulge of a great-circle arc 1.5 h long between
+// two points on it, where the refinement splits an open segment (62N at 60 km: 0.0027 degree).
+TEST(CoastReal, a_region_box_holds_its_mesh_along_its_parallels) {
+    for (const auto &[box, h] : {std::pair{std::array<double, 4>{-12, 46, 13, 62}, 60.0},
+                                 std::pair{std::array<double, 4>{-20, 60, 60, 80}, 100.0}}) {
+        MeshOptions o = region_run("coast/ne_50m_land.gpkg", box, h);
+        o.coast_layer = "land";
+        const Mesh mesh = mesh_ocean(o).mesh;
+        double lat_max = -90, lat_min = 90;
+        for (const Vec3 &p : mesh.nodes) {
+            lat_max = std::max(lat_max, vec_to_lonlat(p).lat);
+            lat_min = std::min(lat_min, vec_to_lonlat(p).lat);
+        }
+        const double bulge_deg =
+            std::pow(1.5 * h / earth_radius_km, 2) / 8 * std::tan(box[3] * deg_to_rad) / deg_to_rad;
+        EXPECT_LT(lat_max, box[3] + bulge_deg) << box[3];
+        EXPECT_GT(lat_min, box[1] - 1e-9) << box[1];
+    }
+}
+
 } // namespace
 } // namespace globemesh
