@@ -204,8 +204,8 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
 }
 
 /// The passages of --passages that reach into the region (a point of the line inside its W,S,E,N
-/// box; with --region-file, the line reaching the region's ocean `rings`; all of them globally),
-/// with their widths in water on the source land.
+/// box, or the line reaching the region's ocean `rings`, which a line across the box with its
+/// ends outside does; all of them globally), with their widths in water on the source land.
 std::vector<Passage> region_passages(const MeshOptions &o, const Boundary &rings,
                                      const LandTest *land) {
     std::vector<Passage> all = read_passages(o.passages, o.passages_layer), kept;
@@ -218,9 +218,10 @@ std::vector<Passage> region_passages(const MeshOptions &o, const Boundary &rings
         return ll.lat >= r[1] && ll.lat <= r[3] && east <= span;
     };
     auto in_region = [&](const Passage &p) {
-        if (o.region)
-            return std::any_of(p.line.begin(), p.line.end(), inside);
-        return o.region_file.empty() || line_meets_ocean(p.line, rings);
+        if (!o.region && o.region_file.empty())
+            return true;
+        return (o.region && std::any_of(p.line.begin(), p.line.end(), inside)) ||
+               line_meets_ocean(p.line, rings);
     };
     for (Passage &p : all)
         if (in_region(p))

@@ -265,6 +265,24 @@ TEST(Passages, RegionFileKeepsOnlyThePassagesInIt) {
     expect_mesh_verify(dir.path() / "m.nc", "--min-quality 0.3");
 }
 
+// A region box across a strait with the passage's ends outside it: the box's region kept only a
+// line with a point inside, and the Florida Straits' line (ends on the Keys and Cuba) was dropped:
+// 8 nodes of 100 km across them. The line reaching the box's ocean is kept, as with a region file.
+TEST(Passages, RegionBoxKeepsALineAcrossItWithItsEndsOutside) {
+    TempDir dir;
+    std::string out;
+    ASSERT_EQ(run_exe("mesh --coast " + quote(land50) + " --coast-layer land --hmax 100km" +
+                          " --region -82,23.3,-80,24.5 --passages default --passage-cells 8 -o " +
+                          quote((dir.path() / "m.nc").string()),
+                      out),
+              0)
+        << out;
+    EXPECT_TRUE(regex_search(
+        out, R"(passages +1, 1 with >= 8 cells across \(fewest [0-9]+: Florida Straits)"))
+        << out;
+    expect_mesh_verify(dir.path() / "m.nc", "--min-quality 0.3");
+}
+
 // A line drawn on land (no water across) ends with no cell: a warning names it, never silent.
 TEST(Passages, WarnsOfAPassageShortOfCells) {
     TempDir dir;
