@@ -66,11 +66,11 @@ void add_node_estimate(const std::function<double(const Vec3 &)> &size_km, const
 // boundary nodes alone (before refinement, which would otherwise fill them with slivers). An
 // unconstrained ocean edge a-b between two nodes of one ring cuts the ocean in two: the ring's
 // arc from a to b and the edge close a curve. When a-b is shorter than inlet_width * h at its
-// midpoint and one side holds at most inlet_area * h^2 of ocean, with no open (sea) boundary
-// and no other ring (every ring stays a boundary loop), that side becomes land and a-b a coast
-// segment. A dead-end channel narrower than the bound closes whole, a bit at a time; water
-// behind a narrow mouth closes when it is small (a lagoon) or narrow on average too (twice its
-// area over its perimeter under inlet_width * h: a river with lakes along it, up to
+// midpoint and one side holds at most inlet_area * h^2 of ocean, with no open (sea) boundary,
+// no other ring (every ring stays a boundary loop) and no passage line, that side becomes land and
+// a-b a coast segment. A dead-end channel narrower than the bound closes whole, a bit at a time;
+// water behind a narrow mouth closes when it is small (a lagoon) or narrow on average too (twice
+// its area over its perimeter under inlet_width * h: a river with lakes along it, up to
 // inlet_narrow_area h^2), and stays when it is large and wide (the Black Sea behind the
 // Bosphorus).
 void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report) {
@@ -121,8 +121,8 @@ void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report)
             const TriangleId t = out[k];
             area += spherical_triangle_area(dt.point(dt.vertex(t, 0)), dt.point(dt.vertex(t, 1)),
                                             dt.point(dt.vertex(t, 2)));
-            if (area > narrow_cap)
-                return -1.0;
+            if (area > narrow_cap || (!options.passages.empty() && on_passage(m, options, t)))
+                return -1.0; // too large, or a passage runs through it (it stays open)
             for (int i = 0; i < 3; ++i) {
                 const HalfEdge e = half_edge(t, i);
                 if (e == cut || e == dt.twin(cut))

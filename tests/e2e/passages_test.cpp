@@ -283,6 +283,26 @@ TEST(Passages, RegionBoxKeepsALineAcrossItWithItsEndsOutside) {
     expect_mesh_verify(dir.path() / "m.nc", "--min-quality 0.3");
 }
 
+// --passage-cells 1 (the size across the passage its width): the inlet rule closed the Little
+// Belt's water, which no strait closing may take (GSHHG i at 10 km: 0 cells, with a warning).
+// A passage line keeps the inlet it runs through open too.
+TEST(Passages, OneCellAcrossKeepsTheInletOpen) {
+    TempDir dir;
+    std::string out;
+    ASSERT_EQ(run_exe("mesh --coast " +
+                          quote(fixture("coast/hostile/gshhg_i_little_belt.geojson").string()) +
+                          " --region 9.2,55.2,10.2,55.8 --hmax 10km --passages default"
+                          " --passage-cells 1 -o " +
+                          quote((dir.path() / "m.nc").string()),
+                      out),
+              0)
+        << out;
+    EXPECT_TRUE(regex_search(
+        out, R"(passages +1, 1 with >= 1 cells across \(fewest [1-9][0-9]*: Little Belt)"))
+        << out;
+    EXPECT_FALSE(regex_search(out, "warning: passage")) << out;
+}
+
 // A line drawn on land (no water across) ends with no cell: a warning names it, never silent.
 TEST(Passages, WarnsOfAPassageShortOfCells) {
     TempDir dir;
