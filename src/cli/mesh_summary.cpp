@@ -160,6 +160,26 @@ void warn_thin_channels(std::ostream &err, const Mesh &mesh) {
            "channel with --feature-size 3\n";
 }
 
+/// The warning on `err` that a region's ocean fell into pieces and only the largest was meshed,
+/// where a piece dropped holds a tenth of its area or more (a region file of several seas, a box
+/// across an isthmus: Panama's Caribbean side), and how to keep them all.
+void warn_region_pieces(std::ostream &err, const MesherReport &m) {
+    double kept = 0, dropped = 0;
+    std::size_t count = 0;
+    for (const OceanComponent &c : m.components) {
+        if (c.kept)
+            kept = std::max(kept, c.area_km2);
+        else
+            dropped = std::max(dropped, c.area_km2), ++count;
+    }
+    if (count == 0 || dropped < 0.1 * kept)
+        return;
+    err << "globemesh: warning: the region's ocean is in pieces apart; only the largest ("
+        << report_number(kept) << " km2) is meshed and " << count
+        << (count == 1 ? " piece is" : " pieces are") << " dropped (the largest "
+        << report_number(dropped) << " km2); --keep-inland-seas meshes them all\n";
+}
+
 /// The closed straits in the --report JSON: place, width and the size each needs.
 std::string straits_json(const MesherReport &m) {
     std::string r = "[";
@@ -249,6 +269,8 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
     else if (o.mesh.keep_straits && !s.run.mesh.faces.empty() &&
              s.stats.quality_min < quality_floor && !o.quiet)
         warn_thin_channels(err, s.run.mesh);
+    if ((o.mesh.region || !o.mesh.region_file.empty()) && !o.mesh.keep_inland_seas && !o.quiet)
+        warn_region_pieces(err, s.run.mesher);
     print_timings(out, s.timings); // its last line: the total
     out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
         << "wrote             " << outputs_text(s.planned, &s.run.mesh);

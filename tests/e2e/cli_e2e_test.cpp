@@ -248,6 +248,25 @@ print('OK', faces)
     EXPECT_FALSE(fs::exists(dir / "g.dat"));
 }
 
+TEST(CliE2e, a_region_whose_ocean_falls_in_pieces_warns_that_only_the_largest_is_meshed) {
+    // A box across Panama (NE 1:50m at 10 km): its Pacific (29,800 km2) and Caribbean (25,100
+    // km2) sides are apart, and only the largest was meshed, with a line in the summary alone.
+    TempDir dir;
+    std::string out, err;
+    const std::vector<std::string> run{
+        "mesh",   "--coast", land50, "--coast-layer",        "land", "--region", "-81,7.5,-78,10",
+        "--hmax", "10km",    "-o",   (dir / "p.nc").string()};
+    ASSERT_EQ(run_exe(run, out, err, dir.path()), 0) << err;
+    EXPECT_TRUE(globemesh::test::regex_search(
+        err, "warning: the region's ocean is in pieces apart; only the "
+             "largest \\(29[0-9.]+ km2\\) is meshed and 1 piece is dropped"))
+        << err;
+    std::vector<std::string> kept = run;
+    kept.insert(kept.end(), {"--keep-inland-seas", "--overwrite"});
+    ASSERT_EQ(run_exe(kept, out, err, dir.path()), 0) << err;
+    EXPECT_FALSE(globemesh::test::regex_search(err, "in pieces apart")) << err;
+}
+
 TEST(CliE2e, regional_run_has_coast_and_open_boundaries_inside_the_region) {
     TempDir dir;
     std::string out, err;
