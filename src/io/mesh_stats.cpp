@@ -69,16 +69,23 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
     s.boundary_loops = count_boundary_loops(topo, mesh.nodes.size());
     // The nodes' extent is computed on another thread meanwhile: it sets members of `s` of its
     // own, so the statistics do not depend on the timing.
+    // The longitudes in [0, 360) where they span a degree less so (a region across 180, as the
+    // writers put it: east_longitudes), else in [-180, 180) (a global mesh spans 360 in both).
     auto node_extent = [&] {
         if (mesh.nodes.empty())
             return;
         s.lon_min = s.lat_min = 1e300;
         s.lon_max = s.lat_max = -1e300;
+        double east_min = 1e300, east_max = -1e300;
         for (const auto &v : mesh.nodes) {
             LonLat p = vec_to_lonlat(v);
             s.lon_min = std::min(s.lon_min, p.lon), s.lon_max = std::max(s.lon_max, p.lon);
             s.lat_min = std::min(s.lat_min, p.lat), s.lat_max = std::max(s.lat_max, p.lat);
+            const double east = p.lon < 0 ? p.lon + 360 : p.lon;
+            east_min = std::min(east_min, east), east_max = std::max(east_max, east);
         }
+        if (east_max - east_min < s.lon_max - s.lon_min - 1)
+            s.lon_min = east_min, s.lon_max = east_max;
     };
     // Joined before `s` is returned, or by its destructor should the faces or edges throw.
     std::future<void> nodes_done = start_task(node_extent);

@@ -482,5 +482,21 @@ TEST(CoastReal, a_region_box_holds_its_mesh_along_its_parallels) {
     }
 }
 
+// The summary's and `info`'s extent of a region across 180 was lon -180 .. 180 (the whole
+// band); it is the region's box, in [0, 360) as the writers put such a region, and a global
+// mesh's stays -180 .. 180.
+TEST(CoastReal, a_region_across_180_has_its_extent_east_of_180) {
+    MeshOptions o = region_run("coast/ne_50m_land.gpkg", {170, -50, -170, -30}, 60);
+    o.coast_layer = "land";
+    const MeshStats across = compute_stats(mesh_ocean(o).mesh);
+    EXPECT_NEAR(across.lon_min, 170, 1e-9);
+    EXPECT_NEAR(across.lon_max, 190, 1e-9);
+    o.region.reset();
+    o.hmax_km = 500;
+    const MeshStats global = compute_stats(mesh_ocean(o).mesh);
+    EXPECT_NEAR(global.lon_min, -180, 1);
+    EXPECT_NEAR(global.lon_max, 180, 1);
+}
+
 } // namespace
 } // namespace globemesh
