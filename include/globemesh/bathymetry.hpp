@@ -6,14 +6,16 @@
 // lon/lat grid of cell centres, in metres, elevation positive up (land > 0, sea floor < 0). No GDAL
 // type appears in this interface.
 //
-// Georeferencing: a raster in a geographic CRS with a north-up (or south-up) geotransform is read
-// as is, longitudes in 0..360 or -180..180 alike. Any other raster (projected, rotated) is read
-// through an in-memory warped VRT to EPSG:4326 (GDALWarp, bilinear, exact transformer -et 0,
-// NaN outside the source footprint). bathy_srs replaces the file's CRS (or gives one). A file
-// without a CRS whose coordinates are CF longitude and latitude (GDAL metadata such as
-// lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles, classic global relief
-// NetCDF grids), with a geotransform whose extent can be degrees, is read as WGS 84 lon/lat
-// (the progress stage says so, which the CLI shows with --verbose).
+// Georeferencing: a raster in WGS 84 lon/lat in effect (PROJ's transformation to EPSG:4326 moves
+// no point of it: EPSG:4326, CRS84, the WGS 84 ellipsoid without a datum) with a north-up (or
+// south-up) geotransform is read as is, longitudes in 0..360 or -180..180 alike. Any other
+// raster (projected, rotated, or geographic on another datum, prime meridian or unit: NAD27,
+// ED50, a Paris meridian) is read through an in-memory warped VRT to EPSG:4326 (GDALWarp,
+// bilinear, exact transformer -et 0, NaN outside the source footprint). bathy_srs replaces the
+// file's CRS (or gives one). A file without a CRS whose coordinates are CF longitude and latitude
+// (GDAL metadata such as lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles,
+// classic global relief NetCDF grids), with a geotransform whose extent can be degrees, is read
+// as WGS 84 lon/lat (the progress stage says so, which the CLI shows with --verbose).
 // A grid whose columns span 360 degrees (within a tenth of a cell: coordinates written with few
 // digits or as float32) is global, its spacing taken as exactly 360 / columns, and wraps across
 // its seam; a node-registered global grid (the last column repeats the first meridian, e.g.

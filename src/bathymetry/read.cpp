@@ -42,15 +42,42 @@ private:
     char **list_ = nullptr;
 };
 
-/// True when the dataset's CRS is geographic in degrees and its geotransform is not rotated.
+/// True when PROJ's transformation from srs to WGS 84 lon/lat (EPSG:4326) is the identity over
+/// the nx x ny raster of geotransform gt: it moves none of 3 x 3 cell centres spread over it
+/// (latitudes clamped to the poles) by more than 1e-9 degrees, longitudes taken modulo 360.
+/// Another datum with a known shift (NAD27), prime meridian (Paris) or angular unit moves them;
+/// EPSG:4326, CRS84 or a bare WGS 84 ellipsoid (GDAL's netCDF "WGS 84") do not.
+bool is_wgs84_in_effect(OGRSpatialReferenceH srs, const double gt[6], int nx, int ny) {
+    gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr)), src(OSRClone(srs));
+    OSRImportFromEPSG(wgs84.get(), 4326);
+    OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    OSRSetAxisMappingStrategy(src.get(), OAMS_TRADITIONAL_GIS_ORDER);
+    gdal::TransformPtr ct(OCTNewCoordinateTransformation(src.get(), wgs84.get()));
+    if (!ct)
+        return false;
+    double x[9], y[9], z[9] = {}, x0[9], y0[9];
+    int ok[9] = {};
+    for (int k = 0; k < 9; ++k) {
+        const double px = 0.5 + (nx - 1) * (k % 3) / 2.0, py = 0.5 + (ny - 1) * (k / 3) / 2.0;
+        x[k] = x0[k] = gt[0] + px * gt[1];
+        y[k] = y0[k] = std::clamp(gt[3] + py * gt[5], -90.0, 90.0);
+    }
+    if (!OCTTransformEx(ct.get(), 9, x, y, z, ok))
+        return false;
+    for (int k = 0; k < 9; ++k)
+        if (!ok[k] || std::abs(std::remainder(x[k] - x0[k], 360.0)) > 1e-9 ||
+            std::abs(y[k] - y0[k]) > 1e-9)
+            return false;
+    return true;
+}
+
+/// True when the dataset's CRS is WGS 84 lon/lat in effect (is_wgs84_in_effect) and its
+/// geotransform is north- or south-up: then its cells are read as they are, with no warp.
 bool is_plain_lonlat(GDALDatasetH ds, const double gt[6]) {
     OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
-    if (!srs || !OSRIsGeographic(srs))
+    if (!srs || !OSRIsGeographic(srs) || gt[2] != 0 || gt[4] != 0 || !(gt[1] > 0) || gt[5] == 0)
         return false;
-    double unit = OSRGetAngularUnits(srs, nullptr);
-    if (std::abs(unit - deg_to_rad) > 1e-12)
-        return false;
-    return gt[2] == 0 && gt[4] == 0 && gt[1] > 0 && gt[5] != 0;
+    return is_wgs84_in_effect(srs, gt, GDALGetRasterXSize(ds), GDALGetRasterYSize(ds));
 }
 
 /// True when GDAL's metadata of ds ("variable#attribute" items, as the netCDF driver gives a

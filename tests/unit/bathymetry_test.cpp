@@ -12,7 +12,9 @@
 #include <vector>
 
 #include <cpl_conv.h>
+#include <cpl_string.h>
 #include <gdal.h>
+#include <gdal_utils.h>
 #include <netcdf.h>
 #include <ogr_srs_api.h>
 
@@ -789,6 +791,126 @@ TEST(Bathymetry, bathy_srs_replaces_a_wrong_declared_crs) {
     Stages same;
     read_raster(path, 1, false, same.callback(), RasterLimits{}, "EPSG:3857");
     EXPECT_TRUE(same.any_contains("(EPSG:3857) from --bathy-srs)")) << same.names.front();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geographic CRSs other than WGS 84: warped to it, as a projected raster is
+
+namespace {
+
+/// gdal_translate `args` `source` `path`, as the sweep made its variants of the fixtures.
+void translate(const std::string &source, const std::string &path,
+               const std::vector<std::string> &args) {
+    GDALAllRegister();
+    char **argv = nullptr;
+    for (const std::string &a : args)
+        argv = CSLAddString(argv, a.c_str());
+    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv, nullptr);
+    CSLDestroy(argv);
+    GDALDatasetH src = GDALOpen(source.c_str(), GA_ReadOnly);
+    ASSERT_NE(src, nullptr) << source;
+    GDALDatasetH out = GDALTranslate(path.c_str(), src, opts, nullptr);
+    GDALTranslateOptionsFree(opts);
+    GDALClose(src);
+    ASSERT_NE(out, nullptr) << path;
+    GDALClose(out);
+}
+
+/// (lon, lat) in degrees from the geographic CRS `from` to `to` (EPSG codes) by PROJ, as GDAL's
+/// warper moves a raster of extent `area` (W, S, E, N): PROJ's operation for that area (NAD27's
+/// differ by 4 m between areas).
+LonLat transformed(int from, int to, LonLat p, const std::array<double, 4> &area) {
+    OGRSpatialReferenceH a = OSRNewSpatialReference(nullptr), b = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(a, from);
+    OSRImportFromEPSG(b, to);
+    OSRSetAxisMappingStrategy(a, OAMS_TRADITIONAL_GIS_ORDER);
+    OSRSetAxisMappingStrategy(b, OAMS_TRADITIONAL_GIS_ORDER);
+    OGRCoordinateTransformationOptionsH options = OCTNewCoordinateTransformationOptions();
+    OCTCoordinateTransformationOptionsSetAreaOfInterest(options, area[0], area[1], area[2],
+                                                        area[3]);
+    OGRCoordinateTransformationH ct = OCTNewCoordinateTransformationEx(a, b, options);
+    EXPECT_TRUE(ct != nullptr && OCTTransform(ct, 1, &p.lon, &p.lat, nullptr));
+    OCTDestroyCoordinateTransformationOptions(options);
+    OCTDestroyCoordinateTransformation(ct);
+    OSRRelease(a);
+    OSRRelease(b);
+    return p;
+}
+
+} // namespace
+
+// ETOPO5's north-west shelf (the fixture) labelled with a CRS on the Paris meridian, its
+// longitudes less Paris's 2.33722917 degrees east of Greenwich (the sweep's shelf_paris): the
+// same cells on the same ground. Read, it is the fixture again, not the fixture moved 2.3
+// degrees west, as when every geographic CRS in degrees was taken for WGS 84 (up to 4.6 km off).
+TEST(Bathymetry, a_raster_on_the_paris_meridian_is_read_where_it_lies) {
+    const std::string source = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    TempDir dir;
+    const std::string path = (dir / "paris.tif").string();
+    translate(source, path,
+              {"-a_srs", "+proj=longlat +ellps=WGS84 +towgs84=0,0,0 +pm=paris +no_defs", "-a_ullr",
+               "-14.378895836666666", "62.041666666666664", "10.704437496666666",
+               "45.958333333333336"});
+    const Raster truth = read_raster(source), r = read_raster(path);
+    EXPECT_NEAR(r.bounds().west, truth.bounds().west, 1e-3);
+    EXPECT_NEAR(r.bounds().east, truth.bounds().east, 1e-3);
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<double> ulon(-11.5, 12.5), ulat(46.5, 61.5);
+    for (int k = 0; k < 2000; ++k) {
+        const double x = ulon(rng), y = ulat(rng);
+        EXPECT_NEAR(r.elevation_m(x, y), truth.elevation_m(x, y), 2.0) << x << " " << y;
+    }
+}
+
+// A plane in NAD27 longitude and latitude (EPSG:4267) at Sabine Pass, where PROJ puts NAD27
+// about 25 m from WGS 84: read, a WGS 84 point takes the plane's value at its NAD27
+// coordinates (PROJ's transformation, computed here), not at its own (9.4 m off). The
+// bilinear warp and sample are exact on a plane.
+TEST(Bathymetry, a_nad27_raster_is_moved_to_wgs84) {
+    TempDir dir;
+    const std::string path = (dir / "nad27.tif").string();
+    auto plane = [](double lon, double lat) {
+        return -100.0 + 20000.0 * (lon + 93.9) - 30000.0 * (lat - 29.8);
+    };
+    write_tiff(path, {-94.0, 29.9, 0.001, 0.001, 200, 200, 4267}, plane);
+    const Raster r = read_raster(path);
+    const std::array<double, 4> area{-94.0, 29.7, -93.8, 29.9};
+    const LonLat shift = transformed(4267, 4326, {-93.9, 29.8}, area);
+    ASSERT_GT(std::hypot(shift.lon + 93.9, shift.lat - 29.8), 1e-4) << "PROJ moves NAD27 here";
+    for (double lon : {-93.97, -93.9, -93.83})
+        for (double lat : {29.73, 29.8, 29.87}) {
+            const LonLat nad27 = transformed(4326, 4267, {lon, lat}, area);
+            EXPECT_NEAR(r.elevation_m(lon, lat), plane(nad27.lon, nad27.lat), 0.01)
+                << lon << " " << lat;
+        }
+}
+
+// WGS 84 lon/lat however it is written stays a plain read of the cells, with no warp: the
+// fixture labelled EPSG:4326, OGC:CRS84, the WGS 84 ellipsoid without a datum (what GDAL's
+// netCDF driver makes of a CF latitude_longitude grid mapping) and the fixture as GDAL writes it
+// to NetCDF are read to the same grid and the same values.
+TEST(Bathymetry, wgs84_lonlat_in_any_spelling_is_read_as_its_cells) {
+    const std::string source = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    TempDir dir;
+    const Raster truth = read_raster(source);
+    struct Variant {
+        std::string name;
+        std::vector<std::string> args;
+    };
+    for (const Variant &v : {Variant{"epsg4326.tif", {"-a_srs", "EPSG:4326"}},
+                             Variant{"crs84.tif", {"-a_srs", "OGC:CRS84"}},
+                             Variant{"ellipsoid.tif", {"-a_srs", "+proj=longlat +ellps=WGS84"}},
+                             Variant{"gdal.nc", {"-of", "netCDF"}}}) {
+        const std::string path = (dir / v.name).string();
+        translate(source, path, v.args);
+        const Raster r = read_raster(path);
+        ASSERT_EQ(r.nlon(), truth.nlon()) << v.name;
+        ASSERT_EQ(r.nlat(), truth.nlat()) << v.name;
+        EXPECT_EQ(r.dlon_deg(), truth.dlon_deg()) << v.name;
+        EXPECT_NEAR(r.lon0_deg(), truth.lon0_deg(), 1e-12) << v.name;
+        EXPECT_NEAR(r.lat0_deg(), truth.lat0_deg(), 1e-12) << v.name;
+        EXPECT_EQ(r.values(), truth.values()) << v.name;
+    }
 }
 
 // Global grids whose last column repeats the first meridian (node registered), from 20 1/6 E
