@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
@@ -266,13 +267,16 @@ double finest_lonlat_step(GDALDatasetH ds) {
 /// ds warped to EPSG:4326 as a lazy in-memory VRT: bilinear, exact transformer, Float32 with NaN
 /// where the source has no data or no coverage, at the source's finest pixel size.
 DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
-    const std::string res = std::to_string(finest_lonlat_step(ds));
+    // All digits: std::to_string's six decimals cut 1/12 degree to 0.083333, 1 arc second by 0.1%.
+    const double step = finest_lonlat_step(ds);
+    char res[32];
+    std::snprintf(res, sizeof res, "%.17g", step);
     StringList argv{"-of", "VRT", "-t_srs", "EPSG:4326", "-r",         "bilinear",
                     "-et", "0",   "-ot",    "Float32",   "-dstnodata", "nan"};
-    if (res != "0.000000") {
+    if (step > 0) {
         argv.add("-tr");
-        argv.add(res.c_str());
-        argv.add(res.c_str());
+        argv.add(res);
+        argv.add(res);
     }
     GDALWarpAppOptions *opts = GDALWarpAppOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
