@@ -63,7 +63,8 @@ struct OceanMesh {
 
 /// Meshes the ocean as the options say (validate(options) first). Deterministic: the same
 /// options and inputs give the same mesh. Throws UsageError (bad options), DataError (inputs
-/// that give no mesh, a run over max_nodes or max_memory_bytes), IoError (unreadable inputs) or
+/// that give no mesh, a run over max_nodes or max_memory_bytes, a node where the bathymetry has
+/// no data and no bathy_fill_m is set), IoError (unreadable inputs) or
 /// Cancelled (progress returned false); the messages name options by their MeshOptions field
 /// (Error::message says them in a caller's words).
 OceanMesh mesh_ocean(const MeshOptions &options, const Progress &progress = {},

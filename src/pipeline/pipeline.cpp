@@ -126,6 +126,44 @@ DepthReport apply_min_depth(std::vector<double> &depths, std::optional<double> m
     return f;
 }
 
+/// The DataError for `missing` nodes of `nodes` without a depth in `bathy` (the file `path`):
+/// how many, where the first is, how many lie past the raster's edges, and bathy_fill_m.
+DataError missing_depths(const Raster &bathy, const std::vector<Vec3> &nodes,
+                         const std::vector<double> &depths, const std::string &path) {
+    std::size_t missing = 0, outside = 0, first = nodes.size();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (!std::isnan(depths[i]))
+            continue;
+        ++missing;
+        first = std::min(first, i);
+        const LonLat p = vec_to_lonlat(nodes[i]);
+        outside += !bathy.contains(p.lon, p.lat);
+    }
+    const LonLat at = vec_to_lonlat(nodes[first]);
+    const LonLatBounds b = bathy.bounds();
+    char where[256];
+    std::snprintf(where, sizeof where,
+                  "the first at lon %.5f, lat %.5f (%zu past the raster's edges at lon %.5f..%.5f, "
+                  "lat %.5f..%.5f; %zu on cells without data)",
+                  at.lon, at.lat, outside, b.west, b.east, b.south, b.north, missing - outside);
+    return DataError(option("bathy") + " " + path + ": no data at " + std::to_string(missing) +
+                     " of the mesh's " + std::to_string(nodes.size()) + " nodes, " + where +
+                     "; pass " + option("bathy_fill_m") + " DEPTH to give them that depth");
+}
+
+/// The depths (m, positive down) of `bathy` (the file `path`) at `nodes`. Throws
+/// missing_depths' DataError when some have none (no data there and no bathy_fill_m).
+std::vector<double> node_depths(const Raster &bathy, const std::vector<Vec3> &nodes,
+                                const std::string &path) {
+    std::vector<double> depths;
+    depths.reserve(nodes.size());
+    for (const Vec3 &p : nodes)
+        depths.push_back(bathy.depth_m(p));
+    if (std::any_of(depths.begin(), depths.end(), [](double d) { return std::isnan(d); }))
+        throw missing_depths(bathy, nodes, depths, path);
+    return depths;
+}
+
 /// --parts, or with 0 (asked for) 1 for a region (the lunes' borders cross a region's coasts
 /// wherever they happen to fall, and there the worst faces of the Gulf of Mexico at 0.85 km,
 /// 2.8e6 nodes, went from q 0.60 to 0.53) and where even the field's smallest size over the whole
@@ -361,9 +399,7 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
                     "m",
                     "sea_floor_depth_below_mean_sea_level",
                     {}};
-        depth.values.reserve(mesh.nodes.size());
-        for (const Vec3 &p : mesh.nodes)
-            depth.values.push_back(bathy->depth_m(p));
+        depth.values = node_depths(*bathy, mesh.nodes, o.bathy);
         run.depth = apply_min_depth(depth.values, o.min_depth_m);
         mesh.node_fields.insert(mesh.node_fields.begin(), std::move(depth));
     }

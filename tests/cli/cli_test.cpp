@@ -1623,6 +1623,94 @@ TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
 
 namespace {
 
+/// The ETOPO5 shelf fixture (301 x 193 cells of 5 minutes from 12 1/24 W, 62 1/24 N) copied to
+/// `path` with nodata (-32768) in columns c0..c1 and rows r0..r1, as the sweep's shelf_hole.tif.
+void shelf_with_hole(const fs::path &path, int c0, int c1, int r0, int r1) {
+    GDALAllRegister();
+    GDALDatasetH src = GDALOpen(fixture("bathy/etopo5_nwshelf_5min.tif").c_str(), GA_ReadOnly);
+    ASSERT_NE(src, nullptr);
+    GDALDatasetH ds = GDALCreateCopy(GDALGetDriverByName("GTiff"), path.c_str(), src, FALSE,
+                                     nullptr, nullptr, nullptr);
+    GDALClose(src);
+    ASSERT_NE(ds, nullptr) << path;
+    GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+    EXPECT_EQ(GDALSetRasterNoDataValue(band, -32768), CE_None);
+    std::vector<std::int16_t> hole(std::size_t(c1 - c0 + 1) * std::size_t(r1 - r0 + 1), -32768);
+    EXPECT_EQ(GDALRasterIO(band, GF_Write, c0, r0, c1 - c0 + 1, r1 - r0 + 1, hole.data(),
+                           c1 - c0 + 1, r1 - r0 + 1, GDT_Int16, 0, 0),
+              CE_None);
+    GDALClose(ds);
+}
+
+} // namespace
+
+// A nodata hole in the raster under the region's ocean (the sweep's shelf_hole.tif: 37 x 37
+// cells of the shelf fixture in the North Sea) used to leave its nodes with NaN depths and exit
+// 0. Without --bathy-fill the run stops with one line naming how many nodes and the first, and
+// writes nothing; with it those nodes, and only those, take the fill, the others the depths of
+// the raster without the hole (a uniform size: the same mesh either way).
+TEST(Cli, nodes_without_bathymetry_data_are_an_error_unless_bathy_fill_gives_them_a_depth) {
+    TempDir dir;
+    const fs::path hole = dir / "hole.tif";
+    shelf_with_hole(hole, 169, 205, 60, 96);
+    auto mesh = [&](const std::string &bathy, const fs::path &out, std::vector<std::string> extra) {
+        std::vector<std::string> args = {
+            "mesh",     "--coast",      coast,    "--coast-layer", "land", "--bathy",    bathy,
+            "--region", "-10,47,11,60", "--hmax", "30km",          "-o",   out.string(), "-q"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const Result refused = mesh(hole.string(), dir / "m.nc", {});
+    EXPECT_EQ(refused.status, 1) << refused.err;
+    std::vector<std::string> g;
+    ASSERT_TRUE(regex_match(
+        refused.err,
+        "globemesh: --bathy " + hole.string() +
+            R"(: no data at ([0-9]+) of the mesh's ([0-9]+) nodes, the first at lon (-?[0-9.]+), )"
+            R"(lat (-?[0-9.]+) \(0 past the raster's edges at lon [-0-9.]+\.\.[-0-9.]+, lat )"
+            R"([-0-9.]+\.\.[-0-9.]+; ([0-9]+) on cells without data\); pass --bathy-fill DEPTH to )"
+            R"(give them that depth\n)",
+        &g))
+        << refused.err;
+    EXPECT_EQ(g[5], g[1]);
+    EXPECT_FALSE(fs::exists(dir / "m.nc"));
+    EXPECT_FALSE(fs::exists(dir / "m.qml"));
+
+    const Result filled = mesh(hole.string(), dir / "f.nc", {"--bathy-fill", "12345.5m"});
+    ASSERT_EQ(filled.status, 0) << filled.err;
+    const Result plain = mesh(fixture("bathy/etopo5_nwshelf_5min.tif").string(), dir / "p.nc", {});
+    ASSERT_EQ(plain.status, 0) << plain.err;
+    const std::vector<double> lon = nc_doubles(dir / "f.nc", "mesh_node_lon"),
+                              lat = nc_doubles(dir / "f.nc", "mesh_node_lat"),
+                              depth = nc_doubles(dir / "f.nc", "depth"),
+                              plain_depth = nc_doubles(dir / "p.nc", "depth");
+    ASSERT_EQ(lon, nc_doubles(dir / "p.nc", "mesh_node_lon"));
+    ASSERT_EQ(depth.size(), plain_depth.size());
+    EXPECT_EQ(std::to_string(depth.size()), g[2]);
+    std::size_t fills = 0, first = depth.size();
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        // A cell or more from the hole (2 1/24 .. 5 1/8 E, 53 23/24 .. 57 1/24 N) as without it.
+        const bool near = lon[i] > 1.95 && lon[i] < 5.21 && lat[i] > 53.87 && lat[i] < 57.13;
+        if (depth[i] != 12345.5) {
+            EXPECT_TRUE(near || depth[i] == plain_depth[i]) << lon[i] << " " << lat[i];
+            continue;
+        }
+        first = std::min(first, i);
+        ++fills;
+        // Within half a cell of the hole.
+        EXPECT_TRUE(lon[i] > 2.0 && lon[i] < 5.17 && lat[i] > 53.9 && lat[i] < 57.09)
+            << lon[i] << " " << lat[i];
+    }
+    EXPECT_GT(fills, 50u);
+    EXPECT_EQ(std::to_string(fills), g[1]);
+    ASSERT_LT(first, depth.size());
+    EXPECT_NEAR(lon[first], std::stod(g[3]), 1e-5);
+    EXPECT_NEAR(lat[first], std::stod(g[4]), 1e-5);
+    globemesh::test::expect_mesh_verify(dir / "f.nc");
+}
+
+namespace {
+
 /// Adds a layer `name` (EPSG:4326) holding the box W,S,E,N (degrees) to the GeoPackage `path`,
 /// created when missing.
 void add_box_layer(const std::string &path, const char *name, double w, double s, double e,
