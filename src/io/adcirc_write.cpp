@@ -131,22 +131,11 @@ void write_strings(TextOut &out, const std::vector<NodeString> &strings, const c
     }
 }
 
-/// Refuses a depth field with nodes the bathymetry left without a value.
-void check_depths(const Field *depth, const fs::path &path, const std::string &what) {
-    if (!depth)
-        return;
-    const auto missing = std::count_if(depth->values.begin(), depth->values.end(),
-                                       [](double d) { return !std::isfinite(d); });
-    if (missing > 0)
-        throw DataError(what + " " + path.string() + ": " + std::to_string(missing) +
-                        " nodes have no depth (the bathymetry does not cover them), and the "
-                        "model needs one at every node: give a bathymetry that covers the mesh");
-}
-
 void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &options,
                 const std::string &what) {
     const Field *depth = mesh.node_field("depth");
-    check_depths(depth, path, what);
+    if (depth)
+        io::require_depths(*depth, what + " " + path.string());
     const io::ModelCoordinates xy =
         io::model_coordinates(mesh, options.output_srs, what + " " + path.string());
     OutputFile file(path, options.overwrite, what);

@@ -29,6 +29,7 @@
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_topology.hpp"
+#include "model_coordinates.hpp"
 #include "text_out.hpp"
 
 namespace globemesh {
@@ -79,16 +80,6 @@ std::vector<double> levels(const WriteOptions &options, const fs::path &path) {
         throw UsageError("FESOM2 output " + path.string() + ": LEVELS=" + text + ": " +
                          fesom2_levels_problem(text));
     return r;
-}
-
-/// Refuses nodes the bathymetry left without a depth (NaN): FESOM2 needs one at every node.
-void check_depths(const Field &depth, const fs::path &path) {
-    const auto missing = std::count_if(depth.values.begin(), depth.values.end(),
-                                       [](double d) { return !std::isfinite(d); });
-    if (missing > 0)
-        throw DataError("FESOM2 output " + path.string() + ": " + std::to_string(missing) +
-                        " nodes have no depth (the bathymetry does not cover them), and the "
-                        "model needs one at every node: give a bathymetry that covers the mesh");
 }
 
 /// Creates `folder` when it is missing (its parent must exist); true when it did.
@@ -183,7 +174,7 @@ void write_as_fesom2(const Mesh &mesh, const fs::path &path, const WriteOptions 
     if (depth == nullptr)
         throw DataError("FESOM2 output " + path.string() +
                         " needs depths, and the mesh has none (mesh with a bathymetry)");
-    check_depths(*depth, path);
+    io::require_depths(*depth, "FESOM2 output " + path.string());
     // A folder this call makes goes again if the run fails: the batch's task when one is alive,
     // else this guard's until the files are in place.
     const bool created = make_folder(path);

@@ -1,6 +1,7 @@
 // The model formats' node coordinates: see model_coordinates.hpp.
 #include "model_coordinates.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -116,6 +117,16 @@ ModelCoordinates model_coordinates(const Mesh &mesh, const std::string &output_s
                             "large for it, or global)");
     check_faces_keep_their_turn(mesh, c, what);
     return c;
+}
+
+void require_depths(const Field &depth, const std::string &what) {
+    const auto missing = std::count_if(depth.values.begin(), depth.values.end(),
+                                       [](double d) { return !std::isfinite(d); });
+    if (missing > 0)
+        throw DataError(what + ": " + std::to_string(missing) +
+                        " nodes have no depth, and the model needs one at every node: mesh with a "
+                        "bathymetry that covers them, or with " +
+                        option("bathy_fill_m") + " DEPTH");
 }
 
 } // namespace globemesh::io

@@ -1,6 +1,7 @@
 // Internal to io/: the node coordinates of the model formats (ADCIRC, SCHISM, SELAFIN, gmsh):
 // the mesh's lon/lat, or planar ones in an --output-srs (WriteOptions::output_srs), transformed by
-// GDAL/PROJ with the axes in the traditional GIS order (x = easting or longitude).
+// GDAL/PROJ with the axes in the traditional GIS order (x = easting or longitude); and the check
+// that every node has the depth the models need (ADCIRC, SCHISM, SELAFIN, FESOM2).
 #pragma once
 
 #include <optional>
@@ -38,5 +39,10 @@ struct ModelCoordinates {
 /// (a global mesh always does).
 ModelCoordinates model_coordinates(const Mesh &mesh, const std::string &output_srs,
                                    const std::string &what);
+
+/// Throws DataError beginning with `what` (e.g. "ADCIRC output fort.14") when nodes of `depth`
+/// have none (NaN, as in a converted file), naming bathy_fill_m: the model needs one at every
+/// node.
+void require_depths(const Field &depth, const std::string &what);
 
 } // namespace globemesh::io

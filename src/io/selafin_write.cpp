@@ -142,14 +142,8 @@ void check_mesh(const Mesh &mesh, const Field *depth, const fs::path &path) {
         throw DataError("SELAFIN output " + path.string() + ": " +
                         std::to_string(mesh.faces.size()) +
                         " triangles are more than a SELAFIN record holds (about 1.8e8)");
-    if (!depth)
-        return;
-    const auto missing = std::count_if(depth->values.begin(), depth->values.end(),
-                                       [](double d) { return !std::isfinite(d); });
-    if (missing > 0)
-        throw DataError("SELAFIN output " + path.string() + ": " + std::to_string(missing) +
-                        " nodes have no depth (the bathymetry does not cover them), and the "
-                        "model needs one at every node: give a bathymetry that covers the mesh");
+    if (depth)
+        io::require_depths(*depth, "SELAFIN output " + path.string());
 }
 
 /// The integer origin SELAFIN's IPARAM(3) and IPARAM(4) give planar coordinates (the centre of

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "globemesh/error.hpp"
+#include "globemesh/ugrid.hpp"
 #include "globemesh/writers.hpp"
 #include "support.hpp"
 #include "unit/io_test_meshes.hpp"
@@ -180,7 +181,9 @@ TEST(ModelGrid, a_region_across_the_antimeridian_is_written_in_0_to_360) {
     EXPECT_EQ(rows.size(), at + 5 + n);
 }
 
-// A node without a depth (NaN) has no value a model can run on: refused, no file.
+// A node without a depth (NaN) has no value a model can run on: refused, no file. The message
+// names bathy_fill_m, the way to mesh one with a depth everywhere: `globemesh convert` of a
+// UGRID file with a missing depth says it in its own words (--bathy-fill).
 TEST(ModelGrid, a_node_without_depth_is_refused_and_nothing_is_written) {
     TempDir dir;
     globemesh::Mesh cap = globemesh::test::icosphere_cap(3, 0, 0, 20);
@@ -189,7 +192,17 @@ TEST(ModelGrid, a_node_without_depth_is_refused_and_nothing_is_written) {
     const std::string message = globemesh::test::thrown_message<globemesh::DataError>(
         [&] { write_adcirc(cap, dir / "cap.14"); });
     EXPECT_NE(message.find("1 nodes have no depth"), std::string::npos) << message;
+    EXPECT_NE(message.find("or with bathy_fill_m DEPTH"), std::string::npos) << message;
     EXPECT_TRUE(fs::is_empty(dir.path()));
+    globemesh::write_ugrid(cap, dir / "cap.nc");
+    std::string err;
+    EXPECT_EQ(run_exe({"convert", "-q", (dir / "cap.nc").string(), (dir / "cap.14").string()}, err,
+                      dir.path()),
+              1);
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_NE(err.find("1 nodes have no depth"), std::string::npos) << err;
+    EXPECT_NE(err.find("or with --bathy-fill DEPTH"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir / "cap.14"));
 }
 
 TEST(ModelGrid, a_regional_fort14_gr3_and_ll_have_the_open_and_land_strings_of_the_ugrid_file) {
