@@ -116,15 +116,28 @@ void validate_coast(const CoastOptions &o) {
             option("region_layer") + " names a layer of " + region_file + ", which is not given");
 }
 
+/// Refuses the raster's options without the raster (bathy): they would be ignored without a word.
+/// The band only when not the default 1, which --print-config writes for every run.
+void require_bathy_for_its_options(const BathymetryOptions &o) {
+    if (!o.bathy.empty())
+        return;
+    const ErrorText needs = " needs " + option("bathy");
+    require(!o.min_depth_m, option("min_depth_m") + needs + ": it raises the sampled depths");
+    require(!o.bathy_fill_m,
+            option("bathy_fill_m") + needs + ": it is the depth where the raster has no data");
+    require(!o.depth_positive,
+            option("depth_positive") + needs + ": it says the raster stores depth");
+    require(o.bathy_srs.empty(), option("bathy_srs") + needs + ": it is the raster's CRS");
+    require(o.bathy_band == 1, option("bathy_band") + " " + std::to_string(o.bathy_band) + needs +
+                                   ": it picks a band of the raster");
+}
+
 void validate_bathymetry(const BathymetryOptions &o) {
     require(o.bathy_band >= 1, option("bathy_band") + " must be 1 or more");
-    if (o.min_depth_m) {
+    if (o.min_depth_m)
         require(std::isfinite(*o.min_depth_m),
                 option("min_depth_m") + " must be a depth in metres, e.g. 5m");
-        // A depth floor without depths would be ignored without a word.
-        require(!o.bathy.empty(), option("min_depth_m") + " needs " + option("bathy") +
-                                      ": it raises the sampled depths");
-    }
+    require_bathy_for_its_options(o);
 }
 
 } // namespace

@@ -28,6 +28,26 @@ TEST(Options, validate_names_the_fields_a_library_user_set) {
     o = MeshOptions{};
     o.min_depth_m = 5;
     EXPECT_EQ(usage_message(o), "min_depth_m needs bathy: it raises the sampled depths");
+    // The raster's other options without a raster, ignored before without a word.
+    o = MeshOptions{};
+    o.bathy_fill_m = 20;
+    EXPECT_EQ(usage_message(o),
+              "bathy_fill_m needs bathy: it is the depth where the raster has no data");
+    o = MeshOptions{};
+    o.depth_positive = true;
+    EXPECT_EQ(usage_message(o), "depth_positive needs bathy: it says the raster stores depth");
+    o = MeshOptions{};
+    o.bathy_srs = "EPSG:4326";
+    EXPECT_EQ(usage_message(o), "bathy_srs needs bathy: it is the raster's CRS");
+    o = MeshOptions{};
+    o.bathy_band = 2;
+    EXPECT_EQ(usage_message(o), "bathy_band 2 needs bathy: it picks a band of the raster");
+    o.bathy = "shelf.tif"; // with the raster, all of them stand
+    o.bathy_fill_m = 20;
+    o.depth_positive = true;
+    o.bathy_srs = "EPSG:4326";
+    o.min_depth_m = 5;
+    EXPECT_NO_THROW(validate(o));
     o = MeshOptions{};
     o.region = std::array<double, 4>{0, 0, 10, 10};
     o.region_file = "r.gpkg";
