@@ -47,9 +47,10 @@
 // top while reading.
 //
 // Errors: IoError when the file cannot be opened or read; UsageError for a band that does not
-// exist or a bathy_srs that is no CRS; DataError for a raster without georeferencing, with no valid
-// cell, or that does not cover the region (unless bathy_fill_m gives a value for the uncovered
-// part).
+// exist (for a file of several rasters and no band, a NetCDF of several 2-D variables: naming
+// them as GDAL's subdatasets, NETCDF:"file.nc":elevation, to give one as bathy) or a bathy_srs
+// that is no CRS; DataError for a raster without georeferencing, with no valid cell, or that
+// does not cover the region (unless bathy_fill_m gives a value for the uncovered part).
 #pragma once
 
 #include <array>

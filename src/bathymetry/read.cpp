@@ -158,6 +158,30 @@ gdal::SrsRefPtr parse_bathy_srs(const std::string &srs) {
     return parsed;
 }
 
+/// The UsageError for band `band` missing from ds (the file `path`, `nbands` bands). A file of
+/// no band but subdatasets (a NetCDF of several 2-D variables): their names (SUBDATASET_n_NAME,
+/// the first four), to give one as bathy; any other: the band that does not exist.
+UsageError missing_band_error(GDALDatasetH ds, const std::string &path, int band, int nbands) {
+    std::vector<std::string> names;
+    for (char **item = GDALGetMetadata(ds, "SUBDATASETS"); item && *item; ++item) {
+        const std::string s = *item;
+        const std::size_t eq = s.find('=');
+        if (eq != std::string::npos && eq >= 5 && s.compare(eq - 5, 5, "_NAME") == 0)
+            names.push_back(s.substr(eq + 1));
+    }
+    if (nbands > 0 || names.empty())
+        return UsageError(option("bathy_band") + " " + std::to_string(band) + ": " + path +
+                          " has " + std::to_string(nbands) + " band" + (nbands == 1 ? "" : "s"));
+    std::string list;
+    for (std::size_t i = 0; i < std::min<std::size_t>(names.size(), 4); ++i)
+        list += (i ? ", " : "") + names[i];
+    if (names.size() > 4)
+        list += " and " + std::to_string(names.size() - 4) + " more (gdalinfo lists them)";
+    return UsageError(option("bathy") + " " + path + ": holds " + std::to_string(names.size()) +
+                      " rasters (subdatasets), not one; give one of them as " + option("bathy") +
+                      " (in single quotes in a shell): " + list);
+}
+
 /// The name of a CRS and its authority code when it has one: "WGS 84 (EPSG:4326)".
 std::string srs_name(OGRSpatialReferenceH srs) {
     const char *name = OSRGetName(srs);
@@ -459,8 +483,7 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
     GDALDatasetH h = ds.get();
     const int nbands = GDALGetRasterCount(h);
     if (band < 1 || band > nbands)
-        throw UsageError(option("bathy_band") + " " + std::to_string(band) + ": " + path + " has " +
-                         std::to_string(nbands) + " band" + (nbands == 1 ? "" : "s"));
+        throw missing_band_error(h, path, band, nbands);
     GDALRasterBandH src_band = GDALGetRasterBand(h, band);
 
     // The CRS given in place of the file's (--bathy-srs, or lon/lat for CF lon/lat axes) is

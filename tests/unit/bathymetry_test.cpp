@@ -630,8 +630,9 @@ TEST(Bathymetry, without_a_budget_or_a_floor_the_raster_is_read_at_full_resoluti
 
 namespace {
 
-/// A CF grid written with netCDF-C: z(lat, lon) float, coordinate variables lon and lat of the
-/// given type with the given attributes (name, value) each, and no CRS (no grid_mapping).
+/// A CF grid written with netCDF-C: z(lat, lon) float (or variables of the given names, the k-th
+/// z - k), coordinate variables lon and lat of the given type with the given attributes (name,
+/// value) each, and no CRS (no grid_mapping).
 struct CfGrid {
     std::vector<double> lon, lat;
     std::vector<float> z; // row j (lat[j]) after row
@@ -640,16 +641,19 @@ struct CfGrid {
                                                                     {"units", "degrees_east"}};
     std::vector<std::pair<std::string, std::string>> lat_attributes{{"standard_name", "latitude"},
                                                                     {"units", "degrees_north"}};
+    std::vector<std::string> variables{"z"};
 };
 
 void write_cf(const std::string &path, const CfGrid &g) {
-    int nc = -1, dims[2], lon_id, lat_id, z_id;
+    int nc = -1, dims[2], lon_id, lat_id;
     ASSERT_EQ(nc_create(path.c_str(), NC_CLOBBER | NC_64BIT_OFFSET, &nc), NC_NOERR);
     ASSERT_EQ(nc_def_dim(nc, "lat", g.lat.size(), &dims[0]), NC_NOERR);
     ASSERT_EQ(nc_def_dim(nc, "lon", g.lon.size(), &dims[1]), NC_NOERR);
     ASSERT_EQ(nc_def_var(nc, "lat", NC_DOUBLE, 1, &dims[0], &lat_id), NC_NOERR);
     ASSERT_EQ(nc_def_var(nc, "lon", g.lon_type, 1, &dims[1], &lon_id), NC_NOERR);
-    ASSERT_EQ(nc_def_var(nc, "z", NC_FLOAT, 2, dims, &z_id), NC_NOERR);
+    std::vector<int> z_ids(g.variables.size());
+    for (std::size_t k = 0; k < g.variables.size(); ++k)
+        ASSERT_EQ(nc_def_var(nc, g.variables[k].c_str(), NC_FLOAT, 2, dims, &z_ids[k]), NC_NOERR);
     for (const auto &[k, v] : g.lon_attributes)
         nc_put_att_text(nc, lon_id, k.c_str(), v.size(), v.c_str());
     for (const auto &[k, v] : g.lat_attributes)
@@ -657,7 +661,12 @@ void write_cf(const std::string &path, const CfGrid &g) {
     ASSERT_EQ(nc_enddef(nc), NC_NOERR);
     ASSERT_EQ(nc_put_var_double(nc, lat_id, g.lat.data()), NC_NOERR);
     ASSERT_EQ(nc_put_var_double(nc, lon_id, g.lon.data()), NC_NOERR); // netCDF converts to lon_type
-    ASSERT_EQ(nc_put_var_float(nc, z_id, g.z.data()), NC_NOERR);
+    for (std::size_t k = 0; k < g.variables.size(); ++k) {
+        std::vector<float> z = g.z;
+        for (float &v : z)
+            v -= static_cast<float>(k);
+        ASSERT_EQ(nc_put_var_float(nc, z_ids[k], z.data()), NC_NOERR);
+    }
     ASSERT_EQ(nc_close(nc), NC_NOERR);
 }
 
@@ -913,6 +922,66 @@ TEST(Bathymetry, wgs84_lonlat_in_any_spelling_is_read_as_its_cells) {
         EXPECT_NEAR(r.lat0_deg(), truth.lat0_deg(), 1e-12) << v.name;
         EXPECT_EQ(r.values(), truth.values()) << v.name;
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A NetCDF file of several 2-D variables: GDAL opens it with no band, its variables as subdatasets
+
+namespace {
+
+/// The ETOPO5 shelf fixture as a CF grid (write_cf) of 2-D variables of the given names.
+void write_variables(const std::string &path, const std::vector<std::string> &variables) {
+    const std::string source = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpen(source.c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    const int nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
+    double gt[6];
+    GDALGetGeoTransform(ds, gt);
+    CfGrid g;
+    g.variables = variables;
+    g.z.resize(std::size_t(nx) * std::size_t(ny));
+    ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, nx, ny, g.z.data(), nx, ny,
+                           GDT_Float32, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    for (int i = 0; i < nx; ++i)
+        g.lon.push_back(gt[0] + (i + 0.5) * gt[1]);
+    for (int j = 0; j < ny; ++j)
+        g.lat.push_back(gt[3] + (j + 0.5) * gt[5]);
+    write_cf(path, g);
+}
+
+} // namespace
+
+// The fixture as a NetCDF with elevation and source_id (the sweep's shelf_2var.nc) used to be
+// refused as "bathy_band 1: ... has 0 bands". The message names the variables as GDAL opens them
+// (NETCDF:"file":elevation), and one given as bathy reads as the fixture.
+TEST(Bathymetry, a_netcdf_of_several_variables_names_them_as_rasters_to_give) {
+    TempDir dir;
+    const std::string path = (dir / "two.nc").string();
+    write_variables(path, {"elevation", "source_id"});
+    const std::string m =
+        test::thrown_message<UsageError>([&] { read_raster(path); }, "two variables");
+    const std::string elevation = "NETCDF:\"" + path + "\":elevation";
+    EXPECT_EQ(m, "bathy " + path +
+                     ": holds 2 rasters (subdatasets), not one; give one of them as bathy (in "
+                     "single quotes in a shell): " +
+                     elevation + ", NETCDF:\"" + path + "\":source_id");
+    const Raster r = read_raster(elevation),
+                 truth = read_raster(fixture("bathy/etopo5_nwshelf_5min.tif").string());
+    ASSERT_EQ(r.nlon(), truth.nlon());
+    ASSERT_EQ(r.nlat(), truth.nlat());
+    EXPECT_NEAR(r.lon0_deg(), truth.lon0_deg(), 1e-9);
+    EXPECT_NEAR(r.lat0_deg(), truth.lat0_deg(), 1e-9);
+    EXPECT_EQ(r.values(), truth.values());
+    // Six: the first four named, and how many more.
+    const std::string six = (dir / "six.nc").string();
+    write_variables(six, {"a", "b", "c", "d", "e", "f"});
+    const std::string m6 = test::thrown_message<UsageError>([&] { read_raster(six); }, "six");
+    EXPECT_NE(m6.find(":\"" + six + "\":d and 2 more (gdalinfo lists them)"), std::string::npos)
+        << m6;
+    EXPECT_EQ(m6.find(":e"), std::string::npos) << m6;
 }
 
 // Global grids whose last column repeats the first meridian (node registered), from 20 1/6 E
