@@ -249,6 +249,18 @@ DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string &path) {
     return out;
 }
 
+/// The shorter side (degrees) of a geographic raster's cells, 0 for another CRS: another datum or
+/// meridian barely changes it, where the steps finest_lonlat_step samples collapse at a pole
+/// (every longitude there is one point, which a datum shift moves as one).
+double geographic_cell_deg(GDALDatasetH ds) {
+    double gt[6];
+    OGRSpatialReferenceH srs = GDALGetSpatialRef(ds);
+    if (!srs || !OSRIsGeographic(srs) || GDALGetGeoTransform(ds, gt) != CE_None)
+        return 0;
+    const double unit_deg = OSRGetAngularUnits(srs, nullptr) / deg_to_rad;
+    return unit_deg * std::min(std::hypot(gt[1], gt[4]), std::hypot(gt[2], gt[5]));
+}
+
 /// The smallest lon/lat size (degrees) of a source pixel step over a 21 x 21 sample of the
 /// raster, or 0 when it cannot be computed. Warping at this resolution only upsamples, so GDAL's
 /// bilinear kernel stays the plain 2 x 2 one (exact on planes); downsampling widens it.
@@ -292,7 +304,7 @@ double finest_lonlat_step(GDALDatasetH ds) {
 /// where the source has no data or no coverage, at the source's finest pixel size.
 DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
     // All digits: std::to_string's six decimals cut 1/12 degree to 0.083333, 1 arc second by 0.1%.
-    const double step = finest_lonlat_step(ds);
+    const double cell = geographic_cell_deg(ds), step = cell > 0 ? cell : finest_lonlat_step(ds);
     char res[32];
     std::snprintf(res, sizeof res, "%.17g", step);
     StringList argv{"-of", "VRT", "-t_srs", "EPSG:4326", "-r",         "bilinear",

@@ -896,6 +896,36 @@ TEST(Bathymetry, a_nad27_raster_is_moved_to_wgs84) {
         }
 }
 
+// ETOPO5 (the global fixture, averaged to half a degree) labelled ED50 by its Helmert shift to
+// WGS 84: at a pole every longitude is one point, which the shift moves as one, so the warp's
+// cell size sampled there was nothing and GDAL was asked for a -2147483648-cell raster. A
+// geographic raster keeps its own cells' size: read, global, every cell valid, and the grid
+// moved by the shift's 200 m (of its 55 km cells): the median point within 10 m of it.
+TEST(Bathymetry, a_global_raster_on_another_datum_is_warped_at_its_own_cell_size) {
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    TempDir dir;
+    const std::string path = (dir / "ed50.tif").string(), wgs84 = (dir / "wgs84.tif").string();
+    const std::vector<std::string> half = {"-outsize", "720", "360", "-r", "average"};
+    std::vector<std::string> args = half;
+    args.insert(args.end(), {"-a_srs", "+proj=longlat +ellps=intl +towgs84=-87,-98,-121"});
+    translate(source, path, args);
+    translate(source, wgs84, half);
+    const Raster r = read_raster(path), truth = read_raster(wgs84);
+    EXPECT_TRUE(r.global());
+    EXPECT_EQ(r.nlon(), 720u);
+    EXPECT_NEAR(r.dlon_deg(), 0.5, 1e-12);
+    EXPECT_EQ(r.valid_count(), r.values().size());
+    std::mt19937 rng(43);
+    std::uniform_real_distribution<double> ulon(-180, 180), ulat(-80, 80);
+    std::vector<double> off;
+    for (int k = 0; k < 1001; ++k) {
+        const double x = ulon(rng), y = ulat(rng);
+        off.push_back(std::abs(r.elevation_m(x, y) - truth.elevation_m(x, y)));
+    }
+    std::nth_element(off.begin(), off.begin() + 500, off.end());
+    EXPECT_LT(off[500], 10.0);
+}
+
 // WGS 84 lon/lat however it is written stays a plain read of the cells, with no warp: the
 // fixture labelled EPSG:4326, OGC:CRS84, the WGS 84 ellipsoid without a datum (what GDAL's
 // netCDF driver makes of a CF latitude_longitude grid mapping) and the fixture as GDAL writes it
