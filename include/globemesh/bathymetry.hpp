@@ -100,11 +100,19 @@ public:
     bool global() const { return global_; }
     /// Edges of the cells (half a cell beyond the outermost centres), degrees.
     LonLatBounds bounds() const;
-    /// True when (lon, lat) lies inside bounds() (longitude taken modulo 360).
+    /// True when (lon, lat) lies inside bounds(), or less than edge_margin of a cell past them
+    /// (longitude taken modulo 360).
     bool contains(double lon_deg, double lat_deg) const;
 
-    /// Bilinear value at (lon, lat) in degrees, any longitude; NaN outside or without data.
+    /// Bilinear value at (lon, lat) in degrees, any longitude (the edge cells' values up to
+    /// edge_margin of a cell past bounds()); NaN outside or without data.
     double sample(double lon_deg, double lat_deg) const;
+
+    /// How far past its edges (cells) a raster is read, at its edge cells' values: a region's
+    /// open edge along a parallel is great-circle arcs between nodes on it, which sag past a
+    /// raster cut to the region (ETOPO5 cut at 62N, a mesh at 60 km: nodes 0.0002-0.0008 degree
+    /// past it, a twentieth of a 10' cell at most).
+    static constexpr double edge_margin = 0.25;
 
     /// Elevation at a point, metres positive up: sample(), or the fill where that is NaN.
     double elevation_m(double lon_deg, double lat_deg) const;
@@ -124,6 +132,9 @@ private:
     std::size_t nlon_ = 0, nlat_ = 0;
     bool global_ = false;
     double v_lo_ = 0, v_hi_ = 0; ///< valid row positions (cell units from row 0)
+    /// A non-global raster's column position of lon (cell units from column 0), taken from
+    /// edge_margin of a cell west of its west edge round to 360 degrees further.
+    double column_of(double lon_deg) const;
     std::vector<float> values_;
     std::optional<double> fill_;
 };

@@ -32,10 +32,11 @@ Raster::Raster(double lon0_deg, double lat0_deg, double dlon_deg, double dlat_de
     if (!(dlon_ > 0) || !(dlat_ != 0) || !std::isfinite(lon0_) || !std::isfinite(lat0_))
         throw DataError("raster grid: spacing must be dlon > 0 and dlat != 0 degrees");
     global_ = std::abs(static_cast<double>(nlon_) * dlon_ - 360.0) <= 1e-6 * dlon_;
-    // Rows are valid from half a cell before the first to half a cell after the last; a global
-    // grid whose edge row lies within one cell of a pole holds that row up to the pole.
-    v_lo_ = -0.5 - 1e-9;
-    v_hi_ = static_cast<double>(nlat_) - 0.5 + 1e-9;
+    // Rows are valid from half a cell before the first to half a cell after the last, and
+    // edge_margin beyond; a global grid whose edge row lies within one cell of a pole holds that
+    // row up to the pole.
+    v_lo_ = -0.5 - edge_margin - 1e-9;
+    v_hi_ = static_cast<double>(nlat_) - 0.5 + edge_margin + 1e-9;
     if (global_) {
         for (double pole : {-90.0, 90.0}) {
             double v = (pole - lat0_) / dlat_;
@@ -63,10 +64,13 @@ bool Raster::contains(double lon, double lat) const {
         return false;
     if (global_)
         return true;
-    double west = lon0_ - 0.5 * dlon_;
-    double u =
-        (west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_ - lon0_) / dlon_;
-    return u <= static_cast<double>(nlon_) - 0.5 + 1e-9;
+    return column_of(lon) <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9;
+}
+
+double Raster::column_of(double lon) const {
+    const double from = lon0_ - (0.5 + edge_margin) * dlon_;
+    const double l = from + positive_mod(lon - from + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_;
+    return (l - lon0_) / dlon_;
 }
 
 namespace {
@@ -101,13 +105,8 @@ double Raster::sample(double lon, double lat) const {
         i1 = i0 + 1 == nlon_ ? 0 : i0 + 1;
         fu = u - fl;
     } else {
-        double west = lon0_ - 0.5 * dlon_;
-        // Bring lon into [west, west + 360), keeping the west edge itself inside.
-        double l = lon;
-        if (l < west - 1e-9 * dlon_ || l >= west + 360.0)
-            l = west + positive_mod(lon - west + 1e-9 * dlon_, 360.0) - 1e-9 * dlon_;
-        double u = (l - lon0_) / dlon_;
-        if (u > n_lon - 0.5 + 1e-9)
+        const double u = column_of(lon);
+        if (u > n_lon - 0.5 + edge_margin + 1e-9)
             return nan_value;
         bracket(u, nlon_, i0, i1, fu);
     }

@@ -17,7 +17,9 @@
 #include <thread>
 #include <vector>
 
+#include <cpl_string.h>
 #include <gdal.h>
+#include <gdal_utils.h>
 #include <netcdf.h>
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
@@ -1756,6 +1758,39 @@ void add_box_layer(const std::string &path, const char *name, double w, double s
 }
 
 } // namespace
+
+// ETOPO5 cut to the region's box (gdal_translate -projwin -12 62 13 46, the sweep's g_regcut):
+// the box's open edge along 62N is great-circle arcs between nodes on it, 0.0002-0.0008 degree
+// past the raster's edge, and the run was refused ("the ocean of --region reaches lon 4.87, lat
+// 62.00022"). A raster is read a quarter of a cell past its edges (Raster::edge_margin): the
+// run meshes, every node with a depth, ADCIRC's fort.14 written.
+TEST(Cli, a_raster_cut_to_the_region_box_covers_the_mesh) {
+    TempDir dir;
+    const fs::path cut = dir / "cut.tif";
+    GDALAllRegister();
+    char **argv = CSLAddString(nullptr, "-projwin");
+    for (const char *a : {"-12", "62", "13", "46"})
+        argv = CSLAddString(argv, a);
+    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv, nullptr);
+    CSLDestroy(argv);
+    GDALDatasetH src = GDALOpen(fixture("bathy/etopo5_global_10min.nc").c_str(), GA_ReadOnly);
+    ASSERT_NE(src, nullptr);
+    GDALDatasetH out = GDALTranslate(cut.c_str(), src, opts, nullptr);
+    GDALTranslateOptionsFree(opts);
+    GDALClose(src);
+    ASSERT_NE(out, nullptr);
+    GDALClose(out);
+    const Result r =
+        run({"mesh", "--coast", coast, "--coast-layer", "land", "--bathy", cut.string(), "--region",
+             "-12,46,13,62", "--hmax", "60km", "--hmin", "5km", "-o", (dir / "m.nc").string(), "-o",
+             (dir / "fort.14").string(), "-q"},
+            globemesh::library_calls());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::vector<double> depth = nc_doubles(dir / "m.nc", "depth");
+    ASSERT_FALSE(depth.empty());
+    EXPECT_TRUE(std::all_of(depth.begin(), depth.end(), [](double d) { return std::isfinite(d); }));
+    EXPECT_TRUE(fs::exists(dir / "fort.14"));
+}
 
 TEST(Cli, region_layer_picks_one_layer_of_a_region_file) {
     TempDir dir;

@@ -128,10 +128,17 @@ TEST(Bathymetry, linear_slope_is_exact_at_nodes_and_inside_cells) {
         double lon = ulon(rng), lat = ulat(rng);
         EXPECT_NEAR(r.elevation_m(lon, lat), plane(lon, lat), 1e-9) << lon << " " << lat;
     }
-    // Half a cell beyond the outermost centres holds the edge; farther is outside.
+    // Half a cell beyond the outermost centres holds the edge, and a quarter of a cell past the
+    // cells' edges (Raster::edge_margin); farther is outside.
     EXPECT_NEAR(r.elevation_m(10.1, 45.25), plane(10.25, 45.25), 1e-9);
-    EXPECT_TRUE(std::isnan(r.elevation_m(9.9, 45.0)));
-    EXPECT_TRUE(std::isnan(r.elevation_m(15.0, 50.1)));
+    EXPECT_NEAR(r.elevation_m(9.9, 45.25), plane(10.25, 45.25), 1e-9);
+    EXPECT_NEAR(r.elevation_m(15.25, 50.1), plane(15.25, 49.75), 1e-9);
+    EXPECT_NEAR(r.elevation_m(20.6, 42.6), plane(20.25, 42.75), 1e-9);
+    EXPECT_TRUE(r.contains(9.9, 45.0) && r.contains(20.6, 42.6));
+    EXPECT_TRUE(std::isnan(r.elevation_m(9.85, 45.0)));
+    EXPECT_TRUE(std::isnan(r.elevation_m(15.0, 50.15)));
+    EXPECT_TRUE(std::isnan(r.elevation_m(20.65, 45.0)));
+    EXPECT_FALSE(r.contains(9.85, 45.0) || r.contains(15.0, 50.15));
     EXPECT_TRUE(std::isnan(r.elevation_m(-165.0, 45.0)));
 }
 
