@@ -64,6 +64,9 @@ std::vector<Box> near_boxes(const std::array<double, 4> &near,
 /// feature (a region of open sea) the layer is read whole only up to a first polygon or line,
 /// so that a layer of no features, or of points only, gets the errors below as without a
 /// region. Line layers are read whole: their lines close into land only together.
+/// `where` goes to OGR in parentheses; a failure GDAL reports while reading (a filter that
+/// fails only inside the spatial filter's statement) is a UsageError naming coast_where, or
+/// without one an IoError: never a partial read.
 /// max_bytes (0: no limit): the layer's vertices are counted while they are read; once they
 /// pass max_bytes / coast_bytes_per_vertex nothing more is kept (memory stays bounded by one
 /// feature), the rest is only counted, and a DataError names the layer, the count and

@@ -358,6 +358,21 @@ std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near
                : near_boxes(near);
 }
 
+/// Throws when GDAL reported a failure since the last reset (a reading loop's end: its
+/// GetNextFeature returned null on an error, not at the end of the layer, or skipped a feature),
+/// naming the filter when there is one: the features read so far are not the layer's.
+void throw_if_read_failed(const std::string &where, const ErrorText &where_msg) {
+    if (CPLGetLastErrorType() < CE_Failure)
+        return;
+    if (!where.empty())
+        throw UsageError(option("coast_where") + " '" + where + "' failed on " + where_msg + ": " +
+                         gdal::last_error() +
+                         "; give one SQL expression on the layer's fields, without ';' or a "
+                         "comment");
+    throw IoError(where_msg + ": reading failed (" + gdal::last_error() +
+                  "); check the file, or convert it with ogr2ogr");
+}
+
 } // namespace
 
 std::vector<Box> near_boxes(const std::array<double, 4> &near, double x_min, double x_max) {
@@ -386,9 +401,13 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     Source src;
     src.layer = OGR_L_GetName(layer);
     const ErrorText where_msg = option(field) + " " + path + " layer '" + src.layer + "'";
-    if (!where.empty() && OGR_L_SetAttributeFilter(layer, where.c_str()) != OGRERR_NONE)
+    // In parentheses: SQLite drivers (GeoPackage) paste the filter into their statement, which
+    // ignored text after a ';' or in a '--' comment alone and failed on it with a region's
+    // spatial filter; parenthesized it fails alike with or without one.
+    if (!where.empty() &&
+        OGR_L_SetAttributeFilter(layer, ("(" + where + ")").c_str()) != OGRERR_NONE)
         throw UsageError(option("coast_where") + " '" + where + "' is not a valid filter for " +
-                         where_msg + ": " + CPLGetLastErrorMsg());
+                         where_msg + ": " + gdal::last_error());
 
     SrsPtr source_srs = source_crs(layer, srs_override, where_msg, field);
     SrsPtr wgs84(OSRNewSpatialReference(nullptr));
@@ -444,6 +463,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             if (fid == OGRNullFID || seen.insert(fid).second)
                 take(f.get());
         }
+        throw_if_read_failed(where, where_msg);
     }
     // Whole, without a region or with nothing near it; then only up to a first polygon or
     // line (a region of open sea reads no more), for the errors below to be the whole layer's.
@@ -455,6 +475,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             if (!boxes.empty() && (!src.polygons.empty() || !src.lines.empty()))
                 break;
         }
+        throw_if_read_failed(where, where_msg);
     }
     if (too_many)
         throw DataError(where_msg + " has " + std::to_string(vertices) +
@@ -465,9 +486,6 @@ Source read_source(const std::string &path, const std::string &layer_name, const
                         option("max_memory_bytes") +
                         ", or simplify the layer first (e.g. "
                         "ogr2ogr -simplify 0.001)");
-    if (src.features == 0 && !where.empty() && CPLGetLastErrorType() >= CE_Failure)
-        throw UsageError(option("coast_where") + " '" + where + "' failed on " + where_msg + ": " +
-                         CPLGetLastErrorMsg());
     if (src.features == 0)
         throw DataError(where_msg + " has no features" +
                         (where.empty() ? ErrorText("") : " matching " + option("coast_where")) +

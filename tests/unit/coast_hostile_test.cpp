@@ -588,6 +588,35 @@ TEST(CoastHostile, bad_attribute_filter_is_a_usage_error) {
     EXPECT_NE(m.find("no features"), std::string::npos) << m;
 }
 
+// Found by a sweep on DCW: GeoPackage ran a filter ending in ';' (or a '--' comment) without a
+// spatial filter, but failed on it inside a region's; the failure ended the read with no
+// feature, the layer was read again unfiltered up to a first polygon, and the rest of the land
+// in the region became sea (Aland: 17 faces on land, exit 0). Now an error, with or without one.
+TEST(CoastHostile, a_filter_that_fails_inside_the_region_read_is_a_usage_error) {
+    MeshOptions o = options_for(globemesh::test::fixture("coast/ne_110m_land.gpkg").string());
+    o.coast_layer = "land";
+    for (const std::string where :
+         {"scalerank < 9;", "scalerank < 9 -- a comment", "1=1; DROP TABLE land"}) {
+        for (const bool region : {true, false}) {
+            if (region)
+                o.region = {{5, 53, 25, 66}}; // the Baltic
+            else
+                o.region.reset();
+            o.coast_where = where;
+            const std::string m =
+                test::thrown_message<UsageError>([&] { load_coast(o); }, "load_coast");
+            EXPECT_EQ(m.rfind("coast_where '" + where + "' failed on coast ", 0), 0u) << m;
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        }
+    }
+    // The same filter without them reads all the land in the region.
+    o.region = {{5, 53, 25, 66}};
+    o.coast_where = "scalerank < 9";
+    const CoastData filtered = load_coast(o);
+    o.coast_where = "";
+    EXPECT_NEAR(filtered.ocean_area_km2, load_coast(o).ocean_area_km2, 1.0);
+}
+
 TEST(CoastHostile, longitude_far_beyond_the_antimeridian_is_refused_at_once) {
     // Found by fuzz_coast: a vertex at lon 8.9e57 made the antimeridian cut loop once per 360
     // degrees. A ring drawn across the seam needs one wrap (lon 190, or [0, 360)); one beyond
