@@ -13,14 +13,15 @@
 //      GIS operations run in planar lon/lat with GEOS (where they are planar by nature); the
 //      rings then become great-circle polylines (planar edges longer than 0.5 degree are first
 //      densified in lon/lat) and are verified on the sphere.
-//   2. shape_boundary(): drop islands (and closed water bodies) smaller than
-//      options.min_island_triangles equilateral triangles of the local size; find each ring's
-//      corners at the scale of h (Douglas-Peucker on the sphere with tolerance h/2, nodes closer
-//      than h/2 thinned, then the nodes where that line turns by more than 40 degrees, at least
-//      h/2 apart); simplify again to 0.3 h and cut each run of that line between corners into
-//      equal pieces of about h(x) (boundary nodes lie within about 0.3 h of the source); make
-//      an original node a corner wherever a resampled arc would touch or cross another arc
-//      (topology preserved: rings never cross, islands never merge).
+//   2. shape_boundary(): drop islands (and holes of a region's outline, and closed water
+//      bodies) smaller than options.min_island_triangles equilateral triangles of the local
+//      size; find each ring's corners at the scale of h (Douglas-Peucker on the sphere with
+//      tolerance h/2, nodes closer than h/2 thinned, then the nodes where that line turns by
+//      more than 40 degrees, at least h/2 apart); simplify again to 0.3 h and cut each run of
+//      that line between corners into equal pieces of about h(x) (boundary nodes lie within
+//      about 0.3 h of the source); make an original node a corner wherever a resampled arc
+//      would touch or cross another arc (topology preserved: rings never cross, islands never
+//      merge).
 //
 // Invariants of every Boundary returned (boundary.hpp): rings closed, >= 3 nodes, no two
 // consecutive nodes equal or antipodal, rings simple and mutually non-crossing as great-circle

@@ -240,9 +240,10 @@ template <class H>
 std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
                                          const CoastOptions &options, CoastReport &rep,
                                          std::vector<std::vector<Vec3>> &dropped_islands) {
-    // 1. Small rings: islands (land on the right smaller than a few triangles) and enclosed
-    //    water bodies (ocean on the left that small, also a pocket of water that land cuts off
-    //    at a region's edge); the land outside a region's outline is never an island.
+    // 1. Small rings: islands (land on the right smaller than a few triangles, or as small a
+    //    hole in a region's outline: kept, a thin one came out of resampling as a triangle the
+    //    other way round) and enclosed water bodies (ocean on the left that small, also a pocket
+    //    of water that land cuts off at a region's edge).
     const double r2 = earth_radius_km * earth_radius_km;
     std::vector<ShapedRing> shaped;
     bool dropped_water = false;
@@ -265,8 +266,6 @@ std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
         s.h_rad.reserve(ring.nodes.size());
         for (const auto &v : ring.nodes)
             s.h_rad.push_back(h_at(v));
-        bool has_open = std::any_of(ring.kinds.begin(), ring.kinds.end(),
-                                    [](SegmentKind k) { return k == SegmentKind::open; });
         if (options.min_island_triangles > 0 && r != largest_open) {
             const double left = left_of[r];
             Vec3 sum{};
@@ -281,7 +280,7 @@ std::vector<ShapedRing> drop_small_rings(const CoastData &coast, const H &h_at,
                     dropped_water = true;
                     continue;
                 }
-            } else if (!has_open && 4 * pi - left < threshold) {
+            } else if (4 * pi - left < threshold) {
                 ++rep.islands_removed;
                 rep.area_gained_km2 += (4 * pi - left) * r2;
                 dropped_islands.push_back(ring.nodes);

@@ -73,6 +73,44 @@ TEST(CoastReal, an_islet_a_fraction_of_a_metre_off_the_mainland_meshes) {
     expect_valid_mesh(mesh, o, "strait.nc");
 }
 
+/// Whether a face of the mesh holds the point (on its edges counts).
+bool covered(const Mesh &mesh, const Vec3 &p) {
+    return std::any_of(mesh.faces.begin(), mesh.faces.end(), [&](const auto &f) {
+        const Vec3 &a = mesh.nodes[f[0]], &b = mesh.nodes[f[1]], &c = mesh.nodes[f[2]];
+        const double s[3] = {dot(cross(a, b), p), dot(cross(b, c), p), dot(cross(c, a), p)};
+        return (s[0] >= 0 && s[1] >= 0 && s[2] >= 0) || (s[0] <= 0 && s[1] <= 0 && s[2] <= 0);
+    });
+}
+
+/// Whether a boundary edge of the mesh has an end in the lon/lat box W, S, E, N.
+bool boundary_in(const Mesh &mesh, const std::array<double, 4> &box) {
+    auto inside = [&](NodeIndex n) {
+        const LonLat p = vec_to_lonlat(mesh.nodes[n]);
+        return p.lon > box[0] && p.lat > box[1] && p.lon < box[2] && p.lat < box[3];
+    };
+    return std::any_of(mesh.boundary.begin(), mesh.boundary.end(),
+                       [&](const BoundaryEdge &e) { return inside(e.a) || inside(e.b); });
+}
+
+// DCW's Denmark buffered 0.02 degrees as the region, GSHHG intermediate as the coast, at 5 km:
+// the region has a hole of 1.8 km2 in the water off Helnaes, a thin crescent. Unlike an island
+// that small, a hole in a region's outline was kept; resampled to three nodes it came out the
+// other way round, and the mesher stopped ("a boundary ring has the ocean on its right near lon
+// 10.1083, lat 55.1651"; at 8, 10 and 15 km elsewhere on Denmark's outline, after f4707a6 kept
+// more of the open rings' nodes). Smaller than a few triangles, it is meshed over as such an
+// island is: no boundary is left in it.
+TEST(CoastReal, a_region_hole_smaller_than_a_few_triangles_is_meshed_over_as_an_island_is) {
+    MeshOptions o;
+    o.coast = test::fixture("coast/hostile/gshhg_i_south_funen.geojson").string();
+    o.region_file = test::fixture("regions/dcw_denmark_buffer_0.02_south_funen.geojson").string();
+    o.hmax_km = 5;
+    const Mesh mesh = mesh_ocean(o).mesh;
+    EXPECT_FALSE(boundary_in(mesh, {10.0487, 55.1495, 10.1158, 55.1652})); // the hole's box
+    EXPECT_TRUE(covered(mesh, lonlat_to_vec({10.1035, 55.1573})));         // inside the hole
+    EXPECT_FALSE(covered(mesh, lonlat_to_vec({9.92, 55.1})));              // water off the region
+    expect_valid_mesh(mesh, o, "south_funen.nc");
+}
+
 // GSHHG full resolution of the Sogn coast (western Norway), clipped to a lon/lat box and stored
 // in UTM 32N (EPSG:25832) as a shapefile, meshed with that box as --region: the land runs
 // along the region's outline, an island closes a notch of water against it, and every size
