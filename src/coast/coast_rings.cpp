@@ -74,18 +74,31 @@ public:
             if (p.lat == q.lat && (p.lat == clip_.s || p.lat == clip_.n))
                 return EdgeKind::open;
         } else if (clip_.boundary) {
-            for (const LonLat &m : {p, q, LonLat{0.5 * (p.lon + q.lon), 0.5 * (p.lat + q.lat)}}) {
-                GEOSCoordSequence *seq = GEOSCoordSeq_create_r(geos_.get(), 1, 2);
-                GEOSCoordSeq_setXY_r(geos_.get(), seq, 0, m.lon, m.lat);
-                GeomPtr pt = own(geos_, GEOSGeom_createPoint_r(geos_.get(), seq), "build a point");
-                double d = 1;
-                GEOSPreparedDistance_r(geos_.get(), clip_.boundary, pt.get(), &d);
-                if (d > snap_grid_deg)
-                    return EdgeKind::coast; // noded at a hot pixel: still the outline
-            }
+            for (const LonLat &m : {p, q, LonLat{0.5 * (p.lon + q.lon), 0.5 * (p.lat + q.lat)}})
+                if (!on_outline(m))
+                    return EdgeKind::coast;
             return EdgeKind::open;
         }
         return EdgeKind::coast;
+    }
+
+    /// Whether a point lies on the region file's outline (within a snap cell: an edge noded at
+    /// a hot pixel is still the outline).
+    bool on_outline(const LonLat &m) const {
+        GEOSCoordSequence *seq = GEOSCoordSeq_create_r(geos_.get(), 1, 2);
+        GEOSCoordSeq_setXY_r(geos_.get(), seq, 0, m.lon, m.lat);
+        GeomPtr pt = own(geos_, GEOSGeom_createPoint_r(geos_.get(), seq), "build a point");
+        double d = 1;
+        GEOSPreparedDistance_r(geos_.get(), clip_.boundary, pt.get(), &d);
+        return d <= snap_grid_deg;
+    }
+
+    /// The kind of the seam from lat a to lat b with ocean on one side only (on its +180 side
+    /// when `ocean_west`): coast, unless a region file ends at the seam there (its outline does
+    /// not reach the other side).
+    SegmentKind seam_kind(double a, double b, bool ocean_west) const {
+        const LonLat other{ocean_west ? -180.0 : 180.0, 0.5 * (a + b)};
+        return clip_.boundary && !on_outline(other) ? SegmentKind::open : SegmentKind::coast;
     }
 
     /// Adds one ring of an ocean polygon (closed, oriented with the ocean on the left). Returns
@@ -214,12 +227,14 @@ private:
         for (std::size_t k = 0; k + 1 < lats.size(); ++k) {
             run += net[k];
             for (long c = 0; c < std::abs(run); ++c) {
-                // Ocean on one side of the seam only: a (data) coast along the meridian.
+                // Ocean on one side of the seam only: a (data) coast along the meridian, or
+                // where a region file ends there its open edge. Going north the ocean on the
+                // left is on the +180 side.
                 Chain ch;
                 LonLat lo{180.0, lats[k]}, hi{180.0, lats[k + 1]};
                 ch.pts.push_back(run > 0 ? lo : hi);
                 append_densified(ch.pts, ch.kinds, run > 0 ? lo : hi, run > 0 ? hi : lo,
-                                 SegmentKind::coast);
+                                 seam_kind(lats[k], lats[k + 1], run > 0));
                 chains_.push_back(std::move(ch));
             }
         }
@@ -323,7 +338,7 @@ GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_m
                                 max_memory_bytes);
     std::vector<GeomPtr> rparts;
     for (const auto &poly : region.polygons)
-        rparts.push_back(make_valid(geos, make_polygon(geos, poly).get()));
+        add_wrapped(geos, make_valid(geos, make_polygon(geos, poly).get()), rparts);
     if (rparts.empty())
         throw DataError(option("region_file") + " " + options.region_file + " holds no polygons");
     GeomPtr all = make_collection(geos, rparts);
@@ -335,7 +350,9 @@ GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_m
     outline = own(geos, GEOSBoundary_r(geos.get(), domain.get()), "take the region outline");
     prepared_outline.reset(GEOSPrepare_r(geos.get(), outline.get()));
     clip.boundary = prepared_outline.get();
-    clip.seam_glued = false; // the outline along +-180 is the user's region edge
+    // The region's pieces either side of +-180 join there (a polygon across it, or round a
+    // pole); where it ends at the seam, the seam is open (seam_kind).
+    clip.seam_glued = true;
     return domain;
 }
 

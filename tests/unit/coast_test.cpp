@@ -500,6 +500,78 @@ TEST(Coast, region_file_in_a_projected_crs_bounds_the_ocean_with_open_edges) {
     expect_valid(shape_boundary(d, uniform(30), o));
 }
 
+/// A GeoJSON file in `dir` holding one feature of `geometry` (lon/lat, or `crs` when given).
+std::string geojson_file(const globemesh::test::TempDir &dir, const std::string &name,
+                         const std::string &geometry, const std::string &crs = "") {
+    const std::string path = (dir / name).string();
+    std::ofstream(path) << "{\"type\":\"FeatureCollection\","
+                        << (crs.empty() ? ""
+                                        : "\"crs\":{\"type\":\"name\",\"properties\":{\"name\":\"" +
+                                              crs + "\"}},")
+                        << "\"features\":[{\"type\":\"Feature\",\"properties\":{},"
+                        << "\"geometry\":" << geometry << "}]}";
+    return path;
+}
+
+/// Segments of `b` of kind `kind` that run along the +-180 meridian.
+std::size_t seam_segments(const Boundary &b, SegmentKind kind) {
+    std::size_t n = 0;
+    for (const auto &r : b.rings)
+        for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+            const LonLat p = vec_to_lonlat(r.nodes[i]),
+                         q = vec_to_lonlat(r.nodes[(i + 1) % r.nodes.size()]);
+            n += r.kinds[i] == kind && std::abs(std::abs(p.lon) - 180) < 1e-9 &&
+                 std::abs(std::abs(q.lon) - 180) < 1e-9;
+        }
+    return n;
+}
+
+// A --region-file polygon across +-180 (lon 170 to 190, or two polygons split at 180), or round
+// the North Pole in lon/lat (north of 65N, two of its sides on the seam), bounds the ocean of the
+// same --region box: its pieces either side of the seam join there, as the box's do. The seam's
+// two sides were open edges on one meridian: refused as an outline along the coast (the cap,
+// the split polygons) or the part past 180 dropped (found by a sweep). A region that ends at 180
+// keeps its side there open.
+TEST(Coast, a_region_file_across_the_antimeridian_or_round_a_pole_bounds_the_box_ocean) {
+    globemesh::test::TempDir dir;
+    const std::string fiji_box = "[[170,-25],[180,-25],[180,-10],[170,-10],[170,-25]]";
+    const std::string tonga_box = "[[-180,-25],[-170,-25],[-170,-10],[-180,-10],[-180,-25]]";
+    struct Case {
+        std::string name, geometry;
+        std::array<double, 4> box;
+    };
+    for (
+        const Case &c :
+        {Case{
+             "past_180.geojson",
+             R"({"type":"Polygon","coordinates":[[[170,-25],[190,-25],[190,-10],[170,-10],[170,-25]]]})",
+             {170, -25, -170, -10}},
+         Case{"split.geojson",
+              R"({"type":"MultiPolygon","coordinates":[[)" + fiji_box + "],[" + tonga_box + "]]}",
+              {170, -25, -170, -10}},
+         Case{
+             "cap.geojson",
+             R"({"type":"Polygon","coordinates":[[[-180,65],[180,65],[180,90],[-180,90],[-180,65]]]})",
+             {-180, 65, 180, 90}},
+         Case{"to_180.geojson",
+              R"({"type":"Polygon","coordinates":[)" + fiji_box + "]}",
+              {170, -25, 180, -10}}}) {
+        SCOPED_TRACE(c.name);
+        MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+        o.region = c.box;
+        const CoastData box = load_coast(o);
+        o.region.reset();
+        o.region_file = geojson_file(dir, c.name, c.geometry);
+        const CoastData file = load_coast(o);
+        expect_valid(file.rings);
+        EXPECT_NEAR(file.ocean_area_km2, box.ocean_area_km2, 1e-6 * box.ocean_area_km2);
+        EXPECT_EQ(file.rings.rings.size(), box.rings.rings.size());
+        EXPECT_EQ(seam_segments(file.rings, SegmentKind::open),
+                  seam_segments(box.rings, SegmentKind::open));
+        expect_valid(shape_boundary(file, uniform(50), o));
+    }
+}
+
 // The land itself, reprojected to Equal Earth and back, as the region: the region's outline runs
 // along the coast everywhere, a few micro-degrees off it. An outline that follows the coast is
 // land where it is on land (issue 37), so no sliver of ocean is left between them: the region is
