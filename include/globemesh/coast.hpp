@@ -31,6 +31,9 @@
 // Input rules: the layer is --coast-layer, else the only polygon or line layer of the source
 // (else a DataError listing the layers); --coast-srs, when given, overrides the layer's CRS;
 // polygons drawn with longitudes beyond +-180 are cut there and wrapped back by 360 degrees.
+// A polygon ring reprojected from a CRS that holds a pole as a point (polar stereographic) that
+// goes round the pole, or through it at whatever longitude the projection gives it, is closed
+// through it along lat +-90, as Antarctica is drawn in lon/lat.
 // Coastline lines are merged at shared ends; a line whose ends lie within 0.001 degree of the
 // seam is closed along it (same side) or through the nearer pole (opposite sides, Antarctica);
 // a gap of at most 0.5 degree is closed straight; any other open line is a DataError. Land is

@@ -15,6 +15,7 @@
 #include "coast_parallel.hpp"
 #include "disjoint_sets.hpp"
 #include "globemesh/error.hpp"
+#include "pole_rings.hpp"
 
 namespace globemesh::coast_detail {
 namespace {
@@ -314,15 +315,10 @@ GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const 
                                 std::to_string(b.lat) +
                                 ") is not closed and does not end on the +-180 meridian; give "
                                 "closed coastlines or land polygons");
-            if (a.lon != b.lon) {
-                double mean = 0;
-                for (const auto &p : pts)
-                    mean += p.lat;
-                double pole = mean < 0 ? -90.0 : 90.0;
-                pts.push_back({b.lon, pole});
-                pts.push_back({a.lon, pole});
-            }
-            pts.push_back(a);
+            if (a.lon != b.lon)
+                detail::close_through_pole(pts, detail::nearer_pole(pts)); // as Antarctica
+            else
+                pts.push_back(a);
         }
         if (pts.size() < 4)
             continue;

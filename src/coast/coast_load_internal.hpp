@@ -51,7 +51,9 @@ std::vector<Box> near_boxes(const std::array<double, 4> &near,
                             double x_min = -std::numeric_limits<double>::infinity(),
                             double x_max = std::numeric_limits<double>::infinity());
 
-/// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order).
+/// Reads every polygon and line of a layer of `path` in lon/lat (WGS84, GIS axis order); from a
+/// CRS that holds a pole as a point, a polygon's ring round or through the pole is closed
+/// through it (pole_rings.hpp: its longitudes may then pass +-180, for add_wrapped).
 /// `field` is the option whose file it is, named in messages ("coast" or "region_file"; its
 /// layer option is "coast_layer" or "region_layer"). With `near` (a region
 /// W,S,E,N) a polygon layer is read through OGR's spatial filter: only the features whose

@@ -20,6 +20,7 @@
 #include "coast_load_internal.hpp"
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
+#include "pole_rings.hpp"
 
 namespace globemesh::coast_detail {
 namespace {
@@ -150,13 +151,18 @@ PointList read_points(OGRGeometryH g, bool transformed) {
     return pts;
 }
 
-void collect_geometry(OGRGeometryH g, bool transformed, Source &out) {
+/// How a geometry reached lon/lat: as stored, or reprojected from a CRS (one that holds a pole as
+/// a point, where a ring may go round or through it: pole_rings.hpp).
+enum class Reprojected { no, yes, from_pole_point };
+
+void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
+    const bool transformed = how != Reprojected::no;
     if (!g || OGR_G_IsEmpty(g))
         return;
     OGRwkbGeometryType t = wkbFlatten(OGR_G_GetGeometryType(g));
     if (OGR_GT_IsNonLinear(t)) {
         OgrGeometryPtr linear(OGR_G_GetLinearGeometry(g, 0, nullptr));
-        collect_geometry(linear.get(), transformed, out);
+        collect_geometry(linear.get(), how, out);
         return;
     }
     switch (t) {
@@ -167,6 +173,10 @@ void collect_geometry(OGRGeometryH g, bool transformed, Source &out) {
             if (!ring.empty() &&
                 (ring.front().lon != ring.back().lon || ring.front().lat != ring.back().lat))
                 ring.push_back(ring.front());
+            // Round or through a pole of a polar CRS: closed through it along lat +-90
+            // (add_wrapped takes what passes +-180).
+            if (how == Reprojected::from_pole_point)
+                detail::close_at_pole(ring);
             if (ring.size() < 4) {
                 if (i == 0)
                     return; // degenerate shell: no polygon
@@ -191,7 +201,7 @@ void collect_geometry(OGRGeometryH g, bool transformed, Source &out) {
         return;
     default:
         for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
-            collect_geometry(OGR_G_GetGeometryRef(g, i), transformed, out);
+            collect_geometry(OGR_G_GetGeometryRef(g, i), how, out);
     }
 }
 
@@ -425,6 +435,10 @@ Source read_source(const std::string &path, const std::string &layer_name, const
         near && is_polygon_type(OGR_L_GetGeomType(layer))
             ? filter_boxes(layer, *near, transform.get(), wgs84.get(), source_srs.get())
             : std::vector<Box>{};
+    const Reprojected how = !transform ? Reprojected::no
+                            : detail::holds_a_pole_as_a_point(source_srs.get())
+                                ? Reprojected::from_pole_point
+                                : Reprojected::yes;
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;
@@ -448,9 +462,9 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
                                 " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
-            collect_geometry(copy.get(), true, src);
+            collect_geometry(copy.get(), how, src);
         } else {
-            collect_geometry(g, false, src);
+            collect_geometry(g, Reprojected::no, src);
         }
     };
     // Through each box, a feature met by two read once.

@@ -1,8 +1,6 @@
 // Hostile coast inputs, written as small GeoJSON/CSV files into a temporary directory: each is
 // repaired into valid rings (checked by an independent brute force and by area oracles) or
 // refused with a one-line UsageError / DataError / IoError, never a crash.
-#include <gdal.h>
-#include <gdal_utils.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -489,19 +487,7 @@ TEST(CoastHostile, a_local_crs_counts_as_none) {
     const std::string csv =
         write(dir, "local.csv", "WKT,name\n\"POLYGON ((0 0,10 0,10 10,0 10,0 0))\",a\n");
     const std::string shp = (dir / "local.shp").string();
-    {
-        GDALAllRegister();
-        GDALDatasetH src = GDALOpenEx(csv.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
-        ASSERT_NE(src, nullptr);
-        const char *argv[] = {"-a_srs", "LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]", nullptr};
-        GDALVectorTranslateOptions *opts =
-            GDALVectorTranslateOptionsNew(const_cast<char **>(argv), nullptr);
-        GDALDatasetH out = GDALVectorTranslate(shp.c_str(), nullptr, 1, &src, opts, nullptr);
-        GDALVectorTranslateOptionsFree(opts);
-        ASSERT_NE(out, nullptr);
-        GDALClose(out);
-        GDALClose(src);
-    }
+    ASSERT_TRUE(test::ogr2ogr(csv, shp, {"-a_srs", "LOCAL_CS[\"unnamed\",UNIT[\"unknown\",1]]"}));
     MeshOptions o = options_for(shp);
     auto m = message_of<DataError>(o);
     EXPECT_NE(m.find("declares no coordinate reference system (only a local one, of unknown "

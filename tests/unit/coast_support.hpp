@@ -8,6 +8,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 #include <gdal.h>
+#include <gdal_utils.h>
 #include <ogr_api.h>
 
 #include <algorithm>
@@ -125,6 +126,25 @@ inline double layer_area_km2(const std::string &path, const std::string &layer_n
     for (double a : areas)
         sum += a;
     return sum;
+}
+
+/// Copies the vector data set `src` to `dst` as ogr2ogr does with `args` (GDALVectorTranslate);
+/// false when GDAL cannot open or write it.
+inline bool ogr2ogr(const std::string &src, const std::string &dst,
+                    std::vector<const char *> args) {
+    GDALAllRegister();
+    GDALDatasetH in = GDALOpenEx(src.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+    if (!in)
+        return false;
+    args.push_back(nullptr);
+    GDALVectorTranslateOptions *opts =
+        GDALVectorTranslateOptionsNew(const_cast<char **>(args.data()), nullptr);
+    GDALDatasetH out = GDALVectorTranslate(dst.c_str(), nullptr, 1, &in, opts, nullptr);
+    GDALVectorTranslateOptionsFree(opts);
+    if (out)
+        GDALClose(out);
+    GDALClose(in);
+    return out != nullptr;
 }
 
 } // namespace globemesh::test

@@ -3,6 +3,7 @@
 // the South Pole, shapefile = GeoPackage, projected copy within 1 m, shaping at 100 and 10 km,
 // regions across +-180 and at a pole, a region with islands inside against the source clipped.
 #include <gtest/gtest.h>
+#include <ogr_srs_api.h>
 
 #include <algorithm>
 #include <array>
@@ -29,6 +30,14 @@ MeshOptions coast_options(const std::string &rel, const std::string &layer = "la
     MeshOptions o;
     o.coast = fixture(rel).string();
     o.coast_layer = layer;
+    return o;
+}
+
+/// Options reading layer `land` of the file at `path`.
+MeshOptions coast_options_at(const std::string &path) {
+    MeshOptions o;
+    o.coast = path;
+    o.coast_layer = "land";
     return o;
 }
 
@@ -570,6 +579,58 @@ TEST(Coast, a_region_file_across_the_antimeridian_or_round_a_pole_bounds_the_box
                   seam_segments(box.rings, SegmentKind::open));
         expect_valid(shape_boundary(file, uniform(50), o));
     }
+}
+
+/// A circle of `radius_m` about the North Pole in polar stereographic EPSG:3413 (128 vertices),
+/// as a GeoJSON polygon, and the latitude its vertices lie at.
+std::pair<std::string, double> polar_circle(double radius_m) {
+    std::string ring;
+    for (int k = 0; k <= 128; ++k) {
+        const double a = 2 * pi * (k % 128) / 128;
+        ring += (k ? "," : "") + std::string("[") + std::to_string(radius_m * std::cos(a)) + "," +
+                std::to_string(radius_m * std::sin(a)) + "]";
+    }
+    OGRSpatialReferenceH polar = OSRNewSpatialReference(nullptr),
+                         wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(polar, 3413);
+    OSRImportFromEPSG(wgs84, 4326);
+    OSRSetAxisMappingStrategy(wgs84, OAMS_TRADITIONAL_GIS_ORDER);
+    OGRCoordinateTransformationH to_lonlat = OCTNewCoordinateTransformation(polar, wgs84);
+    double x = radius_m, y = 0;
+    OCTTransform(to_lonlat, 1, &x, &y, nullptr);
+    OCTDestroyCoordinateTransformation(to_lonlat);
+    OSRDestroySpatialReference(polar);
+    OSRDestroySpatialReference(wgs84);
+    return {R"({"type":"Polygon","coordinates":[[)" + ring + "]]}", y};
+}
+
+// A polygon about a pole in a polar CRS comes back to lon/lat as a ring round the pole, which
+// bounds nothing there, or through it at the longitude the projection gives the pole: closed
+// through the pole it is the cap it held. A 1500 km circle in EPSG:3413 as --region-file was
+// refused ("GEOS failed to take the region outline: ... GeometryCollection", found by a sweep):
+// now the ocean of the --region box north of the latitude it lies at. Natural Earth's land in
+// EPSG:3031 (Antarctica through the South Pole, at the longitude 0 the projection gives it)
+// lost the land round the pole: now the rings of the lon/lat source.
+TEST(Coast, a_polygon_about_a_pole_in_a_polar_crs_closes_through_the_pole) {
+    globemesh::test::TempDir dir;
+    const auto [circle, lat] = polar_circle(1.5e6);
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.region = {-180, lat, 180, 90};
+    const CoastData box = load_coast(o);
+    o.region.reset();
+    o.region_file = geojson_file(dir, "circle.geojson", circle, "EPSG:3413");
+    const CoastData file = load_coast(o);
+    expect_valid(file.rings);
+    EXPECT_NEAR(file.ocean_area_km2, box.ocean_area_km2, 1e-5 * box.ocean_area_km2);
+    EXPECT_EQ(file.rings.rings.size(), box.rings.rings.size());
+    expect_valid(shape_boundary(file, uniform(50), o));
+
+    const std::string south = (dir / "land_3031.gpkg").string();
+    ASSERT_TRUE(test::ogr2ogr(fixture("coast/ne_110m_land.gpkg").string(), south,
+                              {"-t_srs", "EPSG:3031", "land"}));
+    const CoastData polar = load_coast(coast_options_at(south));
+    EXPECT_EQ(polar.rings.rings.size(), ne110().rings.rings.size());
+    EXPECT_NEAR(polar.ocean_area_km2, ne110().ocean_area_km2, 1.0);
 }
 
 // The land itself, reprojected to Equal Earth and back, as the region: the region's outline runs
