@@ -2,6 +2,7 @@
 // rasteriser (the grid's node is the centre of a raster cell, so "cell centre inside" is exactly
 // GDAL's default burn rule).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
 #include "grid.hpp"
+#include "pole_rings.hpp"
 
 namespace globemesh::detail {
 
@@ -61,6 +63,37 @@ std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string &path,
     return layers;
 }
 
+/// Widens `lon_range` to the longitudes of `g` (a polygon may be drawn past +-180).
+void widen_lon_range(OGRGeometryH g, std::array<double, 2> &lon_range) {
+    OGREnvelope e;
+    OGR_G_GetEnvelope(g, &e);
+    lon_range = {std::min(lon_range[0], e.MinX), std::max(lon_range[1], e.MaxX)};
+}
+
+/// Closes through its pole each ring of a polygon or multipolygon reprojected to lon/lat from a
+/// CRS that holds a pole as a point, where it goes round or through one (close_at_pole: drawn
+/// about a pole, it burnt nothing), and widens `lon_range` to its longitudes (such a ring may
+/// pass +-180).
+void close_rings_round_poles(OGRGeometryH g, std::array<double, 2> &lon_range) {
+    if (wkbFlatten(OGR_G_GetGeometryType(g)) == wkbMultiPolygon) {
+        for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
+            close_rings_round_poles(OGR_G_GetGeometryRef(g, i), lon_range);
+        return;
+    }
+    for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i) {
+        OGRGeometryH ring = OGR_G_GetGeometryRef(g, i);
+        std::vector<LonLat> pts(static_cast<std::size_t>(OGR_G_GetPointCount(ring)));
+        for (std::size_t k = 0; k < pts.size(); ++k)
+            pts[k] = {OGR_G_GetX(ring, int(k)), OGR_G_GetY(ring, int(k))};
+        if (!detail::close_at_pole(pts))
+            continue;
+        OGR_G_SetPointCount(ring, static_cast<int>(pts.size()));
+        for (std::size_t k = 0; k < pts.size(); ++k)
+            OGR_G_SetPoint_2D(ring, int(k), pts[k].lon, pts[k].lat);
+    }
+    widen_lon_range(g, lon_range);
+}
+
 } // namespace
 
 void apply_size_regions(const BackgroundGrid &g, const std::string &path,
@@ -77,8 +110,9 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
     OSRImportFromEPSG(wgs84.get(), 4326);
     OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);
 
-    // Polygons in lon/lat with their sizes.
+    // Polygons in lon/lat with their sizes, and their longitudes' range.
     std::vector<std::pair<double, GeometryPtr>> regions;
+    std::array<double, 2> lon_range{180.0, -180.0};
     bool any_field = false;
     for (OGRLayerH layer : size_layers(ds.get(), path, layer_name)) {
         OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
@@ -96,6 +130,7 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
         if (!to_lonlat)
             throw DataError(option("size_regions") + " " + path + ": cannot transform layer " +
                             OGR_L_GetName(layer) + " to lon/lat");
+        const bool pole_point = detail::holds_a_pole_as_a_point(srs);
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
@@ -115,6 +150,10 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                 throw DataError(option("size_regions") + " " + path +
                                 ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " to lon/lat");
+            if (pole_point)
+                close_rings_round_poles(copy.get(), lon_range);
+            else
+                widen_lon_range(copy.get(), lon_range);
             regions.emplace_back(size, std::move(copy));
         }
     }
@@ -138,12 +177,13 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
     const double west = g.lon0 - 0.5 * g.dlon,
                  north = g.lat0 + (static_cast<double>(g.nlat) - 0.5) * g.dlat;
     std::vector<float> row(g.nlon);
-    // Grids reaching beyond [-180, 180] also burn the polygons shifted by 360 degrees.
+    // Grids reaching beyond [-180, 180], and polygons, also burn the polygons shifted by 360
+    // degrees.
     for (double shift : {0.0, -360.0, 360.0}) {
         const double east = west + static_cast<double>(g.nlon) * g.dlon;
-        if (shift < 0 && east <= 180.0)
+        if (shift < 0 && east <= 180.0 && lon_range[0] >= -180.0)
             continue;
-        if (shift > 0 && west >= -180.0)
+        if (shift > 0 && west >= -180.0 && lon_range[1] <= 180.0)
             continue;
         DatasetPtr target(GDALCreate(mem, "", nx, ny, 1, GDT_Float32, nullptr));
         if (!target)

@@ -334,6 +334,45 @@ TEST(SizeField, size_regions_from_a_projected_polygon_file) {
     EXPECT_NE(m.find("has no CRS (only a local one, of unknown units)"), std::string::npos) << m;
 }
 
+// A size region drawn about the North Pole in EPSG:3413 (a 1500 km circle) came back to lon/lat
+// as a ring round the pole that bounds nothing there, and burnt nothing; one drawn past 180 in
+// lon/lat (177 to 183E) burnt only its part west of 180 in a global run (found by a sweep). Each
+// burns its whole area now, the cap closed through the pole as the coast's polygons are.
+TEST(SizeField, size_regions_about_a_pole_or_past_180_burn_their_whole_area) {
+    TempDir dir;
+    std::string circle = "POLYGON ((";
+    for (int k = 0; k <= 64; ++k) {
+        const double a = 2 * pi * (k % 64) / 64;
+        circle += (k ? ", " : "") + std::to_string(1.5e6 * std::cos(a)) + " " +
+                  std::to_string(1.5e6 * std::sin(a));
+    }
+    circle += "))";
+    OGRSpatialReferenceH polar = OSRNewSpatialReference(nullptr),
+                         wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(polar, 3413);
+    OSRImportFromEPSG(wgs84, 4326);
+    const std::string cap = (dir / "cap.gpkg").string(), past = (dir / "past_180.gpkg").string();
+    write_size_region(cap, "GPKG", polar, circle.c_str(), 30.0);
+    write_size_region(past, "GPKG", wgs84,
+                      "POLYGON ((177 -20, 183 -20, 183 -16, 177 -16, 177 -20))", 7.0);
+    OSRRelease(polar);
+    OSRRelease(wgs84);
+    MeshOptions o;
+    o.hmax_km = 100;
+    o.size_regions = cap;
+    const SizeField polar_field = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    // The circle lies at 76.2N: all round the pole inside it, 100 km far from it.
+    for (const auto &[lon, lat] :
+         {std::pair{0.0, 80.0}, {-45.0, 89.0}, {179.9, 85.0}, {100.0, 78.0}})
+        EXPECT_NEAR(polar_field.size_km(lon, lat), 30, 1e-5) << lon << " " << lat;
+    EXPECT_NEAR(polar_field.size_km(0, 30), 100, 1e-5);
+    o.size_regions = past;
+    const SizeField past_field = build_size_field(o, nullptr, nullptr, {}, 1 << 18);
+    for (const double lon : {178.0, 180.0, -178.0})
+        EXPECT_NEAR(past_field.size_km(lon, -18), 7, 1e-5) << lon;
+    EXPECT_GT(past_field.size_km(-150, -18), 50);
+}
+
 /// Adds a layer `name` (EPSG:4326, with a size_km field when `size` > 0) holding the square
 /// [x0, x0 + 2] x [y0, y0 + 2] degrees to the GeoPackage `path` (created when missing).
 void add_square_layer(const std::string &path, const char *name, double x0, double y0,
