@@ -97,6 +97,28 @@ std::vector<GeomPtr> valid_parts(Geos &geos, const std::vector<PolygonRings> &po
     return parts;
 }
 
+/// The lon/lat box a --region-file's polygons lie in, half a degree wider (W > E across 180), for
+/// the coast's read to take only the land near it as a --region box does; none where they go
+/// round the globe (a cap about a pole, pieces either side of 180 stored apart).
+std::optional<std::array<double, 4>> region_file_box(const CoastOptions &options,
+                                                     std::uint64_t max_memory_bytes) {
+    const Source region = read_source(options.region_file, options.region_layer, "", "",
+                                      "region_file", max_memory_bytes);
+    double w = 1e300, e = -1e300, s = 90, n = -90;
+    for (const PolygonRings &poly : region.polygons)
+        for (const PointList &ring : poly)
+            for (const LonLat &p : ring) {
+                w = std::min(w, p.lon), e = std::max(e, p.lon);
+                s = std::min(s, p.lat), n = std::max(n, p.lat);
+            }
+    constexpr double margin = 0.5;
+    if (!(e - w < 360 - 2 * margin - 10))
+        return std::nullopt;
+    auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
+    return std::array<double, 4>{wrap(w - margin), std::max(-90.0, s - margin), wrap(e + margin),
+                                 std::min(90.0, n + margin)};
+}
+
 } // namespace
 
 CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes,
@@ -107,8 +129,13 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
                          "any OGR format)");
     report(progress, 0.0, "reading coast");
     CoastData out;
+    // A --region-file reads the coast near its polygons' box alone (GSHHG f about the Oresund:
+    // 13.8 s and 2.0 GB for the whole layer, 0.27 s as the same --region box).
+    const std::optional<std::array<double, 4>> near =
+        options.region || options.region_file.empty() ? options.region
+                                                      : region_file_box(options, max_memory_bytes);
     Source src = read_source(options.coast, options.coast_layer, options.coast_where,
-                             options.coast_srs, "coast", max_memory_bytes, options.region);
+                             options.coast_srs, "coast", max_memory_bytes, near);
     out.layer = src.layer;
     const ErrorText where = option("coast") + " " + options.coast + " layer '" + src.layer + "'";
     report(progress, 0.25, "cleaning coast");
@@ -116,9 +143,9 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     Geos geos;
     // Land: valid polygons, dissolved.
     // Cut to the region first, unless --min-island-area weighs each island whole.
-    const bool clip = options.region && !(options.min_island_area_km2 > 0);
+    const bool clip = near && !(options.min_island_area_km2 > 0);
     std::vector<GeomPtr> parts =
-        valid_parts(geos, src.polygons, clip ? near_boxes(*options.region) : std::vector<Box>{});
+        valid_parts(geos, src.polygons, clip ? near_boxes(*near) : std::vector<Box>{});
     if (!src.lines.empty())
         add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
     SnapCount snapped;
