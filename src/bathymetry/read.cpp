@@ -19,6 +19,7 @@
 #include "gdal_handles.hpp"
 #include "globemesh/bathymetry.hpp"
 #include "globemesh/error.hpp"
+#include "io/netcdf_lock.hpp"
 
 namespace globemesh {
 
@@ -487,6 +488,10 @@ private:
 
 Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
                    const RasterLimits &limits, const std::string &srs) {
+    // GDAL's netCDF driver under the process's netCDF lock too: its own mutex does not keep it
+    // from this process's writers (netcdf_lock.hpp).
+    const NetcdfLock netcdf(netcdf_mutex());
+    quiet_hdf5_errors();
     GDALAllRegister();
     gdal::QuietErrors quiet;
     const BlockCacheCap cache(limits.max_bytes);

@@ -21,6 +21,7 @@
 #include <hdf5.h>
 
 #include "globemesh/error.hpp"
+#include "netcdf_lock.hpp"
 
 struct libdeflate_compressor;
 
@@ -73,6 +74,7 @@ private:
     /// The IoError of a failed HDF5 call at `step`.
     IoError failure(const std::string &step) const;
 
+    NetcdfLock lock_{netcdf_mutex()}; // HDF5 as netCDF-C: one thread at a time (netcdf_lock.hpp)
     std::filesystem::path temp_, target_;
     const char *what_;
     hid_t file_ = H5I_INVALID_HID;

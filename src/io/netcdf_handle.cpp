@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <system_error>
 
+#include <hdf5.h>
+
 #include "globemesh/output_file.hpp"
 
 namespace globemesh::io {
@@ -42,6 +44,10 @@ void nc_check(int status, const fs::path &file, const std::string &step, const c
                   (status == NC_EHDFERR ? OutputFile::full_disk_note(file) : ""));
 }
 
+NcHandle::NcHandle() {
+    quiet_hdf5_errors();
+}
+
 NcHandle::~NcHandle() {
     if (id_ < 0)
         return;
@@ -70,3 +76,11 @@ void NcHandle::close(const fs::path &file, const char *what) {
 }
 
 } // namespace globemesh::io
+
+namespace globemesh {
+
+void quiet_hdf5_errors() {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+} // namespace globemesh

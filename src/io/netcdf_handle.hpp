@@ -8,6 +8,7 @@
 #include <netcdf.h>
 
 #include "globemesh/error.hpp"
+#include "netcdf_lock.hpp"
 
 namespace globemesh::io {
 
@@ -21,7 +22,8 @@ void nc_check(int status, const std::filesystem::path &file, const std::string &
 /// abandoned, whose last flush must not fail). Returns how many it moved.
 int divert_to_memory(const std::filesystem::path &file);
 
-/// Owns an open netCDF id; abandons (nc_abort) a file that was not closed explicitly.
+/// Owns an open netCDF id, under the process's netCDF lock (netcdf_lock.hpp) from construction to
+/// destruction; abandons (nc_abort) a file that was not closed explicitly.
 ///
 /// HDF5 flushes a netCDF-4 file as it closes it, abandoned or not. When that flush fails (a full
 /// disk), HDF5 keeps the file open, netCDF-C 4.9.0 crashes listing its open objects, and HDF5
@@ -30,7 +32,7 @@ int divert_to_memory(const std::filesystem::path &file);
 /// at an empty memory file (it is a temporary file, deleted next), where the flush succeeds.
 class NcHandle {
 public:
-    NcHandle() = default;
+    NcHandle();
     ~NcHandle();
     NcHandle(const NcHandle &) = delete;
     NcHandle &operator=(const NcHandle &) = delete;
@@ -45,6 +47,7 @@ public:
     void close(const std::filesystem::path &file, const char *what = "UGRID file");
 
 private:
+    NetcdfLock lock_{netcdf_mutex()}; // first: released after the destructor's abandon
     int id_ = -1;
     std::filesystem::path created_;
 };

@@ -12,17 +12,22 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <set>
 #include <sstream>
+#include <thread>
 
+#include "globemesh/bathymetry.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/ugrid.hpp"
 #include "io_test_meshes.hpp"
+#include "netcdf_handle.hpp"
 #include "support.hpp"
 #include "write_hooks.hpp"
 
@@ -173,6 +178,55 @@ TEST(Ugrid, closed_icosphere_passes_mesh_verify_and_round_trips_its_statistics) 
     EXPECT_EQ(back.node_field("depth")->standard_name, "sea_floor_depth_below_geoid");
     ASSERT_NE(back.face_field("quality"), nullptr);
     expect_same_stats(compute_stats(back), s);
+}
+
+// netCDF-C and HDF5 are not thread-safe: two UGRID files written at once in one process (two
+// Python threads, two QGIS Processing tasks) failed with made-up errors ("String match to name
+// in use", "HDF error") or crashed, and so did a NetCDF raster read through GDAL meanwhile. An
+// open netCDF file holds the process's netCDF lock: a raster read and a UGRID write in other
+// threads wait for it to close. Then both threads' writes and the read run at once.
+TEST(Ugrid, netcdf_files_and_raster_reads_take_turns_across_threads) {
+    TempDir dir;
+    Mesh m = icosphere(4);
+    add_fields(m);
+    std::atomic<bool> closed{false}, read_early{false}, written_early{false};
+    std::thread reader, writer;
+    {
+        io::NcHandle held; // as a writer holds its file
+        reader = std::thread([&] {
+            read_raster(fixture("bathy/etopo5_global_10min.nc").string());
+            read_early = !closed;
+        });
+        writer = std::thread([&] {
+            write_ugrid(m, dir / "w.nc");
+            written_early = !closed;
+        });
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        closed = true;
+    }
+    reader.join();
+    writer.join();
+    EXPECT_FALSE(read_early) << "a raster read while a netCDF file was open";
+    EXPECT_FALSE(written_early) << "a UGRID file written while another was open";
+
+    std::atomic<int> failures{0};
+    auto writes = [&](const std::string &name) {
+        for (int k = 0; k < 6; ++k)
+            try {
+                UgridOptions o;
+                o.overwrite = true;
+                write_ugrid(m, dir / name, o);
+            } catch (const std::exception &e) {
+                ++failures;
+                ADD_FAILURE() << name << ": " << e.what();
+            }
+    };
+    std::thread a(writes, "a.nc"), b(writes, "b.nc");
+    a.join();
+    b.join();
+    EXPECT_EQ(failures.load(), 0);
+    for (const char *name : {"a.nc", "b.nc"})
+        EXPECT_EQ(read_ugrid(dir / name).faces, m.faces) << name;
 }
 
 TEST(Ugrid, size_ratio_median_is_the_median_of_all_edge_ratios) {
