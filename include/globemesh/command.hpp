@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "globemesh/error.hpp"
@@ -37,6 +38,9 @@ struct Run {
     std::string history;     ///< the files' `history` attribute
     std::string land;        ///< the coast a preview draws under the mesh ("": none)
     std::optional<std::array<double, 4>> extent_deg; ///< a preview's extent (the region)
+    /// The run's input files by keyword (coast, bathy, ...), absolute where they are files: no
+    /// write replaces one, whatever the directory by then.
+    std::vector<std::pair<std::string, std::string>> inputs;
 };
 
 /// `globemesh mesh ARGS` without outputs: ARGS parsed by the command line's parser ("--hmax=50km",

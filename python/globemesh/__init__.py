@@ -40,6 +40,13 @@ __all__ = ["mesh_ocean", "triangulate", "Result", "Error", "UsageError", "DataEr
 _KEYWORDS = {name: (flag, count) for name, flag, count in _globemesh.mesh_keywords()}
 
 
+def _number(value):
+    """A number as the command line reads it: 3.0 as 3 (for the options that take a count, such
+    as passage_cells or smooth), any other float with all its digits."""
+    value = float(value)
+    return str(int(value)) if value.is_integer() and abs(value) < 2 ** 53 else repr(value)
+
+
 def _argument(name, value):
     """The command line argument of keyword `name`: --name=value, --flag, or None (default)."""
     flag, count = _KEYWORDS[name]
@@ -48,12 +55,14 @@ def _argument(name, value):
         return None
     if flag:
         return option if value else option + "=false"
+    if isinstance(value, str) and not value:
+        raise ValueError("%s='' is empty: give it a value, or None for its default" % name)
     if count > 1 and not isinstance(value, (str, bytes)):
-        value = ",".join(repr(float(v)) if isinstance(v, float) else str(v) for v in value)
+        value = ",".join(_number(v) if isinstance(v, float) else str(v) for v in value)
     elif isinstance(value, _os.PathLike):
         value = _os.fspath(value)
     elif isinstance(value, float):
-        value = repr(value)
+        value = _number(value)
     return option + "=" + str(value)
 
 

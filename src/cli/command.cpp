@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <utility>
 
 #include "cli_common.hpp"
@@ -18,6 +19,8 @@
 #include "option_flags.hpp"
 
 namespace globemesh::command {
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -122,8 +125,22 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
     summary.total_s = cli::seconds_since(t0);
     summary.peak = cli::peak_memory_bytes();
     result.report_json = cli::report_json(summary);
-    result.land = o.mesh.coast;
+    // Inputs named by files absolute, as a later chdir would otherwise move them (a data set
+    // GDAL opens by another name, e.g. PG:..., stays as given).
+    auto absolute = [](const std::string &path) {
+        std::error_code ec;
+        return !path.empty() && fs::exists(path, ec) ? fs::absolute(path).string() : path;
+    };
+    result.land = absolute(o.mesh.coast);
     result.extent_deg = o.mesh.region;
+    for (const auto &[name, path] :
+         {std::pair<const char *, const std::string &>{"coast", o.mesh.coast},
+          {"bathy", o.mesh.bathy},
+          {"region_file", o.mesh.region_file},
+          {"size_regions", o.mesh.size_regions},
+          {"passages", o.mesh.passages}})
+        if (!path.empty())
+            result.inputs.emplace_back(name, absolute(path));
     result.mesh = std::move(run.mesh);
     return result;
 }
@@ -144,7 +161,8 @@ void write(const Run &run, const Outputs &outputs, const Progress &progress) {
         cli::plan_outputs(choices, table, {}, run.mesh.node_field("depth") != nullptr);
     const std::vector<OutputRequest> requests = cli::requests(planned);
     check_output_srs(outputs.output_srs, requests);
-    cli::check_output_files(cli::output_files(planned, "", "", table), {}, outputs.overwrite);
+    cli::check_output_files(cli::output_files(planned, "", "", table), run.inputs,
+                            outputs.overwrite);
     WriteOptions options;
     options.overwrite = outputs.overwrite;
     options.history = run.history;

@@ -127,6 +127,25 @@ class SameAsCommandLine(TempDir):
             r.write(self.path("py.nc"))
         r.write(self.path("py.nc"), overwrite=True)
 
+    def test_write_refuses_to_replace_an_input_even_after_a_chdir(self):
+        # write(..., overwrite=True) replaced the coast it was meshed from (a GeoPackage became
+        # the mesh's layers); the command line refuses, naming the input. A relative coast
+        # stays the same file after os.chdir.
+        import shutil
+        coast = self.path("coast.gpkg")
+        shutil.copy(LAND110, coast)
+        before = open(coast, "rb").read()
+        here = os.getcwd()
+        os.chdir(self.dir)
+        try:
+            r = globemesh.mesh_ocean("coast.gpkg", coast_layer="land", hmax="800km")
+        finally:
+            os.chdir(here)
+        with self.assertRaises(globemesh.UsageError) as caught:
+            r.write(coast, overwrite=True)
+        self.assertIn("is the coast file", str(caught.exception))
+        self.assertEqual(open(coast, "rb").read(), before)
+
     def test_arrays_are_read_only_views(self):
         r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
         faces = r.faces
@@ -215,6 +234,19 @@ class Errors(TempDir):
             globemesh.triangulate([0, 1, 2], [0, 91, 2])
         with self.assertRaisesRegex(globemesh.DataError, "one circle"):
             globemesh.triangulate([0, 10, 20], [0, 0, 0])
+
+
+class Keywords(TempDir):
+    def test_whole_floats_count_and_an_empty_string_is_refused(self):
+        # smooth=4.0 or passage_cells=3.0 (numpy scalars, QGIS's numbers) went as "4.0", which
+        # the count options refused ("Could not convert"); coast_srs="" took the next keyword
+        # as its value ("--coast-srs '--hmax=600km' is not a CRS").
+        r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax=np.float64(800), smooth=4.0,
+                                 passage_cells=np.float64(3))
+        self.assertGreater(len(r.faces), 0)
+        with self.assertRaises(ValueError) as caught:
+            globemesh.mesh_ocean(LAND110, coast_layer="land", coast_srs="", hmax="800km")
+        self.assertIn("coast_srs='' is empty", str(caught.exception))
 
 
 class Cancel(TempDir):
