@@ -3,9 +3,11 @@ module (import globemesh): a run reports its progress to the progress bar and st
 user cancels, and the mesh is written by the command line's own writers (Result.write)."""
 
 import os
+import re
 
-from qgis.core import (QgsCoordinateReferenceSystem, QgsExpression, QgsFeatureRequest, QgsMeshDatasetIndex,
-                       QgsMeshLayer, QgsProcessing, QgsProcessingAlgorithm, QgsProcessingContext,
+from qgis.core import (QgsCoordinateReferenceSystem, QgsCoordinateTransform, QgsExpression, QgsFeatureRequest,
+                       QgsMeshDatasetIndex, QgsMeshLayer, QgsPointXY, QgsProcessing, QgsProcessingAlgorithm,
+                       QgsProcessingContext,
                        QgsProcessingException, QgsProcessingLayerPostProcessorInterface, QgsProcessingParameterBoolean,
                        QgsProcessingParameterCrs, QgsProcessingParameterDefinition, QgsProcessingParameterExtent,
                        QgsProcessingParameterFeatureSource, QgsProcessingParameterField,
@@ -344,10 +346,39 @@ class MeshOcean(_Algorithm):
         if parameters.get(self.REGION) and parameters.get(self.REGION_LAYER):
             raise QgsProcessingException("give the region as an extent or as a polygon layer, not both")
         if parameters.get(self.REGION):
-            r = self.parameterAsExtent(parameters, self.REGION, context, WGS84)
-            options["region"] = (r.xMinimum(), r.yMinimum(), r.xMaximum(), r.yMaximum())
+            options["region"] = self._lonlat_region(parameters, context)
         options["region_file"], options["region_layer"] = self._layer_file(parameters, self.REGION_LAYER, context,
                                                                            feedback)
+
+    def _lonlat_region(self, parameters, context):
+        """The extent as globemesh's region W,S,E,N in degrees, W > E across 180. An extent written
+        xmin,xmax,ymin,ymax [EPSG:4326] with xmin above xmax crosses 180 (QGIS swaps the two);
+        one in another CRS is its outline's shortest span of longitudes in lon/lat (QGIS's own
+        transform took the whole band for an extent across 180), unless it holds a pole."""
+        raw, crs = parameters.get(self.REGION), self.parameterAsExtentCrs(parameters, self.REGION, context)
+        number = r"\s*([-+0-9.eE]+)\s*"
+        m = re.match(",".join([number] * 4), raw) if isinstance(raw, str) else None
+        if m and (not crs.isValid() or crs.isGeographic()):
+            x0, x1, y0, y1 = map(float, m.groups())
+            if x0 > x1:
+                return (x0, min(y0, y1), x1, max(y0, y1))
+        whole = self.parameterAsExtent(parameters, self.REGION, context, WGS84)
+        whole = (whole.xMinimum(), whole.yMinimum(), whole.xMaximum(), whole.yMaximum())
+        if not crs.isValid() or crs.isGeographic():
+            return whole
+        r = self.parameterAsExtent(parameters, self.REGION, context)
+        to_lonlat = QgsCoordinateTransform(crs, WGS84, context.transformContext())
+        steps = [k / 16 for k in range(17)]
+        outline = [(r.xMinimum() + f * r.width(), r.yMinimum() + g * r.height())
+                   for f in steps for g in (0, 1)] + [(r.xMinimum() + f * r.width(), r.yMinimum() + g * r.height())
+                                                      for g in steps for f in (0, 1)]
+        points = [to_lonlat.transform(QgsPointXY(x, y)) for x, y in outline]
+        lons = sorted(p.x() for p in points)
+        gaps = [(lons[k + 1] - lons[k], k) for k in range(len(lons) - 1)] + [(lons[0] + 360 - lons[-1], -1)]
+        gap, k = max(gaps)
+        if k == -1 or gap < 60:  # no span across 180, or the outline all round a pole
+            return whole
+        return (lons[k + 1], min(p.y() for p in points), lons[k], max(p.y() for p in points))
 
     def _passages(self, parameters, context, feedback, options):
         if self.parameterAsBool(parameters, self.DEFAULT_PASSAGES, context):

@@ -148,6 +148,18 @@ def nodes_in(nc, west, south, east, north):
     return int(((lon >= west) & (lon <= east) & (lat >= south) & (lat <= north)).sum()), len(lon)
 
 
+# An extent across 180, written west above east in lon/lat, or in a CRS whose x runs across it
+# (EPSG:3832, the Pacific's Mercator): QGIS swapped the first and took the second's whole band
+# of longitudes, and the run meshed about the whole world's band (5012 nodes at -68..170).
+with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
+    for extent in ("170,-170,-50,-30 [EPSG:4326]", "2226390,4452780,-6446276,-3503549 [EPSG:3832]"):
+        nc = os.path.join(folder, "pacific.nc")
+        processing.run("globemesh:meshocean", {"COAST": coast.id(), "REGION": extent, "HMAX": 200, "OUTPUT": nc})
+        import netCDF4
+        with netCDF4.Dataset(nc) as file:
+            lon = file["mesh_node_lon"][:] % 360
+        assert lon.min() >= 169.99 and lon.max() <= 190.01, (extent, lon.min(), lon.max())
+
 # A region (as Processing writes an extent: xmin,xmax,ymin,ymax [crs]) and the selected features only:
 # with Great Britain left out of the selection, the sea covers England.
 from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition  # noqa: E402
