@@ -19,6 +19,20 @@ inline py::object &gdal_warning_class() {
     return cls;
 }
 
+/// The Python class of the run's own warnings (the command line's on stderr; a UserWarning).
+inline py::object &mesh_warning_class() {
+    static py::object cls;
+    return cls;
+}
+
+/// Each of a run's warnings through warnings.warn, with the GIL (raises if a filter makes it an
+/// error).
+inline void warn_run(const std::vector<std::string> &warnings) {
+    for (const std::string &w : warnings)
+        if (PyErr_WarnEx(mesh_warning_class().ptr(), w.c_str(), 1) != 0)
+            throw py::error_already_set();
+}
+
 /// Collects GDAL's warnings on this thread (where the run calls GDAL) while it lives, GIL
 /// released; warn() then gives them to Python, with the GIL. GDAL's errors are not warnings: the
 /// library turns them into its exceptions, as the command line does.

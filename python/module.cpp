@@ -40,6 +40,7 @@ std::shared_ptr<PyMesh> mesh_ocean_args(const std::vector<std::string> &args, py
     ProgressBridge bridge(std::move(callback));
     result->run = run_without_gil(
         bridge, [&](const Progress &progress) { return command::mesh(args, progress); });
+    warn_run(result->run.warnings);
     return result;
 }
 
@@ -115,6 +116,9 @@ PYBIND11_MODULE(_globemesh, m) {
     gdal_warning_class() = py::reinterpret_steal<py::object>(
         PyErr_NewException("globemesh._globemesh.GdalWarning", PyExc_UserWarning, nullptr));
     m.attr("GdalWarning") = gdal_warning_class();
+    mesh_warning_class() = py::reinterpret_steal<py::object>(
+        PyErr_NewException("globemesh._globemesh.MeshWarning", PyExc_UserWarning, nullptr));
+    m.attr("MeshWarning") = mesh_warning_class();
     bind_result(m);
     m.def("mesh_keywords", &mesh_keywords);
     // For the tests: a GDAL warning raised during a run, as a reader's would be.

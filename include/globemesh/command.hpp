@@ -41,6 +41,9 @@ struct Run {
     /// The run's input files by keyword (coast, bathy, ...), absolute where they are files: no
     /// write replaces one, whatever the directory by then.
     std::vector<std::pair<std::string, std::string>> inputs;
+    /// The command line's warnings about the run (its "globemesh: warning: ..." lines on stderr,
+    /// without that prefix): straits closed, a region's ocean in pieces, nodes above sea level.
+    std::vector<std::string> warnings;
 };
 
 /// `globemesh mesh ARGS` without outputs: ARGS parsed by the command line's parser ("--hmax=50km",

@@ -18,7 +18,9 @@ RuntimeError):
     Cancelled                    the progress callback returned False
 and KeyboardInterrupt for Ctrl-C during a run (or the exception the callback raised). GDAL's
 warnings during a run (a raster's odd metadata...) come as Python warnings of the class
-globemesh.GdalWarning (a UserWarning), not on stderr.
+globemesh.GdalWarning (a UserWarning), not on stderr; the run's own warnings, which the command
+line prints (straits closed, a region's ocean in pieces, nodes above sea level), as
+globemesh.MeshWarning (a UserWarning).
 
 A run releases the GIL; progress(fraction, stage) is called at most every 50 ms, and Ctrl-C stops
 the run there. A cancelled or failed write() leaves no file.
@@ -28,13 +30,13 @@ import os as _os
 import tempfile as _tempfile
 
 from . import _globemesh
-from ._globemesh import Cancelled, DataError, Error, GdalWarning, IoError, UsageError
+from ._globemesh import Cancelled, DataError, Error, GdalWarning, IoError, MeshWarning, UsageError
 
-for _e in (Cancelled, DataError, Error, GdalWarning, IoError, UsageError):
+for _e in (Cancelled, DataError, Error, GdalWarning, IoError, MeshWarning, UsageError):
     _e.__module__ = __name__  # globemesh.DataError in tracebacks, as users name them
 __version__ = _globemesh.__version__
 __all__ = ["mesh_ocean", "triangulate", "Result", "Error", "UsageError", "DataError", "IoError",
-           "Cancelled", "GdalWarning"]
+           "Cancelled", "GdalWarning", "MeshWarning"]
 
 # keyword -> (is a flag, values it takes), from the command line's own option list.
 _KEYWORDS = {name: (flag, count) for name, flag, count in _globemesh.mesh_keywords()}

@@ -4,6 +4,7 @@ user cancels, and the mesh is written by the command line's own writers (Result.
 
 import os
 import re
+import warnings
 
 from qgis.core import (QgsCoordinateReferenceSystem, QgsCoordinateTransform, QgsExpression, QgsFeatureRequest,
                        QgsMeshDatasetIndex, QgsMeshLayer, QgsPointXY, QgsProcessing, QgsProcessingAlgorithm,
@@ -230,7 +231,11 @@ class _Algorithm(QgsProcessingAlgorithm):
         Processing's; a cancelled run writes nothing."""
         globemesh = _globemesh()
         try:
-            mesh = run(globemesh, _progress(feedback))
+            with warnings.catch_warnings(record=True) as caught:  # the run's, as the log's warnings
+                warnings.simplefilter("always")
+                mesh = run(globemesh, _progress(feedback))
+            for w in caught:
+                feedback.pushWarning(str(w.message))
             return self._write(mesh, parameters, context, feedback)
         except globemesh.Cancelled:
             feedback.pushInfo("cancelled: nothing written")

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <sstream>
 #include <utility>
 
 #include "cli_common.hpp"
@@ -125,6 +126,14 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
     summary.total_s = cli::seconds_since(t0);
     summary.peak = cli::peak_memory_bytes();
     result.report_json = cli::report_json(summary);
+    // The summary's warnings, as the command line prints them on stderr.
+    std::ostringstream summary_out, summary_err;
+    cli::print_mesh_summary(summary_out, summary_err, summary);
+    const std::string prefix = "globemesh: warning: ";
+    std::istringstream lines(summary_err.str());
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind(prefix, 0) == 0)
+            result.warnings.push_back(line.substr(prefix.size()));
     // Inputs named by files absolute, as a later chdir would otherwise move them (a data set
     // GDAL opens by another name, e.g. PG:..., stays as given).
     auto absolute = [](const std::string &path) {

@@ -249,6 +249,14 @@ class Keywords(TempDir):
         self.assertIn("coast_srs='' is empty", str(caught.exception))
 
 
+class Warnings(TempDir):
+    def test_the_command_lines_warnings_come_as_mesh_warnings(self):
+        # The command line warns that a box across Panama meshes only its largest piece of
+        # ocean; Python and QGIS said nothing.
+        with self.assertWarnsRegex(globemesh.MeshWarning, "in pieces apart; only the largest"):
+            globemesh.mesh_ocean(LAND50, coast_layer="land", hmax="10km", region=(-81, 7.5, -78, 10))
+
+
 class Cancel(TempDir):
     """A cancelled run raises, and leaves no file."""
 
