@@ -44,6 +44,7 @@ struct Run {
     /// The command line's warnings about the run (its "globemesh: warning: ..." lines on stderr,
     /// without that prefix): straits closed, a region's ocean in pieces, nodes above sea level.
     std::vector<std::string> warnings;
+    std::string title; ///< the files' title ("": the writers' own, an ocean mesh's)
 };
 
 /// `globemesh mesh ARGS` without outputs: ARGS parsed by the command line's parser ("--hmax=50km",

@@ -113,6 +113,8 @@ class Result:
         self._mesh = mesh
 
     def __getattr__(self, name):
+        if name == "_mesh":  # not set yet (copy.copy makes a Result without __init__)
+            raise AttributeError(name)
         return getattr(self._mesh, name)
 
     def __repr__(self):

@@ -159,6 +159,7 @@ Run triangulate(std::vector<Vec3> points, const Progress &progress) {
     result.mesh = triangulate_points(std::move(points), TriangulateOptions{}, progress);
     result.stats = compute_stats(result.mesh);
     result.history = cli::history_text("triangulate", std::vector<std::string>{"(Python)"});
+    result.title = "globemesh spherical Delaunay triangulation"; // as `globemesh triangulate`
     result.report_json = "{\"mesh\": " + cli::stats_json(result.stats, "") + "}";
     return result;
 }
@@ -175,6 +176,8 @@ void write(const Run &run, const Outputs &outputs, const Progress &progress) {
     WriteOptions options;
     options.overwrite = outputs.overwrite;
     options.history = run.history;
+    if (!run.title.empty())
+        options.title = run.title;
     options.stats = &run.stats;
     options.land = run.land;
     options.extent_deg = run.extent_deg;

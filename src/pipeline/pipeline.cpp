@@ -23,6 +23,11 @@ namespace globemesh {
 
 namespace {
 
+/// A node estimate as the refusals write it: "about 4.18366e+26", or "too many" past a double.
+std::string nodes_text(double estimate) {
+    return std::isfinite(estimate) ? "about " + report_number(std::round(estimate)) : "too many";
+}
+
 using Clock = std::chrono::steady_clock;
 
 class StageClock {
@@ -196,11 +201,10 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
     if (const double estimate = nodes_for_area(coast.ocean_area_km2, o.hmax_km);
         0.9 * estimate > static_cast<double>(o.max_nodes))
         throw DataError("the ocean (" + std::to_string(std::llround(coast.ocean_area_km2)) +
-                        " km2) takes about " + std::to_string(std::llround(estimate)) +
-                        " nodes at " + option("hmax_km") + " " + report_number(o.hmax_km) +
-                        " km, more than " + option("max_nodes") + " " +
-                        std::to_string(o.max_nodes) + ": raise " + option("hmax_km") + " or " +
-                        option("max_nodes"));
+                        " km2) takes " + nodes_text(estimate) + " nodes at " + option("hmax_km") +
+                        " " + report_number(o.hmax_km) + " km, more than " + option("max_nodes") +
+                        " " + std::to_string(o.max_nodes) + ": raise " + option("hmax_km") +
+                        " or " + option("max_nodes"));
     // The same for the water along the coast at --coast-size: the size grows from s there at
     // rate g = min(--coast-rate, --grade) up to --hmax, and along a straight coast of length L
     // the band takes L * integral of dd / (c (s + g d)^2) = L (1/s - 1/hmax) / (c g) nodes (c h^2
@@ -227,9 +231,8 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
         if (segments > 0 && s <= coast_km / double(segments) &&
             0.5 * estimate > static_cast<double>(o.max_nodes))
             throw DataError("the water along the coast (" + std::to_string(std::llround(coast_km)) +
-                            " km) takes about " + std::to_string(std::llround(estimate)) +
-                            " nodes at " + option("coast_size_km") + " " +
-                            report_number(o.coast_size_km) + " km" +
+                            " km) takes " + nodes_text(estimate) + " nodes at " +
+                            option("coast_size_km") + " " + report_number(o.coast_size_km) + " km" +
                             (s > o.coast_size_km ? " (" + report_number(s) + " km: sizes stop at " +
                                                        option("hmin_km") + ", by default " +
                                                        option("hmax_km") + " / 1000)"

@@ -237,6 +237,16 @@ class Errors(TempDir):
 
 
 class Keywords(TempDir):
+    def test_a_result_copies_and_a_triangulation_keeps_its_title(self):
+        # copy.copy(result) recursed in __getattr__ (no _mesh yet); triangulate()'s files said
+        # "globemesh ocean mesh", where the command line's say what they are.
+        import copy
+        r = globemesh.triangulate([0, 90, 180, -90, 0], [0, 0, 0, 0, 90])
+        self.assertEqual(len(copy.copy(r).faces), len(r.faces))
+        r.write(self.path("tri.nc"))
+        with netCDF4.Dataset(self.path("tri.nc")) as nc:
+            self.assertEqual(nc.title, "globemesh spherical Delaunay triangulation")
+
     def test_whole_floats_count_and_an_empty_string_is_refused(self):
         # smooth=4.0 or passage_cells=3.0 (numpy scalars, QGIS's numbers) went as "4.0", which
         # the count options refused ("Could not convert"); coast_srs="" took the next keyword
@@ -247,6 +257,11 @@ class Keywords(TempDir):
         with self.assertRaises(ValueError) as caught:
             globemesh.mesh_ocean(LAND110, coast_layer="land", coast_srs="", hmax="800km")
         self.assertIn("coast_srs='' is empty", str(caught.exception))
+        # A size far too small: its node count said -9223372036854775808 (an overflow).
+        with self.assertRaisesRegex(globemesh.DataError, r"takes about [0-9.]+e\+[0-9]+ nodes"):
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="1e-9km")
+        with self.assertRaisesRegex(globemesh.DataError, r"takes too many nodes"):
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax=1e-300)
 
 
 class Warnings(TempDir):
