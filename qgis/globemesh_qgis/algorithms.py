@@ -244,6 +244,15 @@ class _Algorithm(QgsProcessingAlgorithm):
             raise QgsProcessingException(str(e))
 
 
+def _declares(path, layer, crs):
+    """Whether the file's layer declares `crs` (a QgsCoordinateReferenceSystem), as OGR reads it."""
+    from osgeo import ogr
+    data = ogr.Open(path)
+    found = data and (data.GetLayerByName(layer) if layer else data.GetLayer(0))
+    srs = found.GetSpatialRef() if found else None
+    return srs is not None and QgsCoordinateReferenceSystem.fromWkt(srs.ExportToWkt()) == crs
+
+
 # The size and coast options beside hmax and hmin: (parameter, keyword, description, default
 # (globemesh's), unit, advanced). A value other than the default is passed on.
 NUMBER_OPTIONS = (("FEATURE_SIZE", "feature_size", "Elements across every channel (3 as OceanMesh2D; 0: off)", 0, "",
@@ -331,6 +340,12 @@ class MeshOcean(_Algorithm):
             return None, None
         path, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(parameters, name, context, ["gpkg", "shp"],
                                                                             "gpkg", feedback)
+        shown = self.parameterAsVectorLayer(parameters, name, context)
+        if shown is not None and shown.crs().isValid() and not _declares(path, layer, shown.crs()):
+            # The CRS set on the layer in QGIS, which its file lacks or names otherwise: a copy
+            # of the features carries it (globemesh reads the file's, or refuses a file without).
+            path, layer = self.parameterAsCompatibleSourceLayerPathAndLayerName(parameters, name, context, [],
+                                                                                "gpkg", feedback)
         return path, layer or _first_layer(path)
 
     def _size_regions(self, parameters, context, feedback):

@@ -148,6 +148,25 @@ def nodes_in(nc, west, south, east, north):
     return int(((lon >= west) & (lon <= east) & (lat >= south) & (lat <= north)).sum()), len(lon)
 
 
+# A shapefile without its .prj, its CRS set on the layer in QGIS: the provider passed the file, and
+# globemesh refused it ("declares no coordinate reference system; give it with --coast-srs"),
+# which Processing offers no way to give. A file that declares the layer's CRS is passed as it is.
+from globemesh_qgis.algorithms import _declares  # noqa: E402
+from qgis.core import QgsCoordinateReferenceSystem  # noqa: E402
+assert _declares(os.path.join(FIXTURES, "coast", "ne_110m_land.gpkg"), "land", QgsCoordinateReferenceSystem("EPSG:4326"))
+with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
+    import shutil
+    for ext in ("shp", "shx", "dbf"):
+        shutil.copy(os.path.join(FIXTURES, "coast", "ne_110m_land_shp", "ne_110m_land." + ext), folder)
+    bare = QgsVectorLayer(os.path.join(folder, "ne_110m_land.shp"), "bare", "ogr")
+    bare.setCrs(QgsCoordinateReferenceSystem("EPSG:4326"))
+    QgsProject.instance().addMapLayer(bare)
+    assert not _declares(bare.source(), None, bare.crs())
+    nc = os.path.join(folder, "bare.nc")
+    processing.run("globemesh:meshocean", {"COAST": bare.id(), "HMAX": 800, "OUTPUT": nc})
+    assert nodes_in(nc, -180, -90, 180, 90)[0] > 0
+    QgsProject.instance().removeMapLayer(bare.id())
+
 # An extent across 180, written west above east in lon/lat, or in a CRS whose x runs across it
 # (EPSG:3832, the Pacific's Mercator): QGIS swapped the first and took the second's whole band
 # of longitudes, and the run meshed about the whole world's band (5012 nodes at -68..170).
