@@ -626,8 +626,7 @@ TEST(Parts, the_straits_closed_are_measured_as_in_one_part) {
                     // The same place to 1e-12 (its face's nodes rounded apart in the parts):
                     // the same width to as little.
                     ++same_place;
-                    EXPECT_NEAR(r.straits_closed_width_km[i], one.straits_closed_width_km[j],
-                                1e-9);
+                    EXPECT_NEAR(r.straits_closed_width_km[i], one.straits_closed_width_km[j], 1e-9);
                 }
         }
         EXPECT_GE(same_place, 1u) << "the Ionian Sea's closing, as in one part";
