@@ -22,6 +22,14 @@ namespace py = pybind11;
 /// Progress it gives captures only a pointer to it, so the library may copy that freely.
 class ProgressBridge {
 public:
+    /// Whether a callback's return is False: Python's, or numpy's (np.False_), not None or 0.
+    static bool is_false(const py::object &r) {
+        const bool boolean = PyBool_Check(r.ptr()) ||
+                             (py::hasattr(r, "dtype") && py::hasattr(r.attr("dtype"), "kind") &&
+                              py::str(r.attr("dtype").attr("kind")).cast<std::string>() == "b");
+        return boolean && PyObject_IsTrue(r.ptr()) == 0;
+    }
+
     /// `callback`: None, or a callable(fraction, stage) whose False return cancels.
     explicit ProgressBridge(py::object callback) : callback_(std::move(callback)) {}
 
@@ -54,7 +62,7 @@ private:
         try {
             if (PyErr_CheckSignals() != 0)
                 throw py::error_already_set();
-            if (!callback_.is_none() && callback_(f, std::string(stage)).is(py::bool_(false)))
+            if (!callback_.is_none() && is_false(callback_(f, std::string(stage))))
                 stopped_ = true; // Cancelled reaches the caller as globemesh.Cancelled
         } catch (py::error_already_set &e) {
             error_.emplace(std::move(e));

@@ -56,7 +56,14 @@ def _argument(name, value):
     if value is None:
         return None
     if flag:
+        if isinstance(value, str):  # "false" is a non-empty string: as the command line reads it
+            words = {"true": True, "1": True, "yes": True, "false": False, "0": False, "no": False}
+            if value.lower() not in words:
+                raise ValueError("%s=%r: give True or False" % (name, value))
+            value = words[value.lower()]
         return option if value else option + "=false"
+    if isinstance(value, bytes):  # a path as bytes (os.fsencode's)
+        value = _os.fsdecode(value)
     if isinstance(value, str) and not value:
         raise ValueError("%s='' is empty: give it a value, or None for its default" % name)
     if count > 1 and not isinstance(value, (str, bytes)):
@@ -145,7 +152,9 @@ class Result:
         of paths, written together. An existing file is an IoError unless overwrite=True. On an
         error or a cancel no file is left."""
         paths = [path] if isinstance(path, (str, bytes, _os.PathLike)) else list(path)
-        paths = [_os.fspath(p) for p in paths]
+        paths = [_os.fsdecode(p) for p in paths]
+        if not paths:
+            raise ValueError("write() was given no path: give a file, or a list of files")
         creation = ["%s=%s" % (k, v) for k, v in creation_options.items()]
         self._mesh.write(paths, format or "", creation, overwrite, output_srs or "", progress)
 

@@ -247,6 +247,21 @@ class Keywords(TempDir):
         with netCDF4.Dataset(self.path("tri.nc")) as nc:
             self.assertEqual(nc.title, "globemesh spherical Delaunay triangulation")
 
+    def test_flags_paths_and_a_numpy_false_read_as_they_say(self):
+        # keep_straits="false" turned the flag on (a non-empty string); coast=b"path" became
+        # "b'path'"; write([]) wrote nothing, silently; a progress callback returning np.False_
+        # did not cancel.
+        a = globemesh.mesh_ocean(LAND110.encode(), coast_layer="land", hmax="800km",
+                                 keep_straits="false")
+        self.assertIn("keep-straits=false", a.attributes["globemesh_configuration"].splitlines())
+        with self.assertRaises(ValueError):
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km", keep_straits="maybe")
+        with self.assertRaises(ValueError):
+            a.write([])
+        with self.assertRaises(globemesh.Cancelled):
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km",
+                                 progress=lambda f, stage: np.False_)
+
     def test_whole_floats_count_and_an_empty_string_is_refused(self):
         # smooth=4.0 or passage_cells=3.0 (numpy scalars, QGIS's numbers) went as "4.0", which
         # the count options refused ("Could not convert"); coast_srs="" took the next keyword
