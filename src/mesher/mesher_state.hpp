@@ -19,6 +19,7 @@
 #include "globemesh/error.hpp"
 #include "globemesh/mesher.hpp"
 #include "globemesh/predicates.hpp"
+#include "lonlat_box.hpp"
 #include "star_search.hpp"
 
 namespace globemesh::mesher_internal {
@@ -73,12 +74,7 @@ using detail::star_worst_quality;
 /// Whether p lies in the region's box (MesherOptions::region; true without one): where a
 /// boundary node may slide to.
 inline bool in_region(const MesherOptions &options, const Vec3 &p) {
-    if (!options.region)
-        return true;
-    const auto [w, s, e, n] = *options.region;
-    const LonLat q = vec_to_lonlat(p);
-    return q.lat >= s && q.lat <= n &&
-           (w <= e ? q.lon >= w && q.lon <= e : q.lon >= w || q.lon <= e);
+    return !options.region || in_lonlat_box(*options.region, vec_to_lonlat(p));
 }
 
 /// How many of the star triangles p, b, c (far edges b -> c) have their centroid on land.

@@ -18,6 +18,7 @@
 #include "globemesh/mesher.hpp"
 #include "globemesh/parts.hpp"
 #include "globemesh/sizefield.hpp"
+#include "lonlat_box.hpp"
 
 namespace globemesh {
 
@@ -250,14 +251,7 @@ void refuse_too_many_nodes(const MeshOptions &o, const CoastData &coast) {
 std::vector<Passage> region_passages(const MeshOptions &o, const Boundary &rings,
                                      const LandTest *land) {
     std::vector<Passage> all = read_passages(o.passages, o.passages_layer), kept;
-    auto inside = [&](const Vec3 &p) {
-        const LonLat ll = vec_to_lonlat(p);
-        const auto &r = *o.region;
-        double east = ll.lon - r[0];
-        east -= 360 * std::floor(east / 360);
-        const double span = r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360;
-        return ll.lat >= r[1] && ll.lat <= r[3] && east <= span;
-    };
+    auto inside = [&](const Vec3 &p) { return in_lonlat_box(*o.region, vec_to_lonlat(p)); };
     auto in_region = [&](const Passage &p) {
         if (!o.region && o.region_file.empty())
             return true;
