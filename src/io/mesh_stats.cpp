@@ -69,8 +69,8 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
     s.boundary_loops = count_boundary_loops(topo, mesh.nodes.size());
     // The nodes' extent is computed on another thread meanwhile: it sets members of `s` of its
     // own, so the statistics do not depend on the timing.
-    // The longitudes in [0, 360) where they span a degree less so (a region across 180, as the
-    // writers put it: east_longitudes), else in [-180, 180) (a global mesh spans 360 in both).
+    // The longitudes in [0, 360) where the writers put them so (east_longitudes: a region across
+    // 180, or up to it), else in [-180, 180).
     auto node_extent = [&] {
         if (mesh.nodes.empty())
             return;
@@ -84,7 +84,7 @@ MeshStats compute_stats(const Mesh &mesh, const MeshTopology &topo) {
             const double east = p.lon < 0 ? p.lon + 360 : p.lon;
             east_min = std::min(east_min, east), east_max = std::max(east_max, east);
         }
-        if (east_max - east_min < s.lon_max - s.lon_min - 1)
+        if (east_longitudes(mesh))
             s.lon_min = east_min, s.lon_max = east_max;
     };
     // Joined before `s` is returned, or by its destructor should the faces or edges throw.
