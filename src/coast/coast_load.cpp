@@ -97,13 +97,10 @@ std::vector<GeomPtr> valid_parts(Geos &geos, const std::vector<PolygonRings> &po
     return parts;
 }
 
-/// The lon/lat box a --region-file's polygons lie in, half a degree wider (W > E across 180), for
-/// the coast's read to take only the land near it as a --region box does; none where they go
-/// round the globe (a cap about a pole, pieces either side of 180 stored apart).
-std::optional<std::array<double, 4>> region_file_box(const CoastOptions &options,
-                                                     std::uint64_t max_memory_bytes) {
-    const Source region = read_source(options.region_file, options.region_layer, "", "",
-                                      "region_file", max_memory_bytes);
+/// The lon/lat box a --region-file's polygons (`region`) lie in, half a degree wider (W > E
+/// across 180), for the coast's read to take only the land near it as a --region box does; none
+/// where they go round the globe (a cap about a pole, pieces either side of 180 stored apart).
+std::optional<std::array<double, 4>> region_file_box(const Source &region) {
     double w = 1e300, e = -1e300, s = 90, n = -90;
     for (const PolygonRings &poly : region.polygons)
         for (const PointList &ring : poly)
@@ -129,11 +126,14 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
                          "any OGR format)");
     report(progress, 0.0, "reading coast");
     CoastData out;
-    // A --region-file reads the coast near its polygons' box alone (GSHHG f about the Oresund:
-    // 13.8 s and 2.0 GB for the whole layer, 0.27 s as the same --region box).
+    // A --region-file, read once, reads the coast near its polygons' box alone (GSHHG f about
+    // the Oresund: 13.8 s and 2.0 GB for the whole layer, 0.27 s as the same --region box).
+    std::optional<Source> region_file;
+    if (!options.region && !options.region_file.empty())
+        region_file = read_source(options.region_file, options.region_layer, "", "", "region_file",
+                                  max_memory_bytes);
     const std::optional<std::array<double, 4>> near =
-        options.region || options.region_file.empty() ? options.region
-                                                      : region_file_box(options, max_memory_bytes);
+        region_file ? region_file_box(*region_file) : options.region;
     Source src = read_source(options.coast, options.coast_layer, options.coast_where,
                              options.coast_srs, "coast", max_memory_bytes, near);
     out.layer = src.layer;
@@ -190,7 +190,8 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     if (!options.region && options.region_file.empty()) {
         rings = world_rings(geos, land, options.keep_inland_seas, out);
     } else {
-        rings = region_rings(geos, land, options, max_memory_bytes, where, out);
+        rings =
+            region_rings(geos, land, options, region_file ? &*region_file : nullptr, where, out);
     }
     report(progress, 0.85, "checking rings");
     {

@@ -172,10 +172,10 @@ struct Chain {
 /// cut at the seam and the poles and stitched; inland water as keep_inland_seas says.
 std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, bool keep_inland_seas,
                                CoastData &out);
-/// The ocean of a region (--region box or --region-file polygons): the region less the land.
+/// The ocean of a region (--region box, or --region-file polygons: `region_file`, as read_source
+/// read them, null for a box): the region less the land.
 std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
-                                std::uint64_t max_memory_bytes, const ErrorText &where,
-                                CoastData &out);
+                                const Source *region_file, const ErrorText &where, CoastData &out);
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
 Ring to_sphere(const Chain &c);
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in

@@ -330,12 +330,10 @@ GeomPtr box_domain(Geos &geos, const std::array<double, 4> &region, Clip &clip) 
     return own(geos, GEOSUnaryUnion_r(geos.get(), domain.get()), "build the region");
 }
 
-/// The --region-file polygons, valid, dissolved and clipped to the globe; `clip` gets their
-/// prepared outline (held in `outline` and `prepared_outline`).
-GeomPtr file_domain(Geos &geos, const CoastOptions &options, std::uint64_t max_memory_bytes,
-                    Clip &clip, GeomPtr &outline, PreparedPtr &prepared_outline) {
-    Source region = read_source(options.region_file, options.region_layer, "", "", "region_file",
-                                max_memory_bytes);
+/// The --region-file polygons (`region`, as read_source read them), valid, dissolved and clipped
+/// to the globe; `clip` gets their prepared outline (held in `outline` and `prepared_outline`).
+GeomPtr file_domain(Geos &geos, const CoastOptions &options, const Source &region, Clip &clip,
+                    GeomPtr &outline, PreparedPtr &prepared_outline) {
     std::vector<GeomPtr> rparts;
     for (const auto &poly : region.polygons)
         add_wrapped(geos, make_valid(geos, make_polygon(geos, poly).get()), rparts);
@@ -687,8 +685,7 @@ std::vector<std::size_t> polygons_holding(Geos &geos,
 /// The ocean of a region (--region box, two boxes across +-180, or --region-file polygons):
 /// region minus land with GEOS, its rings with region edges tagged open.
 std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
-                                std::uint64_t max_memory_bytes, const ErrorText &where,
-                                CoastData &out) {
+                                const Source *region_file, const ErrorText &where, CoastData &out) {
     Clip clip;
     GeomPtr domain;
     PreparedPtr prepared_outline(nullptr, GeosDeleter{geos.get()});
@@ -699,7 +696,7 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
     if (options.region) {
         domain = box_domain(geos, *options.region, clip);
     } else {
-        domain = file_domain(geos, options, max_memory_bytes, clip, outline, prepared_outline);
+        domain = file_domain(geos, options, *region_file, clip, outline, prepared_outline);
     }
     // Only the land near the region matters: cut it to the region's extent first (fast).
     double x0, y0, x1, y1;
