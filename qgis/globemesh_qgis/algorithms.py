@@ -427,8 +427,8 @@ class MeshOcean(_Algorithm):
         self._passages(parameters, context, feedback, options)
         for name, keyword, _, default, unit, _ in NUMBER_OPTIONS:
             value = self.parameterAsDouble(parameters, name, context)
-            if value != default:  # a count as 3, not 3.0, which the option refuses
-                options[keyword] = "%s%s" % (int(value) if value.is_integer() else repr(value), unit)
+            if value != default:  # a number alone as globemesh writes it (a count 3.0 as 3)
+                options[keyword] = "%r%s" % (value, unit) if unit else value
         if self.parameterAsBool(parameters, self.KEEP_INLAND_SEAS, context):
             options["keep_inland_seas"] = True
         return {k: v for k, v in options.items() if v is not None}

@@ -231,7 +231,8 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
                                                         REGION_LAYER=QgsProcessingFeatureSourceDefinition(regions.id(),
                                                                                                           True),
                                                         SIZE_REGIONS=sizes.id(), SIZE_FIELD="h",
-                                                        DEFAULT_PASSAGES=True, FEATURE_SIZE=2), context=context)
+                                                        DEFAULT_PASSAGES=True, FEATURE_SIZE=2, PASSAGE_CELLS=3),
+                           context=context)
     net = os.path.join(folder, "north_sea_net.nc")  # D-Flow FM's name ending, which picks its format
     assert {k: v for k, v in result.items() if v} == dict(out, OUTPUT_DFLOWFM=net), result
     nc = out["OUTPUT"]
@@ -245,6 +246,7 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
         lon, lat, faces = (numpy.asarray(file[v][:]) for v in ("mesh_node_lon", "mesh_node_lat", "mesh_face_nodes"))
     assert 'passages="default"' in configuration  # the world's list, found (else the run fails)
     assert "feature-size=2" in configuration and 'size-regions="' in configuration, configuration
+    assert "passage-cells=3" in configuration, configuration  # a count, not "3.0" (refused)
     # The size region: edges of about 15 km inside (km along the meridian and the parallel), over 40 km
     # off Ireland (100 km at most, shorter near the coast).
     def edge_km(where):
