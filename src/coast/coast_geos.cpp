@@ -28,23 +28,6 @@ constexpr double max_line_gap_deg = 0.5;
 constexpr std::size_t tiled_polygons = 256;
 constexpr std::size_t tile_vertices = 16'384;
 
-/// XOR of many polygonal geometries by pairwise reduction (even-odd fill of nested rings).
-GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
-    if (parts.empty())
-        return own(geos, GEOSGeom_createEmptyPolygon_r(geos.get()), "build");
-    while (parts.size() > 1) {
-        std::vector<GeomPtr> next;
-        for (std::size_t i = 0; i + 1 < parts.size(); i += 2)
-            next.push_back(own(geos,
-                               GEOSSymDifference_r(geos.get(), parts[i].get(), parts[i + 1].get()),
-                               "combine coastline rings"));
-        if (parts.size() % 2)
-            next.push_back(std::move(parts.back()));
-        parts = std::move(next);
-    }
-    return std::move(parts.front());
-}
-
 /// Union-find over polygon indices.
 using Groups = DisjointSets<std::size_t>;
 
@@ -336,7 +319,7 @@ GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const 
         GeomPtr pieces = own(geos, GEOSPolygonize_r(geos.get(), input, 1), "polygonize a line");
         faces.push_back(own(geos, GEOSUnaryUnion_r(geos.get(), pieces.get()), "union faces"));
     }
-    return symmetric_difference_all(geos, std::move(faces));
+    return parity_fill(geos, std::move(faces));
 }
 
 std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, double grid,

@@ -146,8 +146,14 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     const bool clip = near && !(options.min_island_area_km2 > 0);
     std::vector<GeomPtr> parts =
         valid_parts(geos, src.polygons, clip ? near_boxes(*near) : std::vector<Box>{});
-    if (!src.lines.empty())
-        add_wrapped(geos, make_valid(geos, polygonize_lines(geos, src.lines, where).get()), parts);
+    if (!src.lines.empty()) {
+        // each polygon wrapped alone: only those past +-180 are cut, not all the land at once
+        GeomPtr from_lines = polygonize_lines(geos, src.lines, where);
+        std::vector<const GEOSGeometry *> polys;
+        polygons_of(geos, from_lines.get(), polys);
+        for (const GEOSGeometry *p : polys)
+            add_wrapped(geos, clone(geos, p), parts);
+    }
     SnapCount snapped;
     std::vector<GeomPtr> land = dissolve(geos, parts, snap_grid_deg, snapped);
     out.polygons_joined = snapped.joined;

@@ -100,8 +100,13 @@ PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon);
 /// Polygonizes closed coastline lines (GSHHG / OSM style). Lines are first merged at shared
 /// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
 /// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the
-/// orientation of the lines does not matter and islands in lakes come out right.
+/// orientation of the lines does not matter and islands in lakes come out right. Valid output.
 GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where);
+
+/// The even-odd fill of valid polygonal faces' rings (a polygon's shell and holes alike), as
+/// their symmetric difference (ring_parity.cpp): faces whose boundaries meet are overlaid by
+/// GEOS, then every ring is a shell or a hole by how many rings hold it. Valid output.
+GeomPtr parity_fill(Geos &geos, std::vector<GeomPtr> faces);
 
 /// What snap rounding did to the land (CoastData reports it).
 struct SnapCount {

@@ -704,6 +704,39 @@ TEST(CoastHostile, closed_coastline_lines_are_polygonized) {
     expect_valid_both_stages(d, 20);
 }
 
+// Coastline lines fill as the symmetric difference of all their rings: GSHHG's Kyushu as 147
+// lines with three rings added, a lake in Kyushu and an island in it (rings apart, filled by their
+// nesting) and a rectangle across its coast (rings that cross, overlaid), against shapely's XOR of
+// the same 150 rings (the fixture's README row).
+TEST(CoastHostile, coastline_lines_fill_as_the_xor_of_their_rings) {
+    using namespace coast_detail;
+    const Source lines = read_source(fixture("coast/hostile/gshhg_i_kyushu_lines.geojson").string(),
+                                     "", "", "", "coast");
+    const Source xor_of_rings = read_source(
+        fixture("coast/hostile/gshhg_i_kyushu_xor.geojson").string(), "", "", "", "coast");
+    ASSERT_EQ(lines.lines.size(), 150u);
+    Geos geos;
+    GeomPtr fill = polygonize_lines(geos, lines.lines, "coast");
+    EXPECT_EQ(GEOSisValid_r(geos.get(), fill.get()), 1);
+    std::vector<const GEOSGeometry *> polys;
+    polygons_of(geos, fill.get(), polys);
+    EXPECT_EQ(polys.size(), xor_of_rings.polygons.size());
+    std::vector<GEOSGeometry *> expected_parts;
+    for (const PolygonRings &p : xor_of_rings.polygons)
+        expected_parts.push_back(make_polygon(geos, p).release());
+    GeomPtr expected =
+        own(geos,
+            GEOSGeom_createCollection_r(geos.get(), GEOS_MULTIPOLYGON, expected_parts.data(),
+                                        static_cast<unsigned>(expected_parts.size())),
+            "collect");
+    GeomPtr diff = own(geos, GEOSSymDifference_r(geos.get(), fill.get(), expected.get()), "diff");
+    double diff_area = -1, area = 0;
+    GEOSArea_r(geos.get(), diff.get(), &diff_area);
+    GEOSArea_r(geos.get(), expected.get(), &area);
+    EXPECT_GT(area, 3.0); // square degrees: the land, less the lake, the rectangle's XOR
+    EXPECT_LT(diff_area, 1e-12 * area);
+}
+
 // Found by fuzz_coast (tests/fuzz/corpus/fuzz_coast/regression-pole-to-pole-fold): a ring from
 // lon 200, lat 89.64 to the south pole and back folds onto itself over 180 degrees. Its arcs
 // overlap at every split, so the splitting of straying arcs doubled them each round and did not
