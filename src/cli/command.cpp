@@ -117,7 +117,8 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
     Run result;
     StageTimings timings;
     const auto t0 = std::chrono::steady_clock::now();
-    OceanMesh run = mesh_and_check(o, progress, timings, result.stats);
+    // The check and the statistics after the run take the last hundredth of the progress.
+    OceanMesh run = mesh_and_check(o, sub_progress(progress, 0, 0.99), timings, result.stats);
     // The effective configuration travels with the mesh, as the command line's files carry it.
     run.mesh.attributes.emplace_back(
         "globemesh_configuration", cli::file_configuration(command.app.config_to_str(true, false)));
@@ -151,6 +152,7 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
         if (!path.empty())
             result.inputs.emplace_back(name, absolute(path));
     result.mesh = std::move(run.mesh);
+    report(progress, 1.0, "statistics");
     return result;
 }
 

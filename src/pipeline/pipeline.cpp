@@ -412,6 +412,8 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     run.passage_cells = o.passage_cells;
     run.mesh = std::move(mesh);
     run.mesh.attributes = ocean_attributes(run);
+    // The run's end: a caller's progress bar reaches the end of the run's share.
+    globemesh::report(progress, 1.0, "mesh");
     return run;
 }
 

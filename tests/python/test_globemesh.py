@@ -192,6 +192,7 @@ class Errors(TempDir):
         missing = self.path("nowhere.gpkg")
         self.same(OSError, ["--coast", missing], coast=missing)
 
+
     def test_every_error_is_a_globemesh_error(self):
         for kind, python_kind in ((globemesh.UsageError, ValueError), (globemesh.IoError, OSError),
                                   (globemesh.DataError, RuntimeError),
@@ -347,6 +348,32 @@ class Cancel(TempDir):
             counter.join()
         # Held for the whole run, the GIL would not let the counter tick at all in between.
         self.assertGreater(len(ticks), 20)
+
+
+class Progress(TempDir):
+    """progress(fraction, stage) goes up to 1, reached at the end of each call."""
+
+    def fractions(self, run):
+        calls = []
+        run(lambda fraction, stage: calls.append(fraction))
+        return calls
+
+    def assert_up_to_one(self, calls):
+        self.assertTrue(0 <= calls[0] < 1, calls)
+        self.assertEqual(calls[-1], 1)  # the run stopped at 0.97: the mesher's share's end
+        self.assertEqual(calls, sorted(calls))
+
+    def test_a_run_and_its_write_each_end_at_one(self):
+        # Two parts in two threads, each reporting: the fractions still only go up.
+        runs = [dict(), dict(parts=2, threads=2)]
+        for options in runs:
+            mesh = []
+            self.assert_up_to_one(self.fractions(lambda p: mesh.append(globemesh.mesh_ocean(
+                LAND50, ETOPO, coast_layer="land", hmax="60km", progress=p, **options))))
+        self.assert_up_to_one(self.fractions(lambda p: mesh[0].write(
+            [self.path("o.nc"), self.path("o.gpkg")], progress=p)))
+        self.assert_up_to_one(self.fractions(lambda p: globemesh.triangulate(
+            [0, 90, 180, -90, 0], [0, 0, 0, 0, 90], progress=p)))
 
 
 class Xarray(TempDir):
