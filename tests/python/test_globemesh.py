@@ -118,6 +118,17 @@ class SameAsCommandLine(TempDir):
             cli_config = nc.getncattr("globemesh_configuration").splitlines()
         self.assertEqual(run_options(config), run_options(cli_config))
 
+    def test_a_config_file_gives_the_inputs(self):
+        # config= holds the coast as the command line's --config does: no coast keyword needed.
+        config = self.path("run.toml")
+        with open(config, "w") as f:
+            f.write('coast = "%s"\ncoast-layer = "land"\nhmax = "800km"\n' % LAND110)
+        status, err = cli("mesh", "-q", "--config", config, "-o", self.path("cli.nc"))
+        self.assertEqual(status, 0, err)
+        self.compare(globemesh.mesh_ocean(config=config), self.path("cli.nc"))
+        with self.assertRaisesRegex(ValueError, "^--coast is required"):
+            globemesh.mesh_ocean(hmax="800km")
+
     def test_write_is_the_command_lines_file(self):
         r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
         r.write([self.path("py.nc"), self.path("py.gpkg")])
