@@ -1,7 +1,10 @@
 // The `mesh` subcommand's options, one function per group of --help, and their parsing.
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 
@@ -32,6 +35,25 @@ std::array<double, 4> checked_preview_region(const std::vector<double> &r) {
         throw UsageError(flag + "W and E must differ (W > E crosses +-180)");
     return {r[0], r[1], r[2], r[3]};
 }
+
+namespace {
+
+/// --seed's check: CLI11 alone wraps -1 and saturates 2^70 into the unsigned 64-bit field.
+CLI::Validator seed_check() {
+    return CLI::Validator(
+        [](std::string &value) -> std::string {
+            std::uint64_t seed = 0;
+            const char *end = value.data() + value.size();
+            const auto [last, ec] = std::from_chars(value.data(), end, seed);
+            if (value.empty() || ec != std::errc() || last != end)
+                return "'" + value + "' is not a whole number in 0.." +
+                       std::to_string(std::numeric_limits<std::uint64_t>::max());
+            return {};
+        },
+        "");
+}
+
+} // namespace
 
 MeshCommand::MeshCommand(std::span<const Writer> table) {
     app.option_defaults()->always_capture_default();
@@ -234,7 +256,8 @@ void MeshCommand::add_mesher_options(const std::string &mesher) {
         ->type_name("N");
     app.add_option("--seed", m.seed, "Seed of every pseudo-random choice")
         ->group(mesher)
-        ->type_name("N");
+        ->type_name("N")
+        ->check(seed_check());
     app.add_option("--parts", m.parts,
                    "Mesh N lunes apart and join them (1..6; the mesh depends on N; 0, the default: "
                    "2 for a global mesh of 2e6 nodes or more, else 1)")

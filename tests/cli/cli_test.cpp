@@ -506,6 +506,14 @@ TEST(Cli, an_unknown_config_key_is_a_usage_error_naming_it) {
     }
 }
 
+TEST(Cli, seed_takes_every_unsigned_64_bit_number) {
+    for (const std::uint64_t seed : {std::uint64_t(0), std::uint64_t(18446744073709551615u)})
+        EXPECT_EQ(
+            globemesh::parse_mesh_args(std::vector<std::string>{"--seed", std::to_string(seed)})
+                .mesh.seed,
+            seed);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors: status, one line naming the option or file, no output, no library call
 
@@ -641,6 +649,16 @@ INSTANTIATE_TEST_SUITE_P(
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax"},
                   2,
                   "--hmax needs a value (LENGTH)"},
+        // The seed is an unsigned 64-bit number: CLI11 alone wrapped -1 and saturated 2^70.
+        ErrorCase{"negative_seed",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "-1"},
+                  2,
+                  "--seed: '-1' is not a whole number in 0..18446744073709551615"},
+        ErrorCase{
+            "seed_beyond_64_bits",
+            {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "18446744073709551616"},
+            2,
+            "--seed: '18446744073709551616' is not a whole number in 0..18446744073709551615"},
         ErrorCase{"region_of_three_numbers",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3"},
                   2,

@@ -203,6 +203,13 @@ class Errors(TempDir):
         missing = self.path("nowhere.gpkg")
         self.same(OSError, ["--coast", missing], coast=missing)
 
+    def test_seed_out_of_range(self):
+        # The seed is an unsigned 64-bit number: -1 and 2**70 were wrapped and cut to one.
+        for seed in (-1, 2 ** 64, 2 ** 70):
+            self.same(ValueError, ["--coast", LAND110, "--seed", str(seed)], coast=LAND110, seed=seed)
+            with self.assertRaisesRegex(ValueError, r"--seed: .* in 0\.\.18446744073709551615"):
+                globemesh.mesh_ocean(LAND110, seed=seed)
+
 
     def test_every_error_is_a_globemesh_error(self):
         for kind, python_kind in ((globemesh.UsageError, ValueError), (globemesh.IoError, OSError),
