@@ -97,10 +97,11 @@ std::string usage_text(const CLI::ParseError &e, const std::string &command) {
         std::vector<std::string> w;
         for (std::string x; rest >> x;)
             w.push_back(x);
+        // N counts values, not uses: a single value given twice, or --region's 4 given 5.
         if (w.size() == 7 && w[0] == "At" && w[1] == "Most" && w[3] == "required" &&
             w[5] == "received")
-            return name + " is given " + w[6] + " times; give it " +
-                   (w[2] == "1" ? std::string("once") : "at most " + w[2] + " times");
+            return w[2] == "1" ? name + " is given " + w[6] + " times; give it once"
+                               : name + " takes " + w[2] + " values, got " + w[6];
         if (w.size() == 7 && w[0] == "At" && w[1] == "least" && w[3] == "required" &&
             w[5] == "received")
             return name + " needs " + w[2] + " values, got " + w[6];

@@ -649,6 +649,11 @@ INSTANTIATE_TEST_SUITE_P(
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--hmax"},
                   2,
                   "--hmax needs a value (LENGTH)"},
+        // Five values are too many values, not an option given five times.
+        ErrorCase{"region_of_five_numbers",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3,4,5"},
+                  2,
+                  "--region takes 4 values, got 5"},
         // The seed is an unsigned 64-bit number: CLI11 alone wrapped -1 and saturated 2^70.
         ErrorCase{"negative_seed",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "-1"},

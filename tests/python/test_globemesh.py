@@ -203,6 +203,13 @@ class Errors(TempDir):
         missing = self.path("nowhere.gpkg")
         self.same(OSError, ["--coast", missing], coast=missing)
 
+    def test_region_of_five_values(self):
+        # Five values: too many values, not "--region is given 5 times".
+        self.same(ValueError, ["--coast", LAND110, "--region", "1,2,3,4,5"], coast=LAND110,
+                  region=(1, 2, 3, 4, 5))
+        with self.assertRaisesRegex(ValueError, "^--region takes 4 values, got 5$"):
+            globemesh.mesh_ocean(LAND110, region=(1, 2, 3, 4, 5))
+
     def test_seed_out_of_range(self):
         # The seed is an unsigned 64-bit number: -1 and 2**70 were wrapped and cut to one.
         for seed in (-1, 2 ** 64, 2 ** 70):
