@@ -1,5 +1,6 @@
 #include "cli_support.hpp"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <semaphore.h>
 #include <sys/resource.h>
@@ -358,6 +359,18 @@ bool is_gdal_special(const std::string &path) {
     return true;
 }
 
+/// The error text of creating a file in `folder`, or "" when it can: a probe file made and
+/// removed at once, as a folder can look writable (root on /proc) and take no file.
+std::string cannot_create_in(const std::filesystem::path &folder) {
+    const std::filesystem::path probe = folder / (".globemesh-probe-" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0)
+        return errno == EEXIST ? "" : std::strerror(errno);
+    ::close(fd);
+    ::unlink(probe.c_str());
+    return "";
+}
+
 } // namespace
 
 void check_output_path(const std::string &path, const std::string &what, bool overwrite) {
@@ -383,6 +396,9 @@ void check_output_path(const std::string &path, const std::string &what, bool ov
         throw IoError(what + ": " + path + " exists; use --overwrite to replace it");
     if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
         throw IoError(what + ": " + path + " is not a regular file (a socket?); give a file name");
+    if (const std::string reason = cannot_create_in(folder); !reason.empty())
+        throw IoError(what + ": " + path + ": the folder " + folder.string() +
+                      " takes no new file (" + reason + ")");
 }
 
 void check_input_path(const std::string &path, const std::string &what) {

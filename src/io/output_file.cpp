@@ -162,7 +162,8 @@ OutputFile::OutputFile(fs::path target, bool overwrite, std::string what)
 std::string OutputFile::full_disk_note(const fs::path &file) {
     const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
     struct statvfs disk {};
-    if (::statvfs(folder.c_str(), &disk) != 0)
+    // A file system of no blocks (proc, sysfs) is not full: it holds no files at all.
+    if (::statvfs(folder.c_str(), &disk) != 0 || disk.f_blocks == 0)
         return "";
     return static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize) < 1048576.0
                ? " (the disk is full)"

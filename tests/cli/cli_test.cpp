@@ -514,6 +514,12 @@ TEST(Cli, seed_takes_every_unsigned_64_bit_number) {
             seed);
 }
 
+// A file system of no blocks (proc) has 0 blocks free without being full: a failed write there
+// said "(the disk is full)".
+TEST(Cli, a_file_system_without_blocks_is_not_called_full) {
+    EXPECT_EQ(globemesh::OutputFile::full_disk_note("/proc/o.nc"), "");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors: status, one line naming the option or file, no output, no library call
 
@@ -664,6 +670,11 @@ INSTANTIATE_TEST_SUITE_P(
             {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "18446744073709551616"},
             2,
             "--seed: '18446744073709551616' is not a whole number in 0..18446744073709551615"},
+        // /proc looks writable to root but takes no file: said before the run, not "disk full".
+        ErrorCase{"output_in_a_folder_that_takes_no_file",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "/proc/o.gpkg"},
+                  1,
+                  "--gpkg: /proc/o.gpkg: the folder /proc takes no new file"},
         ErrorCase{"region_of_three_numbers",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3"},
                   2,

@@ -217,6 +217,13 @@ class Errors(TempDir):
             with self.assertRaisesRegex(ValueError, r"--seed: .* in 0\.\.18446744073709551615"):
                 globemesh.mesh_ocean(LAND110, seed=seed)
 
+    def test_write_where_no_file_can_be(self):
+        # /proc takes no file, though it looks writable to root: no "(the disk is full)".
+        r = globemesh.triangulate([0, 90, 180, -90, 0], [0, 0, 0, 0, 90])
+        for path in ("/proc/mesh.nc", "/proc/mesh.gpkg"):
+            with self.assertRaisesRegex(globemesh.IoError, "^--output: %s: the folder /proc takes no "
+                                        "new file \\(" % path):
+                r.write(path)
 
     def test_every_error_is_a_globemesh_error(self):
         for kind, python_kind in ((globemesh.UsageError, ValueError), (globemesh.IoError, OSError),
