@@ -71,6 +71,19 @@ using SrsPtr = HandlePtr<OGRSpatialReferenceH, OSRDestroySpatialReference>;
 using SrsRefPtr = HandlePtr<OGRSpatialReferenceH, OSRRelease>;
 using TransformPtr = HandlePtr<OGRCoordinateTransformationH, OCTDestroyCoordinateTransformation>;
 
+/// Opens `path` read-only as vector data. Throws IoError "WHERE: cannot open as vector data:
+/// REASON", GDAL's reason (no such file, a format it does not read) by GDAL_OF_VERBOSE_ERROR.
+inline DatasetPtr open_vector(const std::string &path, const ErrorText &where) {
+    const QuietErrors quiet;
+    DatasetPtr ds(GDALOpenEx(path.c_str(),
+                             GDAL_OF_VECTOR | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
+                             nullptr, nullptr));
+    if (!ds)
+        throw IoError(where + ": cannot open as vector data: " +
+                      last_error("not a vector format GDAL reads"));
+    return ds;
+}
+
 /// A Progress as GDAL's GDALProgressFunc, on [lo, hi] of it under the name `stage`: pass
 /// &ProgressBridge::call and the bridge's address. When the callback asks to stop, GDAL's call
 /// fails and `cancelled` tells the caller to throw Cancelled rather than an error.

@@ -38,12 +38,7 @@ void check_inputs(const CliOptions &o) {
     if (o.mesh.coast.empty())
         throw UsageError(
             "--coast is required: land polygons or coast lines, e.g. --coast land.gpkg");
-    const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
-                                                          {"--bathy", o.mesh.bathy},
-                                                          {"--region-file", o.mesh.region_file},
-                                                          {"--size-regions", o.mesh.size_regions},
-                                                          {"--config", o.config}};
-    for (const auto &[name, path] : inputs)
+    for (const auto &[name, path] : cli::mesh_input_files(o))
         cli::check_input_path(path, name);
 }
 

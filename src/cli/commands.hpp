@@ -6,6 +6,7 @@
 #include <ostream>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -75,6 +76,10 @@ struct InfoCommand {
 /// --preview-region's W,S,E,N, checked as --region is (W > E crosses +-180); one-line
 /// UsageError otherwise (mesh and convert).
 std::array<double, 4> checked_preview_region(const std::vector<double> &r);
+
+/// The input files of a `mesh` run, (option, path), unset ones empty: each must exist before
+/// the run (check_input_path) and none may be an output (check_not_an_input).
+std::vector<std::pair<std::string, std::string>> mesh_input_files(const CliOptions &o);
 
 /// The `convert` subcommand's CLI11 App and options.
 struct ConvertCommand {

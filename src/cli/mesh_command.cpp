@@ -55,6 +55,15 @@ CLI::Validator seed_check() {
 
 } // namespace
 
+std::vector<std::pair<std::string, std::string>> mesh_input_files(const CliOptions &o) {
+    return {{"--coast", o.mesh.coast},
+            {"--bathy", o.mesh.bathy},
+            {"--region-file", o.mesh.region_file},
+            {"--size-regions", o.mesh.size_regions},
+            {"--passages", o.mesh.passages},
+            {"--config", o.config}};
+}
+
 MeshCommand::MeshCommand(std::span<const Writer> table) {
     app.option_defaults()->always_capture_default();
     app.set_version_flag("--version", version_text(), "Print the version and exit");

@@ -49,12 +49,7 @@ std::vector<PlannedOutput> check_mesh_run(const CliOptions &o, std::span<const W
         }))
         throw UsageError("--preview-region zooms the PNG picture: give --preview OUT.png too");
     const auto files = output_files(planned, o.timings, o.report, table);
-    const std::pair<std::string, std::string> inputs[] = {{"--coast", o.mesh.coast},
-                                                          {"--bathy", o.mesh.bathy},
-                                                          {"--region-file", o.mesh.region_file},
-                                                          {"--size-regions", o.mesh.size_regions},
-                                                          {"--passages", o.mesh.passages},
-                                                          {"--config", o.config}};
+    const auto inputs = mesh_input_files(o);
     for (const auto &[name, path] : inputs)
         check_input_path(path, name); // (--config was read)
     check_output_files(files, inputs, o.overwrite);

@@ -106,11 +106,7 @@ void read_layer(OGRLayerH layer, const std::string &path, OGRSpatialReferenceH w
 std::vector<Passage> read_passages(const std::string &path, const std::string &layer) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
-    DatasetPtr ds(
-        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds)
-        throw IoError(where(path) +
-                      ": cannot open as vector data: " + gdal::last_error("unknown error"));
+    DatasetPtr ds = gdal::open_vector(path, where(path));
     gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(wgs84.get(), 4326);
     OSRSetAxisMappingStrategy(wgs84.get(), OAMS_TRADITIONAL_GIS_ORDER);

@@ -100,11 +100,7 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                         const std::string &layer_name, std::vector<float> &h) {
     GDALAllRegister();
     gdal::QuietErrors quiet;
-    DatasetPtr ds(
-        GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds)
-        throw IoError(option("size_regions") + " " + path +
-                      ": cannot open as vector data: " + last_message());
+    DatasetPtr ds = gdal::open_vector(path, option("size_regions") + " " + path);
 
     gdal::SrsRefPtr wgs84(OSRNewSpatialReference(nullptr));
     OSRImportFromEPSG(wgs84.get(), 4326);

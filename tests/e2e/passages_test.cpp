@@ -336,6 +336,17 @@ TEST(Passages, Errors) {
     EXPECT_EQ(run_exe(base + "--passages " + quote((dir.path() / "none.geojson").string()), out),
               1);
     EXPECT_TRUE(regex_search(out, R"(^globemesh: .*--passages.*none\.geojson)")) << out;
+    // A file that holds no vector data (a raster): GDAL's reason, not "unknown error"; the
+    // size regions are opened by the same code.
+    const std::string raster = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    for (const std::string option : {"--passages ", "--size-regions "}) {
+        EXPECT_EQ(run_exe(base + option + quote(raster), out), 1);
+        EXPECT_TRUE(regex_search(out, "^globemesh: " + option +
+                                          ".*etopo5_nwshelf_5min.tif: cannot open as vector data: "
+                                          ".*not recognized as a supported file format"))
+            << out;
+        EXPECT_EQ(out.find("unknown error"), std::string::npos) << out;
+    }
     EXPECT_EQ(run_exe(base + "--passages " + quote(land50), out), 1);
     EXPECT_TRUE(
         regex_search(out, R"(^globemesh: --passages .*Polygon.*lines drawn across straits)"))

@@ -202,6 +202,9 @@ class Errors(TempDir):
     def test_missing_file(self):
         missing = self.path("nowhere.gpkg")
         self.same(OSError, ["--coast", missing], coast=missing)
+        # The passages too are checked before the run (their reader said "unknown error").
+        self.same(OSError, ["--coast", LAND110, "--passages", missing], coast=LAND110,
+                  passages=missing)
 
     def test_region_of_five_values(self):
         # Five values: too many values, not "--region is given 5 times".
