@@ -85,9 +85,19 @@ def with_ending(path, ending):
     return (root if ext and ending.endswith(ext.lower()) else path) + ending
 
 
+def _mesh_endings():
+    """The name endings of the files QGIS's mesh reader (MDAL) has a driver for ("*.slf" in its
+    file filters: .slf and .nc, not .msh, .14, .gr3)."""
+    from qgis.core import QgsProviderRegistry
+    return tuple(p[1:].lower() for p in re.findall(r"\*\.[\w.]+", QgsProviderRegistry.instance().fileMeshFilters()))
+
+
 def loads_in_qgis(path):
-    """Whether QGIS's mesh reader (MDAL) opens the file (it reads .slf and _net.nc, not .msh, .14, .gr3),
-    without GDAL's messages about the formats it tries."""
+    """Whether QGIS's mesh reader (MDAL) opens the file, without GDAL's messages about the formats
+    it tries. A file no MDAL driver claims by its ending is not tried: MDAL prints "Unable to load
+    mesh" on stderr for it, past GDAL's error handler."""
+    if not path.lower().endswith(_mesh_endings()):
+        return False
     from osgeo import gdal
     gdal.PushErrorHandler("CPLQuietErrorHandler")
     try:
