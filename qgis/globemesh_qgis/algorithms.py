@@ -85,6 +85,15 @@ def with_ending(path, ending):
     return (root if ext and ending.endswith(ext.lower()) else path) + ending
 
 
+def output_format(path):
+    """What globemesh writes to `path`, by the name's ending as the command line picks the format
+    (src/io/writers.cpp; _net.nc is D-Flow FM's): "UGRID", "GPKG" or "model" (any other)."""
+    lower = path.lower()
+    if lower.endswith((".nc", ".nc4")) and not lower.endswith("_net.nc"):
+        return "UGRID"
+    return "GPKG" if lower.endswith(".gpkg") else "model"
+
+
 def _mesh_endings():
     """The name endings of the files QGIS's mesh reader (MDAL) has a driver for ("*.slf" in its
     file filters: .slf and .nc, not .msh, .14, .gr3)."""
@@ -198,11 +207,16 @@ class _Algorithm(QgsProcessingAlgorithm):
                    progress=_progress(feedback, RUN_SHARE, 1.0))
         nc = outputs[self.OUTPUT]
         name = os.path.splitext(os.path.basename(nc))[0]
-        shown = self._display_copy(mesh, nc, feedback)
-        self._load(shown, name if shown == nc else name + " (display)", self.OUTPUT, context, _post_processor())
-        for layer in GPKG_LAYERS if self.OUTPUT_GPKG in outputs else ():
-            self._load("%s|layername=%s" % (outputs[self.OUTPUT_GPKG], layer), "%s %s" % (name, layer),
-                       self.OUTPUT_GPKG, context, _post_processor(layer), QgsProcessingUtils.LayerHint.Vector)
+        format = output_format(nc)
+        if format == "UGRID":
+            shown = self._display_copy(mesh, nc, feedback)
+            self._load(shown, name if shown == nc else name + " (display)", self.OUTPUT, context, _post_processor())
+        elif format == "GPKG":  # the UGRID output named .gpkg: a GeoPackage, loaded as one
+            self._load_gpkg(nc, name, self.OUTPUT, context)
+        else:
+            self._load_model(nc, self.OUTPUT, srs, context, feedback)
+        if self.OUTPUT_GPKG in outputs:
+            self._load_gpkg(outputs[self.OUTPUT_GPKG], name, self.OUTPUT_GPKG, context)
         self._load_models(outputs, srs, context, feedback)
         results = {p: outputs.get(p) for p in [self.OUTPUT, self.OUTPUT_GPKG] + [m[0] for m in MODEL_OUTPUTS]}
         results[OUTPUT_FESOM2] = outputs.get(OUTPUT_FESOM2)
@@ -214,17 +228,25 @@ class _Algorithm(QgsProcessingAlgorithm):
         details.setPostProcessor(post_processor)
         context.addLayerToLoadOnCompletion(path, details)
 
+    def _load_gpkg(self, path, name, output, context):
+        """Loads the GeoPackage's layers GPKG_LAYERS, each styled."""
+        for layer in GPKG_LAYERS:
+            self._load("%s|layername=%s" % (path, layer), "%s %s" % (name, layer), output, context,
+                       _post_processor(layer), QgsProcessingUtils.LayerHint.Vector)
+
+    def _load_model(self, path, output, srs, context, feedback):
+        """Loads a model file if QGIS reads it (in its CRS: the one asked, else lon/lat); says so if not."""
+        if loads_in_qgis(path):
+            self._load(path, os.path.basename(path), output, context, _post_processor(crs=srs or WGS84))
+        else:
+            feedback.pushInfo("%s: written; QGIS's mesh reader does not open this format, so it is not loaded"
+                              % path)
+
     def _load_models(self, outputs, srs, context, feedback):
-        """Loads the model files QGIS reads (in their CRS: the one asked, else lon/lat); says which it does not."""
+        """Loads the model files asked for that QGIS reads."""
         for name, _, _, _ in MODEL_OUTPUTS:
-            path = outputs.get(name)
-            if path is None:
-                continue
-            if loads_in_qgis(path):
-                self._load(path, os.path.basename(path), name, context, _post_processor(crs=srs or WGS84))
-            else:
-                feedback.pushInfo("%s: written; QGIS's mesh reader does not open this format, so it is not loaded"
-                                  % path)
+            if outputs.get(name) is not None:
+                self._load_model(outputs[name], name, srs, context, feedback)
 
     @staticmethod
     def _display_copy(mesh, nc, feedback):

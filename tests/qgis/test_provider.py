@@ -142,6 +142,16 @@ print("OK: %d faces" % mesh.meshFaceCount())
 del mesh, layer, loads, context, feedback  # QGIS's objects go before QGIS does
 
 
+class Told(QgsProcessingFeedback):
+    """A feedback that keeps what the algorithm tells the log."""
+    def __init__(self):
+        super().__init__()
+        self.told = []
+
+    def pushInfo(self, info):  # noqa: N802 (QGIS's name)
+        self.told.append(info)
+
+
 class stderr_to:
     """Sends the process's standard error (file descriptor 2, where C libraries print) to a file."""
     def __init__(self, path):
@@ -200,7 +210,7 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
 
 # A region (as Processing writes an extent: xmin,xmax,ymin,ymax [crs]) and the selected features only:
 # with Great Britain left out of the selection, the sea covers England.
-from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition  # noqa: E402
+from qgis.core import QgsGeometry, QgsPointXY, QgsProcessingFeatureSourceDefinition, QgsProcessingUtils  # noqa: E402
 with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     england = (-2.5, 52, -1, 53.2)  # the Midlands
     for selected in (False, True):
@@ -311,6 +321,22 @@ with tempfile.TemporaryDirectory(prefix="globemesh-qgis-") as folder:
     nc = os.path.join(folder, "two_layers.nc")
     result = processing.run("globemesh:meshocean", {"COAST": two, "HMAX": 500, "OUTPUT": nc})
     assert {k: v for k, v in result.items() if v} == {"OUTPUT": nc}, result
+
+    # The mesh output named .gpkg or .msh (the format follows the name): a GeoPackage loads as its
+    # layers, a gmsh file, which QGIS's mesh reader does not open, is not loaded and the log says
+    # so (both were loaded as a mesh layer, invalid).
+    for name, expected in (("as.gpkg", ["as.gpkg|layername=boundary", "as.gpkg|layername=faces"]), ("as.msh", [])):
+        context, log = QgsProcessingContext(), Told()
+        context.setProject(project)
+        processing.run("globemesh:meshocean", {"COAST": coast.id(), "HMAX": 800, "OUTPUT": os.path.join(folder, name)},
+                       context=context, feedback=log)
+        loads = context.layersToLoadOnCompletion()
+        assert sorted(os.path.basename(p) for p in loads) == expected, sorted(loads)
+        for path in loads:
+            layer = QgsVectorLayer(path, "x", "ogr")
+            assert loads[path].layerTypeHint == QgsProcessingUtils.LayerHint.Vector and layer.featureCount() > 0
+        assert any("does not open this format, so it is not loaded" in t for t in log.told) == (not expected), log.told
+    del layer, loads, context, log
 
     # Cancelled (as the progress bar's Cancel button does): nothing written.
     cancelled = QgsProcessingFeedback()
