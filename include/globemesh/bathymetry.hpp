@@ -16,6 +16,8 @@
 // (GDAL metadata such as lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles,
 // classic global relief NetCDF grids), with a geotransform whose extent can be degrees, is read
 // as WGS 84 lon/lat (the progress stage says so, which the CLI shows with --verbose).
+// A netCDF variable stored X before Y (z(lon, lat)), which GDAL's netCDF raster driver reads
+// with its axes swapped, is read through GDAL's multidimensional view of it (2-D only).
 // A grid whose columns span 360 degrees (within a tenth of a cell: coordinates written with few
 // digits or as float32) is global, its spacing taken as exactly 360 / columns, and wraps across
 // its seam; a node-registered global grid (the last column repeats the first meridian, e.g.

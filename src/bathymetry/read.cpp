@@ -183,6 +183,66 @@ UsageError missing_band_error(GDALDatasetH ds, const std::string &path, int band
                       " (in single quotes in a shell): " + list);
 }
 
+using GroupPtr = gdal::HandlePtr<GDALGroupH, GDALGroupRelease>;
+using MdArrayPtr = gdal::HandlePtr<GDALMDArrayH, GDALMDArrayRelease>;
+
+/// A netCDF variable stored X before Y (z(lon, lat)) as GDAL's multidimensional API reads it: a
+/// classic raster with columns along X (GDALMDArrayAsClassicDataset), and the file it keeps open.
+struct XyView {
+    DatasetPtr multidim, classic;
+};
+
+/// The short name of ds's driver, "" when it has none.
+std::string driver_name(GDALDatasetH ds) {
+    GDALDriverH driver = GDALGetDatasetDriver(ds);
+    return driver ? GDALGetDriverShortName(driver) : "";
+}
+
+/// The XyView of band `band` of ds when it is a netCDF variable whose last two dimensions are X
+/// then Y (CF axes, as GDAL types them): GDAL's netCDF raster driver reads those with the axes
+/// swapped (columns along latitude). Empty for any other raster. Throws DataError for such a
+/// variable of more than two dimensions, which that view does not read (GDAL 3.6).
+XyView netcdf_xy_view(GDALDatasetH ds, int band, const std::string &path) {
+    const char *var = GDALGetMetadataItem(GDALGetRasterBand(ds, band), "NETCDF_VARNAME", nullptr);
+    char **files = GDALGetFileList(ds);
+    const std::string file = files && files[0] ? files[0] : "";
+    CSLDestroy(files);
+    if (driver_name(ds) != "netCDF" || !var || file.empty())
+        return {};
+    DatasetPtr multidim(GDALOpenEx(file.c_str(), GDAL_OF_MULTIDIM_RASTER | GDAL_OF_READONLY,
+                                   nullptr, nullptr, nullptr));
+    const GroupPtr root(multidim ? GDALDatasetGetRootGroup(multidim.get()) : nullptr);
+    const MdArrayPtr array(root ? GDALGroupOpenMDArray(root.get(), var, nullptr) : nullptr);
+    if (!array)
+        return {};
+    std::size_t n = 0;
+    GDALDimensionH *dims = GDALMDArrayGetDimensions(array.get(), &n);
+    std::vector<std::string> names, types;
+    for (std::size_t k = 0; k < n; ++k) {
+        const char *type = GDALDimensionGetType(dims[k]);
+        names.emplace_back(GDALDimensionGetName(dims[k]));
+        types.emplace_back(type ? type : "");
+    }
+    GDALReleaseDimensions(dims, n);
+    if (n < 2 || types[n - 2] != "HORIZONTAL_X" || types[n - 1] != "HORIZONTAL_Y")
+        return {};
+    if (n > 2) {
+        std::swap(names[n - 2], names[n - 1]);
+        std::string order;
+        for (const std::string &name : names)
+            order += (order.empty() ? "" : ",") + name;
+        throw DataError(option("bathy") + " " + path + ": variable " + var +
+                        " has its X dimension before its Y one and more than two dimensions, "
+                        "which GDAL does not read; reorder it, e.g. ncpdq -a " +
+                        order + " IN.nc OUT.nc");
+    }
+    DatasetPtr classic(GDALMDArrayAsClassicDataset(array.get(), 0, 1));
+    if (!classic)
+        throw IoError(option("bathy") + " " + path + ": cannot read variable " + var +
+                      " (stored X before Y): " + gdal::last_error());
+    return {std::move(multidim), std::move(classic)};
+}
+
 /// The name of a CRS and its authority code when it has one: "WGS 84 (EPSG:4326)".
 std::string srs_name(OGRSpatialReferenceH srs) {
     const char *name = OSRGetName(srs);
@@ -194,13 +254,15 @@ std::string srs_name(OGRSpatialReferenceH srs) {
 
 /// The CRS read_raster gives a raster in place of its own: --bathy-srs when set (`srs`), WGS 84
 /// lon/lat for a grid without a CRS whose axes are CF longitude and latitude (see
-/// has_cf_lonlat_axes), none otherwise. `note` says which, for the progress line.
+/// has_cf_lonlat_axes, on the file's `metadata`), none otherwise. `note` says which, for the
+/// progress line.
 struct AssignedCrs {
     DatasetPtr dataset; ///< the raster with that CRS (a VRT), or null: its own CRS stands
     std::string note;
 };
 
-AssignedCrs assign_crs(GDALDatasetH ds, const std::string &srs, const std::string &path) {
+AssignedCrs assign_crs(GDALDatasetH ds, GDALDatasetH metadata, const std::string &srs,
+                       const std::string &path) {
     OGRSpatialReferenceH own = GDALGetSpatialRef(ds);
     if (own && OSRIsLocal(own))
         own = nullptr; // a local CRS of unknown units is none
@@ -217,7 +279,7 @@ AssignedCrs assign_crs(GDALDatasetH ds, const std::string &srs, const std::strin
                 "CRS " + srs_name(parsed.get()) + " from --bathy-srs" +
                     (replaced ? ", not the file's " + srs_name(own) : "")};
     }
-    if (own || GDALGetGeoTransform(ds, gt) != CE_None || !has_cf_lonlat_axes(ds) ||
+    if (own || GDALGetGeoTransform(ds, gt) != CE_None || !has_cf_lonlat_axes(metadata) ||
         !lonlat_extent(gt, GDALGetRasterXSize(ds), GDALGetRasterYSize(ds)))
         return {};
     return {with_srs(ds, SRS_WKT_WGS84_LAT_LONG, path),
@@ -506,14 +568,18 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
     if (band < 1 || band > nbands)
         throw missing_band_error(h, path, band, nbands);
     GDALRasterBandH src_band = GDALGetRasterBand(h, band);
+    // The grid read: the file as GDAL's raster driver gives it, or for a netCDF variable stored
+    // (lon, lat) its multidimensional view (the same cells, the axes the right way round).
+    const XyView view = netcdf_xy_view(h, band, path);
+    GDALDatasetH grid = view.classic ? view.classic.get() : h;
 
     // The CRS given in place of the file's (--bathy-srs, or lon/lat for CF lon/lat axes) is
     // said on the progress line, which --verbose shows.
-    const AssignedCrs assigned = assign_crs(h, srs, path);
+    const AssignedCrs assigned = assign_crs(grid, h, srs, path);
     const std::string stage =
         assigned.dataset ? "read bathymetry (" + assigned.note + ")" : "read bathymetry";
     report(progress, 0.0, stage);
-    GDALDatasetH geo = assigned.dataset ? assigned.dataset.get() : h; // the source with its CRS
+    GDALDatasetH geo = assigned.dataset ? assigned.dataset.get() : grid; // the grid with its CRS
 
     // Scale, offset and nodata belong to the original band; the warper keeps raw values.
     int has = 0;
@@ -541,7 +607,7 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
 
     // The dataset actually read: the source, or a single-band VRT warped to lon/lat.
     DatasetPtr band_vrt, warped;
-    GDALRasterBandH read_band = src_band;
+    GDALRasterBandH read_band = GDALGetRasterBand(grid, band);
     bool warp = !is_plain_lonlat(geo, gt);
     if (warp) {
         band_vrt = single_band_vrt(geo, band, path);
@@ -552,7 +618,7 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
                             ": the warped raster has no geotransform");
         has_nodata = 0; // the warper writes NaN where there is no data
     }
-    GDALDatasetH read_ds = warped ? warped.get() : h;
+    GDALDatasetH read_ds = warped ? warped.get() : grid;
     std::size_t nx = static_cast<std::size_t>(GDALGetRasterXSize(read_ds));
     std::size_t ny = static_cast<std::size_t>(GDALGetRasterYSize(read_ds));
 

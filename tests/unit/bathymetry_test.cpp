@@ -1237,3 +1237,106 @@ TEST(Bathymetry, coverage_is_that_of_the_ocean_of_the_region_file_or_box) {
     o.bathy_fill_m = 20.0; // the fill answers for the rest
     EXPECT_NO_THROW(read_bathymetry(o, {}, &ocean));
 }
+
+namespace {
+
+/// ETOPO5 (the fixture) rewritten with netCDF-C as elevation(lon, lat): X before Y, as some CF
+/// writers store it, every third row and column to keep it small, its CRS variable kept; with
+/// `time` a leading dimension of one step. Returns the source's lon, lat and values read there.
+struct Etopo5Sample {
+    std::vector<double> lon, lat;
+    std::vector<float> z; // z[j * lon.size() + i] at (lon[i], lat[j])
+};
+
+Etopo5Sample write_etopo5_lon_lat(const std::string &path, bool time) {
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    int nc = -1, lon_id, lat_id, z_id;
+    std::vector<double> lon(2160), lat(1080);
+    std::vector<float> z(2160 * 1080);
+    EXPECT_EQ(nc_open(source.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    nc_inq_varid(nc, "lon", &lon_id);
+    nc_inq_varid(nc, "lat", &lat_id);
+    nc_inq_varid(nc, "elevation", &z_id);
+    nc_get_var_double(nc, lon_id, lon.data());
+    nc_get_var_double(nc, lat_id, lat.data());
+    EXPECT_EQ(nc_get_var_float(nc, z_id, z.data()), NC_NOERR);
+    nc_close(nc);
+    Etopo5Sample s;
+    for (std::size_t i = 1; i < 2160; i += 3)
+        s.lon.push_back(lon[i]);
+    for (std::size_t j = 1; j < 1080; j += 3)
+        s.lat.push_back(lat[j]);
+    for (std::size_t j = 1; j < 1080; j += 3)
+        for (std::size_t i = 1; i < 2160; i += 3)
+            s.z.push_back(z[j * 2160 + i]);
+    std::vector<float> transposed(s.z.size()); // [i * nlat + j]
+    for (std::size_t j = 0; j < s.lat.size(); ++j)
+        for (std::size_t i = 0; i < s.lon.size(); ++i)
+            transposed[i * s.lat.size() + j] = s.z[j * s.lon.size() + i];
+    int out = -1, dims[3], t_id, crs_id;
+    EXPECT_EQ(nc_create(path.c_str(), NC_CLOBBER | NC_NETCDF4, &out), NC_NOERR);
+    nc_def_dim(out, "time", 1, &dims[0]);
+    nc_def_dim(out, "lon", s.lon.size(), &dims[1]);
+    nc_def_dim(out, "lat", s.lat.size(), &dims[2]);
+    nc_def_var(out, "time", NC_DOUBLE, 1, &dims[0], &t_id);
+    nc_def_var(out, "lon", NC_DOUBLE, 1, &dims[1], &lon_id);
+    nc_def_var(out, "lat", NC_DOUBLE, 1, &dims[2], &lat_id);
+    nc_def_var(out, "crs", NC_INT, 0, nullptr, &crs_id);
+    EXPECT_EQ(nc_def_var(out, "elevation", NC_FLOAT, time ? 3 : 2, time ? dims : dims + 1, &z_id),
+              NC_NOERR);
+    auto text = [&](int id, const char *k, const std::string &v) {
+        nc_put_att_text(out, id, k, v.size(), v.c_str());
+    };
+    text(t_id, "units", "days since 2000-01-01");
+    text(lon_id, "standard_name", "longitude");
+    text(lon_id, "units", "degrees_east");
+    text(lat_id, "standard_name", "latitude");
+    text(lat_id, "units", "degrees_north");
+    text(crs_id, "grid_mapping_name", "latitude_longitude");
+    const double a = 6378137, rf = 298.257223563;
+    nc_put_att_double(out, crs_id, "semi_major_axis", NC_DOUBLE, 1, &a);
+    nc_put_att_double(out, crs_id, "inverse_flattening", NC_DOUBLE, 1, &rf);
+    text(z_id, "grid_mapping", "crs");
+    text(z_id, "units", "m");
+    EXPECT_EQ(nc_enddef(out), NC_NOERR);
+    const double t0 = 0;
+    nc_put_var_double(out, t_id, &t0);
+    nc_put_var_double(out, lon_id, s.lon.data());
+    nc_put_var_double(out, lat_id, s.lat.data());
+    EXPECT_EQ(nc_put_var_float(out, z_id, transposed.data()), NC_NOERR);
+    EXPECT_EQ(nc_close(out), NC_NOERR);
+    return s;
+}
+
+} // namespace
+
+// A CF variable stored elevation(lon, lat) is a valid grid that ncview, xarray and GDAL's
+// multidimensional API read with X along longitude; GDAL's netCDF raster driver swaps its axes
+// (columns along latitude: Hawaii read 5 km off). Read the right way round, it equals the
+// source at every cell centre; with a further dimension it is refused saying how to reorder.
+TEST(Bathymetry, a_netcdf_variable_stored_lon_lat_is_read_with_its_axes_the_right_way) {
+    TempDir dir;
+    const std::string path = (dir / "etopo5_lon_lat.nc").string();
+    const Etopo5Sample s = write_etopo5_lon_lat(path, false);
+    Raster r = read_raster(path, 1, false, {}, RasterLimits{});
+    EXPECT_EQ(r.nlon(), s.lon.size());
+    EXPECT_EQ(r.nlat(), s.lat.size());
+    EXPECT_TRUE(r.global());
+    for (std::size_t j = 0; j < s.lat.size(); j += 7)
+        for (std::size_t i = 0; i < s.lon.size(); i += 5)
+            ASSERT_NEAR(r.elevation_m(s.lon[i], s.lat[j]), s.z[j * s.lon.size() + i], 1e-6)
+                << s.lon[i] << " " << s.lat[j];
+    // Between cells: bilinear between the four source values.
+    const std::size_t i = 300, j = 200, n = s.lon.size();
+    const double x = s.lon[i] + 0.25 * (s.lon[i + 1] - s.lon[i]),
+                 y = s.lat[j] + 0.5 * (s.lat[j + 1] - s.lat[j]);
+    const double expect = 0.75 * 0.5 * s.z[j * n + i] + 0.25 * 0.5 * s.z[j * n + i + 1] +
+                          0.75 * 0.5 * s.z[(j + 1) * n + i] + 0.25 * 0.5 * s.z[(j + 1) * n + i + 1];
+    EXPECT_NEAR(r.elevation_m(x, y), expect, 1e-3);
+
+    const std::string timed = (dir / "etopo5_time_lon_lat.nc").string();
+    write_etopo5_lon_lat(timed, true);
+    const std::string m = test::thrown_message<DataError>(
+        [&] { read_raster(timed, 1, false, {}, RasterLimits{}); }, "a 3-D lon, lat variable");
+    EXPECT_NE(m.find("ncpdq -a time,lat,lon"), std::string::npos) << m;
+}
