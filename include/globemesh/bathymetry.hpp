@@ -11,7 +11,9 @@
 // south-up) geotransform is read as is, longitudes in 0..360 or -180..180 alike. Any other
 // raster (projected, rotated, or geographic on another datum, prime meridian or unit: NAD27,
 // ED50, a Paris meridian) is read through an in-memory warped VRT to EPSG:4326 (GDALWarp,
-// bilinear, exact transformer -et 0, NaN outside the source footprint). bathy_srs replaces the
+// bilinear, exact transformer -et 0, over the source's whole extent, NaN outside the source
+// footprint but in the cells just off it, which hold their neighbours' mean as a plain raster
+// holds its edge values past its edge). bathy_srs replaces the
 // file's CRS (or gives one). A file without a CRS whose coordinates are CF longitude and latitude
 // (GDAL metadata such as lon#standard_name=longitude or lat#units=degrees_north: CUDEM tiles,
 // classic global relief NetCDF grids), with a geotransform whose extent can be degrees, is read

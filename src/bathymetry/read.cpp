@@ -13,6 +13,7 @@
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal.h>
+#include <gdal_alg.h>
 #include <gdal_utils.h>
 #include <ogr_srs_api.h>
 
@@ -363,24 +364,44 @@ double finest_lonlat_step(GDALDatasetH ds) {
     return best;
 }
 
-/// ds warped to EPSG:4326 as a lazy in-memory VRT: bilinear, exact transformer, Float32 with NaN
-/// where the source has no data or no coverage, at the source's finest pixel size.
-DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
-    // All digits: std::to_string's six decimals cut 1/12 degree to 0.083333, 1 arc second by 0.1%.
-    const double cell = geographic_cell_deg(ds), step = cell > 0 ? cell : finest_lonlat_step(ds);
-    char res[32];
-    std::snprintf(res, sizeof res, "%.17g", step);
+/// Where a raster warped to lon/lat has cells: GDAL's transformer from lon/lat (EPSG:4326) to
+/// the source's pixel positions, as the warper uses it.
+class Footprint {
+public:
+    explicit Footprint(GDALDatasetH source)
+        : nx_(GDALGetRasterXSize(source)), ny_(GDALGetRasterYSize(source)) {
+        StringList options{"DST_SRS=EPSG:4326"};
+        transformer_.reset(GDALCreateGenImgProjTransformer2(source, nullptr, options.get()));
+    }
+    /// GDAL's transformer (GDALGenImgProjTransform's argument), null when GDAL made none.
+    void *transformer() const { return transformer_.get(); }
+    /// True when (lon, lat) degrees lies on a cell of the source (or on its edge).
+    bool contains(double lon, double lat) const {
+        if (!transformer_)
+            return true; // no transformer: the warp made none either, and failed before
+        double x = lon, y = lat, z = 0;
+        int ok = 0;
+        GDALGenImgProjTransform(transformer_.get(), TRUE, 1, &x, &y, &z, &ok);
+        return ok && x >= 0 && x <= nx_ && y >= 0 && y <= ny_;
+    }
+
+private:
+    int nx_, ny_;
+    std::unique_ptr<void, gdal::Deleter<GDALDestroyGenImgProjTransformer>> transformer_;
+};
+
+/// ds warped to EPSG:4326 by GDALWarp as a lazy in-memory VRT: bilinear, exact transformer,
+/// Float32 with NaN where the source has no data or no coverage, and the options `extra`.
+DatasetPtr warp_vrt(GDALDatasetH ds, const std::vector<std::string> &extra,
+                    const std::string &path) {
     // XSCALE/YSCALE 1: the plain 2 x 2 kernel in every block. GDAL widens it by a block's source
     // window over its own size, which a block across a global raster's seam takes for a 4-fold
     // downsampling (ETOPO5 in ED50: 2 km off at Hawaii).
     StringList argv{"-of", "VRT",      "-t_srs", "EPSG:4326", "-r",         "bilinear",
                     "-et", "0",        "-ot",    "Float32",   "-dstnodata", "nan",
                     "-wo", "XSCALE=1", "-wo",    "YSCALE=1"};
-    if (step > 0) {
-        argv.add("-tr");
-        argv.add(res);
-        argv.add(res);
-    }
+    for (const std::string &item : extra)
+        argv.add(item.c_str());
     GDALWarpAppOptions *opts = GDALWarpAppOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
     GDALDatasetH src = ds;
@@ -390,6 +411,62 @@ DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
         throw DataError(option("bathy") + " " + path +
                         ": cannot reproject to lon/lat (EPSG:4326): " + gdal::last_error());
     return out;
+}
+
+/// v with all its digits: std::to_string's six decimals cut 1/12 degree to 0.083333, 1 arc
+/// second by 0.1%.
+std::string all_digits(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+/// ds warped to EPSG:4326 (warp_vrt) at the source's finest pixel size, over the source's extent
+/// in lon/lat (GDALSuggestedWarpOutput2, as GDALWarp computes it) with its pixels rounded up to
+/// whole steps: GDALWarp rounds them to the nearest, cutting up to half a step off the east and
+/// south edges of the source.
+DatasetPtr warped_to_lonlat(GDALDatasetH ds, const std::string &path) {
+    const double cell = geographic_cell_deg(ds), step = cell > 0 ? cell : finest_lonlat_step(ds);
+    const Footprint footprint(ds);
+    double gt[6], extent[4];
+    int px = 0, py = 0;
+    if (!(step > 0) || !footprint.transformer() ||
+        GDALSuggestedWarpOutput2(ds, GDALGenImgProjTransform, footprint.transformer(), gt, &px, &py,
+                                 extent, 0) != CE_None)
+        return warp_vrt(ds, {}, path);
+    const double west = extent[0], south = extent[1], east = extent[2], north = extent[3];
+    // Rounded up; 1e-6 of a step absorbs the rounding of an extent that is whole steps.
+    const double cols = std::ceil((east - west) / step - 1e-6),
+                 rows = std::ceil((north - south) / step - 1e-6);
+    const std::string res = all_digits(step);
+    return warp_vrt(ds,
+                    {"-tr", res, res, "-te", all_digits(west), all_digits(north - rows * step),
+                     all_digits(west + cols * step), all_digits(north)},
+                    path);
+}
+
+/// Gives the cells of a warped grid (bx x by, cell (0, 0) centred at lon0, lat0) that lie just
+/// off the source's footprint the mean of their neighbours that have data, as a plain raster
+/// holds its edge values past its edge: the warper leaves a cell without data when its centre
+/// falls off the source, so a point on the source nearest such a cell would have none. Cells
+/// without data on the footprint (the source's nodata) stay so.
+void hold_footprint_edge(std::vector<float> &values, std::size_t bx, std::size_t by, double lon0,
+                         double lat0, double dlon, double dlat, const Footprint &footprint) {
+    const std::vector<float> read = values;
+    for (std::size_t j = 0; j < by; ++j)
+        for (std::size_t i = 0; i < bx; ++i) {
+            if (!std::isnan(read[j * bx + i]))
+                continue;
+            double sum = 0;
+            int n = 0;
+            for (std::size_t jj = j ? j - 1 : 0; jj <= std::min(by - 1, j + 1); ++jj)
+                for (std::size_t ii = i ? i - 1 : 0; ii <= std::min(bx - 1, i + 1); ++ii)
+                    if (const float v = read[jj * bx + ii]; !std::isnan(v))
+                        sum += v, ++n;
+            if (n > 0 && !footprint.contains(lon0 + static_cast<double>(i) * dlon,
+                                             lat0 + static_cast<double>(j) * dlat))
+                values[j * bx + i] = static_cast<float>(sum / n);
+        }
 }
 
 /// Columns [c_lo, c_hi) and rows [r_lo, r_hi) of an nx x ny lon/lat raster (geotransform gt,
@@ -681,6 +758,9 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
 
     const double west = gt[0] + static_cast<double>(c0) * gt[1],
                  top = gt[3] + static_cast<double>(r0) * gt[5];
+    if (warp)
+        hold_footprint_edge(values, bx, by, west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat,
+                            Footprint(band_vrt.get()));
     Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
     if (raster.valid_count() == 0)
         throw DataError(option("bathy") + " " + path + ": band " + std::to_string(band) +

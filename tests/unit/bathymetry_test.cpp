@@ -814,22 +814,35 @@ TEST(Bathymetry, bathy_srs_replaces_a_wrong_declared_crs) {
 
 namespace {
 
-/// gdal_translate `args` `source` `path`, as the sweep made its variants of the fixtures.
-void translate(const std::string &source, const std::string &path,
-               const std::vector<std::string> &args) {
+/// Opens `source`, writes `path` from it with `make` (a GDAL utility), closes both.
+void gdal_app(const std::string &source, const std::string &path,
+              const std::function<GDALDatasetH(GDALDatasetH)> &make) {
     GDALAllRegister();
-    char **argv = nullptr;
-    for (const std::string &a : args)
-        argv = CSLAddString(argv, a.c_str());
-    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv, nullptr);
-    CSLDestroy(argv);
     GDALDatasetH src = GDALOpen(source.c_str(), GA_ReadOnly);
     ASSERT_NE(src, nullptr) << source;
-    GDALDatasetH out = GDALTranslate(path.c_str(), src, opts, nullptr);
-    GDALTranslateOptionsFree(opts);
+    GDALDatasetH out = make(src);
     GDALClose(src);
     ASSERT_NE(out, nullptr) << path;
     GDALClose(out);
+}
+
+/// `args` as a GDAL argv list (CSLDestroy frees it).
+char **argv_of(const std::vector<std::string> &args) {
+    char **argv = nullptr;
+    for (const std::string &a : args)
+        argv = CSLAddString(argv, a.c_str());
+    return argv;
+}
+
+/// gdal_translate `args` `source` `path`, as the sweep made its variants of the fixtures.
+void translate(const std::string &source, const std::string &path,
+               const std::vector<std::string> &args) {
+    char **argv = argv_of(args);
+    GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv, nullptr);
+    CSLDestroy(argv);
+    gdal_app(source, path,
+             [&](GDALDatasetH src) { return GDALTranslate(path.c_str(), src, opts, nullptr); });
+    GDALTranslateOptionsFree(opts);
 }
 
 /// (lon, lat) in degrees from the geographic CRS `from` to `to` (EPSG codes) by PROJ, as GDAL's
@@ -1339,4 +1352,66 @@ TEST(Bathymetry, a_netcdf_variable_stored_lon_lat_is_read_with_its_axes_the_righ
     const std::string m = test::thrown_message<DataError>(
         [&] { read_raster(timed, 1, false, {}, RasterLimits{}); }, "a 3-D lon, lat variable");
     EXPECT_NE(m.find("ncpdq -a time,lat,lon"), std::string::npos) << m;
+}
+
+namespace {
+
+/// gdalwarp `args` `source` `path` (GeoTIFF), as a user reprojects a raster.
+void warp(const std::string &source, const std::string &path,
+          const std::vector<std::string> &args) {
+    char **argv = argv_of(args);
+    GDALWarpAppOptions *opts = GDALWarpAppOptionsNew(argv, nullptr);
+    CSLDestroy(argv);
+    gdal_app(source, path, [&](GDALDatasetH src) {
+        return GDALWarp(path.c_str(), nullptr, 1, &src, opts, nullptr);
+    });
+    GDALWarpAppOptionsFree(opts);
+}
+
+} // namespace
+
+// ETOPO5's north-west shelf (the fixture) warped to UTM 31N at 10 km (gdalwarp), as a user's
+// projected raster comes. Read, it has a depth up to the source's edges: at points 2% of a
+// pixel inside its outline (moved to lon/lat by PROJ) within the range of the source pixels
+// around them. 79 of these 204 points had none: the warper leaves a lon/lat cell without data
+// when its centre falls off the source, and GDALWarp's -tr rounded the lon/lat grid's size to
+// the nearest step, cutting 0.48 of a step off its east edge.
+TEST(Bathymetry, a_projected_raster_is_read_up_to_its_edges) {
+    TempDir dir;
+    const std::string path = (dir / "nwshelf_utm31.tif").string();
+    warp(fixture("bathy/etopo5_nwshelf_5min.tif").string(), path,
+         {"-t_srs", "EPSG:32631", "-r", "bilinear", "-tr", "10000", "10000", "-te", "200000",
+          "5300000", "640000", "6600000"});
+    const int nx = 44, ny = 130;
+    std::vector<double> z(nx * ny);
+    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, nx, ny, z.data(), nx, ny,
+                           GDT_Float64, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    Raster r = read_raster(path, 1, false, {}, RasterLimits{});
+    int tested = 0;
+    auto check = [&](double px, double py) {
+        const double x = 200000 + 10000 * px, y = 6600000 - 10000 * py;
+        const LonLat p = transformed(32631, 4326, {x, y}, {-3, 47, 7, 60});
+        double lo = 1e9, hi = -1e9;
+        for (int j = std::max(0, int(py) - 2); j <= std::min(ny - 1, int(py) + 2); ++j)
+            for (int i = std::max(0, int(px) - 2); i <= std::min(nx - 1, int(px) + 2); ++i)
+                lo = std::min(lo, z[j * nx + i]), hi = std::max(hi, z[j * nx + i]);
+        const double v = r.elevation_m(p.lon, p.lat);
+        EXPECT_TRUE(v >= lo - 1e-3 && v <= hi + 1e-3)
+            << v << " at " << p.lon << " " << p.lat << " (pixel " << px << " " << py << ")";
+        ++tested;
+    };
+    for (double t = 0.01; t < 1; t += 0.02) {
+        check(0.02, t * ny);
+        check(nx - 0.02, t * ny);
+        check(t * nx, 0.02);
+        check(t * nx, ny - 0.02);
+    }
+    for (double px : {0.02, nx - 0.02})
+        for (double py : {0.02, ny - 0.02})
+            check(px, py); // the north-east corner is the source's easternmost point
+    EXPECT_EQ(tested, 204);
 }
