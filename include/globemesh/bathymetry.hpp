@@ -222,8 +222,11 @@ inline RasterLimits bathymetry_limits(const MeshOptions &options, const Boundary
 /// or region_file) the region is that ocean: the raster must hold every point of its outline
 /// (a point a quarter of a cell apart along the great-circle segments) and a pole inside it;
 /// land in the region needs no raster. Without: region's box, or the whole globe.
-/// Throws as read_raster, and DataError (naming a point not covered) when the raster covers
-/// only part of the region and no bathy_fill_m is set. Messages name options by field.
+/// Throws as read_raster, and DataError (naming a point not covered, and the whole raster's
+/// lon/lat extent) when the raster covers only part of the region and no bathy_fill_m is set;
+/// a warped raster covers a point within about a cell of its source's cells (its footprint,
+/// through GDAL's transformer), so a rotated or projected raster is refused here, before any
+/// meshing, for an ocean inside its lon/lat box but off its cells. Messages name options by field.
 Raster read_bathymetry(const BathymetryOptions &options, const BathymetryContext &context,
                        const Progress &progress = {}, const Boundary *ocean = nullptr);
 

@@ -469,6 +469,14 @@ void hold_footprint_edge(std::vector<float> &values, std::size_t bx, std::size_t
         }
 }
 
+/// The lon/lat edges of an nx x ny north- or south-up raster of geotransform gt, latitudes
+/// within the poles.
+LonLatBounds grid_bounds(const double gt[6], std::size_t nx, std::size_t ny) {
+    const double lat_a = gt[3], lat_b = gt[3] + static_cast<double>(ny) * gt[5];
+    return {gt[0], std::max(-90.0, std::min(lat_a, lat_b)), gt[0] + static_cast<double>(nx) * gt[1],
+            std::min(90.0, std::max(lat_a, lat_b))};
+}
+
 /// Columns [c_lo, c_hi) and rows [r_lo, r_hi) of an nx x ny lon/lat raster (geotransform gt,
 /// not rotated) that cover box b and a margin of three cells (the raster's own, or min_cell_deg
 /// when larger). The box is taken at whichever of its 360-degree shifts meets the raster most;
@@ -625,8 +633,20 @@ private:
     bool set_ = false;
 };
 
-Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
-                   const RasterLimits &limits, const std::string &srs) {
+namespace {
+
+/// A raster as read_source reads it: the lon/lat grid of the window read, the lon/lat extent of
+/// the whole raster, and for one warped to lon/lat where its source has cells.
+struct SourceRaster {
+    Raster raster;
+    LonLatBounds extent;
+    std::shared_ptr<const Footprint> footprint; ///< null for a plain lon/lat raster
+};
+
+/// read_raster, with the extent and footprint read_bathymetry checks the coverage with.
+SourceRaster read_source(const std::string &path, int band, bool depth_positive,
+                         const Progress &progress, const RasterLimits &limits,
+                         const std::string &srs) {
     // GDAL's netCDF driver under the process's netCDF lock too: its own mutex does not keep it
     // from this process's writers (netcdf_lock.hpp).
     const NetcdfLock netcdf(netcdf_mutex());
@@ -707,6 +727,7 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
         gt[0] = first_centre - 0.5 * gt[1];
         nx = n;
     }
+    const LonLatBounds extent = grid_bounds(gt, nx, ny);
 
     // The window of limits.window: columns c0 .. c0 + nx - 1 and rows r0 .. r0 + ny - 1.
     std::size_t c0 = 0, r0 = 0;
@@ -758,15 +779,25 @@ Raster read_raster(const std::string &path, int band, bool depth_positive, const
 
     const double west = gt[0] + static_cast<double>(c0) * gt[1],
                  top = gt[3] + static_cast<double>(r0) * gt[5];
-    if (warp)
+    std::shared_ptr<const Footprint> footprint;
+    if (warp) {
+        footprint = std::make_shared<const Footprint>(band_vrt.get());
         hold_footprint_edge(values, bx, by, west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat,
-                            Footprint(band_vrt.get()));
+                            *footprint);
+    }
     Raster raster(west + 0.5 * dlon, top + 0.5 * dlat, dlon, dlat, bx, by, std::move(values));
     if (raster.valid_count() == 0)
         throw DataError(option("bathy") + " " + path + ": band " + std::to_string(band) +
                         " holds no valid value (all nodata)");
     report(progress, 1.0, stage);
-    return raster;
+    return {std::move(raster), extent, std::move(footprint)};
+}
+
+} // namespace
+
+Raster read_raster(const std::string &path, int band, bool depth_positive, const Progress &progress,
+                   const RasterLimits &limits, const std::string &srs) {
+    return read_source(path, band, depth_positive, progress, limits, srs).raster;
 }
 
 void validate_bathy_srs(const std::string &srs) {
@@ -815,17 +846,34 @@ double outside_deg(const LonLatBounds &b, double lon, double lat) {
     return std::max(dlat, dlon);
 }
 
+/// True when s covers (lon, lat): inside its grid and, for a warped raster, within about a
+/// cell of its source's footprint (the point or a corner of the 3 x 3 cells round it on it),
+/// where hold_footprint_edge gives the nearest cell data. A point refused here has none.
+bool is_covered(const SourceRaster &s, double lon, double lat) {
+    if (!s.raster.contains(lon, lat))
+        return false;
+    if (!s.footprint || s.footprint->contains(lon, lat))
+        return true;
+    const double hx = 1.5 * s.raster.dlon_deg(), hy = 1.5 * std::abs(s.raster.dlat_deg());
+    for (const double dx : {-hx, hx})
+        for (const double dy : {-hy, hy})
+            if (s.footprint->contains(lon + dx, std::clamp(lat + dy, -90.0, 90.0)))
+                return true;
+    return false;
+}
+
 /// The point of the ocean's outline (its rings' nodes, and on segments longer than a raster
 /// cell points a quarter of a cell apart, as the great-circle arcs bulge) or a pole inside it
-/// that r does not cover, farthest outside r; nullopt when r covers them all.
-std::optional<LonLat> uncovered_point(const Raster &r, const Boundary &ocean) {
+/// that s does not cover, farthest outside its grid; nullopt when s covers them all.
+std::optional<LonLat> uncovered_point(const SourceRaster &s, const Boundary &ocean) {
+    const Raster &r = s.raster;
     const double cell = std::min(r.dlon_deg(), std::abs(r.dlat_deg())) * deg_to_rad,
                  step = 0.25 * cell;
     const LonLatBounds b = r.bounds();
     std::optional<LonLat> worst;
     double worst_deg = -1;
     auto check = [&](const LonLat &p) {
-        if (r.contains(p.lon, p.lat))
+        if (is_covered(s, p.lon, p.lat))
             return;
         if (const double d = outside_deg(b, p.lon, p.lat); d > worst_deg)
             worst_deg = d, worst = p;
@@ -857,28 +905,33 @@ Raster read_bathymetry(const BathymetryOptions &o, const BathymetryContext &cont
         throw UsageError(option("bathy") + ": no raster given");
     if (o.bathy_fill_m && !std::isfinite(*o.bathy_fill_m))
         throw UsageError(option("bathy_fill_m") + " must be a depth in metres");
-    Raster r = read_raster(o.bathy, o.bathy_band, o.depth_positive, progress,
-                           bathymetry_limits(context, ocean), o.bathy_srs);
+    SourceRaster source = read_source(o.bathy, o.bathy_band, o.depth_positive, progress,
+                                      bathymetry_limits(context, ocean), o.bathy_srs);
+    Raster &r = source.raster;
     if (o.bathy_fill_m) {
         r.set_fill_elevation_m(-*o.bathy_fill_m);
-        return r;
+        return std::move(r);
     }
-    const LonLatBounds b = r.bounds();
-    const ErrorText covers = option("bathy") + " " + o.bathy + ": covers only lon " +
-                             fmt_deg(b.west) + ".." + fmt_deg(b.east) + ", lat " +
-                             fmt_deg(b.south) + ".." + fmt_deg(b.north);
+    // The whole raster's extent, not the window read; a warped one's cells fill only part of it.
+    const LonLatBounds &b = source.extent;
+    const ErrorText covers =
+        option("bathy") + " " + o.bathy + ": covers only lon " + fmt_deg(b.west) + ".." +
+        fmt_deg(b.east) + ", lat " + fmt_deg(b.south) + ".." + fmt_deg(b.north) +
+        (source.footprint ? ErrorText(" (its cells, rotated or in another CRS, fill only part of "
+                                      "that box)")
+                          : ErrorText(""));
     const ErrorText remedy = "; pass " + option("bathy_fill_m") + " DEPTH for the rest, or a " +
                              option("region") + " or " + option("region_file") +
                              " inside the raster";
     // A region's ocean, as the coast stage cut it: its outline (a pole inside it) in the raster.
     if (ocean && !ocean->rings.empty() && (context.region || !context.region_file.empty())) {
-        if (const auto p = uncovered_point(r, *ocean))
+        if (const auto p = uncovered_point(source, *ocean))
             throw DataError(covers + " but the ocean of " +
                             (context.region ? option("region")
                                             : option("region_file") + " " + context.region_file) +
                             " reaches lon " + fmt_deg(p->lon) + ", lat " + fmt_deg(p->lat) +
                             remedy);
-        return r;
+        return std::move(r);
     }
     // Coverage of the region (the whole globe without --region), on a dense set of points.
     double w = -180, s = -90, e = 180, n = 90;
@@ -895,15 +948,16 @@ Raster read_bathymetry(const BathymetryOptions &o, const BathymetryContext &cont
     for (int k = 0; k <= steps && covered; ++k) {
         double lon = w + (e - w) * k / steps;
         double lat = s + (n - s) * k / steps;
-        covered = r.contains(lon, 0.5 * (s + n)) && r.contains(0.5 * (w + e), lat) &&
-                  r.contains(lon, s) && r.contains(lon, n);
+        covered = is_covered(source, lon, 0.5 * (s + n)) &&
+                  is_covered(source, 0.5 * (w + e), lat) && is_covered(source, lon, s) &&
+                  is_covered(source, lon, n);
     }
     if (!covered)
         throw DataError(covers +
                         (context.region ? " but not all of " + option("region")
                                         : ErrorText(" but the region is the whole globe")) +
                         remedy);
-    return r;
+    return std::move(r);
 }
 
 } // namespace globemesh

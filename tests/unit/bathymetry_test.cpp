@@ -1415,3 +1415,61 @@ TEST(Bathymetry, a_projected_raster_is_read_up_to_its_edges) {
             check(px, py); // the north-east corner is the source's easternmost point
     EXPECT_EQ(tested, 204);
 }
+
+// ETOPO5's north-west shelf (the fixture) with rotation terms in its geotransform (a copy whose
+// columns run 0.01 degree north-east of east, its rows 0.005 east of south): its cells fill a
+// parallelogram inside its lon/lat box. An ocean reaching the box's empty corner is refused
+// as the raster is read, before any meshing, naming a point off the parallelogram; one on
+// it is read. At main the box alone was checked and the mesh stage ran before the nodes off
+// the parallelogram were found without data.
+TEST(Bathymetry, a_rotated_raster_not_covering_the_ocean_is_refused_as_it_is_read) {
+    TempDir dir;
+    const std::string path = (dir / "nwshelf_rotated.tif").string();
+    translate(fixture("bathy/etopo5_nwshelf_5min.tif").string(), path, {"-of", "GTiff"});
+    GDALDatasetH ds = GDALOpen(path.c_str(), GA_Update);
+    ASSERT_NE(ds, nullptr);
+    double gt[6] = {-12.041666666666666, 1.0 / 12, 0.01, 62.041666666666664, 0.005, -1.0 / 12};
+    const std::string wkt = GDALGetProjectionRef(ds); // a rotated GeoTIFF writes both anew
+    ASSERT_EQ(GDALSetGeoTransform(ds, gt), CE_None);
+    ASSERT_EQ(GDALSetProjection(ds, wkt.c_str()), CE_None);
+    GDALClose(ds);
+    MeshOptions o = options_for(path);
+    o.region = std::array<double, 4>{-11.5, 50, 0, 58};
+    // The west edge of the cells (pixel column 0) at 50 N: x = gt0 + py * gt2, py from y.
+    const double py = (50 - gt[3]) / gt[5], west_at_50 = gt[0] + py * gt[2];
+    ASSERT_GT(west_at_50, -11.5 + 0.5); // the ring's corner lies half a degree off the cells
+    Boundary ocean;
+    ocean.rings.push_back(ring_of({{-11.5, 50}, {0, 50}, {0, 58}, {-11.5, 58}}));
+    const std::string m =
+        test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); }, "rotated");
+    EXPECT_NE(m.find("fill only part of that box"), std::string::npos) << m;
+    EXPECT_NE(m.find("reaches lon -11.5, lat"), std::string::npos) << m;
+    o.region = std::array<double, 4>{-9, 50, 0, 58};
+    ocean.rings[0] = ring_of({{-9, 50}, {0, 50}, {0, 58}, {-9, 58}});
+    EXPECT_NO_THROW(read_bathymetry(o, {}, &ocean));
+}
+
+// A region reaching south of ETOPO5's north-west shelf (the fixture, 45.96 N to 62.04 N): the
+// refusal gives the raster's extent as gdalinfo does, not the window read for the region.
+TEST(Bathymetry, the_coverage_error_gives_the_rasters_own_extent) {
+    const std::string path = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    GDALAllRegister();
+    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
+    ASSERT_NE(ds, nullptr);
+    double gt[6];
+    ASSERT_EQ(GDALGetGeoTransform(ds, gt), CE_None);
+    const int nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
+    GDALClose(ds);
+    char extent[160];
+    std::snprintf(extent, sizeof extent, "covers only lon %.7g..%.7g, lat %.7g..%.7g", gt[0],
+                  gt[0] + nx * gt[1], gt[3] + ny * gt[5], gt[3]);
+    MeshOptions o = options_for(path);
+    o.region = std::array<double, 4>{-10, 44, 0, 50};
+    Boundary ocean;
+    ocean.rings.push_back(ring_of({{-10, 44}, {0, 44}, {0, 50}, {-10, 50}}));
+    std::string m = test::thrown_message<DataError>([&] { read_bathymetry(o, {}, &ocean); },
+                                                    "an ocean south of the raster");
+    EXPECT_NE(m.find(extent), std::string::npos) << m << "\nnot: " << extent;
+    m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a box south of the raster");
+    EXPECT_NE(m.find(extent), std::string::npos) << m << "\nnot: " << extent;
+}
