@@ -1,10 +1,11 @@
 // globemesh/bathymetry.hpp: bathymetry from any GDAL raster, as a plain lon/lat grid in memory.
 //
 // read_bathymetry() opens the raster named by bathy with GDAL, takes band bathy_band, applies
-// GDAL's scale/offset, turns the nodata value and NaN into "no data", flips depth-positive grids
-// (depth_positive) to elevation positive up, and hands back a Raster: values on a regular
-// lon/lat grid of cell centres, in metres, elevation positive up (land > 0, sea floor < 0). No GDAL
-// type appears in this interface.
+// GDAL's scale/offset, turns the nodata value, NaN and the cells GDAL's mask band marks invalid
+// (a per-dataset or per-band mask, an alpha band: GDALGetMaskFlags) into "no data", flips
+// depth-positive grids (depth_positive) to elevation positive up, and hands back a Raster:
+// values on a regular lon/lat grid of cell centres, in metres, elevation positive up (land > 0,
+// sea floor < 0). No GDAL type appears in this interface.
 //
 // Georeferencing: a raster in WGS 84 lon/lat in effect (PROJ's transformation to EPSG:4326 moves
 // no point of it: EPSG:4326, CRS84, the WGS 84 ellipsoid without a datum) with a north-up (or

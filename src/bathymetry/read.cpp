@@ -299,10 +299,21 @@ std::size_t global_columns(std::size_t nx, double dx) {
     return 0;
 }
 
-/// A VRT holding band `band` of ds alone (the warper takes every band otherwise).
+/// True when GDAL marks band's cells without data by a mask besides a nodata value: a
+/// per-dataset or per-band mask (internal, .msk) or an alpha band (GDALGetMaskFlags).
+bool has_mask(GDALRasterBandH band) {
+    return (GDALGetMaskFlags(band) & (GMF_ALL_VALID | GMF_NODATA)) == 0;
+}
+
+/// A VRT holding band `band` of ds alone (the warper takes every band otherwise), with that
+/// band's mask as its own (an alpha band is not among the bands kept).
 DatasetPtr single_band_vrt(GDALDatasetH ds, int band, const std::string &path) {
-    std::string b = std::to_string(band);
+    std::string b = std::to_string(band), mask = "mask," + b;
     StringList argv{"-of", "VRT", "-b", b.c_str()};
+    if (has_mask(GDALGetRasterBand(ds, band))) {
+        argv.add("-mask");
+        argv.add(mask.c_str());
+    }
     GDALTranslateOptions *opts = GDALTranslateOptionsNew(argv.get(), nullptr);
     int usage_error = 0;
     DatasetPtr out(GDALTranslate("", ds, opts, &usage_error));
@@ -537,26 +548,22 @@ std::string fmt_count(double v) {
 }
 
 /// Reads the window (columns c0 .. c0 + nx - 1, rows r0 .. r0 + ny - 1) of the band into
-/// `values`, bx x by cells (GDAL's average when that is coarser), as float.
-void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std::size_t nx,
-                 std::size_t ny, std::size_t bx, std::size_t by, std::vector<float> &values,
-                 const Progress &progress, const std::string &stage, const std::string &path) {
+/// `values`, bx x by cells (GDAL's average when that is coarser, which leaves out masked cells),
+/// as float; NaN where mask_band (when not null) says no cell has data.
+void read_window(GDALRasterBandH read_band, GDALRasterBandH mask_band, std::size_t c0,
+                 std::size_t r0, std::size_t nx, std::size_t ny, std::size_t bx, std::size_t by,
+                 std::vector<float> &values, const Progress &progress, const std::string &stage,
+                 const std::string &path) {
     const double sy = static_cast<double>(ny) / static_cast<double>(by);
     // Strips of rows, so that progress and cancellation are reported while GDAL reads its blocks.
     int block_x = 0, block_y = 0;
     GDALGetBlockSize(read_band, &block_x, &block_y);
     std::size_t strip = std::max<std::size_t>(1, std::min<std::size_t>(by, std::max(block_y, 64)));
+    std::vector<float> mask;
     for (std::size_t s0 = 0; s0 < by; s0 += strip) {
         std::size_t s1 = std::min(by, s0 + strip);
         GDALRasterIOExtraArg extra;
         INIT_RASTERIO_EXTRA_ARG(extra);
-        gdal::ProgressBridge bridge{
-            &progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
-            0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
-        if (progress) {
-            extra.pfnProgress = gdal::ProgressBridge::call;
-            extra.pProgressData = &bridge;
-        }
         double y0 = static_cast<double>(s0) * sy, y1 = static_cast<double>(s1) * sy;
         int iy0 = static_cast<int>(std::floor(y0));
         int iy1 = std::min(static_cast<int>(ny), static_cast<int>(std::ceil(y1 - 1e-9)));
@@ -568,14 +575,33 @@ void read_window(GDALRasterBandH read_band, std::size_t c0, std::size_t r0, std:
             extra.dfYOff = static_cast<double>(r0) + y0;
             extra.dfYSize = y1 - y0;
         }
-        CPLErr err = GDALRasterIOEx(read_band, GF_Read, static_cast<int>(c0),
-                                    static_cast<int>(r0) + iy0, static_cast<int>(nx), iy1 - iy0,
-                                    values.data() + s0 * bx, static_cast<int>(bx),
-                                    static_cast<int>(s1 - s0), GDT_Float32, 0, 0, &extra);
+        auto read = [&](GDALRasterBandH band, float *out, GDALRasterIOExtraArg *arg) {
+            return GDALRasterIOEx(band, GF_Read, static_cast<int>(c0), static_cast<int>(r0) + iy0,
+                                  static_cast<int>(nx), iy1 - iy0, out, static_cast<int>(bx),
+                                  static_cast<int>(s1 - s0), GDT_Float32, 0, 0, arg);
+        };
+        // The mask first, without progress: the strip's share goes to the values.
+        if (mask_band) {
+            mask.resize((s1 - s0) * bx);
+            if (read(mask_band, mask.data(), &extra) != CE_None)
+                throw IoError(option("bathy") + " " + path +
+                              ": reading its mask failed: " + gdal::last_error());
+        }
+        gdal::ProgressBridge bridge{
+            &progress, 0.05 + 0.9 * static_cast<double>(s0) / static_cast<double>(by),
+            0.05 + 0.9 * static_cast<double>(s1) / static_cast<double>(by), stage};
+        if (progress) {
+            extra.pfnProgress = gdal::ProgressBridge::call;
+            extra.pProgressData = &bridge;
+        }
+        CPLErr err = read(read_band, values.data() + s0 * bx, &extra);
         if (bridge.cancelled)
             throw Cancelled();
         if (err != CE_None)
             throw IoError(option("bathy") + " " + path + ": read failed: " + gdal::last_error());
+        for (std::size_t k = 0; k < mask.size() && mask_band; ++k)
+            if (mask[k] == 0)
+                values[s0 * bx + k] = std::numeric_limits<float>::quiet_NaN();
     }
 }
 
@@ -773,7 +799,10 @@ SourceRaster read_source(const std::string &path, int band, bool depth_positive,
     const double dlon = gt[1] * sx, dlat = gt[5] * sy;
 
     std::vector<float> values(bx * by);
-    read_window(read_band, c0, r0, nx, ny, bx, by, values, progress, stage, path);
+    // A mask besides nodata (GDAL's per-dataset or per-band mask, an alpha band) marks cells
+    // without data too; the warper applies it itself.
+    GDALRasterBandH mask_band = has_mask(read_band) ? GDALGetMaskBand(read_band) : nullptr;
+    read_window(read_band, mask_band, c0, r0, nx, ny, bx, by, values, progress, stage, path);
 
     to_elevation(values, scale, offset, has_nodata, nodata, depth_positive);
 

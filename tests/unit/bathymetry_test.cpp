@@ -821,9 +821,10 @@ void gdal_app(const std::string &source, const std::string &path,
     GDALDatasetH src = GDALOpen(source.c_str(), GA_ReadOnly);
     ASSERT_NE(src, nullptr) << source;
     GDALDatasetH out = make(src);
+    EXPECT_NE(out, nullptr) << path;
+    if (out)
+        GDALClose(out); // before its source: a VRT refers to it
     GDALClose(src);
-    ASSERT_NE(out, nullptr) << path;
-    GDALClose(out);
 }
 
 /// `args` as a GDAL argv list (CSLDestroy frees it).
@@ -1472,4 +1473,101 @@ TEST(Bathymetry, the_coverage_error_gives_the_rasters_own_extent) {
     EXPECT_NE(m.find(extent), std::string::npos) << m << "\nnot: " << extent;
     m = test::thrown_message<DataError>([&] { read_bathymetry(o); }, "a box south of the raster");
     EXPECT_NE(m.find(extent), std::string::npos) << m << "\nnot: " << extent;
+}
+
+namespace {
+
+/// ETOPO5's north-west shelf (the fixture) as a GeoTIFF whose cells in lon -8..-4, lat 46..48
+/// (Biscay) hold 0 and are masked out by an internal per-dataset mask (GDAL_TIFF_INTERNAL_MASK),
+/// not a nodata value; its path. `values` gets the fixture's cells, row after row.
+std::string write_masked_shelf(const TempDir &dir, std::vector<double> &values, double gt[6]) {
+    const std::string source = fixture("bathy/etopo5_nwshelf_5min.tif").string(),
+                      path = (dir / "shelf_masked.tif").string();
+    GDALAllRegister();
+    GDALDatasetH src = GDALOpen(source.c_str(), GA_ReadOnly);
+    EXPECT_NE(src, nullptr);
+    const int nx = GDALGetRasterXSize(src), ny = GDALGetRasterYSize(src);
+    GDALGetGeoTransform(src, gt);
+    values.resize(static_cast<std::size_t>(nx * ny));
+    EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(src, 1), GF_Read, 0, 0, nx, ny, values.data(), nx, ny,
+                           GDT_Float64, 0, 0),
+              CE_None);
+    std::vector<double> stored = values;
+    std::vector<GByte> mask(stored.size(), 255);
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const double lon = gt[0] + (i + 0.5) * gt[1], lat = gt[3] + (j + 0.5) * gt[5];
+            if (lon > -8 && lon < -4 && lat > 46 && lat < 48)
+                stored[j * nx + i] = 0, mask[j * nx + i] = 0;
+        }
+    CPLSetConfigOption("GDAL_TIFF_INTERNAL_MASK", "YES");
+    GDALDatasetH ds =
+        GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), nx, ny, 1, GDT_Int16, nullptr);
+    EXPECT_NE(ds, nullptr);
+    GDALSetGeoTransform(ds, gt);
+    GDALSetProjection(ds, GDALGetProjectionRef(src));
+    GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+    EXPECT_EQ(GDALRasterIO(band, GF_Write, 0, 0, nx, ny, stored.data(), nx, ny, GDT_Float64, 0, 0),
+              CE_None);
+    EXPECT_EQ(GDALCreateDatasetMaskBand(ds, GMF_PER_DATASET), CE_None);
+    EXPECT_EQ(GDALRasterIO(GDALGetMaskBand(band), GF_Write, 0, 0, nx, ny, mask.data(), nx, ny,
+                           GDT_Byte, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    CPLSetConfigOption("GDAL_TIFF_INTERNAL_MASK", nullptr);
+    GDALClose(src);
+    return path;
+}
+
+} // namespace
+
+// A raster whose cells without data are marked by a GDAL mask rather than a nodata value (an
+// internal per-dataset mask, or the same as an alpha band in a VRT): the masked cells are no
+// data, read at full resolution, averaged coarser, or warped (--bathy-srs ED50), and the others
+// are the fixture's values. At main the masked cells were read as depth 0.
+TEST(Bathymetry, cells_a_gdal_mask_marks_invalid_have_no_data) {
+    TempDir dir;
+    std::vector<double> z;
+    double gt[6];
+    const std::string masked = write_masked_shelf(dir, z, gt);
+    // The same mask as an alpha band: gdal_translate -b 1 -b mask, band 2 called alpha.
+    const std::string alpha = (dir / "shelf_alpha.vrt").string();
+    translate(masked, alpha, {"-of", "VRT", "-b", "1", "-b", "mask"});
+    GDALDatasetH vrt = GDALOpen(alpha.c_str(), GA_Update);
+    ASSERT_NE(vrt, nullptr);
+    GDALSetRasterColorInterpretation(GDALGetRasterBand(vrt, 2), GCI_AlphaBand);
+    GDALClose(vrt);
+    const int nx = 301;
+    auto masked_cell = [](double lon, double lat) {
+        return lon > -8 && lon < -4 && lat > 46 && lat < 48;
+    };
+    for (const std::string &path : {masked, alpha}) {
+        const Raster r = read_raster(path, 1, false, {}, RasterLimits{});
+        int holes = 0;
+        for (std::size_t j = 0; j < r.nlat(); ++j)
+            for (std::size_t i = 0; i < r.nlon(); ++i) {
+                const double v = r.value(i, j);
+                if (masked_cell(r.lon_deg(i), r.lat_deg(j))) {
+                    EXPECT_TRUE(std::isnan(v)) << path << " " << i << " " << j << " " << v;
+                    ++holes;
+                } else {
+                    ASSERT_EQ(v, z[j * nx + i]) << path << " " << i << " " << j;
+                }
+            }
+        EXPECT_EQ(holes, 47 * 23) << path; // centres -7 11/12 .. -4 1/12, 46 1/12 .. 47 11/12
+        // Averaged to a quarter degree (3 x 3 cells): a cell all masked has no data, one with
+        // no masked cell has data.
+        RasterLimits coarse;
+        coarse.min_cell_deg = 0.25;
+        const Raster c = read_raster(path, 1, false, {}, coarse);
+        EXPECT_TRUE(std::isnan(c.elevation_m(-6, 47))) << path;
+        EXPECT_FALSE(std::isnan(c.elevation_m(-9, 47))) << path;
+        // Warped: the same file in ED50, whose cells lie about 100 m from WGS 84's.
+        MeshOptions o = options_for(path);
+        o.bathy_srs = "EPSG:4230";
+        o.bathy_fill_m = 1.0; // no coverage check: the file is regional
+        const Raster w = read_bathymetry(o);
+        EXPECT_EQ(w.elevation_m(-6, 47), -1.0) << path;  // the fill
+        EXPECT_LT(w.elevation_m(-9, 47), -1000) << path; // Biscay's abyssal plain, off the mask
+    }
 }
