@@ -42,10 +42,12 @@
 // average resampling through RasterIO, which uses the raster's overviews when it has some and
 // only the source window a VRT maps otherwise) applies to rasters with more than max_cells
 // cells (default 2^28, 1 GiB: a 1-arc-minute global grid fits) and, through RasterLimits, to
-// cells finer than the mesh can use. With region (or region_file, the extent of its ocean),
-// only the cells that cover the region (and a margin: 1% of its larger side and three cells) are
-// read: a regional run reads a small window of a global raster,
-// at the resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half
+// cells finer than the mesh can use. A global grid read whole is averaged by whole blocks of
+// columns that divide half its columns (when they fit the memory budget), so the same grid
+// stored from 0 or from -180 E gives the same cells. With region (or region_file, the extent of
+// its ocean), only the cells that cover the region (and a margin: 1% of its larger side and
+// three cells) are read: a regional run reads a small window of a global raster, at the
+// resolution the region's mesh needs. read_bathymetry() asks for cells no finer than half
 // the smallest edge length (hfloor / 2, see sizefield.hpp, as degrees of a great circle) and
 // refuses (DataError naming max_memory_bytes) when the values would take more than half of
 // options.max_memory_bytes. GDAL's block cache (GDAL_CACHEMAX, 5% of RAM by default) comes on

@@ -480,6 +480,18 @@ void hold_footprint_edge(std::vector<float> &values, std::size_t bx, std::size_t
         }
 }
 
+/// The columns (a whole number, at most f, at least 1) a global grid of nx columns read whole
+/// is averaged by: a divisor of nx / 2 (of nx when odd), so that the blocks' edges fall on both
+/// 0 and 180 E. GDAL averages a fractional block from the first column read, so the same grid
+/// stored from 0 or from -180 E gave other cells (and another mesh with --slope).
+std::size_t global_block(std::size_t nx, double f) {
+    const std::size_t half = nx % 2 == 0 ? nx / 2 : nx;
+    std::size_t k = static_cast<std::size_t>(std::min(f, static_cast<double>(half)));
+    while (k > 1 && half % k != 0)
+        --k;
+    return std::max<std::size_t>(k, 1);
+}
+
 /// The lon/lat edges of an nx x ny north- or south-up raster of geotransform gt, latitudes
 /// within the poles.
 LonLatBounds grid_bounds(const double gt[6], std::size_t nx, std::size_t ny) {
@@ -747,11 +759,12 @@ SourceRaster read_source(const std::string &path, int band, bool depth_positive,
 
     // A global grid: its columns exactly 360 / n apart (the seam closes), and a last column
     // that repeats the first meridian dropped.
-    if (const std::size_t n = global_columns(nx, gt[1]); n > 0) {
+    const std::size_t global_nx = global_columns(nx, gt[1]);
+    if (global_nx > 0) {
         const double first_centre = gt[0] + 0.5 * gt[1];
-        gt[1] = 360.0 / static_cast<double>(n);
+        gt[1] = 360.0 / static_cast<double>(global_nx);
         gt[0] = first_centre - 0.5 * gt[1];
-        nx = n;
+        nx = global_nx;
     }
     const LonLatBounds extent = grid_bounds(gt, nx, ny);
 
@@ -777,6 +790,13 @@ SourceRaster read_source(const std::string &path, int band, bool depth_positive,
             cx = std::max(1.0, std::ceil(cx / fx - 1e-9));
         if (fy > 1)
             cy = std::max(1.0, std::ceil(cy / fy - 1e-9));
+        // A global grid read whole: whole blocks (global_block), when they fit the budget.
+        const double whole = global_nx > 0 && nx == global_nx && fx > 1
+                                 ? static_cast<double>(nx / global_block(nx, fx))
+                                 : cx;
+        if (limits.max_bytes == 0 ||
+            whole * cy * sizeof(float) <= static_cast<double>(limits.max_bytes))
+            cx = whole;
     }
     if (limits.max_cells > 0 && cx * cy > static_cast<double>(limits.max_cells)) {
         double f = std::sqrt(cx * cy / static_cast<double>(limits.max_cells));

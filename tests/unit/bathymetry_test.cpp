@@ -540,7 +540,9 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     EXPECT_NE(m.find(vrt + ": 69120 x 34560 cells"), std::string::npos) << m;
     EXPECT_NE(m.find("max_memory_bytes"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-    // Coarser sizes fit: hmin 40 km asks for cells of 20 km (0.18 degree), rounded up in count.
+    // Coarser sizes fit: hmin 40 km asks for cells of 20 km (0.18 degree, 34.5 of the file's);
+    // rows rounded up in count, columns averaged by whole blocks that divide half the globe's
+    // 69120 (2^9 3^3 5): 32, no more than asked.
     o.hmin_km = 40;
     o.hmax_km = 100;
     const RasterLimits limits = bathymetry_limits(o);
@@ -548,7 +550,7 @@ TEST(Bathymetry, four_gigabyte_raster_beyond_the_budget_is_refused_naming_max_me
     EXPECT_EQ(limits.max_bytes, 250'000'000u);
     Raster r = read_bathymetry(o);
     const double cell = 20.0 / (earth_radius_km * deg_to_rad);
-    EXPECT_EQ(r.nlon(), static_cast<std::size_t>(std::ceil(360 / cell)));
+    EXPECT_EQ(r.nlon(), 69120u / 32);
     EXPECT_EQ(r.nlat(), static_cast<std::size_t>(std::ceil(180 / cell)));
     EXPECT_LE(r.dlon_deg(), cell);
 }
@@ -1569,5 +1571,57 @@ TEST(Bathymetry, cells_a_gdal_mask_marks_invalid_have_no_data) {
         const Raster w = read_bathymetry(o);
         EXPECT_EQ(w.elevation_m(-6, 47), -1.0) << path;  // the fill
         EXPECT_LT(w.elevation_m(-9, 47), -1000) << path; // Biscay's abyssal plain, off the mask
+    }
+}
+
+// ETOPO5 (the fixture, every third row) stored from -180 E and from 0 E, as CF files come:
+// averaged to the cells a coarse mesh asks for (0.27 and 0.7 degree: 1.62 and 4.2 of its
+// cells), both give the same depths everywhere. GDAL averaged fractional blocks from the first
+// column read, so the two spellings gave node depths up to 766 m apart (and other meshes with
+// --slope: 49852 nodes against 49505 at --hmin 60).
+TEST(Bathymetry, a_global_grid_averages_the_same_stored_from_0_or_from_minus_180) {
+    const std::string source = fixture("bathy/etopo5_global_10min.nc").string();
+    int nc = -1, lon_id, lat_id, z_id;
+    ASSERT_EQ(nc_open(source.c_str(), NC_NOWRITE, &nc), NC_NOERR);
+    nc_inq_varid(nc, "lon", &lon_id);
+    nc_inq_varid(nc, "lat", &lat_id);
+    nc_inq_varid(nc, "elevation", &z_id);
+    std::vector<double> lon(2160), lat(1080);
+    std::vector<float> z(2160 * 1080);
+    nc_get_var_double(nc, lon_id, lon.data());
+    nc_get_var_double(nc, lat_id, lat.data());
+    ASSERT_EQ(nc_get_var_float(nc, z_id, z.data()), NC_NOERR);
+    nc_close(nc);
+    TempDir dir;
+    const std::string west = (dir / "from_180w.nc").string(), east = (dir / "from_0.nc").string();
+    CfGrid a, b;
+    for (std::size_t i = 0; i < 2160; ++i) {
+        a.lon.push_back(lon[i]);
+        b.lon.push_back(i < 1080 ? lon[i + 1080] : lon[i - 1080] + 360);
+    }
+    for (std::size_t j = 1; j < 1080; j += 3) {
+        a.lat.push_back(lat[j]);
+        b.lat.push_back(lat[j]);
+        for (std::size_t i = 0; i < 2160; ++i) {
+            a.z.push_back(z[j * 2160 + i]);
+            b.z.push_back(z[j * 2160 + (i + 1080) % 2160]);
+        }
+    }
+    write_cf(west, a);
+    write_cf(east, b);
+    std::mt19937 rng(43);
+    std::uniform_real_distribution<double> ulon(-180, 180), ulat(-85, 85);
+    for (const double cell : {0.27, 0.7}) {
+        RasterLimits limits;
+        limits.min_cell_deg = cell;
+        const Raster ra = read_raster(west, 1, false, {}, limits),
+                     rb = read_raster(east, 1, false, {}, limits);
+        ASSERT_TRUE(ra.global() && rb.global());
+        EXPECT_LE(ra.dlon_deg(), cell);
+        for (int k = 0; k < 3000; ++k) {
+            const double x = ulon(rng), y = ulat(rng);
+            ASSERT_NEAR(ra.elevation_m(x, y), rb.elevation_m(x, y), 1e-6)
+                << cell << " " << x << " " << y;
+        }
     }
 }
