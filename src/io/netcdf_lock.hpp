@@ -1,9 +1,9 @@
 // Internal to io/ (and the bathymetry read): the one lock on netCDF-C and HDF5 in this process.
-// Neither library is thread-safe as Debian builds it, and GDAL guards its netCDF driver with a
-// mutex of its own: two runs at once (two Python threads, two QGIS Processing tasks) crashed in
-// nc_enddef, one writing its UGRID file while the other read a NetCDF raster through GDAL. Every
-// netCDF or HDF5 file this process opens is held under it from open to close, and so is a raster
-// GDAL reads.
+// netCDF-C is not thread-safe (Debian's HDF5 is built thread-safe, netCDF-C's own state is not
+// guarded), and GDAL guards its netCDF driver with a mutex of its own: two runs at once (two Python
+// threads, two QGIS Processing tasks) crashed in nc_enddef, one writing its UGRID file while the
+// other read a NetCDF raster through GDAL. Every netCDF or HDF5 file this process opens is held
+// under it from open to close, and so is a raster GDAL reads.
 #pragma once
 
 #include <mutex>
