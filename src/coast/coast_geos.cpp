@@ -256,9 +256,32 @@ PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon) {
     return rings;
 }
 
-GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where) {
+namespace {
+
+/// Whether the lon/lat box of `pts` meets one of `boxes` (all of them when there are none).
+bool meets_any(const PointList &pts, const std::vector<Box> &boxes) {
+    if (boxes.empty())
+        return true;
+    double w = 1e300, e = -1e300, s = 1e300, n = -1e300;
+    for (const LonLat &p : pts) {
+        w = std::min(w, p.lon), e = std::max(e, p.lon);
+        s = std::min(s, p.lat), n = std::max(n, p.lat);
+    }
+    return std::any_of(boxes.begin(), boxes.end(), [&](const Box &b) {
+        return w <= b[2] && e >= b[0] && s <= b[3] && n >= b[1];
+    });
+}
+
+} // namespace
+
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where,
+                         const std::vector<Box> &near) {
     std::vector<GeomPtr> linestrings;
     for (const auto &l : lines) {
+        // A closed line off the region's boxes holds none of its land, nor any land of it.
+        if (!l.empty() && l.front().lon == l.back().lon && l.front().lat == l.back().lat &&
+            !meets_any(l, near))
+            continue;
         std::vector<double> xy;
         for (const auto &p : l) {
             xy.push_back(p.lon);
@@ -303,7 +326,7 @@ GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const 
             else
                 pts.push_back(a);
         }
-        if (pts.size() < 4)
+        if (pts.size() < 4 || !meets_any(pts, near))
             continue;
         GeomPtr ring = make_ring(geos, pts);
         GeomPtr poly =

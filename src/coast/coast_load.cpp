@@ -148,7 +148,8 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
         valid_parts(geos, src.polygons, clip ? near_boxes(*near) : std::vector<Box>{});
     if (!src.lines.empty()) {
         // each polygon wrapped alone: only those past +-180 are cut, not all the land at once
-        GeomPtr from_lines = polygonize_lines(geos, src.lines, where);
+        GeomPtr from_lines =
+            polygonize_lines(geos, src.lines, where, clip ? near_boxes(*near) : std::vector<Box>{});
         std::vector<const GEOSGeometry *> polys;
         polygons_of(geos, from_lines.get(), polys);
         for (const GEOSGeometry *p : polys)

@@ -101,7 +101,10 @@ PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon);
 /// ends; a line whose ends lie on the +-180 seam is closed along it (same side) or through the
 /// nearer pole (opposite sides, as Antarctica). Land is the even-odd fill of all rings, so the
 /// orientation of the lines does not matter and islands in lakes come out right. Valid output.
-GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where);
+/// With `near` (a region's boxes, near_boxes), the rings whose lon/lat box meets none of them are
+/// left out: their land and holes lie off the region, and they hold no part of it.
+GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where,
+                         const std::vector<Box> &near = {});
 
 /// The even-odd fill of valid polygonal faces' rings (a polygon's shell and holes alike), as
 /// their symmetric difference (ring_parity.cpp): faces whose boundaries meet are overlaid by

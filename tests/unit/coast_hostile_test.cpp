@@ -737,6 +737,33 @@ TEST(CoastHostile, coastline_lines_fill_as_the_xor_of_their_rings) {
     EXPECT_LT(diff_area, 1e-12 * area);
 }
 
+// A region of a coast given as lines takes only the rings near it (GSHHG full as lines about
+// the Oresund: 53 s -> 8 s), and the same ocean as from the land polygons: the Kyushu lines
+// against their XOR, in a box across Kyushu's north-west coast and the ring across it, with the
+// rings that enclose the box (Kyushu's) kept and those off it (Honshu's) left out.
+TEST(CoastHostile, a_region_of_coastline_lines_takes_the_rings_near_it) {
+    using namespace coast_detail;
+    const std::string lines = fixture("coast/hostile/gshhg_i_kyushu_lines.geojson").string();
+    MeshOptions from_lines = options_for(lines),
+                from_polygons =
+                    options_for(fixture("coast/hostile/gshhg_i_kyushu_xor.geojson").string());
+    from_lines.region = from_polygons.region = std::array<double, 4>{129.5, 33, 130.5, 34};
+    const CoastData a = load_coast(from_lines), b = load_coast(from_polygons);
+    EXPECT_GT(b.ocean_area_km2, 1000.0);
+    EXPECT_NEAR(a.ocean_area_km2, b.ocean_area_km2, 1e-9 * b.ocean_area_km2);
+    EXPECT_EQ(a.rings.rings.size(), b.rings.rings.size());
+
+    Geos geos;
+    const Source source = read_source(lines, "", "", "", "coast");
+    std::vector<const GEOSGeometry *> all, near;
+    GeomPtr whole = polygonize_lines(geos, source.lines, "coast");
+    GeomPtr part = polygonize_lines(geos, source.lines, "coast", near_boxes(*from_lines.region));
+    polygons_of(geos, whole.get(), all);
+    polygons_of(geos, part.get(), near);
+    EXPECT_LT(near.size(), all.size() / 2);
+    EXPECT_GE(near.size(), 2u); // Kyushu and the rectangle's piece off its coast
+}
+
 // Found by fuzz_coast (tests/fuzz/corpus/fuzz_coast/regression-pole-to-pole-fold): a ring from
 // lon 200, lat 89.64 to the south pole and back folds onto itself over 180 degrees. Its arcs
 // overlap at every split, so the splitting of straying arcs doubled them each round and did not
