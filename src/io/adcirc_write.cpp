@@ -11,9 +11,11 @@
 // outer boundaries counter-clockwise, islands clockwise). A loop with open edges splits into
 // alternating open and land runs (IBTYPE 0), the node where two runs meet ending one and starting
 // the next. A loop of coast edges only is one closed string, its first node repeated at its end:
-// IBTYPE 0 (mainland) when it is an outer boundary, 1 (island) otherwise. Outer: in a mesh with
-// open edges (a region) a loop whose lon/lat area is positive; in a mesh without (global) the
-// loop of most nodes, there being no outside.
+// IBTYPE 0 (mainland) when it is an outer boundary, 1 (island) otherwise. Outer: never in a part
+// of the mesh (faces joined by nodes) with open edges, whose loop is its outer one (the lon/lat
+// area cannot tell a loop around a pole); in another part of a region, a loop whose lon/lat area
+// is positive; in a mesh without open edges (global) the loop of most nodes, there being no
+// outside.
 //
 // Coordinates are lon/lat degrees, in [-180, 180), or [0, 360) for a mesh that crosses the
 // antimeridian and fits there without a face cut; or, with an --output-srs (WriteOptions), x y in
@@ -27,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "disjoint_sets.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/output_file.hpp"
 #include "globemesh/writers.hpp"
@@ -45,6 +48,7 @@ using io::TextOut;
 struct NodeString {
     std::vector<std::uint32_t> nodes;
     int ibtype = 0;
+    bool beside_open = false; ///< a closed string in a part of the mesh with open edges
 };
 
 struct BoundaryStrings {
@@ -80,11 +84,20 @@ void split_loop(const io::MeshTopology &topo, const std::vector<std::size_t> &lo
     }
 }
 
+/// Each node's part of the mesh: the root of the nodes its faces join.
+std::vector<std::uint32_t> node_parts(const Mesh &mesh) {
+    DisjointSets<> parts(mesh.nodes.size());
+    for (const auto &f : mesh.faces)
+        parts.join(f[0], f[1]), parts.join(f[0], f[2]);
+    return std::move(parts).roots();
+}
+
 /// IBTYPE of the closed coast strings: 0 for an outer boundary (see the top of the file), else 1.
 void ring_types(std::vector<NodeString> &rings, bool regional, const std::vector<LonLat> &p) {
     std::size_t longest = 0;
     for (std::size_t i = 0; i < rings.size(); ++i) {
-        rings[i].ibtype = regional && ring_area(rings[i].nodes, p) > 0 ? 0 : 1;
+        const bool outer = !rings[i].beside_open && ring_area(rings[i].nodes, p) > 0;
+        rings[i].ibtype = regional && outer ? 0 : 1;
         if (rings[i].nodes.size() > rings[longest].nodes.size())
             longest = i;
     }
@@ -96,12 +109,15 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
     const auto topology = io::topology_of(mesh);
     const io::MeshTopology &topo = *topology;
     const auto is_open = [&](std::size_t e) { return topo.boundary_tags[e] == int(EdgeTag::open); };
+    const std::vector<std::uint32_t> part = node_parts(mesh);
+    std::vector<bool> part_open(mesh.nodes.size(), false);
     BoundaryStrings s;
     std::vector<NodeString> rings;
     bool regional = false;
     for (auto &loop : io::boundary_loops(topo, mesh.nodes.size())) {
         if (std::any_of(loop.begin(), loop.end(), is_open)) {
             regional = true;
+            part_open[part[topo.edge_nodes(std::size_t(topo.boundary_edges[loop[0]]))[0]]] = true;
             split_loop(topo, loop, s);
             continue;
         }
@@ -111,6 +127,8 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
         ring.nodes.push_back(ring.nodes.front()); // a closed coast string ends where it starts
         rings.push_back(std::move(ring));
     }
+    for (auto &ring : rings) // after every loop: an open one may come after a ring of its part
+        ring.beside_open = part_open[part[ring.nodes.front() - 1]];
     ring_types(rings, regional, p);
     s.land.insert(s.land.end(), std::make_move_iterator(rings.begin()),
                   std::make_move_iterator(rings.end()));

@@ -110,6 +110,23 @@ def check(grid, ugrid, regional):
         assert len(opens) == 0, len(opens)
     return len(opens), len(lands)
 
+def islands_in_the_plane(grid):
+    """Closed land strings of a planar grid turn as ADCIRC orders them (mesh on the left): outer
+    boundaries (IBTYPE 0) counter-clockwise, islands (1) clockwise. Returns the islands."""
+    xyz, _, _, lands = read_grid(grid)
+    islands = 0
+    for kind, s in lands:
+        if s[0] != s[-1]:
+            continue
+        x, y = xyz[np.array(s) - 1, 0], xyz[np.array(s) - 1, 1]
+        area = np.sum(x[:-1] * y[1:] - x[1:] * y[:-1]) / 2
+        assert (area < 0) == (kind == 1), ('closed string of', len(s), 'IBTYPE', kind, area)
+        islands += kind == 1
+    return islands
+
+if sys.argv[2] == 'planar':
+    print('OK islands %d' % islands_in_the_plane(sys.argv[3]))
+    sys.exit(0)
 ugrid, regional = sys.argv[1], sys.argv[2] == 'regional'
 counts = {check(g, ugrid, regional) for g in sys.argv[3:]}
 assert len(counts) == 1, counts
@@ -253,6 +270,21 @@ TEST(ModelGrid, a_global_fort14_has_no_open_boundary_and_one_mainland) {
     expect_mesh_verify(dir / "m.nc");
     const std::string verdict = check_grids(dir, "global", {"g.14"});
     EXPECT_EQ(verdict.rfind("OK 0 ", 0), 0u) << verdict;
+}
+
+// The Southern Ocean south of 50 S: Antarctica's coast winds round the pole, so its lon/lat area
+// says nothing; in a part of the mesh with an open boundary it is an island (IBTYPE 1), clockwise
+// in the polar stereographic plane, as ADCIRC orders islands.
+TEST(ModelGrid, antarctica_in_a_southern_ocean_region_is_an_island) {
+    TempDir dir;
+    std::string err;
+    const int status =
+        run_exe({"mesh", "--coast", fixture("coast/ne_110m_land.gpkg").string(), "--coast-layer",
+                 "land", "--region", "-180,-90,180,-50", "--hmax", "400km", "--output-srs",
+                 "EPSG:3031", "-o", (dir / "m.nc").string(), "-o", (dir / "s.14").string(), "-q"},
+                err, dir.path());
+    ASSERT_EQ(status, 0) << err;
+    EXPECT_EQ(check_grids(dir, "planar", {"s.14"}), "OK islands 1\n");
 }
 
 TEST(ModelGrid, an_unwritable_fort14_is_one_line_and_leaves_no_file) {
