@@ -64,9 +64,9 @@ std::vector<LonLatPart> face_polygons(const Vec3 &a, const Vec3 &b, const Vec3 &
         ring.back()[0] + wrap_delta(ring.front()[0] - ring.back()[0]) - ring.front()[0];
     if (std::fabs(winding) > 180) {
         // The face goes round a pole: close it along that pole's line (north when
-        // counter-clockwise).
+        // counter-clockwise), its last side ending at the first corner a full turn on.
         const double lat = winding > 0 ? 90.0 : -90.0;
-        ring.push_back({ring.front()[0] + winding, ring.back()[1]});
+        ring.push_back({ring.front()[0] + winding, ring.front()[1]});
         ring.push_back({ring.front()[0] + winding, lat});
         ring.push_back({ring.front()[0], lat});
     }

@@ -576,6 +576,35 @@ TEST(Gpkg, simple_face_ring_is_face_polygons_one_ring_wherever_it_applies) {
     EXPECT_GT(general, 10000);
 }
 
+// A face round a pole whose corners have different latitudes (an Arctic mesh's polar face: NE
+// 10m, 20-80 km, corners at 89.63, 89.63 and 89.41 N) covers, in lon/lat, what lies between its
+// three straight sides and the pole line, no more: the sum of the sides' trapezoids up to the
+// pole. Its closing side came back at the last corner's latitude, adding a triangle under the
+// side to the first corner that belongs to the neighbouring face.
+TEST(Gpkg, a_face_round_a_pole_covers_only_up_to_its_sides) {
+    struct Case {
+        std::array<LonLat, 3> corners; // counter-clockwise seen from outside the sphere
+        double pole;
+    };
+    const Case cases[] = {{{{{90, 89.6349}, {-90, 89.6349}, {0, 89.407}}}, 90},
+                          {{{{90.0001, 89.0921}, {-91.5451, 89.0721}, {1.4437, 88.5221}}}, 90},
+                          {{{{10, -88.2}, {-110, -89.1}, {130, -88.9}}}, -90}};
+    for (const Case &c : cases) {
+        const auto parts = io::face_polygons(lonlat_to_vec(c.corners[0].lon, c.corners[0].lat),
+                                             lonlat_to_vec(c.corners[1].lon, c.corners[1].lat),
+                                             lonlat_to_vec(c.corners[2].lon, c.corners[2].lat));
+        double area = 0, want = 0;
+        for (const auto &part : parts)
+            area += std::fabs(io::ring_area(part));
+        for (int i = 0; i < 3; ++i) { // each side's trapezoid to the pole, the longitude step
+            const LonLat &p = c.corners[i], &q = c.corners[(i + 1) % 3]; // taken the short way
+            const double step = std::remainder(q.lon - p.lon, 360.0);
+            want += std::fabs(step) * std::fabs(c.pole - (p.lat + q.lat) / 2);
+        }
+        EXPECT_NEAR(area, want, 1e-9 * want) << c.corners[2].lat;
+    }
+}
+
 TEST(Gpkg, pole_corner_is_written_as_two_points_at_the_neighbouring_longitudes) {
     TempDir dir;
     Mesh m = icosphere(0); // node 0 is the north pole; face 0 is (pole, u, un)
