@@ -13,8 +13,9 @@
 // the next. A loop of coast edges only is one closed string, its first node repeated at its end:
 // IBTYPE 0 (mainland) when it is an outer boundary, 1 (island) otherwise. Outer: never in a part
 // of the mesh (faces joined by nodes) with open edges, whose loop is its outer one (the lon/lat
-// area cannot tell a loop around a pole); in another part of a region, a loop whose lon/lat area
-// is positive; in a mesh without open edges (global) the loop of most nodes, there being no
+// area cannot tell a loop around a pole); else a loop whose area in the file's x y is positive:
+// with an --output-srs (which keeps every face counter-clockwise) as ADCIRC sees the plane, and
+// in lon/lat in a region; in a global lon/lat mesh the loop of most nodes, there being no
 // outside.
 //
 // Coordinates are lon/lat degrees, in [-180, 180), or [0, 360) for a mesh that crosses the
@@ -56,15 +57,21 @@ struct BoundaryStrings {
     std::size_t open_nodes = 0, land_nodes = 0;
 };
 
-/// The signed area of a closed ring of 1-based nodes in lon/lat (positive counter-clockwise), each
-/// longitude step taken the shorter way round.
-double ring_area(const std::vector<std::uint32_t> &ring, const std::vector<LonLat> &p) {
+/// Whether the file's x y are planar (an --output-srs), not lon/lat degrees.
+bool planar(const io::ModelCoordinates &xy) {
+    return xy.crs && xy.crs->projected;
+}
+
+/// The signed area of a closed ring of 1-based nodes in the file's x y (positive
+/// counter-clockwise), in lon/lat each longitude step taken the shorter way round.
+double ring_area(const std::vector<std::uint32_t> &ring, const io::ModelCoordinates &xy) {
     double area = 0;
     for (std::size_t i = 0; i + 1 < ring.size(); ++i) {
-        const LonLat &a = p[ring[i] - 1], &b = p[ring[i + 1] - 1];
-        double step = b.lon - a.lon;
-        step -= 360 * std::round(step / 360);
-        area -= step * (a.lat + b.lat) / 2; // the trapezoid under the step
+        const std::size_t a = ring[i] - 1, b = ring[i + 1] - 1;
+        double step = xy.x[b] - xy.x[a];
+        if (!planar(xy))
+            step -= 360 * std::round(step / 360);
+        area -= step * (xy.y[a] + xy.y[b]) / 2; // the trapezoid under the step
     }
     return area;
 }
@@ -93,19 +100,20 @@ std::vector<std::uint32_t> node_parts(const Mesh &mesh) {
 }
 
 /// IBTYPE of the closed coast strings: 0 for an outer boundary (see the top of the file), else 1.
-void ring_types(std::vector<NodeString> &rings, bool regional, const std::vector<LonLat> &p) {
+void ring_types(std::vector<NodeString> &rings, bool regional, const io::ModelCoordinates &xy) {
+    const bool by_area = regional || planar(xy);
     std::size_t longest = 0;
     for (std::size_t i = 0; i < rings.size(); ++i) {
-        const bool outer = !rings[i].beside_open && ring_area(rings[i].nodes, p) > 0;
-        rings[i].ibtype = regional && outer ? 0 : 1;
+        const bool outer = !rings[i].beside_open && ring_area(rings[i].nodes, xy) > 0;
+        rings[i].ibtype = by_area && outer ? 0 : 1;
         if (rings[i].nodes.size() > rings[longest].nodes.size())
             longest = i;
     }
-    if (!regional && !rings.empty())
+    if (!by_area && !rings.empty())
         rings[longest].ibtype = 0;
 }
 
-BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p) {
+BoundaryStrings boundary_strings(const Mesh &mesh, const io::ModelCoordinates &xy) {
     const auto topology = io::topology_of(mesh);
     const io::MeshTopology &topo = *topology;
     const auto is_open = [&](std::size_t e) { return topo.boundary_tags[e] == int(EdgeTag::open); };
@@ -129,7 +137,7 @@ BoundaryStrings boundary_strings(const Mesh &mesh, const std::vector<LonLat> &p)
     }
     for (auto &ring : rings) // after every loop: an open one may come after a ring of its part
         ring.beside_open = part_open[part[ring.nodes.front() - 1]];
-    ring_types(rings, regional, p);
+    ring_types(rings, regional, xy);
     s.land.insert(s.land.end(), std::make_move_iterator(rings.begin()),
                   std::make_move_iterator(rings.end()));
     for (const auto &r : s.open)
@@ -157,7 +165,6 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
     const io::ModelCoordinates xy =
         io::model_coordinates(mesh, options.output_srs, what + " " + path.string());
     OutputFile file(path, options.overwrite, what);
-    const std::vector<LonLat> p = io::node_lonlats(mesh);
     TextOut out(file.temp_path(), path, what);
     std::string title = options.title;
     std::replace_if(
@@ -166,7 +173,7 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
     out.integer(mesh.faces.size()).text(" ").integer(mesh.nodes.size()).text(" ! NE NP").line();
     const double total = double(mesh.nodes.size() + mesh.faces.size()) + 1;
     constexpr std::size_t step = 1 << 16;
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
         if (i % step == 0)
             report(options.progress, double(i) / total, "write_model_grid");
         out.integer(i + 1).text(" ").real(xy.x[i]).text(" ").real(xy.y[i]).text(" ");
@@ -174,12 +181,12 @@ void write_grid(const Mesh &mesh, const fs::path &path, const WriteOptions &opti
     }
     for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
         if (f % step == 0)
-            report(options.progress, double(p.size() + f) / total, "write_model_grid");
+            report(options.progress, double(mesh.nodes.size() + f) / total, "write_model_grid");
         const auto &face = mesh.faces[f];
         out.integer(f + 1).text(" 3 ").integer(face[0] + 1).text(" ").integer(face[1] + 1);
         out.text(" ").integer(face[2] + 1).line();
     }
-    const BoundaryStrings s = boundary_strings(mesh, p);
+    const BoundaryStrings s = boundary_strings(mesh, xy);
     out.integer(s.open.size()).text(" ! NOPE: open boundaries").line();
     out.integer(s.open_nodes).text(" ! NETA: open boundary nodes").line();
     write_strings(out, s.open, "open");

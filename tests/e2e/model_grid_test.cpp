@@ -110,10 +110,19 @@ def check(grid, ugrid, regional):
         assert len(opens) == 0, len(opens)
     return len(opens), len(lands)
 
-def islands_in_the_plane(grid):
-    """Closed land strings of a planar grid turn as ADCIRC orders them (mesh on the left): outer
-    boundaries (IBTYPE 0) counter-clockwise, islands (1) clockwise. Returns the islands."""
+def islands_in_the_plane(grid, crs):
+    """Closed land strings of a planar grid (or of a lon/lat one projected to crs by GDAL) turn as
+    ADCIRC orders them (mesh on the left): outer boundaries (IBTYPE 0) counter-clockwise, islands
+    (1) clockwise. Returns the islands."""
     xyz, _, _, lands = read_grid(grid)
+    if crs:
+        from osgeo import osr
+        wgs84, to = osr.SpatialReference(), osr.SpatialReference()
+        wgs84.ImportFromEPSG(4326)
+        to.SetFromUserInput(crs)
+        for s in (wgs84, to):
+            s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+        xyz[:, :2] = np.array(osr.CoordinateTransformation(wgs84, to).TransformPoints(xyz[:, :2]))[:, :2]
     islands = 0
     for kind, s in lands:
         if s[0] != s[-1]:
@@ -124,8 +133,8 @@ def islands_in_the_plane(grid):
         islands += kind == 1
     return islands
 
-if sys.argv[2] == 'planar':
-    print('OK islands %d' % islands_in_the_plane(sys.argv[3]))
+if sys.argv[2].startswith('planar'):  # 'planar' or 'planar:CRS'
+    print('OK islands %d' % islands_in_the_plane(sys.argv[3], sys.argv[2][len('planar:'):]))
     sys.exit(0)
 ugrid, regional = sys.argv[1], sys.argv[2] == 'regional'
 counts = {check(g, ugrid, regional) for g in sys.argv[3:]}
@@ -145,6 +154,29 @@ std::string check_grids(const TempDir &dir, const std::string &kind,
     std::string out;
     EXPECT_EQ(run_command(command, out), 0) << out;
     return out;
+}
+
+/// Meshes NE 1:110m land at 400 km with `options` (a region, an --output-srs) into m.nc and
+/// fort.14; returns the checker's verdict on how the closed strings turn in the file's plane, or
+/// in `crs` (a lon/lat file's nodes projected there by GDAL).
+std::string planar_islands(const TempDir &dir, const std::vector<std::string> &options,
+                           const std::string &crs = "") {
+    std::vector<std::string> args = {"mesh",
+                                     "--coast",
+                                     fixture("coast/ne_110m_land.gpkg").string(),
+                                     "--coast-layer",
+                                     "land",
+                                     "--hmax",
+                                     "400km",
+                                     "-o",
+                                     (dir / "m.nc").string(),
+                                     "-o",
+                                     (dir / "fort.14").string(),
+                                     "-q"};
+    args.insert(args.end(), options.begin(), options.end());
+    std::string err;
+    EXPECT_EQ(run_exe(args, err, dir.path()), 0) << err;
+    return check_grids(dir, crs.empty() ? "planar" : "planar:" + crs, {"fort.14"});
 }
 
 /// The whitespace-separated leading numbers of each line of a file (what follows "!" dropped).
@@ -272,19 +304,20 @@ TEST(ModelGrid, a_global_fort14_has_no_open_boundary_and_one_mainland) {
     EXPECT_EQ(verdict.rfind("OK 0 ", 0), 0u) << verdict;
 }
 
-// The Southern Ocean south of 50 S: Antarctica's coast winds round the pole, so its lon/lat area
-// says nothing; in a part of the mesh with an open boundary it is an island (IBTYPE 1), clockwise
-// in the polar stereographic plane, as ADCIRC orders islands.
+// The Southern Ocean south of 50 S in lon/lat: Antarctica's coast winds round the pole, so its
+// lon/lat area says nothing; in a part of the mesh with an open boundary it is an island
+// (IBTYPE 1), clockwise in the polar stereographic plane, as ADCIRC orders islands.
 TEST(ModelGrid, antarctica_in_a_southern_ocean_region_is_an_island) {
     TempDir dir;
-    std::string err;
-    const int status =
-        run_exe({"mesh", "--coast", fixture("coast/ne_110m_land.gpkg").string(), "--coast-layer",
-                 "land", "--region", "-180,-90,180,-50", "--hmax", "400km", "--output-srs",
-                 "EPSG:3031", "-o", (dir / "m.nc").string(), "-o", (dir / "s.14").string(), "-q"},
-                err, dir.path());
-    ASSERT_EQ(status, 0) << err;
-    EXPECT_EQ(check_grids(dir, "planar", {"s.14"}), "OK islands 1\n");
+    EXPECT_EQ(planar_islands(dir, {"--region", "-180,-90,180,-50"}, "EPSG:3031"), "OK islands 1\n");
+}
+
+// A global mesh in EPSG:3995 (the South Pole on land) is a plane domain whose outer boundary is
+// Antarctica's coast: the closed strings are typed as they turn in the file's x y, where ADCIRC
+// reads them, not by length (the Afro-Eurasian coast was IBTYPE 0 there, and clockwise).
+TEST(ModelGrid, a_global_fort14_in_a_polar_projection_has_its_outer_boundary_as_mainland) {
+    TempDir dir;
+    EXPECT_EQ(planar_islands(dir, {"--output-srs", "EPSG:3995"}).rfind("OK islands ", 0), 0u);
 }
 
 TEST(ModelGrid, an_unwritable_fort14_is_one_line_and_leaves_no_file) {
