@@ -75,11 +75,14 @@ Mesh mesh_boundary(const Boundary &boundary, const std::function<double(const Ve
     // Last, the coast's corners too sharp for the faces there (corners.cpp), then the floor
     // (quality.cpp). The floor's moves can leave a sliver on the coast below it, which blunting
     // removes: then both run once more.
+    const auto before_corners = static_cast<VertexId>(m.dt.vertex_count());
     blunt_sharp_corners(m, options);
     if (!raise_quality_floor(m, options, as_made)) {
         blunt_sharp_corners(m, options);
         raise_quality_floor(m, options, as_made);
     }
+    if (options.land)
+        clear_land_after_splits(m, options, before_corners);
     // The closings may leave small pieces alone (a face hanging at a pinched node): they go.
     close_cut_off_pieces(m, options, report);
     if (options.land && options.measure_straits)

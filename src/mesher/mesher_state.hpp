@@ -582,6 +582,9 @@ std::size_t nudge_off_land(Mesher &m, const LandTest &land_test, const MesherOpt
 // straits.cpp: straits narrower than a face closed; clear_land runs the land clean-up (with
 // options.land): remove_land_faces, nudge_off_land, then close_straits and a second nudge.
 void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId> island_faces);
+// clear_land_after_splits: the faces around the nodes the corners' splits added (from
+// `first_new` on) that are centred on land, removed or nudged as clear_land's.
+void clear_land_after_splits(Mesher &m, const MesherOptions &options, VertexId first_new);
 void close_straits(Mesher &m, const LandTest &land_test, std::vector<TriangleId> &faces,
                    const MesherOptions &options, BoundaryLoops &loops, MesherReport &report);
 // pieces.cpp: whether a passage line (MesherOptions::passages) meets face t, and the small

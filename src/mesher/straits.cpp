@@ -1,4 +1,5 @@
 // Straits narrower than a face closed.
+#include <algorithm>
 #include <numeric>
 
 #include "mesher_state.hpp"
@@ -185,6 +186,27 @@ void clear_land(Mesher &m, const MesherOptions &options, std::vector<TriangleId>
     } else {
         close_dead_ends(m, options, report); // the short chords alone
     }
+    report.land_faces_left = report.land_faces_at.size();
+}
+
+// A corner's split of a segment that a land removal drew across a strip of water narrower than a
+// face makes faces over the land beside it (ne_50m_land, --region -100,70,-70,90 at 50 km: a face
+// centred on land at 85.86W 70.05N): they go, or are nudged off, as clear_land's did.
+void clear_land_after_splits(Mesher &m, const MesherOptions &options, VertexId first_new) {
+    std::vector<TriangleId> faces;
+    for (TriangleId t = 0; t < m.dt.triangle_slots(); ++t)
+        if (m.dt.is_live(t) && m.dt.label(t) == ocean &&
+            std::max({m.dt.vertex(t, 0), m.dt.vertex(t, 1), m.dt.vertex(t, 2)}) >= first_new &&
+            options.land->contains(m.centroid(t)))
+            faces.push_back(t);
+    if (faces.empty())
+        return;
+    MesherReport &report = m.report;
+    std::vector<TriangleId> left;
+    BoundaryLoops loops;
+    remove_land_faces(m, *options.land, std::move(faces), options, report, left, loops);
+    report.land_faces_nudged +=
+        nudge_off_land(m, *options.land, options, left, left, report.land_faces_at);
     report.land_faces_left = report.land_faces_at.size();
 }
 

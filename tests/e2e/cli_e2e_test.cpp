@@ -299,6 +299,23 @@ print('OK')
     EXPECT_EQ(verdict, "OK\n");
 }
 
+// A strip of water a few km wide between the region's south edge (70N) and the coast of the
+// Gulf of Boothia is closed by the land removal along a segment across the land; a corner's
+// split of that segment made a face centred on land (85.86W 70.05N), which mesh-verify, reading
+// the same polygons, counts.
+TEST(CliE2e, a_corner_split_beside_a_closed_strip_leaves_no_face_centred_on_land) {
+    TempDir dir;
+    std::string out, err;
+    ASSERT_EQ(
+        run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "-100,70,-70,90",
+                 "--hmin", "50", "--hmax", "50", "-o", (dir / "b.nc").string(), "--quiet"},
+                out, err, dir.path()),
+        0)
+        << err;
+    expect_mesh_verify(dir / "b.nc",
+                       "--coast " + land50 + " --coast-layer land --max-land-faces 0");
+}
+
 TEST(CliE2e, preview_region_zooms_the_picture_and_draws_the_edges_through_the_nodes) {
     // Oracles: the picture's size follows the asked region; each node of the UGRID file (read by
     // netCDF4) placed by the asked region's W,S,E,N lands on or next to a dark edge pixel of the
