@@ -20,6 +20,7 @@
 #include "globemesh/error.hpp"
 #include "grid.hpp"
 #include "pole_rings.hpp"
+#include "projected_edges.hpp"
 
 namespace globemesh::detail {
 
@@ -110,6 +111,8 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
     std::vector<std::pair<double, GeometryPtr>> regions;
     std::array<double, 2> lon_range{180.0, -180.0};
     bool any_field = false;
+    // Sides drawn in a projected CRS are split a grid cell apart (the rasteriser sees no finer).
+    const double edge_step_m = g.dlat * earth_radius_km * 1000 * pi / 180;
     for (OGRLayerH layer : size_layers(ds.get(), path, layer_name)) {
         OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
         int field = OGR_FD_GetFieldIndex(defn, "size_km");
@@ -142,6 +145,7 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                                 std::to_string(OGR_F_GetFID(fh)) + " has size_km " +
                                 OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
             GeometryPtr copy(OGR_G_Clone(geom));
+            split_projected_edges(copy.get(), srs, edge_step_m);
             if (OGR_G_Transform(copy.get(), to_lonlat.get()) != OGRERR_NONE)
                 throw DataError(option("size_regions") + " " + path +
                                 ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +

@@ -789,6 +789,64 @@ TEST(CliE2e, run_cli_in_process_prints_the_summary_on_out_only) {
     expect_mesh_verify(dir / "p.nc");
 }
 
+// Squares drawn in polar stereographic (EPSG:3413) about the North Pole, as a --region-file (2000
+// km side) and a --size-regions polygon (1200 km side, size_km 30): their sides are the straight
+// lines of that CRS, not lines straight in lon/lat between the corners (which reached 414 km
+// and 242 km past them). Read back with OSR: no node lies past the region's sides by more than
+// a kilometre, and none at the size region's size lies past its sides by more than that size.
+TEST(CliE2e, polygons_drawn_in_a_projected_crs_keep_their_straight_sides) {
+    TempDir dir;
+    python(R"(
+from osgeo import ogr, osr
+polar = osr.SpatialReference(); polar.ImportFromEPSG(3413)
+for name, half in (('region', 1e6), ('size', 6e5)):
+    ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
+               dir.path().string() + R"(/' + name + '.gpkg')
+    layer = ds.CreateLayer(name, polar, ogr.wkbPolygon)
+    layer.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
+    f = ogr.Feature(layer.GetLayerDefn()); f.SetField('size_km', 30)
+    f.SetGeometry(ogr.CreateGeometryFromWkt('POLYGON((-{0} -{0},{0} -{0},{0} {0},-{0} {0},-{0} -{0}))'.format(half)))
+    layer.CreateFeature(f); ds = None
+)",
+           dir.path());
+    std::string out, err;
+    ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region-file",
+                       (dir / "region.gpkg").string(), "--hmax", "50", "-o",
+                       (dir / "r.nc").string(), "--quiet"},
+                      out, err, dir.path()),
+              0)
+        << err;
+    expect_mesh_verify(dir / "r.nc");
+    ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region",
+                       "-180,70,180,90", "--hmax", "100", "--size-regions",
+                       (dir / "size.gpkg").string(), "-o", (dir / "s.nc").string(), "--quiet"},
+                      out, err, dir.path()),
+              0)
+        << err;
+    const std::string verdict = python(R"(
+import netCDF4, numpy as np
+from osgeo import osr
+wgs, polar = osr.SpatialReference(), osr.SpatialReference()
+wgs.ImportFromEPSG(4326); polar.ImportFromEPSG(3413)
+wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+polar.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+to_polar = osr.CoordinateTransformation(wgs, polar)
+def past_sides(path, half):
+    m = netCDF4.Dataset(path)
+    xy = np.array(to_polar.TransformPoints(np.c_[m['mesh_node_lon'][:], m['mesh_node_lat'][:]]))
+    return np.abs(xy[:, :2]).max(axis=1) - half, m['target_size'][:]
+past, _ = past_sides(')" + (dir / "r.nc").string() +
+                                           R"(', 1e6)
+assert past.max() < 1e3, past.max()
+past, size = past_sides(')" + (dir / "s.nc").string() +
+                                           R"(', 6e5)
+assert (size < 30.5).sum() > 100 and past[size < 30.5].max() < 30e3, past[size < 30.5].max()
+print('OK')
+)",
+                                       dir.path());
+    EXPECT_EQ(verdict, "OK\n");
+}
+
 // A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
 // UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
 // and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
