@@ -1,10 +1,10 @@
-// Internal to globemesh_lib: lon/lat rings closed through a pole, for the coast (coastline lines
-// ending on the +-180 seam, polygons reprojected from a polar CRS) and --size-regions. In a CRS
-// where a pole is a point (polar stereographic: EPSG:3413, 3031) a polygon may hold it.
-// Reprojected, its ring either goes round the pole without reaching it, which in lon/lat bounds
-// nothing, or passes through it at whatever longitude the inverse projection gives the pole
-// (EPSG:3413: -45), which leaves a spike. Closed through the pole along lat +-90 it bounds the
-// cap it held, as Antarctica's polygon is drawn.
+// Internal to globemesh_lib: lon/lat rings closed through a pole, or joined across +-180, for the
+// coast (coastline lines ending on the +-180 seam, polygons reprojected from a polar CRS), a
+// --region-file and --size-regions. In a CRS where a pole is a point (polar stereographic:
+// EPSG:3413, 3031) a polygon may hold it. Reprojected, its ring either goes round the pole
+// without reaching it, which in lon/lat bounds nothing, or passes through it at whatever
+// longitude the inverse projection gives the pole (EPSG:3413: -45), which leaves a spike. Closed
+// through the pole along lat +-90 it bounds the cap it held, as Antarctica's polygon is drawn.
 #pragma once
 
 #include <cmath>
@@ -135,6 +135,29 @@ inline bool close_at_pole(std::vector<LonLat> &ring) {
     const std::size_t first = (run_end + 1) % n;
     std::vector<LonLat> path = continuous_run(ring, n, ring[first], first + 1, n - on_pole - 1);
     close_through_pole(path, pole);
+    ring = std::move(path);
+    return true;
+}
+
+/// A closed ring (first == last) reprojected to lon/lat that jumps across +-180 but goes round
+/// no pole (a UTM zone 1 or 60 polygon across the antimeridian: the inverse projection returns
+/// 179 then -179, and the ring read as drawn spans every longitude but the ones it holds), with
+/// its longitudes made continuous from its first vertex (true; false: left as it was). They then
+/// pass +-180 on one side: the caller wraps that part back by 360 degrees.
+inline bool join_across_seam(std::vector<LonLat> &ring) {
+    const std::size_t n = ring.size() > 0 ? ring.size() - 1 : 0;
+    if (n < 3)
+        return false;
+    double winding = 0;
+    bool jumps = false;
+    for (std::size_t i = 0; i < n; ++i) {
+        winding += lon_step(ring[i].lon, ring[i + 1].lon);
+        jumps = jumps || std::abs(ring[i + 1].lon - ring[i].lon) > 180.0;
+    }
+    if (!jumps || std::abs(winding) > 180.0)
+        return false;
+    std::vector<LonLat> path = continuous_run(ring, n, ring[0], 1, n - 1);
+    path.push_back(ring[0]);
     ring = std::move(path);
     return true;
 }

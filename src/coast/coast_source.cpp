@@ -157,9 +157,10 @@ PointList read_points(OGRGeometryH g, bool transformed) {
     return pts;
 }
 
-/// How a geometry reached lon/lat: as stored, or reprojected from a CRS (one that holds a pole as
-/// a point, where a ring may go round or through it: pole_rings.hpp).
-enum class Reprojected { no, yes, from_pole_point };
+/// How a geometry reached lon/lat: as stored, or reprojected from a geographic CRS, a projected
+/// one (where a ring may cross +-180), or one that holds a pole as a point (where a ring may also
+/// go round or through it: pole_rings.hpp).
+enum class Reprojected { no, geographic, projected, from_pole_point };
 
 void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
     const bool transformed = how != Reprojected::no;
@@ -179,10 +180,12 @@ void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
             if (!ring.empty() &&
                 (ring.front().lon != ring.back().lon || ring.front().lat != ring.back().lat))
                 ring.push_back(ring.front());
-            // Round or through a pole of a polar CRS: closed through it along lat +-90
-            // (add_wrapped takes what passes +-180).
-            if (how == Reprojected::from_pole_point)
-                detail::close_at_pole(ring);
+            // Round or through a pole of a polar CRS: closed through it along lat +-90; else
+            // across +-180 from a projected CRS, joined there (add_wrapped takes what passes
+            // +-180).
+            if (!(how == Reprojected::from_pole_point && detail::close_at_pole(ring)) &&
+                (how == Reprojected::projected || how == Reprojected::from_pole_point))
+                detail::join_across_seam(ring);
             if (ring.size() < 4) {
                 if (i == 0)
                     return; // degenerate shell: no polygon
@@ -444,7 +447,8 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     const Reprojected how = !transform ? Reprojected::no
                             : detail::holds_a_pole_as_a_point(source_srs.get())
                                 ? Reprojected::from_pole_point
-                                : Reprojected::yes;
+                            : OSRIsProjected(source_srs.get()) ? Reprojected::projected
+                                                               : Reprojected::geographic;
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;

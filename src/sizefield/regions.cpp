@@ -71,14 +71,15 @@ void widen_lon_range(OGRGeometryH g, std::array<double, 2> &lon_range) {
     lon_range = {std::min(lon_range[0], e.MinX), std::max(lon_range[1], e.MaxX)};
 }
 
-/// Closes through its pole each ring of a polygon or multipolygon reprojected to lon/lat from a
-/// CRS that holds a pole as a point, where it goes round or through one (close_at_pole: drawn
-/// about a pole, it burnt nothing), and widens `lon_range` to its longitudes (such a ring may
-/// pass +-180).
-void close_rings_round_poles(OGRGeometryH g, std::array<double, 2> &lon_range) {
+/// Each ring of a polygon or multipolygon reprojected to lon/lat from a projected CRS: closed
+/// through its pole where it goes round or through one, from a CRS that holds a pole as a point
+/// (`pole_point`; close_at_pole: drawn about a pole, it burnt nothing), else joined across +-180
+/// where it jumps there (join_across_seam: drawn across the antimeridian, it burnt every
+/// longitude but its own); `lon_range` widened to its longitudes (which may then pass +-180).
+void unwrap_rings(OGRGeometryH g, bool pole_point, std::array<double, 2> &lon_range) {
     if (wkbFlatten(OGR_G_GetGeometryType(g)) == wkbMultiPolygon) {
         for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
-            close_rings_round_poles(OGR_G_GetGeometryRef(g, i), lon_range);
+            unwrap_rings(OGR_G_GetGeometryRef(g, i), pole_point, lon_range);
         return;
     }
     for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i) {
@@ -86,7 +87,7 @@ void close_rings_round_poles(OGRGeometryH g, std::array<double, 2> &lon_range) {
         std::vector<LonLat> pts(static_cast<std::size_t>(OGR_G_GetPointCount(ring)));
         for (std::size_t k = 0; k < pts.size(); ++k)
             pts[k] = {OGR_G_GetX(ring, int(k)), OGR_G_GetY(ring, int(k))};
-        if (!detail::close_at_pole(pts))
+        if (!(pole_point && detail::close_at_pole(pts)) && !detail::join_across_seam(pts))
             continue;
         OGR_G_SetPointCount(ring, static_cast<int>(pts.size()));
         for (std::size_t k = 0; k < pts.size(); ++k)
@@ -129,7 +130,8 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
         if (!to_lonlat)
             throw DataError(option("size_regions") + " " + path + ": cannot transform layer " +
                             OGR_L_GetName(layer) + " to lon/lat");
-        const bool pole_point = detail::holds_a_pole_as_a_point(srs);
+        const bool projected = OSRIsProjected(srs),
+                   pole_point = detail::holds_a_pole_as_a_point(srs);
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
@@ -150,8 +152,8 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                 throw DataError(option("size_regions") + " " + path +
                                 ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " to lon/lat");
-            if (pole_point)
-                close_rings_round_poles(copy.get(), lon_range);
+            if (projected)
+                unwrap_rings(copy.get(), pole_point, lon_range);
             else
                 widen_lon_range(copy.get(), lon_range);
             regions.emplace_back(size, std::move(copy));

@@ -73,6 +73,25 @@ std::set<std::string> files_in(const fs::path &dir) {
     return names;
 }
 
+/// Python (netCDF4, numpy, OSR) defining nodes_in(path): a UGRID file's node coordinates in
+/// EPSG:`epsg` (x, y) and its target_size.
+std::string nodes_in_crs_python(int epsg) {
+    return R"(
+import netCDF4, numpy as np
+from osgeo import osr
+wgs, crs = osr.SpatialReference(), osr.SpatialReference()
+wgs.ImportFromEPSG(4326); crs.ImportFromEPSG()" +
+           std::to_string(epsg) + R"()
+wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+crs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+def nodes_in(path):
+    m = netCDF4.Dataset(path)
+    xy = np.array(osr.CoordinateTransformation(wgs, crs).TransformPoints(
+        np.c_[m['mesh_node_lon'][:], m['mesh_node_lat'][:]]))
+    return xy[:, 0], xy[:, 1], m['target_size'][:]
+)";
+}
+
 int count_lines(const std::string &s) {
     int n = 0;
     for (char c : s)
@@ -823,24 +842,68 @@ for name, half in (('region', 1e6), ('size', 6e5)):
                       out, err, dir.path()),
               0)
         << err;
-    const std::string verdict = python(R"(
-import netCDF4, numpy as np
-from osgeo import osr
-wgs, polar = osr.SpatialReference(), osr.SpatialReference()
-wgs.ImportFromEPSG(4326); polar.ImportFromEPSG(3413)
-wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-polar.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-to_polar = osr.CoordinateTransformation(wgs, polar)
+    const std::string verdict = python(nodes_in_crs_python(3413) + R"(
 def past_sides(path, half):
-    m = netCDF4.Dataset(path)
-    xy = np.array(to_polar.TransformPoints(np.c_[m['mesh_node_lon'][:], m['mesh_node_lat'][:]]))
-    return np.abs(xy[:, :2]).max(axis=1) - half, m['target_size'][:]
+    x, y, size = nodes_in(path)
+    return np.maximum(np.abs(x), np.abs(y)) - half, size
 past, _ = past_sides(')" + (dir / "r.nc").string() +
                                            R"(', 1e6)
 assert past.max() < 1e3, past.max()
 past, size = past_sides(')" + (dir / "s.nc").string() +
                                            R"(', 6e5)
 assert (size < 30.5).sum() > 100 and past[size < 30.5].max() < 30e3, past[size < 30.5].max()
+print('OK')
+)",
+                                       dir.path());
+    EXPECT_EQ(verdict, "OK\n");
+}
+
+// A rectangle drawn in UTM zone 1N across the antimeridian (the western Aleutians, 330 x 270
+// km), reprojected, jumps from 179 to -179 degrees: as a --region-file it meshed the whole band
+// of latitudes but its own longitudes (nodes from 59W to 3W), and as --size-regions (5 km) it
+// set that size all round the band (nodes at it 571 km outside). Read back with OSR in UTM 1N:
+// every node of the region's mesh lies within a kilometre of the rectangle, and the nodes at the
+// size region's size lie in it while those 20 km inside it all have that size.
+TEST(CliE2e, polygons_drawn_in_utm_across_the_antimeridian_stay_where_they_are_drawn) {
+    TempDir dir;
+    python(R"(
+from osgeo import ogr, osr
+utm = osr.SpatialReference(); utm.ImportFromEPSG(32601)
+ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
+               dir.path().string() + R"(/aleutians.gpkg')
+layer = ds.CreateLayer('aleutians', utm, ogr.wkbPolygon)
+layer.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
+f = ogr.Feature(layer.GetLayerDefn()); f.SetField('size_km', 5)
+f.SetGeometry(ogr.CreateGeometryFromWkt('POLYGON((150e3 5600e3,480e3 5600e3,480e3 5870e3,150e3 5870e3,150e3 5600e3))'))
+layer.CreateFeature(f); ds = None
+)",
+           dir.path());
+    const std::string file = (dir / "aleutians.gpkg").string();
+    std::string out, err;
+    ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region-file", file,
+                       "--hmax", "20", "-o", (dir / "r.nc").string(), "--quiet"},
+                      out, err, dir.path()),
+              0)
+        << err;
+    expect_mesh_verify(dir / "r.nc");
+    ASSERT_EQ(
+        run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region", "170,45,-170,60",
+                 "--hmax", "50", "--size-regions", file, "-o", (dir / "s.nc").string(), "--quiet"},
+                out, err, dir.path()),
+        0)
+        << err;
+    const std::string verdict = python(nodes_in_crs_python(32601) + R"(
+def outside(path):
+    x, y, size = nodes_in(path)
+    return np.maximum.reduce([150e3 - x, x - 480e3, 5600e3 - y, y - 5870e3]), size
+past, _ = outside(')" + (dir / "r.nc").string() +
+                                           R"(')
+assert past.max() < 1e3, past.max()
+past, size = outside(')" + (dir / "s.nc").string() +
+                                           R"(')
+at = size < 5.05
+assert at.sum() > 100 and past[at].max() < 1e3, past[at].max()
+assert at[past < -20e3].all(), (~at[past < -20e3]).sum()
 print('OK')
 )",
                                        dir.path());
