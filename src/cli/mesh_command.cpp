@@ -108,7 +108,7 @@ void MeshCommand::add_coast_options(const std::string &coast) {
     region_opt->always_capture_default(false)->default_str("")->run_callback_for_default(
         false); // no region: the globe
     app.add_option("--region-file", m.region_file,
-                   "Polygons (any OGR source, any CRS) bounding the ocean")
+                   "Polygons or closed lines (any OGR source, any CRS) bounding the ocean")
         ->group(coast)
         ->type_name("SOURCE");
     app.add_option("--region-layer", m.region_layer,

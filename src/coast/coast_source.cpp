@@ -214,6 +214,28 @@ void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
     }
 }
 
+/// A copy of `g` with each closed line string a polygon (a --region-file's outline drawn as a
+/// line); its other parts as they are.
+OgrGeometryPtr closed_lines_to_polygons(OGRGeometryH g) {
+    const OGRwkbGeometryType t = wkbFlatten(OGR_G_GetGeometryType(g));
+    if (t == wkbLineString)
+        return OgrGeometryPtr(OGR_G_ForceToPolygon(OGR_G_Clone(g)));
+    if (t != wkbMultiLineString && t != wkbGeometryCollection)
+        return OgrGeometryPtr(OGR_G_Clone(g));
+    OgrGeometryPtr out(OGR_G_CreateGeometry(wkbGeometryCollection));
+    for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
+        OGR_G_AddGeometryDirectly(out.get(),
+                                  closed_lines_to_polygons(OGR_G_GetGeometryRef(g, i)).release());
+    return out;
+}
+
+/// What a layer of the option `field` should hold, for messages.
+std::string expected_geometry(const char *field) {
+    return std::string_view(field) == "region_file"
+               ? "polygons (or closed lines) bounding the ocean to mesh"
+               : "land polygons or coastlines";
+}
+
 /// Vertices of a geometry (all its parts and rings), as OGR holds them; curves count their
 /// control points (a linearized curve has more, but curves are rare in coastlines).
 std::uint64_t vertex_count(OGRGeometryH g) {
@@ -453,6 +475,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;
     bool too_many = false;
+    const bool region = std::string_view(field) == "region_file";
     // One feature: counted, and its polygons and lines kept in lon/lat.
     auto take = [&](OGRFeatureH f) {
         ++src.features;
@@ -467,10 +490,14 @@ Source read_source(const std::string &path, const std::string &layer_name, const
         }
         if (too_many)
             return;
+        // A region's outline drawn as a closed line bounds what a polygon would.
+        OgrGeometryPtr outline = region ? closed_lines_to_polygons(g) : nullptr;
+        if (outline)
+            g = outline.get();
         if (transform) {
             OgrGeometryPtr copy(OGR_G_Clone(g));
             // A region's sides are the lines drawn in its CRS (the coast is dense already).
-            if (std::string_view(field) == "region_file")
+            if (region)
                 detail::split_projected_edges(copy.get(), source_srs.get(), region_edge_step_m);
             if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
@@ -516,11 +543,18 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     if (src.features == 0)
         throw DataError(where_msg + " has no features" +
                         (where.empty() ? ErrorText("") : " matching " + option("coast_where")) +
-                        "; give a layer of land polygons or coastlines");
+                        "; give a layer of " + expected_geometry(field));
     if (src.polygons.empty() && src.lines.empty())
         throw DataError(where_msg + " holds no polygons or lines" +
-                        (src.points ? " (only points)" : "") +
-                        "; give land polygons or coastlines");
+                        (src.points ? " (only points)" : "") + "; give " +
+                        expected_geometry(field));
+    if (region && !src.lines.empty()) {
+        const LonLat a = src.lines.front().front(), b = src.lines.front().back();
+        throw DataError(where_msg + ": a line from (" + std::to_string(a.lon) + ", " +
+                        std::to_string(a.lat) + ") to (" + std::to_string(b.lon) + ", " +
+                        std::to_string(b.lat) + ") does not close; give " +
+                        expected_geometry(field));
+    }
     return src;
 }
 

@@ -64,6 +64,30 @@ std::vector<OGRLayerH> size_layers(GDALDatasetH ds, const std::string &path,
     return layers;
 }
 
+/// Features a layer's reading skipped, for its message: how many, and the first.
+struct Skipped {
+    std::size_t count = 0;
+    GIntBig first = OGRNullFID;
+    OGRwkbGeometryType first_type = wkbNone;
+    void add(OGRFeatureH f, OGRwkbGeometryType type) {
+        if (count++ == 0)
+            first = OGR_F_GetFID(f), first_type = type;
+    }
+    /// "feature 3 `one`" or "2 features `many` (the first, feature 3, `first`)".
+    std::string text(const std::string &one, const std::string &many,
+                     const std::string &first_is) const {
+        const std::string fid = "feature " + std::to_string(first);
+        return count == 1 ? fid + " " + one
+                          : std::to_string(count) + " features " + many + " (the first, " + fid +
+                                ", " + first_is + ")";
+    }
+    /// The first one's geometry type, "a Line String" or "no geometry".
+    std::string first_geometry() const {
+        return first_type == wkbNone ? "no geometry"
+                                     : std::string("a ") + OGRGeometryTypeToName(first_type);
+    }
+};
+
 /// Widens `lon_range` to the longitudes of `g` (a polygon may be drawn past +-180).
 void widen_lon_range(OGRGeometryH g, std::array<double, 2> &lon_range) {
     OGREnvelope e;
@@ -132,15 +156,21 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                             OGR_L_GetName(layer) + " to lon/lat");
         const bool projected = OSRIsProjected(srs),
                    pole_point = detail::holds_a_pole_as_a_point(srs);
+        Skipped not_polygons, without_size;
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
             OGRGeometryH geom = OGR_F_GetGeometryRef(fh);
-            if (!geom || !OGR_F_IsFieldSetAndNotNull(fh, field))
+            const OGRwkbGeometryType type =
+                geom ? wkbFlatten(OGR_G_GetGeometryType(geom)) : wkbNone;
+            if (type != wkbPolygon && type != wkbMultiPolygon) {
+                not_polygons.add(fh, type);
                 continue;
-            OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geom));
-            if (type != wkbPolygon && type != wkbMultiPolygon)
+            }
+            if (!OGR_F_IsFieldSetAndNotNull(fh, field)) {
+                without_size.add(fh, type);
                 continue;
+            }
             double size = OGR_F_GetFieldAsDouble(fh, field);
             if (!(std::isfinite(size) && size > 0))
                 throw DataError(option("size_regions") + " " + path + ": feature " +
@@ -158,12 +188,27 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                 widen_lon_range(copy.get(), lon_range);
             regions.emplace_back(size, std::move(copy));
         }
+        const ErrorText where =
+            option("size_regions") + " " + path + " layer '" + OGR_L_GetName(layer) + "'";
+        if (not_polygons.count)
+            throw DataError(
+                where + ": " +
+                not_polygons.text("is " + not_polygons.first_geometry() + ", not a polygon",
+                                  "are not polygons", "is " + not_polygons.first_geometry()) +
+                "; size regions are polygons with a size_km");
+        if (without_size.count)
+            throw DataError(
+                where + ": " +
+                without_size.text("has no size_km (null)", "have no size_km (null)", "has none") +
+                "; give each polygon its edge length in km, or leave them out "
+                "(ogr2ogr -where \"size_km IS NOT NULL\")");
     }
     if (!any_field)
         throw DataError(option("size_regions") + " " + path +
                         ": no layer has a size_km field (edge length in km)");
     if (regions.empty())
-        return;
+        throw DataError(option("size_regions") + " " + path +
+                        ": no polygon in it; size regions are polygons with a size_km");
     // Largest first: with the REPLACE rule the smallest size burnt last wins (a minimum).
     std::stable_sort(regions.begin(), regions.end(),
                      [](const auto &a, const auto &b) { return a.first > b.first; });

@@ -910,6 +910,90 @@ print('OK')
     EXPECT_EQ(verdict, "OK\n");
 }
 
+// Region files and size regions that hold the wrong things, derived from the real
+// fixtures with OGR: DCW's Denmark buffered about South Funen as closed lines meshes as its
+// polygon does (a closed line bounds the same water, as --help says; the two meshes' nodes are
+// equal), and every other case is refused in one line naming the file and the cause, with no
+// output: an open line (a critical passage) as the region, a region layer of no features, size
+// regions with lines or a null size_km (were ignored without a word).
+TEST(CliE2e, region_and_size_region_files_holding_the_wrong_things_say_what_is_wrong) {
+    TempDir dir;
+    const std::string d = dir.path().string() + "/";
+    python(R"(
+from osgeo import ogr
+d = ')" + d + R"('
+src = ogr.Open(')" +
+               fixture("regions/dcw_denmark_buffer_0.02_south_funen.geojson").string() +
+               R"(')
+region = src.GetLayer(0)
+passages_ds = ogr.Open(')" +
+               fixture("passages/passages.geojson").string() + R"(')
+passages = passages_ds.GetLayer(0)
+srs = region.GetSpatialRef()
+feature = region.GetNextFeature()  # kept: its geometry is a reference into it
+polygon = feature.GetGeometryRef().Clone()
+lines = [f.GetGeometryRef().Clone() for f in passages]
+def write(name, geometry_type, features):
+    ds = ogr.GetDriverByName('GPKG').CreateDataSource(d + name + '.gpkg')
+    l = ds.CreateLayer(name, srs, geometry_type)
+    l.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
+    for g, size in features:
+        f = ogr.Feature(l.GetLayerDefn()); f.SetGeometry(g)
+        if size is not None:
+            f.SetField('size_km', size)
+        l.CreateFeature(f)
+    f = l = None; ds = None  # the layer before its data set
+write('outline', ogr.wkbMultiLineString, [(ogr.ForceToMultiLineString(polygon.GetBoundary()), None)])
+write('empty', ogr.wkbPolygon, [])
+write('open_line', ogr.wkbLineString, [(lines[0], None)])
+write('size_lines', ogr.wkbUnknown, [(polygon, 2), (lines[0], 2), (lines[1], 2)])
+write('size_null', ogr.wkbPolygon, [(polygon, 2), (polygon, None)])
+)",
+           dir.path());
+    const std::string coast = fixture("coast/hostile/gshhg_i_south_funen.geojson").string();
+    std::string out, err;
+    for (const std::string region : {"outline", "polygon"}) {
+        const std::string file =
+            region == "outline"
+                ? d + "outline.gpkg"
+                : fixture("regions/dcw_denmark_buffer_0.02_south_funen.geojson").string();
+        ASSERT_EQ(run_exe({"mesh", "--coast", coast, "--region-file", file, "--hmax", "5", "-o",
+                           d + region + ".nc", "--quiet"},
+                          out, err, dir.path()),
+                  0)
+            << err;
+    }
+    EXPECT_EQ(python(R"(
+import netCDF4, numpy as np
+a, b = (netCDF4.Dataset(')" +
+                         d + R"(' + n + '.nc') for n in ('outline', 'polygon'))
+for v in ('mesh_node_lon', 'mesh_node_lat', 'mesh_face_nodes'):
+    assert np.array_equal(a[v][:], b[v][:]), v
+print('OK')
+)",
+                     dir.path()),
+              "OK\n");
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{"--region-file", d + "open_line.gpkg"},
+         "does not close; give polygons (or closed lines)"},
+        {{"--region-file", d + "empty.gpkg"},
+         "layer 'empty' has no features; give a layer of polygons (or closed lines)"},
+        {{"--region", "9.9,55,10.3,55.3", "--size-regions", d + "size_lines.gpkg"},
+         "2 features are not polygons (the first, feature 2, is a Line String)"},
+        {{"--region", "9.9,55,10.3,55.3", "--size-regions", d + "size_null.gpkg"},
+         "feature 2 has no size_km (null)"},
+    };
+    for (const auto &[args, message] : cases) {
+        std::vector<std::string> run = {"mesh", "--coast", coast,      "--hmax",
+                                        "5",    "-o",      d + "x.nc", "-q"};
+        run.insert(run.end(), args.begin(), args.end());
+        EXPECT_EQ(run_exe(run, out, err, dir.path()), 1) << err;
+        EXPECT_EQ(count_lines(err), 1) << err;
+        EXPECT_NE(err.find(message), std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(d + "x.nc"));
+    }
+}
+
 // A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
 // UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
 // and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
