@@ -994,6 +994,54 @@ print('OK')
     }
 }
 
+// GSHHG's coast of South Funen buffered 0.006 degree (a strip about 1 km wide) as a 5 km size
+// region of a global 100 km mesh, whose size grid's cells are some 14 km: the strip fell between
+// their centres and its nodes got 5.7 to 8.5 km. Read back with OGR and netCDF4, every node in
+// the strip has the size it asks, within the grid's interpolation (5.5 km).
+TEST(CliE2e, a_size_region_narrower_than_a_grid_cell_sets_the_size_where_it_lies) {
+    TempDir dir;
+    const std::string strip = (dir / "strip.gpkg").string();
+    const std::string nodes_in_strip = R"(
+from osgeo import ogr
+src = ogr.Open(')" + fixture("coast/hostile/gshhg_i_south_funen.geojson").string() +
+                                       R"(')
+land = src.GetLayer(0)
+strips = [f.GetGeometryRef().GetBoundary().Buffer(0.006) for f in land]
+)";
+    python(nodes_in_strip + R"(
+ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
+               strip + R"(')
+layer = ds.CreateLayer('strip', land.GetSpatialRef(), ogr.wkbMultiPolygon)
+layer.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
+for g in strips:
+    f = ogr.Feature(layer.GetLayerDefn()); f.SetGeometry(ogr.ForceToMultiPolygon(g))
+    f.SetField('size_km', 5); layer.CreateFeature(f)
+f = layer = None; ds = None
+)",
+           dir.path());
+    std::string out, err;
+    ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--hmax", "100",
+                       "--size-regions", strip, "-o", (dir / "g.nc").string(), "--quiet"},
+                      out, err, dir.path()),
+              0)
+        << err;
+    EXPECT_EQ(python(nodes_in_strip + R"(
+import netCDF4, numpy as np
+m = netCDF4.Dataset(')" + (dir / "g.nc").string() +
+                         R"(')
+lon, lat, size = m['mesh_node_lon'][:], m['mesh_node_lat'][:], m['target_size'][:]
+sizes = []
+for i in np.flatnonzero((lon > 9.7) & (lon < 10.5) & (lat > 54.8) & (lat < 55.5)):
+    p = ogr.Geometry(ogr.wkbPoint); p.AddPoint_2D(float(lon[i]), float(lat[i]))
+    if any(g.Contains(p) for g in strips):
+        sizes.append(float(size[i]))
+assert len(sizes) >= 5 and max(sizes) <= 5.5, sizes
+print('OK')
+)",
+                     dir.path()),
+              "OK\n");
+}
+
 // A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
 // UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
 // and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
