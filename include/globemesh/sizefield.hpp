@@ -129,7 +129,8 @@ private:
 };
 
 /// Builds the size field the options ask for (see the file comment), over `region` (the run's
-/// CoastOptions::region, W,S,E,N degrees; nullopt: the whole globe). bathy: the bathymetry
+/// CoastOptions::region, or the box of a region file's ocean; W,S,E,N degrees; nullopt: the whole
+/// globe). bathy: the bathymetry
 /// (required when wavelength or slope is on, else may be null); coast: the boundary rings at
 /// full resolution (required when coast_size_km or feature_size is on). max_nodes caps the
 /// background grid.

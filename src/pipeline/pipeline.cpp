@@ -72,14 +72,27 @@ constexpr std::uint64_t ring_bytes_per_node = 40;
 /// rounded up; its cells come on top (LandMask::cell_bytes).
 constexpr std::uint64_t land_bytes_per_vertex = 100;
 
+/// The region the size field's grid covers: --region, or with --region-file the lon/lat box of
+/// the ocean it bounds (ocean_extent; the globe's grid, 14 km cells, sampled a region of a few km
+/// as coarsely), or the globe (nullopt).
+std::optional<std::array<double, 4>> size_grid_region(const MeshOptions &o, const Boundary &ocean) {
+    if (o.region || o.region_file.empty())
+        return o.region;
+    const std::optional<LonLatBounds> box = ocean_extent(ocean);
+    if (!box || box->east - box->west >= 360)
+        return std::nullopt;
+    auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
+    return std::array<double, 4>{wrap(box->west), box->south, wrap(box->east), box->north};
+}
+
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
 /// the region plus a cell of margin, at most size_grid_max_nodes).
-double size_grid_nodes(const MeshOptions &o) {
+double size_grid_nodes(const MeshOptions &o, const std::optional<std::array<double, 4>> &region) {
     const double hfloor = size_floor_km(o);
     const double spacing = std::max(1e-6, 0.5 * hfloor / earth_radius_km * rad_to_deg);
     double lon_span = 360, lat_span = 180;
-    if (o.region) {
-        const auto &r = *o.region;
+    if (region) {
+        const auto &r = *region;
         lon_span = std::min(360.0, (r[2] > r[0] ? r[2] - r[0] : r[2] - r[0] + 360) + 2 * spacing);
         lat_span = std::min(180.0, r[3] - r[1] + 2 * spacing);
     }
@@ -311,8 +324,9 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     clock.lap("read_bathy", true);
 
     // The background grid, when the field needs one, is held against the budget before it is made.
+    const std::optional<std::array<double, 4>> grid_region = size_grid_region(o, coast.rings);
     auto reserve_grid = [&] {
-        const double grid_nodes = size_grid_nodes(o);
+        const double grid_nodes = size_grid_nodes(o, grid_region);
         budget.require(grid_nodes * static_cast<double>(size_grid_bytes_per_node),
                        "the size field's background grid (" +
                            std::to_string(static_cast<std::uint64_t>(grid_nodes)) + " nodes)",
@@ -320,9 +334,9 @@ OceanMesh mesh_ocean(const MeshOptions &o, const Progress &run_progress, StageTi
     };
     // Uniform when no component of the field is on: then no background grid is built.
     const SizeField field =
-        build_size_field(size_field_options(o), o.region, bathy ? &*bathy : nullptr, &coast.rings,
-                         sub_progress(progress, 0.15, 0.25), size_grid_max_nodes, reserve_grid,
-                         passages, static_cast<std::size_t>(std::max(0, o.threads)));
+        build_size_field(size_field_options(o), grid_region, bathy ? &*bathy : nullptr,
+                         &coast.rings, sub_progress(progress, 0.15, 0.25), size_grid_max_nodes,
+                         reserve_grid, passages, static_cast<std::size_t>(std::max(0, o.threads)));
     const SizeFn size = field.function();
     SizeFieldReport size_report{field.is_uniform(), 0, field.min_km(), field.max_km()};
     if (!field.is_uniform()) {

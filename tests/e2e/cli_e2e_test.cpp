@@ -1042,6 +1042,41 @@ print('OK')
               "OK\n");
 }
 
+// DCW's Denmark buffered about South Funen as --region-file, GSHHG's coast there, --coast-size
+// 300 m: the size field's grid was the globe's (cells of some 14 km) for a region 25 km across,
+// and the nodes on the coast got 362 m at least. Its grid now covers the region's ocean: read
+// back with OGR, every node on the coast (within 1e-6 degree of it) has 300 m, to 10 m.
+TEST(CliE2e, a_region_file_gets_a_size_grid_over_its_own_ocean) {
+    TempDir dir;
+    const std::string coast = fixture("coast/hostile/gshhg_i_south_funen.geojson").string();
+    std::string out, err;
+    ASSERT_EQ(
+        run_exe({"mesh", "--coast", coast, "--region-file",
+                 fixture("regions/dcw_denmark_buffer_0.02_south_funen.geojson").string(),
+                 "--coast-size", "0.3", "--hmax", "3", "-o", (dir / "f.nc").string(), "--quiet"},
+                out, err, dir.path()),
+        0)
+        << err;
+    EXPECT_EQ(python(R"(
+import netCDF4, numpy as np
+from osgeo import ogr
+src = ogr.Open(')" + coast +
+                         R"(')
+shores = [f.GetGeometryRef().GetBoundary() for f in src.GetLayer(0)]
+m = netCDF4.Dataset(')" + (dir / "f.nc").string() +
+                         R"(')
+on_coast = []
+for x, y, h in zip(m['mesh_node_lon'][:], m['mesh_node_lat'][:], m['target_size'][:]):
+    p = ogr.Geometry(ogr.wkbPoint); p.AddPoint_2D(float(x), float(y))
+    if min(s.Distance(p) for s in shores) < 1e-6:
+        on_coast.append(float(h))
+assert len(on_coast) > 30 and abs(np.array(on_coast) - 0.3).max() < 0.01, (len(on_coast), max(on_coast))
+print('OK')
+)",
+                     dir.path()),
+              "OK\n");
+}
+
 // A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
 // UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
 // and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
