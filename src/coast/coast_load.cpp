@@ -97,23 +97,58 @@ std::vector<GeomPtr> valid_parts(Geos &geos, const std::vector<PolygonRings> &po
     return parts;
 }
 
+/// The shortest arc of longitudes (west, east; degrees, east - west < 360, west in [-180, 180))
+/// that holds every span [w, e] of `spans` (each e - w < 360): the circle less the widest gap
+/// between them. None when they leave no gap.
+std::optional<std::array<double, 2>> covering_arc(std::vector<std::array<double, 2>> spans) {
+    for (auto &[w, e] : spans) {
+        const double shift = 360 * std::floor((w + 180) / 360);
+        w -= shift, e -= shift;
+    }
+    std::sort(spans.begin(), spans.end());
+    double reach = spans.front()[1], gap = 0, west = 0, east = 0;
+    auto gap_to = [&](double next_west) {
+        if (next_west - reach > gap)
+            gap = next_west - reach, west = next_west, east = reach;
+    };
+    for (const auto &[w, e] : spans) {
+        gap_to(w);
+        reach = std::max(reach, e);
+    }
+    gap_to(spans.front()[0] + 360); // round the circle, back to the first
+    if (!(gap > 0))
+        return std::nullopt;
+    if (west >= 180)
+        west -= 360;
+    return std::array<double, 2>{west, east < west ? east + 360 : east};
+}
+
 /// The lon/lat box a --region-file's polygons (`region`) lie in, half a degree wider (W > E
-/// across 180), for the coast's read to take only the land near it as a --region box does; none
-/// where they go round the globe (a cap about a pole, pieces either side of 180 stored apart).
+/// across 180), for the coast's read to take only the land near it as a --region box does: its
+/// longitudes the shortest arc holding every polygon (pieces either side of 180 stored apart lie
+/// in one box across it); none where they go round the globe (a cap about a pole).
 std::optional<std::array<double, 4>> region_file_box(const Source &region) {
-    double w = 1e300, e = -1e300, s = 90, n = -90;
-    for (const PolygonRings &poly : region.polygons)
+    std::vector<std::array<double, 2>> spans;
+    double s = 90, n = -90;
+    for (const PolygonRings &poly : region.polygons) {
+        double w = 1e300, e = -1e300;
         for (const PointList &ring : poly)
             for (const LonLat &p : ring) {
                 w = std::min(w, p.lon), e = std::max(e, p.lon);
                 s = std::min(s, p.lat), n = std::max(n, p.lat);
             }
+        if (!(e - w < 360))
+            return std::nullopt;
+        spans.push_back({w, e});
+    }
     constexpr double margin = 0.5;
-    if (!(e - w < 360 - 2 * margin - 10))
+    const std::optional<std::array<double, 2>> arc =
+        spans.empty() ? std::nullopt : covering_arc(spans);
+    if (!arc || !((*arc)[1] - (*arc)[0] < 360 - 2 * margin - 10))
         return std::nullopt;
     auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
-    return std::array<double, 4>{wrap(w - margin), std::max(-90.0, s - margin), wrap(e + margin),
-                                 std::min(90.0, n + margin)};
+    return std::array<double, 4>{wrap((*arc)[0] - margin), std::max(-90.0, s - margin),
+                                 wrap((*arc)[1] + margin), std::min(90.0, n + margin)};
 }
 
 } // namespace
