@@ -1121,6 +1121,41 @@ assert feature.GetGeometryRef().GetGeometryCount() == 2
     expect_same_mesh(d + "split.nc", d + "past.nc", dir.path());
 }
 
+// GSHHG's Chukotka (one polygon from 175E to 185E) reprojected to polar stereographic (EPSG:3413)
+// as --coast: back in lon/lat its ring jumped from 180 to -180 and the land was meshed as sea
+// (1,016 faces on land at 10 km). mesh-verify, given the lon/lat polygons, finds no face on land,
+// and the ocean's area is the lon/lat source's (netCDF4, within 0.1%).
+TEST(CliE2e, a_coast_in_a_polar_crs_with_land_across_the_antimeridian_stays_land) {
+    TempDir dir;
+    const std::string d = dir.path().string() + "/";
+    const std::string lonlat = fixture("coast/hostile/gshhg_i_chukotka_175_185.geojson").string();
+    python(R"(
+from osgeo import gdal
+gdal.UseExceptions()
+gdal.VectorTranslate(')" +
+               d + R"(polar.gpkg', ')" + lonlat + R"(', options='-t_srs EPSG:3413 -nln land')
+)",
+           dir.path());
+    std::string out, err;
+    for (const std::string &coast : {d + "polar.gpkg", lonlat})
+        ASSERT_EQ(
+            run_exe({"mesh", "--coast", coast, "--region", "176,64.5,-176,67.5", "--hmax", "10",
+                     "-o", d + (coast == lonlat ? "lonlat" : "polar") + ".nc", "--quiet"},
+                    out, err, dir.path()),
+            0)
+            << err;
+    expect_mesh_verify(d + "polar.nc", "--coast " + lonlat + " --max-land-faces 0");
+    EXPECT_EQ(python(R"(
+import netCDF4
+polar, lonlat = (netCDF4.Dataset(')" +
+                         d + R"(' + n + '.nc')['area'][:].sum() for n in ('polar', 'lonlat'))
+assert abs(polar / lonlat - 1) < 1e-3, (polar, lonlat)
+print('OK')
+)",
+                     dir.path()),
+              "OK\n");
+}
+
 // A CUDEM tile as published (CF lon/lat axes, no CRS) meshes a region given as a polygon in
 // UTM 15N: read as lon/lat (--verbose says so), the raster need cover only that region's ocean,
 // and every node's depth is the tile's bilinear value there (netCDF4 and numpy). A region
