@@ -79,8 +79,10 @@ std::optional<std::array<double, 4>> size_grid_region(const MeshOptions &o, cons
     if (o.region || o.region_file.empty())
         return o.region;
     const std::optional<LonLatBounds> box = ocean_extent(ocean);
-    if (!box || box->east - box->west >= 360)
+    if (!box || (box->south <= -90 && box->north >= 90))
         return std::nullopt;
+    if (box->east - box->west >= 360) // a band of latitudes (a cap about a pole)
+        return std::array<double, 4>{-180, box->south, 180, box->north};
     auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
     return std::array<double, 4>{wrap(box->west), box->south, wrap(box->east), box->north};
 }

@@ -92,6 +92,27 @@ def nodes_in(path):
 )";
 }
 
+/// Writes a GeoPackage at `path` of one polygon (`wkt`, in EPSG:`epsg`) with a size_km of
+/// `size_km` (OGR, python3).
+void write_polygon(const std::string &path, int epsg, const std::string &wkt, double size_km,
+                   const fs::path &dir) {
+    python(R"(
+from osgeo import ogr, osr
+crs = osr.SpatialReference(); crs.ImportFromEPSG()" +
+               std::to_string(epsg) + R"()
+ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
+               path + R"(')
+layer = ds.CreateLayer('region', crs, ogr.wkbPolygon)
+layer.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
+f = ogr.Feature(layer.GetLayerDefn()); f.SetField('size_km', )" +
+               std::to_string(size_km) + R"()
+f.SetGeometry(ogr.CreateGeometryFromWkt(')" +
+               wkt + R"('))
+layer.CreateFeature(f); f = layer = None; ds = None
+)",
+           dir);
+}
+
 /// Expects two UGRID files to hold the same nodes and faces (read by netCDF4).
 void expect_same_mesh(const std::string &a, const std::string &b, const fs::path &dir) {
     EXPECT_EQ(python(R"(
@@ -881,18 +902,9 @@ print('OK')
 // size region's size lie in it while those 20 km inside it all have that size.
 TEST(CliE2e, polygons_drawn_in_utm_across_the_antimeridian_stay_where_they_are_drawn) {
     TempDir dir;
-    python(R"(
-from osgeo import ogr, osr
-utm = osr.SpatialReference(); utm.ImportFromEPSG(32601)
-ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
-               dir.path().string() + R"(/aleutians.gpkg')
-layer = ds.CreateLayer('aleutians', utm, ogr.wkbPolygon)
-layer.CreateField(ogr.FieldDefn('size_km', ogr.OFTReal))
-f = ogr.Feature(layer.GetLayerDefn()); f.SetField('size_km', 5)
-f.SetGeometry(ogr.CreateGeometryFromWkt('POLYGON((150e3 5600e3,480e3 5600e3,480e3 5870e3,150e3 5870e3,150e3 5600e3))'))
-layer.CreateFeature(f); ds = None
-)",
-           dir.path());
+    write_polygon(dir.path().string() + "/aleutians.gpkg", 32601,
+                  "POLYGON((150e3 5600e3,480e3 5600e3,480e3 5870e3,150e3 5870e3,150e3 5600e3))", 5,
+                  dir.path());
     const std::string file = (dir / "aleutians.gpkg").string();
     std::string out, err;
     ASSERT_EQ(run_exe({"mesh", "--coast", land50, "--coast-layer", "land", "--region-file", file,
@@ -1083,6 +1095,43 @@ print('OK')
               "OK\n");
 }
 
+// A --region-file about the North Pole (a 2000 km square in EPSG:3413), Natural Earth 1:110m,
+// --coast-size 4 km: the grid of a region round a pole is its band of latitudes, not the globe's
+// (with --coast-size 2 the nodes on the coast got up to 2.64 km before, 2.16 after). Read back
+// with OGR: every node on the coast has 4 km to within a quarter of a km.
+TEST(CliE2e, a_region_file_about_a_pole_gets_a_size_grid_over_its_band) {
+    TempDir dir;
+    const std::string d = dir.path().string() + "/";
+    write_polygon(d + "cap.gpkg", 3413, "POLYGON((-1e6 -1e6,1e6 -1e6,1e6 1e6,-1e6 1e6,-1e6 -1e6))",
+                  4, dir.path());
+    std::string out, err;
+    ASSERT_EQ(
+        run_exe({"mesh", "--coast", land110, "--coast-layer", "land", "--region-file",
+                 d + "cap.gpkg", "--hmax", "100", "--coast-size", "4", "-o", d + "c.nc", "--quiet"},
+                out, err, dir.path()),
+        0)
+        << err;
+    EXPECT_EQ(python(R"(
+import netCDF4, numpy as np
+from osgeo import ogr
+src = ogr.Open(')" + land110 +
+                         R"(')
+layer = src.GetLayerByName('land'); layer.SetSpatialFilterRect(-180, 60, 180, 90)
+shores = [f.GetGeometryRef().GetBoundary() for f in layer]
+m = netCDF4.Dataset(')" + d +
+                         R"(c.nc')
+on_coast = []
+for x, y, h in zip(m['mesh_node_lon'][:], m['mesh_node_lat'][:], m['target_size'][:]):
+    p = ogr.Geometry(ogr.wkbPoint); p.AddPoint_2D(float(x), float(y))
+    if any(s.Distance(p) < 1e-6 for s in shores):
+        on_coast.append(float(h))
+assert len(on_coast) > 30 and abs(np.array(on_coast) - 4).max() < 0.25, (len(on_coast), max(on_coast))
+print('OK')
+)",
+                     dir.path()),
+              "OK\n");
+}
+
 // A region across the antimeridian as ogr2ogr -wrapdateline stores it (two polygons, one either
 // side of 180) was read as going round the globe: the whole coast layer was read for it (GSHHG
 // high: 11 s and 566 MB, against 0.2 s and 65 MB for the polygon drawn past 180), and within
@@ -1091,16 +1140,11 @@ print('OK')
 TEST(CliE2e, a_region_file_split_at_the_antimeridian_reads_only_the_coast_near_it) {
     TempDir dir;
     const std::string d = dir.path().string() + "/";
+    write_polygon(d + "past.gpkg", 4326, "POLYGON((176 50.5,183 50.5,183 53,176 53,176 50.5))", 0,
+                  dir.path());
     python(R"(
-from osgeo import gdal, ogr, osr
+from osgeo import gdal, ogr
 gdal.UseExceptions()
-wgs = osr.SpatialReference(); wgs.ImportFromEPSG(4326)
-ds = ogr.GetDriverByName('GPKG').CreateDataSource(')" +
-               d + R"(past.gpkg')
-layer = ds.CreateLayer('region', wgs, ogr.wkbPolygon)
-f = ogr.Feature(layer.GetLayerDefn())
-f.SetGeometry(ogr.CreateGeometryFromWkt('POLYGON((176 50.5,183 50.5,183 53,176 53,176 50.5))'))
-layer.CreateFeature(f); f = layer = None; ds = None
 gdal.VectorTranslate(')" +
                d + R"(split.gpkg', ')" + d +
                R"(past.gpkg', options='-wrapdateline -nlt MULTIPOLYGON')
