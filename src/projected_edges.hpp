@@ -1,8 +1,10 @@
 // Internal to globemesh_lib: a polygon drawn in a projected CRS (UTM, polar stereographic) has
 // straight edges in that CRS; reprojected vertex by vertex to lon/lat, each edge would become a
-// line straight in lon/lat instead (a 2000 km square in EPSG:3413 about the North Pole: its
-// mesh reached 414 km past the drawn sides). Its long edges are split in that CRS first, with
-// OGR's segmentize, for --region-file and --size-regions.
+// line straight in lon/lat instead (a 1200 km square size region in EPSG:3413 about the North
+// Pole set its size up to 242 km past the drawn sides). Its long edges are split in that CRS first,
+// with OGR's segmentize, for --size-regions. Not for --region-file: its outline may be the coast
+// reprojected vertex by vertex (issue 37, coast_test's Equal Earth land), whose edges are the
+// lon/lat lines of the data it came from; split, it left slivers of ocean along the coast.
 #pragma once
 
 #include <ogr_api.h>

@@ -22,7 +22,6 @@
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
 #include "pole_rings.hpp"
-#include "projected_edges.hpp"
 
 namespace globemesh::coast_detail {
 namespace {
@@ -41,10 +40,6 @@ constexpr double seam_snap_deg = 1e-9;
 /// quality 1e-4 at 20 km).
 constexpr double seam_notch_deg = 1e-4;
 constexpr double pole_snap_deg = 2e-3;
-/// The longest edge of a --region-file polygon in a projected CRS, metres (split_projected_edges):
-/// a straight side of UTM or polar stereographic 1 km long strays from the lon/lat line between
-/// its ends by 1.4 m at most (100 km from a pole), below any mesh's size.
-constexpr double region_edge_step_m = 1000;
 
 /// Moves onto the seam each vertex within seam_notch_deg of it whose neighbour along the ring
 /// lies on it, on the same side (neighbours judged as they were before this pass).
@@ -496,9 +491,6 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             g = outline.get();
         if (transform) {
             OgrGeometryPtr copy(OGR_G_Clone(g));
-            // A region's sides are the lines drawn in its CRS (the coast is dense already).
-            if (region)
-                detail::split_projected_edges(copy.get(), source_srs.get(), region_edge_step_m);
             if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
                                 " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
