@@ -128,6 +128,19 @@ std::string usage_text(const CLI::ParseError &e, const std::string &command) {
     }
     if (dynamic_cast<const CLI::RequiredError *>(&e))
         return what + " (" + help + ")";
+    // "Could not convert: NAME = VALUE": a word for a number, or a number past its type's range.
+    const std::string convert = "Could not convert: ";
+    if (const std::size_t eq = what.find(" = "); dynamic_cast<const CLI::ConversionError *>(&e) &&
+                                                 what.rfind(convert, 0) == 0 &&
+                                                 eq != std::string::npos) {
+        const std::string name = what.substr(convert.size(), eq - convert.size()),
+                          value = what.substr(eq + 3);
+        const bool number =
+            !value.empty() && value.find_first_not_of("-+0123456789") == std::string::npos;
+        return name + ": '" + value + "' is " +
+               (number ? "out of its range" : "not a value it takes") + " (" + help +
+               " gives the kind of value it takes)";
+    }
     return what;
 }
 

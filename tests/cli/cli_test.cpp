@@ -670,6 +670,16 @@ INSTANTIATE_TEST_SUITE_P(
             {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "18446744073709551616"},
             2,
             "--seed: '18446744073709551616' is not a whole number in 0..18446744073709551615"},
+        // CLI11's "Could not convert: --smooth = abc" in globemesh's words.
+        ErrorCase{"a_word_for_a_count",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--smooth", "abc"},
+                  2,
+                  "--smooth: 'abc' is not a value it takes (globemesh mesh --help"},
+        ErrorCase{
+            "a_count_past_its_range",
+            {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--smooth", "1180591620717411303424"},
+            2,
+            "--smooth: '1180591620717411303424' is out of its range"},
         // /proc looks writable to root but takes no file: said before the run, not "disk full".
         ErrorCase{"output_in_a_folder_that_takes_no_file",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--gpkg", "/proc/o.gpkg"},
