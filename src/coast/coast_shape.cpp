@@ -405,6 +405,23 @@ void check_node_count(const std::vector<ShapedRing> &shaped, std::uint64_t max_n
                         option("hmax_km") + " or " + option("max_nodes"));
 }
 
+/// Whether sample y lies on a region's outline: on an open source segment, or at a node that ends
+/// one.
+bool on_outline(const Ring &source, const Sample &y) {
+    const std::size_t n = source.nodes.size();
+    return source.kinds[y.node] == SegmentKind::open ||
+           (y.p == source.nodes[y.node] && source.kinds[(y.node + n - 1) % n] == SegmentKind::open);
+}
+
+/// The kind of the shaped segment from sample x to sample y: its source segment's, but coast
+/// where it would leave the outline. A kind change closer than h/2 to another corner goes with
+/// the resampling, and the segment from the box edge to the coast beyond it (Porto Lagos at 41N,
+/// 3-20 km: to 24.96E, 40.95N, across 9 km of coast) was open for the box edge it started on.
+SegmentKind span_kind(const Ring &source, const Sample &x, const Sample &y) {
+    const SegmentKind kind = source.kinds[x.node];
+    return kind == SegmentKind::open && !on_outline(source, y) ? SegmentKind::coast : kind;
+}
+
 /// Step 3's last part: merge_close_samples on the resampled rings (every arc clear in `grid`),
 /// for nodes closer than `gap` times the local size (CoastOptions::close_node_gap; dropping one
 /// moves the coast by less than that, well within the fidelity target h/4). A sample can go
@@ -594,9 +611,9 @@ Boundary shape_boundary(const CoastData &coast, const SizeFn &size_km, const Coa
         const auto &samples = resampled[r].samples;
         ring.nodes.reserve(samples.size());
         ring.kinds.reserve(samples.size());
-        for (const auto &x : samples) {
-            ring.nodes.push_back(x.p);
-            ring.kinds.push_back(s.ring->kinds[x.node]);
+        for (std::size_t k = 0; k < samples.size(); ++k) {
+            ring.nodes.push_back(samples[k].p);
+            ring.kinds.push_back(span_kind(*s.ring, samples[k], samples[(k + 1) % samples.size()]));
         }
         out.rings.push_back(std::move(ring));
     }

@@ -520,6 +520,38 @@ TEST(CoastReal, a_region_box_holds_its_mesh_along_its_parallels) {
     }
 }
 
+// Where the box's north edge at 41N meets the Thracian coast in short pieces (Porto Lagos, GSHHG
+// i), the coast/box corners closer than h/2 went with the resampling, and the shaped segment
+// from the box edge at 25.16E to the coast at 24.96E, 40.95N was tagged open for the box edge it
+// started on: an open boundary (ADCIRC's forced elevations) leaving the box across 9 km of coast.
+// A segment that leaves the outline is coast: every open edge lies on the box.
+TEST(CoastReal, every_open_edge_lies_on_the_region_box) {
+    const std::array<double, 4> box{24.3, 40.5, 25.8, 41};
+    MeshOptions o = region_run("coast/hostile/gshhg_i_porto_lagos.geojson", box, 20);
+    o.hmin_km = 3;
+    const Mesh mesh = mesh_ocean(o).mesh;
+    // a node on the box: on a meridian edge (the land's snap grid, 2^-20 degree, apart), or on a
+    // parallel edge up to the sag of the arcs bisected along it (0.0002 degree here; the segment
+    // from the box to the coast ended 0.048 degree south of it)
+    const double sag = 0.002;
+    auto on_box = [&](NodeIndex n) {
+        const LonLat p = vec_to_lonlat(mesh.nodes[n]);
+        return std::abs(p.lon - box[0]) < 1e-6 || std::abs(p.lon - box[2]) < 1e-6 ||
+               std::abs(p.lat - box[1]) < sag || std::abs(p.lat - box[3]) < sag;
+    };
+    std::size_t open = 0;
+    for (const auto &e : mesh.boundary) {
+        if (e.tag != EdgeTag::open)
+            continue;
+        ++open;
+        EXPECT_TRUE(on_box(e.a) && on_box(e.b))
+            << vec_to_lonlat(mesh.nodes[e.a]).lon << " " << vec_to_lonlat(mesh.nodes[e.a]).lat
+            << " - " << vec_to_lonlat(mesh.nodes[e.b]).lon << " "
+            << vec_to_lonlat(mesh.nodes[e.b]).lat;
+    }
+    EXPECT_GE(open, 8u);
+}
+
 // The summary's and `info`'s extent of a region across 180 was lon -180 .. 180 (the whole
 // band); it is the region's box, in [0, 360) as the writers put such a region, and a global
 // mesh's stays -180 .. 180.
