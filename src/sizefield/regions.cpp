@@ -162,8 +162,9 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
             OGRFeatureH fh = f.get();
             OGRGeometryH geom = OGR_F_GetGeometryRef(fh);
-            const OGRwkbGeometryType type =
-                geom ? wkbFlatten(OGR_G_GetGeometryType(geom)) : wkbNone;
+            if (!geom || OGR_G_IsEmpty(geom))
+                continue; // a row without a shape (a table edited in QGIS) sizes nothing
+            const OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geom));
             if (type != wkbPolygon && type != wkbMultiPolygon) {
                 not_polygons.add(fh, type);
                 continue;

@@ -920,7 +920,8 @@ print('OK')
 // polygon does (a closed line bounds the same water, as --help says; the two meshes' nodes are
 // equal), and every other case is refused in one line naming the file and the cause, with no
 // output: an open line (a critical passage) as the region, a region layer of no features, size
-// regions with lines or a null size_km (were ignored without a word).
+// regions with lines or a null size_km (were ignored without a word). Size regions' rows without
+// a shape are left out, as GDAL's tools leave them.
 TEST(CliE2e, region_and_size_region_files_holding_the_wrong_things_say_what_is_wrong) {
     TempDir dir;
     const std::string d = dir.path().string() + "/";
@@ -953,6 +954,8 @@ write('empty', ogr.wkbPolygon, [])
 write('open_line', ogr.wkbLineString, [(lines[0], None)])
 write('size_lines', ogr.wkbUnknown, [(polygon, 2), (lines[0], 2), (lines[1], 2)])
 write('size_null', ogr.wkbPolygon, [(polygon, 2), (polygon, None)])
+write('size_one', ogr.wkbPolygon, [(polygon, 2)])
+write('size_and_no_shape', ogr.wkbPolygon, [(None, 3), (polygon, 2), (None, None)])
 )",
            dir.path());
     const std::string coast = fixture("coast/hostile/gshhg_i_south_funen.geojson").string();
@@ -969,6 +972,15 @@ write('size_null', ogr.wkbPolygon, [(polygon, 2), (polygon, None)])
             << err;
     }
     expect_same_mesh(d + "outline.nc", d + "polygon.nc", dir.path());
+    // Rows without a shape (a table edited in QGIS) size nothing: the same mesh as without them.
+    for (const std::string sizes : {"size_one", "size_and_no_shape"})
+        ASSERT_EQ(
+            run_exe({"mesh", "--coast", coast, "--region", "9.9,55,10.3,55.3", "--hmax", "5",
+                     "--size-regions", d + sizes + ".gpkg", "-o", d + sizes + ".nc", "--quiet"},
+                    out, err, dir.path()),
+            0)
+            << err;
+    expect_same_mesh(d + "size_one.nc", d + "size_and_no_shape.nc", dir.path());
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
         {{"--region-file", d + "open_line.gpkg"},
          "does not close; give polygons (or closed lines)"},
