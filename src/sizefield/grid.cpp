@@ -239,12 +239,19 @@ BackgroundGrid make_background_grid(const std::optional<std::array<double, 4>> &
 
 std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b, double max_km,
                                      const Progress &progress) {
-    // Sources: the rings densified to a quarter of the smallest grid spacing.
+    // Sources: the coast segments densified to a quarter of the smallest grid spacing; a
+    // region's open edge is water on both sides, no coast.
     const double step = 0.25 * std::min(g.dlat, g.dlon) * deg_to_rad;
     std::vector<Vec3> sources;
     for (const Ring &ring : b.rings) {
         const std::size_t m = ring.nodes.size();
+        // a ring without kinds (a caller's own boundary) is coast all round
+        auto coast = [&](std::size_t k) {
+            return k >= ring.kinds.size() || ring.kinds[k] == SegmentKind::coast;
+        };
         for (std::size_t k = 0; k < m; ++k) {
+            if (!coast(k))
+                continue;
             const Vec3 &a = ring.nodes[k];
             const Vec3 &c = ring.nodes[(k + 1) % m];
             double angle = arc_angle(a, c);
@@ -255,6 +262,8 @@ std::vector<float> coast_distance_km(const BackgroundGrid &g, const Boundary &b,
                     p == 0 ? a
                            : arc_interpolate(a, c,
                                              static_cast<double>(p) / static_cast<double>(pieces)));
+            if (!coast((k + 1) % m))
+                sources.push_back(c); // the coast's last node before an open edge
         }
     }
     HugeVector<float> key(g.size(), float_inf); // chord^2 to the nearest source found

@@ -60,13 +60,32 @@ double distance_to_arc_km(const Vec3 &p, const Vec3 &a, const Vec3 &b) {
            earth_radius_km;
 }
 
+/// Great-circle distance (km) from p to the coast segments of b (open ones are water).
 double distance_to_boundary_km(const Vec3 &p, const Boundary &b) {
     double best = std::numeric_limits<double>::infinity();
     for (const Ring &r : b.rings)
         for (std::size_t k = 0; k < r.nodes.size(); ++k)
-            best = std::min(best,
-                            distance_to_arc_km(p, r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]));
+            if (r.kinds[k] == SegmentKind::coast)
+                best = std::min(
+                    best, distance_to_arc_km(p, r.nodes[k], r.nodes[(k + 1) % r.nodes.size()]));
     return best;
+}
+
+/// The coast component 10 km + 0.1 d (at most 150 km) built over the box, and its largest
+/// deviation (km) on every third grid node from that formula with the brute-force distance.
+double worst_coast_component_error_km(const Boundary &b, double w, double s, double e, double n) {
+    MeshOptions o = regional(w, s, e, n, 10, 150);
+    o.coast_size_km = 10;
+    o.coast_rate = 0.1;
+    SizeField f = build_size_field(o, nullptr, &b, {}, 1 << 18);
+    const Raster &g = f.grid();
+    double worst = 0;
+    for (std::size_t j = 0; j < g.nlat(); j += 3)
+        for (std::size_t i = 0; i < g.nlon(); i += 3) {
+            double d = distance_to_boundary_km(lonlat_to_vec(g.lon_deg(i), g.lat_deg(j)), b);
+            worst = std::max(worst, std::abs(g.value(i, j) - std::min(150.0, 10 + 0.1 * d)));
+        }
+    return worst;
 }
 
 Boundary ring_of(std::initializer_list<LonLat> corners) {
@@ -203,21 +222,19 @@ TEST(SizeField, slope_component_matches_its_formula_over_a_seamount) {
 
 TEST(SizeField, coast_component_matches_great_circle_distance_to_the_rings) {
     Boundary island = ring_of({{-2, -1}, {2, -1.5}, {2.5, 2}, {-1, 1.5}});
-    MeshOptions o = regional(-10, -10, 10, 10, 10, 150);
-    o.coast_size_km = 10;
-    o.coast_rate = 0.1;
-    SizeField f = build_size_field(o, nullptr, &island, {}, 1 << 18);
-    const Raster &g = f.grid();
-    const double spacing = g.dlat_deg() * deg_to_rad * earth_radius_km;
-    double worst = 0;
-    for (std::size_t j = 0; j < g.nlat(); j += 3)
-        for (std::size_t i = 0; i < g.nlon(); i += 3) {
-            double d = distance_to_boundary_km(lonlat_to_vec(g.lon_deg(i), g.lat_deg(j)), island);
-            double expect = std::min(150.0, 10 + 0.1 * d);
-            worst = std::max(worst, std::abs(g.value(i, j) - expect));
-        }
-    // Distance error below a quarter of the grid spacing, times the rate.
-    EXPECT_LT(worst, 0.1 * 0.25 * spacing) << "grid spacing " << spacing << " km";
+    // Distance error below a quarter of the grid spacing (5 km: hmin 10 km), times the rate.
+    EXPECT_LT(worst_coast_component_error_km(island, -10, -10, 10, 10), 0.1 * 0.25 * 5.0);
+}
+
+TEST(SizeField, coast_component_measures_from_the_coast_not_from_a_regions_open_edges) {
+    // A region's box whose south and east sides are coast and north and west sides open water:
+    // h grows with the distance to the two coast sides alone, also along the open sides (the
+    // north-west corner, 1100 km from the coast, takes 120 km, not the coast's 10 km).
+    Boundary box;
+    box.rings.push_back(test::ring_of_points({{-5, -5}, {5, -5}, {5, 5}, {-5, 5}}));
+    box.rings[0].kinds = {SegmentKind::coast, SegmentKind::coast, SegmentKind::open,
+                          SegmentKind::open};
+    EXPECT_LT(worst_coast_component_error_km(box, -5, -5, 5, 5), 0.1 * 0.25 * 5.0);
 }
 
 TEST(SizeField, gradation_holds_on_every_grid_edge_across_the_seam_and_the_poles) {
