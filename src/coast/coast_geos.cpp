@@ -28,12 +28,10 @@ constexpr double max_line_gap_deg = 0.5;
 constexpr std::size_t tiled_polygons = 256;
 constexpr std::size_t tile_vertices = 16'384;
 
-/// Union-find over polygon indices.
-using Groups = DisjointSets<std::size_t>;
+} // namespace
 
-/// Joins the polygons that intersect: an STR tree's candidates confirmed by GEOS's prepared test.
-void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
-                       const std::vector<int> &vertices, Groups &groups) {
+void join_meeting(Geos &geos, const std::vector<GeomPtr> &polys, const std::vector<int> &vertices,
+                  Groups &groups, const MeetTest &meet_test) {
     const std::size_t n = polys.size();
     auto find = [&](std::size_t i) { return groups.find(i); };
     TreePtr tree(GEOSSTRtree_create_r(geos.get(), 10), GeosDeleter{geos.get()});
@@ -55,10 +53,7 @@ void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
             if (j > i)
                 pairs.emplace_back(i, j);
     }
-    // Each pair tested against its polygon with more vertices, prepared once on the thread that
-    // takes that polygon: a continent meets hundreds of islands' boxes, and GEOS builds the
-    // index of the geometry tested against a prepared one anew on every call. On every core,
-    // the largest polygons first.
+    // Each pair tested against its polygon with more vertices (see the header).
     std::vector<std::vector<std::size_t>> pairs_of(n);
     for (std::size_t k = 0; k < pairs.size(); ++k) {
         const auto [i, j] = pairs[k];
@@ -79,8 +74,7 @@ void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
                                        GeosDeleter{g.get()});
             for (std::size_t k : pairs_of[big]) {
                 const std::size_t small = pairs[k].first == big ? pairs[k].second : pairs[k].first;
-                meet[k] =
-                    GEOSPreparedIntersects_r(g.get(), prepared.get(), polys[small].get()) == 1;
+                meet[k] = meet_test(g, prepared.get(), big, small);
             }
         },
         &first);
@@ -91,6 +85,8 @@ void join_intersecting(Geos &geos, const std::vector<GeomPtr> &polys,
             groups.join(i, j);
     }
 }
+
+namespace {
 
 /// Joins the polygons whose outlines come within 2 cells of each other (near-touches), marking
 /// in near_only those joined by distance alone.
@@ -361,7 +357,10 @@ std::vector<GeomPtr> dissolve(Geos &geos, const std::vector<GeomPtr> &parts, dou
     std::vector<int> vertices(n);
     for (std::size_t i = 0; i < n; ++i)
         vertices[i] = GEOSGetNumCoordinates_r(geos.get(), polys[i].get());
-    join_intersecting(geos, polys, vertices, joined);
+    join_meeting(geos, polys, vertices, joined,
+                 [&](Geos &g, const GEOSPreparedGeometry *big, std::size_t, std::size_t small) {
+                     return GEOSPreparedIntersects_r(g.get(), big, polys[small].get()) == 1;
+                 });
     // Outlines within 2 cells of each other (near-touches) are snap-rounded together too.
     join_near(geos, polys, grid, joined, near_only);
     // A polygon alone is rounded alone (snap_job), a group of several through a snap-rounding

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -16,6 +17,10 @@
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
 #include "globemesh/sphere.hpp"
+
+namespace globemesh {
+template <class Index> class DisjointSets; // disjoint_sets.hpp
+} // namespace globemesh
 
 namespace globemesh::coast_detail {
 
@@ -105,6 +110,21 @@ PolygonRings polygon_rings(const Geos &geos, const GEOSGeometry *polygon);
 /// left out: their land and holes lie off the region, and they hold no part of it.
 GeomPtr polygonize_lines(Geos &geos, const std::vector<PointList> &lines, const ErrorText &where,
                          const std::vector<Box> &near = {});
+
+/// Union-find over polygon indices.
+using Groups = DisjointSets<std::size_t>;
+/// Whether polygons `big` (prepared in the thread's context) and `small` meet, big the one of
+/// the pair with more vertices.
+using MeetTest = std::function<bool(Geos &, const GEOSPreparedGeometry *big_prepared,
+                                    std::size_t big, std::size_t small)>;
+/// Joins in `groups` the polygons whose boxes meet (an STR tree's candidates) and that
+/// `meet_test` finds meeting. Each pair is tested against its polygon with more vertices
+/// (`vertices`), prepared once on the thread that takes it: a continent meets hundreds of
+/// islands' boxes, and GEOS builds the index of the geometry tested against a prepared one anew
+/// on every call. On every core, the largest polygons first; the joins in pair order, as one
+/// thread makes them (the same groups, the same roots).
+void join_meeting(Geos &geos, const std::vector<GeomPtr> &polys, const std::vector<int> &vertices,
+                  Groups &groups, const MeetTest &meet_test);
 
 /// The even-odd fill of valid polygonal faces' rings (a polygon's shell and holes alike), as
 /// their symmetric difference (ring_parity.cpp): faces whose boundaries meet are overlaid by

@@ -77,10 +77,10 @@ GeomPtr symmetric_difference_all(Geos &geos, std::vector<GeomPtr> parts) {
 /// boundaries meet (they intersect, neither inside the other's interior) replaced by its XOR.
 std::vector<GeomPtr> faces_apart(Geos &geos, std::vector<GeomPtr> faces) {
     const std::size_t n = faces.size();
-    Boxes boxes(geos, faces);
-    Prepared prepared(geos, faces);
+    std::vector<int> vertices(n);
     std::vector<std::array<double, 4>> box(n);
     for (std::size_t i = 0; i < n; ++i) {
+        vertices[i] = GEOSGetNumCoordinates_r(geos.get(), faces[i].get());
         auto &b = box[i];
         GEOSGeom_getExtent_r(geos.get(), faces[i].get(), &b[0], &b[1], &b[2], &b[3]);
     }
@@ -88,25 +88,21 @@ std::vector<GeomPtr> faces_apart(Geos &geos, std::vector<GeomPtr> faces) {
         return box[a][0] >= box[b][0] && box[a][1] >= box[b][1] && box[a][2] <= box[b][2] &&
                box[a][3] <= box[b][3];
     };
-    // Whether face `in` lies in the interior of face `out`, asked only where its box lies in
-    // out's (a prepared test costs the size of the face tested: an island against a continent).
-    auto properly_in = [&](std::size_t in, std::size_t out) {
-        return within(in, out) &&
-               GEOSPreparedContainsProperly_r(geos.get(), prepared[out], faces[in].get()) == 1;
-    };
-    DisjointSets<std::size_t> groups(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        coast::GeosInterrupt::poll();
-        for (std::size_t j : boxes.near(faces[i].get())) {
-            if (j <= i || groups.find(i) == groups.find(j))
-                continue;
-            // the smaller face tested against the larger's prepared geometry
-            const std::size_t small = within(i, j) ? i : j, large = small == i ? j : i;
-            if (GEOSPreparedIntersects_r(geos.get(), prepared[large], faces[small].get()) == 1 &&
-                !properly_in(small, large) && !properly_in(large, small))
-                groups.join(i, j);
-        }
-    }
+    // Inside the other's interior is asked only where the boxes nest; the smaller face inside
+    // the larger (by vertices) is the common case, the other way round is prepared here.
+    Groups groups(n);
+    join_meeting(
+        geos, faces, vertices, groups,
+        [&](Geos &g, const GEOSPreparedGeometry *prepared, std::size_t big, std::size_t small) {
+            const GEOSGeometry *b = faces[big].get(), *s = faces[small].get();
+            if (GEOSPreparedIntersects_r(g.get(), prepared, s) != 1 ||
+                (within(small, big) && GEOSPreparedContainsProperly_r(g.get(), prepared, s) == 1))
+                return false;
+            if (!within(big, small))
+                return true;
+            const PreparedPtr around(GEOSPrepare_r(g.get(), s), GeosDeleter{g.get()});
+            return GEOSPreparedContainsProperly_r(g.get(), around.get(), b) != 1;
+        });
     std::vector<std::vector<GeomPtr>> members(n);
     for (std::size_t i = 0; i < n; ++i)
         members[groups.find(i)].push_back(std::move(faces[i]));
