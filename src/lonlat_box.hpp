@@ -1,5 +1,5 @@
-// Internal: whether a point lies in a region's box W,S,E,N in degrees (W > E crosses 180), for
-// the pipeline's passages and the mesher's slides.
+// Internal: longitudes into [-180, 180), and whether a point lies in a region's box W,S,E,N in
+// degrees (W > E crosses 180), for the pipeline's passages and the mesher's slides.
 #pragma once
 
 #include <array>
@@ -8,6 +8,11 @@
 #include "globemesh/sphere.hpp"
 
 namespace globemesh {
+
+/// lon moved by a multiple of 360 degrees into [-180, 180).
+inline double wrap_lon(double lon) {
+    return lon - 360 * std::floor((lon + 180) / 360);
+}
 
 /// Whether p lies in `box` (W, S, E, N degrees; W > E across 180), edges included: its longitude
 /// east of W by at most the box's span (modulo 360, so that 180 and -180 are one meridian).

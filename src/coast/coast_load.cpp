@@ -18,6 +18,7 @@
 #include "coast_parallel.hpp"
 #include "globemesh/coast.hpp"
 #include "globemesh/error.hpp"
+#include "lonlat_box.hpp"
 
 namespace globemesh {
 namespace {
@@ -102,7 +103,7 @@ std::vector<GeomPtr> valid_parts(Geos &geos, const std::vector<PolygonRings> &po
 /// between them. None when they leave no gap.
 std::optional<std::array<double, 2>> covering_arc(std::vector<std::array<double, 2>> spans) {
     for (auto &[w, e] : spans) {
-        const double shift = 360 * std::floor((w + 180) / 360);
+        const double shift = w - wrap_lon(w);
         w -= shift, e -= shift;
     }
     std::sort(spans.begin(), spans.end());
@@ -146,9 +147,8 @@ std::optional<std::array<double, 4>> region_file_box(const Source &region) {
         spans.empty() ? std::nullopt : covering_arc(spans);
     if (!arc || !((*arc)[1] - (*arc)[0] < 360 - 2 * margin - 10))
         return std::nullopt;
-    auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
-    return std::array<double, 4>{wrap((*arc)[0] - margin), std::max(-90.0, s - margin),
-                                 wrap((*arc)[1] + margin), std::min(90.0, n + margin)};
+    return std::array<double, 4>{wrap_lon((*arc)[0] - margin), std::max(-90.0, s - margin),
+                                 wrap_lon((*arc)[1] + margin), std::min(90.0, n + margin)};
 }
 
 } // namespace
@@ -179,12 +179,11 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     // Land: valid polygons, dissolved.
     // Cut to the region first, unless --min-island-area weighs each island whole.
     const bool clip = near && !(options.min_island_area_km2 > 0);
-    std::vector<GeomPtr> parts =
-        valid_parts(geos, src.polygons, clip ? near_boxes(*near) : std::vector<Box>{});
+    const std::vector<Box> clip_boxes = clip ? near_boxes(*near) : std::vector<Box>{};
+    std::vector<GeomPtr> parts = valid_parts(geos, src.polygons, clip_boxes);
     if (!src.lines.empty()) {
         // each polygon wrapped alone: only those past +-180 are cut, not all the land at once
-        GeomPtr from_lines =
-            polygonize_lines(geos, src.lines, where, clip ? near_boxes(*near) : std::vector<Box>{});
+        GeomPtr from_lines = polygonize_lines(geos, src.lines, where, clip_boxes);
         std::vector<const GEOSGeometry *> polys;
         polygons_of(geos, from_lines.get(), polys);
         for (const GEOSGeometry *p : polys)

@@ -83,8 +83,7 @@ std::optional<std::array<double, 4>> size_grid_region(const MeshOptions &o, cons
         return std::nullopt;
     if (box->east - box->west >= 360) // a band of latitudes (a cap about a pole)
         return std::array<double, 4>{-180, box->south, 180, box->north};
-    auto wrap = [](double lon) { return lon - 360 * std::floor((lon + 180) / 360); };
-    return std::array<double, 4>{wrap(box->west), box->south, wrap(box->east), box->north};
+    return std::array<double, 4>{wrap_lon(box->west), box->south, wrap_lon(box->east), box->north};
 }
 
 /// Upper bound of the background grid's node count (make_background_grid: spacing hfloor / 2,
