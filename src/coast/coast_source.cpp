@@ -2,6 +2,7 @@
 // order), reprojected from its CRS, snapped to the +-180 seam and the poles.
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -394,17 +395,53 @@ std::vector<Box> filter_boxes(OGRLayerH layer, const std::array<double, 4> &near
                : near_boxes(near);
 }
 
+/// The layer's attribute fields, for a filter's error: "a, b, c" (at most 12, then "...").
+std::string field_names(OGRLayerH layer) {
+    OGRFeatureDefnH defn = OGR_L_GetLayerDefn(layer);
+    const int n = OGR_FD_GetFieldCount(defn);
+    std::string names;
+    for (int i = 0; i < n && i < 12; ++i)
+        names += (i ? ", " : "") + std::string(OGR_Fld_GetNameRef(OGR_FD_GetFieldDefn(defn, i)));
+    return n == 0 ? "none" : n > 12 ? names + ", ..." : names;
+}
+
+/// A filter's error without OGR SQL's caret drawing ("... Occurred around :\n(x >)\n ^").
+std::string filter_reason(std::string reason) {
+    std::string::size_type at = reason.find("Occurred around");
+    while (at != std::string::npos && at > 0 &&
+           std::isspace(static_cast<unsigned char>(reason[at - 1])))
+        --at;
+    return at == std::string::npos ? reason : reason.substr(0, at);
+}
+
+/// What is wrong with the layer's attribute filter after a read failed on it. SQLite drivers
+/// (GeoPackage) fail a read with their whole statement ("failed to prepare SQL: SELECT ..."),
+/// and a count with SQLite's reason ("...) failed: no such column: x"): the count's is given.
+std::string filter_error(OGRLayerH layer) {
+    std::string reason = gdal::last_error();
+    CPLErrorReset();
+    OGR_L_SetSpatialFilter(layer, nullptr);
+    OGR_L_GetFeatureCount(layer, TRUE);
+    const std::string counted = CPLGetLastErrorMsg();
+    const std::string::size_type at = counted.find(") failed: ");
+    if (at != std::string::npos)
+        reason = counted.substr(at + 10);
+    else if (reason.starts_with("failed to prepare SQL"))
+        reason = "the driver's SQL does not take it";
+    return filter_reason(reason);
+}
+
 /// Throws when GDAL reported a failure since the last reset (a reading loop's end: its
 /// GetNextFeature returned null on an error, not at the end of the layer, or skipped a feature),
 /// naming the filter when there is one: the features read so far are not the layer's.
-void throw_if_read_failed(const std::string &where, const ErrorText &where_msg) {
+void throw_if_read_failed(OGRLayerH layer, const std::string &where, const ErrorText &where_msg) {
     if (CPLGetLastErrorType() < CE_Failure)
         return;
     if (!where.empty())
-        throw UsageError(option("coast_where") + " '" + where + "' failed on " + where_msg + ": " +
-                         gdal::last_error() +
-                         "; give one SQL expression on the layer's fields, without ';' or a "
-                         "comment");
+        throw UsageError(option("coast_where") + " '" + where + "' is not a valid filter for " +
+                         where_msg + " (" + filter_error(layer) +
+                         "); give one SQL expression on its fields (" + field_names(layer) +
+                         "), without ';' or a comment");
     throw IoError(where_msg + ": reading failed (" + gdal::last_error() +
                   "); check the file, or convert it with ogr2ogr");
 }
@@ -443,7 +480,8 @@ Source read_source(const std::string &path, const std::string &layer_name, const
     if (!where.empty() &&
         OGR_L_SetAttributeFilter(layer, ("(" + where + ")").c_str()) != OGRERR_NONE)
         throw UsageError(option("coast_where") + " '" + where + "' is not a valid filter for " +
-                         where_msg + ": " + gdal::last_error());
+                         where_msg + " (" + filter_reason(gdal::last_error()) +
+                         "); give one SQL expression on its fields (" + field_names(layer) + ")");
 
     SrsPtr source_srs = source_crs(layer, srs_override, where_msg, field);
     SrsPtr wgs84(OSRNewSpatialReference(nullptr));
@@ -509,7 +547,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             if (fid == OGRNullFID || seen.insert(fid).second)
                 take(f.get());
         }
-        throw_if_read_failed(where, where_msg);
+        throw_if_read_failed(layer, where, where_msg);
     }
     // Whole, without a region or with nothing near it; then only up to a first polygon or
     // line (a region of open sea reads no more), for the errors below to be the whole layer's.
@@ -521,7 +559,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             if (!boxes.empty() && (!src.polygons.empty() || !src.lines.empty()))
                 break;
         }
-        throw_if_read_failed(where, where_msg);
+        throw_if_read_failed(layer, where, where_msg);
     }
     if (too_many)
         throw DataError(where_msg + " has " + std::to_string(vertices) +
