@@ -97,11 +97,17 @@ std::string usage_text(const CLI::ParseError &e, const std::string &command) {
         std::vector<std::string> w;
         for (std::string x; rest >> x;)
             w.push_back(x);
-        // N counts values, not uses: a single value given twice, or --region's 4 given 5.
+        // N counts values, not uses: a single value given twice, or --region's 4 given 5; a
+        // multiple of N is the option given again as often as not (--region twice: 8 values).
         if (w.size() == 7 && w[0] == "At" && w[1] == "Most" && w[3] == "required" &&
-            w[5] == "received")
-            return w[2] == "1" ? name + " is given " + w[6] + " times; give it once"
-                               : name + " takes " + w[2] + " values, got " + w[6];
+            w[5] == "received") {
+            if (w[2] == "1")
+                return name + " is given " + w[6] + " times; give it once";
+            const bool multiple =
+                std::atoi(w[6].c_str()) % std::max(1, std::atoi(w[2].c_str())) == 0;
+            return name + " takes " + w[2] + " values, got " + w[6] +
+                   (multiple ? "; give it once, with " + w[2] : "");
+        }
         if (w.size() == 7 && w[0] == "At" && w[1] == "least" && w[3] == "required" &&
             w[5] == "received")
             return name + " needs " + w[2] + " values, got " + w[6];

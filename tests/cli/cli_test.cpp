@@ -660,6 +660,12 @@ INSTANTIATE_TEST_SUITE_P(
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3,4,5"},
                   2,
                   "--region takes 4 values, got 5"},
+        // Given twice, its values add up: said as too many values, and to give it once.
+        ErrorCase{"region_given_twice",
+                  {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--region", "1,2,3,4", "--region",
+                   "5,6,7,8"},
+                  2,
+                  "--region takes 4 values, got 8; give it once, with 4"},
         // The seed is an unsigned 64-bit number: CLI11 alone wrapped -1 and saturated 2^70.
         ErrorCase{"negative_seed",
                   {"mesh", "--coast", coast, "-o", "{dir}/o.nc", "--seed", "-1"},
