@@ -79,9 +79,9 @@ def mesh_ocean(coast=None, bathy=None, *, progress=None, **options):
     """Meshes the ocean between the coastlines of `coast` (any OGR source), graded by the options
     of `globemesh mesh` given as keywords (hmax="50km", region=(-12, 48, 12, 64), ...), with depths
     from `bathy` (any GDAL raster) when given. config="run.toml" reads options, the inputs too, from
-    a file as `globemesh mesh --config` does; keywords override it. `progress(fraction, stage)` is
-    called during the run, from 0 to 1 at its end; returning False cancels it (Cancelled). Returns
-    a Result."""
+    a file as `globemesh mesh --config` does (its outputs are not written: a MeshWarning says so);
+    keywords override it. `progress(fraction, stage)` is called during the run, from 0 to 1 at its
+    end; returning False cancels it (Cancelled). Returns a Result."""
     unknown = sorted(set(options) - set(_KEYWORDS))
     if unknown:
         raise TypeError("mesh_ocean() got an unexpected keyword argument '%s' (it takes: %s)"

@@ -110,6 +110,15 @@ Run mesh(std::span<const std::string> args, const Progress &progress) {
     validate(o.mesh);
     check_inputs(o);
     Run result;
+    // Outputs only a --config file can name here: mesh() writes none, which is said.
+    std::string outputs;
+    for (const CLI::Option *option : command.app.get_options())
+        if (option->get_group() == "Output" && option->count() > 0)
+            outputs += (outputs.empty() ? "" : ", ") + option->get_name();
+    if (!outputs.empty())
+        result.warnings.push_back("--config " + o.config + " names outputs (" + outputs +
+                                  ") that mesh_ocean() does not write: "
+                                  "write them with its result's write()");
     StageTimings timings;
     const auto t0 = std::chrono::steady_clock::now();
     // The check and the statistics after the run take the last hundredth of the progress.

@@ -11,6 +11,7 @@ import tempfile
 import threading
 import time
 import unittest
+import warnings
 
 import netCDF4
 import numpy as np
@@ -128,6 +129,25 @@ class SameAsCommandLine(TempDir):
         self.compare(globemesh.mesh_ocean(config=config), self.path("cli.nc"))
         with self.assertRaisesRegex(ValueError, "^--coast is required"):
             globemesh.mesh_ocean(hmax="800km")
+
+    def test_outputs_in_a_config_file_are_said_not_written(self):
+        # A config shared with the command line names its outputs: mesh_ocean() writes none of
+        # them (the result is in memory), and says so instead of passing over them.
+        config = self.path("run.toml")
+        with open(config, "w") as f:
+            f.write('coast = "%s"\ncoast-layer = "land"\nhmax = "800km"\noutput = "%s"\n'
+                    'gpkg = "%s"\n' % (LAND110, self.path("o.nc"), self.path("o.gpkg")))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            globemesh.mesh_ocean(config=config)
+        said = [str(w.message) for w in caught if issubclass(w.category, globemesh.MeshWarning)]
+        self.assertIn("--config %s names outputs (--output, --gpkg) that mesh_ocean() does not "
+                      "write: write them with its result's write()" % config, said)
+        self.assertFalse(os.path.exists(self.path("o.nc")))
+        with warnings.catch_warnings(record=True) as caught:  # without outputs: not said
+            warnings.simplefilter("always")
+            globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
+        self.assertFalse([w for w in caught if "names outputs" in str(w.message)])
 
     def test_write_is_the_command_lines_file(self):
         r = globemesh.mesh_ocean(LAND110, coast_layer="land", hmax="800km")
