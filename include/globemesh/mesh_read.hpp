@@ -18,12 +18,13 @@ Mesh read_adcirc(const std::filesystem::path &path);
 /// Whether `path` is named as an ADCIRC or SCHISM grid (fort.14, .14, .gr3, .ll).
 bool is_adcirc_name(const std::filesystem::path &path);
 
-/// Reads a gmsh MSH file, ASCII 4.1 or 2.2 (as globemesh, gmsh and seamsh write them): nodes in
+/// Reads a gmsh MSH file, 4.1 or 2.2, ASCII or binary (as globemesh, gmsh, seamsh and meshio write
+/// them; binary in this machine's byte order): nodes in
 /// lon/lat degrees (every z 0) or in 3-D on a sphere of any radius, the 3-node triangles as faces,
 /// the 2-node lines as boundary tags (open in a physical group named "open" or "open_<k>", else
 /// coast; boundary edges on no line are coast), and a $NodeData "depth" as node field "depth".
-/// Throws IoError (not readable) or DataError (binary, a projected mesh ($Projection), other
-/// element types, indices out of range).
+/// Throws IoError (not readable) or DataError (binary in the other byte order, a projected mesh
+/// ($Projection), other element types, indices out of range, a file cut short).
 Mesh read_gmsh(const std::filesystem::path &path);
 
 /// Whether `path` is named as a gmsh mesh (.msh).

@@ -1,16 +1,20 @@
-// gmsh MSH reader (ASCII 4.1 and 2.2): see globemesh/mesh_read.hpp.
+// gmsh MSH reader (4.1 and 2.2, ASCII and binary): see globemesh/mesh_read.hpp.
 //
 // Sections read, as gmsh's file format documentation lays them out: $MeshFormat (version, file
-// type 0 = ASCII), $PhysicalNames ("dim tag "name""), $Entities (4.1: each curve's physical tags),
-// $Nodes (4.1: blocks of tags then coordinates; 2.2: "id x y z"), $Elements (4.1: blocks of one
-// entity and type; 2.2: "id type ntags tags... nodes"), $NodeData "depth". Other sections are
-// skipped; $Projection (a projected mesh, as globemesh and seamsh write it) is refused.
-// Triangles (type 2) are the faces; lines (type 1) tag the boundary edges: those in a physical
-// group named "open" or "open_<k>" are open, the rest coast; points (type 15) are ignored.
-// Coordinates are lon/lat degrees when every z is 0, else points in 3-D on a sphere (any radius).
+// type 0 = ASCII or 1 = binary, data size: that of size_t), $PhysicalNames ("dim tag "name""),
+// $Entities (4.1: each curve's physical tags), $Nodes (4.1: blocks of tags then coordinates; 2.2:
+// "id x y z"), $Elements (4.1: blocks of one entity and type; 2.2: "id type ntags tags... nodes"),
+// $NodeData "depth". Other sections are skipped; $Projection (a projected mesh, as globemesh and
+// seamsh write it) is refused. Triangles (type 2) are the faces; lines (type 1) tag the boundary
+// edges: those in a physical group named "open" or "open_<k>" are open, the rest coast; points
+// (type 15) are ignored. Coordinates are lon/lat degrees when every z is 0, else points in 3-D on a
+// sphere (any radius). A binary file has the same sections with their numbers as the machine's int,
+// size_t and double (little-endian here, checked by the int 1 after $MeshFormat's line), its text
+// lines as in ASCII.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -33,6 +37,8 @@ constexpr int line_type = 1, triangle_type = 2, point_type = 15;
 
 struct MshContent {
     bool v4 = true;
+    bool binary = false;
+    std::size_t size_bytes = 8;                      ///< a binary file's size_t
     std::map<int, std::string> line_groups;          ///< physical tag of dimension 1 -> name
     std::map<int, std::vector<int>> curve_groups;    ///< 4.1: curve entity -> physical tags
     std::vector<long long> node_tags;                ///< in the order read
@@ -57,8 +63,63 @@ void read_format(Lines &in, MshContent &c) {
         c.v4 = false;
     else
         in.fail("MSH version " + version + " is not read (4.1 or 2.2)");
-    if (w[1] != "0")
-        in.fail("a binary MSH file is not read; save it as ASCII (gmsh: -bin 0)");
+    if (w[1] != "0" && w[1] != "1")
+        in.fail("file type " + std::string(w[1]) + " is neither ASCII (0) nor binary (1)");
+    c.binary = w[1] == "1";
+    if (!c.binary)
+        return;
+    c.size_bytes = in.count(w[2], "data size");
+    if (c.size_bytes != 4 && c.size_bytes != 8)
+        in.fail("data size " + std::string(w[2]) + " is not that of a size_t (4 or 8)");
+    std::int32_t one = 0;
+    in.bytes(&one, sizeof one, "the binary format's int 1");
+    if (one == 0x01000000)
+        in.fail("a binary file written with the other byte order is not read; save it as ASCII "
+                "(gmsh: -bin 0)");
+    if (one != 1)
+        in.fail("a binary file's int 1 does not follow its format line (the file is cut, or "
+                "not binary)");
+}
+
+/// A binary file's numbers, read where its last text line ended.
+struct Binary {
+    Lines &in;
+    std::size_t size_bytes;
+    int i32(const char *what) {
+        std::int32_t v;
+        in.bytes(&v, sizeof v, what);
+        return v;
+    }
+    double f64(const char *what) {
+        double v;
+        in.bytes(&v, sizeof v, what);
+        return v;
+    }
+    /// A size_t (a count or a tag) of at most `max`.
+    std::size_t size(const char *what, std::uint64_t max = std::uint64_t(1) << 40) {
+        std::uint64_t v = 0;
+        if (size_bytes == 8) {
+            in.bytes(&v, 8, what);
+        } else {
+            std::uint32_t v32;
+            in.bytes(&v32, 4, what);
+            v = v32;
+        }
+        if (v > max)
+            in.fail(std::string(what) + " " + std::to_string(v) + " is out of range");
+        return std::size_t(v);
+    }
+};
+
+constexpr std::uint64_t max_count = std::uint64_t(1) << 31;
+
+/// The nodes of an element of `type` that the reader takes (3-node triangles, 2-node lines,
+/// points), else a failure naming it.
+std::size_t nodes_of_type(Lines &in, long long type) {
+    if (type == triangle_type || type == line_type || type == point_type)
+        return type == triangle_type ? 3 : type == line_type ? 2 : 1;
+    in.fail("element type " + std::to_string(type) +
+            " is not read (3-node triangles, 2-node lines and points only)");
 }
 
 void read_physical_names(Lines &in, MshContent &c) {
@@ -70,8 +131,35 @@ void read_physical_names(Lines &in, MshContent &c) {
     }
 }
 
+/// 4.1's binary $Entities: per entity its tag, its box, its physical tags and (but points) its
+/// bounding entities.
+void read_entities_binary(Lines &in, MshContent &c) {
+    Binary b{in, c.size_bytes};
+    std::size_t counts[4];
+    for (std::size_t &n : counts)
+        n = b.size("an entity count", max_count);
+    for (int dim = 0; dim < 4; ++dim)
+        for (std::size_t i = 0; i < counts[dim]; ++i) {
+            const int tag = b.i32("an entity tag");
+            for (int k = 0; k < (dim == 0 ? 3 : 6); ++k)
+                b.f64("an entity's box");
+            const std::size_t n = b.size("a number of physical tags", max_count);
+            std::vector<int> physical;
+            for (std::size_t k = 0; k < n; ++k)
+                physical.push_back(std::abs(b.i32("a physical tag")));
+            if (dim == 1)
+                c.curve_groups[tag] = std::move(physical);
+            if (dim > 0)
+                for (std::size_t k = 0, m = b.size("a number of bounding entities", max_count);
+                     k < m; ++k)
+                    b.i32("a bounding entity");
+        }
+}
+
 /// 4.1's $Entities: the physical tags of each curve (points, surfaces, volumes skipped).
 void read_entities(Lines &in, MshContent &c) {
+    if (c.binary)
+        return read_entities_binary(in, c);
     const auto &counts = in.need(4, "numPoints numCurves numSurfaces numVolumes");
     const std::size_t points = in.count(counts[0], "count"), curves = in.count(counts[1], "count"),
                       others = in.count(counts[2], "count") + in.count(counts[3], "count");
@@ -97,7 +185,42 @@ void add_node(Lines &in, MshContent &c, long long tag, const std::vector<std::st
         {in.number(w[first], "x"), in.number(w[first + 1], "y"), in.number(w[first + 2], "z")});
 }
 
+/// Binary $Nodes: 2.2's "int id, 3 doubles" per node after the count's line; 4.1's blocks (a
+/// header of 3 ints and a size_t, the node tags, then each node's x y z and parameters).
+void read_nodes_binary(Lines &in, MshContent &c) {
+    Binary b{in, c.size_bytes};
+    auto coordinates = [&](long long tag, int params) {
+        c.node_tags.push_back(tag);
+        c.xyz.push_back({b.f64("a node's x"), b.f64("a node's y"), b.f64("a node's z")});
+        for (int k = 0; k < params; ++k)
+            b.f64("a node's parametric coordinate");
+    };
+    if (!c.v4) {
+        const std::size_t n = in.count(in.need(1, "the number of nodes")[0], "node count");
+        for (std::size_t i = 0; i < n; ++i)
+            coordinates(b.i32("a node id"), 0);
+        return;
+    }
+    const std::size_t blocks = b.size("the number of node blocks", max_count);
+    for (int k = 0; k < 3; ++k)
+        b.size("the node count or tag range");
+    std::vector<long long> tags;
+    for (std::size_t block = 0; block < blocks; ++block) {
+        const int dim = b.i32("a node block's dimension");
+        b.i32("a node block's entity");
+        const bool parametric = b.i32("a node block's parametric flag") != 0;
+        const std::size_t n = b.size("a node block's count", max_count);
+        tags.clear();
+        for (std::size_t i = 0; i < n; ++i)
+            tags.push_back(static_cast<long long>(b.size("a node tag")));
+        for (std::size_t i = 0; i < n; ++i)
+            coordinates(tags[i], parametric ? dim : 0);
+    }
+}
+
 void read_nodes(Lines &in, MshContent &c) {
+    if (c.binary)
+        return read_nodes_binary(in, c);
     if (!c.v4) {
         const std::size_t n = in.count(in.need(1, "the number of nodes")[0], "node count");
         for (std::size_t i = 0; i < n; ++i) {
@@ -138,7 +261,73 @@ void add_element(Lines &in, MshContent &c, long long type, const std::vector<std
                 " is not read (3-node triangles, 2-node lines and points only)");
 }
 
+/// One element of `type` with node tags `nodes` (as many as nodes_of_type) and group `physical`.
+void add_element_tags(MshContent &c, long long type, const long long *nodes, int physical) {
+    if (type == triangle_type)
+        c.triangles.push_back({nodes[0], nodes[1], nodes[2]});
+    else if (type == line_type)
+        c.lines.push_back({{nodes[0], nodes[1]}, physical});
+}
+
+/// The physical group of a 4.1 element block's entity: a curve's first, else none (0).
+int block_group(const MshContent &c, int dim, int entity) {
+    const auto groups = c.curve_groups.find(entity);
+    return dim == 1 && groups != c.curve_groups.end() && !groups->second.empty()
+               ? groups->second.front()
+               : 0;
+}
+
+/// Binary $Elements: 2.2's headers (type, count, number of tags as ints) each followed by its
+/// elements (id, tags, nodes as ints); 4.1's blocks (3 ints and a size_t, then per element its
+/// tag and nodes as size_t).
+void read_elements_binary(Lines &in, MshContent &c) {
+    Binary b{in, c.size_bytes};
+    long long nodes[3];
+    if (!c.v4) {
+        const std::size_t total =
+            in.count(in.need(1, "the number of elements")[0], "element count");
+        for (std::size_t done = 0; done < total;) {
+            const long long type = b.i32("an element header's type");
+            const int count = b.i32("an element header's count"), tags = b.i32("a tag count");
+            if (count <= 0 || std::size_t(count) > total - done || tags < 0 || tags > 1000)
+                in.fail("an element header's counts do not add up to the elements");
+            const std::size_t n = nodes_of_type(in, type);
+            for (int i = 0; i < count; ++i, ++done) {
+                b.i32("an element id");
+                int physical = 0;
+                for (int k = 0; k < tags; ++k) {
+                    const int t = b.i32("an element tag");
+                    physical = k == 0 ? t : physical;
+                }
+                for (std::size_t k = 0; k < n; ++k)
+                    nodes[k] = b.i32("an element's node");
+                add_element_tags(c, type, nodes, physical);
+            }
+        }
+        return;
+    }
+    const std::size_t blocks = b.size("the number of element blocks", max_count);
+    for (int k = 0; k < 3; ++k)
+        b.size("the element count or tag range");
+    for (std::size_t block = 0; block < blocks; ++block) {
+        const int dim = b.i32("an element block's dimension"),
+                  entity = b.i32("an element block's entity");
+        const long long type = b.i32("an element block's type");
+        const std::size_t count = b.size("an element block's count", max_count);
+        const std::size_t n = nodes_of_type(in, type);
+        const int physical = block_group(c, dim, entity);
+        for (std::size_t i = 0; i < count; ++i) {
+            b.size("an element tag");
+            for (std::size_t k = 0; k < n; ++k)
+                nodes[k] = static_cast<long long>(b.size("an element's node"));
+            add_element_tags(c, type, nodes, physical);
+        }
+    }
+}
+
 void read_elements(Lines &in, MshContent &c) {
+    if (c.binary)
+        return read_elements_binary(in, c);
     if (!c.v4) {
         const std::size_t n = in.count(in.need(1, "the number of elements")[0], "element count");
         for (std::size_t i = 0; i < n; ++i) {
@@ -156,10 +345,7 @@ void read_elements(Lines &in, MshContent &c) {
         const int dim = int(in.integer(w[0], "dimension")), entity = int(in.integer(w[1], "tag"));
         const long long type = in.integer(w[2], "element type");
         const std::size_t n = in.count(w[3], "element count");
-        const auto groups = c.curve_groups.find(entity);
-        const int physical = dim == 1 && groups != c.curve_groups.end() && !groups->second.empty()
-                                 ? groups->second.front()
-                                 : 0;
+        const int physical = block_group(c, dim, entity);
         for (std::size_t i = 0; i < n; ++i)
             add_element(in, c, type, in.need(2, "an element: tag nodes..."), 1, physical);
     }
@@ -182,6 +368,20 @@ void read_node_data(Lines &in, MshContent &c) {
             components = v;
         if (i == 2)
             values = v;
+    }
+    if (c.binary) { // per value: the node tag (int), its components (doubles)
+        Binary b{in, c.size_bytes};
+        for (std::size_t i = 0; i < values; ++i) {
+            const long long tag = b.i32("a node value's tag");
+            double first = 0;
+            for (std::size_t k = 0; k < components; ++k) {
+                const double v = b.f64("a node value");
+                first = k == 0 ? v : first;
+            }
+            if (name == "depth" && components == 1)
+                c.depth[tag] = first;
+        }
+        return;
     }
     for (std::size_t i = 0; i < values; ++i) {
         const auto &w = in.need(1 + components, "a node value: tag value");

@@ -73,6 +73,11 @@ public:
             fail(std::string(what) + " '" + s + "' is not a number");
         return v;
     }
+    /// `n` raw bytes from where the last line ended (a binary section's data).
+    void bytes(void *out, std::size_t n, const char *what) {
+        if (!in_.read(static_cast<char *>(out), static_cast<std::streamsize>(n)))
+            fail(std::string("the file ends where ") + what + " should be");
+    }
     /// A count of at most `max`.
     std::size_t count(std::string_view w, const char *what, long long max = 1LL << 31) const {
         const long long v = integer(w, what);

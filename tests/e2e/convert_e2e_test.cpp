@@ -278,9 +278,10 @@ TEST(ConvertE2e, a_mesh_gmsh_made_converts_with_its_physical_groups) {
     TempDir dir;
     std::ofstream(dir / "made.py") << R"(
 import sys, gmsh, netCDF4, numpy as np
-version, msh = sys.argv[1], sys.argv[2]
+version, binary, msh = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 gmsh.initialize(); gmsh.option.setNumber('General.Terminal', 0)
 gmsh.option.setNumber('Mesh.MshFileVersion', float(version))
+gmsh.option.setNumber('Mesh.Binary', binary)
 occ = gmsh.model.geo
 p = [occ.addPoint(x, y, 0, 0.4) for x, y in ((0, 50), (4, 50), (4, 53), (0, 53))]
 l = [occ.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
@@ -288,10 +289,16 @@ s = occ.addPlaneSurface([occ.addCurveLoop(l)]); occ.synchronize()
 for dim, tags, tag, name in ((1, l[:3], 1, 'coast'), (1, [l[3]], 2, 'open'), (2, [s], 3, 'ocean')):
     gmsh.model.addPhysicalGroup(dim, tags, tag); gmsh.model.setPhysicalName(dim, tag, name)
 gmsh.model.mesh.generate(2); gmsh.write(msh)
-nodes = len(gmsh.model.mesh.getNodes()[0])
+nt, xyz, _ = gmsh.model.mesh.getNodes()
 tris = sum(len(t) for t in gmsh.model.mesh.getElements(2, s)[1])
 opens = sum(len(t) for t in gmsh.model.mesh.getElements(1, l[3])[1])
-print(nodes, tris, opens)
+# A depth view saved with its mesh ($NodeData "depth"): 100 m + 10 m per degree north.
+v = gmsh.view.add('depth')
+gmsh.view.addModelData(v, 0, gmsh.model.getCurrent(), 'NodeData', list(nt),
+                       [[100.0 + 10 * xyz[3 * i + 1]] for i in range(len(nt))])
+gmsh.option.setNumber('PostProcessing.SaveMesh', 1)
+gmsh.view.write(v, 'depth_' + msh)
+print(len(nt), tris, opens)
 )";
     std::ofstream(dir / "read.py") << R"(
 import sys, netCDF4, numpy as np
@@ -300,30 +307,43 @@ topo = [v for v in ds.variables.values() if getattr(v, 'cf_role', '') == 'mesh_t
 x = ds[topo.node_coordinates.split()[0]][:]
 f = ds[topo.face_node_connectivity][:]
 t = ds['boundary_tag'][:]
+if len(sys.argv) > 2:  # the depth file's: gmsh's values at the nodes' latitudes
+    lat = ds[topo.node_coordinates.split()[1]][:]
+    assert np.abs(ds['depth'][:] - (100 + 10 * lat)).max() < 1e-9, 'depth'
 print(len(x), len(f), int((t == 2).sum()))
 )";
-    for (const char *version : {"4.1", "2.2"}) {
-        SCOPED_TRACE(version);
-        const std::string msh = std::string("g") + version + ".msh", nc = msh + ".nc";
-        std::string made, read, err;
-        ASSERT_EQ(run_command("cd " + quote(dir.path().string()) + " && /usr/bin/python3 made.py " +
-                                  version + " " + msh,
-                              made),
-                  0)
-            << made;
-        ASSERT_EQ(run_exe({"convert", msh, nc, "-q"}, err, dir.path()), 0) << err;
-        ASSERT_EQ(
-            run_command("cd " + quote(dir.path().string()) + " && /usr/bin/python3 read.py " + nc,
-                        read),
-            0)
-            << read;
-        // gmsh's counts (the last line it printed) equal the converted file's.
-        made = made.substr(made.rfind('\n', made.size() - 2) + 1);
-        EXPECT_EQ(read, made);
-        // gmsh's mesh is Delaunay in the lon/lat plane, not on the sphere: a few edges fail the
-        // spherical test; everything else must hold.
-        expect_mesh_verify(dir / nc, "--allow-nondelaunay 20");
-    }
+    // ASCII and binary (Mesh.Binary 1: gmsh -bin), with gmsh's numbers as ints, size_t, doubles.
+    for (const std::string version : {"4.1", "2.2"})
+        for (const std::string binary : {"0", "1"}) {
+            SCOPED_TRACE(version + " binary " + binary);
+            const std::string msh = "g" + version + "_" + binary + ".msh", nc = msh + ".nc";
+            std::string made, read, err;
+            ASSERT_EQ(run_command("cd " + quote(dir.path().string()) +
+                                      " && /usr/bin/python3 made.py " + version + " " + binary +
+                                      " " + msh,
+                                  made),
+                      0)
+                << made;
+            ASSERT_EQ(run_exe({"convert", msh, nc, "-q"}, err, dir.path()), 0) << err;
+            ASSERT_EQ(run_exe({"convert", "depth_" + msh, "depth_" + nc, "-q"}, err, dir.path()), 0)
+                << err;
+            ASSERT_EQ(run_command("cd " + quote(dir.path().string()) +
+                                      " && /usr/bin/python3 read.py depth_" + nc + " depth",
+                                  read),
+                      0)
+                << read;
+            ASSERT_EQ(run_command("cd " + quote(dir.path().string()) +
+                                      " && /usr/bin/python3 read.py " + nc,
+                                  read),
+                      0)
+                << read;
+            // gmsh's counts (the last line it printed) equal the converted file's.
+            made = made.substr(made.rfind('\n', made.size() - 2) + 1);
+            EXPECT_EQ(read, made);
+            // gmsh's mesh is Delaunay in the lon/lat plane, not on the sphere: a few edges fail
+            // the spherical test; everything else must hold.
+            expect_mesh_verify(dir / nc, "--allow-nondelaunay 20");
+        }
 }
 
 TEST(ConvertE2e, another_tools_one_based_file_converts_with_its_tags_or_all_coast_without) {
@@ -372,7 +392,7 @@ TEST(ConvertE2e, refusals_are_one_line_and_leave_no_file) {
         {{"convert", "text.nc", "out.msh"}, 1, "cannot open"},
         {{"convert", etopo, "out.msh"}, 1, "not a UGRID mesh"},
         {{"convert", "bad.14", "out.msh"}, 1, "line 2: NP 'x' is not an integer"},
-        {{"convert", "binary.msh", "out.nc"}, 1, "a binary MSH file is not read"},
+        {{"convert", "binary.msh", "out.nc"}, 1, "line 2: a binary file's int 1 does not follow"},
         {{"convert", "text.msh", "out.nc"}, 1, "not a gmsh MSH file"},
         {{"convert", "quads.msh", "out.nc"}, 1, "element type 3 is not read"},
         {{"convert", "utm.msh", "out.nc"}, 1, "projected CRS ($Projection)"},
