@@ -1,7 +1,8 @@
 // TELEMAC SELAFIN writer (the SELAFIN row of writers.cpp): the geometry file NAME.slf and its
 // boundary conditions file NAME.cli, written beside it.
 //
-// .slf (single precision SELAFIN, "SERAFIN " in the title's last 8 characters): big-endian
+// .slf (single precision SELAFIN, "SERAFIN " in the title's last 8 characters; with --co
+// PRECISION=DOUBLE double precision, "SERAFIND", every real record in float64): big-endian
 // Fortran sequential records, each framed by its byte length before and after. Records: the
 // title (80 characters); NBV1 NBV2 (1 0); the variable name and unit (32 characters: BOTTOM, M);
 // IPARAM (10 integers, IPARAM(1) = 1, IPARAM(10) = 0: no date record); NELEM NPOIN NDP(3) 1;
@@ -51,12 +52,22 @@ public:
     /// The length marker that opens and closes a record of `bytes` bytes.
     void marker(std::size_t bytes) { word(std::uint32_t(bytes)); }
     void integer(std::int64_t v) { word(std::uint32_t(std::int32_t(v))); }
+    /// A real as float32, or float64 in a double precision (SERAFIND) file.
     void real(double v) {
+        if (double_) {
+            std::uint64_t u;
+            std::memcpy(&u, &v, 8);
+            word(std::uint32_t(u >> 32));
+            word(std::uint32_t(u));
+            return;
+        }
         const float f = float(v);
         std::uint32_t u;
         std::memcpy(&u, &f, 4);
         word(u);
     }
+    std::size_t real_bytes() const { return double_ ? 8 : 4; }
+    void set_double(bool on) { double_ = on; }
     void text(const std::string &s, std::size_t width) {
         std::string padded = s.substr(0, width);
         padded.resize(width, ' ');
@@ -82,6 +93,7 @@ private:
         file_.put({b, 4});
     }
     io::BufferedFile file_;
+    bool double_ = false;
 };
 
 /// A boundary node in the boundary numbering: its 0-based node and whether it is open.
@@ -138,7 +150,8 @@ std::vector<BoundaryNode> boundary_numbering(const io::MeshTopology &topo, std::
 
 /// Refuses what SELAFIN cannot hold: nodes without a depth, counts past its 32-bit records.
 void check_mesh(const Mesh &mesh, const Field *depth, const fs::path &path) {
-    if (3 * mesh.faces.size() * 4 >= std::size_t(INT32_MAX))
+    if (3 * mesh.faces.size() * 4 >= std::size_t(INT32_MAX) ||
+        8 * mesh.nodes.size() >= std::size_t(INT32_MAX))
         throw DataError("SELAFIN output " + path.string() + ": " +
                         std::to_string(mesh.faces.size()) +
                         " triangles are more than a SELAFIN record holds (about 1.8e8)");
@@ -163,7 +176,7 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary,
     std::replace_if(
         title.begin(), title.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
     title.resize(72, ' ');
-    out.text_record(title + "SERAFIN ", 80);
+    out.text_record(title + (out.real_bytes() == 8 ? "SERAFIND" : "SERAFIN "), 80);
     out.integer_record({1, 0});
     out.text_record("BOTTOM          M               ", 32);
     const auto at = origin(xy);
@@ -188,15 +201,16 @@ void write_slf(const Mesh &mesh, const std::vector<BoundaryNode> &boundary,
     const Field *depth = mesh.node_field("depth");
     for (int part = 0; part < 3; ++part) { // X, Y, BOTTOM
         report(options.progress, double(ne + (part + 1) * np) / total, "write_selafin");
+        const std::size_t real = out.real_bytes();
         if (part == 2)
-            out.marker(4), out.real(0), out.marker(4); // the time step's time: 0
-        out.marker(4 * np);
+            out.marker(real), out.real(0), out.marker(real); // the time step's time: 0
+        out.marker(real * np);
         for (std::size_t i = 0; i < np; ++i)
             out.real(part == 0   ? xy.x[i] - at[0]
                      : part == 1 ? xy.y[i] - at[1]
                      : depth     ? -depth->values[i]
                                  : 0.0);
-        out.marker(4 * np);
+        out.marker(real * np);
     }
 }
 
@@ -231,6 +245,7 @@ void write_as_selafin(const Mesh &mesh, const fs::path &path, const WriteOptions
     const std::vector<BoundaryNode> boundary =
         boundary_numbering(io::build_topology(mesh), mesh.nodes.size());
     RecordOut out(slf.temp_path(), path);
+    out.set_double(creation_option(options.creation_options, "PRECISION", "SINGLE") == "DOUBLE");
     write_slf(mesh, boundary, xy, out, options);
     out.close();
     write_cli(boundary, cli.temp_path(), cli_path);

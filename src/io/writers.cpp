@@ -99,6 +99,10 @@ const std::vector<Writer> &writers() {
          .extensions = {".slf"},
          .report_key = "selafin",
          .progress_weight = 0.25, // 0.6 s at 1.08e6 nodes, as above
+         .creation_options = {{"PRECISION",
+                               {"SINGLE", "DOUBLE"},
+                               "SINGLE: SERAFIN, float32 reals; DOUBLE: SERAFIND, float64 (lon/lat "
+                               "to the micrometre)"}},
          .takes_output_srs = true,
          .write = write_as_selafin},
         {.name = "DFLOWFM",

@@ -51,7 +51,8 @@ def records(path):
 
 def read_slf(path):
     r = iter(records(path))
-    title = next(r); assert len(title) == 80 and title[72:] == b'SERAFIN ', title
+    title = next(r); assert len(title) == 80 and title[72:] in (b'SERAFIN ', b'SERAFIND'), title
+    real = '>f8' if title[72:] == b'SERAFIND' else '>f4'  # every real record in that type
     nbv1, nbv2 = struct.unpack('>2i', next(r))
     names = [next(r) for _ in range(nbv1 + nbv2)]
     iparam = struct.unpack('>10i', next(r))
@@ -61,13 +62,13 @@ def read_slf(path):
     assert ndp == 3 and one == 1, (ndp, one)
     ikle = np.frombuffer(next(r), '>i4').reshape(nelem, 3)
     ipobo = np.frombuffer(next(r), '>i4')
-    x, y = np.frombuffer(next(r), '>f4'), np.frombuffer(next(r), '>f4')
+    x, y = np.frombuffer(next(r), real), np.frombuffer(next(r), real)
     steps = []
     for time in r:
-        assert len(time) == 4
-        steps.append([np.frombuffer(next(r), '>f4') for _ in range(nbv1)])
+        assert len(time) == np.dtype(real).itemsize and np.frombuffer(time, real)[0] == 0
+        steps.append([np.frombuffer(next(r), real) for _ in range(nbv1)])
     assert ipobo.size == npoin and x.size == npoin and len(steps) == 1, (ipobo.size, len(steps))
-    return names, ikle, ipobo, x, y, steps[0]
+    return names, ikle, ipobo, x, y, steps[0], real
 
 def read_cli(path):
     rows = [l.split() for l in open(path).read().splitlines()]
@@ -80,11 +81,13 @@ faces = nc['mesh_face_nodes'][:] - nc['mesh_face_nodes'].start_index
 depth = np.asarray(nc['depth'][:], dtype=float)
 en = nc['mesh_edge_nodes'][:] - nc['mesh_edge_nodes'].start_index
 tag = nc['boundary_tag'][:]  # on edges: 0 interior, 1 coast, 2 open
-names, ikle, ipobo, x, y, (bottom,) = read_slf(sys.argv[2])
+names, ikle, ipobo, x, y, (bottom,), real = read_slf(sys.argv[2])
 assert names == [b'BOTTOM          M               '], names
 assert np.array_equal(ikle - 1, faces), 'IKLE is not the faces'
-assert np.abs((x - lon + 180) % 360 - 180).max() < 1e-4 and np.abs(y - lat).max() < 1e-4
-assert np.array_equal(bottom, (-depth).astype('>f4')), 'BOTTOM is not minus the depth'
+# float32 keeps lon/lat to about 1e-5 degrees; SERAFIND has the UGRID file's doubles exactly.
+tol = 1e-4 if real == '>f4' else 0
+assert np.abs((x - lon + 180) % 360 - 180).max() <= tol and np.abs(y - lat).max() <= tol
+assert np.array_equal(bottom, (-depth).astype(real)), 'BOTTOM is not minus the depth'
 # IPOBO numbers exactly the nodes of the boundary edges, 1 .. NPTFR once each.
 on_boundary = set(en[tag > 0].ravel())
 nptfr = len(on_boundary)
@@ -153,8 +156,10 @@ assert int(nodes) == nc['mesh_node_lon'].size, nodes
 v = np.array([[float(t) for t in l.split()] for l in lines[1:]])
 lon, lat, depth = nc['mesh_node_lon'][:], nc['mesh_node_lat'][:], nc['depth'][:]
 assert v.shape[0] == lon.size
-assert np.abs((v[:, 0] - lon + 180) % 360 - 180).max() < 1e-4 and np.abs(v[:, 1] - lat).max() < 1e-4
-assert np.array_equal(v[:, 2], np.asarray(-depth, dtype=np.float32).astype(float)), 'BOTTOM'
+# A double precision (SERAFIND) file as the UGRID file's doubles, through repr's 17 digits.
+real, tol = (np.float64, 0) if sys.argv[3:] == ['double'] else (np.float32, 1e-4)
+assert np.abs((v[:, 0] - lon + 180) % 360 - 180).max() <= tol and np.abs(v[:, 1] - lat).max() <= tol
+assert np.array_equal(v[:, 2], np.asarray(-depth, dtype=real).astype(float)), 'BOTTOM'
 print('SAME %d' % v.shape[0])
 )";
 
@@ -174,11 +179,15 @@ bool qgis_available() {
     return run_command("/usr/bin/python3 -c 'import qgis.core' 2>&1", out) == 0;
 }
 
-/// Meshes with `args` into dir/m.nc and dir/m.slf, checks both readers; returns the verdict.
-std::string mesh_and_check(const TempDir &dir, std::vector<std::string> args) {
+/// Meshes with `args` into dir/m.nc and dir/m.slf (double precision when asked), checks both
+/// readers; returns the verdict.
+std::string mesh_and_check(const TempDir &dir, std::vector<std::string> args,
+                           bool double_precision = false) {
     args.insert(args.begin(), "mesh");
     for (const char *out : {"m.nc", "m.slf"})
         args.insert(args.end(), {"-o", (dir / out).string()});
+    if (double_precision)
+        args.insert(args.end(), {"--co", "PRECISION=DOUBLE"});
     args.push_back("-q");
     std::string err;
     EXPECT_EQ(run_exe(args, err, dir.path()), 0) << err;
@@ -192,8 +201,10 @@ std::string mesh_and_check(const TempDir &dir, std::vector<std::string> args) {
     const std::string seen =
         run_python(dir, "read_in_qgis.py", qgis_reader, {dir / "m.slf", dir / "qgis.txt"});
     EXPECT_NE(seen.find("VALID True"), std::string::npos) << seen;
-    const std::string same =
-        run_python(dir, "compare.py", qgis_compare, {dir / "m.nc", dir / "qgis.txt"});
+    std::vector<fs::path> compared{dir / "m.nc", dir / "qgis.txt"};
+    if (double_precision)
+        compared.push_back("double");
+    const std::string same = run_python(dir, "compare.py", qgis_compare, compared);
     EXPECT_EQ(same.rfind("SAME ", 0), 0u) << same;
     return verdict + seen;
 }
@@ -212,6 +223,23 @@ TEST(Selafin, a_regional_slf_and_cli_match_the_ugrid_file_with_open_and_coast_no
                                              "OK (\\d+) (\\d+)\n", &groups))
         << verdict;
     EXPECT_GT(std::stoi(groups[2]), 0); // open nodes
+}
+
+// PRECISION=DOUBLE: a SERAFIND file, read by the reader here and by MDAL with the UGRID file's
+// node positions and depths exactly (float32 rounds lon/lat by up to about 1e-5 degrees, a metre).
+TEST(Selafin, a_double_precision_slf_has_the_ugrid_files_coordinates_exactly) {
+    TempDir dir;
+    const std::string verdict = mesh_and_check(
+        dir,
+        {"--coast", fixture("coast/ne_50m_land.gpkg").string(), "--coast-layer", "land", "--region",
+         "-12,46,13,62", "--bathy", fixture("bathy/etopo5_nwshelf_5min.tif").string(), "--hmax",
+         "60km", "--hmin", "10km"},
+        true);
+    EXPECT_EQ(verdict.rfind("OK ", 0), 0u) << verdict;
+    std::ifstream slf(dir / "m.slf", std::ios::binary);
+    std::string head(84, ' ');
+    slf.read(head.data(), 84);
+    EXPECT_EQ(head.substr(76, 8), "SERAFIND");
 }
 
 TEST(Selafin, a_global_slf_has_only_solid_boundary_nodes) {
