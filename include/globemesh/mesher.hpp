@@ -5,8 +5,9 @@
 //   2. recovers every boundary segment by edge flips, splitting a segment at its midpoint only
 //      where flips cannot recover it; recovered segments are constrained for good;
 //   3. classifies triangles by flood fill across unconstrained edges, seeded on the left of every
-//      segment, drops land and the ocean components not connected to the largest one (inland
-//      seas) unless keep_inland_seas, and reports each component by area; then closes the
+//      segment, drops land and the ocean components apart from the largest one that reach no
+//      open (region) segment (inland seas) unless keep_inland_seas, and reports each component
+//      by area; then closes the
 //      inlets narrower than inlet_width * h (an edge between two nodes of one ring, shorter than
 //      that, becomes coast when the water behind it is under inlet_area * h^2, or narrower on
 //      average than inlet_width * h and under 25 h^2; repeated, so a dead-end channel closes
@@ -106,7 +107,8 @@ struct MesherOptions {
     std::uint64_t max_nodes = 20'000'000; ///< refuse when the size field asks for more nodes
     std::uint64_t max_memory = 0;  ///< bytes; refuse when the estimated peak exceeds it (0: no cap)
     int smooth_iterations = 4;     ///< smoothing sweeps
-    bool keep_inland_seas = false; ///< keep ocean components apart from the largest
+    bool keep_inland_seas = false; ///< keep ocean components apart from the largest (those
+                                   ///< reaching an open segment are kept always)
     double inlet_width = 0.5;      ///< close inlets narrower than this times h (0: none)
     double inlet_area = 1.0; ///< ... holding at most this times h^2 of water (or narrow on average)
     /// Once the inlets have closed, a coast segment shorter than this times h (a closed mouth

@@ -160,9 +160,9 @@ void warn_thin_channels(std::ostream &err, const Mesh &mesh) {
            "channel with --feature-size 3\n";
 }
 
-/// The warning on `err` that a region's ocean fell into pieces and only the largest was meshed,
-/// where a piece dropped holds a tenth of its area or more (a region file of several seas, a box
-/// across an isthmus: Panama's Caribbean side), and how to keep them all.
+/// The warning on `err` that a region's ocean fell into pieces and one enclosed by the coast
+/// (no edge on the region's outline: water that joins no ocean outside the region) was dropped,
+/// where it holds a tenth of the largest's area or more, and how to keep them all.
 void warn_region_pieces(std::ostream &err, const MesherReport &m) {
     double kept = 0, dropped = 0;
     std::size_t count = 0;
@@ -174,10 +174,11 @@ void warn_region_pieces(std::ostream &err, const MesherReport &m) {
     }
     if (count == 0 || dropped < 0.1 * kept)
         return;
-    err << "globemesh: warning: the region's ocean is in pieces apart; only the largest ("
-        << report_number(kept) << " km2) is meshed and " << count
-        << (count == 1 ? " piece is" : " pieces are") << " dropped (the largest "
-        << report_number(dropped) << " km2); --keep-inland-seas meshes them all\n";
+    err << "globemesh: warning: the region's ocean is in pieces apart; " << count
+        << (count == 1 ? " piece" : " pieces") << " enclosed by the coast"
+        << (count == 1 ? " is" : " are") << " dropped beside the largest kept ("
+        << report_number(kept) << " km2; the largest dropped " << report_number(dropped)
+        << " km2); --keep-inland-seas meshes them all\n";
 }
 
 /// The closed straits in the --report JSON: place, width and the size each needs.

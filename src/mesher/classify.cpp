@@ -207,10 +207,11 @@ double flood_component(const SphericalDelaunay &dt, TriangleId seed, std::uint32
 }
 
 // Floods the components on the left of the boundary segments (their areas into
-// component_area), then checks that every segment has land (or the outside of the region) on
-// its right.
+// component_area, 1 in reaches_open for those beside a region's open segment), then checks that
+// every segment has land (or the outside of the region) on its right.
 void flood_left_of_segments(const Mesher &m, std::vector<std::uint32_t> &component,
-                            std::vector<double> &component_area, std::vector<TriangleId> &stack) {
+                            std::vector<double> &component_area, std::vector<char> &reaches_open,
+                            std::vector<TriangleId> &stack) {
     const SphericalDelaunay &dt = m.dt;
     // Consecutive segments of a ring share a node: each edge's triangle is the next one's
     // hint, which saves a walk from the last triangle across the whole triangulation.
@@ -221,9 +222,13 @@ void flood_left_of_segments(const Mesher &m, std::vector<std::uint32_t> &compone
             throw DataError("internal: a recovered boundary segment is missing");
         hint = triangle_of(h);
         TriangleId left = triangle_of(h);
-        if (component[left] == 0xffffffffu)
+        if (component[left] == 0xffffffffu) {
             component_area.push_back(flood_component(
                 dt, left, static_cast<std::uint32_t>(component_area.size()), component, stack));
+            reaches_open.push_back(0);
+        }
+        if (m.is_open(a, b))
+            reaches_open[component[left]] = 1;
     }
     hint = no_triangle;
     for (auto [a, b] : m.directed) {
@@ -251,18 +256,21 @@ void classify_ocean(Mesher &m, const Boundary &boundary, const MesherOptions &op
     const std::size_t slots = dt.triangle_slots();
     std::vector<std::uint32_t> component(slots, 0xffffffffu);
     std::vector<double> component_area;
+    std::vector<char> reaches_open;
     std::vector<TriangleId> stack;
     if (boundary.empty())
         component_area.push_back(flood_component(dt, dt.last_triangle(), 0, component, stack));
     else
-        flood_left_of_segments(m, component, component_area, stack);
+        flood_left_of_segments(m, component, component_area, reaches_open, stack);
+    reaches_open.resize(component_area.size(), 0);
     std::size_t largest = 0;
     for (std::size_t c = 0; c < component_area.size(); ++c)
         if (component_area[c] > component_area[largest])
             largest = c;
     std::vector<char> kept(component_area.size(), 0);
     for (std::size_t c = 0; c < component_area.size(); ++c) {
-        kept[c] = c == largest || options.keep_inland_seas;
+        // Water at a region's open edge joins the ocean outside it: no inland sea.
+        kept[c] = c == largest || options.keep_inland_seas || reaches_open[c];
         m.report.components.push_back(
             {component_area[c] * earth_radius_km * earth_radius_km, kept[c] != 0});
     }

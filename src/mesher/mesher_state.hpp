@@ -498,10 +498,10 @@ void loops_as_whole(const Mesher &m, const std::vector<HalfEdge> &edges,
 std::vector<VertexId> insert_boundary(Mesher &m, const Boundary &boundary);
 void recover_segments(Mesher &m, const Boundary &boundary, const std::vector<VertexId> &ids);
 
-// classify.cpp: the triangles labelled ocean (the largest component left of the segments, or
-// all with keep_inland_seas) or land; narrow inlets closed; corners below 60 degrees marked
-// sharp; the nodes estimated (refused past max_nodes or max_memory) and the triangulation
-// reserved for them.
+// classify.cpp: the triangles labelled ocean (the largest component left of the segments,
+// those beside a region's open segment, or all with keep_inland_seas) or land; narrow inlets
+// closed; corners below 60 degrees marked sharp; the nodes estimated (refused past max_nodes or
+// max_memory) and the triangulation reserved for them.
 void classify_ocean(Mesher &m, const Boundary &boundary, const MesherOptions &options);
 void close_inlets(Mesher &m, const MesherOptions &options, MesherReport &report);
 // A chord across water this short against the inlet width closes by the inlet rule wherever it

@@ -303,23 +303,29 @@ print('OK', faces)
     EXPECT_FALSE(fs::exists(dir / "g.dat"));
 }
 
-TEST(CliE2e, a_region_whose_ocean_falls_in_pieces_warns_that_only_the_largest_is_meshed) {
+TEST(CliE2e, a_region_whose_ocean_falls_in_pieces_at_its_edges_meshes_every_piece) {
     // A box across Panama (NE 1:50m at 10 km): its Pacific (29,800 km2) and Caribbean (25,100
-    // km2) sides are apart, and only the largest was meshed, with a line in the summary alone.
+    // km2) sides are apart inside the box, but both reach its edges, so both are the ocean (no
+    // inland sea); only the largest was meshed, with a warning to add --keep-inland-seas.
     TempDir dir;
     std::string out, err;
     const std::vector<std::string> run{
         "mesh",   "--coast", land50, "--coast-layer",        "land", "--region", "-81,7.5,-78,10",
         "--hmax", "10km",    "-o",   (dir / "p.nc").string()};
     ASSERT_EQ(run_exe(run, out, err, dir.path()), 0) << err;
-    EXPECT_TRUE(globemesh::test::regex_search(
-        err, "warning: the region's ocean is in pieces apart; only the "
-             "largest \\(29[0-9.]+ km2\\) is meshed and 1 piece is dropped"))
-        << err;
+    EXPECT_FALSE(globemesh::test::regex_search(err, "in pieces apart")) << err;
+    std::vector<std::string> area;
+    ASSERT_TRUE(globemesh::test::regex_search(out, "\\narea +([0-9.]+) km2", &area)) << out;
+    EXPECT_GT(std::stod(area[1]), 50000.0) << out;
+    EXPECT_LT(std::stod(area[1]), 60000.0) << out;
+    // --keep-inland-seas adds nothing here: no piece is closed off by the coast.
     std::vector<std::string> kept = run;
     kept.insert(kept.end(), {"--keep-inland-seas", "--overwrite"});
-    ASSERT_EQ(run_exe(kept, out, err, dir.path()), 0) << err;
-    EXPECT_FALSE(globemesh::test::regex_search(err, "in pieces apart")) << err;
+    std::string out_kept;
+    ASSERT_EQ(run_exe(kept, out_kept, err, dir.path()), 0) << err;
+    std::vector<std::string> area_kept;
+    ASSERT_TRUE(globemesh::test::regex_search(out_kept, "\\narea +([0-9.]+) km2", &area_kept));
+    EXPECT_EQ(area_kept[1], area[1]);
 }
 
 TEST(CliE2e, regional_run_has_coast_and_open_boundaries_inside_the_region) {
