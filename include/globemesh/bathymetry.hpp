@@ -142,6 +142,9 @@ private:
     /// A non-global raster's column position of lon (cell units from column 0), taken from
     /// edge_margin of a cell west of its west edge round to 360 degrees further.
     double column_of(double lon_deg) const;
+    /// column_of(lon), but at a pole (every longitude) the middle column when lon is past the
+    /// columns: a raster cut to a box from 155 to 161 E holds 90 N, which a node there names lon 0.
+    double column_at(double lon_deg, double lat_deg) const;
     std::vector<float> values_;
     std::optional<double> fill_;
 };

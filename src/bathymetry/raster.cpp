@@ -64,7 +64,14 @@ bool Raster::contains(double lon, double lat) const {
         return false;
     if (global_)
         return true;
-    return column_of(lon) <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9;
+    return column_at(lon, lat) <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9;
+}
+
+double Raster::column_at(double lon, double lat) const {
+    const double u = column_of(lon);
+    if (std::abs(lat) < 90.0 || u <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9)
+        return u;
+    return 0.5 * (static_cast<double>(nlon_) - 1.0);
 }
 
 double Raster::column_of(double lon) const {
@@ -105,7 +112,7 @@ double Raster::sample(double lon, double lat) const {
         i1 = i0 + 1 == nlon_ ? 0 : i0 + 1;
         fu = u - fl;
     } else {
-        const double u = column_of(lon);
+        const double u = column_at(lon, lat);
         if (u > n_lon - 0.5 + edge_margin + 1e-9)
             return nan_value;
         bracket(u, nlon_, i0, i1, fu);

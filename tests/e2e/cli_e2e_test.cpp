@@ -328,6 +328,21 @@ TEST(CliE2e, a_region_whose_ocean_falls_in_pieces_at_its_edges_meshes_every_piec
     EXPECT_EQ(area_kept[1], area[1]);
 }
 
+TEST(CliE2e, a_box_reaching_the_north_pole_away_from_lon_0_is_covered_by_a_global_raster) {
+    // ETOPO5 covers the globe, but a box from 155 to 161 E up to 90 N was refused: its window
+    // held no column at lon 0, where the pole inside its ocean was looked up.
+    TempDir dir;
+    std::string out, err;
+    const std::string etopo = fixture("bathy/etopo5_global_10min.nc").string();
+    for (const char *region : {"155,80,161,90", "-120,85,-100,90"}) {
+        const std::vector<std::string> run{
+            "mesh",          "-q",      "--overwrite", "--coast", land50,
+            "--coast-layer", "land",    "--region",    region,    "--hmax",
+            "20km",          "--bathy", etopo,         "-o",      (dir / "n.nc").string()};
+        EXPECT_EQ(run_exe(run, out, err, dir.path()), 0) << region << ": " << err;
+    }
+}
+
 TEST(CliE2e, regional_run_has_coast_and_open_boundaries_inside_the_region) {
     TempDir dir;
     std::string out, err;
