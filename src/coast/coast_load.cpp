@@ -180,6 +180,9 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     // Cut to the region first, unless --min-island-area weighs each island whole.
     const bool clip = near && !(options.min_island_area_km2 > 0);
     const std::vector<Box> clip_boxes = clip ? near_boxes(*near) : std::vector<Box>{};
+    // A region's outline may cut a lake the clipping then opens: its holes, read first, tell.
+    const std::vector<GeomPtr> holes =
+        near ? source_holes(geos, src.polygons) : std::vector<GeomPtr>{};
     std::vector<GeomPtr> parts = valid_parts(geos, src.polygons, clip_boxes);
     if (!src.lines.empty()) {
         // each polygon wrapped alone: only those past +-180 are cut, not all the land at once
@@ -231,8 +234,8 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     if (!options.region && options.region_file.empty()) {
         rings = world_rings(geos, land, options.keep_inland_seas, out);
     } else {
-        rings =
-            region_rings(geos, land, options, region_file ? &*region_file : nullptr, where, out);
+        rings = region_rings(geos, land, holes, options, region_file ? &*region_file : nullptr,
+                             where, out);
     }
     report(progress, 0.85, "checking rings");
     {

@@ -200,9 +200,14 @@ struct Chain {
 /// cut at the seam and the poles and stitched; inland water as keep_inland_seas says.
 std::vector<Chain> world_rings(Geos &geos, const std::vector<GeomPtr> &land, bool keep_inland_seas,
                                CoastData &out);
+/// The holes of the source's polygons (lakes, inland seas), each a polygon wrapped as the land
+/// is: read before the land is cut to a region, where an outline across a lake makes it a bay.
+std::vector<GeomPtr> source_holes(Geos &geos, const std::vector<PolygonRings> &polygons);
 /// The ocean of a region (--region box, or --region-file polygons: `region_file`, as read_source
-/// read them, null for a box): the region less the land.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+/// read them, null for a box): the region less the land; water the outline reaches but lying in
+/// one of `holes` (source_holes) is an inland sea.
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land,
+                                const std::vector<GeomPtr> &holes, const CoastOptions &options,
                                 const Source *region_file, const ErrorText &where, CoastData &out);
 /// Converts a lon/lat ring to unit vectors, dropping nodes equal to the previous one.
 Ring to_sphere(const Chain &c);

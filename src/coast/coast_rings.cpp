@@ -682,9 +682,35 @@ std::vector<std::size_t> polygons_holding(Geos &geos,
     return holder;
 }
 
+std::vector<GeomPtr> source_holes(Geos &geos, const std::vector<PolygonRings> &polygons) {
+    std::vector<GeomPtr> holes;
+    for (const PolygonRings &p : polygons)
+        for (std::size_t h = 1; h < p.size(); ++h) {
+            if (p[h].size() < 4)
+                continue;
+            GeomPtr g = make_polygon(geos, PolygonRings{p[h]});
+            if (GEOSisValid_r(geos.get(), g.get()) != 1)
+                g = make_valid(geos, g.get());
+            add_wrapped(geos, std::move(g), holes);
+        }
+    return holes;
+}
+
+/// True when the water polygon p lies in one of `holes` (land_holes): a lake, not the ocean.
+bool in_a_hole(Geos &geos, const std::vector<GeomPtr> &holes, const GEOSGeometry *p) {
+    if (holes.empty())
+        return false;
+    GeomPtr at = own(geos, GEOSPointOnSurface_r(geos.get(), p), "find an inner point");
+    for (const auto &h : holes)
+        if (GEOSContains_r(geos.get(), h.get(), at.get()) == 1)
+            return true;
+    return false;
+}
+
 /// The ocean of a region (--region box, two boxes across +-180, or --region-file polygons):
 /// region minus land with GEOS, its rings with region edges tagged open.
-std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const CoastOptions &options,
+std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land,
+                                const std::vector<GeomPtr> &holes, const CoastOptions &options,
                                 const Source *region_file, const ErrorText &where, CoastData &out) {
     Clip clip;
     GeomPtr domain;
@@ -760,8 +786,9 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
     }
 
     RingBuilder builder(geos, clip);
-    // Water bodies with no edge on the region outline are inland seas (dropped unless
-    // keep_inland_seas, or unless nothing else is ocean: then the largest stays).
+    // Water bodies with no edge on the region outline, or in a hole of the land (a lake the
+    // outline cuts), are inland seas (dropped unless keep_inland_seas, or unless nothing else
+    // is ocean: then the largest stays).
     std::vector<std::pair<std::size_t, std::vector<PointList>>> inland;
     for (std::size_t i = 0; i < ocean_polys.size(); ++i) {
         const GEOSGeometry *p = ocean_polys[i];
@@ -787,7 +814,7 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land, const Co
         for (const auto &r : prings)
             for (std::size_t j = 0; j + 1 < r.size() && !outline_edge; ++j)
                 outline_edge = builder.classify(r[j], r[j + 1]) != EdgeKind::coast;
-        if (outline_edge || options.keep_inland_seas) {
+        if ((outline_edge && !in_a_hole(geos, holes, p)) || options.keep_inland_seas) {
             for (auto &r : prings)
                 builder.add_ring(std::move(r));
         } else {

@@ -328,6 +328,27 @@ TEST(CliE2e, a_region_whose_ocean_falls_in_pieces_at_its_edges_meshes_every_piec
     EXPECT_EQ(area_kept[1], area[1]);
 }
 
+TEST(CliE2e, a_lake_the_region_outline_cuts_stays_an_inland_sea) {
+    // A box from the Aegean to 52 E (NE 1:50m at 30 km) cuts the Caspian, a hole in Eurasia: its
+    // water reaches the box's edge but joins no ocean, so it goes as an inland sea (the
+    // Mediterranean and Black Sea, 702,700 km2, stay) unless --keep-inland-seas.
+    TempDir dir;
+    std::string out, err;
+    const std::vector<std::string> run{
+        "mesh",   "--coast", land50, "--coast-layer",        "land", "--region", "25,35,52,48",
+        "--hmax", "30km",    "-o",   (dir / "c.nc").string()};
+    ASSERT_EQ(run_exe(run, out, err, dir.path()), 0) << err;
+    std::vector<std::string> area;
+    ASSERT_TRUE(globemesh::test::regex_search(out, "\\narea +([0-9.]+) km2", &area)) << out;
+    EXPECT_LT(std::stod(area[1]), 720000.0) << out;
+    EXPECT_TRUE(globemesh::test::regex_search(out, "lakes dropped 1,")) << out;
+    std::vector<std::string> kept = run;
+    kept.insert(kept.end(), {"--keep-inland-seas", "--overwrite"});
+    ASSERT_EQ(run_exe(kept, out, err, dir.path()), 0) << err;
+    ASSERT_TRUE(globemesh::test::regex_search(out, "\\narea +([0-9.]+) km2", &area)) << out;
+    EXPECT_GT(std::stod(area[1]), 950000.0) << out;
+}
+
 TEST(CliE2e, a_box_reaching_the_north_pole_away_from_lon_0_is_covered_by_a_global_raster) {
     // ETOPO5 covers the globe, but a box from 155 to 161 E up to 90 N was refused: its window
     // held no column at lon 0, where the pole inside its ocean was looked up.
