@@ -210,6 +210,46 @@ void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
     }
 }
 
+/// Largest pull toward the central meridian that transform_on_edge tries, relative to a point's
+/// offset from it: 2^-26 (about 0.25 m at 1.7e7 m, the edge of a Robinson world map), past
+/// the 1e-8 to which PROJ's iterative inverses (Robinson) converge.
+constexpr double edge_pull_max = 0x1p-26;
+
+/// Reprojects one point of a projected world map in place, pulling a point the inverse rejects
+/// toward `x_centre` (the false easting) by the least of 2^-52 .. edge_pull_max of its offset
+/// that the inverse accepts: PROJ's Robinson and Mollweide inverses reject points of their
+/// +-180 edge that rounding put a few units in the last place outside. False if none works.
+bool transform_on_edge(OGRCoordinateTransformationH ct, double x_centre, double &x, double &y) {
+    for (double pull = 0; pull <= edge_pull_max; pull = pull == 0 ? 0x1p-52 : 2 * pull) {
+        double px = x_centre + (x - x_centre) * (1 - pull), py = y, pz = 0;
+        int ok = FALSE;
+        if (OCTTransformEx(ct, 1, &px, &py, &pz, &ok) && ok && std::isfinite(px) &&
+            std::isfinite(py)) {
+            x = px;
+            y = py;
+            return true;
+        }
+    }
+    return false;
+}
+
+/// Reprojects every point of `g` (each part, ring and line) in place, a point at a time through
+/// transform_on_edge; keeps Z and M. False if a point cannot be reprojected.
+bool transform_points_on_edge(OGRGeometryH g, OGRCoordinateTransformationH ct, double x_centre) {
+    const int parts = OGR_G_GetGeometryCount(g);
+    for (int i = 0; i < parts; ++i)
+        if (!transform_points_on_edge(OGR_G_GetGeometryRef(g, i), ct, x_centre))
+            return false;
+    for (int i = 0; i < OGR_G_GetPointCount(g); ++i) {
+        double x = 0, y = 0, z = 0, m = 0;
+        OGR_G_GetPointZM(g, i, &x, &y, &z, &m);
+        if (!transform_on_edge(ct, x_centre, x, y))
+            return false;
+        OGR_G_SetPointZM(g, i, x, y, z, m);
+    }
+    return true;
+}
+
 /// A copy of `g` with each closed line string a polygon (a --region-file's outline drawn as a
 /// line); its other parts as they are.
 OgrGeometryPtr closed_lines_to_polygons(OGRGeometryH g) {
@@ -504,6 +544,10 @@ Source read_source(const std::string &path, const std::string &layer_name, const
                                 ? Reprojected::from_pole_point
                             : OSRIsProjected(source_srs.get()) ? Reprojected::projected
                                                                : Reprojected::geographic;
+    const double x_centre =
+        how == Reprojected::projected
+            ? OSRGetProjParm(source_srs.get(), SRS_PP_FALSE_EASTING, 0.0, nullptr)
+            : 0.0;
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;
@@ -529,7 +573,19 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             g = outline.get();
         if (transform) {
             OgrGeometryPtr copy(OGR_G_Clone(g));
-            if (OGR_G_Transform(copy.get(), transform.get()) != OGRERR_NONE)
+            // A world map's points on its +-180 edge may fail the whole-geometry transform:
+            // then point by point, those on the edge pulled inside (transform_on_edge).
+            const bool had_error = CPLGetLastErrorType() >= CE_Failure;
+            bool ok = OGR_G_Transform(copy.get(), transform.get()) == OGRERR_NONE;
+            if (!ok && how == Reprojected::projected) {
+                copy.reset(OGR_G_Clone(g));
+                CPLPushErrorHandler(CPLQuietErrorHandler);
+                ok = transform_points_on_edge(copy.get(), transform.get(), x_centre);
+                CPLPopErrorHandler();
+                if (ok && !had_error)
+                    CPLErrorReset(); // the failure recovered from is not a read error
+            }
+            if (!ok)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
                                 " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
             collect_geometry(copy.get(), how, src);

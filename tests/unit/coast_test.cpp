@@ -652,6 +652,36 @@ TEST(Coast, a_polygon_about_a_pole_in_a_polar_crs_closes_through_the_pole) {
     EXPECT_NEAR(polar.ocean_area_km2, ne110().ocean_area_km2, 1.0);
 }
 
+// A world map in Robinson or Mollweide (ogr2ogr -t_srs from lon/lat) holds the land's vertices
+// on +-180 at the map's edge, where rounding puts some a few units in the last place outside the
+// domain that PROJ's inverse accepts: the whole layer was refused ("feature 8 cannot be
+// reprojected to lon/lat"). Now those vertices come back on the seam: Robinson gives the rings of
+// the lon/lat source; Mollweide, which draws the pole as a 225 m line, the same ocean area.
+TEST(Coast, a_world_map_in_robinson_or_mollweide_reads_its_edge_vertices) {
+    globemesh::test::TempDir dir;
+    const std::string robin = (dir / "land_robin.gpkg").string();
+    ASSERT_TRUE(test::ogr2ogr(fixture("coast/ne_110m_land.gpkg").string(), robin,
+                              {"-t_srs", "+proj=robin +datum=WGS84", "land"}));
+    const CoastData r = load_coast(coast_options_at(robin));
+    ASSERT_EQ(r.rings.rings.size(), ne110().rings.rings.size());
+    double worst_km = 0;
+    for (std::size_t k = 0; k < r.rings.rings.size(); ++k) {
+        const auto &ref = ne110().rings.rings[k].nodes;
+        ASSERT_EQ(r.rings.rings[k].nodes.size(), ref.size()) << "ring " << k;
+        for (std::size_t i = 0; i < ref.size(); ++i)
+            worst_km = std::max(worst_km, arc_km(r.rings.rings[k].nodes[i], ref[i]));
+    }
+    EXPECT_LT(worst_km, 1e-3);
+
+    const std::string moll = (dir / "land_moll.gpkg").string();
+    ASSERT_TRUE(test::ogr2ogr(fixture("coast/ne_110m_land.gpkg").string(), moll,
+                              {"-t_srs", "+proj=moll +datum=WGS84", "land"}));
+    const CoastData m = load_coast(coast_options_at(moll));
+    expect_valid(m.rings);
+    EXPECT_EQ(m.rings.rings.size(), ne110().rings.rings.size());
+    EXPECT_NEAR(m.ocean_area_km2, ne110().ocean_area_km2, 1e-5 * ne110().ocean_area_km2);
+}
+
 // The land itself, reprojected to Equal Earth and back, as the region: the region's outline runs
 // along the coast everywhere, a few micro-degrees off it. An outline that follows the coast is
 // land where it is on land (issue 37), so no sliver of ocean is left between them: the region is
