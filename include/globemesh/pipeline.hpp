@@ -36,6 +36,7 @@ struct DepthReport {
     double shallowest_m = 0;           ///< the smallest sampled depth when above_sea_level > 0
     std::optional<double> min_depth_m; ///< MeshOptions::min_depth_m, when set
     std::size_t raised = 0;            ///< nodes raised to min_depth_m
+    std::size_t nodes = 0;             ///< nodes sampled
 };
 
 /// The size field the mesher used.

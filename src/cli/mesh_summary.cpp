@@ -39,8 +39,11 @@ std::string depth_json(const DepthReport &d) {
 }
 
 /// The summary's depth line, and unless `quiet` the warning on `err` when nodes above sea level
-/// are written with negative depth (no --min-depth).
-void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, bool quiet) {
+/// are written with negative depth (no --min-depth); when most of the ocean's nodes are, the
+/// raster's sign is the likely cause (depth read as height, or height as depth), and the warning
+/// names --depth-positive instead: --min-depth would flatten the whole ocean to it.
+void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, bool depth_positive,
+                 bool quiet) {
     const auto count = static_cast<long long>(d.above_sea_level);
     std::string down_to;
     if (d.above_sea_level > 0)
@@ -50,7 +53,16 @@ void print_depth(std::ostream &out, std::ostream &err, const DepthReport &d, boo
         out << ", " << d.raised << " raised to --min-depth " << report_number(*d.min_depth_m)
             << " m";
     out << "\n";
-    if (count > 0 && !d.min_depth_m && !quiet)
+    if (quiet)
+        return;
+    if (2 * d.above_sea_level > d.nodes)
+        err << "globemesh: warning: " << grouped(count) << " of the "
+            << grouped(static_cast<long long>(d.nodes))
+            << " nodes lie above sea level: does --bathy hold "
+            << (depth_positive ? "heights (positive up)? then leave out --depth-positive"
+                               : "depths (positive down)? then pass --depth-positive")
+            << "\n";
+    else if (count > 0 && !d.min_depth_m)
         err << "globemesh: warning: " << grouped(count)
             << (count == 1 ? " node lies" : " nodes lie") << " above sea level" << down_to
             << (count == 1 ? " and is" : " and are")
@@ -262,7 +274,7 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
     print_coast(out, s.run);
     print_passages(out, err, s.run, o.quiet);
     if (s.run.depth)
-        print_depth(out, err, *s.run.depth, o.quiet);
+        print_depth(out, err, *s.run.depth, o.mesh.depth_positive, o.quiet);
     if (s.run.straits_closing && s.run.mesher.straits_closed > 0 && !o.quiet)
         warn_straits(err, s.run.mesher);
     if (!s.run.straits_closing && s.run.mesher.land_faces_left > 0 && !o.quiet)

@@ -132,6 +132,7 @@ private:
 /// (when set) to it; no-data values (NaN) stay as they are.
 DepthReport apply_min_depth(std::vector<double> &depths, std::optional<double> min_depth_m) {
     DepthReport f;
+    f.nodes = depths.size();
     f.min_depth_m = min_depth_m;
     for (double &d : depths) {
         if (d < 0) {

@@ -1690,6 +1690,62 @@ TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
     globemesh::test::expect_mesh_verify(dir / "d5.nc");
 }
 
+// A raster of depth (positive down) read as height, or of height read as depth with
+// --depth-positive, puts most of the ocean's nodes above sea level: the warning suggested
+// --min-depth 5, which would flatten the whole ocean to 5 m. It now names the sign.
+TEST(Cli, most_nodes_above_sea_level_warn_about_the_raster_sign) {
+    TempDir dir;
+    const fs::path depth = dir / "depth.tif";
+    {
+        GDALAllRegister();
+        const std::string src = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+        const char *args[] = {"-scale", "-32768", "32767", "32768", "-32767", nullptr};
+        GDALTranslateOptions *opts = GDALTranslateOptionsNew(const_cast<char **>(args), nullptr);
+        GDALDatasetH in = GDALOpen(src.c_str(), GA_ReadOnly);
+        ASSERT_NE(in, nullptr);
+        GDALDatasetH out = GDALTranslate(depth.c_str(), in, opts, nullptr);
+        GDALTranslateOptionsFree(opts);
+        GDALClose(in);
+        ASSERT_NE(out, nullptr);
+        GDALClose(out);
+    }
+    auto mesh = [&](const fs::path &bathy, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"mesh",
+                                         "--coast",
+                                         coast,
+                                         "--coast-layer",
+                                         "land",
+                                         "--bathy",
+                                         bathy.string(),
+                                         "--region",
+                                         "-10,48,10,60",
+                                         "--hmax",
+                                         "30km",
+                                         "-o",
+                                         (dir / "m.nc").string(),
+                                         "--overwrite"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const std::string shelf = fixture("bathy/etopo5_nwshelf_5min.tif").string();
+    const std::string sign = R"(globemesh: warning: [0-9,]+ of the [0-9,]+ nodes lie above sea )"
+                             R"(level: does --bathy hold )";
+    const Result as_height = mesh(depth, {});
+    ASSERT_EQ(as_height.status, 0) << as_height.err;
+    EXPECT_TRUE(regex_search(as_height.err, sign + R"(depths \(positive down\)\? then pass )"
+                                                   R"(--depth-positive\n)"))
+        << as_height.err;
+    const Result floored = mesh(depth, {"--min-depth", "5m"});
+    EXPECT_TRUE(regex_search(floored.err, sign + "depths")) << floored.err;
+    const Result as_depth = mesh(shelf, {"--depth-positive"});
+    EXPECT_TRUE(regex_search(as_depth.err, sign + R"(heights \(positive up\)\? then leave out )"
+                                                  R"(--depth-positive\n)"))
+        << as_depth.err;
+    // The same data with its sign right: no such warning.
+    EXPECT_FALSE(regex_search(mesh(depth, {"--depth-positive"}).err, sign));
+    EXPECT_FALSE(regex_search(mesh(shelf, {}).err, sign));
+}
+
 namespace {
 
 /// The ETOPO5 shelf fixture (301 x 193 cells of 5 minutes from 12 1/24 W, 62 1/24 N) copied to
