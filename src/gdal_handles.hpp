@@ -37,6 +37,26 @@ inline std::string last_error(const char *fallback = "unknown GDAL error") {
     return m && *m ? m : fallback;
 }
 
+/// For a path to an archive or compressed file that GDAL opens only through its virtual file
+/// systems (.zip, .tar, .tgz, .tar.gz, .gz, case-insensitive), how to name it: "a zip archive
+/// opens as /vsizip/PATH ...". Empty for any other path, or one already under /vsi.
+inline std::string archive_hint(const std::string &path) {
+    if (path.rfind("/vsi", 0) == 0)
+        return {};
+    auto ends = [&](std::string_view ext) {
+        return path.size() > ext.size() &&
+               EQUAL(path.c_str() + path.size() - ext.size(), std::string(ext).c_str());
+    };
+    if (ends(".zip"))
+        return "a zip archive opens as /vsizip/" + path + " (or /vsizip/" + path +
+               "/FILE for one file in it)";
+    if (ends(".tar") || ends(".tgz") || ends(".tar.gz"))
+        return "a tar archive opens as /vsitar/" + path + "/FILE";
+    if (ends(".gz"))
+        return "a gzip file opens as /vsigzip/" + path;
+    return {};
+}
+
 /// Sets a GDAL configuration option for this thread and restores the old value on scope exit.
 class ScopedConfig {
 public:
@@ -72,15 +92,21 @@ using SrsRefPtr = HandlePtr<OGRSpatialReferenceH, OSRRelease>;
 using TransformPtr = HandlePtr<OGRCoordinateTransformationH, OCTDestroyCoordinateTransformation>;
 
 /// Opens `path` read-only as vector data. Throws IoError "WHERE: cannot open as vector data:
-/// REASON", GDAL's reason (no such file, a format it does not read) by GDAL_OF_VERBOSE_ERROR.
+/// REASON", GDAL's reason (no such file, a format it does not read) by GDAL_OF_VERBOSE_ERROR,
+/// and for an archive the /vsi prefix that opens it (archive_hint).
 inline DatasetPtr open_vector(const std::string &path, const ErrorText &where) {
     const QuietErrors quiet;
     DatasetPtr ds(GDALOpenEx(path.c_str(),
                              GDAL_OF_VECTOR | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
                              nullptr, nullptr));
-    if (!ds)
-        throw IoError(where + ": cannot open as vector data: " +
-                      last_error("not a vector format GDAL reads"));
+    if (!ds) {
+        const std::string hint = archive_hint(path);
+        std::string reason = last_error("not a vector format GDAL reads");
+        if (!hint.empty() && !reason.empty() && reason.back() == '.')
+            reason.pop_back();
+        throw IoError(where + ": cannot open as vector data: " + reason +
+                      (hint.empty() ? "" : "; " + hint));
+    }
     return ds;
 }
 

@@ -1690,6 +1690,50 @@ TEST(Cli, min_depth_raises_the_shallow_nodes_and_the_counts_match_the_file) {
     globemesh::test::expect_mesh_verify(dir / "d5.nc");
 }
 
+// GDAL opens a .zip, .tar or .gz only through /vsizip/, /vsitar/ or /vsigzip/: the error for an
+// archive given as it is ("cannot open as a vector data set; check the path and format") now
+// names the path that opens it, for every option that reads a file.
+TEST(Cli, an_archive_given_as_a_plain_path_is_told_its_vsi_prefix) {
+    TempDir dir;
+    const std::string island = R"({"type":"FeatureCollection","crs":{"type":"name","properties":)"
+                               R"({"name":"EPSG:4326"}},"features":[{"type":"Feature",)"
+                               R"("properties":{"size_km":50},"geometry":{"type":"Polygon",)"
+                               R"("coordinates":[[[5,5],[10,5],[10,10],[5,10],[5,5]]]}}]})";
+    const std::string zip = (dir / "land.zip").string(), gz = (dir / "land.geojson.gz").string();
+    for (const std::string &vsi : {"/vsizip/" + zip + "/land.geojson", "/vsigzip/" + gz}) {
+        VSILFILE *f = VSIFOpenL(vsi.c_str(), "wb");
+        ASSERT_NE(f, nullptr) << vsi;
+        ASSERT_EQ(VSIFWriteL(island.data(), 1, island.size(), f), island.size());
+        VSIFCloseL(f);
+    }
+    auto mesh = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = {
+            "mesh", "--hmax", "200km", "-o", (dir / "m.nc").string(), "--overwrite", "-q"};
+        if (std::find(extra.begin(), extra.end(), "--region-file") == extra.end())
+            extra.insert(extra.end(), {"--region", "0,0,20,20"});
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const std::string zip_hint = "a zip archive opens as /vsizip/" + zip + " (or /vsizip/" + zip +
+                                 "/FILE for one file in it)";
+    for (const char *option : {"--coast", "--region-file", "--size-regions", "--passages"}) {
+        std::vector<std::string> extra = {option, zip};
+        if (std::string(option) != "--coast")
+            extra.insert(extra.end(), {"--coast", "/vsigzip/" + gz});
+        const Result r = mesh(extra);
+        EXPECT_NE(r.status, 0) << option;
+        EXPECT_NE(r.err.find(zip_hint), std::string::npos) << option << ": " << r.err;
+    }
+    const Result r = mesh({"--coast", gz});
+    EXPECT_NE(r.err.find("a gzip file opens as /vsigzip/" + gz + "\n"), std::string::npos) << r.err;
+    const Result b = mesh({"--coast", "/vsizip/" + zip, "--bathy", zip});
+    EXPECT_NE(b.err.find(": cannot open as a raster: "), std::string::npos) << b.err;
+    EXPECT_NE(b.err.find(zip_hint), std::string::npos) << b.err;
+    // The prefixed paths the errors name open.
+    const Result ok = mesh({"--coast", "/vsizip/" + zip, "--size-regions", "/vsigzip/" + gz});
+    EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 // A raster of depth (positive down) read as height, or of height read as depth with
 // --depth-positive, puts most of the ocean's nodes above sea level: the warning suggested
 // --min-depth 5, which would flatten the whole ocean to 5 m. It now names the sign.
