@@ -8,6 +8,7 @@
 
 #include "cli_common.hpp"
 #include "cli_support.hpp"
+#include "globemesh/sphere.hpp"
 #include "globemesh/writers.hpp"
 #include "mesh_summary.hpp"
 
@@ -268,6 +269,21 @@ std::string report_json(const MeshRunSummary &s) {
     return r.str();
 }
 
+/// Warns when a whole-globe mesh covers less than half the sphere: more land than ocean is a
+/// layer of water read as land (Natural Earth's 'ocean' layer meshes the continents), as the
+/// Earth's land is 29% of it.
+void warn_more_land_than_ocean(std::ostream &err, const MeshRunSummary &s) {
+    const double sphere_km2 = 4 * std::acos(-1.0) * earth_radius_km * earth_radius_km;
+    const double share = s.stats.area_km2 / sphere_km2;
+    if (s.run.mesh.faces.empty() || share >= 0.5)
+        return;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "globemesh: warning: the mesh covers %.0f%% of the globe and the land %.0f%%: ",
+                  100 * share, 100 * (1 - share));
+    err << text << "--coast takes land polygons; is layer '" << s.run.coast_layer << "' water?\n";
+}
+
 void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSummary &s) {
     const CliOptions &o = s.options;
     print_stats(out, s.stats, false);
@@ -284,6 +300,8 @@ void print_mesh_summary(std::ostream &out, std::ostream &err, const MeshRunSumma
         warn_thin_channels(err, s.run.mesh);
     if ((o.mesh.region || !o.mesh.region_file.empty()) && !o.mesh.keep_inland_seas && !o.quiet)
         warn_region_pieces(err, s.run.mesher);
+    if (!o.mesh.region && o.mesh.region_file.empty() && !o.quiet)
+        warn_more_land_than_ocean(err, s);
     print_timings(out, s.timings); // its last line: the total
     out << "peak memory       " << exact_text(std::round(s.peak / 1048576.0 * 10) / 10) << " MiB\n"
         << "wrote             " << outputs_text(s.planned, &s.run.mesh);

@@ -1734,6 +1734,32 @@ TEST(Cli, an_archive_given_as_a_plain_path_is_told_its_vsi_prefix) {
     EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// Natural Earth's GeoPackage holds layers 'land' and 'ocean'; --coast-layer ocean meshed the
+// continents without a word. A whole-globe mesh covering less than half the sphere now warns.
+TEST(Cli, a_whole_globe_mesh_of_more_land_than_ocean_warns_of_a_water_layer) {
+    TempDir dir;
+    auto mesh = [&](const std::string &layer, std::vector<std::string> extra) {
+        std::vector<std::string> args = {
+            "mesh",   "--coast", coast, "--coast-layer",         layer,
+            "--hmax", "1000km",  "-o",  (dir / "m.nc").string(), "--overwrite"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args, globemesh::library_calls());
+    };
+    const std::string warning = R"(globemesh: warning: the mesh covers [0-9]+% of the globe and )"
+                                R"(the land [0-9]+%: --coast takes land polygons; is layer )"
+                                R"('ocean' water\?\n)";
+    const Result ocean = mesh("ocean", {});
+    ASSERT_EQ(ocean.status, 0) << ocean.err;
+    EXPECT_TRUE(regex_search(ocean.err, warning)) << ocean.err;
+    EXPECT_EQ(mesh("ocean", {"-q"}).err, "");
+    const Result land = mesh("land", {});
+    ASSERT_EQ(land.status, 0) << land.err;
+    EXPECT_EQ(land.err.find("of the globe and the land"), std::string::npos) << land.err;
+    // A region is any share of the globe.
+    const Result region = mesh("ocean", {"--region", "-20,-20,20,20"});
+    EXPECT_EQ(region.err.find("of the globe and the land"), std::string::npos) << region.err;
+}
+
 // A raster of depth (positive down) read as height, or of height read as depth with
 // --depth-positive, puts most of the ocean's nodes above sea level: the warning suggested
 // --min-depth 5, which would flatten the whole ocean to 5 m. It now names the sign.
