@@ -211,20 +211,30 @@ void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
 }
 
 /// Largest pull toward the central meridian that transform_on_edge tries, relative to a point's
-/// offset from it: 2^-26 (about 0.25 m at 1.7e7 m, the edge of a Robinson world map), past
-/// the 1e-8 to which PROJ's iterative inverses (Robinson) converge.
-constexpr double edge_pull_max = 0x1p-26;
+/// offset from it: 2^-20 (16 m at 1.7e7 m, the edge of a Robinson world map), past the 2.4e-7
+/// that Robinson's inverse needs on its edge at latitude 60 (its table's nodes, every 5 degrees).
+constexpr double edge_pull_max = 0x1p-20;
 
-/// Reprojects one point of a projected world map in place, pulling a point the inverse rejects
-/// toward `x_centre` (the false easting) by the least of 2^-52 .. edge_pull_max of its offset
-/// that the inverse accepts: PROJ's Robinson and Mollweide inverses reject points of their
-/// +-180 edge that rounding put a few units in the last place outside. False if none works.
-bool transform_on_edge(OGRCoordinateTransformationH ct, double x_centre, double &x, double &y) {
+/// A world map's edge in x: its false easting, and the central meridian (degrees) whose
+/// antimeridian the edge draws.
+struct MapEdge {
+    double x_centre = 0;
+    double lon_0 = 0;
+};
+
+/// Reprojects one point of a projected world map in place. A point the inverse rejects is pulled
+/// toward the centre by the least of 2^-52 .. edge_pull_max of its offset that the inverse
+/// accepts: PROJ's Robinson and Mollweide inverses reject points of their +-180 edge that
+/// rounding put just outside. Such a point lies on the edge, so it takes the edge's longitude,
+/// lon_0 +- 180, exactly (the pulled inverse is up to 2e-5 degrees off it). False if none works.
+bool transform_on_edge(OGRCoordinateTransformationH ct, const MapEdge &edge, double &x, double &y) {
     for (double pull = 0; pull <= edge_pull_max; pull = pull == 0 ? 0x1p-52 : 2 * pull) {
-        double px = x_centre + (x - x_centre) * (1 - pull), py = y, pz = 0;
+        double px = edge.x_centre + (x - edge.x_centre) * (1 - pull), py = y, pz = 0;
         int ok = FALSE;
         if (OCTTransformEx(ct, 1, &px, &py, &pz, &ok) && ok && std::isfinite(px) &&
             std::isfinite(py)) {
+            if (pull > 0)
+                px = std::remainder(edge.lon_0 + (x > edge.x_centre ? 180.0 : -180.0), 360.0);
             x = px;
             y = py;
             return true;
@@ -235,15 +245,16 @@ bool transform_on_edge(OGRCoordinateTransformationH ct, double x_centre, double 
 
 /// Reprojects every point of `g` (each part, ring and line) in place, a point at a time through
 /// transform_on_edge; keeps Z and M. False if a point cannot be reprojected.
-bool transform_points_on_edge(OGRGeometryH g, OGRCoordinateTransformationH ct, double x_centre) {
+bool transform_points_on_edge(OGRGeometryH g, OGRCoordinateTransformationH ct,
+                              const MapEdge &edge) {
     const int parts = OGR_G_GetGeometryCount(g);
     for (int i = 0; i < parts; ++i)
-        if (!transform_points_on_edge(OGR_G_GetGeometryRef(g, i), ct, x_centre))
+        if (!transform_points_on_edge(OGR_G_GetGeometryRef(g, i), ct, edge))
             return false;
     for (int i = 0; i < OGR_G_GetPointCount(g); ++i) {
         double x = 0, y = 0, z = 0, m = 0;
         OGR_G_GetPointZM(g, i, &x, &y, &z, &m);
-        if (!transform_on_edge(ct, x_centre, x, y))
+        if (!transform_on_edge(ct, edge, x, y))
             return false;
         OGR_G_SetPointZM(g, i, x, y, z, m);
     }
@@ -546,10 +557,8 @@ Source read_source(const std::string &path, const std::string &layer_name, const
                                 ? Reprojected::from_pole_point
                             : OSRIsProjected(source_srs.get()) ? Reprojected::projected
                                                                : Reprojected::geographic;
-    const double x_centre =
-        how == Reprojected::projected
-            ? OSRGetProjParm(source_srs.get(), SRS_PP_FALSE_EASTING, 0.0, nullptr)
-            : 0.0;
+    const MapEdge edge{OSRGetProjParm(source_srs.get(), SRS_PP_FALSE_EASTING, 0.0, nullptr),
+                       OSRGetProjParm(source_srs.get(), SRS_PP_CENTRAL_MERIDIAN, 0.0, nullptr)};
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;
@@ -579,17 +588,19 @@ Source read_source(const std::string &path, const std::string &layer_name, const
             // then point by point, those on the edge pulled inside (transform_on_edge).
             const bool had_error = CPLGetLastErrorType() >= CE_Failure;
             bool ok = OGR_G_Transform(copy.get(), transform.get()) == OGRERR_NONE;
+            // Said once per transform: the fallback's failures leave no message of their own.
+            const std::string why = gdal::last_error("a point outside the projection's domain");
             if (!ok && how == Reprojected::projected) {
                 copy.reset(OGR_G_Clone(g));
                 CPLPushErrorHandler(CPLQuietErrorHandler);
-                ok = transform_points_on_edge(copy.get(), transform.get(), x_centre);
+                ok = transform_points_on_edge(copy.get(), transform.get(), edge);
                 CPLPopErrorHandler();
                 if (ok && !had_error)
                     CPLErrorReset(); // the failure recovered from is not a read error
             }
             if (!ok)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
-                                " cannot be reprojected to lon/lat (" + CPLGetLastErrorMsg() + ")");
+                                " cannot be reprojected to lon/lat (" + why + ")");
             collect_geometry(copy.get(), how, src);
         } else {
             collect_geometry(g, Reprojected::no, src);

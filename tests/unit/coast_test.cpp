@@ -680,6 +680,35 @@ TEST(Coast, a_world_map_in_robinson_or_mollweide_reads_its_edge_vertices) {
     expect_valid(m.rings);
     EXPECT_EQ(m.rings.rings.size(), ne110().rings.rings.size());
     EXPECT_NEAR(m.ocean_area_km2, ne110().ocean_area_km2, 1e-5 * ne110().ocean_area_km2);
+
+    // A region round the globe between 60S and 30S: Robinson's inverse needs its edge points at
+    // the latitudes of its table (every 5 degrees) pulled 2.4e-7 of the way in, and they come
+    // back 2e-5 degrees off +-180: put on it, the outline closes across the seam as in lon/lat.
+    const std::string band = (dir / "band.geojson").string(),
+                      band_robin = (dir / "band_robin.gpkg").string();
+    {
+        std::ofstream f(band);
+        f << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+             R"("geometry":{"type":"Polygon","coordinates":[[)";
+        for (int lat = -60; lat < -30; lat += 5)
+            f << "[180," << lat << "],";
+        for (int lon = 180; lon > -180; lon -= 10)
+            f << "[" << lon << ",-30],";
+        for (int lat = -30; lat > -60; lat -= 5)
+            f << "[-180," << lat << "],";
+        for (int lon = -180; lon < 180; lon += 10)
+            f << "[" << lon << ",-60],";
+        f << "[180,-60]]]}}]}";
+    }
+    ASSERT_TRUE(test::ogr2ogr(band, band_robin, {"-t_srs", "+proj=robin +datum=WGS84"}));
+    MeshOptions o = coast_options("coast/ne_110m_land.gpkg");
+    o.region_file = band;
+    const CoastData in_lonlat = load_coast(o);
+    o.region_file = band_robin;
+    const CoastData in_robin = load_coast(o);
+    expect_valid(in_robin.rings);
+    EXPECT_EQ(in_robin.rings.rings.size(), in_lonlat.rings.rings.size());
+    EXPECT_NEAR(in_robin.ocean_area_km2, in_lonlat.ocean_area_km2, 1e-5 * in_lonlat.ocean_area_km2);
 }
 
 // The land itself, reprojected to Equal Earth and back, as the region: the region's outline runs
