@@ -250,11 +250,11 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
         if (r.nodes.size() >= 3)
             out.rings.rings.push_back(std::move(r));
     }
-    // A region's rings come out of GEOS's overlay in an order of its own, which the mesher's
-    // choices follow: put them in one of ours, so that the same ocean makes the same mesh however
-    // it was computed.
-    if (options.region || !options.region_file.empty())
-        canonical_order(out.rings);
+    // The rings come out of GEOS (a region's overlay, the global dissolve) in an order and from
+    // starts of its own, which follow the source's (its rings' starts, directions, features), and
+    // the shaping and the mesher's choices follow them: put them in one of ours, so that the same
+    // ocean makes the same mesh however it was stored or computed.
+    canonical_order(out.rings);
     separate_pinches(out.rings);
     // 30 rounds shorten an arc 2^30 times: far past any bulge that snap rounding leaves room for.
     bool clear = false;
