@@ -214,8 +214,9 @@ Ring to_sphere(const Chain &c);
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in
 /// GEOS) by 1e-7 rad into the land on its right.
 std::size_t separate_pinches(Boundary &b);
-/// Each ring started at its smallest node (by x, y, z) and the rings sorted by that node: an
-/// order that depends on the rings alone, not on how GEOS produced them.
+/// Each ring started at its smallest node (by x, y, z; of a node it passes twice, the pass it
+/// reads smallest from) and the rings sorted node by node: an order that depends on the rings
+/// alone, not on how the source stored them or GEOS produced them.
 void canonical_order(Boundary &b);
 
 } // namespace globemesh::coast_detail

@@ -417,18 +417,54 @@ Ring to_sphere(const Chain &c) {
     return r;
 }
 
+namespace {
+
+bool node_less(const Vec3 &p, const Vec3 &q) {
+    return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
+}
+
+/// Whether ring r read from node i comes before it read from node j (node by node, once round).
+bool rotation_less(const Ring &r, std::size_t i, std::size_t j) {
+    const std::size_t n = r.nodes.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        const Vec3 &p = r.nodes[(i + k) % n], &q = r.nodes[(j + k) % n];
+        if (node_less(p, q))
+            return true;
+        if (node_less(q, p))
+            return false;
+    }
+    return false;
+}
+
+/// The index ring r starts from: its smallest node, and where the ring passes that node more
+/// than once, the pass from which it reads smallest.
+std::size_t canonical_start(const Ring &r) {
+    const auto first = std::min_element(r.nodes.begin(), r.nodes.end(), node_less);
+    std::size_t best = static_cast<std::size_t>(first - r.nodes.begin());
+    for (std::size_t i = best + 1; i < r.nodes.size(); ++i)
+        if (r.nodes[i] == *first && rotation_less(r, i, best))
+            best = i;
+    return best;
+}
+
+} // namespace
+
 void canonical_order(Boundary &b) {
-    auto less = [](const Vec3 &p, const Vec3 &q) {
-        return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
-    };
     for (Ring &r : b.rings) {
-        const auto first = std::min_element(r.nodes.begin(), r.nodes.end(), less);
-        const auto shift = first - r.nodes.begin();
-        std::rotate(r.nodes.begin(), first, r.nodes.end());
+        const auto shift = static_cast<std::ptrdiff_t>(canonical_start(r));
+        std::rotate(r.nodes.begin(), r.nodes.begin() + shift, r.nodes.end());
         std::rotate(r.kinds.begin(), r.kinds.begin() + shift, r.kinds.end());
     }
-    std::sort(b.rings.begin(), b.rings.end(),
-              [&](const Ring &r, const Ring &s) { return less(r.nodes.front(), s.nodes.front()); });
+    // Rings that share their first node (two meeting there) by their next nodes, then kinds.
+    std::sort(b.rings.begin(), b.rings.end(), [](const Ring &r, const Ring &s) {
+        if (std::lexicographical_compare(r.nodes.begin(), r.nodes.end(), s.nodes.begin(),
+                                         s.nodes.end(), node_less))
+            return true;
+        if (std::lexicographical_compare(s.nodes.begin(), s.nodes.end(), r.nodes.begin(),
+                                         r.nodes.end(), node_less))
+            return false;
+        return r.kinds < s.kinds;
+    });
 }
 
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "coast_load_internal.hpp"
 #include "globemesh/mesh.hpp"
 #include "globemesh/pipeline.hpp"
 #include "support.hpp"
@@ -132,6 +133,45 @@ TEST(CoastCanonical, the_same_land_stored_another_way_gives_the_same_mesh) {
                                              << want.nodes.size() << " from the original";
         EXPECT_TRUE(got.faces == want.faces) << name;
     }
+}
+
+Ring ring_of(const std::vector<LonLat> &pts) {
+    Ring r;
+    for (const LonLat &p : pts) {
+        r.nodes.push_back(lonlat_to_vec(p));
+        r.kinds.push_back(SegmentKind::coast);
+    }
+    return r;
+}
+
+// Two rings meeting at their smallest node (lon 180 on the equator, x = -1) (valid in GEOS, as two
+// islands touching at a point) tied in the sort by that node, and kept the order they came in.
+TEST(CoastCanonical, rings_meeting_at_their_first_node_are_ordered_by_the_rest) {
+    const Ring a = ring_of({{180, 0}, {179, 1}, {178, 0}});
+    const Ring b = ring_of({{180, 0}, {178, -0.5}, {179, -1}});
+    Boundary ab, ba;
+    ab.rings = {a, b};
+    ba.rings = {b, a};
+    coast_detail::canonical_order(ab);
+    coast_detail::canonical_order(ba);
+    ASSERT_EQ(ab.rings.size(), 2u);
+    for (std::size_t r = 0; r < 2; ++r)
+        EXPECT_TRUE(ab.rings[r].nodes == ba.rings[r].nodes) << r;
+}
+
+// A ring that passes its smallest node twice (pinched there) started from its first pass, which
+// depends on where the source started it.
+TEST(CoastCanonical,
+     a_ring_through_its_smallest_node_twice_starts_from_one_pass_whatever_its_start) {
+    const std::vector<LonLat> pts{{180, 0}, {179, 1}, {178, 0}, {180, 0}, {178, -0.5}, {179, -1}};
+    std::vector<LonLat> turned(pts.begin() + 3, pts.end());
+    turned.insert(turned.end(), pts.begin(), pts.begin() + 3);
+    Boundary one, two;
+    one.rings = {ring_of(pts)};
+    two.rings = {ring_of(turned)};
+    coast_detail::canonical_order(one);
+    coast_detail::canonical_order(two);
+    EXPECT_TRUE(one.rings[0].nodes == two.rings[0].nodes);
 }
 
 } // namespace
