@@ -13,6 +13,7 @@
 
 #include <geos_c.h>
 
+#include "../delaunay/hilbert.hpp"
 #include "coast_internal.hpp"
 #include "coast_load_internal.hpp"
 #include "globemesh/error.hpp"
@@ -455,8 +456,15 @@ void canonical_order(Boundary &b) {
         std::rotate(r.nodes.begin(), r.nodes.begin() + shift, r.nodes.end());
         std::rotate(r.kinds.begin(), r.kinds.begin() + shift, r.kinds.end());
     }
-    // Rings that share their first node (two meeting there) by their next nodes, then kinds.
-    std::sort(b.rings.begin(), b.rings.end(), [](const Ring &r, const Ring &s) {
+    // Rings along the Hilbert curve by their first node (neighbours on the sphere stay
+    // neighbours in the mesh's arrays), then node by node (rings that meet at their first node).
+    std::vector<std::pair<std::uint32_t, std::size_t>> keyed;
+    for (std::size_t i = 0; i < b.rings.size(); ++i)
+        keyed.emplace_back(detail::hilbert_key(b.rings[i].nodes.front()), i);
+    std::sort(keyed.begin(), keyed.end(), [&](const auto &x, const auto &y) {
+        if (x.first != y.first)
+            return x.first < y.first;
+        const Ring &r = b.rings[x.second], &s = b.rings[y.second];
         if (std::lexicographical_compare(r.nodes.begin(), r.nodes.end(), s.nodes.begin(),
                                          s.nodes.end(), node_less))
             return true;
@@ -465,6 +473,11 @@ void canonical_order(Boundary &b) {
             return false;
         return r.kinds < s.kinds;
     });
+    std::vector<Ring> sorted;
+    sorted.reserve(b.rings.size());
+    for (const auto &[key, i] : keyed)
+        sorted.push_back(std::move(b.rings[i]));
+    b.rings = std::move(sorted);
 }
 
 /// Moves every copy of a node that several arcs share (rings meeting at one point, valid in
