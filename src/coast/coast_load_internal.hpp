@@ -215,8 +215,9 @@ Ring to_sphere(const Chain &c);
 /// GEOS) by 1e-7 rad into the land on its right.
 std::size_t separate_pinches(Boundary &b);
 /// Each ring started at its smallest node (by x, y, z; of a node it passes twice, the pass it
-/// reads smallest from) and the rings sorted node by node: an order that depends on the rings
-/// alone, not on how the source stored them or GEOS produced them.
+/// reads smallest from) and the rings sorted along the Hilbert curve by that node, then node by
+/// node: an order that depends on the rings alone, not on how the source stored them or GEOS
+/// produced them.
 void canonical_order(Boundary &b);
 
 } // namespace globemesh::coast_detail
