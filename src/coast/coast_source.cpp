@@ -22,6 +22,7 @@
 #include "coast_load_internal.hpp"
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
+#include "map_edge.hpp"
 #include "pole_rings.hpp"
 
 namespace globemesh::coast_detail {
@@ -208,57 +209,6 @@ void collect_geometry(OGRGeometryH g, Reprojected how, Source &out) {
         for (int i = 0; i < OGR_G_GetGeometryCount(g); ++i)
             collect_geometry(OGR_G_GetGeometryRef(g, i), how, out);
     }
-}
-
-/// Largest pull toward the central meridian that transform_on_edge tries, relative to a point's
-/// offset from it: 2^-20 (16 m at 1.7e7 m, the edge of a Robinson world map), past the 2.4e-7
-/// that Robinson's inverse needs on its edge at latitude 60 (its table's nodes, every 5 degrees).
-constexpr double edge_pull_max = 0x1p-20;
-
-/// A world map's edge in x: its false easting, and the central meridian (degrees) whose
-/// antimeridian the edge draws.
-struct MapEdge {
-    double x_centre = 0;
-    double lon_0 = 0;
-};
-
-/// Reprojects one point of a projected world map in place. A point the inverse rejects is pulled
-/// toward the centre by the least of 2^-52 .. edge_pull_max of its offset that the inverse
-/// accepts: PROJ's Robinson and Mollweide inverses reject points of their +-180 edge that
-/// rounding put just outside. Such a point lies on the edge, so it takes the edge's longitude,
-/// lon_0 +- 180, exactly (the pulled inverse is up to 2e-5 degrees off it). False if none works.
-bool transform_on_edge(OGRCoordinateTransformationH ct, const MapEdge &edge, double &x, double &y) {
-    for (double pull = 0; pull <= edge_pull_max; pull = pull == 0 ? 0x1p-52 : 2 * pull) {
-        double px = edge.x_centre + (x - edge.x_centre) * (1 - pull), py = y, pz = 0;
-        int ok = FALSE;
-        if (OCTTransformEx(ct, 1, &px, &py, &pz, &ok) && ok && std::isfinite(px) &&
-            std::isfinite(py)) {
-            if (pull > 0)
-                px = std::remainder(edge.lon_0 + (x > edge.x_centre ? 180.0 : -180.0), 360.0);
-            x = px;
-            y = py;
-            return true;
-        }
-    }
-    return false;
-}
-
-/// Reprojects every point of `g` (each part, ring and line) in place, a point at a time through
-/// transform_on_edge; keeps Z and M. False if a point cannot be reprojected.
-bool transform_points_on_edge(OGRGeometryH g, OGRCoordinateTransformationH ct,
-                              const MapEdge &edge) {
-    const int parts = OGR_G_GetGeometryCount(g);
-    for (int i = 0; i < parts; ++i)
-        if (!transform_points_on_edge(OGR_G_GetGeometryRef(g, i), ct, edge))
-            return false;
-    for (int i = 0; i < OGR_G_GetPointCount(g); ++i) {
-        double x = 0, y = 0, z = 0, m = 0;
-        OGR_G_GetPointZM(g, i, &x, &y, &z, &m);
-        if (!transform_on_edge(ct, edge, x, y))
-            return false;
-        OGR_G_SetPointZM(g, i, x, y, z, m);
-    }
-    return true;
 }
 
 /// A copy of `g` with each closed line string a polygon (a --region-file's outline drawn as a
@@ -557,8 +507,7 @@ Source read_source(const std::string &path, const std::string &layer_name, const
                                 ? Reprojected::from_pole_point
                             : OSRIsProjected(source_srs.get()) ? Reprojected::projected
                                                                : Reprojected::geographic;
-    const MapEdge edge{OSRGetProjParm(source_srs.get(), SRS_PP_FALSE_EASTING, 0.0, nullptr),
-                       OSRGetProjParm(source_srs.get(), SRS_PP_CENTRAL_MERIDIAN, 0.0, nullptr)};
+    const MapEdge edge = map_edge(source_srs.get());
     CPLErrorReset();
     const std::uint64_t max_vertices = max_bytes / coast_bytes_per_vertex;
     std::uint64_t vertices = 0;

@@ -20,6 +20,7 @@
 #include "gdal_handles.hpp"
 #include "globemesh/error.hpp"
 #include "grid.hpp"
+#include "map_edge.hpp"
 #include "pole_rings.hpp"
 #include "projected_edges.hpp"
 
@@ -157,6 +158,7 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                             OGR_L_GetName(layer) + " to lon/lat");
         const bool projected = OSRIsProjected(srs),
                    pole_point = detail::holds_a_pole_as_a_point(srs);
+        const MapEdge edge = projected ? map_edge(srs) : MapEdge{};
         Skipped not_polygons, without_size;
         OGR_L_ResetReading(layer);
         while (FeaturePtr f{OGR_L_GetNextFeature(layer)}) {
@@ -180,7 +182,15 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                                 OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
             GeometryPtr copy(OGR_G_Clone(geom));
             split_projected_edges(copy.get(), srs, edge_step_m);
-            if (OGR_G_Transform(copy.get(), to_lonlat.get()) != OGRERR_NONE)
+            GeometryPtr split(OGR_G_Clone(copy.get()));
+            bool ok = OGR_G_Transform(copy.get(), to_lonlat.get()) == OGRERR_NONE;
+            if (!ok && projected) { // a world map's points on its +-180 edge (map_edge.hpp)
+                CPLPushErrorHandler(CPLQuietErrorHandler);
+                ok = transform_points_on_edge(split.get(), to_lonlat.get(), edge);
+                CPLPopErrorHandler();
+                copy = std::move(split);
+            }
+            if (!ok)
                 throw DataError(option("size_regions") + " " + path +
                                 ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " to lon/lat");

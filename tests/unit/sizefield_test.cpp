@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <cpl_conv.h>
 #include <gdal.h>
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
@@ -388,6 +389,63 @@ TEST(SizeField, size_regions_about_a_pole_or_past_180_burn_their_whole_area) {
     for (const double lon : {178.0, 180.0, -178.0})
         EXPECT_NEAR(past_field.size_km(lon, -18), 7, 1e-5) << lon;
     EXPECT_GT(past_field.size_km(-150, -18), 50);
+}
+
+// A band round the globe from 60S to 30S drawn in Robinson (its sides on the map's +-180 edge,
+// as ogr2ogr -t_srs '+proj=robin' makes them) was refused, "cannot transform feature 1": PROJ's
+// inverse rejects edge points rounding puts just outside its domain, as for a coast in Robinson
+// (map_edge.hpp). It burns the band as its lon/lat copy does, the seam included.
+TEST(SizeField, a_size_region_on_a_robinson_maps_edge_burns_like_its_lon_lat_copy) {
+    TempDir dir;
+    std::string lonlat = "POLYGON ((";
+    auto add = [&](double lon, double lat) {
+        lonlat +=
+            (lonlat.back() == '(' ? "" : ", ") + std::to_string(lon) + " " + std::to_string(lat);
+    };
+    for (int lon = -180; lon <= 180; lon += 10)
+        add(lon, -60);
+    for (double lat = -59.75; lat < -30; lat += 0.25) // the sides follow the curved map edge
+        add(180, lat);
+    for (int lon = 180; lon >= -180; lon -= 10)
+        add(lon, -30);
+    for (double lat = -30.25; lat > -60; lat -= 0.25)
+        add(-180, lat);
+    add(-180, -60);
+    lonlat += "))";
+    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr),
+                         robin = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(wgs84, 4326);
+    OSRSetAxisMappingStrategy(wgs84, OAMS_TRADITIONAL_GIS_ORDER);
+    OSRImportFromProj4(robin, "+proj=robin +datum=WGS84");
+    OGRGeometryH g = nullptr;
+    char *p = lonlat.data();
+    ASSERT_EQ(OGR_G_CreateFromWkt(&p, nullptr, &g), OGRERR_NONE);
+    OGRCoordinateTransformationH to_robin = OCTNewCoordinateTransformation(wgs84, robin);
+    ASSERT_EQ(OGR_G_Transform(g, to_robin), OGRERR_NONE);
+    char *robin_wkt = nullptr;
+    OGR_G_ExportToWkt(g, &robin_wkt);
+    const std::string in_lonlat = (dir / "band.gpkg").string(),
+                      in_robin = (dir / "band_robin.gpkg").string();
+    write_size_region(in_lonlat, "GPKG", wgs84, lonlat.c_str(), 150.0);
+    write_size_region(in_robin, "GPKG", robin, robin_wkt, 150.0);
+    CPLFree(robin_wkt);
+    OGR_G_DestroyGeometry(g);
+    OCTDestroyCoordinateTransformation(to_robin);
+    OSRRelease(wgs84);
+    OSRRelease(robin);
+    MeshOptions o;
+    o.hmax_km = 800;
+    o.size_regions = in_lonlat;
+    const SizeField a = build_size_field(o, nullptr, nullptr, {}, 1 << 16);
+    o.size_regions = in_robin;
+    const SizeField b = build_size_field(o, nullptr, nullptr, {}, 1 << 16);
+    for (const double lon : {-179.9, -90.0, 0.0, 179.9})
+        for (const double lat : {-58.0, -45.0, -32.0}) {
+            EXPECT_NEAR(b.size_km(lon, lat), 150, 1e-5) << lon << " " << lat;
+            EXPECT_EQ(b.size_km(lon, lat), a.size_km(lon, lat)) << lon << " " << lat;
+        }
+    EXPECT_EQ(b.size_km(0, 0), a.size_km(0, 0));
+    EXPECT_GT(b.size_km(0, 0), 150);
 }
 
 /// Adds a layer `name` (EPSG:4326, with a size_km field when `size` > 0) holding the square
