@@ -4,9 +4,13 @@
 #pragma once
 
 #include <cmath>
+#include <string>
 
+#include <cpl_error.h>
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
+
+#include "gdal_handles.hpp"
 
 namespace globemesh {
 
@@ -66,6 +70,31 @@ inline bool transform_points_on_edge(OGRGeometryH g, OGRCoordinateTransformation
         OGR_G_SetPointZM(g, i, x, y, z, m);
     }
     return true;
+}
+
+/// A clone of `g` reprojected by `ct`. In a projected CRS, when the whole transform fails (a
+/// world map's +-180 edge), another clone point by point (transform_points_on_edge), the retry's
+/// GDAL messages silenced and, once it succeeds, the failure cleared unless an error was pending
+/// before (a failure recovered from is no read error). Null when it cannot be reprojected, `why`
+/// then the first attempt's message.
+inline gdal::GeometryPtr reprojected(OGRGeometryH g, OGRCoordinateTransformationH ct,
+                                     bool projected, const MapEdge &edge, std::string &why) {
+    const bool had_error = CPLGetLastErrorType() >= CE_Failure;
+    gdal::GeometryPtr copy(OGR_G_Clone(g));
+    if (OGR_G_Transform(copy.get(), ct) == OGRERR_NONE)
+        return copy;
+    why = gdal::last_error("a point outside the projection's domain");
+    if (!projected)
+        return nullptr;
+    copy.reset(OGR_G_Clone(g));
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    const bool ok = transform_points_on_edge(copy.get(), ct, edge);
+    CPLPopErrorHandler();
+    if (!ok)
+        return nullptr;
+    if (!had_error)
+        CPLErrorReset();
+    return copy;
 }
 
 } // namespace globemesh

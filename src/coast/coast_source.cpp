@@ -532,22 +532,12 @@ Source read_source(const std::string &path, const std::string &layer_name, const
         if (outline)
             g = outline.get();
         if (transform) {
-            OgrGeometryPtr copy(OGR_G_Clone(g));
             // A world map's points on its +-180 edge may fail the whole-geometry transform:
-            // then point by point, those on the edge pulled inside (transform_on_edge).
-            const bool had_error = CPLGetLastErrorType() >= CE_Failure;
-            bool ok = OGR_G_Transform(copy.get(), transform.get()) == OGRERR_NONE;
-            // Said once per transform: the fallback's failures leave no message of their own.
-            const std::string why = gdal::last_error("a point outside the projection's domain");
-            if (!ok && how == Reprojected::projected) {
-                copy.reset(OGR_G_Clone(g));
-                CPLPushErrorHandler(CPLQuietErrorHandler);
-                ok = transform_points_on_edge(copy.get(), transform.get(), edge);
-                CPLPopErrorHandler();
-                if (ok && !had_error)
-                    CPLErrorReset(); // the failure recovered from is not a read error
-            }
-            if (!ok)
+            // then point by point, those on the edge pulled inside (map_edge.hpp).
+            std::string why;
+            const OgrGeometryPtr copy =
+                reprojected(g, transform.get(), how == Reprojected::projected, edge, why);
+            if (!copy)
                 throw DataError(where_msg + ": feature " + std::to_string(OGR_F_GetFID(f)) +
                                 " cannot be reprojected to lon/lat (" + why + ")");
             collect_geometry(copy.get(), how, src);

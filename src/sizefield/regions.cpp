@@ -180,17 +180,11 @@ void apply_size_regions(const BackgroundGrid &g, const std::string &path,
                 throw DataError(option("size_regions") + " " + path + ": feature " +
                                 std::to_string(OGR_F_GetFID(fh)) + " has size_km " +
                                 OGR_F_GetFieldAsString(fh, field) + "; sizes must be positive km");
-            GeometryPtr copy(OGR_G_Clone(geom));
-            split_projected_edges(copy.get(), srs, edge_step_m);
-            GeometryPtr split(OGR_G_Clone(copy.get()));
-            bool ok = OGR_G_Transform(copy.get(), to_lonlat.get()) == OGRERR_NONE;
-            if (!ok && projected) { // a world map's points on its +-180 edge (map_edge.hpp)
-                CPLPushErrorHandler(CPLQuietErrorHandler);
-                ok = transform_points_on_edge(split.get(), to_lonlat.get(), edge);
-                CPLPopErrorHandler();
-                copy = std::move(split);
-            }
-            if (!ok)
+            GeometryPtr split(OGR_G_Clone(geom));
+            split_projected_edges(split.get(), srs, edge_step_m);
+            std::string why; // a world map's points on its +-180 edge are retried (map_edge.hpp)
+            GeometryPtr copy = reprojected(split.get(), to_lonlat.get(), projected, edge, why);
+            if (!copy)
                 throw DataError(option("size_regions") + " " + path +
                                 ": cannot transform feature " + std::to_string(OGR_F_GetFID(fh)) +
                                 " to lon/lat");
