@@ -57,6 +57,24 @@ inline std::string archive_hint(const std::string &path) {
     return {};
 }
 
+/// What to do about a path GDAL could not open: archive_hint's prefix for an archive, else to
+/// check the path and format.
+inline std::string open_advice(const std::string &path) {
+    const std::string hint = archive_hint(path);
+    return hint.empty() ? "check the path and format" : hint;
+}
+
+/// GDAL's `reason` an open failed, and for an archive archive_hint's prefix after it (the
+/// reason's closing '.' dropped before the "; ").
+inline std::string with_archive_hint(std::string reason, const std::string &path) {
+    const std::string hint = archive_hint(path);
+    if (hint.empty())
+        return reason;
+    if (!reason.empty() && reason.back() == '.')
+        reason.pop_back();
+    return reason + "; " + hint;
+}
+
 /// Sets a GDAL configuration option for this thread and restores the old value on scope exit.
 class ScopedConfig {
 public:
@@ -99,14 +117,9 @@ inline DatasetPtr open_vector(const std::string &path, const ErrorText &where) {
     DatasetPtr ds(GDALOpenEx(path.c_str(),
                              GDAL_OF_VECTOR | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr,
                              nullptr, nullptr));
-    if (!ds) {
-        const std::string hint = archive_hint(path);
-        std::string reason = last_error("not a vector format GDAL reads");
-        if (!hint.empty() && !reason.empty() && reason.back() == '.')
-            reason.pop_back();
-        throw IoError(where + ": cannot open as vector data: " + reason +
-                      (hint.empty() ? "" : "; " + hint));
-    }
+    if (!ds)
+        throw IoError(where + ": cannot open as vector data: " +
+                      with_archive_hint(last_error("not a vector format GDAL reads"), path));
     return ds;
 }
 

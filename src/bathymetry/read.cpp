@@ -695,14 +695,10 @@ SourceRaster read_source(const std::string &path, int band, bool depth_positive,
 
     DatasetPtr ds(
         GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
-    if (!ds) {
-        const std::string hint = gdal::archive_hint(path);
-        std::string reason = gdal::last_error("not a raster format GDAL reads");
-        if (!hint.empty() && !reason.empty() && reason.back() == '.')
-            reason.pop_back();
-        throw IoError(option("bathy") + " " + path + ": cannot open as a raster: " + reason +
-                      (hint.empty() ? "" : "; " + hint));
-    }
+    if (!ds)
+        throw IoError(
+            option("bathy") + " " + path + ": cannot open as a raster: " +
+            gdal::with_archive_hint(gdal::last_error("not a raster format GDAL reads"), path));
     GDALDatasetH h = ds.get();
     const int nbands = GDALGetRasterCount(h);
     if (band < 1 || band > nbands)

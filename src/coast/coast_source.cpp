@@ -467,10 +467,8 @@ Source read_source(const std::string &path, const std::string &layer_name, const
         GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
     if (!ds) {
         std::string msg = CPLGetLastErrorMsg();
-        const std::string hint = gdal::archive_hint(path);
         throw IoError(option(field) + " " + path + ": cannot open as a vector data set" +
-                      (msg.empty() ? "" : " (" + msg + ")") + "; " +
-                      (hint.empty() ? "check the path and format" : hint));
+                      (msg.empty() ? "" : " (" + msg + ")") + "; " + gdal::open_advice(path));
     }
     GDALDatasetH h = ds.get();
     OGRLayerH layer = choose_layer(h, path, layer_name, field);

@@ -85,9 +85,7 @@ PointSource read_point_source(const TriangulateOptions &options, const Progress 
                              is_csv ? open_options : nullptr, nullptr));
     if (!ds)
         throw IoError("POINTS " + path + ": cannot open as a vector data set" + gdal_message() +
-                      "; " +
-                      (gdal::archive_hint(path).empty() ? "check the path and format"
-                                                        : gdal::archive_hint(path)));
+                      "; " + gdal::open_advice(path));
     OGRLayerH layer = nullptr;
     if (!options.layer.empty()) {
         layer = GDALDatasetGetLayerByName(ds.get(), options.layer.c_str());
