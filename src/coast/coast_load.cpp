@@ -180,9 +180,11 @@ CoastData load_coast(const CoastOptions &options, std::uint64_t max_memory_bytes
     // Cut to the region first, unless --min-island-area weighs each island whole.
     const bool clip = near && !(options.min_island_area_km2 > 0);
     const std::vector<Box> clip_boxes = clip ? near_boxes(*near) : std::vector<Box>{};
-    // A region's outline may cut a lake the clipping then opens: its holes, read first, tell.
-    const std::vector<GeomPtr> holes =
-        near ? source_holes(geos, src.polygons) : std::vector<GeomPtr>{};
+    // A region's outline may cut a lake the clipping then opens: its holes, read first, tell
+    // (not needed where every inland sea is kept).
+    const std::vector<GeomPtr> holes = near && !options.keep_inland_seas
+                                           ? source_holes(geos, src.polygons)
+                                           : std::vector<GeomPtr>{};
     std::vector<GeomPtr> parts = valid_parts(geos, src.polygons, clip_boxes);
     if (!src.lines.empty()) {
         // each polygon wrapped alone: only those past +-180 are cut, not all the land at once

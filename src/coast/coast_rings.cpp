@@ -745,7 +745,7 @@ std::vector<GeomPtr> source_holes(Geos &geos, const std::vector<PolygonRings> &p
     return holes;
 }
 
-/// True when the water polygon p lies in one of `holes` (land_holes): a lake, not the ocean.
+/// True when the water polygon p lies in one of `holes` (source_holes): a lake, not the ocean.
 bool in_a_hole(Geos &geos, const std::vector<GeomPtr> &holes, const GEOSGeometry *p) {
     if (holes.empty())
         return false;
@@ -863,7 +863,7 @@ std::vector<Chain> region_rings(Geos &geos, std::vector<GeomPtr> &land,
         for (const auto &r : prings)
             for (std::size_t j = 0; j + 1 < r.size() && !outline_edge; ++j)
                 outline_edge = builder.classify(r[j], r[j + 1]) != EdgeKind::coast;
-        if ((outline_edge && !in_a_hole(geos, holes, p)) || options.keep_inland_seas) {
+        if (options.keep_inland_seas || (outline_edge && !in_a_hole(geos, holes, p))) {
             for (auto &r : prings)
                 builder.add_ring(std::move(r));
         } else {
