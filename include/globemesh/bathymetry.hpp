@@ -145,6 +145,11 @@ private:
     /// column_of(lon), but at a pole (every longitude) the middle column when lon is past the
     /// columns: a raster cut to a box from 155 to 161 E holds 90 N, which a node there names lon 0.
     double column_at(double lon_deg, double lat_deg) const;
+    /// Whether column position u (column_of's) lies on a non-global raster's columns, up to
+    /// edge_margin of a cell past its east edge.
+    bool on_columns(double u) const {
+        return u <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9;
+    }
     std::vector<float> values_;
     std::optional<double> fill_;
 };

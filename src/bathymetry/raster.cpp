@@ -64,12 +64,12 @@ bool Raster::contains(double lon, double lat) const {
         return false;
     if (global_)
         return true;
-    return column_at(lon, lat) <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9;
+    return on_columns(column_at(lon, lat));
 }
 
 double Raster::column_at(double lon, double lat) const {
     const double u = column_of(lon);
-    if (std::abs(lat) < 90.0 || u <= static_cast<double>(nlon_) - 0.5 + edge_margin + 1e-9)
+    if (std::abs(lat) < 90.0 || on_columns(u))
         return u;
     return 0.5 * (static_cast<double>(nlon_) - 1.0);
 }
@@ -113,7 +113,7 @@ double Raster::sample(double lon, double lat) const {
         fu = u - fl;
     } else {
         const double u = column_at(lon, lat);
-        if (u > n_lon - 0.5 + edge_margin + 1e-9)
+        if (!on_columns(u))
             return nan_value;
         bracket(u, nlon_, i0, i1, fu);
     }
