@@ -244,29 +244,27 @@ void read_nodes(Lines &in, MshContent &c) {
     }
 }
 
-/// One element of `type` with the node words `nodes` and physical group `physical` (0: none).
-void add_element(Lines &in, MshContent &c, long long type, const std::vector<std::string_view> &w,
-                 std::size_t first, int physical) {
-    auto node = [&](std::size_t k) {
-        if (first + k >= w.size())
-            in.fail("an element has fewer nodes than its type");
-        return in.integer(w[first + k], "node tag");
-    };
-    if (type == triangle_type)
-        c.triangles.push_back({node(0), node(1), node(2)});
-    else if (type == line_type)
-        c.lines.push_back({{node(0), node(1)}, physical});
-    else if (type != point_type)
-        in.fail("element type " + std::to_string(type) +
-                " is not read (3-node triangles, 2-node lines and points only)");
-}
-
 /// One element of `type` with node tags `nodes` (as many as nodes_of_type) and group `physical`.
 void add_element_tags(MshContent &c, long long type, const long long *nodes, int physical) {
     if (type == triangle_type)
         c.triangles.push_back({nodes[0], nodes[1], nodes[2]});
     else if (type == line_type)
         c.lines.push_back({{nodes[0], nodes[1]}, physical});
+}
+
+/// One element of `type` with its node tags the words of `w` from `first`, and physical group
+/// `physical` (0: none).
+void add_element(Lines &in, MshContent &c, long long type, const std::vector<std::string_view> &w,
+                 std::size_t first, int physical) {
+    const std::size_t n = nodes_of_type(in, type);
+    if (type == point_type)
+        return;
+    if (first + n > w.size())
+        in.fail("an element has fewer nodes than its type");
+    long long nodes[3];
+    for (std::size_t k = 0; k < n; ++k)
+        nodes[k] = in.integer(w[first + k], "node tag");
+    add_element_tags(c, type, nodes, physical);
 }
 
 /// The physical group of a 4.1 element block's entity: a curve's first, else none (0).
