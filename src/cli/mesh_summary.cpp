@@ -273,7 +273,7 @@ std::string report_json(const MeshRunSummary &s) {
 /// layer of water read as land (Natural Earth's 'ocean' layer meshes the continents), as the
 /// Earth's land is 29% of it.
 void warn_more_land_than_ocean(std::ostream &err, const MeshRunSummary &s) {
-    const double sphere_km2 = 4 * std::acos(-1.0) * earth_radius_km * earth_radius_km;
+    const double sphere_km2 = 4 * pi * earth_radius_km * earth_radius_km;
     const double share = s.stats.area_km2 / sphere_km2;
     if (s.run.mesh.faces.empty() || share >= 0.5)
         return;
